@@ -1,0 +1,41 @@
+# Two commands do all set-up on a fresh machine:  make demo  (live demo)  and  make test.
+PY      ?= python3
+VENV    := .venv
+STAMP   := $(VENV)/.installed
+export ROS_AUTOMATIC_DISCOVERY_RANGE := LOCALHOST
+
+.PHONY: setup demo test bench reproduce compare bags clean
+
+setup: $(STAMP)
+
+$(STAMP): requirements.txt setup.py setup.cfg package.xml
+	test -x $(VENV)/bin/python || $(PY) -m venv $(VENV)
+	$(VENV)/bin/pip install --quiet --disable-pip-version-check -r requirements.txt
+	$(VENV)/bin/pip install --quiet --disable-pip-version-check --no-deps --no-build-isolation -e .
+	@# setup.cfg puts the executables where ros2 run looks (<prefix>/lib/vib_estimator); link them
+	@# into .venv/bin as well so they are on the PATH of an activated environment.
+	for exe in $(VENV)/lib/vib_estimator/*; do ln -sf ../lib/vib_estimator/$$(basename $$exe) $(VENV)/bin/; done
+	touch $(STAMP)
+
+demo: setup
+	$(VENV)/bin/vib-estimator demo
+
+test: setup
+	$(VENV)/bin/python -m pytest -q test
+
+bench: setup
+	$(VENV)/bin/python benchmarks/bench_estimator.py
+	$(VENV)/bin/python benchmarks/bench_node.py
+
+reproduce: setup
+	$(VENV)/bin/vib-estimator reproduce fig1 --out out/fig1.png
+	$(VENV)/bin/vib-estimator reproduce fig2 --out out/fig2.png
+
+compare: setup
+	$(VENV)/bin/vib-estimator compare --out out
+
+bags: setup
+	$(VENV)/bin/python scripts/make_bags.py
+
+clean:
+	rm -rf $(VENV) build install log out *.egg-info

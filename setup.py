@@ -1,0 +1,37 @@
+"""ament_python package definition for vib_estimator."""
+from glob import glob
+
+from setuptools import find_packages, setup
+
+PACKAGE = 'vib_estimator'
+
+setup(
+    name=PACKAGE,
+    version='0.1.0',
+    packages=find_packages(exclude=['test']),
+    data_files=[
+        ('share/ament_index/resource_index/packages', ['resource/' + PACKAGE]),
+        ('share/' + PACKAGE, ['package.xml']),
+        ('share/' + PACKAGE + '/config', glob('config/*.yaml')),
+        ('share/' + PACKAGE + '/launch', glob('launch/*.py')),
+        ('share/' + PACKAGE + '/bags', [f for f in glob('bags/**/*', recursive=True)
+                                        if not f.endswith('/') and '.' in f.rsplit('/', 1)[-1]]),
+    ],
+    install_requires=['setuptools'],
+    zip_safe=True,
+    maintainer='vib_estimator developers',
+    maintainer_email='vib-estimator@example.com',
+    description='Fast on-line algebraic frequency estimator of lightly damped vibrations '
+                '(Trapero, Sira-Ramirez, Feliu), with flexible-arm simulator and bag tools.',
+    license='Apache-2.0',
+    tests_require=['pytest'],
+    entry_points={
+        'console_scripts': [
+            'vib-estimator = vib_estimator.cli:main',
+            'estimator_node = vib_estimator.estimator_node:main',
+            'sim_node = vib_estimator.sim_node:main',
+            'bag_replayer = vib_estimator.bag_replayer:main',
+            'bag_recorder = vib_estimator.bag_recorder:main',
+        ],
+    },
+)

@@ -1,0 +1,34 @@
+"""Shared fixtures: an isolated ROS domain per test run and a fresh rclpy context per test."""
+from __future__ import annotations
+
+import os
+import time
+
+import pytest
+
+# One DDS domain per test run, so concurrent runs on one machine never see each other, and discovery
+# kept on this host. Set before rclpy is imported anywhere.
+os.environ.setdefault('ROS_DOMAIN_ID', str(1 + os.getpid() % 100))
+os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+
+
+@pytest.fixture
+def ros_context():
+    """A fresh, initialised :class:`rclpy.Context`, shut down after the test."""
+    import rclpy
+
+    context = rclpy.Context()
+    rclpy.init(context=context, domain_id=int(os.environ['ROS_DOMAIN_ID']))
+    yield context
+    context.try_shutdown()
+
+
+@pytest.fixture
+def executor(ros_context):
+    """The package's executor, bound to the test's context."""
+    from vib_estimator.node_runner import make_executor
+
+    ex = make_executor(context=ros_context)
+    yield ex
+    ex.shutdown()
+

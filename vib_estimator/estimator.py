@@ -1,0 +1,268 @@
+"""Algebraic on-line frequency estimator of Trapero, Sira-Ramirez & Feliu (pure numpy/numba core).
+
+Streaming: ``FrequencyEstimator.update(t, y)`` takes one timestamped sample and returns an
+:class:`Estimate` when the convergence test (Eqs. 16-17) fires; the estimator then resets and starts
+again, giving the consecutive estimates of Section 5.3. Batch: ``FrequencyEstimator.process(t, y)``
+runs the same compiled step over arrays and returns the same floats.
+
+The arithmetic lives in :mod:`vib_estimator.kernel` (its docstring derives Eqs. 7-12 and the
+corrected sign of Eq. 8). This module holds the configuration, its validation, and the Python API.
+
+Error budget behind the defaults. With the cubic interpolation rule the moments carry an
+error ~ h^4 y'''' t per unit time, while the numerator ``n`` grows like w^2 A t^4 / 12, so the relative
+error of an estimate taken ``k`` samples into a segment is about 0.3 (w h)^2 / k^2: below 1e-5 from
+k = 12 samples at fs/f = 100, and below 1e-3 from k = 6 at fs/f = 20. ``min_samples`` = 16 keeps
+every published estimate of a clean sine inside those bounds; ``min_time`` (eps of Eq. 12) adds a
+floor in seconds for noisy signals, where the first milliseconds of ``n_f / d_f`` are dominated by
+noise (d ~ t^4).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field, fields
+from typing import Dict, List, Optional, Sequence, Tuple
+
+import numpy as np
+
+from . import kernel as K
+
+MODELS = ('sinusoid', 'biased-sinusoid')
+
+#: counter names, in the order of :mod:`vib_estimator.kernel`'s counter array
+COUNTER_NAMES = ('received', 'used', 'skipped_non_finite', 'skipped_duplicate',
+                 'skipped_out_of_order', 'time_jump_resets', 'gap_resets', 'rejected_at_rest',
+                 'rejected_fit', 'rejected_nyquist', 'max_window_resets', 'estimates')
+
+
+@dataclass(frozen=True)
+class EstimatorConfig:
+    """Parameters of the estimator; defaults are those of Section 5.3 of the paper.
+
+    Attributes:
+        model: ``sinusoid`` (Eq. 1, the paper) or ``biased-sinusoid`` (y = A sin(wt+phi) + B).
+        lowpass_cutoff_hz: cut-off of the invariant low-pass filter (Eqs. 9-11); 3 Hz = 6 pi rad/s.
+        lowpass_damping: damping ratio of that filter (0.707).
+        window: M of the moving-average convergence test (Eqs. 16-17).
+        tolerance: relative tolerance of that test.
+        min_time: eps of Eq. 12, seconds after a reset during which no estimate is formed.
+        min_samples: samples a segment must hold before the test may fire (see module docstring).
+        max_window: seconds without convergence after which the estimator resets unpublished.
+        band_hz: optional (f_lo, f_hi) band-pass prefilter on y, never reset; None = off.
+        band_damping: damping ratio of the prefilter's two sections (Butterworth, 0.707).
+        min_amplitude: quality gate, amplitude of the fitted sinusoid below which the signal is
+            taken to be at rest (signal units).
+        min_fit: quality gate, fraction of the segment's variance the fitted sinusoid must
+            explain (R^2) for the estimate to be published; rejects noise.
+        max_gap: a forward gap, or a backward jump, between stamps longer than this (s) restarts
+            the estimator; a smaller backward step is skipped as out of order.
+        buffer_samples: segment buffer for the quality gate; a segment longer than this resets.
+    """
+
+    model: str = 'sinusoid'
+    lowpass_cutoff_hz: float = 3.0
+    lowpass_damping: float = 0.707
+    window: int = 3
+    tolerance: float = 1e-3
+    min_time: float = 0.05
+    min_samples: int = 16
+    max_window: float = 10.0
+    band_hz: Optional[Tuple[float, float]] = None
+    band_damping: float = 0.707
+    min_amplitude: float = 0.0
+    min_fit: float = 0.5
+    max_gap: float = 0.5
+    buffer_samples: int = 200_000
+
+    def validate(self) -> None:
+        """Raise ``ValueError`` naming the first invalid parameter and why."""
+        def positive(name):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+                raise ValueError(f'{name} must be a finite number > 0, got {v!r}')
+
+        if self.model not in MODELS:
+            raise ValueError(f'model must be one of {", ".join(MODELS)}, got {self.model!r}')
+        for name in ('lowpass_cutoff_hz', 'lowpass_damping', 'tolerance', 'max_window',
+                     'max_gap', 'band_damping'):
+            positive(name)
+        for name in ('window', 'min_samples', 'buffer_samples'):
+            v = getattr(self, name)
+            if not isinstance(v, (int, np.integer)) or isinstance(v, bool) or v < 1:
+                raise ValueError(f'{name} must be an integer >= 1, got {v!r}')
+        if self.window > 10_000:
+            raise ValueError(f'window must be <= 10000, got {self.window}')
+        if not (math.isfinite(self.min_time) and self.min_time >= 0):
+            raise ValueError(f'min_time must be a finite number >= 0, got {self.min_time!r}')
+        if self.min_time >= self.max_window:
+            raise ValueError(f'min_time ({self.min_time}) must be below max_window '
+                             f'({self.max_window})')
+        if not (math.isfinite(self.min_amplitude) and self.min_amplitude >= 0):
+            raise ValueError(f'min_amplitude must be >= 0, got {self.min_amplitude!r}')
+        if not (math.isfinite(self.min_fit) and 0 <= self.min_fit <= 1):
+            raise ValueError(f'min_fit must be in [0, 1], got {self.min_fit!r}')
+        if self.tolerance >= 1:
+            raise ValueError(f'tolerance must be < 1, got {self.tolerance}')
+        if self.band_hz is not None:
+            band = tuple(self.band_hz)
+            if len(band) != 2 or not all(isinstance(b, (int, float)) and math.isfinite(b)
+                                         for b in band) or not 0 < band[0] < band[1]:
+                raise ValueError(f'band_hz must be [f_lo, f_hi] with 0 < f_lo < f_hi, '
+                                 f'got {self.band_hz!r}')
+
+    def replace(self, **changes) -> 'EstimatorConfig':
+        """A validated copy with ``changes`` applied."""
+        data = asdict(self)
+        data.update(changes)
+        if data.get('band_hz') is not None:
+            data['band_hz'] = tuple(data['band_hz'])
+        cfg = EstimatorConfig(**data)
+        cfg.validate()
+        return cfg
+
+    @classmethod
+    def names(cls) -> List[str]:
+        return [f.name for f in fields(cls)]
+
+    def as_params(self) -> np.ndarray:
+        """The kernel's parameter array."""
+        p = np.zeros(K.N_PARAMS)
+        p[K.P_MODEL] = MODELS.index(self.model)
+        p[K.P_WC] = 2 * math.pi * self.lowpass_cutoff_hz
+        p[K.P_ZC] = self.lowpass_damping
+        p[K.P_M] = self.window
+        p[K.P_TOL] = self.tolerance
+        p[K.P_EPS] = self.min_time
+        p[K.P_MAXWIN] = self.max_window
+        p[K.P_BAND] = 1.0 if self.band_hz is not None else 0.0
+        if self.band_hz is not None:
+            p[K.P_WLO] = 2 * math.pi * self.band_hz[0]
+            p[K.P_WHI] = 2 * math.pi * self.band_hz[1]
+        p[K.P_ZB] = self.band_damping
+        p[K.P_MINAMP] = self.min_amplitude
+        p[K.P_MINFIT] = self.min_fit
+        p[K.P_MAXGAP] = self.max_gap
+        p[K.P_MINSAMP] = self.min_samples
+        return p
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """One published estimate.
+
+    Attributes:
+        t: stamp of the converging sample (same time base as the input), s.
+        frequency_hz: estimated natural frequency, Hz.
+        convergence_time: time from the last reset to convergence, s.
+        samples: samples used by this estimate (segment length).
+        fit: R^2 of the sinusoid at this frequency over the segment (quality gate).
+        amplitude: amplitude of that sinusoid, signal units.
+    """
+
+    t: float
+    frequency_hz: float
+    convergence_time: float
+    samples: int
+    fit: float
+    amplitude: float
+
+    @property
+    def omega(self) -> float:
+        """Estimated angular frequency, rad/s."""
+        return 2 * math.pi * self.frequency_hz
+
+    def as_dict(self) -> Dict[str, float]:
+        return {'t': self.t, 'frequency_hz': self.frequency_hz, 'omega_rad_s': self.omega,
+                'convergence_time_s': self.convergence_time, 'samples': self.samples,
+                'fit': self.fit, 'amplitude': self.amplitude}
+
+
+@dataclass
+class EstimateArrays:
+    """Estimates of a batch run as columns (same fields as :class:`Estimate`)."""
+
+    t: np.ndarray
+    frequency_hz: np.ndarray
+    convergence_time: np.ndarray
+    samples: np.ndarray
+    fit: np.ndarray
+    amplitude: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.t)
+
+    def to_list(self) -> List[Estimate]:
+        return [Estimate(float(a), float(b), float(c), int(d), float(e), float(f))
+                for a, b, c, d, e, f in zip(self.t, self.frequency_hz, self.convergence_time,
+                                            self.samples, self.fit, self.amplitude)]
+
+
+class FrequencyEstimator:
+    """Streaming algebraic frequency estimator; see the module docstring.
+
+    Bad samples never raise: a non-finite value, a duplicate or an out-of-order stamp is skipped
+    and counted; a gap or a backward jump longer than ``max_gap`` restarts the estimator (counted).
+    ``counters`` tells how many samples went where and why estimates were held back.
+    """
+
+    def __init__(self, config: EstimatorConfig = EstimatorConfig()):
+        config.validate()
+        self._config = config
+        self._p = config.as_params()
+        self._s = np.zeros(K.N_STATE_FIXED + 2 * config.window + 1)
+        self._c = np.zeros(K.N_COUNTERS, dtype=np.int64)
+        self._seg = np.zeros((2, config.buffer_samples))
+        self._row = np.zeros(K.N_OUT)
+        self.restart()
+
+    @property
+    def config(self) -> EstimatorConfig:
+        return self._config
+
+    def restart(self) -> None:
+        """Forget the signal entirely (prefilter and history too); counters are kept."""
+        K._restart(self._s, self._c)
+
+    def reset(self) -> None:
+        """Start a new estimation segment at the last sample, as after a convergence."""
+        if self._c[K.C_HIST_N] >= K.NH:
+            K.reset_segment(self._s, self._c, self._seg, self._s[K.S_TLAST],
+                            self._s[K.S_HY + K.NH - 1])
+
+    @property
+    def counters(self) -> Dict[str, int]:
+        return {name: int(self._c[i]) for i, name in enumerate(COUNTER_NAMES)}
+
+    def update(self, t: float, y: float) -> Optional[Estimate]:
+        """Feed one sample (time in s, any origin); return an estimate when one is published."""
+        if K.step(self._p, self._s, self._c, self._seg, float(t), float(y), self._row):
+            r = self._row
+            return Estimate(r[K.O_T], r[K.O_F], r[K.O_CONV], int(r[K.O_SAMPLES]), r[K.O_FIT],
+                            r[K.O_AMP])
+        return None
+
+    def process(self, t: Sequence[float], y: Sequence[float]) -> EstimateArrays:
+        """Feed arrays of samples (continuing the stream); return the estimates as columns."""
+        t = np.ascontiguousarray(t, dtype=np.float64)
+        y = np.ascontiguousarray(y, dtype=np.float64)
+        if t.shape != y.shape or t.ndim != 1:
+            raise ValueError(f't and y must be 1-D arrays of one length, got {t.shape}, {y.shape}')
+        chunks = []
+        start = 0
+        size = max(16, len(t) // 100)
+        while True:
+            out = np.empty((size, K.N_OUT))
+            n, start = K.run(self._p, self._s, self._c, self._seg, t, y, out, start)
+            chunks.append(out[:n])
+            if start >= len(t):
+                break
+            size *= 2
+        rows = np.concatenate(chunks) if chunks else np.empty((0, K.N_OUT))
+        return EstimateArrays(rows[:, K.O_T].copy(), rows[:, K.O_F].copy(),
+                              rows[:, K.O_CONV].copy(), rows[:, K.O_SAMPLES].astype(np.int64),
+                              rows[:, K.O_FIT].copy(), rows[:, K.O_AMP].copy())
+
+
+def estimate(t: Sequence[float], y: Sequence[float],
+             config: EstimatorConfig = EstimatorConfig()) -> EstimateArrays:
+    """Batch convenience: run a fresh estimator over a whole record."""
+    return FrequencyEstimator(config).process(t, y)
