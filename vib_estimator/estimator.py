@@ -46,9 +46,12 @@ class EstimatorConfig:
         tolerance: relative tolerance of that test.
         min_time: eps of Eq. 12, seconds after a reset during which no estimate is formed.
         min_samples: samples a segment must hold before the test may fire (see module docstring).
+        min_periods: the test may fire only once the segment spans this fraction of the period
+            it estimates (scale-free version of eps; 0 = off).
+        invariant_filter: False computes n / d unfiltered (Fig. 1's lower trace); True is Eq. 12.
         max_window: seconds without convergence after which the estimator resets unpublished.
-        band_hz: optional (f_lo, f_hi) band-pass prefilter on y, never reset; None = off.
-        band_damping: damping ratio of the prefilter's two sections (Butterworth, 0.707).
+        band_hz: optional (f_lo, f_hi) band-pass prefilter on y (4th-order Butterworth low-pass
+            at f_hi, 2nd-order Butterworth high-pass at f_lo), never reset; None = off.
         min_amplitude: quality gate, amplitude of the fitted sinusoid below which the signal is
             taken to be at rest (signal units).
         min_fit: quality gate, fraction of the segment's variance the fitted sinusoid must
@@ -63,11 +66,12 @@ class EstimatorConfig:
     lowpass_damping: float = 0.707
     window: int = 3
     tolerance: float = 1e-3
-    min_time: float = 0.05
+    min_time: float = 0.01
     min_samples: int = 16
+    min_periods: float = 0.5
+    invariant_filter: bool = True
     max_window: float = 10.0
     band_hz: Optional[Tuple[float, float]] = None
-    band_damping: float = 0.707
     min_amplitude: float = 0.0
     min_fit: float = 0.5
     max_gap: float = 0.5
@@ -83,7 +87,7 @@ class EstimatorConfig:
         if self.model not in MODELS:
             raise ValueError(f'model must be one of {", ".join(MODELS)}, got {self.model!r}')
         for name in ('lowpass_cutoff_hz', 'lowpass_damping', 'tolerance', 'max_window',
-                     'max_gap', 'band_damping'):
+                     'max_gap'):
             positive(name)
         for name in ('window', 'min_samples', 'buffer_samples'):
             v = getattr(self, name)
@@ -96,6 +100,10 @@ class EstimatorConfig:
         if self.min_time >= self.max_window:
             raise ValueError(f'min_time ({self.min_time}) must be below max_window '
                              f'({self.max_window})')
+        if not (isinstance(self.min_periods, (int, float)) and 0 <= self.min_periods <= 10):
+            raise ValueError(f'min_periods must be in [0, 10], got {self.min_periods!r}')
+        if not isinstance(self.invariant_filter, bool):
+            raise ValueError(f'invariant_filter must be a bool, got {self.invariant_filter!r}')
         if not (math.isfinite(self.min_amplitude) and self.min_amplitude >= 0):
             raise ValueError(f'min_amplitude must be >= 0, got {self.min_amplitude!r}')
         if not (math.isfinite(self.min_fit) and 0 <= self.min_fit <= 1):
@@ -137,11 +145,12 @@ class EstimatorConfig:
         if self.band_hz is not None:
             p[K.P_WLO] = 2 * math.pi * self.band_hz[0]
             p[K.P_WHI] = 2 * math.pi * self.band_hz[1]
-        p[K.P_ZB] = self.band_damping
         p[K.P_MINAMP] = self.min_amplitude
         p[K.P_MINFIT] = self.min_fit
         p[K.P_MAXGAP] = self.max_gap
         p[K.P_MINSAMP] = self.min_samples
+        p[K.P_MINPER] = self.min_periods
+        p[K.P_FILTER] = 1.0 if self.invariant_filter else 0.0
         return p
 
 

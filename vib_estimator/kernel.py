@@ -28,8 +28,9 @@ Mathematics (equation numbers are those of Trapero, Sira-Ramirez & Feliu):
   sampling is handled and ``n_f / d_f`` stays exactly ``w^2`` for a pure sinusoid.
 * Eq. 12: no estimate for ``tau <= eps``; Eqs. 16-17: moving-average convergence test (with the
   absolute value of the relative change: the printed test is one-sided).
-* The optional band-pass prefilter is a Butterworth low-pass at ``f_hi`` followed by a Butterworth
-  high-pass at ``f_lo``, both with the same exact discretisation; it is never reset by an estimate.
+* The optional band-pass prefilter is a 4th-order Butterworth low-pass at ``f_hi`` (steep, against
+  higher modes) followed by a 2nd-order Butterworth high-pass at ``f_lo`` (offset and drift), all
+  with the same exact discretisation; it is never reset by an estimate.
 """
 from __future__ import annotations
 
@@ -39,9 +40,9 @@ import numpy as np
 from numba import njit
 
 # ---- parameter array layout (float64) -------------------------------------------------------
-P_MODEL, P_WC, P_ZC, P_M, P_TOL, P_EPS, P_MAXWIN, P_BAND, P_WLO, P_WHI, P_ZB, P_MINAMP, \
-    P_MINFIT, P_MAXGAP, P_MINSAMP = range(15)
-N_PARAMS = 15
+P_MODEL, P_WC, P_ZC, P_M, P_TOL, P_EPS, P_MAXWIN, P_BAND, P_WLO, P_WHI, P_MINAMP, P_MINFIT, \
+    P_MAXGAP, P_MINSAMP, P_MINPER, P_FILTER = range(16)
+N_PARAMS = 16
 
 # ---- counter array layout (int64) -----------------------------------------------------------
 (C_RECEIVED, C_USED, C_NONFINITE, C_DUPLICATE, C_OUT_OF_ORDER, C_TIME_JUMP, C_GAP, C_REST,
@@ -59,13 +60,10 @@ S_NF = S_MOM + 5    # low-pass state of n: x5, x6 (Eq. 11)
 S_DF = S_NF + 2     # low-pass state of d: x7, x8
 S_NPREV = S_DF + 2  # n, d at the previous sample (first-order hold)
 S_DPREV = S_NPREV + 1
-S_BLP = S_DPREV + 1  # band-pass: low-pass state (2) and previous input
-S_BLP_U = S_BLP + 2
-S_BHP = S_BLP_U + 1  # band-pass: high-pass state (2) and previous input
-S_BHP_U = S_BHP + 2
-S_CACHE_H = S_BHP_U + 1  # step for which the discretisations below were computed
-S_DISC = S_CACHE_H + 1   # 3 sections x 8 numbers (Phi 2x2, G0 2, G1 2)
-S_LAST_DT = S_DISC + 24  # last sampling interval (for the Nyquist check)
+S_BAND = S_DPREV + 1     # band-pass: 3 sections x (2 states, previous input)
+S_CACHE_H = S_BAND + 9   # step for which the discretisations below were computed
+S_DISC = S_CACHE_H + 1   # 4 sections x 8 numbers (Phi 2x2, G0 2, G1 2): Eq. 11, then band
+S_LAST_DT = S_DISC + 32  # last sampling interval (for the Nyquist check)
 S_SCR = S_LAST_DT + 1    # scratch for the interval rule: nodes, differences, coefficients, I_m
 S_W = S_SCR + 3 * NH + 5  # cached weights of the rule on a uniform stencil (5 x NH)
 S_WH = S_W + 5 * NH      # step of the cached weights (-1: none)
@@ -79,6 +77,9 @@ O_T, O_F, O_CONV, O_SAMPLES, O_FIT, O_AMP = range(6)
 N_OUT = 6
 
 TWO_PI = 2.0 * math.pi
+#: band-pass prefilter: 4th-order Butterworth low-pass at f_hi (two sections), then a 2nd-order
+#: Butterworth high-pass at f_lo
+BAND_DAMPING = (math.cos(math.pi / 8), math.cos(3 * math.pi / 8), math.sqrt(0.5))
 
 
 @njit(cache=True)
@@ -159,12 +160,12 @@ def reset_segment(s, c, seg, t0, y0):
 
 
 @njit(cache=True)
-def _newton_integrals(s, kmax, yv, im):
-    """I_m = int_0^h u^m p(u) du, m = 0..kmax, for the polynomial p through the stencil.
+def _newton_integrals(s, kmax, yv, im, q):
+    """I_m = int_0^h u^m p(u) du, m = 0..kmax, for the polynomial p through the q newest samples.
 
-    ``p`` has degree NH-1 and passes through the NH newest sample times (held in ``s``) with values
-    ``yv`` (oldest first); u = s - (left end of the newest interval), h = newest interval.
-    Newton divided differences, then monomial coefficients by Horner.
+    ``p`` has degree q-1 and passes through the q newest sample times (held in ``s``) with values
+    ``yv`` (oldest first, NH of them); u = s - (left end of the newest interval), h = newest
+    interval. Newton divided differences, then monomial coefficients by Horner.
     """
     t_left = s[S_HT + NH - 2]
     z = s[S_SCR:S_SCR + NH]
@@ -175,26 +176,26 @@ def _newton_integrals(s, kmax, yv, im):
     dd[0] = yv[NH - 2]
     z[1] = s[S_HT + NH - 1] - t_left
     dd[1] = yv[NH - 1]
-    for j in range(2, NH):
+    for j in range(2, q):
         z[j] = s[S_HT + NH - 1 - j] - t_left
         dd[j] = yv[NH - 1 - j]
-    for lev in range(1, NH):
-        for j in range(NH - 1, lev - 1, -1):
+    for lev in range(1, q):
+        for j in range(q - 1, lev - 1, -1):
             dd[j] = (dd[j] - dd[j - 1]) / (z[j] - z[j - lev])
     coef[:] = 0.0
-    coef[0] = dd[NH - 1]
-    for j in range(NH - 2, -1, -1):
+    coef[0] = dd[q - 1]
+    for j in range(q - 2, -1, -1):
         # coef <- coef * (u - z[j]) + dd[j]
-        for q in range(NH - 1, 0, -1):
-            coef[q] = coef[q - 1] - z[j] * coef[q]
+        for i in range(q - 1, 0, -1):
+            coef[i] = coef[i - 1] - z[j] * coef[i]
         coef[0] = dd[j] - z[j] * coef[0]
     h = z[1]
     hp = h
     for m in range(kmax + 1):
         acc = 0.0
         hq = hp
-        for q in range(NH):
-            acc += coef[q] * hq / (m + q + 1)
+        for i in range(q):
+            acc += coef[i] * hq / (m + i + 1)
             hq *= h
         im[m] = acc
         hp *= h
@@ -207,7 +208,10 @@ def _interval_moments(s, kmax, a, h):
     ``p`` is the polynomial of degree NH-1 through the NH newest samples and ``a`` the interval's
     left end in segment time. The rule is causal (the interval is the newest of its stencil) and
     holds for any spacing; its local error is O(h^(NH+1)). On a uniform stencil the rule is a fixed
-    set of weights, cached (``S_W``) until the step changes.
+    set of weights, cached (``S_W``) until the step changes. On an irregular stencil, older
+    samples are used only while their intervals are at least h/4 long: after a gap (a long newest
+    interval next to closely spaced older samples) a high-degree polynomial would swing wildly
+    across the gap, so the rule falls back towards the trapezoid for that interval.
     """
     im = s[S_SCR + 3 * NH:S_SCR + 3 * NH + 5]
     yv = s[S_HY:S_HY + NH]
@@ -223,7 +227,7 @@ def _interval_moments(s, kmax, a, h):
             for j in range(NH):
                 unit[:] = 0.0
                 unit[j] = 1.0
-                _newton_integrals(s, 4, unit, im)
+                _newton_integrals(s, 4, unit, im, NH)
                 for m in range(5):
                     w[m * NH + j] = im[m]
             s[S_WH] = h
@@ -234,7 +238,10 @@ def _interval_moments(s, kmax, a, h):
                 acc += w[m * NH + j] * yv[j]
             im[m] = acc
     else:
-        _newton_integrals(s, kmax, yv, im)
+        q = 2
+        while q < NH and s[S_HT + NH - q] - s[S_HT + NH - q - 1] >= 0.25 * h:
+            q += 1
+        _newton_integrals(s, kmax, yv, im, q)
     # M_k += sum_m C(k, m) a^(k-m) I_m
     for k in range(kmax + 1):
         acc = 0.0
@@ -245,6 +252,17 @@ def _interval_moments(s, kmax, a, h):
             binom = binom * (k - j) / (j + 1)
             ap = ap * a
         s[S_MOM + k] += acc
+
+
+@njit(cache=True)
+def _spread(seg, n):
+    """Half the peak-to-peak range of the segment's values (0 for a flat line)."""
+    lo = seg[1, 0]
+    hi = seg[1, 0]
+    for i in range(1, n):
+        lo = min(lo, seg[1, i])
+        hi = max(hi, seg[1, i])
+    return 0.5 * (hi - lo)
 
 
 @njit(cache=True)
@@ -300,24 +318,25 @@ def _fit(seg, n, omega):
 @njit(cache=True)
 def _prefilter(p, s, y):
     """Band-pass the raw sample (never reset by an estimate); returns the filtered value."""
-    u_lp_prev = s[S_BLP_U]
-    _advance(s, S_BLP, S_DISC + 8, u_lp_prev, y)
-    s[S_BLP_U] = y
-    y1 = s[S_BLP]
-    u_hp_prev = s[S_BHP_U]
-    _advance(s, S_BHP, S_DISC + 16, u_hp_prev, y1)
-    s[S_BHP_U] = y1
-    return y1 - s[S_BHP] - (2.0 * p[P_ZB] / p[P_WLO]) * s[S_BHP + 1]
+    u = y
+    for k in range(3):
+        x = S_BAND + 3 * k
+        _advance(s, x, S_DISC + 8 * (k + 1), s[x + 2], u)
+        s[x + 2] = u
+        if k < 2:
+            u = s[x]
+    # high-pass output from the internal low-pass states: u - x - (2 zeta / w) x'
+    x = S_BAND + 6
+    return u - s[x] - (2.0 * BAND_DAMPING[2] / p[P_WLO]) * s[x + 1]
 
 
 @njit(cache=True)
 def _first_sample(p, s, c, t, y):
     """Initialise the prefilter at its steady state for a constant input and prime the history."""
     if p[P_BAND] > 0.0:
-        s[S_BLP] = y
-        s[S_BLP_U] = y
-        s[S_BHP] = y
-        s[S_BHP_U] = y
+        for k in range(3):
+            s[S_BAND + 3 * k] = y
+            s[S_BAND + 3 * k + 2] = y
         y = 0.0
     s[S_HT + NH - 1] = t
     s[S_HY + NH - 1] = y
@@ -358,8 +377,9 @@ def step(p, s, c, seg, t, y, out):
     if abs(h - s[S_CACHE_H]) > 1e-9 * h:
         _discretise(p[P_WC], p[P_ZC], h, s, S_DISC)
         if p[P_BAND] > 0.0:
-            _discretise(p[P_WHI], p[P_ZB], h, s, S_DISC + 8)
-            _discretise(p[P_WLO], p[P_ZB], h, s, S_DISC + 16)
+            for k in range(3):
+                _discretise(p[P_WHI] if k < 2 else p[P_WLO], BAND_DAMPING[k], h, s,
+                            S_DISC + 8 * (k + 1))
         s[S_CACHE_H] = h
     s[S_LAST_DT] = h
     if p[P_BAND] > 0.0:
@@ -393,8 +413,12 @@ def step(p, s, c, seg, t, y, out):
         num = -(tau * tau * y + 2.0 * tau * m0 - 6.0 * m1)
         den = tau * m2 - m3
     # invariant filtering, Eq. 11 (same discretised filter for both)
-    _advance(s, S_NF, S_DISC, s[S_NPREV], num)
-    _advance(s, S_DF, S_DISC, s[S_DPREV], den)
+    if p[P_FILTER] > 0.0:
+        _advance(s, S_NF, S_DISC, s[S_NPREV], num)
+        _advance(s, S_DF, S_DISC, s[S_DPREV], den)
+    else:
+        s[S_NF] = num
+        s[S_DF] = den
     s[S_NPREV] = num
     s[S_DPREV] = den
     nseg = c[C_SEG_N]
@@ -404,7 +428,11 @@ def step(p, s, c, seg, t, y, out):
         seg[1, nseg] = y
     c[C_SEG_N] = nseg + 1
     if tau > p[P_MAXWIN] or nseg + 1 >= cap:
-        c[C_MAX_WINDOW] += 1
+        # no convergence: say whether the signal was at rest or just never converged
+        if _spread(seg, min(nseg + 1, cap)) <= p[P_MINAMP]:
+            c[C_REST] += 1
+        else:
+            c[C_MAX_WINDOW] += 1
         reset_segment(s, c, seg, t, y)
         return 0
     if tau <= p[P_EPS] or nseg + 1 < p[P_MINSAMP]:
@@ -431,6 +459,9 @@ def step(p, s, c, seg, t, y, out):
         ma_now += s[S_MA + ((k - i) % size)]
         ma_then += s[S_MA + ((k - m - i) % size)]
     if abs(ma_now - ma_then) >= p[P_TOL] * ma_now:
+        return 0
+    # the segment must span a fraction of the period it estimates
+    if tau * f < p[P_MINPER]:
         return 0
     # converged: quality gate, then publish and reset
     n_fit = min(nseg + 1, cap)
