@@ -49,6 +49,8 @@ class EstimatorConfig:
         min_periods: the test may fire only once the segment spans this fraction of the period
             it estimates (scale-free version of eps; 0 = off).
         invariant_filter: False computes n / d unfiltered (Fig. 1's lower trace); True is Eq. 12.
+        one_sided_test: Eq. 16 exactly as printed, (MA(k) - MA(k-M)) / MA(k) < tolerance, which
+            accepts any falling estimate; the default tests the absolute change.
         max_window: seconds without convergence after which the estimator resets unpublished.
         band_hz: optional (f_lo, f_hi) band-pass prefilter on y (4th-order Butterworth low-pass
             at f_hi, 2nd-order Butterworth high-pass at f_lo), never reset; None = off.
@@ -70,6 +72,7 @@ class EstimatorConfig:
     min_samples: int = 16
     min_periods: float = 0.5
     invariant_filter: bool = True
+    one_sided_test: bool = False
     max_window: float = 10.0
     band_hz: Optional[Tuple[float, float]] = None
     min_amplitude: float = 0.0
@@ -102,8 +105,9 @@ class EstimatorConfig:
                              f'({self.max_window})')
         if not (isinstance(self.min_periods, (int, float)) and 0 <= self.min_periods <= 10):
             raise ValueError(f'min_periods must be in [0, 10], got {self.min_periods!r}')
-        if not isinstance(self.invariant_filter, bool):
-            raise ValueError(f'invariant_filter must be a bool, got {self.invariant_filter!r}')
+        for name in ('invariant_filter', 'one_sided_test'):
+            if not isinstance(getattr(self, name), bool):
+                raise ValueError(f'{name} must be a bool, got {getattr(self, name)!r}')
         if not (math.isfinite(self.min_amplitude) and self.min_amplitude >= 0):
             raise ValueError(f'min_amplitude must be >= 0, got {self.min_amplitude!r}')
         if not (math.isfinite(self.min_fit) and 0 <= self.min_fit <= 1):
@@ -151,6 +155,7 @@ class EstimatorConfig:
         p[K.P_MINSAMP] = self.min_samples
         p[K.P_MINPER] = self.min_periods
         p[K.P_FILTER] = 1.0 if self.invariant_filter else 0.0
+        p[K.P_ONESIDED] = 1.0 if self.one_sided_test else 0.0
         return p
 
 
@@ -240,6 +245,15 @@ class FrequencyEstimator:
     @property
     def counters(self) -> Dict[str, int]:
         return {name: int(self._c[i]) for i, name in enumerate(COUNTER_NAMES)}
+
+    @property
+    def omega_squared(self) -> float:
+        """Eq. 12's current value n_f / d_f (rad^2/s^2) of the running segment; NaN if undefined.
+
+        For plotting the estimate's trajectory (Fig. 1); published estimates come from ``update``.
+        """
+        df = self._s[K.S_DF]
+        return self._s[K.S_NF] / df if df != 0.0 and self._c[K.C_SEG_N] > 1 else math.nan
 
     def update(self, t: float, y: float) -> Optional[Estimate]:
         """Feed one sample (time in s, any origin); return an estimate when one is published."""
