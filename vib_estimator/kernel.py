@@ -66,11 +66,11 @@ S_BAND = S_DPREV + 1     # band-pass: 3 sections x (2 states, previous input)
 S_CACHE_H = S_BAND + 9   # step for which the discretisations below were computed
 S_DISC = S_CACHE_H + 1   # 4 sections x 8 numbers (Phi 2x2, G0 2, G1 2): Eq. 11, then band
 S_LAST_DT = S_DISC + 32  # last sampling interval (for the Nyquist check)
-S_SCR = S_LAST_DT + 1    # scratch for the interval rule: nodes, differences, coefficients, I_m
-S_W = S_SCR + 3 * NH + 5  # cached weights of the rule on a uniform stencil (5 x NH)
+S_SCR = S_LAST_DT + 1    # scratch for the interval rule: nodes, differences, coefficients
+S_IM = S_SCR + 3 * NH    # the rule's integrals I_0..I_4 of the newest interval
+S_W = S_IM + 5           # cached weights of the rule on a uniform stencil (5 x NH)
 S_WH = S_W + 5 * NH      # step of the cached weights (-1: none)
-S_WK = S_WH + 1          # highest moment order the cache holds
-S_UNIT = S_WK + 1        # scratch unit vector
+S_UNIT = S_WH + 1        # scratch unit vector
 S_MA = S_UNIT + NH       # moving-average ring (2M+1 values) starts here
 N_STATE_FIXED = S_MA
 
@@ -162,44 +162,47 @@ def reset_segment(s, c, seg, t0, y0):
 
 
 @njit(cache=True)
-def _newton_integrals(s, kmax, yv, im, q):
+def _newton_integrals(s, kmax, yoff, q):
     """I_m = int_0^h u^m p(u) du, m = 0..kmax, for the polynomial p through the q newest samples.
 
     ``p`` has degree q-1 and passes through the q newest sample times (held in ``s``) with values
-    ``yv`` (oldest first, NH of them); u = s - (left end of the newest interval), h = newest
-    interval. Newton divided differences, then monomial coefficients by Horner.
+    ``s[yoff:yoff + NH]`` (oldest first); u = s - (left end of the newest interval), h = newest
+    interval. Newton divided differences, then monomial coefficients by Horner. Results go to
+    ``s[S_IM:S_IM + kmax + 1]``. (Index arithmetic only: slicing would cost reference counting.)
     """
     t_left = s[S_HT + NH - 2]
-    z = s[S_SCR:S_SCR + NH]
-    dd = s[S_SCR + NH:S_SCR + 2 * NH]
-    coef = s[S_SCR + 2 * NH:S_SCR + 3 * NH]
+    z = S_SCR
+    dd = S_SCR + NH
+    coef = S_SCR + 2 * NH
     # node order: newest-but-one (u = 0), newest (u = h), then older ones
-    z[0] = 0.0
-    dd[0] = yv[NH - 2]
-    z[1] = s[S_HT + NH - 1] - t_left
-    dd[1] = yv[NH - 1]
+    s[z] = 0.0
+    s[dd] = s[yoff + NH - 2]
+    s[z + 1] = s[S_HT + NH - 1] - t_left
+    s[dd + 1] = s[yoff + NH - 1]
     for j in range(2, q):
-        z[j] = s[S_HT + NH - 1 - j] - t_left
-        dd[j] = yv[NH - 1 - j]
+        s[z + j] = s[S_HT + NH - 1 - j] - t_left
+        s[dd + j] = s[yoff + NH - 1 - j]
     for lev in range(1, q):
         for j in range(q - 1, lev - 1, -1):
-            dd[j] = (dd[j] - dd[j - 1]) / (z[j] - z[j - lev])
-    coef[:] = 0.0
-    coef[0] = dd[q - 1]
+            s[dd + j] = (s[dd + j] - s[dd + j - 1]) / (s[z + j] - s[z + j - lev])
+    for i in range(q):
+        s[coef + i] = 0.0
+    s[coef] = s[dd + q - 1]
     for j in range(q - 2, -1, -1):
         # coef <- coef * (u - z[j]) + dd[j]
+        zj = s[z + j]
         for i in range(q - 1, 0, -1):
-            coef[i] = coef[i - 1] - z[j] * coef[i]
-        coef[0] = dd[j] - z[j] * coef[0]
-    h = z[1]
+            s[coef + i] = s[coef + i - 1] - zj * s[coef + i]
+        s[coef] = s[dd + j] - zj * s[coef]
+    h = s[z + 1]
     hp = h
     for m in range(kmax + 1):
         acc = 0.0
         hq = hp
         for i in range(q):
-            acc += coef[i] * hq / (m + i + 1)
+            acc += s[coef + i] * hq / (m + i + 1)
             hq *= h
-        im[m] = acc
+        s[S_IM + m] = acc
         hp *= h
 
 
@@ -215,42 +218,38 @@ def _interval_moments(s, kmax, a, h):
     interval next to closely spaced older samples) a high-degree polynomial would swing wildly
     across the gap, so the rule falls back towards the trapezoid for that interval.
     """
-    im = s[S_SCR + 3 * NH:S_SCR + 3 * NH + 5]
-    yv = s[S_HY:S_HY + NH]
     uniform = True
     for j in range(NH - 1):
         if abs(s[S_HT + j + 1] - s[S_HT + j] - h) > 1e-9 * h:
             uniform = False
             break
     if uniform:
-        w = s[S_W:S_W + 5 * NH]
-        if not abs(h - s[S_WH]) <= 1e-9 * h or s[S_WK] < kmax:
-            unit = s[S_UNIT:S_UNIT + NH]
+        if not abs(h - s[S_WH]) <= 1e-9 * h:
             for j in range(NH):
-                unit[:] = 0.0
-                unit[j] = 1.0
-                _newton_integrals(s, 4, unit, im, NH)
+                for i in range(NH):
+                    s[S_UNIT + i] = 0.0
+                s[S_UNIT + j] = 1.0
+                _newton_integrals(s, 4, S_UNIT, NH)
                 for m in range(5):
-                    w[m * NH + j] = im[m]
+                    s[S_W + m * NH + j] = s[S_IM + m]
             s[S_WH] = h
-            s[S_WK] = 4
         for m in range(kmax + 1):
             acc = 0.0
             for j in range(NH):
-                acc += w[m * NH + j] * yv[j]
-            im[m] = acc
+                acc += s[S_W + m * NH + j] * s[S_HY + j]
+            s[S_IM + m] = acc
     else:
         q = 2
         while q < NH and s[S_HT + NH - q] - s[S_HT + NH - q - 1] >= 0.25 * h:
             q += 1
-        _newton_integrals(s, kmax, yv, im, q)
+        _newton_integrals(s, kmax, S_HY, q)
     # M_k += sum_m C(k, m) a^(k-m) I_m
     for k in range(kmax + 1):
         acc = 0.0
         binom = 1.0
         ap = 1.0
         for j in range(k + 1):
-            acc += binom * ap * im[k - j]
+            acc += binom * ap * s[S_IM + k - j]
             binom = binom * (k - j) / (j + 1)
             ap = ap * a
         s[S_MOM + k] += acc
@@ -274,7 +273,7 @@ def _fit(seg, n, omega):
     Returns (R^2, amplitude); R^2 = -1 when the segment has no variance.
     """
     s11 = s12 = s13 = s22 = s23 = s33 = 0.0
-    r1 = r2 = r3 = 0.0
+    r1 = r2 = r3 = sstot = 0.0
     ymean = 0.0
     for i in range(n):
         ymean += seg[1, i]
@@ -292,9 +291,7 @@ def _fit(seg, n, omega):
         r1 += sn * y
         r2 += cs * y
         r3 += y
-    sstot = 0.0
-    for i in range(n):
-        sstot += (seg[1, i] - ymean) ** 2
+        sstot += y * y
     if sstot <= 0.0:
         return -1.0, 0.0
     # Cramer's rule on the 3x3 normal equations
@@ -308,12 +305,8 @@ def _fit(seg, n, omega):
           + s13 * (s12 * r3 - r2 * s13)) / det
     cc = (s11 * (s22 * r3 - s23 * r2) - s12 * (s12 * r3 - r2 * s13)
           + r1 * (s12 * s23 - s22 * s13)) / det
-    ssres = 0.0
-    for i in range(n):
-        sn = math.sin(omega * seg[0, i])
-        cs = math.cos(omega * seg[0, i])
-        e = seg[1, i] - ymean - (ca * sn + cb * cs + cc)
-        ssres += e * e
+    # least squares: residual sum of squares = y'y - beta' X'y (y centred, so y'y = sstot)
+    ssres = sstot - (ca * r1 + cb * r2 + cc * r3)
     return 1.0 - ssres / sstot, math.sqrt(ca * ca + cb * cb)
 
 
