@@ -76,7 +76,7 @@ class EstimatorConfig:
     max_window: float = 10.0
     band_hz: Optional[Tuple[float, float]] = None
     min_amplitude: float = 0.0
-    min_fit: float = 0.5
+    min_fit: float = 0.9
     max_gap: float = 0.5
     buffer_samples: int = 200_000
 

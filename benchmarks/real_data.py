@@ -1,0 +1,60 @@
+"""Accuracy on real free-vibration recordings (not part of this project; read where they lie).
+
+Runs ``vib-estimator analyze``'s core over the aluminium-cantilever (ADXL357) recordings in
+``../shared/real-data`` (or the folder given as argument) and prints, per beam and configuration:
+number of estimates, median relative error and 90th percentile of |error| against the reference
+frequency of each file's own FFT (SOURCE.md), and median convergence time in periods.
+Configurations: the paper's estimator as printed (sinusoid model, no prefilter), the
+``biased-sinusoid`` model, and the paper's model with a band-pass prefilter [f/2, 2 f].
+"""
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from vib_estimator.csv_io import read_csv_series
+from vib_estimator.estimator import EstimatorConfig, estimate
+
+#: reference first-mode frequencies (Hz): this file's own FFT, per SOURCE.md
+REFERENCE = {30: 16.360, 40: 9.392, 50: 6.054, 60: 4.268}
+
+
+def configs(f_ref):
+    return {
+        'paper (sinusoid)': EstimatorConfig(),
+        'biased-sinusoid': EstimatorConfig(model='biased-sinusoid'),
+        'sinusoid + band [f/2, 2f]': EstimatorConfig(band_hz=(f_ref / 2, 2 * f_ref)),
+    }
+
+
+def report(label, t, y, f_ref):
+    for name, cfg in configs(f_ref).items():
+        e = estimate(t, y, cfg)
+        if len(e) == 0:
+            print(f'{label:18} {name:28} no estimate')
+            continue
+        err = e.frequency_hz / f_ref - 1
+        print(f'{label:18} {name:28} {len(e):5d} {100 * np.median(err):+8.2f} % '
+              f'{100 * np.percentile(np.abs(err), 90):8.2f} % '
+              f'{np.median(e.convergence_time) * f_ref:6.2f}')
+
+
+def main() -> int:
+    root = Path(sys.argv[1] if len(sys.argv) > 1 else
+                Path(__file__).resolve().parents[2] / 'shared' / 'real-data')
+    folder = root / 'aluminium_cantilever_adxl357'
+    if not folder.is_dir():
+        print(f'no real data at {folder}; pass the real-data folder as argument')
+        return 1
+    print(f'{"recording":18} {"configuration":28} {"n":>5} {"median err":>10} '
+          f'{"p90 |err|":>10} {"conv (periods)":>14}')
+    for length, f_ref in REFERENCE.items():
+        s = read_csv_series(folder / f'{length}cm_uniform_1000Hz.csv')
+        report(f'{length} cm, 1 kHz CSV', s.t, s.y, f_ref)
+        raw = np.load(next(folder.glob(f'raw_{length}cm_*.npy')))
+        report(f'{length} cm, raw ~3.9k', raw[0] - raw[0, 0], raw[1], f_ref)
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
