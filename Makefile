@@ -25,6 +25,7 @@ test: setup
 
 bench: setup
 	$(VENV)/bin/python benchmarks/bench_estimator.py
+	$(VENV)/bin/python benchmarks/bench_accuracy.py
 	$(VENV)/bin/python benchmarks/bench_node.py
 
 reproduce: setup

@@ -172,6 +172,7 @@ def test_public_reset_starts_a_new_segment():
     dict(min_time=-1.0), dict(min_time=20.0), dict(max_window=math.nan),
     dict(band_hz=(5.0, 1.0)), dict(band_hz=(0.0, 1.0)), dict(band_hz=(1.0,)),
     dict(min_fit=1.5), dict(min_amplitude=-1.0), dict(max_gap=0.0), dict(min_periods=-0.1),
+    dict(rule_points=1), dict(rule_points=9), dict(one_sided_test='yes'),
 ])
 def test_invalid_parameters_are_refused_with_a_reason(changes):
     name = next(iter(changes))

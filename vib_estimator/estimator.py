@@ -51,6 +51,8 @@ class EstimatorConfig:
         invariant_filter: False computes n / d unfiltered (Fig. 1's lower trace); True is Eq. 12.
         one_sided_test: Eq. 16 exactly as printed, (MA(k) - MA(k-M)) / MA(k) < tolerance, which
             accepts any falling estimate; the default tests the absolute change.
+        rule_points: samples of the interpolating polynomial the moments are integrated over
+            (2 = trapezoid ... 8 = degree 7, the default); lower values exist for comparison.
         max_window: seconds without convergence after which the estimator resets unpublished.
         band_hz: optional (f_lo, f_hi) band-pass prefilter on y (4th-order Butterworth low-pass
             at f_hi, 2nd-order Butterworth high-pass at f_lo), never reset; None = off.
@@ -73,6 +75,7 @@ class EstimatorConfig:
     min_periods: float = 0.5
     invariant_filter: bool = True
     one_sided_test: bool = False
+    rule_points: int = K.NH
     max_window: float = 10.0
     band_hz: Optional[Tuple[float, float]] = None
     min_amplitude: float = 0.0
@@ -92,10 +95,12 @@ class EstimatorConfig:
         for name in ('lowpass_cutoff_hz', 'lowpass_damping', 'tolerance', 'max_window',
                      'max_gap'):
             positive(name)
-        for name in ('window', 'min_samples', 'buffer_samples'):
+        for name in ('window', 'min_samples', 'buffer_samples', 'rule_points'):
             v = getattr(self, name)
             if not isinstance(v, (int, np.integer)) or isinstance(v, bool) or v < 1:
                 raise ValueError(f'{name} must be an integer >= 1, got {v!r}')
+        if not 2 <= self.rule_points <= K.NH:
+            raise ValueError(f'rule_points must be in [2, {K.NH}], got {self.rule_points}')
         if self.window > 10_000:
             raise ValueError(f'window must be <= 10000, got {self.window}')
         if not (math.isfinite(self.min_time) and self.min_time >= 0):
@@ -156,6 +161,7 @@ class EstimatorConfig:
         p[K.P_MINPER] = self.min_periods
         p[K.P_FILTER] = 1.0 if self.invariant_filter else 0.0
         p[K.P_ONESIDED] = 1.0 if self.one_sided_test else 0.0
+        p[K.P_RULE] = self.rule_points
         return p
 
 

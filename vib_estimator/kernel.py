@@ -43,8 +43,8 @@ from numba import njit
 
 # ---- parameter array layout (float64) -------------------------------------------------------
 P_MODEL, P_WC, P_ZC, P_M, P_TOL, P_EPS, P_MAXWIN, P_BAND, P_WLO, P_WHI, P_MINAMP, P_MINFIT, \
-    P_MAXGAP, P_MINSAMP, P_MINPER, P_FILTER, P_ONESIDED = range(17)
-N_PARAMS = 17
+    P_MAXGAP, P_MINSAMP, P_MINPER, P_FILTER, P_ONESIDED, P_RULE = range(18)
+N_PARAMS = 18
 
 # ---- counter array layout (int64) -----------------------------------------------------------
 (C_RECEIVED, C_USED, C_NONFINITE, C_DUPLICATE, C_OUT_OF_ORDER, C_TIME_JUMP, C_GAP, C_REST,
@@ -207,11 +207,11 @@ def _newton_integrals(s, kmax, yoff, q):
 
 
 @njit(cache=True)
-def _interval_moments(s, kmax, a, h):
+def _interval_moments(s, kmax, a, h, npts):
     """Add to M_0..M_kmax the exact integral over the newest interval of s^k p(s).
 
-    ``p`` is the polynomial of degree NH-1 through the NH newest samples and ``a`` the interval's
-    left end in segment time. The rule is causal (the interval is the newest of its stencil) and
+    ``p`` is the polynomial of degree npts-1 through the npts (default NH) newest samples and ``a``
+    the interval's left end in segment time (npts = 2 is the trapezoid, kept for comparison). The rule is causal (the interval is the newest of its stencil) and
     holds for any spacing; its local error is O(h^(NH+1)). On a uniform stencil the rule is a fixed
     set of weights, cached (``S_W``) until the step changes. On an irregular stencil, older
     samples are used only while their intervals are at least h/4 long: after a gap (a long newest
@@ -229,7 +229,7 @@ def _interval_moments(s, kmax, a, h):
                 for i in range(NH):
                     s[S_UNIT + i] = 0.0
                 s[S_UNIT + j] = 1.0
-                _newton_integrals(s, 4, S_UNIT, NH)
+                _newton_integrals(s, 4, S_UNIT, npts)
                 for m in range(5):
                     s[S_W + m * NH + j] = s[S_IM + m]
             s[S_WH] = h
@@ -240,7 +240,7 @@ def _interval_moments(s, kmax, a, h):
             s[S_IM + m] = acc
     else:
         q = 2
-        while q < NH and s[S_HT + NH - q] - s[S_HT + NH - q - 1] >= 0.25 * h:
+        while q < npts and s[S_HT + NH - q] - s[S_HT + NH - q - 1] >= 0.25 * h:
             q += 1
         _newton_integrals(s, kmax, S_HY, q)
     # M_k += sum_m C(k, m) a^(k-m) I_m
@@ -395,7 +395,7 @@ def step(p, s, c, seg, t, y, out):
     a = s[S_HT + NH - 2] - s[S_T0]
     biased = p[P_MODEL] > 0.0
     kmax = 4 if biased else 3
-    _interval_moments(s, kmax, a, h)
+    _interval_moments(s, kmax, a, h, int(p[P_RULE]))
     m0 = s[S_MOM]
     m1 = s[S_MOM + 1]
     m2 = s[S_MOM + 2]
