@@ -34,91 +34,91 @@ COUNTER_NAMES = ('received', 'used', 'skipped_non_finite', 'skipped_duplicate',
                  'rejected_fit', 'rejected_nyquist', 'max_window_resets', 'estimates')
 
 
+INF = math.inf
+
+
+def _param(default, doc: str, lo=None, hi=None, open_lo=False, open_hi=False):
+    """A configuration field with its description and its range [lo, hi] (bounds open if asked).
+
+    One source for :meth:`EstimatorConfig.validate`, the node's ``ParameterDescriptor`` and the
+    documentation (:meth:`EstimatorConfig.describe`).
+    """
+    return field(default=default, metadata={'doc': doc, 'range': None if lo is None else
+                                            (lo, hi, open_lo, open_hi)})
+
+
 @dataclass(frozen=True)
 class EstimatorConfig:
-    """Parameters of the estimator; defaults are those of Section 5.3 of the paper.
+    """Parameters of the estimator; defaults are those of Section 5.3 of the paper where it gives
+    them. Each field's description and range: :meth:`describe`."""
 
-    Attributes:
-        model: ``sinusoid`` (Eq. 1, the paper) or ``biased-sinusoid`` (y = A sin(wt+phi) + B).
-        lowpass_cutoff_hz: cut-off of the invariant low-pass filter (Eqs. 9-11); 3 Hz = 6 pi rad/s.
-        lowpass_damping: damping ratio of that filter (0.707).
-        window: M of the moving-average convergence test (Eqs. 16-17).
-        tolerance: relative tolerance of that test.
-        min_time: eps of Eq. 12, seconds after a reset during which no estimate is formed.
-        min_samples: samples a segment must hold before the test may fire (see module docstring).
-        min_periods: the test may fire only once the segment spans this fraction of the period
-            it estimates (scale-free version of eps; 0 = off).
-        invariant_filter: False computes n / d unfiltered (Fig. 1's lower trace); True is Eq. 12.
-        one_sided_test: Eq. 16 exactly as printed, (MA(k) - MA(k-M)) / MA(k) < tolerance, which
-            accepts any falling estimate; the default tests the absolute change.
-        rule_points: samples of the interpolating polynomial the moments are integrated over
-            (2 = trapezoid ... 8 = degree 7, the default); lower values exist for comparison.
-        max_window: seconds without convergence after which the estimator resets unpublished.
-        band_hz: optional (f_lo, f_hi) band-pass prefilter on y (4th-order Butterworth low-pass
-            at f_hi, 2nd-order Butterworth high-pass at f_lo), never reset; None = off.
-        min_amplitude: quality gate, amplitude of the fitted sinusoid below which the signal is
-            taken to be at rest (signal units).
-        min_fit: quality gate, fraction of the segment's variance the fitted sinusoid must
-            explain (R^2) for the estimate to be published; rejects noise.
-        max_gap: a forward gap, or a backward jump, between stamps longer than this (s) restarts
-            the estimator; a smaller backward step is skipped as out of order.
-        buffer_samples: segment buffer for the quality gate; a segment longer than this resets.
-    """
+    model: str = _param('sinusoid', 'sinusoid (Eq. 1, the paper) or biased-sinusoid '
+                        '(y = A sin(wt+phi) + B, the offset eliminated algebraically)')
+    lowpass_cutoff_hz: float = _param(3.0, 'cut-off of the invariant low-pass filter of Eqs. '
+                                      '9-11, Hz (3 Hz = 6 pi rad/s, Section 5.3)',
+                                      0.0, INF, open_lo=True, open_hi=True)
+    lowpass_damping: float = _param(0.707, 'damping ratio of the invariant low-pass filter',
+                                    0.0, INF, open_lo=True, open_hi=True)
+    window: int = _param(3, 'M of the moving-average convergence test (Eqs. 16-17)', 1, 10_000)
+    tolerance: float = _param(1e-3, 'relative tolerance of the convergence test (Eq. 16)',
+                              0.0, 1.0, open_lo=True, open_hi=True)
+    min_time: float = _param(0.01, 'eps of Eq. 12: no estimate is formed during the first eps '
+                             'seconds after a reset', 0.0, INF, open_hi=True)
+    min_samples: int = _param(16, 'samples a segment must hold before the test may fire',
+                              1, 10 ** 8)
+    min_periods: float = _param(0.5, 'the test may fire only once the segment spans this '
+                                'fraction of the period it estimates (0 = off)', 0.0, 10.0)
+    invariant_filter: bool = _param(True, 'false computes n/d unfiltered (Fig. 1, lower trace)')
+    one_sided_test: bool = _param(False, 'Eq. 16 exactly as printed, (MA(k) - MA(k-M))/MA(k) < '
+                                  'tolerance, which accepts any falling estimate')
+    rule_points: int = _param(K.NH, 'samples of the interpolating polynomial the moments are '
+                              'integrated over (2 = trapezoid, for comparison)', 2, K.NH)
+    max_window: float = _param(10.0, 'seconds without convergence after which the estimator '
+                               'resets without publishing', 0.0, INF, open_lo=True, open_hi=True)
+    band_hz: Optional[Tuple[float, float]] = _param(
+        None, 'band-pass prefilter [f_lo, f_hi] Hz on the signal (4th-order Butterworth '
+        'low-pass at f_hi, 2nd-order high-pass at f_lo), never reset; none = off')
+    min_amplitude: float = _param(0.0, 'quality gate: a segment whose half range is at or '
+                                  'below this is at rest (signal units)', 0.0, INF, open_hi=True)
+    min_fit: float = _param(0.9, 'quality gate: R^2 a sinusoid at the estimated frequency must '
+                            'reach over the segment for the estimate to be published', 0.0, 1.0)
+    max_gap: float = _param(0.5, 'a gap, or a backward jump, between stamps longer than this '
+                            '(s) restarts the estimator; a smaller step back is skipped',
+                            0.0, INF, open_lo=True, open_hi=True)
+    buffer_samples: int = _param(200_000, 'segment buffer of the quality gate; a longer segment '
+                                 'resets', 1, 10 ** 8)
 
-    model: str = 'sinusoid'
-    lowpass_cutoff_hz: float = 3.0
-    lowpass_damping: float = 0.707
-    window: int = 3
-    tolerance: float = 1e-3
-    min_time: float = 0.01
-    min_samples: int = 16
-    min_periods: float = 0.5
-    invariant_filter: bool = True
-    one_sided_test: bool = False
-    rule_points: int = K.NH
-    max_window: float = 10.0
-    band_hz: Optional[Tuple[float, float]] = None
-    min_amplitude: float = 0.0
-    min_fit: float = 0.9
-    max_gap: float = 0.5
-    buffer_samples: int = 200_000
+    @classmethod
+    def describe(cls, name: str) -> Tuple[str, Optional[tuple]]:
+        """(description, range) of a field; range = (lo, hi, open_lo, open_hi) or None."""
+        meta = next(f for f in fields(cls) if f.name == name).metadata
+        return meta['doc'], meta['range']
 
     def validate(self) -> None:
         """Raise ``ValueError`` naming the first invalid parameter and why."""
-        def positive(name):
-            v = getattr(self, name)
-            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
-                raise ValueError(f'{name} must be a finite number > 0, got {v!r}')
-
+        for f in fields(self):
+            value = getattr(self, f.name)
+            kind = type(f.default) if f.default is not None else None
+            if kind is bool and not isinstance(value, bool):
+                raise ValueError(f'{f.name} must be true or false, got {value!r}')
+            if kind is int and (isinstance(value, bool)
+                                or not isinstance(value, (int, np.integer))):
+                raise ValueError(f'{f.name} must be an integer, got {value!r}')
+            if kind is float and (isinstance(value, bool) or not isinstance(value, (int, float))
+                                  or math.isnan(value)):
+                raise ValueError(f'{f.name} must be a number, got {value!r}')
+            bounds = f.metadata['range']
+            if bounds is not None:
+                lo, hi, open_lo, open_hi = bounds
+                if value < lo or value > hi or (open_lo and value == lo) or \
+                        (open_hi and value == hi):
+                    raise ValueError(f'{f.name} must be in {"(" if open_lo else "["}{lo}, '
+                                     f'{hi}{")" if open_hi else "]"}, got {value!r}')
         if self.model not in MODELS:
             raise ValueError(f'model must be one of {", ".join(MODELS)}, got {self.model!r}')
-        for name in ('lowpass_cutoff_hz', 'lowpass_damping', 'tolerance', 'max_window',
-                     'max_gap'):
-            positive(name)
-        for name in ('window', 'min_samples', 'buffer_samples', 'rule_points'):
-            v = getattr(self, name)
-            if not isinstance(v, (int, np.integer)) or isinstance(v, bool) or v < 1:
-                raise ValueError(f'{name} must be an integer >= 1, got {v!r}')
-        if not 2 <= self.rule_points <= K.NH:
-            raise ValueError(f'rule_points must be in [2, {K.NH}], got {self.rule_points}')
-        if self.window > 10_000:
-            raise ValueError(f'window must be <= 10000, got {self.window}')
-        if not (math.isfinite(self.min_time) and self.min_time >= 0):
-            raise ValueError(f'min_time must be a finite number >= 0, got {self.min_time!r}')
         if self.min_time >= self.max_window:
             raise ValueError(f'min_time ({self.min_time}) must be below max_window '
                              f'({self.max_window})')
-        if not (isinstance(self.min_periods, (int, float)) and 0 <= self.min_periods <= 10):
-            raise ValueError(f'min_periods must be in [0, 10], got {self.min_periods!r}')
-        for name in ('invariant_filter', 'one_sided_test'):
-            if not isinstance(getattr(self, name), bool):
-                raise ValueError(f'{name} must be a bool, got {getattr(self, name)!r}')
-        if not (math.isfinite(self.min_amplitude) and self.min_amplitude >= 0):
-            raise ValueError(f'min_amplitude must be >= 0, got {self.min_amplitude!r}')
-        if not (math.isfinite(self.min_fit) and 0 <= self.min_fit <= 1):
-            raise ValueError(f'min_fit must be in [0, 1], got {self.min_fit!r}')
-        if self.tolerance >= 1:
-            raise ValueError(f'tolerance must be < 1, got {self.tolerance}')
         if self.band_hz is not None:
             band = tuple(self.band_hz)
             if len(band) != 2 or not all(isinstance(b, (int, float)) and math.isfinite(b)

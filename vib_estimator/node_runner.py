@@ -43,11 +43,8 @@ def run(factory: Callable[[], Node], args: Optional[Sequence[str]] = None,
         node = factory()
         executor = make_executor()
         executor.add_node(node)
-        if done is None:
-            executor.spin()
-        else:
-            while rclpy.ok() and not done(node):
-                executor.spin_once(timeout_sec=0.1)
+        while rclpy.ok() and not (done is not None and done(node)):
+            executor.spin_once(timeout_sec=0.1)
         code = getattr(node, 'exit_code', 0)
     except StartupError as err:
         print(f'error: {err}', file=sys.stderr)

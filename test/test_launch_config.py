@@ -1,0 +1,75 @@
+"""config/estimator.yaml and launch/estimator.launch.py, checked without launch_ros.
+
+The params file must hold EstimatorConfig's defaults (Section 5.3), load through rcl's own parser
+into the node, and be what the launch file starts ``estimator_node`` with.
+"""
+from __future__ import annotations
+
+import ast
+import os
+from pathlib import Path
+
+import rclpy
+import yaml
+
+from vib_estimator.estimator import EstimatorConfig
+from vib_estimator.estimator_node import EstimatorNode
+
+ROOT = Path(__file__).resolve().parents[1]
+PARAMS = ROOT / 'config' / 'estimator.yaml'
+LAUNCH = ROOT / 'launch' / 'estimator.launch.py'
+
+
+def test_params_file_holds_the_defaults():
+    params = yaml.safe_load(PARAMS.read_text())['estimator_node']['ros__parameters']
+    assert params.pop('input_topic') == 'coupling_torque'
+    assert params.pop('component') == 'torque.z'
+    defaults = EstimatorConfig()
+    assert set(params) == set(EstimatorConfig.names())
+    for name, value in params.items():
+        default = getattr(defaults, name)
+        expected = [] if default is None else list(default) if isinstance(default, tuple) \
+            else default
+        assert value == expected and type(value) is type(expected), (name, value, expected)
+
+
+def test_params_file_loads_into_the_node():
+    context = rclpy.Context()
+    rclpy.init(context=context, domain_id=int(os.environ['ROS_DOMAIN_ID']),
+               args=['--ros-args', '--params-file', str(PARAMS)])
+    try:
+        node = EstimatorNode(context=context)
+        assert node._estimator.config == EstimatorConfig()
+        assert node.get_parameter('band_hz').value == []
+        node.destroy_node()
+    finally:
+        context.try_shutdown()
+
+
+def test_every_core_parameter_has_a_description_and_numbers_a_range(ros_context):
+    node = EstimatorNode(context=ros_context)
+    try:
+        names = EstimatorConfig.names()
+        for name, descriptor in zip(names, node.describe_parameters(names)):
+            assert descriptor.description, name
+            default = getattr(EstimatorConfig(), name)
+            if isinstance(default, (int, float)) and not isinstance(default, bool):
+                assert descriptor.integer_range or descriptor.floating_point_range, name
+    finally:
+        node.destroy_node()
+
+
+def test_launch_file_starts_the_node_with_the_params_file():
+    tree = ast.parse(LAUNCH.read_text())
+    functions = [n.name for n in tree.body if isinstance(n, ast.FunctionDef)]
+    assert 'generate_launch_description' in functions
+    nodes = [n for n in ast.walk(tree) if isinstance(n, ast.Call)
+             and getattr(n.func, 'id', getattr(n.func, 'attr', None)) == 'Node']
+    assert len(nodes) == 1
+    keywords = {k.arg: k.value for k in nodes[0].keywords}
+    assert ast.literal_eval(keywords['package']) == 'vib_estimator'
+    assert ast.literal_eval(keywords['executable']) == 'estimator_node'
+    assert isinstance(keywords['parameters'], ast.List)
+    strings = {n.value for n in ast.walk(tree) if isinstance(n, ast.Constant)}
+    assert {'vib_estimator', 'config', PARAMS.name} <= strings
+    assert PARAMS.is_file()
