@@ -1,9 +1,12 @@
 """ament_python package definition for vib_estimator."""
+import os
 from glob import glob
 
 from setuptools import find_packages, setup
 
 PACKAGE = 'vib_estimator'
+#: the recorded experiments keep their folder structure (a rosbag2 bag is a directory)
+BAG_DIRS = sorted({os.path.dirname(f) for f in glob('bags/**/*.*', recursive=True)})
 
 setup(
     name=PACKAGE,
@@ -14,9 +17,7 @@ setup(
         ('share/' + PACKAGE, ['package.xml']),
         ('share/' + PACKAGE + '/config', glob('config/*.yaml')),
         ('share/' + PACKAGE + '/launch', glob('launch/*.py')),
-        ('share/' + PACKAGE + '/bags', [f for f in glob('bags/**/*', recursive=True)
-                                        if not f.endswith('/') and '.' in f.rsplit('/', 1)[-1]]),
-    ],
+    ] + [('share/' + PACKAGE + '/' + d, glob(d + '/*.*')) for d in BAG_DIRS],
     install_requires=['setuptools'],
     zip_safe=True,
     maintainer='vib_estimator developers',

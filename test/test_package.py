@@ -8,6 +8,8 @@ from pathlib import Path
 
 import pytest
 
+from vib_estimator.bag_io import read_wrench_series
+
 ROOT = Path(__file__).resolve().parents[1]
 EXECUTABLES = ['vib-estimator', 'estimator_node', 'sim_node', 'bag_replayer', 'bag_recorder']
 #: ROS packages the code may import, by the name package.xml must declare
@@ -47,6 +49,10 @@ def test_colcon_build_installs_the_executables_where_ros2_run_looks(tmp_path):
     share = prefix / 'share' / 'vib_estimator'
     assert (share / 'package.xml').is_file()
     assert list((share / 'config').glob('*.yaml')) and list((share / 'launch').glob('*.py'))
+    shipped = sorted(p.name for p in (ROOT / 'bags').iterdir() if p.is_dir())
+    assert shipped and shipped == sorted(p.name for p in (share / 'bags').iterdir() if p.is_dir())
+    for name in shipped:                      # each bag stays a readable rosbag2 directory
+        assert len(read_wrench_series(share / 'bags' / name)) > 1000
     site = next(prefix.glob('lib/python3*/site-packages'))
     run = subprocess.run([str(prefix / 'lib/vib_estimator/vib-estimator'), '--help'],
                          env={**os.environ, 'PYTHONPATH': str(site)}, capture_output=True,

@@ -36,9 +36,10 @@ from .estimator import COUNTER_NAMES, EstimatorConfig, FrequencyEstimator
 from .node_runner import StartupError, run
 from .wrench import COMPONENTS, check_component, get_component, seconds_since, stamp_ns
 
-#: input history: sensor-data QoS (best effort) but 100 deep instead of 5, so that a scheduling
-#: hiccup of up to 0.2 s at 500 Hz drops nothing (benchmarks/bench_node.py measures the effect)
-INPUT_DEPTH = 100
+#: input history: sensor-data QoS (best effort) but 1000 deep instead of 5, so that a scheduling
+#: hiccup of up to 2 s at 500 Hz, or a player's burst after a stall, drops nothing
+#: (benchmarks/bench_node.py measures the effect of the depth)
+INPUT_DEPTH = 1000
 #: period of /diagnostics, s
 DIAGNOSTICS_PERIOD = 1.0
 #: the status goes STALE when no input arrived for this long, s

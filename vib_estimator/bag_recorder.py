@@ -1,0 +1,199 @@
+"""``bag_recorder``: record topics of any message type into a rosbag2 bag (MCAP storage).
+
+A stand-in for ``ros2 bag record`` where only rclpy is installed. Each topic of ``topics`` is
+subscribed once a publisher of it appears on the graph (its type is taken from the graph), with a
+raw subscription, so messages are stored as the CDR bytes received, never deserialised. The bag is
+a rosbag2 directory written by :class:`vib_estimator.bag_io.BagWriter`; log time = receive time on
+the node's clock, as rosbag2 does. The publishers' offered QoS profiles are recorded per topic.
+
+Loss: the subscriptions are KEEP_ALL and, when every publisher of the topic is reliable, reliable
+(rosbag2's adaptive QoS), so a sample the reader has not taken is never acknowledged or dropped; a
+reliable publisher then keeps it until the recorder has it. A best-effort publisher can still lose
+samples on the wire -- that is its contract.
+
+Stops on SIGINT (the bag is then closed, complete and readable), after ``duration`` seconds, or
+after ``max_messages`` messages.
+
+Parameters (all read-only):
+    topics (string[]): topics to record (relative names resolve in the node's namespace).
+    output (string): bag directory to create; must not exist.
+    storage (string): ``mcap`` (default) or ``sqlite3``.
+    duration (double): stop after this many seconds; 0 = until SIGINT.
+    max_messages (int): stop after this many messages in all; 0 = no limit.
+"""
+from __future__ import annotations
+
+import importlib
+from functools import partial
+from typing import Dict, Iterable, Tuple
+
+from rcl_interfaces.msg import ParameterDescriptor
+from rclpy.duration import Duration
+from rclpy.exceptions import ParameterException
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from rclpy.qos import (DurabilityPolicy, HistoryPolicy, LivelinessPolicy, QoSProfile,
+                       ReliabilityPolicy)
+from rosbags.interfaces import (Qos, QosDurability, QosHistory, QosLiveliness, QosReliability,
+                                QosTime)
+
+from .bag_io import BagError, BagWriter, STORAGES
+from .node_runner import StartupError, run
+
+DISCOVERY_PERIOD = 0.05  # s between looks at the graph for publishers of topics not yet recorded
+
+
+def message_class(msgtype: str):
+    """The rclpy message class of ``pkg/msg/Name``; ``ImportError`` if not installed."""
+    parts = msgtype.split('/')
+    if len(parts) != 3 or parts[1] != 'msg':
+        raise ImportError(f'{msgtype!r} is not a message type name (pkg/msg/Name)')
+    try:
+        return getattr(importlib.import_module(f'{parts[0]}.msg'), parts[2])
+    except (ImportError, AttributeError):
+        raise ImportError(f'message type {msgtype} is not installed') from None
+
+
+def adapted_qos(offered: Iterable[Tuple[ReliabilityPolicy, DurabilityPolicy]],
+                history: HistoryPolicy, depth: int = 0) -> QoSProfile:
+    """A QoS profile that matches every offered (reliability, durability) pair.
+
+    rosbag2's adaptive rule: reliable only if every publisher offers reliable (a reliable reader
+    does not match a best-effort writer), transient-local only if every publisher offers it. With no
+    offer known, reliable and volatile.
+    """
+    offered = list(offered)
+    reliable = all(r == ReliabilityPolicy.RELIABLE for r, _ in offered)
+    latched = bool(offered) and all(d == DurabilityPolicy.TRANSIENT_LOCAL for _, d in offered)
+    return QoSProfile(
+        history=history, depth=depth,
+        reliability=ReliabilityPolicy.RELIABLE if reliable else ReliabilityPolicy.BEST_EFFORT,
+        durability=DurabilityPolicy.TRANSIENT_LOCAL if latched else DurabilityPolicy.VOLATILE)
+
+
+def _bag_time(duration: Duration) -> QosTime:
+    return QosTime(*divmod(duration.nanoseconds, 1_000_000_000))
+
+
+def bag_qos(profile: QoSProfile) -> Qos:
+    """An offered rclpy QoS profile as rosbag2 records it in the bag's metadata."""
+    def enum(cls, policy):
+        return cls(int(policy)) if int(policy) in {e.value for e in cls} else cls.UNKNOWN
+
+    return Qos(enum(QosHistory, profile.history), profile.depth,
+               enum(QosReliability, profile.reliability), enum(QosDurability, profile.durability),
+               _bag_time(profile.deadline), _bag_time(profile.lifespan),
+               enum(QosLiveliness, profile.liveliness),
+               _bag_time(profile.liveliness_lease_duration),
+               profile.avoid_ros_namespace_conventions)
+
+
+class BagRecorder(Node):
+    """Records ``topics`` into the bag ``output``; see the module docstring."""
+
+    def __init__(self, **kwargs) -> None:
+        super().__init__('bag_recorder', **kwargs)
+
+        def declare(name, default, description):
+            try:
+                return self.declare_parameter(name, default, ParameterDescriptor(
+                    description=description, read_only=True)).value
+            except ParameterException as err:  # e.g. rate:=10 for a double: say 10.0
+                raise StartupError(str(err)) from None
+
+        topics = declare('topics', Parameter.Type.STRING_ARRAY, 'topics to record') or []
+        output = declare('output', '', 'bag directory to create (must not exist)')
+        storage = declare('storage', 'mcap', f'storage plugin: {" or ".join(STORAGES)}')
+        duration = declare('duration', 0.0, 'stop after this many seconds; 0 = until SIGINT')
+        self.max_messages = declare('max_messages', 0,
+                                    'stop after this many messages in all; 0 = no limit')
+        if not topics:
+            raise StartupError('parameter topics is empty: give the topics to record, e.g. '
+                               '-p topics:="[/coupling_torque]"')
+        if not output:
+            raise StartupError('parameter output is empty: give the bag directory to create')
+        if storage not in STORAGES:
+            raise StartupError(f'parameter storage must be one of {", ".join(STORAGES)}, '
+                               f'got {storage!r}')
+        if duration < 0 or self.max_messages < 0:
+            raise StartupError('parameters duration and max_messages must be >= 0')
+        try:
+            self._pending = {self.resolve_topic_name(t) for t in topics}
+        except Exception as err:  # rclpy's RCLError, which it does not export
+            raise StartupError(f'invalid topic name in {topics}: {err}') from None
+        try:
+            self._bag = BagWriter(output, storage).open()
+        except (BagError, OSError) as err:
+            raise StartupError(f'cannot create bag {output}: {err}') from None
+
+        #: messages recorded, per topic
+        self.counts: Dict[str, int] = {}
+        self.message_count = 0
+        #: set when ``duration`` or ``max_messages`` is reached; :func:`main` then exits
+        self.finished = False
+        self._discovery = self.create_timer(DISCOVERY_PERIOD, self._discover)
+        if duration > 0:
+            self.create_timer(duration, self._stop)
+        self.get_logger().info(f'recording {", ".join(sorted(self._pending))} into {output} '
+                               f'({storage})')
+
+    def _discover(self) -> None:
+        """Subscribe to each pending topic that now has publishers."""
+        for topic in sorted(self._pending):
+            infos = self.get_publishers_info_by_topic(topic)
+            if not infos:
+                continue
+            types = sorted({info.topic_type for info in infos})
+            if len(types) > 1:
+                self.get_logger().warn(f'{topic} is published with several types {types}; '
+                                       f'waiting for one', throttle_duration_sec=5.0)
+                continue
+            self._pending.discard(topic)
+            try:
+                cls = message_class(types[0])
+                connection = self._bag.add_topic(topic, types[0],
+                                                 [bag_qos(i.qos_profile) for i in infos])
+            except (ImportError, BagError) as err:
+                self.get_logger().error(f'not recording {topic}: {err}')
+                continue
+            qos = adapted_qos(((i.qos_profile.reliability, i.qos_profile.durability)
+                               for i in infos), HistoryPolicy.KEEP_ALL)
+            self.create_subscription(cls, topic, partial(self._on_message, connection), qos,
+                                     raw=True)
+            self.counts[topic] = 0
+            self.get_logger().info(f'recording {topic} ({types[0]}, '
+                                   f'{qos.reliability.name.lower()})')
+        if self._pending:
+            self.get_logger().info(f'waiting for publishers on {", ".join(sorted(self._pending))}',
+                                   throttle_duration_sec=5.0)
+        else:
+            self._discovery.cancel()
+
+    def _on_message(self, connection, data: bytes) -> None:
+        if self.finished:
+            return
+        self._bag.write(connection, self.get_clock().now().nanoseconds, data)
+        self.counts[connection.topic] += 1
+        self.message_count += 1
+        if self.max_messages and self.message_count >= self.max_messages:
+            self._stop()
+
+    def _stop(self) -> None:
+        self.finished = True
+
+    def destroy_node(self) -> None:
+        """Close the bag (index and metadata.yaml written), then destroy the node."""
+        self._bag.close()
+        self.get_logger().info(f'recorded {self.message_count} messages: '
+                               + (', '.join(f'{t} {n}' for t, n in sorted(self.counts.items()))
+                                  or 'no topic had a publisher'))
+        super().destroy_node()
+
+
+def main(args=None) -> int:
+    """Entry point of the ``bag_recorder`` executable."""
+    return run(BagRecorder, args, done=lambda node: node.finished)
+
+
+if __name__ == '__main__':
+    raise SystemExit(main())
