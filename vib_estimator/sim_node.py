@@ -1,0 +1,275 @@
+"""``sim_node``: the flexible arm of Section 5 (:mod:`vib_estimator.arm_model`) as a ROS 2 node.
+
+Publishes the measured coupling torque (Eq. 21, scaled as in Fig. 5) as
+``geometry_msgs/WrenchStamped`` on ``coupling_torque`` (``torque.z``) at ``rate_hz``, and the Eq. 23
+frequency of the current tip mass as ``std_msgs/Float64`` on ``vibration/ground_truth`` (transient
+local, so a late subscriber gets the current value) at start and whenever it changes.
+
+Time: with ``speed`` = 1 the node runs in real time and stamps sample ``k`` with
+``start + k / rate_hz`` (``start`` read from the node clock), so stamps are exactly periodic. With
+any other ``speed``, or with ``publish_clock`` set, it runs a simulated clock, ``speed`` times
+faster (or slower) than real time, publishes it on ``/clock`` and stamps samples with it
+(subscribers then set ``use_sim_time``); the simulated clock starts at :data:`SIM_TIME_ORIGIN_NS`
+(1 s) because ROS takes a zero stamp as unset.
+Samples are produced in batches by a 200 Hz steady-clock timer, as many as are due, so that high
+speeds work. Setting ``tip_mass_kg`` while running changes the frequency abruptly, as in
+Section 5.5. ``duration`` makes the node exit 0 after that much simulated time, and
+``wait_for_subscribers`` holds the start until the consumers are matched (the demo and the tests
+use both).
+"""
+from __future__ import annotations
+
+import math
+import sys
+import time
+from typing import List, Sequence
+
+from geometry_msgs.msg import WrenchStamped
+from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescriptor,
+                                ParameterType, SetParametersResult)
+from rclpy.clock import Clock, ClockType
+from rclpy.exceptions import ParameterException
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rosgraph_msgs.msg import Clock as ClockMsg
+from std_msgs.msg import Float64
+
+from .arm_model import (DEFAULT_NOISE_STD, ArmParameters, ArmSimulator, Move,
+                        natural_frequency_hz)
+from .node_runner import StartupError, run
+
+TICK_HZ = 200.0            # wall-clock rate of the publishing timer
+# A tick produces at most the larger of MAX_BATCH_SECONDS of simulated time and BATCH_TICKS ticks'
+# worth: after a longer stall the node falls behind its speed (and says so) rather than bursting.
+MAX_BATCH_SECONDS = 0.1
+BATCH_TICKS = 4
+MIN_SAMPLES_PER_PERIOD = 20  # a tip mass is refused if f0 (Eq. 23) leaves fewer samples a period
+SIM_TIME_ORIGIN_NS = 1_000_000_000  # stamp of the first sample in simulated time (0 means unset)
+SCHEDULE_FIELDS = 4        # start, final_angle, slope, tip_mass_kg (0 = unchanged)
+
+GROUND_TRUTH_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+                              durability=DurabilityPolicy.TRANSIENT_LOCAL)
+
+
+def schedule_to_array(schedule: Sequence[Move]) -> List[float]:
+    """The ``schedule`` parameter for a sequence of moves (see :func:`schedule_from_array`)."""
+    out: List[float] = []
+    for mv in schedule:
+        out += [float(mv.start), float(mv.final_angle), float(mv.slope),
+                float(mv.tip_mass_kg or 0.0)]
+    return out
+
+
+def schedule_from_array(values: Sequence[float]) -> List[Move]:
+    """Moves from the flat ``schedule`` parameter; raises ``ValueError`` saying what is wrong.
+
+    Groups of four numbers ``[start s, final_angle rad, slope rad/s, tip_mass_kg]``, with starts
+    non-decreasing, slopes > 0 and tip_mass_kg 0 (= unchanged) or > 0.
+    """
+    values = [float(v) for v in values]
+    if len(values) % SCHEDULE_FIELDS:
+        raise ValueError(f'schedule must hold groups of {SCHEDULE_FIELDS} numbers [start, '
+                         f'final_angle, slope, tip_mass_kg], got {len(values)} numbers')
+    if not all(math.isfinite(v) for v in values):
+        raise ValueError('schedule must hold finite numbers')
+    moves = []
+    for i in range(0, len(values), SCHEDULE_FIELDS):
+        start, angle, slope, mass = values[i:i + SCHEDULE_FIELDS]
+        if start < 0 or (moves and start < moves[-1].start):
+            raise ValueError(f'schedule move {i // SCHEDULE_FIELDS}: start {start} must be >= 0 '
+                             'and not before the previous move')
+        if slope <= 0:
+            raise ValueError(f'schedule move {i // SCHEDULE_FIELDS}: slope must be > 0, '
+                             f'got {slope}')
+        if mass < 0:
+            raise ValueError(f'schedule move {i // SCHEDULE_FIELDS}: tip_mass_kg must be 0 '
+                             f'(unchanged) or > 0, got {mass}')
+        moves.append(Move(start, angle, slope, mass if mass > 0 else None))
+    return moves
+
+
+def _descriptor(description, lo=None, hi=None, read_only=False, integer=False, **kw):
+    ranges = {}
+    if lo is not None:
+        ranges = ({'integer_range': [IntegerRange(from_value=lo, to_value=hi, step=1)]} if integer
+                  else {'floating_point_range': [FloatingPointRange(from_value=lo, to_value=hi)]})
+    return ParameterDescriptor(description=description, read_only=read_only, **ranges, **kw)
+
+
+PARAMETERS = {
+    # name: (default, descriptor)
+    'tip_mass_kg': (ArmParameters.tip_mass_kg, _descriptor(
+        'tip mass m of Eqs. 19/23, kg; changing it while running changes the frequency abruptly '
+        '(Section 5.5)', 0.001, 10.0)),
+    'rate_hz': (500.0, _descriptor('sample rate of coupling_torque, Hz (Section 5.2: 2 ms)',
+                                   10.0, 10000.0, read_only=True)),
+    'speed': (1.0, _descriptor('simulated seconds per wall-clock second; other than 1 the node '
+                               'publishes /clock and stamps in simulated time from 1 s',
+                               0.01, 1000.0, read_only=True)),
+    'publish_clock': (False, _descriptor(
+        'stamp in simulated time from 1 s and publish it on /clock even at speed 1 (always so at '
+        'any other speed)', read_only=True)),
+    'damping_ratio': (ArmParameters.damping_ratio, _descriptor(
+        'damping ratio zeta of the bar mode (Eq. 24; 0.004 in Section 5.3)', 0.0, 0.5,
+        read_only=True)),
+    'noise_std': (DEFAULT_NOISE_STD, _descriptor(
+        'standard deviation of the strain-gauge noise on the torque, N m', 0.0, 10.0)),
+    'seed': (0, _descriptor('seed of the noise generator', 0, 2 ** 31 - 1, read_only=True,
+                            integer=True)),
+    'frame_id': ('arm_base', _descriptor('frame_id of the coupling_torque headers',
+                                         read_only=True)),
+    'schedule': ([0.0, 1.0, 1.0, 0.0], _descriptor(
+        'motor command as flat groups [start s, final_angle rad, slope rad/s, tip_mass_kg '
+        '(0 = unchanged)]: from start, ramp towards final_angle at slope and set the tip mass; '
+        'default: the Section 5.3 ramp of slope 1 to 1 rad', read_only=True,
+        type=ParameterType.PARAMETER_DOUBLE_ARRAY)),
+    'wait_for_subscribers': (0, _descriptor(
+        'the simulation starts when coupling_torque has this many subscribers (0 = at once), '
+        'so that a sped-up run loses no sample to discovery', 0, 1000, read_only=True,
+        integer=True)),
+    'duration': (0.0, _descriptor('simulated seconds after which the node exits 0 '
+                                  '(0 = run forever)', 0.0, 1e9, read_only=True)),
+}
+
+
+class SimNode(Node):
+    """The simulated arm publishing ``coupling_torque`` and ``vibration/ground_truth``."""
+
+    def __init__(self, **kwargs):
+        super().__init__('sim_node', **kwargs)
+        try:
+            for name, (default, descriptor) in PARAMETERS.items():
+                self.declare_parameter(name, default, descriptor)
+        except ParameterException as err:
+            raise StartupError(str(err)) from None
+        p = {name: self.get_parameter(name).value for name in PARAMETERS}
+        try:
+            schedule = schedule_from_array(p['schedule'])
+        except ValueError as err:
+            raise StartupError(str(err)) from None
+        if not p['frame_id']:
+            raise StartupError('frame_id must not be empty')
+        self._rate = p['rate_hz']
+        masses = [p['tip_mass_kg']] + [mv.tip_mass_kg for mv in schedule if mv.tip_mass_kg]
+        check = self._validate([Parameter('tip_mass_kg', value=m) for m in masses])
+        if not check.successful:
+            raise StartupError(check.reason)
+        self.add_on_set_parameters_callback(self._validate)
+        self.add_post_set_parameters_callback(self._apply)
+
+        self.exit_code = 0
+        self.finished = False
+        self._speed = p['speed']
+        self._sim_time = self._speed != 1.0 or p['publish_clock']
+        self._duration = p['duration']
+        self._wait_for_subscribers = p['wait_for_subscribers']
+        self._sim = ArmSimulator(
+            ArmParameters(tip_mass_kg=p['tip_mass_kg'], damping_ratio=p['damping_ratio']),
+            rate_hz=self._rate, noise_std=p['noise_std'], seed=p['seed'], schedule=schedule)
+        self._sync_mass_parameter()
+
+        self._torque_pub = self.create_publisher(WrenchStamped, 'coupling_torque', 100)
+        self._truth_pub = self.create_publisher(Float64, 'vibration/ground_truth',
+                                                GROUND_TRUTH_QOS)
+        self._clock_pub = (self.create_publisher(ClockMsg, '/clock', 10)
+                           if self._sim_time else None)
+        self._msg = WrenchStamped()
+        self._msg.header.frame_id = p['frame_id']
+        self._clock_msg = ClockMsg()
+        self._f_true = None
+        self._origin_ns = (SIM_TIME_ORIGIN_NS if self._sim_time
+                           else self.get_clock().now().nanoseconds)
+        self._wall_start = None   # set by the first tick
+        self._publish_truth(self._sim.f_true)
+        self._timer = self.create_timer(1.0 / TICK_HZ, self._tick,
+                                        clock=Clock(clock_type=ClockType.STEADY_TIME))
+        mode = (f'simulated time at {self._speed:g}x, /clock published' if self._sim_time
+                else 'real time')
+        self.get_logger().info(
+            f'flexible arm: m = {p["tip_mass_kg"] * 1e3:.2f} g, f0 = {self._sim.f_true:.3f} Hz '
+            f'(Eq. 23), {self._rate:g} Hz, {mode}, {len(schedule)} move(s)')
+
+    # ---- parameters ------------------------------------------------------------------------
+    def _validate(self, params: List[Parameter]) -> SetParametersResult:
+        """Checks beyond the descriptors' ranges and read-only flags; a refused value is kept out.
+
+        A tip mass is refused when its Eq. 23 frequency would leave fewer than
+        :data:`MIN_SAMPLES_PER_PERIOD` samples per period.
+        """
+        for param in params:
+            if param.name == 'tip_mass_kg':
+                f0 = natural_frequency_hz(param.value)   # Table 1's bar
+                if f0 * MIN_SAMPLES_PER_PERIOD > self._rate:
+                    return SetParametersResult(
+                        successful=False,
+                        reason=f'tip_mass_kg {param.value} gives f0 = {f0:.2f} Hz (Eq. 23), fewer '
+                               f'than {MIN_SAMPLES_PER_PERIOD} samples per period at '
+                               f'{self._rate:g} Hz')
+        return SetParametersResult(successful=True)
+
+    def _apply(self, params: List[Parameter]) -> None:
+        """Apply accepted run-time changes: the tip mass (abruptly, Section 5.5), the noise."""
+        for param in params:
+            if param.name == 'tip_mass_kg' and param.value != self._sim.params.tip_mass_kg:
+                self._sim.set_tip_mass(param.value)
+                self.get_logger().info(f'tip mass set to {param.value * 1e3:.2f} g: f0 = '
+                                       f'{self._sim.f_true:.3f} Hz')
+            elif param.name == 'noise_std':
+                self._sim.noise_std = float(param.value)
+
+    def _sync_mass_parameter(self) -> None:
+        """Show a tip mass set by the schedule in the ``tip_mass_kg`` parameter."""
+        mass = self._sim.params.tip_mass_kg
+        if self.get_parameter('tip_mass_kg').value != mass:
+            self.set_parameters([Parameter('tip_mass_kg', value=mass)])
+
+    # ---- publishing --------------------------------------------------------------------------
+    def _publish_truth(self, f: float) -> None:
+        if f != self._f_true:
+            self._f_true = f
+            self._truth_pub.publish(Float64(data=f))
+
+    def _tick(self) -> None:
+        if self.finished:
+            return
+        if self._wall_start is None:
+            if self._torque_pub.get_subscription_count() < self._wait_for_subscribers:
+                return
+            self._wall_start = time.monotonic()
+        due_t = (time.monotonic() - self._wall_start) * self._speed
+        if self._duration > 0:
+            due_t = min(due_t, self._duration)
+        due = int(due_t * self._rate) + 1 - round(self._sim.t * self._rate)
+        limit = int(max(MAX_BATCH_SECONDS, BATCH_TICKS * self._speed / TICK_HZ) * self._rate)
+        if due > limit:
+            self.get_logger().warning(
+                f'{due / self._rate:.2f} s of simulated time behind: the machine cannot keep up '
+                f'with speed {self._speed:g}', throttle_duration_sec=5.0)
+            due = limit
+        stamp = self._msg.header.stamp
+        torque = self._msg.wrench.torque
+        t = None
+        for _ in range(max(due, 0)):
+            t, torque.z, f = self._sim.step()
+            ns = self._origin_ns + round(t * 1e9)
+            stamp.sec, stamp.nanosec = divmod(ns, 1_000_000_000)
+            self._torque_pub.publish(self._msg)
+            self._publish_truth(f)
+        if t is None:
+            return
+        if self._clock_pub is not None:
+            self._clock_msg.clock.sec, self._clock_msg.clock.nanosec = stamp.sec, stamp.nanosec
+            self._clock_pub.publish(self._clock_msg)
+        self._sync_mass_parameter()
+        if 0 < self._duration <= self._sim.t:
+            self.finished = True
+            self.get_logger().info(f'{self._duration:g} s simulated, done')
+
+
+def main(args=None):
+    sys.exit(run(SimNode, args, done=lambda node: node.finished))
+
+
+if __name__ == '__main__':
+    main()
