@@ -6,7 +6,7 @@ Loss test. A publisher in another process (reliable QoS, history 1000) sends Wre
 of a 1.33 Hz sine (stamps of a notional 500 Hz stream) at a paced rate for one second; the
 subscriber in this process spins its executor until nothing more arrives and counts what its
 callback got. A rate passes when received == sent in REPEATS trials in a row. The subscription
-has the node's QoS (best effort, history 100): a sample is lost when the history overflows before
+has the node's QoS (best effort, history 1000): a sample is lost when the history overflows before
 the executor takes it, the loss a real best-effort sensor stream suffers. Rates rise and stop at
 the first loss, or when the publisher cannot reach the rate (then the figure is a lower bound).
 An empty-callback subscriber with the same QoS, the ceiling of a Python node, takes turns with
@@ -32,6 +32,9 @@ import numpy as np
 
 os.environ.setdefault('ROS_DOMAIN_ID', str(100 + os.getpid() % 100))
 os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
+
+# the node's own input history, used for the empty subscriber too (imported after the env is set)
+from vib_estimator.estimator_node import INPUT_DEPTH as DEPTH  # noqa: E402
 
 RATES = [1000, 2000, 3000, 4500, 6500, 9000, 11000, 13000, 15000, 17500, 20000, 25000, 35000]
 TRIAL_S = 1.0
@@ -206,7 +209,7 @@ def end_to_end(topic):
             m.stamp.sec * 10 ** 9 + m.stamp.nanosec, time.perf_counter()), 100)
         return node
 
-    rig = Rig('node', 'events', 100, topic, extra_nodes=[listener])
+    rig = Rig('node', 'events', DEPTH, topic, extra_nodes=[listener])
     rig.node.entries.clear()
     rig.trial(1000, 5000, fs=100)
     rig.close()
@@ -226,7 +229,7 @@ def main():
         f'{os.environ["ROS_DOMAIN_ID"]}; trials of {TRIAL_S:.0f} s x {REPEATS}')
     results = {}
     for executor_name in ('single', 'events'):
-        rigs = {kind: Rig(kind, executor_name, 100, f'bench_{kind}_{executor_name}')
+        rigs = {kind: Rig(kind, executor_name, DEPTH, f'bench_{kind}_{executor_name}')
                 for kind in ('empty', 'node')}
         best = ramp(list(rigs.values()), log)
         for kind, rig in rigs.items():
@@ -238,7 +241,7 @@ def main():
     shallow.close()
     e2e = end_to_end('bench_node_e2e')
     log('')
-    log('highest input rate with zero loss (msgs/s; best effort, history 100):')
+    log(f'highest input rate with zero loss (msgs/s; best effort, history {DEPTH}):')
     log(f'  {"executor":16s} {"estimator_node":>15s} {"empty callback":>15s} {"ratio":>6s}')
     for executor_name, label in (('single', 'SingleThreaded'), ('events', 'EventsExecutor')):
         n, e = results['node', executor_name], results['empty', executor_name]

@@ -36,7 +36,7 @@ from rosbags.interfaces import (Connection, ConnectionExtRosbag2, Qos, QosDurabi
 from rosbags.rosbag2 import Reader, StoragePlugin, Writer
 from rosbags.typesys import Stores, get_typestore
 
-from .wrench import check_component, get_component, stamp_ns
+from .wrench import check_component, component_getter, stamp_ns
 
 WRENCH_STAMPED = 'geometry_msgs/msg/WrenchStamped'
 
@@ -204,7 +204,7 @@ def read_wrench_series(path, topic: Optional[str] = None,
     cannot be read, an unknown topic, a topic of another type, or no (or several) WrenchStamped
     topics when ``topic`` is None; ``ValueError`` for an unknown ``component``.
     """
-    check_component(component)
+    value_of = component_getter(component)
     with BagReader(path) as bag:
         if topic is None:
             wrench_topics = [t.topic for t in bag.topics.values() if t.msgtype == WRENCH_STAMPED]
@@ -228,7 +228,7 @@ def read_wrench_series(path, topic: Optional[str] = None,
                 if not stamps:
                     frame_id = msg.header.frame_id
                 stamps.append(stamp_ns(msg.header))
-                values.append(get_component(msg, component))
+                values.append(value_of(msg))
     return WrenchSeries(np.array(stamps, dtype=np.int64), np.array(values, dtype=np.float64),
                         frame_id, topic)
 

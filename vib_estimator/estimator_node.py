@@ -34,7 +34,7 @@ from std_msgs.msg import Float64, Header
 
 from .estimator import COUNTER_NAMES, EstimatorConfig, FrequencyEstimator
 from .node_runner import StartupError, run
-from .wrench import COMPONENTS, check_component, get_component, seconds_since, stamp_ns
+from .wrench import COMPONENTS, check_component, component_getter, seconds_since, stamp_ns
 
 #: input history: sensor-data QoS (best effort) but 1000 deep instead of 5, so that a scheduling
 #: hiccup of up to 2 s at 500 Hz, or a player's burst after a stall, drops nothing
@@ -88,10 +88,10 @@ class EstimatorNode(Node):
         try:
             topic = self.declare_parameter('input_topic', 'coupling_torque', _descriptor(
                 'input topic, geometry_msgs/msg/WrenchStamped', read_only=True)).value
-            self._component = check_component(self.declare_parameter(
+            self._component = self.declare_parameter(
                 'component', 'torque.z', _descriptor(
-                    f'field of the wrench to estimate on, one of {", ".join(COMPONENTS)}'))
-                .value)
+                    f'field of the wrench to estimate on, one of {", ".join(COMPONENTS)}')).value
+            self._value = component_getter(self._component)
             self._declare_core_parameters()
             config = self._config_from_parameters()
         except (ParameterException, ValueError) as err:
@@ -166,6 +166,7 @@ class EstimatorNode(Node):
         for name, value in self._estimator.counters.items():
             self._counter_base[name] += value
         self._component = self.get_parameter('component').value
+        self._value = component_getter(self._component)
         self._estimator = FrequencyEstimator(self._config_from_parameters())
         self.get_logger().info(f'parameters {", ".join(sorted(names))} changed: estimator '
                                f'restarted on [{self._component}] with {self._estimator.config}')
@@ -180,7 +181,7 @@ class EstimatorNode(Node):
         if self._origin is None:
             self._origin = stamp
         estimate = self._estimator.update(seconds_since(stamp, self._origin),
-                                          get_component(msg, self._component))
+                                          self._value(msg))
         if estimate is not None:
             self._frequency.data = estimate.frequency_hz
             self._frequency_pub.publish(self._frequency)
