@@ -5,6 +5,12 @@ import os
 import time
 
 import pytest
+from hypothesis import settings
+
+# Property tests draw the same examples on every run (CI must be deterministic) and keep no
+# example database in the tree.
+settings.register_profile('deterministic', derandomize=True, database=None)
+settings.load_profile('deterministic')
 
 # One DDS domain per test run, so concurrent runs on one machine never see each other, and discovery
 # kept on this host. Set before rclpy is imported anywhere.
