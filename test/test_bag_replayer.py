@@ -2,6 +2,7 @@
 replay -> estimator node parity with the offline estimator."""
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 import time
@@ -23,7 +24,7 @@ from ros_helpers import spin_until
 from vib_estimator.bag_io import (TYPESTORE, WRENCH_STAMPED, BagWriter, WrenchSeries,
                                   read_wrench_series, write_wrench_series)
 from vib_estimator.bag_replayer import BagReplayer
-from vib_estimator.wrench import seconds_since, stamp_ns
+from vib_estimator.wrench import stamp_ns
 
 BAGS = Path(__file__).resolve().parents[1] / 'bags'
 REPLAYER = [sys.executable, '-m', 'vib_estimator.bag_replayer']
@@ -243,20 +244,19 @@ def test_executable_plays_to_the_end_and_exits_0(tmp_path):
     assert 'end of bag: 200 messages published' in result.stderr
 
 
-def test_replay_into_estimator_node_matches_offline_estimates(ros_context, executor,
-                                                             monkeypatch):
-    """The estimator node fed by the replayer gives the floats the offline estimator gives."""
+def test_replay_into_estimator_node_matches_analyze(ros_context, executor, monkeypatch, capsys):
+    """The estimator node fed by the replayer gives the floats ``vib-estimator analyze`` gives."""
     from vib_estimator import estimator_node
-    from vib_estimator.estimator import FrequencyEstimator
+    from vib_estimator.cli import main
 
     series = read_wrench_series(BAGS / 'arm_5_3')
-    offline = FrequencyEstimator().process(seconds_since(series.stamps_ns, series.stamps_ns[0]),
-                                           series.values)
+    assert main(['analyze', str(BAGS / 'arm_5_3'), '--format', 'jsonl']) == 0
+    offline = [json.loads(line)['frequency_hz'] for line in capsys.readouterr().out.splitlines()]
     assert len(offline) > 0
     # The input is best effort: when a loaded machine stalls this one-thread executor, the
-    # replayer then publishes the overdue samples in a burst that can overflow the 100-deep
-    # input, and a dropped sample changes the estimates. This test is about the arithmetic, so
-    # the input is made deep enough for any burst.
+    # replayer then publishes the overdue samples in a burst that could overflow the node's
+    # input history, and a dropped sample changes the estimates. This test is about the
+    # arithmetic, so the input is made deep enough for any burst.
     monkeypatch.setattr(estimator_node, 'INPUT_DEPTH', len(series))
     estimator = estimator_node.EstimatorNode(context=ros_context)
     node = replayer(ros_context, BAGS / 'arm_5_3', rate=2.0)
@@ -272,4 +272,23 @@ def test_replay_into_estimator_node_matches_offline_estimates(ros_context, execu
     assert spin_until(executor, lambda: len(frequencies) == len(offline), 5)
     assert spin_until(executor, lambda: estimator.counters['received'] == len(series), 5)
     online = [deserialize_message(d, Float64).data for d in frequencies]
-    assert online == offline.frequency_hz.tolist()  # same floats
+    assert online == offline  # same floats
+
+
+def test_looping_bag_resets_the_estimator_and_estimates_go_on(ros_context, executor, tmp_path):
+    """Each loop sends the stamps back by the bag's length: the node restarts, then estimates."""
+    from vib_estimator.estimator_node import EstimatorNode
+
+    stamps = 1_700_000_000 * 10 ** 9 + np.arange(1500, dtype=np.int64) * 2_000_000   # 3 s
+    values = 0.3 * np.sin(2 * np.pi * 1.33 * (stamps - stamps[0]) * 1e-9)
+    write_wrench_series(tmp_path / 'bag', WrenchSeries(stamps, values, 'arm_base',
+                                                       '/coupling_torque'))
+    estimator = EstimatorNode(context=ros_context)
+    node = replayer(ros_context, tmp_path / 'bag', loop=True, rate=5.0)
+    executor.add_node(estimator)
+    executor.add_node(node)
+    assert spin_until(executor, lambda: estimator.count_publishers('/coupling_torque') > 0, 10)
+    node.resume()
+    assert spin_until(executor, lambda: estimator.counters['time_jump_resets'] >= 2, 15)
+    per_loop = estimator.counters['estimates'] / estimator.counters['time_jump_resets']
+    assert per_loop >= 2

@@ -262,3 +262,29 @@ def test_sigint_shuts_down_cleanly(ros_context):
         probe.destroy_node()
     assert proc.returncode == 0, err
     assert 'Traceback' not in err, err
+
+
+def test_use_sim_time_zero_stamps_follow_the_simulated_clock(make_probe):
+    """With use_sim_time, a zero stamp becomes the /clock time at receipt; estimates follow it."""
+    from rosgraph_msgs.msg import Clock
+
+    p = make_probe(use_sim_time=True)
+    clock_pub = p.probe.create_publisher(Clock, '/clock', 10)
+    assert spin_until(p.executor, lambda: clock_pub.get_subscription_count() >= 1, 10.0)
+    start_ns = 5_000 * 10 ** 9                 # simulated time, far from the wall clock
+    clock = Clock()
+    for i in range(800):                        # 1.6 s of a 1.33 Hz sine at 500 Hz
+        now_ns = start_ns + i * 2_000_000
+        clock.clock.sec, clock.clock.nanosec = divmod(now_ns, 10 ** 9)
+        clock_pub.publish(clock)
+        assert spin_until(p.executor, lambda: p.node.get_clock().now().nanoseconds == now_ns,
+                          5.0)
+        msg = WrenchStamped()                   # header stamp left at zero
+        msg.wrench.torque.z = math.sin(2 * math.pi * 1.33 * i / FS)
+        p.pub.publish(msg)
+        p.sent += 1
+        assert spin_until(p.executor, lambda: p.node.counters['received'] >= p.sent, 5.0)
+    assert spin_until(p.executor, lambda: len(p.resets()) >= 2, 5.0)
+    assert p.node.counters['zero_stamps_replaced'] == 800
+    assert all(start_ns < stamp < start_ns + 1_600_000_000 for stamp, _ in p.resets())
+    assert all(abs(f / 1.33 - 1) < 1e-3 for f in p.frequencies())
