@@ -1,4 +1,4 @@
-"""Test signals of the paper (pure numpy): the Fig. 1 sine and the damped sine of Eqs. 13-15."""
+"""Test signals of the paper (pure numpy): the Fig. 1 sine and the normalised damped sine of Eq. 15."""
 from __future__ import annotations
 
 import numpy as np
@@ -13,13 +13,6 @@ def fig1_signal(t: np.ndarray, seed: int = 0, omega: float = 10.0, phase: float 
     """
     rng = np.random.default_rng(seed)
     return amplitude * np.sin(omega * t + phase) + rng.uniform(-noise, noise, size=len(t))
-
-
-def damped_sine(t: np.ndarray, f: float, zeta: float, amplitude: float = 1.0,
-                phase: float = 0.0) -> np.ndarray:
-    """Eq. 13: ``A exp(-zeta 2 pi f t) sin(2 pi f sqrt(1 - zeta^2) t + phi)``."""
-    return amplitude * np.exp(-zeta * 2 * np.pi * f * t) * np.sin(
-        2 * np.pi * f * np.sqrt(1 - zeta ** 2) * t + phase)
 
 
 def normalised_damped_sine(t_hat: np.ndarray, zeta: float, phase: float = 0.0) -> np.ndarray:
