@@ -18,11 +18,11 @@ Mathematics (equation numbers are those of Trapero, Sira-Ramirez & Feliu):
 
       N = -tau^3 y + 3 tau^2 M0 - 24 tau M1 + 30 M2,   D = -1.5 tau^2 M2 + 4 tau M3 - 2.5 M4
 
-* The moments are integrated interval by interval, exactly, over the cubic that interpolates the
-  last four samples (a causal Adams-Moulton-type rule, local error O(h^5), valid for irregular
-  steps). A trapezoid makes early estimates of a clean sine percent-wrong because ``n`` is a
-  difference of terms that cancel to O(tau^4); the cubic rule makes them 1e-6-exact (see
-  ``FrequencyEstimator`` for the error budget behind the default ``min_time``).
+* The moments are integrated interval by interval, exactly, over the degree-7 polynomial that
+  interpolates the last NH = 8 samples (a causal Adams-Moulton-type rule, local error O(h^9),
+  valid for irregular steps). A trapezoid makes early estimates of a clean sine percent-wrong
+  because ``n`` is a difference of terms that cancel to O(tau^4); this rule makes them exact to
+  ~1e-8 at 100 samples per period (see :mod:`vib_estimator.estimator` for the error budget).
 * Invariant filtering (Eqs. 9-11): ``n`` and ``d`` pass through the same second-order low-pass,
   discretised exactly for a first-order-hold input over each real sampling interval, so irregular
   sampling is handled and ``n_f / d_f`` stays exactly ``w^2`` for a pure sinusoid.
@@ -52,7 +52,7 @@ N_PARAMS = 18
 N_COUNTERS = 15
 
 # ---- state array layout (float64) -----------------------------------------------------------
-NH = 8              # samples in the interpolation stencil (quintic rule)
+NH = 8              # samples in the interpolation stencil (degree-7 rule)
 S_T0 = 0            # time origin of the current segment
 S_TLAST = 1         # time of the last accepted sample
 S_HT = 2            # NH last sample times (oldest first)
