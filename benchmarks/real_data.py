@@ -5,7 +5,9 @@ Runs ``vib-estimator analyze``'s core over the aluminium-cantilever (ADXL357) re
 number of estimates, median relative error and 90th percentile of |error| against the reference
 frequency of each file's own FFT (SOURCE.md), and median convergence time in periods.
 Configurations: the paper's estimator as printed (sinusoid model, no prefilter), the
-``biased-sinusoid`` model, and the paper's model with a band-pass prefilter [f/2, 2 f].
+``biased-sinusoid`` model, the paper's model with a band-pass prefilter [f/2, 2 f], and the
+``damped-sinusoid`` model with that prefilter (which also prints the median damping ratio, to
+compare with the log-decrement values of SOURCE.md).
 """
 import sys
 from pathlib import Path
@@ -24,6 +26,8 @@ def configs(f_ref):
         'paper (sinusoid)': EstimatorConfig(),
         'biased-sinusoid': EstimatorConfig(model='biased-sinusoid'),
         'sinusoid + band [f/2, 2f]': EstimatorConfig(band_hz=(f_ref / 2, 2 * f_ref)),
+        'damped + band [f/2, 2f]': EstimatorConfig(model='damped-sinusoid',
+                                                   band_hz=(f_ref / 2, 2 * f_ref)),
     }
 
 
@@ -34,9 +38,10 @@ def report(label, t, y, f_ref):
             print(f'{label:18} {name:28} no estimate')
             continue
         err = e.frequency_hz / f_ref - 1
+        zeta = f'{np.median(e.damping):11.4f}' if cfg.model == 'damped-sinusoid' else ''
         print(f'{label:18} {name:28} {len(e):5d} {100 * np.median(err):+8.2f} % '
               f'{100 * np.percentile(np.abs(err), 90):8.2f} % '
-              f'{np.median(e.convergence_time) * f_ref:6.2f}')
+              f'{np.median(e.convergence_time) * f_ref:14.2f} {zeta}')
 
 
 def main() -> int:
@@ -47,7 +52,7 @@ def main() -> int:
         print(f'no real data at {folder}; pass the real-data folder as argument')
         return 1
     print(f'{"recording":18} {"configuration":28} {"n":>5} {"median err":>10} '
-          f'{"p90 |err|":>10} {"conv (periods)":>14}')
+          f'{"p90 |err|":>10} {"conv (periods)":>14} {"median zeta":>11}')
     for length, f_ref in REFERENCE.items():
         s = read_csv_series(folder / f'{length}cm_uniform_1000Hz.csv')
         report(f'{length} cm, 1 kHz CSV', s.t, s.y, f_ref)

@@ -25,12 +25,13 @@ def test_clean_sine_every_estimate_is_exact(f, amplitude, phase, ratio):
     assert np.max(np.abs(e.frequency_hz / f - 1)) < bound
 
 
-def test_batch_and_streaming_give_the_same_floats():
+@pytest.mark.parametrize('model', ['sinusoid', 'biased-sinusoid', 'damped-sinusoid'])
+def test_batch_and_streaming_give_the_same_floats(model):
     rng = np.random.default_rng(1)
     t = np.cumsum(rng.uniform(0.0015, 0.0025, 20000))
     y = sine(t, 1.7, 0.3, 0.4, 0.05) + 0.01 * rng.standard_normal(len(t))
     y[500] = np.nan
-    cfg = EstimatorConfig(model='biased-sinusoid', band_hz=(0.5, 5.0))
+    cfg = EstimatorConfig(model=model, band_hz=(0.5, 5.0))
     batch = estimate(t, y, cfg)
     stream = FrequencyEstimator(cfg)
     got = [e for e in (stream.update(a, b) for a, b in zip(t, y)) if e is not None]
@@ -77,6 +78,21 @@ def test_biased_model_removes_an_offset_the_paper_model_cannot():
     biased = estimate(t, y, EstimatorConfig(model='biased-sinusoid'))
     assert np.max(np.abs(biased.frequency_hz / 2.0 - 1)) < 1e-5
     assert len(paper) == 0 or np.max(np.abs(paper.frequency_hz / 2.0 - 1)) > 0.01
+
+
+@pytest.mark.parametrize('zeta', [0.0, 0.004, 0.02, 0.1])
+@pytest.mark.parametrize('phase', [0.0, 1.0, 2.5])
+def test_damped_model_gives_natural_frequency_and_damping_exactly(zeta, phase):
+    f_n = 1.33
+    t = np.arange(0, 4, 0.002)
+    omega_d = 2 * np.pi * f_n * np.sqrt(1 - zeta ** 2)
+    y = 0.2 * np.exp(-zeta * 2 * np.pi * f_n * t) * np.sin(omega_d * t + phase)
+    e = estimate(t, y, EstimatorConfig(model='damped-sinusoid'))
+    assert len(e) >= 5
+    assert np.max(np.abs(e.frequency_hz / f_n - 1)) < 1e-8
+    assert np.max(np.abs(e.damping - zeta)) < 1e-6
+    undamped = estimate(t, y)                   # the paper's model: biased by the damping
+    assert np.isnan(undamped.damping).all()
 
 
 def test_band_prefilter_isolates_the_first_mode():

@@ -29,3 +29,9 @@ def test_cli_writes_the_figures(tmp_path, capsys):
         assert main(['reproduce', fig, '--out', str(tmp_path / f'{fig}.png')]) == 0
         assert (tmp_path / f'{fig}.png').stat().st_size > 10_000
     assert 'zeta_n' in capsys.readouterr().out
+
+
+def test_fig2_damped_model_is_exact_for_every_zeta():
+    r = reproduce.fig2(model='damped-sinusoid')
+    assert np.all(r.mae < 1e-9)
+    assert np.allclose(r.convergence_time, 0.5, atol=0.01)

@@ -71,8 +71,8 @@ def _print(estimates, origin, fmt) -> None:
         rows.append(row)
     out = sys.stdout
     if fmt == 'jsonl':
-        for row in rows:
-            out.write(json.dumps(row) + '\n')
+        for row in rows:     # strict JSON: NaN (e.g. no damping estimate) becomes null
+            out.write(json.dumps({k: None if v != v else v for k, v in row.items()}) + '\n')
     elif fmt == 'csv':
         keys = list(rows[0]) if rows else ['t', 'frequency_hz', 'convergence_time_s']
         out.write(','.join(keys) + '\n')

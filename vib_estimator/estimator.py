@@ -31,7 +31,7 @@ import numpy as np
 
 from . import kernel as K
 
-MODELS = ('sinusoid', 'biased-sinusoid')
+MODELS = ('sinusoid', 'biased-sinusoid', 'damped-sinusoid')
 
 #: counter names, in the order of :mod:`vib_estimator.kernel`'s counter array
 COUNTER_NAMES = ('received', 'used', 'skipped_non_finite', 'skipped_duplicate',
@@ -57,8 +57,9 @@ class EstimatorConfig:
     """Parameters of the estimator; defaults are those of Section 5.3 of the paper where it gives
     them. Each field's description and range: :meth:`describe`."""
 
-    model: str = _param('sinusoid', 'sinusoid (Eq. 1, the paper) or biased-sinusoid '
-                        '(y = A sin(wt+phi) + B, the offset eliminated algebraically)')
+    model: str = _param('sinusoid', 'sinusoid (Eq. 1, the paper), biased-sinusoid '
+                        '(y = A sin(wt+phi) + B, the offset eliminated algebraically) or '
+                        'damped-sinusoid (natural frequency and damping of a decaying sine)')
     lowpass_cutoff_hz: float = _param(3.0, 'cut-off of the invariant low-pass filter of Eqs. '
                                       '9-11, Hz (3 Hz = 6 pi rad/s, Section 5.3)',
                                       0.0, INF, open_lo=True, open_hi=True)
@@ -181,6 +182,7 @@ class Estimate:
         samples: samples used by this estimate (segment length).
         fit: R^2 of the sinusoid at this frequency over the segment (quality gate).
         amplitude: amplitude of that sinusoid, signal units.
+        damping: damping ratio (``damped-sinusoid`` model; NaN for the others).
     """
 
     t: float
@@ -189,6 +191,7 @@ class Estimate:
     samples: int
     fit: float
     amplitude: float
+    damping: float = math.nan
 
     @property
     def omega(self) -> float:
@@ -198,7 +201,7 @@ class Estimate:
     def as_dict(self) -> Dict[str, float]:
         return {'t': self.t, 'frequency_hz': self.frequency_hz, 'omega_rad_s': self.omega,
                 'convergence_time_s': self.convergence_time, 'samples': self.samples,
-                'fit': self.fit, 'amplitude': self.amplitude}
+                'fit': self.fit, 'amplitude': self.amplitude, 'damping': self.damping}
 
 
 @dataclass
@@ -211,14 +214,21 @@ class EstimateArrays:
     samples: np.ndarray
     fit: np.ndarray
     amplitude: np.ndarray
+    damping: np.ndarray
+
+    @classmethod
+    def from_rows(cls, rows: np.ndarray) -> 'EstimateArrays':
+        """Columns of the kernel's estimate rows."""
+        return cls(*(rows[:, i].astype(np.int64) if i == K.O_SAMPLES else rows[:, i].copy()
+                     for i in range(K.N_OUT)))
 
     def __len__(self) -> int:
         return len(self.t)
 
     def to_list(self) -> List[Estimate]:
-        return [Estimate(float(a), float(b), float(c), int(d), float(e), float(f))
-                for a, b, c, d, e, f in zip(self.t, self.frequency_hz, self.convergence_time,
-                                            self.samples, self.fit, self.amplitude)]
+        return [Estimate(*(int(v) if i == K.O_SAMPLES else float(v) for i, v in enumerate(row)))
+                for row in zip(self.t, self.frequency_hz, self.convergence_time, self.samples,
+                               self.fit, self.amplitude, self.damping)]
 
 
 class FrequencyEstimator:
@@ -269,9 +279,8 @@ class FrequencyEstimator:
     def update(self, t: float, y: float) -> Optional[Estimate]:
         """Feed one sample (time in s, any origin); return an estimate when one is published."""
         if K.step(self._p, self._s, self._c, self._seg, float(t), float(y), self._row):
-            r = self._row
-            return Estimate(r[K.O_T], r[K.O_F], r[K.O_CONV], int(r[K.O_SAMPLES]), r[K.O_FIT],
-                            r[K.O_AMP])
+            return Estimate(*(int(v) if i == K.O_SAMPLES else float(v)
+                              for i, v in enumerate(self._row)))
         return None
 
     def process(self, t: Sequence[float], y: Sequence[float]) -> EstimateArrays:
@@ -291,9 +300,7 @@ class FrequencyEstimator:
                 break
             size *= 2
         rows = np.concatenate(chunks) if chunks else np.empty((0, K.N_OUT))
-        return EstimateArrays(rows[:, K.O_T].copy(), rows[:, K.O_F].copy(),
-                              rows[:, K.O_CONV].copy(), rows[:, K.O_SAMPLES].astype(np.int64),
-                              rows[:, K.O_FIT].copy(), rows[:, K.O_AMP].copy())
+        return EstimateArrays.from_rows(rows)
 
 
 def estimate(t: Sequence[float], y: Sequence[float],

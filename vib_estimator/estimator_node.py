@@ -229,6 +229,7 @@ class EstimatorNode(Node):
         values = {
             'last_frequency_hz': estimate.frequency_hz if estimate else math.nan,
             'last_convergence_time_s': estimate.convergence_time if estimate else math.nan,
+            'last_damping_ratio': estimate.damping if estimate else math.nan,
             'last_estimate_age_s': now - published_at if estimate else math.nan,
             'input_rate_hz': (counters['received'] - self._tick_received) / (now - self._tick_at),
             **counters,

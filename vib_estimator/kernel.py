@@ -13,6 +13,11 @@ Mathematics (equation numbers are those of Trapero, Sira-Ramirez & Feliu):
       n = -(tau^2 y + 2 tau M0 - 6 M1),     d = tau M2 - M3,      omega^2 = n / d
 
   This is Eq. 8 with the corrected sign (``dx1/dt = x2 - 4 t y``; the paper prints ``+``).
+* ``damped-sinusoid`` (y'' + 2 sigma y' + w_n^2 y = 0): differentiating
+  ``(s^2 + 2 sigma s + w_n^2) Y = s y0 + y1 + 2 sigma y0`` twice in s and multiplying by s^-2 gives
+  ``n = 2 sigma q + w_n^2 d`` at every instant, with n and d as above and ``q = 3 M2 - 2 tau M1``;
+  the invariant filter (F1) and its running integral (F2) give two such equations, solved for
+  w_n^2 and 2 sigma (so the natural frequency and the damping ratio, exactly, for a damped sine).
 * ``biased-sinusoid`` (y = A sin(wt+phi) + B): the offset is eliminated by a third derivation in s
   of ``s (s^2 + w^2) Y(s) = s^2 y0 + s y1 + B (s^2 + w^2)``, multiplied by ``s^-3``::
 
@@ -62,7 +67,10 @@ S_NF = S_MOM + 5    # low-pass state of n: x5, x6 (Eq. 11)
 S_DF = S_NF + 2     # low-pass state of d: x7, x8
 S_NPREV = S_DF + 2  # n, d at the previous sample (first-order hold)
 S_DPREV = S_NPREV + 1
-S_BAND = S_DPREV + 1     # band-pass: 3 sections x (2 states, previous input)
+S_QF = S_DPREV + 1  # damped model: low-pass state of q (2) and q at the previous sample
+S_QPREV = S_QF + 2
+S_INT = S_QPREV + 1  # damped model: running integrals of n_f, q_f, d_f (the second equation)
+S_BAND = S_INT + 3       # band-pass: 3 sections x (2 states, previous input)
 S_CACHE_H = S_BAND + 9   # step for which the discretisations below were computed
 S_DISC = S_CACHE_H + 1   # 4 sections x 8 numbers (Phi 2x2, G0 2, G1 2): Eq. 11, then band
 S_LAST_DT = S_DISC + 32  # last sampling interval (for the Nyquist check)
@@ -75,8 +83,10 @@ S_MA = S_UNIT + NH       # moving-average ring (2M+1 values) starts here
 N_STATE_FIXED = S_MA
 
 # ---- estimate row layout --------------------------------------------------------------------
-O_T, O_F, O_CONV, O_SAMPLES, O_FIT, O_AMP = range(6)
-N_OUT = 6
+O_T, O_F, O_CONV, O_SAMPLES, O_FIT, O_AMP, O_DAMP = range(7)
+N_OUT = 7
+#: values of P_MODEL
+MODEL_SINUSOID, MODEL_BIASED, MODEL_DAMPED = 0, 1, 2
 
 TWO_PI = 2.0 * math.pi
 #: band-pass prefilter: 4th-order Butterworth low-pass at f_hi (two sections), then a 2nd-order
@@ -156,7 +166,7 @@ def reset_segment(s, c, seg, t0, y0):
     seg[0, 0] = 0.0
     seg[1, 0] = y0
     s[S_MOM:S_MOM + 5] = 0.0
-    s[S_NF:S_DPREV + 1] = 0.0
+    s[S_NF:S_INT + 3] = 0.0
     c[C_SEG_N] = 1
     c[C_MA_N] = 0
 
@@ -393,22 +403,23 @@ def step(p, s, c, seg, t, y, out):
         return 0
     tau = t - s[S_T0]
     a = s[S_HT + NH - 2] - s[S_T0]
-    biased = p[P_MODEL] > 0.0
-    kmax = 4 if biased else 3
+    model = int(p[P_MODEL])
+    kmax = 4 if model == MODEL_BIASED else 3
     _interval_moments(s, kmax, a, h, int(p[P_RULE]))
     m0 = s[S_MOM]
     m1 = s[S_MOM + 1]
     m2 = s[S_MOM + 2]
     m3 = s[S_MOM + 3]
-    if biased:
+    if model == MODEL_BIASED:
         m4 = s[S_MOM + 4]
         num = -tau * tau * tau * y + 3.0 * tau * tau * m0 - 24.0 * tau * m1 + 30.0 * m2
         den = -1.5 * tau * tau * m2 + 4.0 * tau * m3 - 2.5 * m4
     else:
         num = -(tau * tau * y + 2.0 * tau * m0 - 6.0 * m1)
         den = tau * m2 - m3
-    # invariant filtering, Eq. 11 (same discretised filter for both)
-    if p[P_FILTER] > 0.0:
+    # invariant filtering, Eq. 11 (same discretised filter for all)
+    filtered = p[P_FILTER] > 0.0
+    if filtered:
         _advance(s, S_NF, S_DISC, s[S_NPREV], num)
         _advance(s, S_DF, S_DISC, s[S_DPREV], den)
     else:
@@ -416,6 +427,16 @@ def step(p, s, c, seg, t, y, out):
         s[S_DF] = den
     s[S_NPREV] = num
     s[S_DPREV] = den
+    if model == MODEL_DAMPED:
+        q = 3.0 * m2 - 2.0 * tau * m1
+        if filtered:
+            _advance(s, S_QF, S_DISC, s[S_QPREV], q)
+        else:
+            s[S_QF] = q
+        s[S_QPREV] = q
+        s[S_INT] += h * s[S_NF]
+        s[S_INT + 1] += h * s[S_QF]
+        s[S_INT + 2] += h * s[S_DF]
     nseg = c[C_SEG_N]
     cap = seg.shape[1]
     if nseg < cap:
@@ -435,7 +456,20 @@ def step(p, s, c, seg, t, y, out):
     # Eq. 12
     nf = s[S_NF]
     df = s[S_DF]
-    w2 = nf / df if df != 0.0 else -1.0
+    damping = math.nan
+    if model == MODEL_DAMPED:
+        # n = 2 sigma q + w_n^2 d holds at every instant; filtered (F1) and then integrated (F2)
+        # it gives two equations in (2 sigma, w_n^2)
+        qf = s[S_QF]
+        i_n = s[S_INT]
+        i_q = s[S_INT + 1]
+        i_d = s[S_INT + 2]
+        det = qf * i_d - df * i_q
+        w2 = (qf * i_n - nf * i_q) / det if det != 0.0 else -1.0
+        if w2 > 0.0:
+            damping = 0.5 * (nf * i_d - df * i_n) / det / math.sqrt(w2)
+    else:
+        w2 = nf / df if df != 0.0 else -1.0
     if not (w2 > 0.0 and math.isfinite(w2)):
         c[C_MA_N] = 0
         return 0
@@ -478,6 +512,7 @@ def step(p, s, c, seg, t, y, out):
         out[O_SAMPLES] = nseg + 1
         out[O_FIT] = r2
         out[O_AMP] = amp
+        out[O_DAMP] = damping
         c[C_ESTIMATES] += 1
         published = 1
     reset_segment(s, c, seg, t, y)
