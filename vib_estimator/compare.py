@@ -1,6 +1,7 @@
 """``vib-estimator compare``: the algebraic estimator against the trackers of Section 5.4.
 
-Every method -- the algebraic estimator with its default :class:`EstimatorConfig`, Ziarani-Konrad
+Every method -- the algebraic estimator with its default :class:`EstimatorConfig` and with the
+``damped-sinusoid`` model (``Algebraic-damped``), Ziarani-Konrad
 (Eqs. 25-26), Hou (Eqs. 27-29), Mojiri-Bakhshai (Eqs. 30-33), all with the paper's gains, and the
 flight-controller-style :class:`SlidingDFT` -- runs on the same signals:
 
@@ -55,8 +56,11 @@ OUTLIER = 0.05
 #: Table 2 of the paper (algebraic method, Section 5.5): f (Hz) -> (bias Hz, variance Hz^2)
 PAPER_TABLE_2 = {1.64: (7.0e-2, 1.2e-4), 1.33: (3.0e-2, 3.1e-5), 1.15: (1.5e-2, 7.1e-5)}
 ALGEBRAIC = 'Algebraic'
+#: the algebraic estimator as configured by default (the paper's model) and with the damped model
+ALGEBRAIC_CONFIGS = {ALGEBRAIC: EstimatorConfig(),
+                     'Algebraic-damped': EstimatorConfig(model='damped-sinusoid')}
 TRACKERS = (ZiaraniKonrad, Hou, MojiriBakhshai, SlidingDFT)
-METHODS = (ALGEBRAIC,) + tuple(cls.name for cls in TRACKERS)
+METHODS = tuple(ALGEBRAIC_CONFIGS) + tuple(cls.name for cls in TRACKERS)
 
 
 #: a record: sample times (s), signal, true frequency of each sample (Hz)
@@ -110,8 +114,8 @@ class Run:
 def run_method(name: str, t: np.ndarray, y: np.ndarray) -> Run:
     """Run method ``name`` (one of :data:`METHODS`) fresh over a record."""
     empty = np.empty(0)
-    if name == ALGEBRAIC:
-        est = FrequencyEstimator(EstimatorConfig())
+    if name in ALGEBRAIC_CONFIGS:
+        est = FrequencyEstimator(ALGEBRAIC_CONFIGS[name])
         t0 = time.perf_counter()
         e = est.process(t, y)
         seconds = time.perf_counter() - t0
@@ -235,7 +239,7 @@ def compare(seeds: int, cases: Sequence[Case] = CASES,
                     keep.setdefault(case.key, ((t, y, f_true), {}))[1][name] = run
                 for k, seg in enumerate(segs):
                     acc.setdefault((name, k), []).append(
-                        evaluate(run, t, y, seg, case.noise_std, name == ALGEBRAIC))
+                        evaluate(run, t, y, seg, case.noise_std, name in ALGEBRAIC_CONFIGS))
         for name in METHODS:
             for k, (_, _, f) in enumerate(segs):
                 res = acc[(name, k)]
@@ -321,9 +325,9 @@ def plot_case(path: str, case: Case, record: Record, runs: Dict[str, Run]) -> No
         for i, (a, b, f) in enumerate(segments(f_true)):
             ax.hlines(f, t[a], t[b - 1], colors='k', linestyles='--', zorder=4,
                       label='true f' if i == 0 else None)
-        for name, color in zip(METHODS, ('C3', 'C0', 'C1', 'C2', 'C4')):
+        for name, color in zip(METHODS, ('C3', 'C5', 'C0', 'C1', 'C2', 'C4')):
             run = runs[name]
-            if name == ALGEBRAIC:
+            if name in ALGEBRAIC_CONFIGS:
                 ax.plot(t[run.est_index], run.est_f, '*', ms=8, mec='k', mew=0.4, color=color,
                         zorder=5, label=name)
             else:
