@@ -73,8 +73,7 @@ S_INT = S_QPREV + 1  # damped model: running integrals of n_f, q_f, d_f (the sec
 S_BAND = S_INT + 3       # band-pass: 3 sections x (2 states, previous input)
 S_CACHE_H = S_BAND + 9   # step for which the discretisations below were computed
 S_DISC = S_CACHE_H + 1   # 4 sections x 8 numbers (Phi 2x2, G0 2, G1 2): Eq. 11, then band
-S_LAST_DT = S_DISC + 32  # last sampling interval (for the Nyquist check)
-S_SCR = S_LAST_DT + 1    # scratch for the interval rule: nodes, differences, coefficients
+S_SCR = S_DISC + 32     # scratch for the interval rule: nodes, differences, coefficients
 S_IM = S_SCR + 3 * NH    # the rule's integrals I_0..I_4 of the newest interval
 S_W = S_IM + 5           # cached weights of the rule on a uniform stencil (5 x NH)
 S_WH = S_W + 5 * NH      # step of the cached weights (-1: none)
@@ -386,7 +385,6 @@ def step(p, s, c, seg, t, y, out):
                 _discretise(p[P_WHI] if k < 2 else p[P_WLO], BAND_DAMPING[k], h, s,
                             S_DISC + 8 * (k + 1))
         s[S_CACHE_H] = h
-    s[S_LAST_DT] = h
     if p[P_BAND] > 0.0:
         y = _prefilter(p, s, y)
     # shift the interpolation history
