@@ -36,7 +36,8 @@ MODELS = ('sinusoid', 'biased-sinusoid', 'damped-sinusoid')
 #: counter names, in the order of :mod:`vib_estimator.kernel`'s counter array
 COUNTER_NAMES = ('received', 'used', 'skipped_non_finite', 'skipped_duplicate',
                  'skipped_out_of_order', 'time_jump_resets', 'gap_resets', 'rejected_at_rest',
-                 'rejected_fit', 'rejected_nyquist', 'max_window_resets', 'estimates')
+                 'rejected_fit', 'rejected_nyquist', 'max_window_resets', 'estimates',
+                 'rejected_damping')
 
 
 INF = math.inf
@@ -88,6 +89,9 @@ class EstimatorConfig:
                                   'below this is at rest (signal units)', 0.0, INF, open_hi=True)
     min_fit: float = _param(0.9, 'quality gate: R^2 a sinusoid at the estimated frequency must '
                             'reach over the segment for the estimate to be published', 0.0, 1.0)
+    max_damping: float = _param(0.1, 'quality gate of the damped-sinusoid model: an estimate '
+                                'whose |damping ratio| exceeds this is a transient, not published',
+                                0.0, 1.0, open_lo=True)
     max_gap: float = _param(0.5, 'a gap, or a backward jump, between stamps longer than this '
                             '(s) restarts the estimator; a smaller step back is skipped',
                             0.0, INF, open_lo=True, open_hi=True)
@@ -168,6 +172,7 @@ class EstimatorConfig:
         p[K.P_FILTER] = 1.0 if self.invariant_filter else 0.0
         p[K.P_ONESIDED] = 1.0 if self.one_sided_test else 0.0
         p[K.P_RULE] = self.rule_points
+        p[K.P_MAXDAMP] = self.max_damping
         return p
 
 

@@ -45,7 +45,8 @@ DIAGNOSTICS_PERIOD = 1.0
 #: the status goes STALE when no input arrived for this long, s
 STALE_AFTER = 2.0
 #: core counters that grow when the quality gate holds a converged estimate back, or none forms
-HELD_BACK = ('rejected_at_rest', 'rejected_fit', 'rejected_nyquist', 'max_window_resets')
+HELD_BACK = ('rejected_at_rest', 'rejected_fit', 'rejected_nyquist', 'rejected_damping',
+             'max_window_resets')
 
 #: the ROS parameters that configure the core, one per EstimatorConfig field
 CORE_NAMES = frozenset(EstimatorConfig.names())

@@ -48,13 +48,13 @@ from numba import njit
 
 # ---- parameter array layout (float64) -------------------------------------------------------
 P_MODEL, P_WC, P_ZC, P_M, P_TOL, P_EPS, P_MAXWIN, P_BAND, P_WLO, P_WHI, P_MINAMP, P_MINFIT, \
-    P_MAXGAP, P_MINSAMP, P_MINPER, P_FILTER, P_ONESIDED, P_RULE = range(18)
-N_PARAMS = 18
+    P_MAXGAP, P_MINSAMP, P_MINPER, P_FILTER, P_ONESIDED, P_RULE, P_MAXDAMP = range(19)
+N_PARAMS = 19
 
 # ---- counter array layout (int64) -----------------------------------------------------------
 (C_RECEIVED, C_USED, C_NONFINITE, C_DUPLICATE, C_OUT_OF_ORDER, C_TIME_JUMP, C_GAP, C_REST,
- C_FIT, C_NYQUIST, C_MAX_WINDOW, C_ESTIMATES, C_SEG_N, C_HIST_N, C_MA_N) = range(15)
-N_COUNTERS = 15
+ C_FIT, C_NYQUIST, C_MAX_WINDOW, C_ESTIMATES, C_DAMPING, C_SEG_N, C_HIST_N, C_MA_N) = range(16)
+N_COUNTERS = 16
 
 # ---- state array layout (float64) -----------------------------------------------------------
 NH = 8              # samples in the interpolation stencil (degree-7 rule)
@@ -503,6 +503,9 @@ def step(p, s, c, seg, t, y, out):
         c[C_NYQUIST] += 1
     elif r2 < p[P_MINFIT]:
         c[C_FIT] += 1
+    elif model == MODEL_DAMPED and not abs(damping) <= p[P_MAXDAMP]:
+        # a "lightly damped vibration" with |zeta| above this is a transient, not a mode
+        c[C_DAMPING] += 1
     else:
         out[O_T] = t
         out[O_F] = f
