@@ -73,3 +73,27 @@ def test_launch_file_starts_the_node_with_the_params_file():
     strings = {n.value for n in ast.walk(tree) if isinstance(n, ast.Constant)}
     assert {'vib_estimator', 'config', PARAMS.name} <= strings
     assert PARAMS.is_file()
+
+
+def test_readme_parameter_table_states_the_defaults():
+    """The README's estimator-parameter table lists every EstimatorConfig field with its default."""
+    text = (ROOT / 'README.md').read_text()
+    table = text.split('### Estimator parameters', 1)[1].split('\n## ', 1)[0]
+    rows = {}
+    for line in table.splitlines():
+        cells = [c.strip() for c in line.strip('|').split('|')]
+        if len(cells) >= 3 and cells[0].startswith('`'):
+            rows[cells[0].strip('`')] = cells[1].strip('`').removesuffix(' s')
+    defaults = EstimatorConfig()
+    documented = set(EstimatorConfig.names())
+    assert documented <= set(rows), documented - set(rows)
+    for name in documented:
+        default, shown = getattr(defaults, name), rows[name]
+        if default is None:
+            assert shown == 'off', name
+        elif isinstance(default, bool):
+            assert shown == str(default).lower(), name
+        elif isinstance(default, str):
+            assert shown == default, name
+        else:
+            assert float(shown) == default, (name, shown, default)
