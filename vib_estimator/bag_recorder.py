@@ -27,18 +27,16 @@ import importlib
 from functools import partial
 from typing import Dict, Iterable, Tuple
 
-from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.duration import Duration
-from rclpy.exceptions import ParameterException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from rclpy.qos import (DurabilityPolicy, HistoryPolicy, LivelinessPolicy, QoSProfile,
-                       ReliabilityPolicy)
+from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rosbags.interfaces import (Qos, QosDurability, QosHistory, QosLiveliness, QosReliability,
                                 QosTime)
 
 from .bag_io import BagError, BagWriter, STORAGES
 from .node_runner import StartupError, run
+from .parameters import declare, descriptor
 
 DISCOVERY_PERIOD = 0.05  # s between looks at the graph for publishers of topics not yet recorded
 
@@ -94,18 +92,14 @@ class BagRecorder(Node):
     def __init__(self, **kwargs) -> None:
         super().__init__('bag_recorder', **kwargs)
 
-        def declare(name, default, description):
-            try:
-                return self.declare_parameter(name, default, ParameterDescriptor(
-                    description=description, read_only=True)).value
-            except ParameterException as err:  # e.g. rate:=10 for a double: say 10.0
-                raise StartupError(str(err)) from None
+        def param(name, default, description):
+            return declare(self, name, default, descriptor(description, read_only=True))
 
-        topics = declare('topics', Parameter.Type.STRING_ARRAY, 'topics to record') or []
-        output = declare('output', '', 'bag directory to create (must not exist)')
-        storage = declare('storage', 'mcap', f'storage plugin: {" or ".join(STORAGES)}')
-        duration = declare('duration', 0.0, 'stop after this many seconds; 0 = until SIGINT')
-        self.max_messages = declare('max_messages', 0,
+        topics = param('topics', Parameter.Type.STRING_ARRAY, 'topics to record') or []
+        output = param('output', '', 'bag directory to create (must not exist)')
+        storage = param('storage', 'mcap', f'storage plugin: {" or ".join(STORAGES)}')
+        duration = param('duration', 0.0, 'stop after this many seconds; 0 = until SIGINT')
+        self.max_messages = param('max_messages', 0,
                                     'stop after this many messages in all; 0 = no limit')
         if not topics:
             raise StartupError('parameter topics is empty: give the topics to record, e.g. '

@@ -41,9 +41,8 @@ import time
 from typing import Dict, List, Optional
 
 from builtin_interfaces.msg import Time
-from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
+from rcl_interfaces.msg import SetParametersResult
 from rclpy.duration import Duration
-from rclpy.exceptions import ParameterException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
@@ -54,6 +53,7 @@ from std_srvs.srv import Trigger
 from .bag_io import BagError, BagReader, TopicInfo
 from .bag_recorder import adapted_qos, message_class
 from .node_runner import StartupError, run
+from .parameters import declare, descriptor
 
 TICK = 0.001  # s, period of the scheduling timer
 DEPTH = 1000  # history depth of the publishers
@@ -86,23 +86,19 @@ class BagReplayer(Node):
     def __init__(self, **kwargs) -> None:
         super().__init__('bag_replayer', **kwargs)
 
-        def declare(name, default, description, read_only=True):
-            try:
-                return self.declare_parameter(name, default, ParameterDescriptor(
-                    description=description, read_only=read_only)).value
-            except ParameterException as err:  # e.g. rate:=10 for a double: say 10.0
-                raise StartupError(str(err)) from None
+        def param(name, default, description, read_only=True):
+            return declare(self, name, default, descriptor(description, read_only=read_only))
 
-        path = declare('bag', '', 'bag directory, or .mcap / .db3 file, to play')
-        self.rate = declare('rate', 1.0, 'playback speed factor (> 0)', read_only=False)
-        self.loop = declare('loop', False, 'start over at the end of the bag')
-        start_offset = declare('start_offset', 0.0, 'seconds of the bag to skip from its start')
-        topics = declare('topics', Parameter.Type.STRING_ARRAY,
+        path = param('bag', '', 'bag directory, or .mcap / .db3 file, to play')
+        self.rate = param('rate', 1.0, 'playback speed factor (> 0)', read_only=False)
+        self.loop = param('loop', False, 'start over at the end of the bag')
+        start_offset = param('start_offset', 0.0, 'seconds of the bag to skip from its start')
+        topics = param('topics', Parameter.Type.STRING_ARRAY,
                          'topics to play (default: all)') or []
-        remap = declare('remap', Parameter.Type.STRING_ARRAY, 'old:=new topic renames') or []
-        clock_hz = declare('clock_hz', 0.0, 'publish /clock at this rate when > 0')
-        delay = declare('delay', 0.0, 'seconds to wait before playing')
-        start_paused = declare('start_paused', False, 'start paused')
+        remap = param('remap', Parameter.Type.STRING_ARRAY, 'old:=new topic renames') or []
+        clock_hz = param('clock_hz', 0.0, 'publish /clock at this rate when > 0')
+        delay = param('delay', 0.0, 'seconds to wait before playing')
+        start_paused = param('start_paused', False, 'start paused')
         if not path:
             raise StartupError('parameter bag is required: the bag directory or .mcap/.db3 file')
         for name, value in (('start_offset', start_offset), ('clock_hz', clock_hz),

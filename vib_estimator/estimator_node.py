@@ -23,10 +23,8 @@ import time
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import WrenchStamped
-from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescriptor,
-                                SetParametersResult)
+from rcl_interfaces.msg import SetParametersResult
 from rclpy.clock import Clock, ClockType
-from rclpy.exceptions import ParameterException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, qos_profile_sensor_data
@@ -34,6 +32,7 @@ from std_msgs.msg import Float64, Header
 
 from .estimator import COUNTER_NAMES, EstimatorConfig, FrequencyEstimator
 from .node_runner import StartupError, run
+from .parameters import declare, descriptor
 from .wrench import COMPONENTS, check_component, component_getter, seconds_since, stamp_ns
 
 #: input history: sensor-data QoS (best effort) but 1000 deep instead of 5, so that a scheduling
@@ -50,22 +49,6 @@ HELD_BACK = ('rejected_at_rest', 'rejected_fit', 'rejected_nyquist', 'rejected_d
 
 #: the ROS parameters that configure the core, one per EstimatorConfig field
 CORE_NAMES = frozenset(EstimatorConfig.names())
-
-
-def _descriptor(description: str, bounds=None, read_only: bool = False) -> ParameterDescriptor:
-    """A ParameterDescriptor with an integer or floating-point range when ``bounds`` is given.
-
-    ``bounds`` is EstimatorConfig's (lo, hi, open_lo, open_hi); a descriptor range is closed, so
-    an open bound is enforced by EstimatorConfig.validate(), whose reason a refused change returns.
-    """
-    descriptor = ParameterDescriptor(description=description, read_only=read_only)
-    if bounds is not None and isinstance(bounds[0], int):
-        descriptor.integer_range = [IntegerRange(from_value=bounds[0], to_value=bounds[1],
-                                                 step=1)]
-    elif bounds is not None:
-        descriptor.floating_point_range = [FloatingPointRange(from_value=float(bounds[0]),
-                                                              to_value=float(bounds[1]))]
-    return descriptor
 
 
 def _config_value(value):
@@ -86,16 +69,15 @@ class EstimatorNode(Node):
 
     def __init__(self, **kwargs):
         super().__init__('estimator_node', **kwargs)
+        topic = declare(self, 'input_topic', 'coupling_torque', descriptor(
+            'input topic, geometry_msgs/msg/WrenchStamped', read_only=True))
+        self._component = declare(self, 'component', 'torque.z', descriptor(
+            f'field of the wrench to estimate on, one of {", ".join(COMPONENTS)}'))
+        self._declare_core_parameters()
         try:
-            topic = self.declare_parameter('input_topic', 'coupling_torque', _descriptor(
-                'input topic, geometry_msgs/msg/WrenchStamped', read_only=True)).value
-            self._component = self.declare_parameter(
-                'component', 'torque.z', _descriptor(
-                    f'field of the wrench to estimate on, one of {", ".join(COMPONENTS)}')).value
             self._value = component_getter(self._component)
-            self._declare_core_parameters()
             config = self._config_from_parameters()
-        except (ParameterException, ValueError) as err:
+        except ValueError as err:
             raise StartupError(str(err)) from None
         self._estimator = FrequencyEstimator(config)
         self._counter_base = dict.fromkeys(COUNTER_NAMES, 0)  # of the estimators replaced
@@ -133,12 +115,12 @@ class EstimatorNode(Node):
             if default is None:
                 # an optional array, off by default: rclpy cannot infer a type from [], so
                 # declare the type and store an empty array unless an override set a value
-                self.declare_parameter(name, Parameter.Type.DOUBLE_ARRAY,
-                                       _descriptor(description + ' ([] = off)'))
+                declare(self, name, Parameter.Type.DOUBLE_ARRAY,
+                        descriptor(description + ' ([] = off)'))
                 if self.get_parameter_or(name).type_ == Parameter.Type.NOT_SET:
                     self.set_parameters([Parameter(name, Parameter.Type.DOUBLE_ARRAY, [])])
             else:
-                self.declare_parameter(name, default, _descriptor(description, bounds))
+                declare(self, name, default, descriptor(description, bounds))
 
     def _config_from_parameters(self) -> EstimatorConfig:
         """The EstimatorConfig of the current parameter values (raises ValueError if invalid)."""

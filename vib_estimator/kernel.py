@@ -43,7 +43,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 from numba import njit
 
 # ---- parameter array layout (float64) -------------------------------------------------------

@@ -25,10 +25,8 @@ import time
 from typing import List, Sequence
 
 from geometry_msgs.msg import WrenchStamped
-from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescriptor,
-                                ParameterType, SetParametersResult)
+from rcl_interfaces.msg import ParameterType, SetParametersResult
 from rclpy.clock import Clock, ClockType
-from rclpy.exceptions import ParameterException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
@@ -38,6 +36,7 @@ from std_msgs.msg import Float64
 from .arm_model import (DEFAULT_NOISE_STD, ArmParameters, ArmSimulator, Move,
                         natural_frequency_hz)
 from .node_runner import StartupError, run
+from .parameters import declare, descriptor
 
 TICK_HZ = 200.0            # wall-clock rate of the publishing timer
 # A tick produces at most the larger of MAX_BATCH_SECONDS of simulated time and BATCH_TICKS ticks'
@@ -89,47 +88,37 @@ def schedule_from_array(values: Sequence[float]) -> List[Move]:
     return moves
 
 
-def _descriptor(description, lo=None, hi=None, read_only=False, integer=False, **kw):
-    ranges = {}
-    if lo is not None:
-        ranges = ({'integer_range': [IntegerRange(from_value=lo, to_value=hi, step=1)]} if integer
-                  else {'floating_point_range': [FloatingPointRange(from_value=lo, to_value=hi)]})
-    return ParameterDescriptor(description=description, read_only=read_only, **ranges, **kw)
-
-
 PARAMETERS = {
     # name: (default, descriptor)
-    'tip_mass_kg': (ArmParameters.tip_mass_kg, _descriptor(
+    'tip_mass_kg': (ArmParameters.tip_mass_kg, descriptor(
         'tip mass m of Eqs. 19/23, kg; changing it while running changes the frequency abruptly '
-        '(Section 5.5)', 0.001, 10.0)),
-    'rate_hz': (500.0, _descriptor('sample rate of coupling_torque, Hz (Section 5.2: 2 ms)',
-                                   10.0, 10000.0, read_only=True)),
-    'speed': (1.0, _descriptor('simulated seconds per wall-clock second; other than 1 the node '
+        '(Section 5.5)', (0.001, 10.0))),
+    'rate_hz': (500.0, descriptor('sample rate of coupling_torque, Hz (Section 5.2: 2 ms)',
+                                   (10.0, 10000.0), read_only=True)),
+    'speed': (1.0, descriptor('simulated seconds per wall-clock second; other than 1 the node '
                                'publishes /clock and stamps in simulated time from 1 s',
-                               0.01, 1000.0, read_only=True)),
-    'publish_clock': (False, _descriptor(
+                               (0.01, 1000.0), read_only=True)),
+    'publish_clock': (False, descriptor(
         'stamp in simulated time from 1 s and publish it on /clock even at speed 1 (always so at '
         'any other speed)', read_only=True)),
-    'damping_ratio': (ArmParameters.damping_ratio, _descriptor(
-        'damping ratio zeta of the bar mode (Eq. 24; 0.004 in Section 5.3)', 0.0, 0.5,
+    'damping_ratio': (ArmParameters.damping_ratio, descriptor(
+        'damping ratio zeta of the bar mode (Eq. 24; 0.004 in Section 5.3)', (0.0, 0.5),
         read_only=True)),
-    'noise_std': (DEFAULT_NOISE_STD, _descriptor(
-        'standard deviation of the strain-gauge noise on the torque, N m', 0.0, 10.0)),
-    'seed': (0, _descriptor('seed of the noise generator', 0, 2 ** 31 - 1, read_only=True,
-                            integer=True)),
-    'frame_id': ('arm_base', _descriptor('frame_id of the coupling_torque headers',
+    'noise_std': (DEFAULT_NOISE_STD, descriptor(
+        'standard deviation of the strain-gauge noise on the torque, N m', (0.0, 10.0))),
+    'seed': (0, descriptor('seed of the noise generator', (0, 2 ** 31 - 1), read_only=True)),
+    'frame_id': ('arm_base', descriptor('frame_id of the coupling_torque headers',
                                          read_only=True)),
-    'schedule': ([0.0, 1.0, 1.0, 0.0], _descriptor(
+    'schedule': ([0.0, 1.0, 1.0, 0.0], descriptor(
         'motor command as flat groups [start s, final_angle rad, slope rad/s, tip_mass_kg '
         '(0 = unchanged)]: from start, ramp towards final_angle at slope and set the tip mass; '
         'default: the Section 5.3 ramp of slope 1 to 1 rad', read_only=True,
         type=ParameterType.PARAMETER_DOUBLE_ARRAY)),
-    'wait_for_subscribers': (0, _descriptor(
+    'wait_for_subscribers': (0, descriptor(
         'the simulation starts when coupling_torque has this many subscribers (0 = at once), '
-        'so that a sped-up run loses no sample to discovery', 0, 1000, read_only=True,
-        integer=True)),
-    'duration': (0.0, _descriptor('simulated seconds after which the node exits 0 '
-                                  '(0 = run forever)', 0.0, 1e9, read_only=True)),
+        'so that a sped-up run loses no sample to discovery', (0, 1000), read_only=True)),
+    'duration': (0.0, descriptor('simulated seconds after which the node exits 0 '
+                                  '(0 = run forever)', (0.0, 1e9), read_only=True)),
 }
 
 
@@ -138,11 +127,8 @@ class SimNode(Node):
 
     def __init__(self, **kwargs):
         super().__init__('sim_node', **kwargs)
-        try:
-            for name, (default, descriptor) in PARAMETERS.items():
-                self.declare_parameter(name, default, descriptor)
-        except ParameterException as err:
-            raise StartupError(str(err)) from None
+        for name, (default, desc) in PARAMETERS.items():
+            declare(self, name, default, desc)
         p = {name: self.get_parameter(name).value for name in PARAMETERS}
         try:
             schedule = schedule_from_array(p['schedule'])
