@@ -16,9 +16,9 @@ from rclpy.qos import QoSProfile
 from rclpy.serialization import deserialize_message, serialize_message
 from std_msgs.msg import String
 
-from ros_helpers import spin_until
 from vib_estimator.bag_io import WRENCH_STAMPED, BagReader
 from vib_estimator.bag_recorder import BagRecorder
+from vib_estimator.node_runner import spin_until
 
 RECORDER = [sys.executable, '-m', 'vib_estimator.bag_recorder']
 

@@ -20,10 +20,10 @@ from rosgraph_msgs.msg import Clock
 from std_msgs.msg import Float64, String
 from std_srvs.srv import Trigger
 
-from ros_helpers import spin_until
 from vib_estimator.bag_io import (TYPESTORE, WRENCH_STAMPED, BagWriter, WrenchSeries,
                                   read_wrench_series, write_wrench_series)
 from vib_estimator.bag_replayer import BagReplayer
+from vib_estimator.node_runner import spin_until
 from vib_estimator.wrench import stamp_ns
 
 BAGS = Path(__file__).resolve().parents[1] / 'bags'

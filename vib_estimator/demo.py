@@ -192,7 +192,7 @@ def run(args: argparse.Namespace) -> int:
     import rclpy
     from rclpy.executors import ExternalShutdownException
 
-    from .node_runner import make_executor
+    from .node_runner import make_executor, spin_until
     from .plotting import plot_estimates
     from .sim_node import schedule_to_array
 
@@ -215,21 +215,12 @@ def run(args: argparse.Namespace) -> int:
     executor.add_node(listener.node)
     procs: List[subprocess.Popen] = []
 
-    def spin_until(predicate, timeout):
-        """Spin until predicate() or timeout; Ctrl-C (rclpy shuts the context) raises."""
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline and not predicate():
-            if not context.ok():
-                raise KeyboardInterrupt
-            executor.spin_once(timeout_sec=0.02)
-        return predicate()
-
     try:
         print(f'demo: ROS domain {domain}, {duration:g} s simulated at {args.speed:g}x, tip masses '
               + ' -> '.join(f'{m * 1e3:g} g' for m in MASSES_5_5), flush=True)
         estimator = _start('estimator_node', ['use_sim_time:=true'], env)
         procs.append(estimator)
-        up = spin_until(lambda: estimator.poll() is not None or (
+        up = spin_until(executor, lambda: estimator.poll() is not None or (
             listener.counts('vibration/frequency')[0] and listener.counts('coupling_torque')[1]),
             STARTUP_TIMEOUT)
         if not up or estimator.poll() is not None:
@@ -239,8 +230,9 @@ def run(args: argparse.Namespace) -> int:
                                   'publish_clock:=true', 'wait_for_subscribers:=2',
                                   'schedule:=[' + ', '.join(map(repr, schedule)) + ']'], env)
         procs.append(sim)
-        spin_until(lambda: sim.poll() is not None, STARTUP_TIMEOUT + duration / args.speed)
-        spin_until(lambda: False, 0.5)   # the last messages in flight
+        spin_until(executor, lambda: sim.poll() is not None,
+                   STARTUP_TIMEOUT + duration / args.speed)
+        spin_until(executor, lambda: False, 0.5)   # the last messages in flight
         if sim.returncode != 0:
             print('error: sim_node ' + ('did not finish in time' if sim.returncode is None
                                         else f'exited with {sim.returncode}'), file=sys.stderr)

@@ -9,6 +9,7 @@ workload (see the README's figures).
 from __future__ import annotations
 
 import sys
+import time
 from typing import Callable, Optional, Sequence
 
 import rclpy
@@ -27,6 +28,19 @@ class StartupError(Exception):
 def make_executor(context=None):
     """Return the executor the package's nodes spin in (one place to change it)."""
     return EventsExecutor(context=context)
+
+
+def spin_until(executor, predicate: Callable[[], bool], timeout: float) -> bool:
+    """Spin ``executor`` until ``predicate()`` holds or ``timeout`` s pass; return ``predicate()``.
+
+    Raises ``ExternalShutdownException`` when the executor's context is shut down (Ctrl-C).
+    """
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline and not predicate():
+        if not executor.context.ok():
+            raise ExternalShutdownException()
+        executor.spin_once(timeout_sec=0.01)
+    return predicate()
 
 
 def run(factory: Callable[[], Node], args: Optional[Sequence[str]] = None,
