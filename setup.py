@@ -29,10 +29,10 @@ setup(
     entry_points={
         'console_scripts': [
             'vib-estimator = vib_estimator.cli:main',
-            'estimator_node = vib_estimator.estimator_node:main',
-            'sim_node = vib_estimator.sim_node:main',
-            'bag_replayer = vib_estimator.bag_replayer:main',
-            'bag_recorder = vib_estimator.bag_recorder:main',
+            'estimator_node = vib_estimator.nodes.estimator_node:main',
+            'sim_node = vib_estimator.nodes.sim_node:main',
+            'bag_replayer = vib_estimator.nodes.bag_replayer:main',
+            'bag_recorder = vib_estimator.nodes.bag_recorder:main',
         ],
     },
 )

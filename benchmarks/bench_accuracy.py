@@ -7,7 +7,7 @@ prints the worst relative error of any published estimate, for fs/f >= 100 and 2
 """
 import numpy as np
 
-from vib_estimator.estimator import EstimatorConfig, estimate
+from vib_estimator.core import EstimatorConfig, estimate
 
 
 def cases(n=300, seed=0):

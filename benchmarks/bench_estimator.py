@@ -11,7 +11,7 @@ import time
 
 import numpy as np
 
-from vib_estimator.estimator import FrequencyEstimator
+from vib_estimator.core import FrequencyEstimator
 
 
 def best(fn, repeats=3):

@@ -34,7 +34,7 @@ os.environ.setdefault('ROS_DOMAIN_ID', str(100 + os.getpid() % 100))
 os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
 
 # the node's own input history, used for the empty subscriber too (imported after the env is set)
-from vib_estimator.estimator_node import INPUT_DEPTH as DEPTH  # noqa: E402
+from vib_estimator.nodes.estimator_node import INPUT_DEPTH as DEPTH  # noqa: E402
 
 RATES = [1000, 2000, 3000, 4500, 6500, 9000, 11000, 13000, 15000, 17500, 20000, 25000, 35000]
 TRIAL_S = 1.0
@@ -84,7 +84,7 @@ def make_subscriber(kind, context, topic, depth):
     from rclpy.parameter import Parameter
     from rclpy.qos import QoSProfile, qos_profile_sensor_data
 
-    import vib_estimator.estimator_node as en
+    import vib_estimator.nodes.estimator_node as en
 
     if kind == 'empty':
         node = Node('empty_subscriber', context=context)

@@ -14,8 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
-from vib_estimator.csv_io import read_csv_series
-from vib_estimator.estimator import EstimatorConfig, estimate
+from vib_estimator.io.csv_reader import read_csv_series
+from vib_estimator.core import EstimatorConfig, estimate
 
 #: reference first-mode frequencies (Hz): this file's own FFT, per SOURCE.md
 REFERENCE = {30: 16.360, 40: 9.392, 50: 6.054, 60: 4.268}

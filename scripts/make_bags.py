@@ -5,9 +5,9 @@
 
 Writes three rosbag2 directories with MCAP storage (see ``bags/README.md``):
 
-* ``arm_5_3``  -- Section 5.3 / Fig. 5: :func:`vib_estimator.arm_model.experiment_5_3`;
-* ``arm_5_5``  -- Section 5.5 / Fig. 7: :func:`vib_estimator.arm_model.experiment_5_5`;
-* ``fig1``     -- Section 4 / Fig. 1: :func:`vib_estimator.signals.fig1_signal`.
+* ``arm_5_3``  -- Section 5.3 / Fig. 5: :func:`vib_estimator.sim.arm_model.experiment_5_3`;
+* ``arm_5_5``  -- Section 5.5 / Fig. 7: :func:`vib_estimator.sim.arm_model.experiment_5_5`;
+* ``fig1``     -- Section 4 / Fig. 1: :func:`vib_estimator.sim.signals.fig1_signal`.
 
 Each holds ``/coupling_torque`` (``geometry_msgs/msg/WrenchStamped``, the signal in ``torque.z``,
 frame ``arm_base``) and ``/vibration/ground_truth`` (``std_msgs/msg/Float64``, the true natural
@@ -24,9 +24,9 @@ from pathlib import Path
 
 import numpy as np
 
-from vib_estimator import arm_model
-from vib_estimator.bag_io import TYPESTORE, WRENCH_STAMPED, BagWriter, wrench_message
-from vib_estimator.signals import fig1_signal
+from vib_estimator.sim import arm_model
+from vib_estimator.io.bags import TYPESTORE, WRENCH_STAMPED, BagWriter, wrench_message
+from vib_estimator.sim.signals import fig1_signal
 
 EPOCH_NS = 1_700_000_000 * 1_000_000_000  # 2023-11-14 22:13:20 UTC, time of the first sample
 TOPIC = '/coupling_torque'

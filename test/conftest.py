@@ -31,7 +31,7 @@ def ros_context():
 @pytest.fixture
 def executor(ros_context):
     """The package's executor, bound to the test's context."""
-    from vib_estimator.node_runner import make_executor
+    from vib_estimator.nodes.runner import make_executor
 
     ex = make_executor(context=ros_context)
     yield ex

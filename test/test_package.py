@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from vib_estimator.bag_io import read_wrench_series
+from vib_estimator.io.bags import read_wrench_series
 
 ROOT = Path(__file__).resolve().parents[1]
 EXECUTABLES = ['vib-estimator', 'estimator_node', 'sim_node', 'bag_replayer', 'bag_recorder']
@@ -23,7 +23,7 @@ def test_package_xml_declares_every_ros_package_the_code_imports():
     assert root.find('export/build_type').text == 'ament_python'
     declared = {e.text for e in root if e.tag in ('exec_depend', 'depend')}
     imported = set()
-    for path in (ROOT / 'vib_estimator').glob('*.py'):
+    for path in (ROOT / 'vib_estimator').rglob('*.py'):
         for node in ast.walk(ast.parse(path.read_text())):
             if isinstance(node, ast.Import):
                 imported |= {a.name.split('.')[0] for a in node.names}

@@ -12,10 +12,10 @@ import sys
 from typing import Optional, Sequence
 
 COMMANDS = {
-    'analyze': ('vib_estimator.analyze', 'estimate frequencies in a recorded signal (CSV, MCAP, '
+    'analyze': ('vib_estimator.analysis.analyze', 'estimate frequencies in a recorded signal (CSV, MCAP, '
                 'rosbag2)'),
-    'reproduce': ('vib_estimator.reproduce', "reproduce the paper's Figs. 1 and 2"),
-    'compare': ('vib_estimator.compare', 'algebraic vs adaptive/FFT estimators (Table 2, Figs. 6-7, '
+    'reproduce': ('vib_estimator.analysis.reproduce', "reproduce the paper's Figs. 1 and 2"),
+    'compare': ('vib_estimator.analysis.compare', 'algebraic vs adaptive/FFT estimators (Table 2, Figs. 6-7, '
                 'Cramer-Rao bound)'),
     'demo': ('vib_estimator.demo', 'live demo: simulator + estimator node, three tip masses'),
 }

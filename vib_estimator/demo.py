@@ -29,7 +29,7 @@ from typing import List, Tuple
 
 import numpy as np
 
-from .arm_model import MASSES_5_5, natural_frequency_hz, schedule_5_5
+from .sim.arm_model import MASSES_5_5, natural_frequency_hz, schedule_5_5
 
 #: exit criterion: every mass's median |error| within this (%)
 MAX_MEDIAN_ERROR_PCT = 3.0
@@ -112,8 +112,8 @@ class Listener:
         from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
         from std_msgs.msg import Float64, Header
 
-        from .sim_node import SIM_TIME_ORIGIN_NS
-        from .wrench import seconds_since, stamp_ns
+        from .nodes.sim_node import SIM_TIME_ORIGIN_NS
+        from .io.fields import seconds_since, stamp_ns
 
         self._stamp_ns, self._seconds_since = stamp_ns, seconds_since
         self._origin = SIM_TIME_ORIGIN_NS
@@ -192,9 +192,9 @@ def run(args: argparse.Namespace) -> int:
     import rclpy
     from rclpy.executors import ExternalShutdownException
 
-    from .node_runner import make_executor, spin_until
-    from .plotting import plot_estimates
-    from .sim_node import schedule_to_array
+    from .nodes.runner import make_executor, spin_until
+    from .analysis.plotting import plot_estimates
+    from .nodes.sim_node import schedule_to_array
 
     if args.speed <= 0 or args.seconds_per_mass <= 2:
         print('error: --speed must be > 0 and --seconds-per-mass > 2', file=sys.stderr)

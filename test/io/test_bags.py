@@ -7,11 +7,11 @@ import numpy as np
 import pytest
 from mcap.reader import make_reader
 
-from vib_estimator.bag_io import (TYPESTORE, WRENCH_STAMPED, BagError, BagReader, BagWriter,
+from vib_estimator.io.bags import (TYPESTORE, WRENCH_STAMPED, BagError, BagReader, BagWriter,
                                   WrenchSeries, read_wrench_series, wrench_message,
                                   write_wrench_series)
 
-BAGS = Path(__file__).resolve().parents[1] / 'bags'
+BAGS = Path(__file__).resolve().parents[2] / 'bags'
 
 #: shipped bag -> (samples on /coupling_torque, ground-truth messages, true frequencies in Hz)
 SHIPPED = {

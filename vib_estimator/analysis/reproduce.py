@@ -19,8 +19,8 @@ from typing import List
 
 import numpy as np
 
-from .estimator import EstimatorConfig, FrequencyEstimator
-from .signals import fig1_signal, normalised_damped_sine
+from ..core import EstimatorConfig, FrequencyEstimator
+from ..sim.signals import fig1_signal, normalised_damped_sine
 
 FIG1_WC = 15.0                     # rad/s
 #: s; the paper gives neither the solver step nor the noise's hold time. At 0.1 ms the noise is

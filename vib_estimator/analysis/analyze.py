@@ -14,9 +14,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .csv_io import CsvError, read_csv_series
-from .estimator import MODELS, COUNTER_NAMES, EstimatorConfig, FrequencyEstimator
-from .wrench import COMPONENTS, seconds_since
+from ..io.csv_reader import CsvError, read_csv_series
+from ..core import MODELS, COUNTER_NAMES, EstimatorConfig, FrequencyEstimator
+from ..io.fields import COMPONENTS, seconds_since
 
 #: CLI option -> EstimatorConfig field for the estimator's scalar parameters
 _CONFIG_OPTIONS = {
@@ -52,7 +52,7 @@ def _load(args):
         return series.t, series.y, None, series.name
     if not path.exists():
         raise ValueError(f'no such file or directory: {path}')
-    from .bag_io import read_wrench_series
+    from ..io.bags import read_wrench_series
 
     series = read_wrench_series(path, args.topic, args.component)
     if len(series) == 0:
@@ -86,7 +86,7 @@ def _print(estimates, origin, fmt) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from .bag_io import BagError
+    from ..io.bags import BagError
 
     try:
         config = EstimatorConfig().replace(

@@ -21,10 +21,10 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from std_msgs.msg import Float64, Header
 
-from vib_estimator.estimator import EstimatorConfig, FrequencyEstimator
-from vib_estimator.estimator_node import EstimatorNode
-from vib_estimator.node_runner import spin_until
-from vib_estimator.wrench import seconds_since
+from vib_estimator.core import EstimatorConfig, FrequencyEstimator
+from vib_estimator.nodes.estimator_node import EstimatorNode
+from vib_estimator.nodes.runner import spin_until
+from vib_estimator.io.fields import seconds_since
 
 EPOCH_NS = 1_000_000_000 * 1_000_000_000   # synthetic stamps start in 2001, far from "now"
 FS = 500.0

@@ -3,7 +3,7 @@
 A stand-in for ``ros2 bag record`` where only rclpy is installed. Each topic of ``topics`` is
 subscribed once a publisher of it appears on the graph (its type is taken from the graph), with a
 raw subscription, so messages are stored as the CDR bytes received, never deserialised. The bag is
-a rosbag2 directory written by :class:`vib_estimator.bag_io.BagWriter`; log time = receive time on
+a rosbag2 directory written by :class:`vib_estimator.io.bags.BagWriter`; log time = receive time on
 the node's clock, as rosbag2 does. The publishers' offered QoS profiles are recorded per topic.
 
 Loss: the subscriptions are KEEP_ALL and, when every publisher of the topic is reliable, reliable
@@ -34,8 +34,8 @@ from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPo
 from rosbags.interfaces import (Qos, QosDurability, QosHistory, QosLiveliness, QosReliability,
                                 QosTime)
 
-from .bag_io import BagError, BagWriter, STORAGES
-from .node_runner import StartupError, run
+from ..io.bags import BagError, BagWriter, STORAGES
+from .runner import StartupError, run
 from .parameters import declare, descriptor
 
 DISCOVERY_PERIOD = 0.05  # s between looks at the graph for publishers of topics not yet recorded

@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from vib_estimator.estimator import EstimatorConfig, FrequencyEstimator, estimate
-from vib_estimator.signals import fig1_signal
+from vib_estimator.core import EstimatorConfig, FrequencyEstimator, estimate
+from vib_estimator.sim.signals import fig1_signal
 
 
 def sine(t, f, amplitude=1.0, phase=0.0, offset=0.0):

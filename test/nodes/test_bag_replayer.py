@@ -20,14 +20,14 @@ from rosgraph_msgs.msg import Clock
 from std_msgs.msg import Float64, String
 from std_srvs.srv import Trigger
 
-from vib_estimator.bag_io import (TYPESTORE, WRENCH_STAMPED, BagWriter, WrenchSeries,
+from vib_estimator.io.bags import (TYPESTORE, WRENCH_STAMPED, BagWriter, WrenchSeries,
                                   read_wrench_series, write_wrench_series)
-from vib_estimator.bag_replayer import BagReplayer
-from vib_estimator.node_runner import spin_until
-from vib_estimator.wrench import stamp_ns
+from vib_estimator.nodes.bag_replayer import BagReplayer
+from vib_estimator.nodes.runner import spin_until
+from vib_estimator.io.fields import stamp_ns
 
-BAGS = Path(__file__).resolve().parents[1] / 'bags'
-REPLAYER = [sys.executable, '-m', 'vib_estimator.bag_replayer']
+BAGS = Path(__file__).resolve().parents[2] / 'bags'
+REPLAYER = [sys.executable, '-m', 'vib_estimator.nodes.bag_replayer']
 
 
 def wrench_bag(path, n, rate_hz, topic='/coupling_torque', storage='mcap'):
@@ -246,7 +246,7 @@ def test_executable_plays_to_the_end_and_exits_0(tmp_path):
 
 def test_replay_into_estimator_node_matches_analyze(ros_context, executor, monkeypatch, capsys):
     """The estimator node fed by the replayer gives the floats ``vib-estimator analyze`` gives."""
-    from vib_estimator import estimator_node
+    from vib_estimator.nodes import estimator_node
     from vib_estimator.cli import main
 
     series = read_wrench_series(BAGS / 'arm_5_3')
@@ -277,7 +277,7 @@ def test_replay_into_estimator_node_matches_analyze(ros_context, executor, monke
 
 def test_looping_bag_resets_the_estimator_and_estimates_go_on(ros_context, executor, tmp_path):
     """Each loop sends the stamps back by the bag's length: the node restarts, then estimates."""
-    from vib_estimator.estimator_node import EstimatorNode
+    from vib_estimator.nodes.estimator_node import EstimatorNode
 
     stamps = 1_700_000_000 * 10 ** 9 + np.arange(1500, dtype=np.int64) * 2_000_000   # 3 s
     values = 0.3 * np.sin(2 * np.pi * 1.33 * (stamps - stamps[0]) * 1e-9)

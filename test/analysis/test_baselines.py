@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from vib_estimator.baselines import Hou, MojiriBakhshai, SlidingDFT, ZiaraniKonrad, hold_last
-from vib_estimator.cramer_rao import crlb_frequency_std, fisher_frequency_std, window_crlb_std
+from vib_estimator.analysis.baselines import Hou, MojiriBakhshai, SlidingDFT, ZiaraniKonrad, hold_last
+from vib_estimator.analysis.bounds import crlb_frequency_std, fisher_frequency_std, window_crlb_std
 
 FS = 500.0
 ODE_TRACKERS = (ZiaraniKonrad, Hou, MojiriBakhshai)

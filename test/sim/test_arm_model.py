@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from vib_estimator.arm_model import (MASSES_5_5, ArmParameters, ArmSimulator, Move,
+from vib_estimator.sim.arm_model import (MASSES_5_5, ArmParameters, ArmSimulator, Move,
                                      experiment_5_3, experiment_5_5, natural_frequency_hz,
                                      schedule_5_5, simulate)
 

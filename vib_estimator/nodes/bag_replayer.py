@@ -50,9 +50,9 @@ from rosbags.interfaces import QosDurability, QosReliability
 from rosgraph_msgs.msg import Clock
 from std_srvs.srv import Trigger
 
-from .bag_io import BagError, BagReader, TopicInfo
+from ..io.bags import BagError, BagReader, TopicInfo
 from .bag_recorder import adapted_qos, message_class
-from .node_runner import StartupError, run
+from .runner import StartupError, run
 from .parameters import declare, descriptor
 
 TICK = 0.001  # s, period of the scheduling timer

@@ -36,7 +36,7 @@ from rosbags.interfaces import (Connection, ConnectionExtRosbag2, Qos, QosDurabi
 from rosbags.rosbag2 import Reader, StoragePlugin, Writer
 from rosbags.typesys import Stores, get_typestore
 
-from .wrench import check_component, component_getter, stamp_ns
+from .fields import check_component, component_getter, stamp_ns
 
 WRENCH_STAMPED = 'geometry_msgs/msg/WrenchStamped'
 

@@ -1,7 +1,7 @@
 """The paper's Figs. 1 and 2, reproduced (``vib-estimator reproduce``)."""
 import numpy as np
 
-from vib_estimator import reproduce
+from vib_estimator.analysis import reproduce
 from vib_estimator.cli import main
 
 

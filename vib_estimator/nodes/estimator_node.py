@@ -30,10 +30,10 @@ from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, qos_profile_sensor_data
 from std_msgs.msg import Float64, Header
 
-from .estimator import COUNTER_NAMES, EstimatorConfig, FrequencyEstimator
-from .node_runner import StartupError, run
+from ..core import COUNTER_NAMES, EstimatorConfig, FrequencyEstimator
+from .runner import StartupError, run
 from .parameters import declare, descriptor
-from .wrench import COMPONENTS, check_component, component_getter, seconds_since, stamp_ns
+from ..io.fields import COMPONENTS, check_component, component_getter, seconds_since, stamp_ns
 
 #: input history: sensor-data QoS (best effort) but 1000 deep instead of 5, so that a scheduling
 #: hiccup of up to 2 s at 500 Hz, or a player's burst after a stall, drops nothing

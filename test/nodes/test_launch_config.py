@@ -12,10 +12,10 @@ from pathlib import Path
 import rclpy
 import yaml
 
-from vib_estimator.estimator import EstimatorConfig
-from vib_estimator.estimator_node import EstimatorNode
+from vib_estimator.core import EstimatorConfig
+from vib_estimator.nodes.estimator_node import EstimatorNode
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 PARAMS = ROOT / 'config' / 'estimator.yaml'
 LAUNCH = ROOT / 'launch' / 'estimator.launch.py'
 

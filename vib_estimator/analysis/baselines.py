@@ -1,6 +1,6 @@
 """Baseline frequency trackers of Section 5.4, and a flight-controller-style windowed-DFT tracker.
 
-Every tracker has the streaming/batch shape of :class:`vib_estimator.estimator.FrequencyEstimator`:
+Every tracker has the streaming/batch shape of :class:`vib_estimator.core.estimator.FrequencyEstimator`:
 ``update(t, y)`` feeds one sample and returns the current estimate in Hz (a float at every sample,
 ``None`` while the tracker has none), ``reset()`` forgets the signal, and ``process(t, y)`` feeds
 arrays and returns the per-sample estimates (NaN where ``update`` returns ``None``), the same floats

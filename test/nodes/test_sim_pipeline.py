@@ -15,10 +15,10 @@ from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Float64, Header
 
-from vib_estimator.arm_model import MASSES_5_5, natural_frequency_hz, schedule_5_5
-from vib_estimator.estimator_node import EstimatorNode
-from vib_estimator.node_runner import StartupError, make_executor, spin_until
-from vib_estimator.sim_node import (SIM_TIME_ORIGIN_NS, SimNode, schedule_from_array,
+from vib_estimator.sim.arm_model import MASSES_5_5, natural_frequency_hz, schedule_5_5
+from vib_estimator.nodes.estimator_node import EstimatorNode
+from vib_estimator.nodes.runner import StartupError, make_executor, spin_until
+from vib_estimator.nodes.sim_node import (SIM_TIME_ORIGIN_NS, SimNode, schedule_from_array,
                                     schedule_to_array)
 
 SECONDS_PER_MASS = 6.0

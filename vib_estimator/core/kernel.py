@@ -1,9 +1,9 @@
 """Compiled per-sample step of the algebraic estimator (numba; no rclpy, no Python objects).
 
-This module holds the arithmetic of :mod:`vib_estimator.estimator` as one function, :func:`step`,
+This module holds the arithmetic of :mod:`vib_estimator.core.estimator` as one function, :func:`step`,
 that both the streaming API (one call per sample) and the batch API (:func:`run`, a compiled loop
 over arrays) execute, so the two give the same floats. The state lives in three flat arrays whose
-layout is the constants below; :class:`vib_estimator.estimator.FrequencyEstimator` owns them.
+layout is the constants below; :class:`vib_estimator.core.estimator.FrequencyEstimator` owns them.
 
 Mathematics (equation numbers are those of Trapero, Sira-Ramirez & Feliu):
 
@@ -27,7 +27,7 @@ Mathematics (equation numbers are those of Trapero, Sira-Ramirez & Feliu):
   interpolates the last NH = 8 samples (a causal Adams-Moulton-type rule, local error O(h^9),
   valid for irregular steps). A trapezoid makes early estimates of a clean sine percent-wrong
   because ``n`` is a difference of terms that cancel to O(tau^4); this rule makes them exact to
-  ~1e-8 at 100 samples per period (see :mod:`vib_estimator.estimator` for the error budget).
+  ~1e-8 at 100 samples per period (see :mod:`vib_estimator.core.estimator` for the error budget).
 * Invariant filtering (Eqs. 9-11): ``n`` and ``d`` pass through the same second-order low-pass,
   discretised exactly for a first-order-hold input over each real sampling interval, so irregular
   sampling is handled and ``n_f / d_f`` stays exactly ``w^2`` for a pure sinusoid.

@@ -1,4 +1,4 @@
-"""``sim_node``: the flexible arm of Section 5 (:mod:`vib_estimator.arm_model`) as a ROS 2 node.
+"""``sim_node``: the flexible arm of Section 5 (:mod:`vib_estimator.sim.arm_model`) as a ROS 2 node.
 
 Publishes the measured coupling torque (Eq. 21, scaled as in Fig. 5) as
 ``geometry_msgs/WrenchStamped`` on ``coupling_torque`` (``torque.z``) at ``rate_hz``, and the Eq. 23
@@ -33,9 +33,9 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock as ClockMsg
 from std_msgs.msg import Float64
 
-from .arm_model import (DEFAULT_NOISE_STD, ArmParameters, ArmSimulator, Move,
+from ..sim.arm_model import (DEFAULT_NOISE_STD, ArmParameters, ArmSimulator, Move,
                         natural_frequency_hz)
-from .node_runner import StartupError, run
+from .runner import StartupError, run
 from .parameters import declare, descriptor
 
 TICK_HZ = 200.0            # wall-clock rate of the publishing timer

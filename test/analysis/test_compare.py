@@ -6,7 +6,9 @@ import math
 
 import numpy as np
 
-from vib_estimator import arm_model, cli, compare
+from vib_estimator.sim import arm_model
+from vib_estimator import cli
+from vib_estimator.analysis import compare
 
 
 def test_segments_of_the_three_mass_experiment():

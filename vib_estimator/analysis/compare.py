@@ -25,7 +25,7 @@ stretch of constant true frequency is a *segment*. Definitions (per method, case
   current value, the algebraic method's latest published estimate (held). Median over the seeds
   where it happens; ``ok`` is the fraction of seeds where it does within the segment;
 * ``CRLB``: the Cramer-Rao bound on the std for the data each method used, from the exact Fisher
-  information (:func:`vib_estimator.cramer_rao.window_crlb_std`): for the algebraic method the
+  information (:func:`vib_estimator.analysis.bounds.window_crlb_std`): for the algebraic method the
   samples of each estimate's segment (RMS of the per-estimate bounds, the bound on the pooled
   variance); for a tracker, the samples from the segment's start to its ``tracked`` instant (the
   data it needed to converge; NaN when it never does). ``std/CRLB`` is the measured std over that;
@@ -45,11 +45,11 @@ from typing import Callable, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from . import arm_model
+from ..sim import arm_model
 from .baselines import Hou, MojiriBakhshai, SlidingDFT, ZiaraniKonrad, hold_last
-from .cramer_rao import window_crlb_std
-from .estimator import EstimatorConfig, FrequencyEstimator
-from .signals import fig1_signal
+from .bounds import window_crlb_std
+from ..core import EstimatorConfig, FrequencyEstimator
+from ..sim.signals import fig1_signal
 
 TOLERANCE = 0.02
 OUTLIER = 0.05

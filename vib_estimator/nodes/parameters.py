@@ -1,5 +1,5 @@
 """Parameter declaration shared by the package's nodes: descriptors with ranges, and one place
-where a value the node cannot start with becomes a :class:`~vib_estimator.node_runner.StartupError`.
+where a value the node cannot start with becomes a :class:`~vib_estimator.nodes.runner.StartupError`.
 """
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescri
 from rclpy.exceptions import ParameterException
 from rclpy.node import Node
 
-from .node_runner import StartupError
+from .runner import StartupError
 
 
 def descriptor(description: str, bounds: Optional[Sequence] = None, read_only: bool = False,

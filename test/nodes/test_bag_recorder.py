@@ -16,11 +16,11 @@ from rclpy.qos import QoSProfile
 from rclpy.serialization import deserialize_message, serialize_message
 from std_msgs.msg import String
 
-from vib_estimator.bag_io import WRENCH_STAMPED, BagReader
-from vib_estimator.bag_recorder import BagRecorder
-from vib_estimator.node_runner import spin_until
+from vib_estimator.io.bags import WRENCH_STAMPED, BagReader
+from vib_estimator.nodes.bag_recorder import BagRecorder
+from vib_estimator.nodes.runner import spin_until
 
-RECORDER = [sys.executable, '-m', 'vib_estimator.bag_recorder']
+RECORDER = [sys.executable, '-m', 'vib_estimator.nodes.bag_recorder']
 
 
 def recorder_process(output, topic, *params):

@@ -4,10 +4,10 @@ import json
 import numpy as np
 import pytest
 
-from vib_estimator.bag_io import WrenchSeries, write_wrench_series
+from vib_estimator.io.bags import WrenchSeries, write_wrench_series
 from vib_estimator.cli import main
-from vib_estimator.estimator import EstimatorConfig, estimate
-from vib_estimator.wrench import seconds_since
+from vib_estimator.core import EstimatorConfig, estimate
+from vib_estimator.io.fields import seconds_since
 
 
 @pytest.fixture

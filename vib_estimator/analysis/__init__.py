@@ -1,0 +1,1 @@
+"""Offline studies and commands: analyze, reproduce, compare, baselines, Cramer-Rao bounds, plots."""
