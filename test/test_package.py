@@ -13,7 +13,7 @@ from vib_estimator.io.bags import read_wrench_series
 ROOT = Path(__file__).resolve().parents[1]
 EXECUTABLES = ['vib-estimator', 'estimator_node', 'sim_node', 'bag_replayer', 'bag_recorder']
 #: ROS packages the code may import, by the name package.xml must declare
-ROS_PACKAGES = {'rclpy', 'std_msgs', 'geometry_msgs', 'diagnostic_msgs', 'rosgraph_msgs',
+ROS_PACKAGES = {'rclpy', 'std_msgs', 'geometry_msgs', 'sensor_msgs', 'diagnostic_msgs', 'rosgraph_msgs',
                 'std_srvs', 'rcl_interfaces', 'builtin_interfaces'}
 
 

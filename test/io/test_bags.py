@@ -54,7 +54,7 @@ def test_other_component_and_topic_choice(tmp_path):
     read = read_wrench_series(tmp_path / 'bag', '/wrist', 'force.y')
     np.testing.assert_array_equal(read.values, written.values)
     assert not read_wrench_series(tmp_path / 'bag', '/wrist', 'torque.z').values.any()
-    with pytest.raises(ValueError, match='component must be one of'):
+    with pytest.raises(ValueError, match='component of geometry_msgs/msg/WrenchStamped must be one of'):
         read_wrench_series(tmp_path / 'bag', component='torque.w')
 
 

@@ -15,14 +15,16 @@ from pathlib import Path
 import numpy as np
 
 from ..io.csv_reader import CsvError, read_csv_series
-from ..core import MODELS, COUNTER_NAMES, EstimatorConfig, FrequencyEstimator
+from ..core import MODELS, COUNTER_NAMES, EstimatorConfig
+from ..core.modes import create_estimator
 from ..io.fields import COMPONENTS, seconds_since
 
 #: CLI option -> EstimatorConfig field for the estimator's scalar parameters
 _CONFIG_OPTIONS = {
     'lowpass_cutoff_hz': float, 'lowpass_damping': float, 'window': int, 'tolerance': float,
     'min_time': float, 'min_periods': float, 'max_window': float, 'min_fit': float,
-    'min_amplitude': float, 'max_damping': float, 'max_gap': float,
+    'min_amplitude': float, 'max_damping': float, 'max_gap': float, 'target_std_rel': float,
+    'modes': int,
 }
 
 
@@ -99,11 +101,11 @@ def run(args: argparse.Namespace) -> int:
         if bad.size:
             i = int(bad[0]) + 1
             raise ValueError(f'{args.input}: time is not strictly increasing at sample {i} '
-                             f'(t = {t[i - 1]!r} then {t[i]!r})')
+                             f'(t = {float(t[i - 1])!r} then {float(t[i])!r})')
     except (CsvError, BagError, ValueError) as err:
         print(f'vib-estimator analyze: error: {err}', file=sys.stderr)
         return 2
-    estimator = FrequencyEstimator(config)
+    estimator = create_estimator(config)
     estimates = estimator.process(t, y)
     _print(estimates, origin, args.format)
     counters = estimator.counters

@@ -50,7 +50,7 @@ class EstimatorConfig:
     min_samples: int = _param(16, 'samples a segment must hold before the test may fire',
                               1, 10 ** 8)
     min_periods: float = _param(0.5, 'the test may fire only once the segment spans this '
-                                'fraction of the period it estimates (0 = off)', 0.0, 10.0)
+                                'many periods of the frequency it estimates (0 = off)', 0.0, 50.0)
     invariant_filter: bool = _param(True, 'false computes n/d unfiltered (Fig. 1, lower trace)')
     one_sided_test: bool = _param(False, 'Eq. 16 exactly as printed, (MA(k) - MA(k-M))/MA(k) < '
                                   'tolerance, which accepts any falling estimate')
@@ -71,6 +71,11 @@ class EstimatorConfig:
     max_gap: float = _param(0.5, 'a gap, or a backward jump, between stamps longer than this '
                             '(s) restarts the estimator; a smaller step back is skipped',
                             0.0, INF, open_lo=True, open_hi=True)
+    target_std_rel: float = _param(0.0, 'publish as soon as the predicted relative standard '
+                                   'deviation of the frequency is at or below this, whatever the '
+                                   'period fraction (0 = off)', 0.0, 1.0)
+    modes: int = _param(0, 'modes to find and track, each with its own estimator (0 = one '
+                        'estimator on the whole, optionally band-limited, signal)', 0, 8)
     buffer_samples: int = _param(200_000, 'segment buffer of the quality gate; a longer segment '
                                  'resets', 1, 10 ** 8)
 

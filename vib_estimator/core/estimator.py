@@ -52,6 +52,9 @@ class Estimate:
         fit: R^2 of the sinusoid at this frequency over the segment (quality gate).
         amplitude: amplitude of that sinusoid, signal units.
         damping: damping ratio (``damped-sinusoid`` model; NaN for the others).
+        frequency_std_hz: predicted standard deviation of ``frequency_hz`` (NaN if not computed).
+        damping_std: predicted standard deviation of ``damping`` (NaN if not computed).
+        mode: the mode it belongs to, 1 = the lowest (``modes`` >= 1); 0 with ``modes`` = 0.
     """
 
     t: float
@@ -61,6 +64,9 @@ class Estimate:
     fit: float
     amplitude: float
     damping: float = math.nan
+    frequency_std_hz: float = math.nan
+    damping_std: float = math.nan
+    mode: int = 0
 
     @property
     def omega(self) -> float:
@@ -70,7 +76,9 @@ class Estimate:
     def as_dict(self) -> Dict[str, float]:
         return {'t': self.t, 'frequency_hz': self.frequency_hz, 'omega_rad_s': self.omega,
                 'convergence_time_s': self.convergence_time, 'samples': self.samples,
-                'fit': self.fit, 'amplitude': self.amplitude, 'damping': self.damping}
+                'fit': self.fit, 'amplitude': self.amplitude, 'damping': self.damping,
+                'frequency_std_hz': self.frequency_std_hz, 'damping_std': self.damping_std,
+                'mode': self.mode}
 
 
 @dataclass
@@ -84,20 +92,35 @@ class EstimateArrays:
     fit: np.ndarray
     amplitude: np.ndarray
     damping: np.ndarray
+    frequency_std_hz: np.ndarray
+    damping_std: np.ndarray
+    mode: np.ndarray
 
     @classmethod
-    def from_rows(cls, rows: np.ndarray) -> 'EstimateArrays':
-        """Columns of the kernel's estimate rows."""
+    def from_rows(cls, rows: np.ndarray, mode: int = 0) -> 'EstimateArrays':
+        """Columns of the kernel's estimate rows, all of one ``mode``."""
         return cls(*(rows[:, i].astype(np.int64) if i == K.O_SAMPLES else rows[:, i].copy()
-                     for i in range(K.N_OUT)))
+                     for i in range(K.N_OUT)), np.full(len(rows), mode, dtype=np.int64))
+
+    @classmethod
+    def concatenate(cls, parts: Sequence['EstimateArrays']) -> 'EstimateArrays':
+        """One set of columns from several, sorted by time (stable: ties keep their order)."""
+        names = list(cls.__dataclass_fields__)
+        if not parts:
+            return cls.from_rows(np.empty((0, K.N_OUT)))
+        cols = {n: np.concatenate([getattr(p, n) for p in parts]) for n in names}
+        order = np.argsort(cols['t'], kind='stable')
+        return cls(**{n: c[order] for n, c in cols.items()})
 
     def __len__(self) -> int:
         return len(self.t)
 
     def to_list(self) -> List[Estimate]:
-        return [Estimate(*(int(v) if i == K.O_SAMPLES else float(v) for i, v in enumerate(row)))
+        ints = {K.O_SAMPLES, K.N_OUT}
+        return [Estimate(*(int(v) if i in ints else float(v) for i, v in enumerate(row)))
                 for row in zip(self.t, self.frequency_hz, self.convergence_time, self.samples,
-                               self.fit, self.amplitude, self.damping)]
+                               self.fit, self.amplitude, self.damping, self.frequency_std_hz,
+                               self.damping_std, self.mode)]
 
 
 class FrequencyEstimator:

@@ -81,8 +81,8 @@ S_MA = S_UNIT + NH       # moving-average ring (2M+1 values) starts here
 N_STATE_FIXED = S_MA
 
 # ---- estimate row layout --------------------------------------------------------------------
-O_T, O_F, O_CONV, O_SAMPLES, O_FIT, O_AMP, O_DAMP = range(7)
-N_OUT = 7
+O_T, O_F, O_CONV, O_SAMPLES, O_FIT, O_AMP, O_DAMP, O_FSTD, O_DSTD = range(9)
+N_OUT = 9
 #: values of P_MODEL
 MODEL_SINUSOID, MODEL_BIASED, MODEL_DAMPED = 0, 1, 2
 
@@ -513,6 +513,8 @@ def step(p, s, c, seg, t, y, out):
         out[O_FIT] = r2
         out[O_AMP] = amp
         out[O_DAMP] = damping
+        out[O_FSTD] = math.nan
+        out[O_DSTD] = math.nan
         c[C_ESTIMATES] += 1
         published = 1
     reset_segment(s, c, seg, t, y)

@@ -1,29 +1,114 @@
-"""Field access on ``geometry_msgs/WrenchStamped`` messages, for rclpy and rosbags messages alike.
+"""The input message types, their scalar fields (``component``), and the stamp time base.
 
 No rclpy import: the functions only use attribute access, which both rclpy's generated classes and
-rosbags' deserialised dataclasses provide.
+rosbags' deserialised dataclasses provide, so the node, the replayer and the offline readers share
+one definition of what a component is.
+
+Supported types (full names, as in ``input_type``) and their components:
+
+* ``geometry_msgs/msg/WrenchStamped``  -- ``force.x|y|z``, ``torque.x|y|z``
+* ``sensor_msgs/msg/Imu``              -- ``linear_acceleration.x|y|z``, ``angular_velocity.x|y|z``
+* ``geometry_msgs/msg/AccelStamped``   -- ``accel.linear.x|y|z``, ``accel.angular.x|y|z``
+* ``geometry_msgs/msg/Vector3Stamped`` -- ``vector.x|y|z``
+* ``sensor_msgs/msg/JointState``       -- ``effort[NAME]``, ``position[NAME]``, ``velocity[NAME]``
+  (the joint is looked up by name in every message; a message without it gives ``None``)
+* ``std_msgs/msg/Float64``             -- ``data`` (no header: the receiver's clock is the time base)
 """
 from __future__ import annotations
 
+import re
 from operator import attrgetter
-from typing import Callable
+from typing import Callable, Dict, Optional, Tuple
 
-COMPONENTS = ('force.x', 'force.y', 'force.z', 'torque.x', 'torque.y', 'torque.z')
+WRENCH_STAMPED = 'geometry_msgs/msg/WrenchStamped'
+IMU = 'sensor_msgs/msg/Imu'
+ACCEL_STAMPED = 'geometry_msgs/msg/AccelStamped'
+VECTOR3_STAMPED = 'geometry_msgs/msg/Vector3Stamped'
+JOINT_STATE = 'sensor_msgs/msg/JointState'
+FLOAT64 = 'std_msgs/msg/Float64'
+
+_XYZ = ('x', 'y', 'z')
+#: fixed components of each type, as attribute paths from the message
+_FIXED: Dict[str, Tuple[str, ...]] = {
+    WRENCH_STAMPED: tuple(f'{v}.{a}' for v in ('force', 'torque') for a in _XYZ),
+    IMU: tuple(f'{v}.{a}' for v in ('linear_acceleration', 'angular_velocity') for a in _XYZ),
+    ACCEL_STAMPED: tuple(f'accel.{v}.{a}' for v in ('linear', 'angular') for a in _XYZ),
+    VECTOR3_STAMPED: tuple(f'vector.{a}' for a in _XYZ),
+    JOINT_STATE: (),
+    FLOAT64: ('data',),
+}
+#: every supported input type, default first
+INPUT_TYPES: Tuple[str, ...] = tuple(_FIXED)
+#: default component of each type
+DEFAULT_COMPONENT = {WRENCH_STAMPED: 'torque.z', IMU: 'linear_acceleration.z',
+                     ACCEL_STAMPED: 'accel.linear.z', VECTOR3_STAMPED: 'vector.z',
+                     JOINT_STATE: 'effort[joint1]', FLOAT64: 'data'}
+#: the components of a WrenchStamped (the default input type)
+COMPONENTS = _FIXED[WRENCH_STAMPED]
+_JOINT = re.compile(r'^(effort|position|velocity)\[(.+)\]$')
 
 
-def check_component(component: str) -> str:
-    """Return ``component`` if it names a Wrench field, else raise ``ValueError`` saying which do."""
-    if component not in COMPONENTS:
-        raise ValueError(f'component must be one of {", ".join(COMPONENTS)}, got {component!r}')
+def normalise_type(name: str) -> str:
+    """``pkg/Name`` (older bags, ROS 1 style) as ``pkg/msg/Name``; other names unchanged."""
+    parts = name.split('/')
+    return f'{parts[0]}/msg/{parts[1]}' if len(parts) == 2 else name
+
+
+def check_input_type(input_type: str) -> str:
+    """The full type name if it is a supported input type, else ``ValueError`` listing them."""
+    full = normalise_type(input_type)
+    if full not in _FIXED:
+        raise ValueError(f'input_type must be one of {", ".join(INPUT_TYPES)}, got {input_type!r}')
+    return full
+
+
+def has_header(input_type: str) -> bool:
+    """Whether messages of this type carry a ``std_msgs/Header`` (time base: its stamp)."""
+    return check_input_type(input_type) != FLOAT64
+
+
+def describe_components(input_type: str) -> str:
+    """The components of a type, as a phrase for help texts and error messages."""
+    full = check_input_type(input_type)
+    if full == JOINT_STATE:
+        return 'effort[NAME], position[NAME] or velocity[NAME] (NAME: a joint name)'
+    return ', '.join(_FIXED[full])
+
+
+def check_component(component: str, input_type: str = WRENCH_STAMPED) -> str:
+    """Return ``component`` if it names a field of ``input_type``, else raise ``ValueError``."""
+    full = check_input_type(input_type)
+    ok = _JOINT.match(component) is not None if full == JOINT_STATE else component in _FIXED[full]
+    if not ok:
+        raise ValueError(f'component of {full} must be one of {describe_components(full)}, '
+                         f'got {component!r}')
     return component
 
 
-def component_getter(component: str) -> Callable[[object], float]:
-    """A function returning ``component`` (e.g. ``torque.z``) of a WrenchStamped message.
+def component_getter(component: str, input_type: str = WRENCH_STAMPED
+                     ) -> Callable[[object], Optional[float]]:
+    """A function returning ``component`` of a message of ``input_type``.
 
-    Built once (``operator.attrgetter``), so the per-message cost is one C call.
+    Fixed fields are one ``operator.attrgetter`` (one C call per message). For ``JointState`` the
+    joint is found by name in each message (publishers may reorder or omit joints); the function
+    returns ``None`` when the message lacks it, or lacks that array's entry.
     """
-    return attrgetter('wrench.' + check_component(component))
+    full = check_input_type(input_type)
+    check_component(component, full)
+    if full == WRENCH_STAMPED:
+        return attrgetter('wrench.' + component)
+    if full != JOINT_STATE:
+        return attrgetter(component)
+    field, joint = _JOINT.match(component).groups()
+    values_of = attrgetter(field)
+
+    def joint_value(msg) -> Optional[float]:
+        try:
+            i = list(msg.name).index(joint)
+            return float(values_of(msg)[i])
+        except (ValueError, IndexError):
+            return None
+    return joint_value
 
 
 def stamp_ns(header) -> int:
