@@ -255,8 +255,11 @@ class EstimatorNode(Node):
         """``~/self_test``: three tones through a fresh estimator of the live configuration."""
         response.success, response.message = self_test(self._estimator.config,
                                                        self._health.sample_rate_hz)
-        log = self.get_logger().info if response.success else self.get_logger().warn
-        log('self test ' + response.message.replace('\n', '; '))
+        text = 'self test ' + response.message.replace('\n', '; ')
+        if response.success:   # one call site per severity (rclpy refuses a change)
+            self.get_logger().info(text)
+        else:
+            self.get_logger().warn(text)
         return response
 
     # ---- diagnostics -----------------------------------------------------------------------

@@ -160,7 +160,7 @@ class Health:
                            last_t)
         values = {**self._estimate_values(now), 'input_rate_hz': input_rate,
                   'sample_rate_hz': self.sample_rate_hz, **self._mode_values(now, modes),
-                  **totals}
+                  **totals, **self.node_counters}
         return Status(level, message, values, log)
 
     def _update_sample_rate(self, used: int, last_t: Optional[float]) -> None:
@@ -177,12 +177,14 @@ class Health:
             self.sample_rate_hz = n / span
 
     def _check_band(self, band_hz, received: int):
-        """(problem text or None, warning to log once or None) for ``band_hz`` against the
-        Nyquist frequency; counts the samples received while the band reaches above it."""
+        """(problem text or None, warning to log or None) for ``band_hz`` against the Nyquist
+        frequency; counts the samples received while the band reaches above it. The warning is
+        logged once per band, again when the band changes to another one above Nyquist."""
         if band_hz is None or not len(band_hz) or math.isnan(self.sample_rate_hz):
             return None, None
         nyquist = self.sample_rate_hz / 2
         if band_hz[1] < nyquist:
+            self._band_warned = None
             return None, None
         self.count('band_above_nyquist', received)
         text = (f'band_hz upper edge {band_hz[1]:g} Hz is at or above the Nyquist frequency '

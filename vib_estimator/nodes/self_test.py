@@ -100,4 +100,7 @@ def self_test(config: EstimatorConfig, sample_rate_hz: Optional[float] = None
     ok = all(r.passed for r in results)
     head = (f'{"passed" if ok else "FAILED"}: 3 tones at {rate:.6g} Hz sampling, SNR '
             f'{SNR_DB:g} dB, tolerance {100 * TOLERANCE:g} % of the median')
+    if config.band_hz is not None and config.band_hz[1] >= rate / 2:
+        head += (f' (band_hz upper edge {config.band_hz[1]:g} Hz is at or above the Nyquist frequency '
+                 f'{rate / 2:.6g} Hz)')
     return ok, '\n'.join([head] + [r.describe() for r in results])
