@@ -49,15 +49,11 @@ def message(input_type, component, stamp_ns, value, joints=JOINTS):
         msg.header.frame_id = FRAME
     if input_type == fields.JOINT_STATE:
         array, joint = component[:-1].split('[')
-        msg.name = list(joints)
-        setattr(msg, array, [float(value) if j == joint else 100.0 + i
-                             for i, j in enumerate(joints)])
-        return msg
-    path = ('wrench.' + component if input_type == fields.WRENCH_STAMPED else component).split('.')
-    target = msg
-    for name in path[:-1]:
-        target = getattr(target, name)
-    setattr(target, path[-1], float(value))
+        for i, name in enumerate(joints):
+            fields.component_setter(f'{array}[{name}]', input_type)(
+                msg, value if name == joint else 100.0 + i)
+    else:
+        fields.component_setter(component, input_type)(msg, value)
     return msg
 
 
