@@ -33,6 +33,7 @@ from rcl_interfaces.msg import SetParametersResult
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, qos_profile_sensor_data
+from rclpy.time import Time
 from std_msgs.msg import Float64, Header
 from std_srvs.srv import Trigger
 
@@ -126,7 +127,7 @@ class EstimatorNode(Node):
         self._health = H.Health(time.monotonic())
         self._origin = None          # first stamp received, ns: t = 0
         self._t = None               # time of the last sample, s
-        self._receipt = None         # receipt time of the last sample without a header
+        self._receipt = None         # receipt time (ns) of the last sample without a header
         self._clock = self.get_clock()
         self._outputs = Outputs(self)
         self._estimator = None
@@ -206,9 +207,12 @@ class EstimatorNode(Node):
         self._feed(stamp_ns(header), value, header)
 
     def _on_unstamped(self, msg) -> None:
-        """A message without a header: its receipt time on the node clock is the sample's time."""
-        self._receipt = now = self._clock.now()
-        self._feed(now.nanoseconds, self._value(msg), None)
+        """A message without a header: its receipt time on the node clock is the sample's time
+        (read through the clock's handle: a third of the cost of ``Clock.now()``)."""
+        handle = self._clock.handle
+        with handle:
+            self._receipt = now = handle.get_now().nanoseconds
+        self._feed(now, self._value(msg), None)
 
     def _feed(self, stamp: int, value: float, header) -> None:
         """Feed one sample to the core; publish what it returns (see :class:`Outputs`)."""
@@ -222,7 +226,7 @@ class EstimatorNode(Node):
     def _publish(self, estimates, header) -> None:
         """Publish estimates of the sample of ``header`` (None: stamped with its receipt time)."""
         if header is None:
-            header = Header(stamp=self._receipt.to_msg())
+            header = Header(stamp=Time(nanoseconds=self._receipt).to_msg())
         for estimate in estimates:
             self._outputs.publish(estimate, header)
             self._health.record(estimate, time.monotonic(), self.counters)
