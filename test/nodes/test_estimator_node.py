@@ -24,10 +24,11 @@ from rosgraph_msgs.msg import Clock
 from std_msgs.msg import Float64, Header
 from std_srvs.srv import Trigger
 
-from vib_estimator.core import EstimatorConfig, FrequencyEstimator
+from vib_estimator.core import Estimate, EstimatorConfig, FrequencyEstimator
 from vib_estimator.core import modes as core_modes
 from vib_estimator.io import fields
 from vib_estimator.nodes.estimator_node import EstimatorNode, message_class
+from vib_estimator.nodes import stream
 from vib_estimator.nodes.runner import StartupError, spin_until
 from vib_estimator.io.fields import seconds_since
 
@@ -276,7 +277,7 @@ def test_parameter_changes(make_probe):
     p.feed(stamps, values[:1500])
     before = len(p.frequencies())
     # invalid: refused with a reason, the estimator untouched
-    estimator = p.node._estimator
+    estimator = p.node._stream.estimator
     for name, value, reason in [
             ('window', 0, 'window out of range'), ('lowpass_damping', -1.0, 'out of range'),
             ('band_hz', [5.0, 1.0], 'band_hz must be'), ('model', 'foo', 'model must be'),
@@ -286,10 +287,10 @@ def test_parameter_changes(make_probe):
             ('component', 'linear_acceleration.z', 'component of geometry_msgs/msg/Wrench')]:
         result = p.node.set_parameters([Parameter(name, value=value)])[0]
         assert not result.successful and reason in result.reason, (name, result.reason)
-    assert p.node._estimator is estimator
+    assert p.node._stream.estimator is estimator
     # valid: a new estimator with the new configuration, same time origin
     assert p.node.set_parameters([Parameter('window', value=5)])[0].successful
-    assert p.node._estimator.config.window == 5
+    assert p.node._stream.estimator.config.window == 5
     assert p.node.get_parameter('window').value == 5
     later = sine_stamps(3000)[1500:]
     p.feed(later, values[1500:])
@@ -299,10 +300,10 @@ def test_parameter_changes(make_probe):
     assert p.frequencies()[before:] == expected.frequency_hz.tolist()
     assert p.node.counters['received'] == 3000        # counters span the change
     assert p.node.set_parameters([Parameter('band_hz', value=[0.5, 5.0])])[0].successful
-    assert p.node._estimator.config.band_hz == (0.5, 5.0)
+    assert p.node._stream.estimator.config.band_hz == (0.5, 5.0)
     assert p.node.set_parameters(
         [Parameter('band_hz', Parameter.Type.DOUBLE_ARRAY, [])])[0].successful
-    assert p.node._estimator.config.band_hz is None
+    assert p.node._stream.estimator.config.band_hz is None
 
 
 def test_sigint_shuts_down_cleanly(ros_context):
@@ -534,7 +535,7 @@ class TwoBandTracker:
 
     def update(self, t, y):
         found = [(k, e.update(t, y)) for k, e in enumerate(self._estimators, 1)]
-        return [core_modes.Estimate(**{**e.__dict__, 'mode': k}) for k, e in found if e]
+        return [Estimate(**{**e.__dict__, 'mode': k}) for k, e in found if e]
 
     @property
     def counters(self):
@@ -549,8 +550,7 @@ class TwoBandTracker:
 
 
 def test_each_mode_on_its_own_topics(make_probe, monkeypatch):
-    from vib_estimator.nodes import estimator_node
-    monkeypatch.setattr(estimator_node, 'create_estimator', lambda config: TwoBandTracker(
+    monkeypatch.setattr(stream, 'create_estimator', lambda config: TwoBandTracker(
         config) if config.modes else FrequencyEstimator(config))
     p = make_probe(modes=2)
     n = 3000
@@ -558,7 +558,7 @@ def test_each_mode_on_its_own_topics(make_probe, monkeypatch):
     values = 0.5 * np.sin(2 * np.pi * 1.33 * t) + np.sin(2 * np.pi * 40.0 * t + 1.0)
     stamps = sine_stamps(n)
     p.feed(stamps, values)
-    tracker = TwoBandTracker(p.node._estimator.config)
+    tracker = TwoBandTracker(p.node._stream.estimator.config)
     expected = [e for ti, y in zip(seconds_since(np.asarray(stamps), stamps[0]), values)
                 for e in tracker.update(ti, y)]
     assert spin_until(p.executor, lambda: len(p.resets('mode2/reset'))

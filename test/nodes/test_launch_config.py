@@ -41,7 +41,7 @@ def test_params_file_loads_into_the_node():
                args=['--ros-args', '--params-file', str(PARAMS)])
     try:
         node = EstimatorNode(context=context)
-        assert node._estimator.config == EstimatorConfig()
+        assert node._stream.config == EstimatorConfig()
         assert node.get_parameter('band_hz').value == []
         assert node.get_parameter('input_type').value == WRENCH_STAMPED
         node.destroy_node()

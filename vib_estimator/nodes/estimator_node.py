@@ -1,8 +1,9 @@
 """ROS 2 node running the algebraic frequency estimator on one field of a sensor stream.
 
-``ros2 run vib_estimator estimator_node``. A thin shell around the core: it declares the parameters,
-converts each message to a ``(t, y)`` sample, calls the estimator (``create_estimator``: one
-:class:`FrequencyEstimator`, or a mode tracker with ``modes`` >= 1) and publishes.
+``ros2 run vib_estimator estimator_node``. A thin shell: it declares the parameters, converts each
+message to a ``(stamp, value)`` sample, hands it to :class:`~.stream.EstimatorStream` (the time
+base, the estimator -- one :class:`FrequencyEstimator`, or a mode tracker with ``modes`` >= 1 --
+and the diagnostics bookkeeping, all without rclpy) and publishes what comes back.
 
 * Input: ``coupling_torque`` (parameter ``input_topic``, read-only) of type ``input_type``
   (read-only; the types and components of :mod:`vib_estimator.io.fields`), best-effort sensor-data
@@ -15,9 +16,8 @@ converts each message to a ``(t, y)`` sample, calls the estimator (``create_esti
 * Services ``~/reset`` (a new segment now) and ``~/self_test`` (:mod:`.self_test`), std_srvs/Trigger.
 * ``/diagnostics`` at 1 Hz (steady clock): one status named after the node (:mod:`.health`).
 
-Time base: the header stamps, as ``seconds_since(stamp_ns(header), origin)`` with ``origin`` the
-first stamp received, exactly as the offline ``vib-estimator analyze``, so both give the same
-floats. A zero stamp, and every sample of a type without a header (``std_msgs/msg/Float64``), is
+Time base: the header stamps (``t`` = stamp - first stamp, as the offline ``vib-estimator
+analyze``, so both give the same floats). A zero stamp, and every sample of a type without a header (``std_msgs/msg/Float64``), is
 stamped with the receipt time on the node clock (``use_sim_time`` applies). Non-finite values,
 duplicate and out-of-order stamps, gaps and backward jumps are the core's business (skipped or
 restarted, and counted); a JointState without the configured joint is skipped and counted here.
@@ -38,14 +38,11 @@ from std_msgs.msg import Float64, Header
 from std_srvs.srv import Trigger
 
 from ..core.config import EstimatorConfig
-from ..core.modes import create_estimator
-from ..io.fields import (DEFAULT_COMPONENT, INPUT_TYPES, WRENCH_STAMPED, check_component,
-                         check_input_type, component_getter, describe_components, has_header,
-                         seconds_since, stamp_ns)
+from ..io.fields import check_component, check_input_type, component_getter, has_header, stamp_ns
 from . import health as H
-from .parameters import config_of, config_value, declare, declare_config, descriptor
+from .parameters import config_of, config_value, declare_config, declare_input
 from .runner import StartupError, run
-from .self_test import self_test
+from .stream import EstimatorStream
 
 #: input history: sensor-data QoS (best effort) but 1000 deep instead of 5, so that a scheduling
 #: hiccup of up to 2 s at 500 Hz, or a player's burst after a stall, drops nothing
@@ -115,23 +112,18 @@ class EstimatorNode(Node):
 
     def __init__(self, **kwargs):
         super().__init__('estimator_node', **kwargs)
-        self._input_type, topic = self._declare_input()
+        self._input_type, topic = declare_input(self)
         declare_config(self)
         try:
             self._component = check_component(self.get_parameter('component').value,
                                               self._input_type)
             self._value = component_getter(self._component, self._input_type)
-            config = config_of(self)
+            self._stream = EstimatorStream(config_of(self), time.monotonic())
         except ValueError as err:
             raise StartupError(str(err)) from None
-        self._health = H.Health(time.monotonic())
-        self._origin = None          # first stamp received, ns: t = 0
-        self._t = None               # time of the last sample, s
-        self._receipt = None         # receipt time (ns) of the last sample without a header
         self._clock = self.get_clock()
         self._outputs = Outputs(self)
-        self._estimator = None
-        self._set_estimator(config)
+        self._outputs.set_modes(self._stream.config.modes)
         qos = QoSProfile(depth=INPUT_DEPTH, reliability=qos_profile_sensor_data.reliability,
                          durability=qos_profile_sensor_data.durability)
         self._subscription = self.create_subscription(
@@ -146,23 +138,10 @@ class EstimatorNode(Node):
         self.create_timer(DIAGNOSTICS_PERIOD, self._publish_diagnostics,
                           clock=Clock(clock_type=ClockType.STEADY_TIME))
         self.get_logger().info(f'estimating on {self._subscription.topic_name} '
-                               f'({self._input_type} [{self._component}]) with {config}')
+                               f'({self._input_type} [{self._component}]) with '
+                               f'{self._stream.config}')
 
     # ---- parameters ------------------------------------------------------------------------
-    def _declare_input(self):
-        """Declare ``input_type``, ``input_topic`` and ``component``; (full type, topic)."""
-        input_type = declare(self, 'input_type', WRENCH_STAMPED, descriptor(
-            f'input message type, one of {", ".join(INPUT_TYPES)}', read_only=True))
-        try:
-            input_type = check_input_type(input_type)
-        except ValueError as err:
-            raise StartupError(str(err)) from None
-        topic = declare(self, 'input_topic', 'coupling_torque', descriptor(
-            'input topic, of type input_type', read_only=True))
-        declare(self, 'component', DEFAULT_COMPONENT[input_type], descriptor(
-            f'field of the input to estimate on: {describe_components(input_type)}'))
-        return input_type, topic
-
     def _check_parameters(self, parameters) -> SetParametersResult:
         """Refuse, with the core's reason, a change that would make an invalid configuration."""
         changes = {p.name: config_value(p.value) for p in parameters if p.name in CORE_NAMES}
@@ -170,7 +149,7 @@ class EstimatorNode(Node):
             for p in parameters:
                 if p.name == 'component':
                     check_component(p.value, self._input_type)
-            self._estimator.config.replace(**changes)
+            self._stream.config.replace(**changes)
         except ValueError as err:
             return SetParametersResult(successful=False, reason=str(err))
         return SetParametersResult(successful=True)
@@ -182,17 +161,10 @@ class EstimatorNode(Node):
             return
         self._component = self.get_parameter('component').value
         self._value = component_getter(self._component, self._input_type)
-        self._set_estimator(config_of(self))
+        self._stream.configure(config_of(self))
+        self._outputs.set_modes(self._stream.config.modes)
         self.get_logger().info(f'parameters {", ".join(sorted(names))} changed: estimator '
-                               f'restarted on [{self._component}] with {self._estimator.config}')
-
-    def _set_estimator(self, config: EstimatorConfig) -> None:
-        """A fresh estimator of ``config``; the counters of the one it replaces are kept."""
-        if self._estimator is not None:
-            self._health.absorb(self._estimator.counters)
-        self._estimator = create_estimator(config)
-        self._outputs.set_modes(config.modes)
-        self._health.forget_modes(config.modes)
+                               f'restarted on [{self._component}] with {self._stream.config}')
 
     # ---- data path -------------------------------------------------------------------------
     def _on_stamped(self, msg) -> None:
@@ -204,44 +176,37 @@ class EstimatorNode(Node):
         header = msg.header
         if header.stamp.sec == 0 and header.stamp.nanosec == 0:
             self._replace_zero_stamp(header)
-        self._feed(stamp_ns(header), value, header)
+        estimates = self._stream.feed(stamp_ns(header), value)
+        if estimates:
+            self._publish(estimates, header)
 
     def _on_unstamped(self, msg) -> None:
         """A message without a header: its receipt time on the node clock is the sample's time
         (read through the clock's handle: a third of the cost of ``Clock.now()``)."""
         handle = self._clock.handle
         with handle:
-            self._receipt = now = handle.get_now().nanoseconds
-        self._feed(now, self._value(msg), None)
+            now = handle.get_now().nanoseconds
+        estimates = self._stream.feed(now, self._value(msg))
+        if estimates:
+            self._publish(estimates, Header(stamp=Time(nanoseconds=now).to_msg()))
 
-    def _feed(self, stamp: int, value: float, header) -> None:
-        """Feed one sample to the core; publish what it returns (see :class:`Outputs`)."""
-        if self._origin is None:
-            self._origin = stamp
-        self._t = t = seconds_since(stamp, self._origin)
-        result = self._estimator.update(t, value)
-        if result:     # an Estimate, or a non-empty list of them (modes >= 1)
-            self._publish(result if isinstance(result, list) else (result,), header)
-
-    def _publish(self, estimates, header) -> None:
-        """Publish estimates of the sample of ``header`` (None: stamped with its receipt time)."""
-        if header is None:
-            header = Header(stamp=Time(nanoseconds=self._receipt).to_msg())
+    def _publish(self, estimates, header: Header) -> None:
+        """Publish the estimates of the sample of ``header`` (see :class:`Outputs`)."""
         for estimate in estimates:
             self._outputs.publish(estimate, header)
-            self._health.record(estimate, time.monotonic(), self.counters)
+            self._stream.published(estimate, time.monotonic())
 
     def _replace_zero_stamp(self, header: Header) -> None:
         """Stamp a message that came without one with its receipt time (node clock)."""
         header.stamp = self._clock.now().to_msg()
-        if self._health.count('zero_stamps_replaced') == 1:   # warn once (rclpy's once=True
+        if self._stream.health.count('zero_stamps_replaced') == 1:   # warn once (rclpy's once=True
             # costs ~0.15 ms a call)
             self.get_logger().warn(f'{self._subscription.topic_name}: zero header stamps are '
                                    'replaced by the receipt time (counted in the diagnostics)')
 
     def _skip_joint_missing(self) -> None:
         """Count (and the first time, log) a JointState message without the configured joint."""
-        if self._health.count('skipped_joint_missing') == 1:
+        if self._stream.health.count('skipped_joint_missing') == 1:
             self.get_logger().warn(f'{self._subscription.topic_name}: messages without the '
                                    f'joint of [{self._component}] are skipped (counted in the '
                                    'diagnostics)')
@@ -249,7 +214,7 @@ class EstimatorNode(Node):
     # ---- services --------------------------------------------------------------------------
     def _on_reset(self, request, response):
         """``~/reset``: start a new segment at the last sample; counters kept."""
-        self._estimator.reset()
+        self._stream.reset()
         response.success = True
         response.message = 'new segment started'
         self.get_logger().info('reset requested: new segment started')
@@ -257,8 +222,7 @@ class EstimatorNode(Node):
 
     def _on_self_test(self, request, response):
         """``~/self_test``: three tones through a fresh estimator of the live configuration."""
-        response.success, response.message = self_test(self._estimator.config,
-                                                       self._health.sample_rate_hz)
+        response.success, response.message = self._stream.self_test()
         text = 'self test ' + response.message.replace('\n', '; ')
         if response.success:   # one call site per severity (rclpy refuses a change)
             self.get_logger().info(text)
@@ -271,14 +235,12 @@ class EstimatorNode(Node):
     def counters(self):
         """The core counters since start (across parameter changes) and the node's own
         (:data:`~vib_estimator.nodes.health.NODE_COUNTERS`)."""
-        return self._health.totals(self._estimator.counters)
+        return self._stream.counters
 
     def _publish_diagnostics(self) -> None:
         """Publish the status; log the last estimate every 10 s (rclpy's throttled logging costs
         ~0.15 ms a call, too much for the data path)."""
-        config = self._estimator.config
-        status = self._health.status(time.monotonic(), self.counters, self._t, config.band_hz,
-                                     config.modes)
+        status = self._stream.status(time.monotonic())
         if status.log:
             self.get_logger().warn(status.log)
         array = DiagnosticArray(status=[DiagnosticStatus(
@@ -288,7 +250,7 @@ class EstimatorNode(Node):
                     for key, value in status.values.items()])])
         array.header.stamp = self._clock.now().to_msg()
         self._diagnostics_pub.publish(array)
-        estimate = self._health.last_estimate
+        estimate = self._stream.health.last_estimate
         if estimate is not None:
             self.get_logger().info(f'{status.message}: last {estimate.frequency_hz:.4f} Hz '
                                    f'after {estimate.convergence_time:.3f} s',

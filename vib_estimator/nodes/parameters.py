@@ -12,6 +12,8 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 
 from ..core.config import EstimatorConfig
+from ..io.fields import (DEFAULT_COMPONENT, INPUT_TYPES, WRENCH_STAMPED, check_input_type,
+                         describe_components)
 from .runner import StartupError
 
 
@@ -69,3 +71,19 @@ def config_of(node: Node) -> EstimatorConfig:
     """The EstimatorConfig of the node's current parameter values (ValueError if invalid)."""
     return EstimatorConfig().replace(**{name: config_value(node.get_parameter(name).value)
                                         for name in EstimatorConfig.names()})
+
+
+def declare_input(node: Node, default_topic: str = 'coupling_torque'):
+    """Declare ``input_type`` and ``input_topic`` (read-only) and ``component`` (its default
+    that of the type); return (the type's full name, the topic)."""
+    input_type = declare(node, 'input_type', WRENCH_STAMPED, descriptor(
+        f'input message type, one of {", ".join(INPUT_TYPES)}', read_only=True))
+    try:
+        input_type = check_input_type(input_type)
+    except ValueError as err:
+        raise StartupError(str(err)) from None
+    topic = declare(node, 'input_topic', default_topic, descriptor(
+        'input topic, of type input_type', read_only=True))
+    declare(node, 'component', DEFAULT_COMPONENT[input_type], descriptor(
+        f'field of the input to estimate on: {describe_components(input_type)}'))
+    return input_type, topic
