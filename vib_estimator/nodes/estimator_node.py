@@ -121,6 +121,7 @@ class EstimatorNode(Node):
             self._stream = EstimatorStream(config_of(self), time.monotonic())
         except ValueError as err:
             raise StartupError(str(err)) from None
+        self._feed = self._stream.feed     # bound once (data path)
         self._clock = self.get_clock()
         self._outputs = Outputs(self)
         self._outputs.set_modes(self._stream.config.modes)
@@ -176,7 +177,7 @@ class EstimatorNode(Node):
         header = msg.header
         if header.stamp.sec == 0 and header.stamp.nanosec == 0:
             self._replace_zero_stamp(header)
-        estimates = self._stream.feed(stamp_ns(header), value)
+        estimates = self._feed(stamp_ns(header), value)
         if estimates:
             self._publish(estimates, header)
 
@@ -186,7 +187,7 @@ class EstimatorNode(Node):
         handle = self._clock.handle
         with handle:
             now = handle.get_now().nanoseconds
-        estimates = self._stream.feed(now, self._value(msg))
+        estimates = self._feed(now, self._value(msg))
         if estimates:
             self._publish(estimates, Header(stamp=Time(nanoseconds=now).to_msg()))
 

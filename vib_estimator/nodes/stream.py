@@ -39,6 +39,7 @@ class EstimatorStream:
         if self.estimator is not None:
             self.health.absorb(self.estimator.counters)
         self.estimator = create_estimator(config)
+        self._update = self.estimator.update     # bound once: the data path's one call
         self.health.forget_modes(config.modes)
 
     def feed(self, stamp_ns: int, value: float) -> Sequence[Estimate]:
@@ -46,7 +47,7 @@ class EstimatorStream:
         if self.origin is None:
             self.origin = stamp_ns
         self.last_t = t = seconds_since(stamp_ns, self.origin)
-        result = self.estimator.update(t, value)
+        result = self._update(t, value)
         if not result:     # None, or an empty list (modes >= 1)
             return _NONE
         return result if isinstance(result, list) else (result,)
