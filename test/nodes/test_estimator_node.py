@@ -436,6 +436,18 @@ def test_component_is_checked_against_the_type(ros_context):
         node.destroy_node()
 
 
+def test_a_component_of_another_type_is_one_error_line_and_exit_2():
+    result = subprocess.run(
+        [os.path.join(os.path.dirname(sys.executable), 'estimator_node'), '--ros-args',
+         '-p', 'input_type:=sensor_msgs/msg/Imu', '-p', 'component:=torque.z'],
+        capture_output=True, text=True, timeout=60)
+    assert result.returncode == 2
+    assert result.stderr.strip().splitlines() == [
+        "error: component of sensor_msgs/msg/Imu must be one of linear_acceleration.x, "
+        "linear_acceleration.y, linear_acceleration.z, angular_velocity.x, angular_velocity.y, "
+        "angular_velocity.z, got 'torque.z'"]
+
+
 # ---- services -------------------------------------------------------------------------------
 def test_reset_service_starts_a_new_segment_counters_kept(make_probe):
     p = make_probe()
