@@ -141,3 +141,12 @@ def test_self_test_fails_with_a_reason():
     assert 'above the Nyquist frequency 250 Hz' in message.splitlines()[-1]
     ok, message = self_test(EstimatorConfig(min_amplitude=1e6, min_fit=0.0), 500.0)
     assert ok   # the tones' amplitude follows the at-rest gate
+
+
+def test_an_estimate_of_any_mode_clears_held_back():
+    h = H.Health(now=0.0)
+    held = h.totals(core(received=100, used=100, rejected_fit=2))
+    assert h.status(1.0, held, 0.2, modes=2).level == H.WARN
+    h.record(estimate(8.0, mode=2), 1.5, held)
+    s = h.status(2.0, h.totals(core(received=200, used=200, rejected_fit=2)), 0.4, modes=2)
+    assert s.level == H.OK and s.message == 'waiting for a first estimate'   # of mode 1

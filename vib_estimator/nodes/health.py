@@ -105,13 +105,14 @@ class Health:
     # ---- estimates ---------------------------------------------------------------------------
     def record(self, estimate, now: float, totals: Mapping[str, int]) -> None:
         """An estimate was published at ``now``: mode 0 or 1 is the one of ``vibration/frequency``;
-        ``totals`` (:meth:`totals`) gives the held-back counters' values at that moment."""
+        ``totals`` (:meth:`totals`) gives the held-back counters' values at that moment (an
+        estimate of any mode clears the WARN of estimates held back)."""
         last = _Last(estimate, now)
         if estimate.mode >= 1:
             self._modes[estimate.mode] = last
         if estimate.mode <= 1:
             self._last = last
-            self._held_at = {name: totals.get(name, 0) for name in HELD_BACK}
+        self._held_at = {name: totals.get(name, 0) for name in HELD_BACK}
 
     @property
     def last_estimate(self):
