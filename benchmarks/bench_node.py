@@ -124,9 +124,9 @@ def make_subscriber(kind, context, topic, depth, input_type):
 
         def _on_stamped(self, msg):
             entry = time.perf_counter()
-            before = self._health.last_estimate
+            before = self._stream.health.last_estimate
             super()._on_stamped(msg)
-            if self._health.last_estimate is not before:
+            if self._stream.health.last_estimate is not before:
                 self.latencies.append(time.perf_counter() - entry)
                 self.entries[msg.header.stamp.sec * 10 ** 9 + msg.header.stamp.nanosec] = entry
 
