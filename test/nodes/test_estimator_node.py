@@ -128,8 +128,9 @@ class Probe:
     def resets(self, topic='reset'):
         return [e[1:] for e in self.events if e[0] == topic]
 
-    def call(self, service, timeout=10.0):
-        """Call a Trigger service of the node; the response."""
+    def call(self, service, timeout=60.0):
+        """Call a Trigger service of the node; the response (the first self-test may compile the
+        kernel's batch path: a clean clone has no numba cache)."""
         client = self.probe.create_client(Trigger, f'/estimator_node/{service}')
         assert spin_until(self.executor, client.service_is_ready, timeout)
         future = client.call_async(Trigger.Request())

@@ -115,9 +115,10 @@ def test_format_value():
     assert H.format_value(math.nan) == 'nan'
 
 
-@pytest.mark.parametrize('model', ['sinusoid', 'biased-sinusoid', 'damped-sinusoid'])
-def test_self_test_passes_with_the_defaults(model):
-    ok, message = self_test(EstimatorConfig(model=model))
+@pytest.mark.parametrize('model, modes', [('sinusoid', 0), ('biased-sinusoid', 0),
+                                          ('damped-sinusoid', 0), ('sinusoid', 1)])
+def test_self_test_passes_with_the_defaults(model, modes):
+    ok, message = self_test(EstimatorConfig(model=model, modes=modes))
     lines = message.splitlines()
     assert ok and lines[0].startswith('passed') and len(lines) == 4, message
     assert all('error' in line for line in lines[1:])
