@@ -6,11 +6,13 @@
 * Input: ``reference`` (``std_msgs/Float64``, the unshaped motor-angle reference, rad; held
   between messages), ``vibration/frequency`` (Hz) and ``vibration/damping_ratio`` (NaN from models
   without damping: ignored) from ``estimator_node``.
-* Output: ``position_command`` (``std_msgs/Float64``) at ``rate_hz`` on the node clock
-  (``use_sim_time`` applies), from the first reference on: the reference sampled at ``rate_hz``
-  and convolved with the shaper ``shaper`` designed for the latest estimate (the median of the
-  last ``median_of``). When several samples are due at once (a stalled executor, a simulated clock
-  running fast) they are all computed and the last one is published.
+* Output: ``position_command`` (``std_msgs/Float64``) at ``rate_hz`` on the node clock, from the
+  first reference on: the reference sampled at ``rate_hz`` and convolved with the shaper
+  ``shaper`` designed for the latest estimate (the median of the last ``median_of``). When several
+  samples are due at once (a stalled executor, a simulated clock running fast) they are all
+  computed and the last one is published. With ``use_sim_time`` the node ticks on every
+  ``/clock`` message, at its time, instead of a timer (so ``sim_node``'s ``lockstep`` gets one
+  command per step).
 * A new design (new estimate, parameter change) is switched in only while the reference is at
   rest (:class:`StreamingShaper`), so a move is never shaped by two shapers. Until the first
   frequency estimate the reference passes through, or is shaped for ``initial_frequency_hz``;
@@ -31,6 +33,7 @@ from rcl_interfaces.msg import SetParametersResult
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from rclpy.parameter import Parameter
+from rosgraph_msgs.msg import Clock as ClockMsg
 from std_msgs.msg import Float64
 
 from ..control.shaping import MAX_DAMPING, SHAPERS, Shaper, StreamingShaper, design, none
@@ -94,7 +97,12 @@ class ShaperNode(Node):
         self.add_on_set_parameters_callback(self._check_parameters)
         self.add_post_set_parameters_callback(self._apply_parameters)
         self._redesign()
-        self.create_timer(1.0 / self._rate, self._tick)
+        if self.get_parameter('use_sim_time').value:
+            # tick on every /clock, at its time: a lockstep simulator gets one answer per step
+            self.create_subscription(ClockMsg, '/clock', self._on_clock, 10)
+        else:
+            self.create_timer(1.0 / self._rate,
+                              lambda: self._tick(self.get_clock().now().nanoseconds))
         self.create_timer(DIAGNOSTICS_PERIOD, self._publish_diagnostics,
                           clock=Clock(clock_type=ClockType.STEADY_TIME))
         self.get_logger().info(f'shaping {self.resolve_topic_name("reference")} into '
@@ -182,12 +190,14 @@ class ShaperNode(Node):
         self._redesign()
 
     # ---- output ----------------------------------------------------------------------------
-    def _tick(self) -> None:
-        """Compute the samples due since the last tick (sample k at t0 + k / rate_hz on the node
+    def _on_clock(self, msg: ClockMsg) -> None:
+        self._tick(msg.clock.sec * 1_000_000_000 + msg.clock.nanosec)
+
+    def _tick(self, now: int) -> None:
+        """Compute the samples due by ``now`` (ns; sample k at t0 + k / rate_hz on the node
         clock) and publish the last one."""
         if self._reference is None:
             return
-        now = self.get_clock().now().nanoseconds
         due = math.floor((now - self._t0_ns) * 1e-9 * self._rate)
         if due < self._k - 1 or due - self._k > MAX_CATCH_UP_S * self._rate:
             self._k = due               # the clock jumped (restarted sim, long stall): skip
@@ -195,14 +205,17 @@ class ShaperNode(Node):
             before = self._shaper.shaper
             self._command.data = self._shaper.update(self._reference)
             if self._shaper.shaper is not before:
-                self._log_switch()
+                self._log_switch(before)
         self._k = max(self._k, due + 1)
         self._command_pub.publish(self._command)
         self.counters['commands_published'] += 1
 
-    def _log_switch(self) -> None:
+    def _log_switch(self, before: Shaper) -> None:
+        """Log a new design: at info level when the shaper's kind changed, else at debug."""
         self._pending_since = None
-        self.get_logger().info(f'reference at rest: shaper now {self._shaper.shaper.describe()}')
+        log = self.get_logger()
+        (log.info if self._shaper.shaper.name != before.name else log.debug)(
+            f'reference at rest: shaper now {self._shaper.shaper.describe()}')
 
     # ---- diagnostics -----------------------------------------------------------------------
     def status(self) -> DiagnosticStatus:

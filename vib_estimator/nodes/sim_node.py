@@ -55,6 +55,10 @@ MAX_BATCH_SECONDS = 0.1
 BATCH_TICKS = 4
 MIN_SAMPLES_PER_PERIOD = 20  # a tip mass is refused if f0 (Eq. 23) leaves fewer samples a period
 SIM_TIME_ORIGIN_NS = 1_000_000_000  # stamp of the first sample in simulated time (0 means unset)
+# lockstep: a batch is at most this much simulated time, and waits at most this long (wall) for
+# the command answering the previous batch's /clock
+LOCKSTEP_BATCH_SECONDS = 0.02
+LOCKSTEP_TIMEOUT = 1.0
 SCHEDULE_FIELDS = 4        # start, final_angle, slope, tip_mass_kg (0 = unchanged)
 #: output_type -> (message class, topic)
 OUTPUTS = {WRENCH_STAMPED: (WrenchStamped, 'coupling_torque'), IMU: (Imu, 'tip_imu')}
@@ -131,6 +135,16 @@ PARAMETERS = {
         'so that a sped-up run loses no sample to discovery', (0, 1000), read_only=True)),
     'duration': (0.0, descriptor('simulated seconds after which the node exits 0 '
                                   '(0 = run forever)', (0.0, 1e9), read_only=True)),
+    'wait_for_command': (False, descriptor(
+        'the simulation starts when the first position_command has arrived (in simulated time '
+        'the start of the clock is published meanwhile, so a use_sim_time commander can run)',
+        read_only=True)),
+    'lockstep': (False, descriptor(
+        'in simulated time, once commands flow, each batch of samples (at most '
+        f'{LOCKSTEP_BATCH_SECONDS * 1e3:g} ms) waits for a position_command received after the '
+        'previous /clock (at most 1 s): a commander answering every /clock (shaper_node with '
+        'use_sim_time) then acts at the simulated times it computed for, however loaded the '
+        'machine; the run goes as fast as that round trip allows, at most speed', read_only=True)),
     'output_type': (WRENCH_STAMPED, descriptor(
         'message of the measurement: geometry_msgs/msg/WrenchStamped (coupling torque, torque.z, on '
         'coupling_torque) or sensor_msgs/msg/Imu (tip acceleration, linear_acceleration.z, on '
@@ -171,6 +185,14 @@ class SimNode(Node):
         self._sim_time = self._speed != 1.0 or p['publish_clock']
         self._duration = p['duration']
         self._wait_for_subscribers = p['wait_for_subscribers']
+        self._wait_for_command = p['wait_for_command']
+        self._lockstep = p['lockstep']
+        if self._lockstep and not self._sim_time:
+            raise StartupError('lockstep needs simulated time: speed other than 1 or '
+                               'publish_clock')
+        self._answered = True             # a command arrived since the last /clock (lockstep)
+        self._clock_at = 0.0              # monotonic time of the last batch's /clock
+        self.lockstep_timeouts = 0
         self._sim = ArmSimulator(
             ArmParameters(tip_mass_kg=p['tip_mass_kg'], damping_ratio=p['damping_ratio']),
             rate_hz=self._rate, noise_std=p['noise_std'], seed=p['seed'], schedule=schedule,
@@ -235,6 +257,18 @@ class SimNode(Node):
             self.get_logger().info(f'position_command {msg.data:g} rad: commands take over from '
                                    'the schedule')
         self.commands_received += 1
+        self._answered = True
+
+    def _lockstep_wait(self) -> bool:
+        """In lockstep, whether the next batch must still wait for the commander's answer."""
+        if not self._lockstep or not self.commands_received or self._answered:
+            return False
+        if time.monotonic() - self._clock_at < LOCKSTEP_TIMEOUT:
+            return True
+        self.lockstep_timeouts += 1
+        self.get_logger().warning(f'lockstep: no position_command for {LOCKSTEP_TIMEOUT:g} s, '
+                                  'going on', throttle_duration_sec=5.0)
+        return False
 
     # ---- parameters ------------------------------------------------------------------------
     def _validate(self, params: List[Parameter]) -> SetParametersResult:
@@ -276,17 +310,28 @@ class SimNode(Node):
             self._f_true = f
             self._truth_pub.publish(Float64(data=f))
 
+    def _publish_clock(self, ns: int) -> None:
+        if self._clock_pub is not None:
+            self._clock_msg.clock.sec, self._clock_msg.clock.nanosec = divmod(ns, 1_000_000_000)
+            self._clock_pub.publish(self._clock_msg)
+
     def _tick(self) -> None:
         if self.finished:
             return
         if self._wall_start is None:
-            if self._output_pub.get_subscription_count() < self._wait_for_subscribers:
+            if (self._output_pub.get_subscription_count() < self._wait_for_subscribers
+                    or (self._wait_for_command and not self.commands_received)):
+                self._publish_clock(self._origin_ns)
                 return
             self._wall_start = time.monotonic()
+        if self._lockstep_wait():
+            return
         due_t = (time.monotonic() - self._wall_start) * self._speed
         if self._duration > 0:
             due_t = min(due_t, self._duration)
         due = int(due_t * self._rate) + 1 - round(self._sim.t * self._rate)
+        if self._lockstep:
+            due = min(due, max(1, int(LOCKSTEP_BATCH_SECONDS * self._rate)))
         limit = int(max(MAX_BATCH_SECONDS, BATCH_TICKS * self._speed / TICK_HZ) * self._rate)
         if due > limit:
             self.get_logger().warning(
@@ -304,9 +349,8 @@ class SimNode(Node):
             self._publish_truth(f)
         if t is None:
             return
-        if self._clock_pub is not None:
-            self._clock_msg.clock.sec, self._clock_msg.clock.nanosec = stamp.sec, stamp.nanosec
-            self._clock_pub.publish(self._clock_msg)
+        self._publish_clock(ns)
+        self._answered, self._clock_at = False, time.monotonic()
         self._sync_mass_parameter()
         if 0 < self._duration <= self._sim.t:
             self.finished = True
