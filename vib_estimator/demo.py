@@ -541,10 +541,12 @@ def _run_shaping(session: 'Session', args: argparse.Namespace, wall_start: float
         and listener.counts('position_command')[0]))
     driver.move(0.0)                                    # the shaper holds the arm at 0
     masses = [Move(i * p, 0.0, 1.0, m) for i, m in enumerate(MASSES_5_5)]
+    sim_start = time.monotonic()
     sim = session.start_sim(sim_params(args.speed, 3 * p, schedule_to_array(masses), 2)
                             + ['wait_for_command:=true', 'lockstep:=true'])
     moves = _drive(session, driver, sim, args)
     session.finish_sim(sim, 3 * p, args.speed)
+    sim_wall = time.monotonic() - sim_start
     rows = measure_moves(listener.record, moves, p)
     lines, ok = summarise_shaping(rows, args.shaper)
     print('\nvibration each move adds (joint fit of the free vibration before and after it):')
@@ -553,8 +555,9 @@ def _run_shaping(session: 'Session', args: argparse.Namespace, wall_start: float
     out.parent.mkdir(parents=True, exist_ok=True)
     plot_shaping(str(out), listener.record, rows, args.shaper, args.speed)
     need = MIN_REDUCTION.get(args.shaper, DEFAULT_MIN_REDUCTION) * 100
-    print(f'\n{len(listener.record.t)} samples in {time.monotonic() - wall_start:.1f} s; '
-          f'figure: {out}')
+    print(f'\n{len(listener.record.t)} samples; {3 * p:g} s simulated in {sim_wall:.1f} s '
+          f'(lockstep: {3 * p / sim_wall:.1f}x achieved of {args.speed:g}x), '
+          f'{time.monotonic() - wall_start:.1f} s in all; figure: {out}')
     print(f'PASS: every shaped move cut the vibration it adds by >= {need:g} %' if ok else
           f'FAIL: a shaped move cut the vibration it adds by less than {need:g} %')
     return 0 if ok else 1

@@ -113,6 +113,8 @@ def residual_vibration(times: Sequence[float], amplitudes: Sequence[float], freq
     ``frequency_hz`` may be an array (the result is then one); ``w = 2 pi f``,
     ``wd = w sqrt(1 - zeta^2)``.
     """
+    if not 0 <= damping < 1:
+        raise ValueError(f'damping ratio must be in [0, 1), got {damping!r}')
     t = np.asarray(times, dtype=float)
     a = np.asarray(amplitudes, dtype=float)
     w = 2 * np.pi * np.asarray(frequency_hz, dtype=float)[..., None]

@@ -257,7 +257,10 @@ class SimNode(Node):
             self.get_logger().info(f'position_command {msg.data:g} rad: commands take over from '
                                    'the schedule')
         self.commands_received += 1
+        was_waiting = not self._answered
         self._answered = True
+        if self._lockstep and was_waiting:
+            self._tick()               # the answer came: the next batch now, not at the next tick
 
     def _lockstep_wait(self) -> bool:
         """In lockstep, whether the next batch must still wait for the commander's answer."""
