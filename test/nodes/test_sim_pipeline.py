@@ -218,3 +218,41 @@ def test_sim_follows_position_commands(ros_context, executor):
         for node in (sim, probe):
             executor.remove_node(node)
             node.destroy_node()
+
+
+def test_lockstep_waits_for_the_commander(ros_context, executor):
+    """wait_for_command + lockstep: nothing is simulated before the first command; afterwards
+    each batch waits for shaper_node's answer to the previous /clock, so when the shaper stops
+    the arm stops (within one batch) and goes on when it is back."""
+    from vib_estimator.nodes.shaper_node import ShaperNode
+    from vib_estimator.nodes.sim_node import LOCKSTEP_BATCH_SECONDS
+
+    with pytest.raises(StartupError, match='lockstep needs simulated time'):
+        sim_node(ros_context, lockstep=True)
+    sim = sim_node(ros_context, namespace='lock', speed=20.0, lockstep=True,
+                   wait_for_command=True)
+    shaper = ShaperNode(context=ros_context, namespace='lock', parameter_overrides=[
+        Parameter('use_sim_time', value=True), Parameter('shaper', value='none')])
+    probe = Node('probe', context=ros_context)
+    ref = probe.create_publisher(Float64, '/lock/reference', 10)
+    for node in (sim, shaper, probe):
+        executor.add_node(node)
+    try:
+        spin_until(executor, lambda: False, 0.3)
+        assert sim._sim.t == 0.0 and sim.commands_received == 0
+        assert spin_until(executor, lambda: ref.get_subscription_count() >= 1, 10.0)
+        ref.publish(Float64(data=0.2))
+        assert spin_until(executor, lambda: sim._sim.t > 1.0, 30.0)
+        executor.remove_node(shaper)
+        spin_until(executor, lambda: False, 0.1)             # in flight
+        stopped_at = sim._sim.t
+        spin_until(executor, lambda: False, 0.5)
+        assert sim._sim.t - stopped_at <= LOCKSTEP_BATCH_SECONDS + 1e-9
+        executor.add_node(shaper)
+        assert spin_until(executor, lambda: sim._sim.t > stopped_at + 0.5, 30.0)
+        assert sim._sim.command == pytest.approx(0.2) and sim.lockstep_timeouts == 0
+    finally:
+        for node in (sim, shaper, probe):
+            if node in executor.get_nodes():
+                executor.remove_node(node)
+            node.destroy_node()
