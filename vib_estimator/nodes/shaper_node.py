@@ -172,21 +172,21 @@ class ShaperNode(Node):
             self._t0_ns = self.get_clock().now().nanoseconds
 
     def _on_frequency(self, msg: Float64) -> None:
-        if not MIN_FREQUENCY_HZ <= msg.data <= self._rate / 4:   # also refuses NaN
-            self.counters['estimates_ignored'] += 1
-            return
-        self.counters['frequency_estimates'] += 1
-        self._frequencies.append(msg.data)
-        self._redesign()
+        self._take_estimate(msg.data, MIN_FREQUENCY_HZ, self._rate / 4, 'frequency_estimates',
+                            self._frequencies)
 
     def _on_damping(self, msg: Float64) -> None:
-        if math.isnan(msg.data):       # a model without damping
-            return
-        if not 0.0 <= msg.data <= MAX_DAMPING:
+        if not math.isnan(msg.data):       # NaN: a model without damping
+            self._take_estimate(msg.data, 0.0, MAX_DAMPING, 'damping_estimates', self._dampings)
+
+    def _take_estimate(self, value: float, lo: float, hi: float, counter: str,
+                       store: deque) -> None:
+        """Keep an estimate within [lo, hi] and redesign; count one outside (or NaN) ignored."""
+        if not lo <= value <= hi:
             self.counters['estimates_ignored'] += 1
             return
-        self.counters['damping_estimates'] += 1
-        self._dampings.append(msg.data)
+        self.counters[counter] += 1
+        store.append(value)
         self._redesign()
 
     # ---- output ----------------------------------------------------------------------------
