@@ -25,13 +25,22 @@ import numpy as np
 @dataclass(frozen=True)
 class AddedVibration:
     """Amplitudes at ``t_settled`` (signal units) of the vibration the move added and of the one
-    continued from before it; the fitted mode; the rms residual of the fit."""
+    continued from before it; the fitted mode; the rms residual of the fit; the move's time and
+    the six coefficients of the model (for :meth:`continued`)."""
 
     added: float
     previous: float
     frequency_hz: float
     damping: float
     rms_residual: float
+    t_move: float = 0.0
+    coefficients: tuple = (0.0,) * 6
+
+    def continued(self, t) -> np.ndarray:
+        """The vibration from before the move, continued to times ``t`` (no offset)."""
+        s = np.asarray(t, dtype=float) - self.t_move
+        m = _design(s, np.zeros(len(s), dtype=bool), self.frequency_hz, self.damping)
+        return m[:, 2:4] @ np.asarray(self.coefficients[2:4])
 
 
 def _design(s: np.ndarray, after: np.ndarray, frequency_hz: float, damping: float) -> np.ndarray:
@@ -72,7 +81,8 @@ def added_vibration(t, y, t_move: float, t_settled: float, before_s: float, afte
     decay = math.exp(-zeta * 2 * math.pi * f * (t_settled - t_move))
     return AddedVibration(added=math.hypot(coef[4], coef[5]) * decay,
                           previous=math.hypot(coef[2], coef[3]) * decay, frequency_hz=float(f),
-                          damping=float(zeta), rms_residual=math.sqrt(rss / len(yk)))
+                          damping=float(zeta), rms_residual=math.sqrt(rss / len(yk)),
+                          t_move=t_move, coefficients=tuple(float(c) for c in coef))
 
 
 def move_onset(t, y, t_command: float, frequency_hz: float, damping: float = 0.0,

@@ -34,7 +34,7 @@ MAX_DAMPING = 0.5
 
 @dataclass(frozen=True)
 class Shaper:
-    """Impulse times (s, from 0) and amplitudes (sum 1) designed for ``frequency_hz``, ``damping``."""
+    """Impulse times (s, from 0) and amplitudes (sum 1), designed for a mode."""
 
     name: str
     times: np.ndarray

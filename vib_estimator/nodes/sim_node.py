@@ -146,8 +146,8 @@ PARAMETERS = {
         'use_sim_time) then acts at the simulated times it computed for, however loaded the '
         'machine; the run goes as fast as that round trip allows, at most speed', read_only=True)),
     'output_type': (WRENCH_STAMPED, descriptor(
-        'message of the measurement: geometry_msgs/msg/WrenchStamped (coupling torque, torque.z, on '
-        'coupling_torque) or sensor_msgs/msg/Imu (tip acceleration, linear_acceleration.z, on '
+        'message of the measurement: geometry_msgs/msg/WrenchStamped (coupling torque, torque.z, '
+        'on coupling_torque) or sensor_msgs/msg/Imu (tip acceleration, linear_acceleration.z, on '
         'tip_imu)', read_only=True)),
 }
 
