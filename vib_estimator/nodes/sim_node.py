@@ -17,11 +17,13 @@ any other ``speed``, or with ``publish_clock`` set, it runs a simulated clock, `
 faster (or slower) than real time, publishes it on ``/clock`` and stamps samples with it
 (subscribers then set ``use_sim_time``); the simulated clock starts at :data:`SIM_TIME_ORIGIN_NS`
 (1 s) because ROS takes a zero stamp as unset.
-Samples are produced in batches by a 200 Hz steady-clock timer, as many as are due, so that high
+Samples are produced in batches by a 1 kHz steady-clock timer, as many as are due, so that high
 speeds work. Setting ``tip_mass_kg`` while running changes the frequency abruptly, as in
 Section 5.5. ``duration`` makes the node exit 0 after that much simulated time, and
 ``wait_for_subscribers`` holds the start until the consumers are matched (the demo and the tests
-use both).
+use both); ``wait_for_command`` until the first command. ``lockstep`` (simulated time) makes each
+batch wait for a command answering the previous ``/clock``, so a closed loop through other nodes
+behaves the same at any speed and load.
 """
 from __future__ import annotations
 
