@@ -195,7 +195,10 @@ def _start(exe: str, params: List[str], env: dict) -> subprocess.Popen:
     cmd = [str(Path(sys.executable).parent / exe), '--ros-args']
     for p in params:
         cmd += ['-p', p]
-    return subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL)
+    # a demo started from a background job inherits SIGINT ignored: give the nodes the default,
+    # so that _stop's SIGINT ends them cleanly
+    return subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
 
 
 def _stop(proc: subprocess.Popen) -> None:

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, strategies as st
+from hypothesis import given, settings, strategies as st
 
 from vib_estimator.control.shaping import (EI_VTOL, SHAPERS, StreamingShaper, design,
                                            discrete_kernel, ei, k_factor, none,
@@ -115,6 +115,7 @@ def test_design_errors():
     assert set(SHAPERS) == {'none', 'zv', 'zvd', 'zvdd', 'ei'}
 
 
+@settings(deadline=None)
 @given(st.floats(0.3, 40.0), st.floats(0.0, 0.2), st.sampled_from(sorted(SHAPERS)))
 def test_discrete_kernel_keeps_sum_and_centroid(f, zeta, name):
     s = design(name, f, zeta)
@@ -124,6 +125,7 @@ def test_discrete_kernel_keeps_sum_and_centroid(f, zeta, name):
     assert centroid == pytest.approx(np.dot(s.times, s.amplitudes), abs=1e-9)
 
 
+@settings(deadline=None, max_examples=50)
 @given(st.sampled_from(sorted(SHAPERS)), st.floats(0.5, 20.0), st.integers(0, 2 ** 32 - 1))
 def test_streaming_equals_convolution(name, f, seed):
     rate = 200.0

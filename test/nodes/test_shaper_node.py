@@ -1,9 +1,14 @@
 """shaper_node end to end, in process, on a simulated clock the test advances itself: a step
 reference in, the shaper's staircase out; a new estimate is switched in only at rest; damping and
-parameters; /diagnostics."""
+parameters; /diagnostics. Then the whole loop as processes: ``vib-estimator demo --shaping`` on a
+short run (its pass criterion)."""
 from __future__ import annotations
 
 import math
+import os
+import subprocess
+import sys
+from pathlib import Path
 
 import pytest
 from builtin_interfaces.msg import Time
@@ -171,3 +176,19 @@ def test_parameters(ros_context, executor):
         assert node.design_mode()[0] == 1.4               # median of 5.0, 1.2, 1.4
     finally:
         node.destroy_node()
+
+
+def test_live_demo_short_run(tmp_path):
+    """vib-estimator demo --shaping end to end (sim_node, estimator_node, shaper_node as
+    processes, in lockstep), on 6 simulated seconds per mass."""
+    exe = Path(sys.executable).parent / 'vib-estimator'
+    out = tmp_path / 'shaping.png'
+    proc = subprocess.run(
+        [str(exe), 'demo', '--shaping', '--seconds-per-mass', '6', '--speed', '20',
+         '--domain-id', os.environ['ROS_DOMAIN_ID'], '--out', str(out)],
+        capture_output=True, text=True, timeout=240)
+    assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
+    assert 'PASS' in proc.stdout and out.stat().st_size > 10_000
+    bad = subprocess.run([str(exe), 'demo', '--shaping', '--seconds-per-mass', '3'],
+                         capture_output=True, text=True, timeout=60)
+    assert bad.returncode == 2 and bad.stderr.startswith('error:')
