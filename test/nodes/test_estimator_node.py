@@ -592,3 +592,40 @@ def test_each_mode_on_its_own_topics(make_probe, monkeypatch):
     assert float(kv['mode2_frequency_hz']) == pytest.approx(mode2[-1], rel=1e-8)
     assert float(kv['mode2_age_s']) >= 0 and 'mode2_frequency_std_hz' in kv
     assert int(kv['estimates']) == len(mode1) + len(mode2)
+
+
+def test_simulated_accelerometer_end_to_end(ros_context, executor):
+    """sim_node publishing sensor_msgs/Imu (tip acceleration) -> estimator_node with input_type
+    Imu: the free vibration after the ramp at Eq. 23's frequency."""
+    from vib_estimator.nodes.sim_node import SIM_TIME_ORIGIN_NS, SimNode
+    from vib_estimator.sim.arm_model import natural_frequency_hz
+
+    estimator = EstimatorNode(context=ros_context, parameter_overrides=[
+        Parameter('input_type', value=fields.IMU),
+        Parameter('input_topic', value='/imu_e2e/tip_imu')])
+    probe = Node('probe', context=ros_context)
+    frequencies, resets = [], []
+    subs = [probe.create_subscription(Float64, 'vibration/frequency',
+                                      lambda m: frequencies.append(m.data), 100),
+            probe.create_subscription(Header, 'vibration/reset', lambda m: resets.append(
+                m.stamp.sec * 10 ** 9 + m.stamp.nanosec), 100)]
+    sim = SimNode(context=ros_context, namespace='imu_e2e', parameter_overrides=[
+        Parameter('output_type', value=fields.IMU), Parameter('speed', value=10.0),
+        Parameter('duration', value=5.0), Parameter('wait_for_subscribers', value=1)])
+    nodes = (estimator, probe, sim)
+    for node in nodes:
+        executor.add_node(node)
+    try:
+        assert spin_until(executor, lambda: all(s.get_publisher_count() >= 1 for s in subs),
+                          10.0)
+        assert spin_until(executor, lambda: sim.finished, 60.0)
+        assert spin_until(executor, lambda: len(frequencies) == len(resets)
+                          == estimator.counters['estimates'], 5.0)
+    finally:
+        for node in nodes:
+            executor.remove_node(node)
+            node.destroy_node()
+    t = (np.array(resets) - SIM_TIME_ORIGIN_NS) * 1e-9   # simulated s since the first sample
+    free = np.array(frequencies)[t > 1.5]                 # after the 1 s ramp
+    assert len(free) >= 3
+    assert np.median(free) == pytest.approx(natural_frequency_hz(0.04555), rel=0.01)
