@@ -629,3 +629,29 @@ def test_simulated_accelerometer_end_to_end(ros_context, executor):
     free = np.array(frequencies)[t > 1.5]                 # after the 1 s ramp
     assert len(free) >= 3
     assert np.median(free) == pytest.approx(natural_frequency_hz(0.04555), rel=0.01)
+
+
+def test_names_are_relative_so_namespaces_apply(ros_context, executor):
+    node = EstimatorNode(context=ros_context, namespace='arm1', parameter_overrides=[
+        Parameter('modes', value=2)])
+    probe = Node('probe', context=ros_context)
+    expected_topics = {f'/arm1/vibration/{t}' for t in OUTPUTS} | {
+        f'/arm1/vibration/mode{k}/{t}' for k in (1, 2) for t in ('frequency', 'reset')}
+    expected_services = {'/arm1/estimator_node/reset', '/arm1/estimator_node/self_test'}
+
+    def graph():
+        topics = {n for n, _ in probe.get_publisher_names_and_types_by_node(
+            'estimator_node', '/arm1')}
+        services = {n for n, _ in probe.get_service_names_and_types_by_node(
+            'estimator_node', '/arm1')}
+        return topics, services
+    try:
+        for n in (node, probe):
+            executor.add_node(n)
+        assert spin_until(executor, lambda: expected_topics <= graph()[0]
+                          and expected_services <= graph()[1], 10.0), graph()
+        assert node._subscription.topic_name == '/arm1/coupling_torque'
+    finally:
+        for n in (node, probe):
+            executor.remove_node(n)
+            n.destroy_node()
