@@ -12,7 +12,9 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Optional, Tuple
 
 import numpy as np
 
@@ -32,7 +34,6 @@ _CONFIG_OPTIONS = {
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    defaults = EstimatorConfig()
     parser.add_argument('input', help='CSV file, MCAP file, or rosbag2 directory')
     parser.add_argument('--topic', help='topic of a bag (default: its only topic of a supported '
                         f'type: {", ".join(t.split("/")[-1] for t in INPUT_TYPES)})')
@@ -41,14 +42,20 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         'linear_acceleration.z of an Imu)')
     parser.add_argument('--column', help='CSV signal column, by header name or 0-based index '
                         '(default: the second column)')
+    add_config_arguments(parser)
+    parser.add_argument('--format', choices=('jsonl', 'csv', 'table'), default='jsonl')
+    parser.add_argument('--plot', metavar='FILE.png', help='write a Fig. 5-like figure')
+
+
+def add_config_arguments(parser: argparse.ArgumentParser) -> None:
+    """The estimator options (``--model``, ``--band-hz``, one per scalar config field)."""
+    defaults = EstimatorConfig()
     parser.add_argument('--model', choices=MODELS, default=defaults.model)
     parser.add_argument('--band-hz', nargs=2, type=float, metavar=('LO', 'HI'),
                         help='band-pass prefilter [LO, HI] Hz (default off)')
     for name, kind in _CONFIG_OPTIONS.items():
         parser.add_argument('--' + name.replace('_', '-'), type=kind,
                             default=getattr(defaults, name), help=f'(default {getattr(defaults, name)})')
-    parser.add_argument('--format', choices=('jsonl', 'csv', 'table'), default='jsonl')
-    parser.add_argument('--plot', metavar='FILE.png', help='write a Fig. 5-like figure')
 
 
 def make_config(args: argparse.Namespace) -> EstimatorConfig:
@@ -78,13 +85,23 @@ def _check_nyquist(config: EstimatorConfig, t: np.ndarray, name: str) -> None:
                          f'frequency {nyquist:g} Hz of {name} (sampled at {2 * nyquist:g} Hz)')
 
 
-def estimate_signal(signal: Signal, config: EstimatorConfig, keep_samples: bool = False):
-    """Stream ``signal`` through a fresh estimator of ``config``.
+@dataclass
+class Run:
+    """The result of :func:`estimate_signal`: the estimator (its counters), the estimates, the
+    first and last sample times, and (``keep_samples``) every ``(t, y)``."""
 
-    Returns ``(estimator, estimates, first_t, samples)``: the estimator (its counters), the
-    estimates as columns, the first time (None if no sample) and, with ``keep_samples``, all
-    ``(t, y)`` (for a plot). Raises ValueError (time not increasing, band above Nyquist) and the
-    readers' CsvError/BagError.
+    estimator: object
+    estimates: EstimateArrays
+    first_t: float
+    last_t: float
+    samples: Optional[Tuple[np.ndarray, np.ndarray]]
+
+
+def estimate_signal(signal: Signal, config: EstimatorConfig, keep_samples: bool = False) -> Run:
+    """Stream ``signal`` through a fresh estimator of ``config``, block by block.
+
+    Raises ValueError (no samples, time not increasing, band above Nyquist) and the readers'
+    CsvError/BagError.
     """
     estimator = create_estimator(config)
     parts, kept = [], []
@@ -106,7 +123,7 @@ def estimate_signal(signal: Signal, config: EstimatorConfig, keep_samples: bool 
         raise ValueError(f'{signal.path} holds no samples' if not signal.topic else
                          f'topic {signal.topic} of {signal.path} has no messages')
     samples = tuple(np.concatenate(p) for p in zip(*kept)) if keep_samples else None
-    return estimator, EstimateArrays.concatenate(parts), first_t, samples
+    return Run(estimator, EstimateArrays.concatenate(parts), first_t, previous, samples)
 
 
 def _print(estimates, origin, fmt) -> None:
@@ -138,12 +155,13 @@ def run(args: argparse.Namespace) -> int:
     try:
         config = make_config(args)
         signal = open_signal(args.input, args.topic, args.component, args.column)
-        estimator, estimates, _, samples = estimate_signal(signal, config, bool(args.plot))
+        result = estimate_signal(signal, config, bool(args.plot))
     except (CsvError, BagError, ValueError) as err:
         print(f'vib-estimator analyze: error: {err}', file=sys.stderr)
         return 2
+    estimates = result.estimates
     _print(estimates, signal.origin_ns, args.format)
-    counters = estimator.counters
+    counters = result.estimator.counters
     extra = f', messages_without_component={signal.skipped}' if signal.skipped else ''
     print('analyze: ' + ', '.join(f'{k}={counters[k]}' for k in COUNTER_NAMES) + extra,
           file=sys.stderr)
@@ -151,7 +169,7 @@ def run(args: argparse.Namespace) -> int:
         from .plotting import plot_estimates
 
         Path(args.plot).parent.mkdir(parents=True, exist_ok=True)
-        plot_estimates(args.plot, *samples, estimates.t, estimates.frequency_hz,
+        plot_estimates(args.plot, *result.samples, estimates.t, estimates.frequency_hz,
                        estimates.convergence_time, title=f'{args.input}: {signal.label}',
                        ylabel=signal.label)
     return 0
