@@ -213,12 +213,23 @@ def bag_signal(path: Path, topic: Optional[str], component: Optional[str]) -> Si
         topic = choose_topic(path, topics, topic)
         msgtype = topics[topic]
         component = check_component(component or DEFAULT_COMPONENT[msgtype], msgtype)
-        files = [Path(p) for p in getattr(reader, 'paths', [path])]
+        files = _storage_files(reader, path)
     finally:
         reader.close()
     signal = Signal(path, f'{topic} {component}', topic, msgtype, component)
     signal._source = lambda: _bag_blocks(signal, files)
     return signal
+
+
+def _storage_files(reader, path: Path) -> List[Path]:
+    """The storage files of an open bag, in its order; the bag itself when they are compressed
+    (then only rosbags, which decompresses them, reads it)."""
+    storages = getattr(reader.storage, 'storages', None)
+    if storages is None:
+        return [path]
+    if reader.compression_mode:
+        return [path]
+    return [Path(storage.path) for storage in storages]
 
 
 def _bag_blocks(signal: Signal, files: List[Path]) -> Iterator[Block]:
