@@ -92,12 +92,18 @@ def peak_rss_mb(code: str) -> float:
     return float(out.split()[-1])
 
 
+def streamed(work: Path, suffix: str, n: int, write):
+    """A recording of ``n`` samples and one of a tenth of it; the streaming reader's CPU time on
+    the first."""
+    big, small = work / f'big{suffix}', work / f'small{suffix}'
+    write(big, n)
+    write(small, n // 10)
+    return big, small, cpu(lambda: drain(streaming.open_signal(big)))
+
+
 def bench_csv(work: Path, rows: int) -> Path:
-    big, small = work / 'big.csv', work / 'small.csv'
-    write_csv(big, rows)
-    write_csv(small, rows // 10)
+    big, small, fast = streamed(work, '.csv', rows, write_csv)
     n = rows // 10
-    fast = cpu(lambda: drain(streaming.open_signal(big)))
     loadtxt = cpu(lambda: np.loadtxt(small, delimiter=',', skiprows=1), 1)
     exact = cpu(lambda: sum(1 for _ in iter_csv_rows(csv_layout(small))), 1)
     print(f'csv   streaming {rows / fast / 1e6:6.2f} M rows/s   numpy.loadtxt {n / loadtxt / 1e6:6.2f}'
@@ -107,11 +113,8 @@ def bench_csv(work: Path, rows: int) -> Path:
 
 
 def bench_bag(work: Path, messages: int) -> Path:
-    big, small = work / 'big_bag', work / 'small_bag'
-    write_bag(big, messages)
-    write_bag(small, messages // 10)
+    big, small, fast = streamed(work, '_bag', messages, write_bag)
     n = messages // 10
-    fast = cpu(lambda: drain(streaming.open_signal(big)))
     from rosbags.rosbag2 import Reader
 
     def generic():

@@ -184,19 +184,25 @@ def supported_topics(topics: Dict[str, str]) -> Dict[str, str]:
     return {name: kind for name, kind in topics.items() if kind in INPUT_TYPES}
 
 
+def only_topic(path: Path, candidates: List[str], what: str, listing: str) -> str:
+    """The one topic of ``candidates`` (shown as they are given), else BagError: none (with the
+    bag's ``listing``) or several (choose one)."""
+    BagError = _bag_error()
+    if not candidates:
+        raise BagError(f'bag {path} has no {what} topic; its topics are {listing}')
+    if len(candidates) > 1:
+        raise BagError(f'bag {path} has several {what} topics, choose one: '
+                       f'{", ".join(candidates)}')
+    return candidates[0].split(' ')[0]
+
+
 def choose_topic(path: Path, topics: Dict[str, str], topic: Optional[str]) -> str:
     """``topic`` checked against the bag, or the bag's only topic of a supported type."""
     BagError = _bag_error()
     listing = ', '.join(f'{n} ({k})' for n, k in topics.items()) or 'none'
     if topic is None:
-        usable = list(supported_topics(topics))
-        if not usable:
-            raise BagError(f'bag {path} has no topic of a supported type '
-                           f'({", ".join(INPUT_TYPES)}); its topics are {listing}')
-        if len(usable) > 1:
-            raise BagError(f'bag {path} has several topics of supported types, choose one with '
-                           f'--topic: {", ".join(f"{n} ({topics[n]})" for n in usable)}')
-        return usable[0]
+        return only_topic(path, [f'{n} ({k})' for n, k in supported_topics(topics).items()],
+                          f'supported-type ({", ".join(INPUT_TYPES)})', listing)
     if topic not in topics:
         raise BagError(f'bag {path} has no topic {topic!r}; its topics are {listing}')
     if topics[topic] not in INPUT_TYPES:
