@@ -138,7 +138,7 @@ def test_topic_choice_and_errors(tmp_path):
         for s in stamps.tolist():
             bag.write_message(a, s, make_message('geometry_msgs/msg/WrenchStamped', s, 'f', 1.0, 0))
             bag.write_message(b, s, make_message('std_msgs/msg/Float64', s, 'f', 2.0, 0))
-    with pytest.raises(BagError, match=r'several .*choose one: /a \(geometry_msgs/msg/WrenchStamped\)'
+    with pytest.raises(BagError, match=r'several input-type topics, choose one with --topic: /a \(geometry_msgs/msg/WrenchStamped\)'
                                        r'.*/b \(std_msgs/msg/Float64\)'):
         open_signal(tmp_path / 'two')
     assert open_signal(tmp_path / 'two', '/b').component == 'data'
@@ -155,7 +155,7 @@ def test_real_split_bags_list_their_topics(name):
     """Split bags of the real rosbag2 (String topics only): the error names the topics."""
     if not SHARED_BAGS.is_dir():
         pytest.skip('shared/ros2-bags is absent')
-    with pytest.raises(BagError, match='no supported-type .* topic; its topics are .*AAA'):
+    with pytest.raises(BagError, match='no input-type topic; its topics are .*AAA'):
         open_signal(SHARED_BAGS / name)
 
 

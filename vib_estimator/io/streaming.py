@@ -184,14 +184,14 @@ def supported_topics(topics: Dict[str, str]) -> Dict[str, str]:
     return {name: kind for name, kind in topics.items() if kind in INPUT_TYPES}
 
 
-def only_topic(path: Path, candidates: List[str], what: str, listing: str) -> str:
+def only_topic(path: Path, candidates: List[str], what: str, listing: str, how: str = '') -> str:
     """The one topic of ``candidates`` (shown as they are given), else BagError: none (with the
-    bag's ``listing``) or several (choose one)."""
+    bag's ``listing``) or several (choose one, ``how``)."""
     BagError = _bag_error()
     if not candidates:
         raise BagError(f'bag {path} has no {what} topic; its topics are {listing}')
     if len(candidates) > 1:
-        raise BagError(f'bag {path} has several {what} topics, choose one: '
+        raise BagError(f'bag {path} has several {what} topics, choose one{how}: '
                        f'{", ".join(candidates)}')
     return candidates[0].split(' ')[0]
 
@@ -202,7 +202,7 @@ def choose_topic(path: Path, topics: Dict[str, str], topic: Optional[str]) -> st
     listing = ', '.join(f'{n} ({k})' for n, k in topics.items()) or 'none'
     if topic is None:
         return only_topic(path, [f'{n} ({k})' for n, k in supported_topics(topics).items()],
-                          f'supported-type ({", ".join(INPUT_TYPES)})', listing)
+                          'input-type', listing, ' with --topic')
     if topic not in topics:
         raise BagError(f'bag {path} has no topic {topic!r}; its topics are {listing}')
     if topics[topic] not in INPUT_TYPES:
