@@ -397,6 +397,10 @@ def plot_trend(rows: List[Dict], path: Path) -> None:
         ax_f.plot([x[i] for i in alarmed], f[alarmed], 'rx', ms=9,
                   label='alarm' if alarmed else None)
         ax_d.plot(x, [r['damping'] for r in line], marker='o', ms=3, label=label)
+    if not any(np.isfinite(r['damping']) for r in good):
+        ax_d.text(0.5, 0.5, 'no damping estimates: the model has no damping\n'
+                  '(--model damped-sinusoid estimates it)', transform=ax_d.transAxes,
+                  ha='center', va='center', color='0.4')
     ax_f.set_ylabel('median frequency (Hz)')
     ax_d.set_ylabel('median damping ratio')
     ax_d.set_xlabel('recording start (UTC)')
