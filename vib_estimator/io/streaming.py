@@ -41,8 +41,9 @@ from .fields import (DEFAULT_COMPONENT, FLOAT64, INPUT_TYPES, check_component, c
 
 #: samples per block handed to the estimator (bags: chunks are grouped up to this size)
 BLOCK_SAMPLES = 1 << 18
-#: bytes of CSV text per parsed block
-CSV_BLOCK_BYTES = 1 << 23
+#: bytes of CSV text per parsed block (2 MB: ~100 k rows; larger blocks parse no faster per CPU
+#: second and raise the peak memory, see benchmarks/bench_survey.py)
+CSV_BLOCK_BYTES = 1 << 21
 
 Block = Tuple[np.ndarray, np.ndarray]
 
@@ -114,7 +115,8 @@ def _csv_blocks(layout) -> Iterator[Block]:
         with layout.path.open('rb') as handle:
             handle.seek(layout.data_offset)
             reader = pacsv.open_csv(
-                handle, read_options=pacsv.ReadOptions(column_names=names,
+                handle, memory_pool=pa.system_memory_pool(),
+                read_options=pacsv.ReadOptions(column_names=names, use_threads=False,
                                                         block_size=CSV_BLOCK_BYTES),
                 parse_options=pacsv.ParseOptions(newlines_in_values=False),
                 convert_options=pacsv.ConvertOptions(
