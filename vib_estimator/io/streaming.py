@@ -230,12 +230,10 @@ def bag_signal(path: Path, topic: Optional[str], component: Optional[str]) -> Si
 
 
 def _storage_files(reader, path: Path) -> List[Path]:
-    """The storage files of an open bag, in its order; the bag itself when they are compressed
-    (then only rosbags, which decompresses them, reads it)."""
+    """The storage files of an open bag, in its order; the bag itself when whole files or messages
+    are compressed (then only rosbags, which decompresses them, reads it)."""
     storages = getattr(reader.storage, 'storages', None)
-    if storages is None:
-        return [path]
-    if reader.compression_mode:
+    if storages is None or reader.compression_mode in ('file', 'message'):
         return [path]
     return [Path(storage.path) for storage in storages]
 
@@ -447,15 +445,12 @@ def _mcap_plan(files: List[Path], topic: str) -> List[_ChunkRead]:
 
 
 def _decompress(kind: str, data: bytes, size: int) -> bytes:
-    if kind == '':
-        return data
-    if kind == 'zstd':
-        import zstandard
-        return zstandard.ZstdDecompressor().decompress(data, max_output_size=size)
-    if kind == 'lz4':
-        import lz4.frame
-        return lz4.frame.decompress(data)
-    raise BagFormatError(f'compression {kind}')
+    """A chunk's records, by rosbags' own MCAP decompressors (none, lz4, zstd)."""
+    from rosbags.rosbag2.storage_mcap import DECOMPRESSORS
+
+    if kind not in DECOMPRESSORS:
+        raise ValueError(f'MCAP chunk compression {kind!r} is not supported')
+    return DECOMPRESSORS[kind](data, size)
 
 
 def _mcap_batches(plan: List[_ChunkRead]):
