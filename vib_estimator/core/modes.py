@@ -57,11 +57,11 @@ from .kernel import BAND_DAMPING, NH, _advance, _discretise
 
 KMAX = 8                 # most modes a tracker follows (the range of ``modes``)
 NPO = 6                  # bank channels per octave
-NOCT = 8                 # octaves: fs/8 down to fs/2048
+NOCT = 8                 # octaves: fs/6 down to fs/1536
 NC = NPO * NOCT
-BANK_TOP = 0.125         # highest channel, cycles per sample
+BANK_TOP = 1.0 / 6.0     # highest channel, cycles per sample
 BANK_Q = 5.0             # quality factor of each of a channel's two resonators
-DEC_CUTOFF = 0.1         # anti-alias low-pass before each decimation by 2, cycles per sample
+DEC_CUTOFF = 0.12        # anti-alias low-pass before each decimation by 2, cycles per sample
 ANALYSIS_EVERY = 16      # samples between two analyses of the bank
 FLOOR_PERCENTILE = 0.1   # noise floor: this quantile of the ready channels' levels
 READY_PERIODS = 2.0      # a channel joins the analysis once its resonators have rung this long
@@ -79,6 +79,7 @@ PENDING_TOL = 0.25       # a candidate peak is the same one from one analysis to
 BAND_RATIO = 1.5         # widest band of a mode: [f / 1.5, 1.5 f]
 MAX_BAND_NU = 0.4        # highest band edge, cycles per sample
 EDGE_MARGIN = 1.05       # estimates must lie this factor inside the band's edges
+CONSISTENCY = 0.01       # ... and within this of the mode's previous estimate
 REPLACE_MARGIN = 1.15    # a centre this close to an edge re-places the band
 REPLACE_CHANGE = 0.15    # ... and so does a wanted edge this far (log) from the placed one
 CONFIRM_PERIODS = 0.5
@@ -612,7 +613,8 @@ class _Slot:
         self.band = (math.nan, math.nan)
         self.est: Optional[FrequencyEstimator] = None
         self.counts: Dict[str, int] = {'estimates': 0, 'rejected_band_edge': 0,
-                                       'rejected_harmonic': 0}
+                                       'rejected_harmonic': 0, 'rejected_inconsistent': 0}
+        self.prev_f = math.nan                   # its estimator's previous estimate
         self.retired: Dict[str, int] = {}        # counters of its replaced estimators
         self.last = (math.nan, math.nan)          # last published (frequency, t)
         self.first_t = math.inf                   # stamp of its first published estimate
@@ -640,9 +642,13 @@ class _Slot:
         n = np.round(r)
         harmonic = inside & np.any((n >= 2) & (n <= MAX_HARMONIC)
                                    & (np.abs(r / np.maximum(n, 1) - 1) < HARMONIC_TOL_EST), axis=1)
-        keep = inside & ~harmonic
+        prev = np.concatenate(([self.prev_f], f[:-1]))
+        keep = inside & ~harmonic & (np.abs(f / prev - 1) < CONSISTENCY)
+        if len(f):
+            self.prev_f = float(f[-1])
         self.counts['rejected_band_edge'] += int(np.count_nonzero(~inside))
         self.counts['rejected_harmonic'] += int(np.count_nonzero(harmonic))
+        self.counts['rejected_inconsistent'] += int(np.count_nonzero(inside & ~harmonic & ~keep))
         self.counts['estimates'] += int(np.count_nonzero(keep))
         return keep
 
