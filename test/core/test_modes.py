@@ -90,7 +90,8 @@ def test_harmonics_of_a_clipped_mode_are_no_modes():
     e = tr.process(t, y)
     assert len(e) > 50
     assert set(e.mode) == {1}
-    assert np.mean(np.abs(e.frequency_hz / 11 - 1) > 0.03) <= 0.02
+    # while it is clipped hard the waveform is no sine: estimates up to ~3 % high, still mode 1
+    assert np.all(np.abs(e.frequency_hz / 11 - 1) < 0.05)
 
 
 def test_streaming_and_batch_give_the_same_floats():
