@@ -135,6 +135,19 @@ def test_interface():
     assert len(e) > 10 and math.isclose(np.median(e.frequency_hz), 10.0, rel_tol=0.003)
 
 
+def test_plot_colours_the_modes(tmp_path):
+    from vib_estimator.analysis.plotting import plot_estimates
+
+    t = np.arange(0, 5, 1 / FS)
+    y = decay(t, 0.5, 8.0, 1.0) + decay(t, 0.5, 21.0, 0.3, 0.001) + noise(t, 0.003, 0)
+    e = ModeTracker(CFG).process(t, y)
+    out = tmp_path / 'modes.png'
+    plot_estimates(str(out), t, y, e.t, e.frequency_hz, e.convergence_time, mode=e.mode)
+    assert out.stat().st_size > 10_000
+    plot_estimates(str(tmp_path / 'none.png'), t, y, e.t[:0], e.frequency_hz[:0],
+                   e.convergence_time[:0], mode=e.mode[:0])
+
+
 REFERENCE = {30: 16.360, 40: 9.392, 50: 6.054, 60: 4.268}
 
 
