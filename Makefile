@@ -4,7 +4,7 @@ VENV    := .venv
 STAMP   := $(VENV)/.installed
 export ROS_AUTOMATIC_DISCOVERY_RANGE := LOCALHOST
 
-.PHONY: setup demo test bench reproduce compare bags clean
+.PHONY: setup demo shaping test bench reproduce compare bags clean
 
 setup: $(STAMP)
 
@@ -19,6 +19,9 @@ $(STAMP): requirements.txt setup.py setup.cfg package.xml
 
 demo: setup
 	$(VENV)/bin/vib-estimator demo
+
+shaping: setup
+	$(VENV)/bin/vib-estimator demo --shaping
 
 test: setup
 	$(VENV)/bin/python -m pytest -q test
