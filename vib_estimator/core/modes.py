@@ -69,6 +69,8 @@ MIN_READY = 12           # channels needed for a floor
 KEEP_DB = 8.0            # a peak this far above the floor keeps a mode alive
 DETECT_DB = 15.0         # ... and this far above it may become a new mode
 DYNAMIC_RANGE_DB = 40.0  # ... and no more than this below the strongest channel
+SINGLE_DB = 8.0          # a single mode's peak: the channels 2 away on both sides this far below
+SINGLE_HYSTERESIS = 4.0  # ... a mode's peak stays single until it is this much wider
 PROMINENCE_DB = 3.0      # dip needed between a peak and a stronger one
 HARMONIC_TOL = 0.02      # relative distance of a peak to n f of a stronger peak (n = 2..5)
 HARMONIC_TOL_EST = 0.01  # same for an estimate against a stronger mode's last estimate
@@ -101,7 +103,8 @@ B_CH = 0
 B_DEC = B_CH + CH_N * NC
 B_LEVEL = B_DEC + DEC_N * NOCT   # NC levels of the last analysis (energy / frequency)
 B_PEAK = B_LEVEL + NC            # PMAX x 3: frequency (cycles/sample), dB above floor, energy
-B_TLAST = B_PEAK + 3 * PMAX
+B_NARROW = B_PEAK + 3 * PMAX    # PMAX: dB of the peak above the channels 2 away (``SINGLE_DB``)
+B_TLAST = B_NARROW + PMAX
 B_DT = B_TLAST + 1               # mean sampling interval, s
 B_FLOOR = B_DT + 1
 B_TAN = B_FLOOR + 1              # time of the last analysis
@@ -112,18 +115,19 @@ N_B = B_HY + HIST
 # ---- int array ic -------------------------------------------------------------------------------
 (I_N, I_NB, I_NDT, I_NPEAK, I_NAN, I_EVENT, I_NPEND, I_UID, I_RECEIVED, I_USED, I_NONFINITE,
  I_DUPLICATE, I_OUT_OF_ORDER, I_TIME_JUMP, I_GAP, I_FOUND, I_LOST, I_REJ_HARM, I_REJ_NOISE,
- I_REPLACED) = range(20)
-N_I = 20
+ I_REPLACED, I_REJ_UNRES) = range(21)
+N_I = 21
 #: input counters of the stage, named as the estimator's
 STAGE_COUNTERS = {'received': I_RECEIVED, 'used': I_USED, 'skipped_non_finite': I_NONFINITE,
                   'skipped_duplicate': I_DUPLICATE, 'skipped_out_of_order': I_OUT_OF_ORDER,
                   'time_jump_resets': I_TIME_JUMP, 'gap_resets': I_GAP}
 #: the finder's counters kept by the stage
 FINDER_COUNTERS = {'modes_found': I_FOUND, 'modes_lost': I_LOST, 'rejected_harmonic': I_REJ_HARM,
-                   'rejected_noise': I_REJ_NOISE, 'band_replacements': I_REPLACED}
+                   'rejected_noise': I_REJ_NOISE, 'band_replacements': I_REPLACED,
+                   'rejected_unresolved': I_REJ_UNRES}
 # ---- modes sl[k]: active, identity, centre (Hz), energy, seconds without a peak, placed band ----
-SL_ACTIVE, SL_UID, SL_F, SL_E, SL_MISS, SL_LO, SL_HI = range(7)
-N_SL = 7
+SL_ACTIVE, SL_UID, SL_F, SL_E, SL_MISS, SL_LO, SL_HI, SL_SINGLE = range(8)
+N_SL = 8
 # ---- candidates pd[i]: frequency (Hz), age (s), rejected as a harmonic ---------------------------
 PD_F, PD_AGE, PD_REJ = range(3)
 # ---- parameters pa ------------------------------------------------------------------------------
@@ -244,6 +248,7 @@ def _analyse(b, ic):
         b[o] = BANK_TOP * 2.0 ** (-(c + delta) / NPO)
         b[o + 1] = 10.0 * (l0 - math.log10(ref))
         b[o + 2] = lv * b[B_CH + CH_N * c + CH_NU]
+        b[B_NARROW + npk] = 10.0 * math.log10(lv / max(b[B_LEVEL + c - 2], b[B_LEVEL + c + 2]))
         npk += 1
     ic[I_NPEAK] = npk
 
@@ -267,7 +272,7 @@ def _local_floor(b, c, ready):
 
 
 @njit(cache=True)
-def _peaks(b, ic, pa, pf, pe, pdb):
+def _peaks(b, ic, pa, pf, pe, pdb, pn):
     """The analysis' peaks in Hz that are neither shoulders of a stronger peak (less than
     ``PROMINENCE_DB`` of dip between them) nor outside the searched band; returns their count."""
     rate = 1.0 / b[B_DT]
@@ -287,6 +292,7 @@ def _peaks(b, ic, pa, pf, pe, pdb):
         if shoulder or f < pa[PA_BLO] or f > pa[PA_BHI] or b[pi] > MAX_BAND_NU:
             continue
         pf[n] = f
+        pn[n] = b[B_NARROW + i]
         pdb[n] = b[pi + 1]
         pe[n] = b[pi + 2]
         n += 1
@@ -313,9 +319,9 @@ def _remove(ic, sl, k):
 
 
 @njit(cache=True)
-def _follow(ic, sl, pf, pe, npk, used, dt):
-    """Each mode takes the strongest free peak inside its band; one without is lost after
-    ``LOSE_PERIODS`` of its period."""
+def _follow(ic, sl, pf, pe, pn, npk, used, dt):
+    """Each mode takes the strongest free peak inside its band (and whether it is a single mode's
+    peak: a change is an event); one without is lost after ``LOSE_PERIODS`` of its period."""
     for k in range(KMAX):
         if sl[k, SL_ACTIVE] == 0.0:
             continue
@@ -333,10 +339,14 @@ def _follow(ic, sl, pf, pe, npk, used, dt):
         sl[k, SL_MISS] = 0.0
         sl[k, SL_F] += CENTRE_GAIN * (pf[best] - sl[k, SL_F])
         sl[k, SL_E] = pe[best]
+        single = pn[best] >= SINGLE_DB - (SINGLE_HYSTERESIS if sl[k, SL_SINGLE] else 0.0)
+        if sl[k, SL_SINGLE] != single:
+            sl[k, SL_SINGLE] = single
+            ic[I_EVENT] = 1
 
 
 @njit(cache=True)
-def _admit(ic, sl, pa, f, e):
+def _admit(ic, sl, pa, f, e, single):
     """A new mode at f if there is room, or if it is 6 dB stronger than the weakest mode."""
     free = -1
     weakest = -1
@@ -358,15 +368,16 @@ def _admit(ic, sl, pa, f, e):
     sl[free, SL_UID] = ic[I_UID]
     sl[free, SL_F] = f
     sl[free, SL_E] = e
+    sl[free, SL_SINGLE] = single
     ic[I_FOUND] += 1
     ic[I_EVENT] = 1
     return True
 
 
 @njit(cache=True)
-def _candidates(ic, sl, pd, pa, pf, pe, pdb, npk, used, dt):
+def _candidates(ic, sl, pd, pa, pf, pe, pdb, pn, npk, used, dt):
     """Peaks no mode explains: age them, confirm those that persisted ``CONFIRM_PERIODS``
-    (unless harmonics), count those that vanished before (noise)."""
+    (unless harmonics, or wider than one mode's peak), count those that vanished before (noise)."""
     new = np.zeros((PMAX, 3))
     matched = np.zeros(PMAX, dtype=np.int64)
     nnew = 0
@@ -385,7 +396,9 @@ def _candidates(ic, sl, pd, pa, pf, pe, pdb, npk, used, dt):
             if _harmonic(pf[i], pe[i], pf, pe, npk, HARMONIC_TOL):
                 ic[I_REJ_HARM] += 1
                 rej = 1.0
-            elif _admit(ic, sl, pa, pf[i], pe[i]):
+            elif pn[i] < SINGLE_DB:
+                ic[I_REJ_UNRES] += 1
+            elif _admit(ic, sl, pa, pf[i], pe[i], 1.0):
                 continue
         new[nnew, PD_F] = pf[i]
         new[nnew, PD_AGE] = age
@@ -487,10 +500,11 @@ def _track(b, ic, sl, pd, nt, pa, t):
     pf = np.empty(PMAX)
     pe = np.empty(PMAX)
     pdb = np.empty(PMAX)
+    pn = np.empty(PMAX)
     used = np.zeros(PMAX, dtype=np.int64)
-    npk = _peaks(b, ic, pa, pf, pe, pdb)
-    _follow(ic, sl, pf, pe, npk, used, dt)
-    _candidates(ic, sl, pd, pa, pf, pe, pdb, npk, used, dt)
+    npk = _peaks(b, ic, pa, pf, pe, pdb, pn)
+    _follow(ic, sl, pf, pe, pn, npk, used, dt)
+    _candidates(ic, sl, pd, pa, pf, pe, pdb, pn, npk, used, dt)
     _arrange(b, ic, sl, pa)
     _set_notches(b, sl, nt)
 
@@ -613,7 +627,9 @@ class _Slot:
         self.band = (math.nan, math.nan)
         self.est: Optional[FrequencyEstimator] = None
         self.counts: Dict[str, int] = {'estimates': 0, 'rejected_band_edge': 0,
-                                       'rejected_harmonic': 0, 'rejected_inconsistent': 0}
+                                       'rejected_harmonic': 0, 'rejected_inconsistent': 0,
+                                       'rejected_unresolved': 0}
+        self.single = True                       # its peak is one mode's (else: not published)
         self.prev_f = math.nan                   # its estimator's previous estimate
         self.retired: Dict[str, int] = {}        # counters of its replaced estimators
         self.last = (math.nan, math.nan)          # last published (frequency, t)
@@ -643,12 +659,15 @@ class _Slot:
         harmonic = inside & np.any((n >= 2) & (n <= MAX_HARMONIC)
                                    & (np.abs(r / np.maximum(n, 1) - 1) < HARMONIC_TOL_EST), axis=1)
         prev = np.concatenate(([self.prev_f], f[:-1]))
-        keep = inside & ~harmonic & (np.abs(f / prev - 1) < CONSISTENCY)
+        keep = inside & ~harmonic & (np.abs(f / prev - 1) < CONSISTENCY) & self.single
+        if not self.single:
+            self.counts['rejected_unresolved'] += len(f)
         if len(f):
             self.prev_f = float(f[-1])
         self.counts['rejected_band_edge'] += int(np.count_nonzero(~inside))
         self.counts['rejected_harmonic'] += int(np.count_nonzero(harmonic))
-        self.counts['rejected_inconsistent'] += int(np.count_nonzero(inside & ~harmonic & ~keep))
+        self.counts['rejected_inconsistent'] += int(np.count_nonzero(inside & ~harmonic & ~keep)) \
+            if self.single else 0
         self.counts['estimates'] += int(np.count_nonzero(keep))
         return keep
 
@@ -798,6 +817,7 @@ class ModeTracker:
         active = sorted(self._slots, key=lambda k: self._sl[k, SL_F])
         self._order = [(k, self._slots[k]) for k in active]
         for k, slot in self._order:
+            slot.single = bool(self._sl[k, SL_SINGLE])
             slot.stronger = np.array([self._slots[j].frequency(self._sl[j, SL_F]) for j in active
                                       if self._sl[j, SL_E] > HARMONIC_RATIO * self._sl[k, SL_E]])
 
