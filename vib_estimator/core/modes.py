@@ -12,32 +12,38 @@ Interface:
 
 How the modes are found (no frequency from the user):
 
-* **Spectral stage** (compiled, one call per sample): a constant-Q bank of ``NC`` = 49 second-order
-  resonators, 6 per octave from fs/8 down to fs/2048 (Q = 8, unit gain at the centre, designed in
-  cycles per sample and converted to Hz with the measured mean sampling interval), each followed by
-  an energy average over one period of its centre frequency. Every 16 samples the bank's levels
-  (energy / centre frequency, i.e. flat for white noise) are compared with the **noise floor**, the
-  30th percentile of the levels across the bank; a channel that is a local maximum over two
-  channels each side and ``KEEP_DB`` above the floor is a peak, its frequency interpolated
-  (parabola in dB).
-* **Tracker** (Python, at ticks: when the set of strong peaks changes, and a few times per period
-  of the lowest mode): a peak ``DETECT_DB`` above the floor that no tracked mode explains becomes a
-  candidate; it is confirmed as a mode once it has persisted ``CONFIRM_PERIODS`` of its period and
-  is neither a shoulder of a stronger peak (less than ``PROMINENCE_DB`` of dip between them) nor a
-  harmonic (within ``HARMONIC_TOL`` of 2..8 times a stronger peak). Each mode gets a
-  :class:`FrequencyEstimator` of the configured model with its own band: [f/1.5, 1.5 f], narrowed
-  to the geometric means with its neighbours, and notch filters at its neighbours' frequencies
-  (their latest estimates) in front of it. The estimator is warmed up on the last period of raw
-  samples, so its band filter has settled when its first segment starts. When a mode's estimates
-  move towards its band edge, or a neighbour appears, the band is re-placed (a new estimator, same
-  mode identity). A mode whose peak stays below ``KEEP_DB`` for ``LOSE_PERIODS`` periods is lost
-  and stops publishing.
-* **Quality rule for an estimate** (besides each estimator's own gate): it must lie inside the inner
-  part of its band (``EDGE_MARGIN`` from either edge; else ``rejected_band_edge``) and must not be
-  within 1 % of 2..8 times a stronger tracked mode (``rejected_harmonic``). Counters of the finder:
-  ``modes_found``, ``modes_lost``, ``rejected_harmonic`` (candidates and estimates),
-  ``rejected_noise`` (candidates that did not persist), ``rejected_band_edge``,
-  ``band_replacements``.
+* **Spectral stage** (compiled, one call per sample): a constant-Q bank of ``NC`` = 48 channels, 6
+  per octave from fs/6 down to fs/1536, each two cascaded resonators (Q = 5 each: -18 dB at 30 %,
+  -40 dB at 2.3x from the centre) followed by an energy average over one period of its centre
+  frequency. The bank is multi-rate (each octave runs on a stream decimated by 2 behind a
+  4th-order Butterworth anti-alias filter) and works in cycles per sample, converted to Hz with
+  the measured mean sampling interval; gaps are bridged by interpolation. Every 16 samples the
+  levels (energy / centre frequency: flat for white noise) are analysed.
+* **Noise-floor rule** for a peak (a channel above its two neighbours each side): its level must
+  be ``KEEP_DB`` (a mode stays) or ``DETECT_DB`` (a new mode) above the highest of the global
+  floor (10th percentile of the levels), the local floor (the lower of the median levels 2-4x
+  below and 2-4x above it: coloured noise) and ``DYNAMIC_RANGE_DB`` below the strongest channel.
+  Peaks that dip less than ``PROMINENCE_DB`` towards a stronger one are its shoulders.
+* **Tracker** (compiled, after each analysis): a mode takes the strongest peak inside its band
+  (its centre follows it); a peak no mode explains is a candidate, confirmed as a new mode once it
+  has persisted ``CONFIRM_PERIODS`` of its period, unless it is a harmonic (within
+  ``HARMONIC_TOL`` of 2..5 times a peak ``HARMONIC_RATIO`` stronger: ``rejected_harmonic``) or
+  wider than one mode's peak (the channels 2 away not ``SINGLE_DB`` below:
+  ``rejected_unresolved``); candidates that vanish before are ``rejected_noise``. A mode without a
+  peak for ``LOSE_PERIODS`` of its period is lost (``modes_lost``) and stops publishing; with K
+  modes tracked a new one replaces the weakest only if 6 dB stronger. Bands: [f/1.5, 1.5 f]
+  narrowed to the geometric means with the neighbours; re-placed (``band_replacements``, same
+  mode identity) when the centre comes within ``REPLACE_MARGIN`` of an edge or a wanted edge moves
+  by more than ``REPLACE_CHANGE``. Each mode's stream has notches at the other modes' centres.
+* **Estimators**: each mode has a :class:`FrequencyEstimator` of the configured model on its band
+  (``config.replace(modes=0, band_hz=band)``), warmed up on the last period of raw samples when
+  (re)placed. Python only acts when the set of modes or a band changes (an event of the stage).
+* **Quality rule for an estimate** (after its estimator's own gate): it is published only if it
+  lies ``EDGE_MARGIN`` inside its band's edges (``rejected_band_edge``), is not within 1 % of 2..5
+  times a stronger mode's last estimate (``rejected_harmonic``), is within ``CONSISTENCY`` of its
+  estimator's previous estimate (``rejected_inconsistent``) and the mode's peak is single
+  (``rejected_unresolved``). Modes are numbered by ascending frequency among the modes that have
+  published, from their first published estimate on.
 
 Streaming and batch give the same floats: the batch path runs the compiled stage until the next
 tick, then each mode's estimator's own batch path over that stretch, then the same tick.
@@ -69,8 +75,8 @@ MIN_READY = 12           # channels needed for a floor
 KEEP_DB = 8.0            # a peak this far above the floor keeps a mode alive
 DETECT_DB = 15.0         # ... and this far above it may become a new mode
 DYNAMIC_RANGE_DB = 40.0  # ... and no more than this below the strongest channel
-SINGLE_DB = 8.0          # a single mode's peak: the channels 2 away on both sides this far below
-SINGLE_HYSTERESIS = 4.0  # ... a mode's peak stays single until it is this much wider
+SINGLE_DB = 6.0          # a single mode's peak: the channels 2 away on both sides this far below
+SINGLE_HYSTERESIS = 1.0  # ... a mode's peak stays single until it is this much wider
 PROMINENCE_DB = 3.0      # dip needed between a peak and a stronger one
 HARMONIC_TOL = 0.02      # relative distance of a peak to n f of a stronger peak (n = 2..5)
 HARMONIC_TOL_EST = 0.01  # same for an estimate against a stronger mode's last estimate
@@ -236,7 +242,7 @@ def _analyse(b, ic):
         if not (lv > b[B_LEVEL + c - 1] and lv >= b[B_LEVEL + c + 1]
                 and lv >= b[B_LEVEL + c - 2] and lv >= b[B_LEVEL + c + 2]) or npk >= PMAX:
             continue
-        ref = max(floor, _local_floor(b, c, ready), top * 10.0 ** (-DYNAMIC_RANGE_DB / 10.0))
+        ref = max(_local_floor(b, c, ready, floor), top * 10.0 ** (-DYNAMIC_RANGE_DB / 10.0))
         if lv < ref * 10.0 ** (KEEP_DB / 10.0):
             continue
         lm = math.log10(b[B_LEVEL + c - 1])
@@ -254,9 +260,10 @@ def _analyse(b, ic):
 
 
 @njit(cache=True)
-def _local_floor(b, c, ready):
+def _local_floor(b, c, ready, floor):
     """The floor of coloured noise around channel c, beyond its own skirts: the lower of the median
-    levels of the channels 6 to 12 away (a factor 2 to 4) below and above it."""
+    levels of the channels 6 to 12 away (a factor 2 to 4) below and above it (a side beyond the
+    bank counts as the global floor), and never below the global floor."""
     out = math.inf
     vals = np.empty(7)
     for side in (-1, 1):
@@ -266,9 +273,8 @@ def _local_floor(b, c, ready):
             if 0 <= cc < ready:
                 vals[n] = b[B_LEVEL + cc]
                 n += 1
-        if n > 0:
-            out = min(out, np.median(vals[:n]))
-    return out if out < math.inf else 0.0
+        out = min(out, np.median(vals[:n]) if n > 0 else floor)
+    return max(out, floor)
 
 
 @njit(cache=True)
