@@ -26,7 +26,6 @@ Usage: ``.venv/bin/python benchmarks/bench_modes.py [--seeds N] [--real-data DIR
 import argparse
 import math
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -35,6 +34,9 @@ from vib_estimator.core import EstimatorConfig, FrequencyEstimator
 from vib_estimator.core.modes import ModeTracker
 from vib_estimator.io.csv_reader import read_csv_series
 from vib_estimator.sim.arm_model import Move, simulate
+
+from bench_estimator import best            # benchmarks/ is the script's folder
+from real_data import REFERENCE as REAL_F1
 
 CONFIG = EstimatorConfig(modes=3, model='damped-sinusoid')
 FS = 1000.0
@@ -49,8 +51,7 @@ CASES = {
                                       (0.002, 0.002, 0.001), None),
     '1 mode 12 Hz clipped at 60 %': ((12.0,), (1.0,), (0.002,), 0.6),
 }
-#: reference first-mode frequencies (each file's FFT, SOURCE.md) and the authors' second modes
-REAL_F1 = {30: 16.360, 40: 9.392, 50: 6.054, 60: 4.268}
+#: the authors' second modes (points_data, SOURCE.md); the first: real_data.REFERENCE
 REAL_F2 = {30: 107.6, 40: 61.54, 50: 39.63, 60: 27.35}
 
 
@@ -209,15 +210,6 @@ def cost():
           f'   (goal >= 1 M samples/s)')
     print(f'  streaming  modes 3 {ts:6.2f} us/sample    one estimator {ss:6.2f}   ratio '
           f'{ts / ss:5.2f}   (goal <= 10 us/sample)')
-
-
-def best(fn, repeats=3):
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - start)
-    return min(times)
 
 
 def main() -> int:
