@@ -1,9 +1,9 @@
 """Several modes at once (issue 10): the mode tracker beside a PX4-style FFT peak tracker.
 
-Runs ``ModeTracker`` (``modes: 3``, ``model: damped-sinusoid``, no ``band_hz``) and a baseline of the
-kind flight controllers use (PX4 ``gyro_fft``: 1 s Hann window, hop 1/4 window, the 3 largest local
-maxima 10x above the median magnitude, parabolic interpolation on the log magnitude) on the same
-signals, and prints the issue's goals side by side:
+Runs ``ModeTracker`` (``modes: 3``, ``model: damped-sinusoid``, no ``band_hz``) and a baseline of
+the kind flight controllers use (PX4 ``gyro_fft``: 1 s Hann window, hop 1/4 window, the 3
+largest local maxima 10x above the median magnitude, parabolic interpolation on the log
+magnitude) on the same signals, and prints the issue's goals side by side:
 
 1. synthetic free decays of 1-3 modes (seeded; separations >= 30 %, amplitude ratios down to 1:20,
    SNR 30 dB for the weakest mode at the excitation, fs/f >= 10 for the highest), plus a clipped
@@ -179,9 +179,10 @@ def real(folder):
             span = (f'{e.t[near2][0]:.2f}-{e.t[near2][-1]:.2f} s, median '
                     f'{100 * (np.median(e.frequency_hz[near2]) / REAL_F2[length] - 1):+.1f} %'
                     if np.any(near2) else '-')
-            print(f'  {label:12} mode 1 n={len(m1):4d} median {100 * (np.median(m1) / f1 - 1):+.3f} %'
-                  f' (fft 1 peak: n={len(ff):3d} {100 * (np.median(ff) / f1 - 1):+.3f} %); '
-                  f'modes >= 2: n={int(np.sum(m2)):3d}, near mode 2: {int(np.sum(near2)):3d} ({span})')
+            print(f'  {label:12} mode 1 n={len(m1):4d} median '
+                  f'{100 * (np.median(m1) / f1 - 1):+.3f} % (fft 1 peak: n={len(ff):3d} '
+                  f'{100 * (np.median(ff) / f1 - 1):+.3f} %); modes >= 2: n={int(np.sum(m2)):3d}, '
+                  f'near mode 2: {int(np.sum(near2)):3d} ({span})')
 
 
 def cost():

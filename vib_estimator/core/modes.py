@@ -83,7 +83,7 @@ HARMONIC_TOL_EST = 0.01  # same for an estimate against a stronger mode's last e
 MAX_HARMONIC = 5
 HARMONIC_RATIO = 4.0     # a harmonic is at least this much weaker (energy) than its parent
 DUPLICATE_TOL = 0.1      # two modes closer than this are one
-PENDING_TOL = 0.25       # a candidate peak is the same one from one analysis to the next within this
+PENDING_TOL = 0.25       # a candidate is the same peak from one analysis to the next within this
 BAND_RATIO = 1.5         # widest band of a mode: [f / 1.5, 1.5 f]
 MAX_BAND_NU = 0.4        # highest band edge, cycles per sample
 EDGE_MARGIN = 1.05       # estimates must lie this factor inside the band's edges
@@ -102,7 +102,8 @@ GAP_STEPS = 1.5          # an interval this many mean intervals long is a gap fo
 MAX_FILL = 64            # ... bridged by at most this many interpolated steps
 
 # ---- stage layout: float array b ----------------------------------------------------------------
-CH_N = 18                # per channel: Phi G0 G1 (8), x1 (2), u1, x2 (2), u2, energy, alpha, gain, nu
+CH_N = 18                # per channel: Phi G0 G1 (8), x1 (2), u1, x2 (2), u2, energy, alpha,
+                         # gain, nu
 CH_X1, CH_U1, CH_X2, CH_U2, CH_E, CH_ALPHA, CH_GAIN, CH_NU = 8, 10, 11, 13, 14, 15, 16, 17
 DEC_N = 22               # per decimator: two sections' Phi G0 G1 (16), states (2 + 2), inputs (2)
 B_CH = 0
