@@ -41,7 +41,8 @@ How the modes are found (no frequency from the user):
 * **Quality rule for an estimate** (after its estimator's own gate): it is published only if it
   lies ``EDGE_MARGIN`` inside its band's edges (``rejected_band_edge``), is not within 1 % of 2..5
   times a stronger mode's last estimate (``rejected_harmonic``), is within ``CONSISTENCY`` of its
-  estimator's previous estimate (``rejected_inconsistent``) and the mode's peak is single
+  estimator's previous estimate (``rejected_inconsistent``), within ``CENTRE_TOL`` of the centre of
+  its mode's peak in the bank (``rejected_off_peak``) and the mode's peak is single
   (``rejected_unresolved``). Modes are numbered by ascending frequency among the modes that have
   published, from their first published estimate on.
 
@@ -93,6 +94,8 @@ REPLACE_CHANGE = 0.15    # ... and so does a wanted edge this far (log) from the
 CONFIRM_PERIODS = 0.5
 LOSE_PERIODS = 1.5
 CENTRE_GAIN = 0.25       # a mode's centre follows its peak with this gain per analysis
+CENTRE_EVENT = 0.02      # ... and is handed to the estimates' rule when it moved this much
+CENTRE_TOL = 0.05        # an estimate must lie this close to its mode's centre
 NOTCH_Q = 2.0
 NOTCH_REDESIGN = 0.005   # a notch is redesigned when its frequency moved this much
 PMAX = 16                # peaks kept per analysis
@@ -133,8 +136,8 @@ FINDER_COUNTERS = {'modes_found': I_FOUND, 'modes_lost': I_LOST, 'rejected_harmo
                    'rejected_noise': I_REJ_NOISE, 'band_replacements': I_REPLACED,
                    'rejected_unresolved': I_REJ_UNRES}
 # ---- modes sl[k]: active, identity, centre (Hz), energy, seconds without a peak, placed band ----
-SL_ACTIVE, SL_UID, SL_F, SL_E, SL_MISS, SL_LO, SL_HI, SL_SINGLE = range(8)
-N_SL = 8
+SL_ACTIVE, SL_UID, SL_F, SL_E, SL_MISS, SL_LO, SL_HI, SL_SINGLE, SL_FSYNC = range(9)
+N_SL = 9
 # ---- candidates pd[i]: frequency (Hz), age (s), rejected as a harmonic ---------------------------
 PD_F, PD_AGE, PD_REJ = range(3)
 # ---- parameters pa ------------------------------------------------------------------------------
@@ -346,6 +349,8 @@ def _follow(ic, sl, pf, pe, pn, npk, used, dt):
         sl[k, SL_MISS] = 0.0
         sl[k, SL_F] += CENTRE_GAIN * (pf[best] - sl[k, SL_F])
         sl[k, SL_E] = pe[best]
+        if abs(sl[k, SL_F] / sl[k, SL_FSYNC] - 1.0) > CENTRE_EVENT:
+            ic[I_EVENT] = 1         # the tracker's copy of the centre (``SL_FSYNC``) is refreshed
         single = pn[best] >= SINGLE_DB - (SINGLE_HYSTERESIS if sl[k, SL_SINGLE] else 0.0)
         if sl[k, SL_SINGLE] != single:
             sl[k, SL_SINGLE] = single
@@ -635,7 +640,8 @@ class _Slot:
         self.est: Optional[FrequencyEstimator] = None
         self.counts: Dict[str, int] = {'estimates': 0, 'rejected_band_edge': 0,
                                        'rejected_harmonic': 0, 'rejected_inconsistent': 0,
-                                       'rejected_unresolved': 0}
+                                       'rejected_unresolved': 0, 'rejected_off_peak': 0}
+        self.centre = math.nan                   # the stage's centre of its peak (Hz)
         self.single = True                       # its peak is one mode's (else: not published)
         self.prev_f = math.nan                   # its estimator's previous estimate
         self.retired: Dict[str, int] = {}        # counters of its replaced estimators
@@ -666,15 +672,18 @@ class _Slot:
         harmonic = inside & np.any((n >= 2) & (n <= MAX_HARMONIC)
                                    & (np.abs(r / np.maximum(n, 1) - 1) < HARMONIC_TOL_EST), axis=1)
         prev = np.concatenate(([self.prev_f], f[:-1]))
-        keep = inside & ~harmonic & (np.abs(f / prev - 1) < CONSISTENCY) & self.single
+        near = np.abs(f / self.centre - 1) < CENTRE_TOL
+        keep = inside & ~harmonic & near & (np.abs(f / prev - 1) < CONSISTENCY) & self.single
         if not self.single:
             self.counts['rejected_unresolved'] += len(f)
         if len(f):
             self.prev_f = float(f[-1])
         self.counts['rejected_band_edge'] += int(np.count_nonzero(~inside))
         self.counts['rejected_harmonic'] += int(np.count_nonzero(harmonic))
-        self.counts['rejected_inconsistent'] += int(np.count_nonzero(inside & ~harmonic & ~keep)) \
+        self.counts['rejected_off_peak'] += int(np.count_nonzero(inside & ~harmonic & ~near)) \
             if self.single else 0
+        self.counts['rejected_inconsistent'] += int(np.count_nonzero(inside & ~harmonic & near
+                                                                     & ~keep)) if self.single else 0
         self.counts['estimates'] += int(np.count_nonzero(keep))
         return keep
 
@@ -825,6 +834,7 @@ class ModeTracker:
         self._order = [(k, self._slots[k]) for k in active]
         for k, slot in self._order:
             slot.single = bool(self._sl[k, SL_SINGLE])
+            slot.centre = self._sl[k, SL_FSYNC] = self._sl[k, SL_F]
             slot.stronger = np.array([self._slots[j].frequency(self._sl[j, SL_F]) for j in active
                                       if self._sl[j, SL_E] > HARMONIC_RATIO * self._sl[k, SL_E]])
 
