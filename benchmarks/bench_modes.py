@@ -102,7 +102,7 @@ def score(est_t, est_f, freqs):
     and the share of estimates farther than 3 % from every true mode."""
     freqs = np.asarray(freqs)
     if len(est_f) == 0:
-        return [(math.nan, 0.0, math.inf)] * len(freqs), math.nan
+        return [(math.nan, 0.0, math.inf)] * len(freqs), math.nan, 0
     rel = est_f[:, None] / freqs[None, :] - 1
     nearest = np.argmin(np.abs(rel), axis=1)
     err = np.abs(rel[np.arange(len(est_f)), nearest])
@@ -113,15 +113,15 @@ def score(est_t, est_f, freqs):
         first = (est_t[ok][0] - T_EXCITE) * freqs.min() if np.any(ok) else math.inf
         rows.append((np.median(e) if len(e) else math.nan, np.mean(e < 0.02) if len(e) else 0.0,
                      first))
-    return rows, float(np.mean(err > 0.03))
+    return rows, float(np.mean(err > 0.03)), len(est_f)
 
 
 def synthetic(seeds):
     print('1. synthetic decays (%d seeds; medians over seeds; fft = 1 s FFT peaks)' % seeds)
     print(f'{"case":34} {"mode":>6} {"med |err| %":>17} {"within 2 %":>15} '
-          f'{"first (periods f1)":>19} {">3 % from all":>15}')
+          f'{"first (periods f1)":>19} {">3 % from all":>15} {"published":>13}')
     print(f'{"":34} {"":>6} {"tracker":>8} {"fft":>8} {"tracker":>7} {"fft":>7} '
-          f'{"tracker":>9} {"fft":>9} {"tracker":>7} {"fft":>7}')
+          f'{"tracker":>9} {"fft":>9} {"tracker":>7} {"fft":>7} {"tracker":>7} {"fft":>5}')
     for name, (freqs, amps, zetas, clip) in CASES.items():
         res = {'tracker': [], 'fft': []}
         for seed in range(seeds):
@@ -135,7 +135,9 @@ def synthetic(seeds):
                 for m in ('tracker', 'fft'):
                     cols.append(np.median([r[0][k][i] for r in res[m]]) * scale)
             spur = [np.median([r[1] for r in res[m]]) * 100 for m in ('tracker', 'fft')]
-            tail = f'{spur[0]:7.2f} {spur[1]:7.2f}' if k == 0 else ''
+            count = [np.median([r[2] for r in res[m]]) for m in ('tracker', 'fft')]
+            tail = (f'{spur[0]:7.2f} {spur[1]:7.2f} {count[0]:7.0f} {count[1]:5.0f}' if k == 0
+                    else '')
             print(f'{name if k == 0 else "":34} {f:6.1f} {cols[0]:8.3f} {cols[1]:8.3f} '
                   f'{cols[2]:7.1f} {cols[3]:7.1f} {cols[4]:9.2f} {cols[5]:9.2f} {tail}')
 
