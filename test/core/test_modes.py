@@ -5,7 +5,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from vib_estimator.core import EstimatorConfig, FrequencyEstimator
+from vib_estimator.core import COUNTER_NAMES, EstimatorConfig, FrequencyEstimator
 from vib_estimator.core.modes import FINDER_COUNTERS, ModeTracker, create_estimator
 from vib_estimator.io.csv_reader import read_csv_series
 
@@ -81,6 +81,7 @@ def test_noise_alone_publishes_nothing():
     e = tr.process(t, noise(t, 1.0, 3))
     assert len(e) == 0
     assert tr.status() == []
+    assert set(COUNTER_NAMES) <= set(tr.counters) and tr.counters['estimates'] == 0
 
 
 def test_harmonics_of_a_clipped_mode_are_no_modes():

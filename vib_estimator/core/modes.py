@@ -59,7 +59,7 @@ import numpy as np
 from numba import njit
 
 from .config import EstimatorConfig
-from .estimator import Estimate, EstimateArrays, FrequencyEstimator
+from .estimator import COUNTER_NAMES, Estimate, EstimateArrays, FrequencyEstimator
 from .kernel import BAND_DAMPING, NH, _advance, _discretise
 
 KMAX = 8                 # most modes a tracker follows (the range of ``modes``)
@@ -772,7 +772,7 @@ class ModeTracker:
     def counters(self) -> Dict[str, int]:
         """The stage's input counters, the modes' estimators' gates and the tracker's rule
         summed over the modes (lost ones included), the finder's own counters."""
-        total = dict(self._retired)
+        total = _add(dict.fromkeys(COUNTER_NAMES, 0), self._retired)
         for slot in self._slots.values():
             total = _add(total, slot.counters())
         for name, i in {**STAGE_COUNTERS, **FINDER_COUNTERS}.items():
