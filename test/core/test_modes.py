@@ -1,0 +1,169 @@
+"""Several modes at once: the mode tracker (pure core, no rclpy)."""
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from vib_estimator.core import COUNTER_NAMES, EstimatorConfig, FrequencyEstimator
+from vib_estimator.core.modes import FINDER_COUNTERS, ModeTracker, create_estimator
+from vib_estimator.io.csv_reader import read_csv_series
+
+CFG = EstimatorConfig(modes=3, model='damped-sinusoid')
+FS = 1000.0
+REAL = Path(__file__).resolve().parents[3] / 'shared' / 'real-data' / \
+    'aluminium_cantilever_adxl357'
+
+
+def decay(t, t0, f, amplitude, zeta=0.002, phase=0.4):
+    """A damped sine starting at t0 (zero before)."""
+    tt = np.maximum(t - t0, 0.0)
+    w = 2 * np.pi * f
+    return (t >= t0) * amplitude * np.exp(-zeta * w * tt) * np.sin(w * tt + phase)
+
+
+def noise(t, std, seed):
+    return std * np.random.default_rng(seed).standard_normal(len(t))
+
+
+@pytest.mark.parametrize('seed', [0, 1, 2])
+def test_a_single_mode_gives_one_mode_and_no_second(seed):
+    t = np.arange(0, 12, 1 / FS)
+    y = decay(t, 1.0, 12.0, 1.0) + noise(t, 0.003, seed)
+    tr = ModeTracker(CFG)
+    e = tr.process(t, y)
+    assert len(e) > 100
+    assert set(e.mode) == {1}
+    assert np.median(np.abs(e.frequency_hz / 12 - 1)) < 0.003
+    assert np.mean(np.abs(e.frequency_hz / 12 - 1) > 0.03) <= 0.02
+    assert [s.mode for s in tr.status()] == [1]
+
+
+@pytest.mark.parametrize('seed', [0, 1])
+def test_two_modes_numbered_by_frequency(seed):
+    t = np.arange(0, 8, 1 / FS)
+    y = decay(t, 0.5, 8.0, 1.0) + decay(t, 0.5, 21.0, 0.3, 0.001) + noise(t, 0.003, seed)
+    tr = ModeTracker(CFG)
+    e = tr.process(t, y)
+    late = e.t > 3.0            # once both are numbered
+    for mode, f in ((1, 8.0), (2, 21.0)):
+        sel = late & (e.mode == mode)
+        assert np.sum(sel) > 10
+        assert abs(np.median(e.frequency_hz[sel]) / f - 1) < 0.005
+    status = tr.status()
+    assert [s.mode for s in status] == [1, 2]
+    assert status[0].band_hz[1] <= status[1].band_hz[0]     # the bands do not overlap
+    assert set(tr.mode_counters()) == {1, 2}
+    assert tr.counters['modes_found'] >= 2
+
+
+def test_a_mode_appears_and_one_disappears():
+    t = np.arange(0, 16, 1 / FS)
+    first = decay(t, 0.5, 9.0, 1.0, 0.0) * (t < 7.0)          # stops at 7 s (into the noise)
+    second = decay(t, 6.0, 30.0, 0.5, 0.0)                    # starts at 6 s
+    y = first + second + noise(t, 0.002, 5)
+    tr = ModeTracker(CFG)
+    e = tr.process(t, y)
+    near9 = np.abs(e.frequency_hz / 9 - 1) < 0.02
+    near30 = np.abs(e.frequency_hz / 30 - 1) < 0.02
+    assert np.mean(near9 | near30) > 0.98
+    assert np.sum(near9) > 30 and np.sum(near30) > 100
+    assert e.t[near30].min() > 6.0 and e.t[near30].min() < 6.5     # picked up within 15 periods
+    assert e.t[near9].max() < 7.5                                  # stops with the mode
+    assert np.all(e.mode[near30 & (e.t > 9)] == 1)                # alone again: it is mode 1
+    assert tr.counters['modes_lost'] >= 1
+    assert [round(s.frequency_hz) for s in tr.status()] == [30]
+
+
+def test_noise_alone_publishes_nothing():
+    t = np.arange(0, 20, 1 / FS)
+    tr = ModeTracker(CFG)
+    e = tr.process(t, noise(t, 1.0, 3))
+    assert len(e) == 0
+    assert tr.status() == []
+    assert set(COUNTER_NAMES) <= set(tr.counters) and tr.counters['estimates'] == 0
+
+
+def test_harmonics_of_a_clipped_mode_are_no_modes():
+    t = np.arange(0, 10, 1 / FS)
+    y = np.clip(decay(t, 0.5, 11.0, 1.0, 0.001), -0.5, 0.5) + noise(t, 0.002, 4)
+    tr = ModeTracker(CFG)
+    e = tr.process(t, y)
+    assert len(e) > 50
+    assert set(e.mode) == {1}
+    # while it is clipped hard the waveform is no sine: estimates up to ~3 % high, still mode 1
+    assert np.all(np.abs(e.frequency_hz / 11 - 1) < 0.05)
+
+
+def test_streaming_and_batch_give_the_same_floats():
+    rng = np.random.default_rng(7)
+    t = np.cumsum(rng.uniform(0.0008, 0.0012, 9000))
+    y = decay(t, 0.3, 9.0, 1.0) + decay(t, 0.3, 25.0, 0.4) + noise(t, 0.003, 8) + 0.05
+    y[1000] = np.nan
+    t[2000] = t[1999]                                          # a duplicate stamp
+    batch = ModeTracker(CFG)
+    parts = [batch.process(t[:4000], y[:4000]), batch.process(t[4000:], y[4000:])]
+    stream = ModeTracker(CFG)
+    got = [e for a, b in zip(t, y) for e in stream.update(a, b)]
+    freqs = np.concatenate([p.frequency_hz for p in parts])
+    assert len(got) == len(freqs) > 20
+    np.testing.assert_array_equal([e.frequency_hz for e in got], freqs)
+    np.testing.assert_array_equal([e.mode for e in got], np.concatenate([p.mode for p in parts]))
+    np.testing.assert_array_equal([e.t for e in got], np.concatenate([p.t for p in parts]))
+    assert batch.counters == stream.counters
+    assert batch.counters['skipped_non_finite'] == 1
+    assert batch.counters['skipped_duplicate'] == 1
+    assert len({e.mode for e in got}) == 2
+
+
+def test_interface():
+    assert isinstance(create_estimator(EstimatorConfig()), FrequencyEstimator)
+    tr = create_estimator(EstimatorConfig(modes=2))
+    assert isinstance(tr, ModeTracker) and tr.config.modes == 2
+    with pytest.raises(ValueError):
+        ModeTracker(EstimatorConfig())
+    with pytest.raises(ValueError):
+        tr.process(np.zeros(3), np.zeros(4))
+    t = np.arange(0, 4, 1 / FS)
+    tr.process(t, decay(t, 0.2, 10.0, 1.0))
+    assert set(FINDER_COUNTERS) <= set(tr.counters)
+    assert 'rejected_inconsistent' in tr.counters
+    tr.reset()
+    before = tr.counters['received']
+    tr.restart()
+    assert tr.status() == [] and tr.counters['received'] == before
+    e = tr.process(t + 10, decay(t, 0.2, 10.0, 1.0))
+    assert len(e) > 10 and math.isclose(np.median(e.frequency_hz), 10.0, rel_tol=0.003)
+
+
+def test_plot_colours_the_modes(tmp_path):
+    from vib_estimator.analysis.plotting import plot_estimates
+
+    t = np.arange(0, 5, 1 / FS)
+    y = decay(t, 0.5, 8.0, 1.0) + decay(t, 0.5, 21.0, 0.3, 0.001) + noise(t, 0.003, 0)
+    e = ModeTracker(CFG).process(t, y)
+    out = tmp_path / 'modes.png'
+    plot_estimates(str(out), t, y, e.t, e.frequency_hz, e.convergence_time, mode=e.mode)
+    assert out.stat().st_size > 10_000
+    plot_estimates(str(tmp_path / 'none.png'), t, y, e.t[:0], e.frequency_hz[:0],
+                   e.convergence_time[:0], mode=e.mode[:0])
+
+
+REFERENCE = {30: 16.360, 40: 9.392, 50: 6.054, 60: 4.268}
+
+
+@pytest.mark.skipif(not REAL.is_dir(), reason='../shared/real-data is not beside the repository')
+@pytest.mark.parametrize('length', sorted(REFERENCE))
+def test_real_beams_mode_1_without_a_band(length):
+    f1 = REFERENCE[length]
+    csv = read_csv_series(REAL / f'{length}cm_uniform_1000Hz.csv')
+    raw = np.load(next(REAL.glob(f'raw_{length}cm_*.npy')))
+    for t, y in ((csv.t, csv.y), (raw[0] - raw[0, 0], raw[1])):
+        e = ModeTracker(CFG).process(t, y)
+        m1 = e.frequency_hz[e.mode == 1]
+        assert len(m1) > 100
+        assert abs(np.median(m1) / f1 - 1) < 0.003
+        # every other published estimate is the second mode (6.4 f1), early, while it rings
+        others = e.frequency_hz[e.mode >= 2]
+        assert np.all(np.abs(others / (6.45 * f1) - 1) < 0.1)
+        assert np.all(e.t[e.mode >= 2] < 3.0)
