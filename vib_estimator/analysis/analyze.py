@@ -18,7 +18,7 @@ from typing import Optional, Tuple
 
 import numpy as np
 
-from ..core import MODELS, COUNTER_NAMES, EstimateArrays, EstimatorConfig
+from ..core import MODELS, EstimateArrays, EstimatorConfig
 from ..core.modes import create_estimator
 from ..io.csv_reader import CsvError
 from ..io.fields import INPUT_TYPES
@@ -126,7 +126,7 @@ def estimate_signal(signal: Signal, config: EstimatorConfig, keep_samples: bool 
     return Run(estimator, EstimateArrays.concatenate(parts), first_t, previous, samples)
 
 
-def _print(estimates, origin, fmt) -> None:
+def _print(estimates, origin, fmt, modes: int = 0) -> None:
     rows = []
     for e in estimates.to_list():
         row = e.as_dict()
@@ -143,9 +143,13 @@ def _print(estimates, origin, fmt) -> None:
         for row in rows:
             out.write(','.join(repr(row[k]) for k in keys) + '\n')
     else:
-        out.write(f'{"t (s)":>12} {"f (Hz)":>12} {"conv (s)":>9} {"samples":>8} {"fit":>6}\n')
+        mode = f'{"mode":>5} ' if modes else ''
+        out.write(f'{"t (s)":>12} {mode}{"f (Hz)":>12} {"f std (Hz)":>10} {"zeta":>8} '
+                  f'{"conv (s)":>9} {"samples":>8} {"fit":>6}\n')
         for row in rows:
-            out.write(f'{row["t"]:12.4f} {row["frequency_hz"]:12.6f} '
+            mode = f'{row["mode"]:5d} ' if modes else ''
+            out.write(f'{row["t"]:12.4f} {mode}{row["frequency_hz"]:12.6f} '
+                      f'{row["frequency_std_hz"]:10.3g} {row["damping"]:8.5f} '
                       f'{row["convergence_time_s"]:9.4f} {row["samples"]:8d} {row["fit"]:6.3f}\n')
 
 
@@ -160,10 +164,10 @@ def run(args: argparse.Namespace) -> int:
         print(f'vib-estimator analyze: error: {err}', file=sys.stderr)
         return 2
     estimates = result.estimates
-    _print(estimates, signal.origin_ns, args.format)
+    _print(estimates, signal.origin_ns, args.format, config.modes)
     counters = result.estimator.counters
     extra = f', messages_without_component={signal.skipped}' if signal.skipped else ''
-    print('analyze: ' + ', '.join(f'{k}={counters[k]}' for k in COUNTER_NAMES) + extra,
+    print('analyze: ' + ', '.join(f'{k}={v}' for k, v in counters.items()) + extra,
           file=sys.stderr)
     if args.plot:
         from .plotting import plot_estimates
@@ -171,5 +175,5 @@ def run(args: argparse.Namespace) -> int:
         Path(args.plot).parent.mkdir(parents=True, exist_ok=True)
         plot_estimates(args.plot, *result.samples, estimates.t, estimates.frequency_hz,
                        estimates.convergence_time, title=f'{args.input}: {signal.label}',
-                       ylabel=signal.label)
+                       ylabel=signal.label, mode=estimates.mode if config.modes else None)
     return 0
