@@ -205,12 +205,17 @@ def bad_bags(tmp_path):
     with BagWriter(tmp_path / 'empty') as bag:
         bag.add_topic('/coupling_torque', WRENCH_STAMPED)
     unknown_type_bag(tmp_path / 'unknown')
+    wrench_bag(tmp_path / 'no_metadata', 10, 10.0)
+    (tmp_path / 'no_metadata' / 'metadata.yaml').unlink()
     return {
         'missing': ([f'bag:={tmp_path / "none"}'], 'does not exist'),
         'corrupt': ([f'bag:={tmp_path / "corrupt.mcap"}'], 'corrupt or truncated'),
         'truncated': ([f'bag:={tmp_path / "truncated.mcap"}'], 'corrupt or truncated'),
         'empty': ([f'bag:={tmp_path / "empty"}'], 'contains no messages'),
-        'unknown type': ([f'bag:={tmp_path / "unknown"}'], 'my_pkg/msg/Custom is not installed'),
+        'unknown type': ([f'bag:={tmp_path / "unknown"}'],
+                         'types of its topics are not installed: /x (my_pkg/msg/Custom)'),
+        'no metadata': ([f'bag:={tmp_path / "no_metadata"}'],
+                        f'run `vib-estimator reindex {tmp_path / "no_metadata"}`'),
         'unknown topic': ([f'bag:={tmp_path / "good"}', 'topics:=[/nope]'],
                           "no topic '/nope'; its topics are /coupling_torque"),
         'bad remap': ([f'bag:={tmp_path / "good"}', 'remap:=[/coupling_torque]'],
@@ -229,7 +234,7 @@ def test_unplayable_bags_are_refused_with_one_line(bad_bags):
                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
              for name, (params, _) in bad_bags.items()}
     for name, proc in procs.items():
-        _, err = proc.communicate(timeout=60)
+        _, err = proc.communicate(timeout=120)
         assert proc.returncode == 2, (name, err)
         assert 'Traceback' not in err, (name, err)
         lines = [line for line in err.splitlines() if line.startswith('error: ')]
