@@ -136,7 +136,7 @@ def _as_bag_error(path: Path, doing: str):
         raise BagError(f'cannot {doing} {path}: {detail} (corrupt or truncated bag?)') from None
 
 
-def _storage_reader(path: Path):
+def storage_reader(path: Path):
     """The rosbags reader of one storage file (``.mcap`` or ``.db3``), opened."""
     storage = _STORAGE_READERS[path.suffix](path)
     storage.open()
@@ -183,7 +183,7 @@ class BagReader:
 
     def _open_storages(self) -> list:
         if self.path.is_file():
-            storage = _storage_reader(self.path)
+            storage = storage_reader(self.path)
             self._stack.callback(storage.close)
             return [storage]
         reader = Reader(self.path)  # metadata.yaml: file list, decompression of the files
@@ -392,6 +392,20 @@ def write_metadata(directory: Path, info: dict) -> None:
     tmp.replace(directory / 'metadata.yaml')
 
 
+def mcap_file(path: Path) -> McapWriter:
+    """rosbags' MCAP storage writer, writing the new file ``path``.
+
+    That writer names its file after the directory it is given, so it is given a scratch directory
+    and its open file is then moved to ``path`` (an open file keeps its data when renamed).
+    """
+    scratch = path.with_name(path.name + '.tmpdir')
+    scratch.mkdir()
+    writer = McapWriter(scratch, CompressionMode.NONE)
+    writer.path = writer.path.rename(path)
+    scratch.rmdir()
+    return writer
+
+
 class _Sqlite3File(Sqlite3Writer):
     """rosbags' sqlite3 storage writer, for a file name of our choosing (``name_3.db3``)."""
 
@@ -466,9 +480,7 @@ class BagWriter:
     def _open_file(self) -> None:
         name = self._file_name(len(self.files))
         if self.storage == 'mcap':
-            self._file = McapWriter(self.path, CompressionMode.NONE)  # writes <dir>/<dir>.mcap
-            if self._file.path.name != name:  # an open file keeps its data when renamed
-                self._file.path = self._file.path.rename(self.path / name)
+            self._file = mcap_file(self.path / name)
         else:
             self._file = _Sqlite3File(self.path / name)
         self._types = set()
