@@ -484,6 +484,7 @@ class BagWriter:
         else:
             self._file = _Sqlite3File(self.path / name)
         self._types = set()
+        self._uncommitted = 0  # bytes of messages written to the file since the last flush
         self.files.append(FileStats(name))
         for connection in self._connections:
             self._register(connection)
@@ -524,8 +525,8 @@ class BagWriter:
             return False
         if self.storage == 'mcap':
             size = self._file.bio.tell() + self._file.chunk.bio.tell()
-        else:
-            size = self._file.path.stat().st_size
+        else:  # the file grows at each commit: add what was written since
+            size = self._file.path.stat().st_size + self._uncommitted
         return size >= max_size
 
     def write(self, connection: Connection, log_time_ns: int, data: bytes) -> None:
@@ -537,6 +538,7 @@ class BagWriter:
                 self._close_file()
                 self._open_file()
             self._file.write(connection, log_time_ns, data)
+        self._uncommitted += len(data)
         self._counts[connection.id] += 1
         self.files[-1].add(log_time_ns)
 
@@ -556,6 +558,7 @@ class BagWriter:
                 os.fsync(self._file.bio.fileno())
             else:
                 self._file.conn.commit()
+            self._uncommitted = 0
 
     def _close_file(self) -> None:
         self._file.close(METADATA_VERSION, _yaml_text(self._metadata()).strip())

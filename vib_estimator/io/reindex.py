@@ -65,6 +65,8 @@ class McapContent:
     messages: List[Tuple[int, int, bytes]] = field(default_factory=list)  # channel, log time, data
     #: byte at which the first incomplete record starts (the file's size when none is)
     complete_bytes: int = 0
+    #: whether the data section is complete (its DataEnd record was read)
+    data_end: bool = False
 
 
 def _records(data: bytes, pos: int, end: int) -> Iterator[Tuple[int, _Fields]]:
@@ -129,6 +131,7 @@ def scan_mcap(data: bytes) -> McapContent:
     try:
         for op, body in _records(data, len(MAGIC), len(data)):
             if op == _OP_DATA_END:
+                content.data_end = True
                 break
             if op == _OP_CHUNK:
                 _read_chunk(body, content, cut=False)
@@ -180,7 +183,9 @@ def repair_mcap(path: Path) -> Optional[str]:
         writer.write(connections[cid], log_time, payload)
     writer.close(METADATA_VERSION, '')
     writer.path.replace(path)
-    if content.complete_bytes < len(data):
+    if content.data_end:
+        cut = f'summary section cut or damaged (file of {len(data)} bytes)'
+    elif content.complete_bytes < len(data):
         cut = (f'cut at byte {content.complete_bytes} of {len(data)} (the rest is an incomplete '
                f'record, dropped)')
     else:
