@@ -42,10 +42,11 @@ class Listener(Node):
 
     def __init__(self, context, topics, msg_type=WrenchStamped, qos=QoSProfile(depth=1000)):
         super().__init__('listener', context=context)
+        types = msg_type if isinstance(msg_type, dict) else dict.fromkeys(topics, msg_type)
         self.received = {topic: [] for topic in topics}
         self.arrival = []
-        self.subs = [self.create_subscription(msg_type, topic, self._callback(topic), qos, raw=True)
-                     for topic in topics]
+        self.subs = [self.create_subscription(types[topic], topic, self._callback(topic), qos,
+                                              raw=True) for topic in topics]
 
     def _callback(self, topic):
         def on_message(data):
@@ -297,3 +298,91 @@ def test_looping_bag_resets_the_estimator_and_estimates_go_on(ros_context, execu
     assert spin_until(executor, lambda: estimator.counters['time_jump_resets'] >= 2, 15)
     per_loop = estimator.counters['estimates'] / estimator.counters['time_jump_resets']
     assert per_loop >= 2
+
+
+# -- bags written by rosbag2, types not installed, waiting for subscribers, split recordings -----
+
+SHARED_BAGS = Path(__file__).resolve().parents[3] / 'shared' / 'ros2-bags'
+#: SOURCE.md of ../shared/ros2-bags: messages per bag, counted in the storage files
+ROSBAG2_COUNTS = {'mcap_talker': 20, 'sqlite3_talker': 20, 'mcap_wbag': 6074, 'sqlite3_wbag': 6074}
+
+
+@pytest.mark.skipif(not SHARED_BAGS.is_dir(), reason='../shared/ros2-bags is absent')
+@pytest.mark.parametrize('name', sorted(ROSBAG2_COUNTS))
+def test_rosbag2_bags_play_every_message(ros_context, executor, name):
+    from rcl_interfaces.msg import Log
+    from vib_estimator.io.bags import BagReader
+
+    with BagReader(SHARED_BAGS / name) as bag:
+        expected = {t: [m.data for m in bag.messages([t])] for t, i in bag.topics.items()
+                    if i.count}
+    assert sum(len(v) for v in expected.values()) == ROSBAG2_COUNTS[name]
+    # /rosout is renamed so that the nodes' own log messages do not mix in
+    remap = {'remap': ['/rosout:=/bag_rosout']} if '/rosout' in expected else {}
+    node = replayer(ros_context, SHARED_BAGS / name, rate=20.0, **remap)
+    topics = {('/bag_rosout' if t == '/rosout' else t): t for t in expected}
+    listener = Listener(ros_context, list(topics),
+                        {t: Log if b == '/rosout' else String for t, b in topics.items()})
+    start(executor, node, listener)
+    assert spin_until(executor, lambda: node.finished, 20)
+    assert spin_until(executor, lambda: sum(map(len, listener.received.values())) ==
+                      ROSBAG2_COUNTS[name], 10)
+    assert node.published == ROSBAG2_COUNTS[name] and node.exit_code == 0
+    for topic, bag_topic in topics.items():
+        assert listener.received[topic] == expected[bag_topic]  # every message, in order
+
+
+def mixed_type_bag(path):
+    """/s (std_msgs/String, old-style name) and /x (a type that is not installed)."""
+    with Writer(path, version=8, storage_plugin=StoragePlugin.MCAP) as bag:
+        strings = bag.add_connection('/s', 'std_msgs/String', msgdef='string data',
+                                     rihs01='RIHS01_' + '0' * 64)
+        other = bag.add_connection('/x', 'test_msgs/msg/Strings', msgdef='string a',
+                                   rihs01='RIHS01_' + '1' * 64)
+        for i in range(5):
+            bag.write(strings, 10 ** 9 + i * 10 ** 7, TYPESTORE.serialize_cdr(
+                TYPESTORE.types['std_msgs/msg/String'](data=str(i)), 'std_msgs/msg/String'))
+            bag.write(other, 10 ** 9 + i * 10 ** 7 + 1, b'\x00\x01\x00\x00' + bytes(8))
+
+
+def test_topics_of_types_not_installed_are_skipped_with_one_warning(tmp_path):
+    mixed_type_bag(tmp_path / 'mixed')
+    result = subprocess.run(REPLAYER + ['--ros-args', '-p', f'bag:={tmp_path / "mixed"}',
+                                        '-p', 'wait_timeout:=0.0'],
+                            capture_output=True, text=True, timeout=60)
+    assert result.returncode == 0, result.stderr
+    warnings = [line for line in result.stderr.splitlines() if 'not installed' in line]
+    assert len(warnings) == 1 and '/x (test_msgs/msg/Strings)' in warnings[0]
+    assert '/s' not in warnings[0]
+    assert 'end of bag: 5 messages published' in result.stderr
+
+
+def test_a_consumer_started_first_gets_every_message(ros_context, executor, tmp_path):
+    """The replayer in another process, no delay: it waits for the subscription to match."""
+    stamps = wrench_bag(tmp_path / 'bag', 200, 1000.0)
+    listener = Listener(ros_context, ['/coupling_torque'])
+    executor.add_node(listener)
+    proc = subprocess.Popen(REPLAYER + ['--ros-args', '-p', f'bag:={tmp_path / "bag"}'],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        received = listener.received['/coupling_torque']
+        spin_until(executor, lambda: len(received) == 200 or proc.poll() is not None, 60)
+        spin_until(executor, lambda: len(received) == 200, 5)
+        _, err = proc.communicate(timeout=30)
+    finally:
+        proc.kill() if proc.poll() is None else None
+    assert proc.returncode == 0, err
+    assert 'after wait_timeout' not in err  # it did not have to give up waiting
+    assert stamps_of(received) == stamps.tolist()
+
+
+def test_wait_timeout_plays_anyway_and_says_so(tmp_path):
+    wrench_bag(tmp_path / 'bag', 5, 100.0, topic='/nobody_listens')
+    began = time.monotonic()
+    result = subprocess.run(REPLAYER + ['--ros-args', '-p', f'bag:={tmp_path / "bag"}',
+                                        '-p', 'wait_timeout:=0.5'],
+                            capture_output=True, text=True, timeout=60)
+    assert result.returncode == 0, result.stderr
+    assert 'no subscriber on /nobody_listens after wait_timeout; playing anyway' in result.stderr
+    assert 'end of bag: 5 messages published' in result.stderr
+    assert time.monotonic() - began > 0.5
