@@ -23,11 +23,20 @@ from vib_estimator.nodes.runner import spin_until
 RECORDER = [sys.executable, '-m', 'vib_estimator.nodes.bag_recorder']
 
 
-def recorder_process(output, topic, *params):
+def recorder_process(output, topic, *params, **popen):
     args = ['topics:=[' + topic + ']', f'output:={output}', *params]
     return subprocess.Popen(RECORDER + ['--ros-args'] + [a for p in args for a in ('-p', p)],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            env=dict(os.environ))
+                            env=dict(os.environ), **popen)
+
+
+def recording(ros_context, executor, output, topic, msg_type, *params, **popen):
+    """The recorder executable on ``topic`` and a publisher of it: ``(process, publisher)``."""
+    recorder = recorder_process(output, topic, *params, **popen)
+    node = Node('test_publisher', context=ros_context)
+    publisher = node.create_publisher(msg_type, topic, QoSProfile(depth=1000))
+    executor.add_node(node)
+    return recorder, publisher
 
 
 def wrench(i):
@@ -48,10 +57,8 @@ def test_records_every_message_byte_for_byte(ros_context, executor, tmp_path):
     """N messages published at 10x the sensor's 500 Hz into the real executable: all N recorded."""
     n, batch, period = 10_000, 10, 0.002  # 5000 messages/s
     topic = f'/rec_all_{os.getpid()}'
-    recorder = recorder_process(tmp_path / 'bag', topic, f'max_messages:={n}')
-    node = Node('test_publisher', context=ros_context)
-    publisher = node.create_publisher(WrenchStamped, topic, QoSProfile(depth=1000))
-    executor.add_node(node)
+    recorder, publisher = recording(ros_context, executor, tmp_path / 'bag', topic, WrenchStamped,
+                                    f'max_messages:={n}')
     try:
         wait_for_subscriber(executor, publisher)
         sent = [serialize_message(wrench(i)) for i in range(n)]
@@ -73,10 +80,7 @@ def test_records_every_message_byte_for_byte(ros_context, executor, tmp_path):
 
 def test_sigint_leaves_a_complete_bag(ros_context, executor, tmp_path):
     topic = f'/rec_sigint_{os.getpid()}'
-    recorder = recorder_process(tmp_path / 'bag', topic)
-    node = Node('test_publisher', context=ros_context)
-    publisher = node.create_publisher(String, topic, QoSProfile(depth=100))
-    executor.add_node(node)
+    recorder, publisher = recording(ros_context, executor, tmp_path / 'bag', topic, String)
     try:
         wait_for_subscriber(executor, publisher)
         for i in range(50):
@@ -172,10 +176,8 @@ def test_sigkill_loses_at_most_the_last_second(ros_context, executor, tmp_path, 
     from vib_estimator.io.reindex import reindex
 
     topic = f'/rec_kill_{storage}_{os.getpid()}'
-    recorder = recorder_process(tmp_path / 'bag', topic, f'storage:={storage}')
-    node = Node('test_publisher', context=ros_context)
-    publisher = node.create_publisher(String, topic, QoSProfile(depth=1000))
-    executor.add_node(node)
+    recorder, publisher = recording(ros_context, executor, tmp_path / 'bag', topic, String,
+                                    f'storage:={storage}')
     try:
         wait_for_subscriber(executor, publisher)
         times = publish_for(executor, publisher, 3.0)
@@ -235,13 +237,8 @@ def test_file_too_large_is_one_error_line_exit_2_and_the_bag_stays_readable(ros_
     def small_disk():
         resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
 
-    args = ['topics:=[' + topic + ']', f'output:={tmp_path / "bag"}', 'flush_period:=0.2']
-    recorder = subprocess.Popen(RECORDER + ['--ros-args'] + [a for p in args for a in ('-p', p)],
-                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                                preexec_fn=small_disk)
-    node = Node('test_publisher', context=ros_context)
-    publisher = node.create_publisher(String, topic, QoSProfile(depth=1000))
-    executor.add_node(node)
+    recorder, publisher = recording(ros_context, executor, tmp_path / 'bag', topic, String,
+                                    'flush_period:=0.2', preexec_fn=small_disk)
     try:
         wait_for_subscriber(executor, publisher)
         deadline, sent = time.monotonic() + 20, 0
