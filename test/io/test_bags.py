@@ -127,7 +127,7 @@ def bad_bag(tmp_path, kind, mcap_bag):
     ('missing', 'does not exist'),
     ('random_mcap', 'corrupt or truncated'),
     ('random_db3', 'corrupt or truncated'),
-    ('truncated_dir', 'corrupt or truncated'),
+    ('truncated_dir', r'corrupt or truncated bag\?; `vib-estimator reindex .*` rebuilds it'),
     ('not_a_bag_dir', 'has no metadata.yaml'),
     ('text_file', 'is not a bag'),
     ('empty', 'contains no messages'),
@@ -245,6 +245,12 @@ def test_rosbag2_bags_read_completely_in_log_time_order(name):
         middle = times[len(times) // 2]
         assert [m.log_time_ns for m in bag.messages(start_ns=middle)] == \
             [t for t in times if t >= middle]
+
+
+@needs_shared
+def test_rosbag2_empty_bag_has_nothing_to_read():
+    with pytest.raises(BagError, match='empty_bag contains no messages'):
+        BagReader(SHARED_BAGS / 'empty_bag')
 
 
 def test_start_filter_on_a_split_bag_with_close_log_times_and_wrong_metadata(tmp_path):

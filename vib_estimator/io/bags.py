@@ -125,7 +125,8 @@ def _as_bag_error(path: Path, doing: str):
 
     A corrupt or truncated file makes ``rosbags`` fail with whatever its parsing step raises
     (``ReaderError``, ``struct.error``, ``KeyError``, ``sqlite3.DatabaseError``, ...), so every
-    exception is caught here, once, and reported with the path.
+    exception is caught here, once, and reported with the path. For a bag directory the sentence
+    names the repair: ``vib-estimator reindex`` (a recorder killed mid-file leaves such a bag).
     """
     try:
         yield
@@ -133,7 +134,10 @@ def _as_bag_error(path: Path, doing: str):
         raise
     except Exception as err:  # noqa: BLE001 -- see docstring
         detail = str(err).strip().rstrip('.') or type(err).__name__
-        raise BagError(f'cannot {doing} {path}: {detail} (corrupt or truncated bag?)') from None
+        repair = (f'; `vib-estimator reindex {path}` rebuilds it from what is complete'
+                  if path.is_dir() else '')
+        raise BagError(f'cannot {doing} {path}: {detail} (corrupt or truncated bag?{repair})'
+                       ) from None
 
 
 def storage_reader(path: Path):
