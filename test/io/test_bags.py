@@ -317,3 +317,17 @@ def test_flushed_messages_are_in_the_file_before_close(tmp_path, storage):
     reindex(tmp_path / 'copy')
     with BagReader(tmp_path / 'copy') as reader:
         assert [m.log_time_ns for m in reader.messages()] == list(range(30))
+
+
+def test_message_compressed_bag(tmp_path):
+    from rosbags.rosbag2 import CompressionFormat, CompressionMode, StoragePlugin, Writer
+    writer = Writer(tmp_path / 'zbag', version=8, storage_plugin=StoragePlugin.MCAP)
+    writer.set_compression(CompressionMode.MESSAGE, CompressionFormat.ZSTD)
+    float64 = TYPESTORE.types['std_msgs/msg/Float64']
+    with writer:
+        conn = writer.add_connection('/f', 'std_msgs/msg/Float64', typestore=TYPESTORE)
+        for i in range(5):
+            writer.write(conn, i, TYPESTORE.serialize_cdr(float64(data=i), conn.msgtype))
+    with BagReader(tmp_path / 'zbag') as reader:
+        assert [TYPESTORE.deserialize_cdr(m.data, m.msgtype).data
+                for m in reader.messages()] == [0.0, 1.0, 2.0, 3.0, 4.0]

@@ -27,32 +27,26 @@ from __future__ import annotations
 
 import contextlib
 import heapq
-import io
 import os
 import sqlite3
-import sys
 from dataclasses import dataclass
+from functools import partial
 from operator import itemgetter
 from pathlib import Path
 from typing import Dict, Iterator, List, Optional, Sequence, Tuple
 
 import numpy as np
+import yaml
 from rosbags.interfaces import (Connection, ConnectionExtRosbag2, MessageDefinition,
                                 MessageDefinitionFormat, Qos, QosDurability, QosHistory,
                                 QosLiveliness, QosReliability, QosTime)
 from rosbags.rosbag2 import CompressionMode, Reader
 from rosbags.rosbag2.metadata import dump_qos_v8
-from rosbags.rosbag2.storage_mcap import McapReader, McapWriter
+from rosbags.rosbag2.storage_mcap import DECOMPRESSORS, McapReader, McapWriter
 from rosbags.rosbag2.storage_sqlite3 import Sqlite3Reader, Sqlite3Writer
 from rosbags.typesys import Stores, get_typestore
-from ruamel.yaml import YAML
 
 from .fields import check_component, component_getter, normalise_type, stamp_ns
-
-if sys.version_info >= (3, 14):
-    from compression import zstd
-else:  # rosbags' own dependency before Python 3.14
-    from backports import zstd
 
 WRENCH_STAMPED = 'geometry_msgs/msg/WrenchStamped'
 
@@ -193,8 +187,8 @@ class BagReader:
         reader = Reader(self.path)  # metadata.yaml: file list, decompression of the files
         reader.open()
         self._stack.callback(reader.close)
-        if reader.compression_mode == 'message':
-            self._decompress = zstd.decompress
+        if reader.compression_mode == 'message':  # zstd, the only one rosbag2 writes
+            self._decompress = partial(DECOMPRESSORS['zstd'], _=0)
         return list(reader.storage.storages)
 
     def describe_topics(self) -> str:
@@ -382,11 +376,7 @@ def bag_metadata(storage: str, files: Sequence[FileStats],
 
 
 def _yaml_text(data) -> str:
-    yaml = YAML(typ='safe')
-    yaml.default_flow_style = False
-    stream = io.StringIO()
-    yaml.dump(data, stream)
-    return stream.getvalue()
+    return yaml.safe_dump(data, default_flow_style=False, width=100)
 
 
 def write_metadata(directory: Path, info: dict) -> None:
