@@ -3,6 +3,7 @@ replay -> estimator node parity with the offline estimator."""
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 import time
@@ -359,13 +360,14 @@ def test_topics_of_types_not_installed_are_skipped_with_one_warning(tmp_path):
 
 def test_a_consumer_started_first_gets_every_message(ros_context, executor, tmp_path):
     """The replayer in another process, no delay: it waits for the subscription to match."""
-    stamps = wrench_bag(tmp_path / 'bag', 200, 1000.0)
-    listener = Listener(ros_context, ['/coupling_torque'])
+    topic = f'/consumer_first_{os.getpid()}'  # no subscriber of an earlier test can match
+    stamps = wrench_bag(tmp_path / 'bag', 200, 1000.0, topic=topic)
+    listener = Listener(ros_context, [topic])
     executor.add_node(listener)
     proc = subprocess.Popen(REPLAYER + ['--ros-args', '-p', f'bag:={tmp_path / "bag"}'],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
-        received = listener.received['/coupling_torque']
+        received = listener.received[topic]
         spin_until(executor, lambda: len(received) == 200 or proc.poll() is not None, 60)
         spin_until(executor, lambda: len(received) == 200, 5)
         _, err = proc.communicate(timeout=30)
