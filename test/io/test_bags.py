@@ -222,7 +222,7 @@ def storage_counts(directory: Path) -> dict:
                 for _, channel, _ in make_reader(f).iter_messages():
                     counts[channel.topic] = counts.get(channel.topic, 0) + 1
         elif file.suffix == '.db3':
-            conn = sqlite3.connect(f'file:{file}?mode=ro', uri=True)
+            conn = sqlite3.connect(f'file:{file}?immutable=1', uri=True)  # no -wal/-shm
             for topic, n in conn.execute('SELECT topics.name, count(*) FROM messages JOIN topics '
                                          'ON messages.topic_id = topics.id GROUP BY topics.name'):
                 counts[topic] = counts.get(topic, 0) + n

@@ -274,5 +274,8 @@ def reindex(path) -> ReindexResult:
     indexed = [_file_index(f) for f in files]
     topics = _merge([c for _, conns in indexed for c in conns])
     stats = [s for s, _ in indexed]
-    write_metadata(path, bag_metadata(storage, stats, topics))
+    try:
+        write_metadata(path, bag_metadata(storage, stats, topics))
+    except OSError as err:
+        raise BagError(f'cannot write {path / "metadata.yaml"}: {err}') from None
     return ReindexResult(path, storage, stats, topics, [c for c in cuts if c])
