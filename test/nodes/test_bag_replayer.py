@@ -281,6 +281,7 @@ def test_replay_into_estimator_node_matches_analyze(ros_context, executor, monke
     assert spin_until(executor, lambda: estimator.counters['received'] == len(series), 5)
     online = [deserialize_message(d, Float64).data for d in frequencies]
     assert online == offline  # same floats
+    estimator.destroy_node()  # off the graph (see the looping test)
 
 
 def test_looping_bag_resets_the_estimator_and_estimates_go_on(ros_context, executor, tmp_path):
@@ -300,6 +301,9 @@ def test_looping_bag_resets_the_estimator_and_estimates_go_on(ros_context, execu
     assert spin_until(executor, lambda: estimator.counters['time_jump_resets'] >= 2, 15)
     per_loop = estimator.counters['estimates'] / estimator.counters['time_jump_resets']
     assert per_loop >= 2
+    # the context's shutdown leaves the subscription visible to later tests' processes
+    # (test_estimator_node counts subscribers of /coupling_torque): take it off the graph
+    estimator.destroy_node()
 
 
 # -- bags written by rosbag2, types not installed, waiting for subscribers, split recordings -----
