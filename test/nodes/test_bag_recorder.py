@@ -23,11 +23,20 @@ from vib_estimator.nodes.runner import spin_until
 RECORDER = [sys.executable, '-m', 'vib_estimator.nodes.bag_recorder']
 
 
-def recorder_process(output, topic, *params):
+def recorder_process(output, topic, *params, **popen):
     args = ['topics:=[' + topic + ']', f'output:={output}', *params]
     return subprocess.Popen(RECORDER + ['--ros-args'] + [a for p in args for a in ('-p', p)],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            env=dict(os.environ))
+                            env=dict(os.environ), **popen)
+
+
+def recording(ros_context, executor, output, topic, msg_type, *params, **popen):
+    """The recorder executable on ``topic`` and a publisher of it: ``(process, publisher)``."""
+    recorder = recorder_process(output, topic, *params, **popen)
+    node = Node('test_publisher', context=ros_context)
+    publisher = node.create_publisher(msg_type, topic, QoSProfile(depth=1000))
+    executor.add_node(node)
+    return recorder, publisher
 
 
 def wrench(i):
@@ -48,10 +57,8 @@ def test_records_every_message_byte_for_byte(ros_context, executor, tmp_path):
     """N messages published at 10x the sensor's 500 Hz into the real executable: all N recorded."""
     n, batch, period = 10_000, 10, 0.002  # 5000 messages/s
     topic = f'/rec_all_{os.getpid()}'
-    recorder = recorder_process(tmp_path / 'bag', topic, f'max_messages:={n}')
-    node = Node('test_publisher', context=ros_context)
-    publisher = node.create_publisher(WrenchStamped, topic, QoSProfile(depth=1000))
-    executor.add_node(node)
+    recorder, publisher = recording(ros_context, executor, tmp_path / 'bag', topic, WrenchStamped,
+                                    f'max_messages:={n}')
     try:
         wait_for_subscriber(executor, publisher)
         sent = [serialize_message(wrench(i)) for i in range(n)]
@@ -73,10 +80,7 @@ def test_records_every_message_byte_for_byte(ros_context, executor, tmp_path):
 
 def test_sigint_leaves_a_complete_bag(ros_context, executor, tmp_path):
     topic = f'/rec_sigint_{os.getpid()}'
-    recorder = recorder_process(tmp_path / 'bag', topic)
-    node = Node('test_publisher', context=ros_context)
-    publisher = node.create_publisher(String, topic, QoSProfile(depth=100))
-    executor.add_node(node)
+    recorder, publisher = recording(ros_context, executor, tmp_path / 'bag', topic, String)
     try:
         wait_for_subscriber(executor, publisher)
         for i in range(50):
@@ -147,3 +151,107 @@ def test_in_process_stops_after_duration(ros_context, executor, tmp_path):
     assert 0.25 < time.monotonic() - began < 2.0
     recorder.destroy_node()
     assert (tmp_path / 'bag' / 'metadata.yaml').exists()
+
+
+# -- crash safety, splitting, write errors --------------------------------------------------------
+
+def publish_for(executor, publisher, seconds, period=0.002, count=None, first=0):
+    """Publish Strings numbered from ``first`` for ``seconds`` (or ``count`` of them), paced at
+    ``period``; their publication times (monotonic)."""
+    times = []
+    start = time.monotonic()
+    while (len(times) < count if count else time.monotonic() - start < seconds):
+        publisher.publish(String(data=f'message {first + len(times)}'))
+        times.append(time.monotonic())
+        executor.spin_once(timeout_sec=0)
+        time.sleep(max(0.0, start + len(times) * period - time.monotonic()))
+    return times
+
+
+@pytest.mark.parametrize('storage', ['mcap', 'sqlite3'])
+def test_sigkill_loses_at_most_the_last_second(ros_context, executor, tmp_path, storage):
+    """Killed with SIGKILL mid-recording, reindexed: rosbags reads every message published more
+    than a second before the kill."""
+    from rosbags.rosbag2 import Reader
+    from vib_estimator.io.reindex import reindex
+
+    topic = f'/rec_kill_{storage}_{os.getpid()}'
+    recorder, publisher = recording(ros_context, executor, tmp_path / 'bag', topic, String,
+                                    f'storage:={storage}')
+    try:
+        wait_for_subscriber(executor, publisher)
+        times = publish_for(executor, publisher, 3.0)
+        recorder.send_signal(signal.SIGKILL)
+        killed = time.monotonic()
+        recorder.communicate(timeout=15)
+    finally:
+        recorder.kill() if recorder.poll() is None else None
+    assert recorder.returncode == -signal.SIGKILL
+    reindex(tmp_path / 'bag')
+    with Reader(tmp_path / 'bag') as reader:  # an independent reader
+        recorded = [deserialize_message(bytes(d), String).data for _, _, d in reader.messages()]
+    older = sum(1 for t in times if t < killed - 1.0)
+    assert older > 500 and len(recorded) >= older, (len(recorded), older, len(times))
+    assert recorded == [f'message {i}' for i in range(len(recorded))]
+
+
+def test_split_recording_replays_in_order(ros_context, executor, tmp_path):
+    from vib_estimator.nodes.bag_replayer import BagReplayer
+
+    topic = f'/rec_split_{os.getpid()}'
+    recorder = BagRecorder(context=ros_context, parameter_overrides=[
+        Parameter('topics', value=[topic]), Parameter('output', value=str(tmp_path / 'bag')),
+        Parameter('max_bag_duration', value=0.3), Parameter('max_messages', value=400)])
+    node = Node('test_publisher', context=ros_context)
+    publisher = node.create_publisher(String, topic, QoSProfile(depth=1000))
+    executor.add_node(recorder)
+    executor.add_node(node)
+    wait_for_subscriber(executor, publisher)
+    publish_for(executor, publisher, None, period=0.0025, count=400)
+    assert spin_until(executor, lambda: recorder.finished, 10)
+    recorder.destroy_node()
+    files = sorted(p.name for p in (tmp_path / 'bag').glob('*.mcap'))
+    assert len(files) >= 3 and files[:3] == ['bag_0.mcap', 'bag_1.mcap', 'bag_2.mcap']
+
+    replayer = BagReplayer(context=ros_context, parameter_overrides=[
+        Parameter('bag', value=str(tmp_path / 'bag')), Parameter('rate', value=4.0),
+        Parameter('remap', value=[f'{topic}:=/replayed_split'])])
+    received = []
+    node.create_subscription(String, '/replayed_split', lambda m: received.append(m.data),
+                             QoSProfile(depth=1000))
+    executor.add_node(replayer)
+    assert spin_until(executor, lambda: replayer.finished, 20)
+    assert spin_until(executor, lambda: len(received) == 400, 5)
+    assert received == [f'message {i}' for i in range(400)]
+
+
+def test_file_too_large_is_one_error_line_exit_2_and_the_bag_stays_readable(ros_context, executor,
+                                                                           tmp_path):
+    """A write refused by the system (here RLIMIT_FSIZE, as a full disk would): exit 2."""
+    import resource
+    from vib_estimator.io.reindex import reindex
+
+    topic = f'/rec_full_{os.getpid()}'
+    limit = 60_000
+
+    def small_disk():
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+
+    recorder, publisher = recording(ros_context, executor, tmp_path / 'bag', topic, String,
+                                    'flush_period:=0.2', preexec_fn=small_disk)
+    try:
+        wait_for_subscriber(executor, publisher)
+        deadline, sent = time.monotonic() + 20, 0
+        while recorder.poll() is None and time.monotonic() < deadline:
+            sent += len(publish_for(executor, publisher, 0.2, first=sent))
+        _, err = recorder.communicate(timeout=15)
+    finally:
+        recorder.kill() if recorder.poll() is None else None
+    assert recorder.returncode == 2, err
+    lines = [line for line in err.splitlines() if line.startswith('error: ')]
+    assert len(lines) == 1 and 'File too large' in lines[0] and 'Traceback' not in err
+    result = reindex(tmp_path / 'bag')
+    with BagReader(tmp_path / 'bag') as bag:
+        recorded = [deserialize_message(m.data, String).data for m in bag.messages()]
+    assert len(recorded) == sum(f.count for f in result.files) > 100
+    assert recorded == [f'message {i}' for i in range(len(recorded))]

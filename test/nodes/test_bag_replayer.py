@@ -3,6 +3,7 @@ replay -> estimator node parity with the offline estimator."""
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 import time
@@ -42,10 +43,11 @@ class Listener(Node):
 
     def __init__(self, context, topics, msg_type=WrenchStamped, qos=QoSProfile(depth=1000)):
         super().__init__('listener', context=context)
+        types = msg_type if isinstance(msg_type, dict) else dict.fromkeys(topics, msg_type)
         self.received = {topic: [] for topic in topics}
         self.arrival = []
-        self.subs = [self.create_subscription(msg_type, topic, self._callback(topic), qos, raw=True)
-                     for topic in topics]
+        self.subs = [self.create_subscription(types[topic], topic, self._callback(topic), qos,
+                                              raw=True) for topic in topics]
 
     def _callback(self, topic):
         def on_message(data):
@@ -205,12 +207,17 @@ def bad_bags(tmp_path):
     with BagWriter(tmp_path / 'empty') as bag:
         bag.add_topic('/coupling_torque', WRENCH_STAMPED)
     unknown_type_bag(tmp_path / 'unknown')
+    wrench_bag(tmp_path / 'no_metadata', 10, 10.0)
+    (tmp_path / 'no_metadata' / 'metadata.yaml').unlink()
     return {
         'missing': ([f'bag:={tmp_path / "none"}'], 'does not exist'),
         'corrupt': ([f'bag:={tmp_path / "corrupt.mcap"}'], 'corrupt or truncated'),
         'truncated': ([f'bag:={tmp_path / "truncated.mcap"}'], 'corrupt or truncated'),
         'empty': ([f'bag:={tmp_path / "empty"}'], 'contains no messages'),
-        'unknown type': ([f'bag:={tmp_path / "unknown"}'], 'my_pkg/msg/Custom is not installed'),
+        'unknown type': ([f'bag:={tmp_path / "unknown"}'],
+                         'types of its topics are not installed: /x (my_pkg/msg/Custom)'),
+        'no metadata': ([f'bag:={tmp_path / "no_metadata"}'],
+                        f'run `vib-estimator reindex {tmp_path / "no_metadata"}`'),
         'unknown topic': ([f'bag:={tmp_path / "good"}', 'topics:=[/nope]'],
                           "no topic '/nope'; its topics are /coupling_torque"),
         'bad remap': ([f'bag:={tmp_path / "good"}', 'remap:=[/coupling_torque]'],
@@ -229,7 +236,7 @@ def test_unplayable_bags_are_refused_with_one_line(bad_bags):
                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
              for name, (params, _) in bad_bags.items()}
     for name, proc in procs.items():
-        _, err = proc.communicate(timeout=60)
+        _, err = proc.communicate(timeout=120)
         assert proc.returncode == 2, (name, err)
         assert 'Traceback' not in err, (name, err)
         lines = [line for line in err.splitlines() if line.startswith('error: ')]
@@ -274,6 +281,7 @@ def test_replay_into_estimator_node_matches_analyze(ros_context, executor, monke
     assert spin_until(executor, lambda: estimator.counters['received'] == len(series), 5)
     online = [deserialize_message(d, Float64).data for d in frequencies]
     assert online == offline  # same floats
+    estimator.destroy_node()  # off the graph (see the looping test)
 
 
 def test_looping_bag_resets_the_estimator_and_estimates_go_on(ros_context, executor, tmp_path):
@@ -293,3 +301,88 @@ def test_looping_bag_resets_the_estimator_and_estimates_go_on(ros_context, execu
     assert spin_until(executor, lambda: estimator.counters['time_jump_resets'] >= 2, 15)
     per_loop = estimator.counters['estimates'] / estimator.counters['time_jump_resets']
     assert per_loop >= 2
+    # the context's shutdown leaves the subscription visible to later tests' processes
+    # (test_estimator_node counts subscribers of /coupling_torque): take it off the graph
+    estimator.destroy_node()
+
+
+# -- bags written by rosbag2, types not installed, waiting for subscribers, split recordings -----
+
+SHARED_BAGS = Path(__file__).resolve().parents[3] / 'shared' / 'ros2-bags'
+#: SOURCE.md of ../shared/ros2-bags: messages per bag, counted in the storage files
+ROSBAG2_COUNTS = {'mcap_talker': 20, 'sqlite3_talker': 20, 'mcap_wbag': 6074, 'sqlite3_wbag': 6074}
+
+
+@pytest.mark.skipif(not SHARED_BAGS.is_dir(), reason='../shared/ros2-bags is absent')
+@pytest.mark.parametrize('name', sorted(ROSBAG2_COUNTS))
+def test_rosbag2_bags_play_every_message(ros_context, executor, name):
+    from rcl_interfaces.msg import Log
+    from vib_estimator.io.bags import BagReader
+
+    with BagReader(SHARED_BAGS / name) as bag:
+        expected = {t: [m.data for m in bag.messages([t])] for t, i in bag.topics.items()
+                    if i.count}
+    assert sum(len(v) for v in expected.values()) == ROSBAG2_COUNTS[name]
+    # /rosout is renamed so that the nodes' own log messages do not mix in
+    remap = {'remap': ['/rosout:=/bag_rosout']} if '/rosout' in expected else {}
+    node = replayer(ros_context, SHARED_BAGS / name, rate=20.0, **remap)
+    topics = {('/bag_rosout' if t == '/rosout' else t): t for t in expected}
+    listener = Listener(ros_context, list(topics),
+                        {t: Log if b == '/rosout' else String for t, b in topics.items()})
+    start(executor, node, listener)
+    assert spin_until(executor, lambda: node.finished, 20)
+    assert spin_until(executor, lambda: sum(map(len, listener.received.values())) ==
+                      ROSBAG2_COUNTS[name], 10)
+    assert node.published == ROSBAG2_COUNTS[name] and node.exit_code == 0
+    for topic, bag_topic in topics.items():
+        assert listener.received[topic] == expected[bag_topic]  # every message, in order
+
+
+def mixed_type_bag(path):
+    """/s (std_msgs/String, old-style name) and /x (a type that is not installed)."""
+    with Writer(path, version=8, storage_plugin=StoragePlugin.MCAP) as bag:
+        strings = bag.add_connection('/s', 'std_msgs/String', msgdef='string data',
+                                     rihs01='RIHS01_' + '0' * 64)
+        other = bag.add_connection('/x', 'test_msgs/msg/Strings', msgdef='string a',
+                                   rihs01='RIHS01_' + '1' * 64)
+        for i in range(5):
+            bag.write(strings, 10 ** 9 + i * 10 ** 7, TYPESTORE.serialize_cdr(
+                TYPESTORE.types['std_msgs/msg/String'](data=str(i)), 'std_msgs/msg/String'))
+            bag.write(other, 10 ** 9 + i * 10 ** 7 + 1, b'\x00\x01\x00\x00' + bytes(8))
+
+
+def test_types_not_installed_are_skipped_and_wait_timeout_plays_anyway(tmp_path):
+    """One warning naming the skipped topic; nobody subscribes, so after wait_timeout it plays
+    anyway and says so."""
+    mixed_type_bag(tmp_path / 'mixed')
+    began = time.monotonic()
+    result = subprocess.run(REPLAYER + ['--ros-args', '-p', f'bag:={tmp_path / "mixed"}',
+                                        '-p', 'wait_timeout:=0.5'],
+                            capture_output=True, text=True, timeout=60)
+    assert result.returncode == 0, result.stderr
+    warnings = [line for line in result.stderr.splitlines() if 'not installed' in line]
+    assert len(warnings) == 1 and '/x (test_msgs/msg/Strings)' in warnings[0]
+    assert '/s' not in warnings[0]
+    assert 'no subscriber on /s after wait_timeout; playing anyway' in result.stderr
+    assert 'end of bag: 5 messages published' in result.stderr
+    assert time.monotonic() - began > 0.5
+
+
+def test_a_consumer_started_first_gets_every_message(ros_context, executor, tmp_path):
+    """The replayer in another process, no delay: it waits for the subscription to match."""
+    topic = f'/consumer_first_{os.getpid()}'  # no subscriber of an earlier test can match
+    stamps = wrench_bag(tmp_path / 'bag', 200, 1000.0, topic=topic)
+    listener = Listener(ros_context, [topic])
+    executor.add_node(listener)
+    proc = subprocess.Popen(REPLAYER + ['--ros-args', '-p', f'bag:={tmp_path / "bag"}'],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        received = listener.received[topic]
+        spin_until(executor, lambda: len(received) == 200 or proc.poll() is not None, 60)
+        spin_until(executor, lambda: len(received) == 200, 5)
+        _, err = proc.communicate(timeout=30)
+    finally:
+        proc.kill() if proc.poll() is None else None
+    assert proc.returncode == 0, err
+    assert 'after wait_timeout' not in err  # it did not have to give up waiting
+    assert stamps_of(received) == stamps.tolist()

@@ -26,17 +26,27 @@ profile: ``ros2msg`` schemas with the full message definitions, ``cdr`` channels
 from __future__ import annotations
 
 import contextlib
+import heapq
+import os
+import sqlite3
 from dataclasses import dataclass
+from functools import partial
+from operator import itemgetter
 from pathlib import Path
 from typing import Dict, Iterator, List, Optional, Sequence, Tuple
 
 import numpy as np
-from rosbags.interfaces import (Connection, ConnectionExtRosbag2, Qos, QosDurability, QosHistory,
+import yaml
+from rosbags.interfaces import (Connection, ConnectionExtRosbag2, MessageDefinition,
+                                MessageDefinitionFormat, Qos, QosDurability, QosHistory,
                                 QosLiveliness, QosReliability, QosTime)
-from rosbags.rosbag2 import Reader, StoragePlugin, Writer
+from rosbags.rosbag2 import CompressionMode, Reader
+from rosbags.rosbag2.metadata import dump_qos_v8
+from rosbags.rosbag2.storage_mcap import DECOMPRESSORS, McapReader, McapWriter
+from rosbags.rosbag2.storage_sqlite3 import Sqlite3Reader, Sqlite3Writer
 from rosbags.typesys import Stores, get_typestore
 
-from .fields import check_component, component_getter, stamp_ns
+from .fields import check_component, component_getter, normalise_type, stamp_ns
 
 WRENCH_STAMPED = 'geometry_msgs/msg/WrenchStamped'
 
@@ -46,8 +56,10 @@ TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
 #: rosbag2 metadata version written by :class:`BagWriter` (see the module docstring)
 METADATA_VERSION = 8
 
-#: ``storage`` argument of :class:`BagWriter` -> rosbags storage plugin
-STORAGES = {'mcap': StoragePlugin.MCAP, 'sqlite3': StoragePlugin.SQLITE3}
+#: ``storage`` argument of :class:`BagWriter` -> file extension
+STORAGES = {'mcap': '.mcap', 'sqlite3': '.db3'}
+#: storage-file extension -> rosbags reader of one such file
+_STORAGE_READERS = {'.mcap': McapReader, '.db3': Sqlite3Reader}
 
 _INFINITE = QosTime(9223372036, 854775807)  # RMW_DURATION_INFINITE, as rosbag2 records it
 
@@ -107,7 +119,8 @@ def _as_bag_error(path: Path, doing: str):
 
     A corrupt or truncated file makes ``rosbags`` fail with whatever its parsing step raises
     (``ReaderError``, ``struct.error``, ``KeyError``, ``sqlite3.DatabaseError``, ...), so every
-    exception is caught here, once, and reported with the path.
+    exception is caught here, once, and reported with the path. For a bag directory the sentence
+    names the repair: ``vib-estimator reindex`` (a recorder killed mid-file leaves such a bag).
     """
     try:
         yield
@@ -115,7 +128,17 @@ def _as_bag_error(path: Path, doing: str):
         raise
     except Exception as err:  # noqa: BLE001 -- see docstring
         detail = str(err).strip().rstrip('.') or type(err).__name__
-        raise BagError(f'cannot {doing} {path}: {detail} (corrupt or truncated bag?)') from None
+        repair = (f'; `vib-estimator reindex {path}` rebuilds it from what is complete'
+                  if path.is_dir() else '')
+        raise BagError(f'cannot {doing} {path}: {detail} (corrupt or truncated bag?{repair})'
+                       ) from None
+
+
+def storage_reader(path: Path):
+    """The rosbags reader of one storage file (``.mcap`` or ``.db3``), opened."""
+    storage = _STORAGE_READERS[path.suffix](path)
+    storage.open()
+    return storage
 
 
 class BagReader:
@@ -123,47 +146,50 @@ class BagReader:
 
     Use as a context manager. Raises :class:`BagError` if the path is missing or not a readable bag,
     or holds no messages.
+
+    Everything but the list of storage files (and their compression) comes from the storage files
+    themselves, not from ``metadata.yaml``: topics, types, counts, offered QoS and the log-time
+    span. rosbag2 has written wrong values there (split bags whose ``starting_time`` and
+    ``duration`` are those of the last file, ros2/rosbag2#841 and #966), and rosbags' directory
+    reader, which trusts them, also drops every message of a topic whose QoS in ``metadata.yaml``
+    differs from the one in the storage file (it matches connections on the whole QoS list) -- the
+    case of rosbag2's own ``talker`` bags. Messages of split bags are merged across files in log
+    time. Types written ``pkg/Name`` (older bags) are reported as ``pkg/msg/Name``.
     """
 
     def __init__(self, path) -> None:
         self.path = Path(path)
-        if not self.path.exists():
-            raise BagError(f'bag {self.path} does not exist')
-        if self.path.is_dir() and not (self.path / 'metadata.yaml').exists():
-            raise BagError(f'{self.path} is not a rosbag2 bag: it has no metadata.yaml')
-        if self.path.is_file() and self.path.suffix not in ('.mcap', '.db3'):
-            raise BagError(f'{self.path} is not a bag: expected a .mcap or .db3 file or a rosbag2 '
-                           f'directory')
+        check_bag_path(self.path)
+        self._stack = contextlib.ExitStack()
+        self._decompress = None
         with _as_bag_error(self.path, 'open bag'):
-            self._reader = Reader(self.path)
-            self._reader.open()
-        self._connections = list(self._reader.connections)
-        counts: Dict[str, int] = {}
-        for conn in self._connections:
-            counts[conn.topic] = counts.get(conn.topic, 0) + conn.msgcount
-        self.topics: Dict[str, TopicInfo] = {}
-        for conn in self._connections:
-            qos = (conn.ext.offered_qos_profiles if isinstance(conn.ext, ConnectionExtRosbag2)
-                   else [])
-            self.topics.setdefault(conn.topic, TopicInfo(conn.topic, conn.msgtype,
-                                                         counts[conn.topic], tuple(qos)))
-        if self._reader.message_count == 0:
+            try:
+                self._storages = self._open_storages()
+            except BaseException:
+                self._stack.close()
+                raise
+        self.topics: Dict[str, TopicInfo] = _merge_topics(self._storages)
+        stats = [s.metadata for s in self._storages if s.metadata.message_count]
+        self.message_count = sum(m.message_count for m in stats)
+        if self.message_count == 0:
             self.close()
             raise BagError(f'bag {self.path} contains no messages')
+        #: log time of the first message, ns
+        self.start_ns = min(m.start_time for m in stats)
+        #: log time of the last message, ns (rosbags reports one past it)
+        self.end_ns = max(m.end_time for m in stats) - 1
 
-    @property
-    def start_ns(self) -> int:
-        """Log time of the first message, ns."""
-        return self._reader.start_time
-
-    @property
-    def end_ns(self) -> int:
-        """Log time of the last message, ns."""
-        return self._reader.end_time - 1  # rosbags reports one past the last message
-
-    @property
-    def message_count(self) -> int:
-        return self._reader.message_count
+    def _open_storages(self) -> list:
+        if self.path.is_file():
+            storage = storage_reader(self.path)
+            self._stack.callback(storage.close)
+            return [storage]
+        reader = Reader(self.path)  # metadata.yaml: file list, decompression of the files
+        reader.open()
+        self._stack.callback(reader.close)
+        if reader.compression_mode == 'message':  # zstd, the only one rosbag2 writes
+            self._decompress = partial(DECOMPRESSORS['zstd'], _=0)
+        return list(reader.storage.storages)
 
     def describe_topics(self) -> str:
         """``'/a (pkg/msg/A), /b (pkg/msg/B)'`` for error messages."""
@@ -179,21 +205,67 @@ class BagReader:
     def messages(self, topics: Optional[Sequence[str]] = None,
                  start_ns: Optional[int] = None) -> Iterator[BagMessage]:
         """The messages of ``topics`` (default: all), from log time ``start_ns`` on, in log-time
-        order (the order they were recorded in)."""
+        order across all storage files (ties: in file order)."""
         names = set(self.topics) if topics is None else {self.topic(t).topic for t in topics}
-        conns = [c for c in self._connections if c.topic in names]
+        streams = []
+        for storage in self._storages:
+            conns = [c for c in storage.connections if c.topic in names]
+            if conns:
+                streams.append(storage.messages(conns, start_ns, None))
         with _as_bag_error(self.path, 'read messages of bag'):
-            for conn, log_time, data in self._reader.messages(connections=conns, start=start_ns):
-                yield BagMessage(conn.topic, conn.msgtype, log_time, bytes(data))
+            for conn, log_time, data in heapq.merge(*streams, key=itemgetter(1)):
+                if self._decompress is not None:
+                    data = self._decompress(data)
+                yield BagMessage(conn.topic, normalise_type(conn.msgtype), log_time, bytes(data))
 
     def close(self) -> None:
-        self._reader.close()
+        self._stack.close()
 
     def __enter__(self) -> 'BagReader':
         return self
 
     def __exit__(self, *exc) -> None:
         self.close()
+
+
+def check_bag_path(path: Path) -> None:
+    """:class:`BagError` unless ``path`` is a ``.mcap``/``.db3`` file or a directory with a
+    ``metadata.yaml`` (a directory of storage files without one: run ``vib-estimator reindex``)."""
+    if not path.exists():
+        raise BagError(f'bag {path} does not exist')
+    if path.is_dir() and not (path / 'metadata.yaml').exists():
+        if storage_files(path):
+            raise BagError(f'bag {path} has no metadata.yaml: run `vib-estimator reindex {path}` '
+                           f'to rebuild it from its storage files')
+        raise BagError(f'{path} is not a rosbag2 bag: it has no metadata.yaml and no .mcap or '
+                       f'.db3 file')
+    if path.is_file() and path.suffix not in _STORAGE_READERS:
+        raise BagError(f'{path} is not a bag: expected a .mcap or .db3 file or a rosbag2 '
+                       f'directory')
+
+
+def storage_files(directory: Path) -> List[Path]:
+    """The ``.mcap`` / ``.db3`` files of a bag directory, in split order (``name_0``, ``name_1``,
+    ..., ``name_10``: by the number after the last ``_``, then by name)."""
+    def order(path: Path):
+        stem, _, index = path.stem.rpartition('_')
+        return (stem, int(index)) if index.isdigit() else (path.stem, -1)
+    return sorted((p for p in directory.iterdir() if p.is_file() and p.suffix in _STORAGE_READERS),
+                  key=order)
+
+
+def _merge_topics(storages) -> Dict[str, TopicInfo]:
+    """The topics of all storage files: counts summed, type and QoS of the first file with it."""
+    counts: Dict[str, int] = {}
+    first = {}
+    for storage in storages:
+        for conn in storage.connections:
+            counts[conn.topic] = counts.get(conn.topic, 0) + conn.msgcount
+            first.setdefault(conn.topic, conn)
+    return {topic: TopicInfo(topic, normalise_type(conn.msgtype), counts[topic],
+                             tuple(conn.ext.offered_qos_profiles
+                                   if isinstance(conn.ext, ConnectionExtRosbag2) else ()))
+            for topic, conn in first.items()}
 
 
 def read_wrench_series(path, topic: Optional[str] = None,
@@ -245,27 +317,182 @@ def wrench_message(stamp: int, frame_id: str, component: str, value: float):
         force=vector(*vec['force']), torque=vector(*vec['torque'])))
 
 
+_NO_MESSAGE = 2 ** 63 - 1  # start time of a file without messages, as rosbags keeps it
+
+
+@dataclass
+class FileStats:
+    """One storage file of a bag as ``metadata.yaml`` lists it: name, log-time span, count."""
+
+    name: str
+    start_ns: int = _NO_MESSAGE
+    end_ns: int = 0
+    count: int = 0
+
+    def add(self, log_time_ns: int, n: int = 1) -> None:
+        self.start_ns = min(self.start_ns, log_time_ns)
+        self.end_ns = max(self.end_ns, log_time_ns)
+        self.count += n
+
+    def as_dict(self) -> dict:
+        return {'path': self.name, 'starting_time': {'nanoseconds_since_epoch': self.start_ns},
+                'duration': {'nanoseconds': max(0, self.end_ns - self.start_ns)},
+                'message_count': self.count}
+
+
+def bag_metadata(storage: str, files: Sequence[FileStats],
+                 topics: Sequence[Tuple[Connection, int]]) -> dict:
+    """The ``rosbag2_bagfile_information`` of a bag (version :data:`METADATA_VERSION`), from its
+    files and its ``(connection, message count)`` topics; what :class:`BagWriter` and
+    ``vib-estimator reindex`` write."""
+    whole = FileStats('')
+    for stats in files:
+        if stats.count:
+            whole.add(stats.start_ns, stats.count)
+            whole.add(stats.end_ns, 0)
+    info = whole.as_dict()
+    return {
+        'version': METADATA_VERSION,
+        'storage_identifier': storage,
+        'relative_file_paths': [f.name for f in files],
+        'duration': info['duration'],
+        'starting_time': info['starting_time'],
+        'message_count': whole.count,
+        'topics_with_message_count': [
+            {'topic_metadata': {'name': c.topic, 'type': c.msgtype,
+                                'serialization_format': c.ext.serialization_format,
+                                'offered_qos_profiles': dump_qos_v8(c.ext.offered_qos_profiles),
+                                'type_description_hash': c.digest},
+             'message_count': count} for c, count in topics],
+        'compression_format': '',
+        'compression_mode': '',
+        'files': [f.as_dict() for f in files],
+        'custom_data': None,
+        'ros_distro': 'rosbags',
+    }
+
+
+def _yaml_text(data) -> str:
+    return yaml.safe_dump(data, default_flow_style=False, width=100)
+
+
+def write_metadata(directory: Path, info: dict) -> None:
+    """Write ``directory/metadata.yaml`` atomically (a crash leaves the old or the new one)."""
+    tmp = directory / 'metadata.yaml.tmp'
+    tmp.write_text(_yaml_text({'rosbag2_bagfile_information': info}), 'utf8')
+    tmp.replace(directory / 'metadata.yaml')
+
+
+def mcap_file(path: Path) -> McapWriter:
+    """rosbags' MCAP storage writer, writing the new file ``path``.
+
+    That writer names its file after the directory it is given, so it is given a scratch directory
+    and its open file is then moved to ``path`` (an open file keeps its data when renamed).
+    """
+    scratch = path.with_name(path.name + '.tmpdir')
+    scratch.mkdir()
+    writer = McapWriter(scratch, CompressionMode.NONE)
+    writer.path = writer.path.rename(path)
+    scratch.rmdir()
+    return writer
+
+
+class _Sqlite3File(Sqlite3Writer):
+    """rosbags' sqlite3 storage writer, for a file name of our choosing (``name_3.db3``)."""
+
+    def __init__(self, path: Path) -> None:  # noqa: D107 -- the parent's, with the path given
+        self.path = path
+        self.conn = sqlite3.connect(f'file:{path}?mode=rwc', uri=True)
+        self.conn.executescript(self.SQLITE_SCHEMA)
+        self.cursor = self.conn.cursor()
+
+
+def connection_for(topic: str, msgtype: str, offered_qos: Sequence[Qos], cid: int) -> Connection:
+    """A rosbags connection of a Jazzy type, with its message definition and RIHS01 hash."""
+    msgdef, _ = TYPESTORE.generate_msgdef(msgtype, ros_version=2)
+    return Connection(cid, topic, msgtype, MessageDefinition(MessageDefinitionFormat.MSG, msgdef),
+                      TYPESTORE.hash_rihs01(msgtype), 0,
+                      ConnectionExtRosbag2('cdr', list(offered_qos)), None)
+
+
 class BagWriter:
-    """Writes a new rosbag2 directory (``metadata.yaml`` + one storage file); a context manager.
+    """Writes a new rosbag2 directory (``metadata.yaml`` + storage files); a context manager.
 
     ``storage`` is ``'mcap'`` (the Jazzy default) or ``'sqlite3'``. The directory must not exist.
-    On leaving the ``with`` block (or :meth:`close`) the storage file's index and ``metadata.yaml``
-    are written; after an exception the partial bag is left without them.
+    Without splitting the bag has one file, ``<name>.mcap`` (or ``.db3``); with ``max_bag_size``
+    (bytes) or ``max_bag_duration_ns`` (log time) > 0 it is split like rosbag2 into
+    ``<name>_0.mcap``, ``<name>_1.mcap``, ...: a new file is begun before a message that would
+    go into a file already that large or that long.
+
+    Crash safety: ``metadata.yaml`` is written when the bag is opened and rewritten each time a
+    file is opened or closed. :meth:`flush` puts every message written so far into the storage
+    file (MCAP: closes the pending chunk, flushes and fsyncs; sqlite3: commits), so a process
+    killed afterwards loses nothing written before; ``vib-estimator reindex`` then rebuilds the
+    index and ``metadata.yaml`` from what is complete. Any failure to write (disk full, file too
+    large, I/O error) is raised as :class:`BagError`; what was flushed before stays readable.
     """
 
-    def __init__(self, path, storage: str = 'mcap') -> None:
+    def __init__(self, path, storage: str = 'mcap', max_bag_size: int = 0,
+                 max_bag_duration_ns: int = 0) -> None:
         self.path = Path(path)
         if storage not in STORAGES:
             raise ValueError(f'storage must be one of {", ".join(STORAGES)}, got {storage!r}')
         if self.path.exists():
             raise BagError(f'{self.path} exists already; a bag is written to a new directory')
-        self._writer = Writer(self.path, version=METADATA_VERSION, storage_plugin=STORAGES[storage])
-        self._open = False
+        self.storage = storage
+        self._limits = (max_bag_size, max_bag_duration_ns)
+        self._connections: List[Connection] = []
+        self._counts: Dict[int, int] = {}
+        self.files: List[FileStats] = []
+        self._file = None  # the storage writer of the file being written
+        self._types: set = set()  # message types whose definition is in the current file
+        self._failed = False
+
+    @contextlib.contextmanager
+    def _writing(self):
+        """Any failure of the storage as one :class:`BagError` (the writer stops writing)."""
+        try:
+            yield
+        except (OSError, sqlite3.Error) as err:
+            self._failed = True
+            raise BagError(f'cannot write bag {self.path}: {err}; what was written before is '
+                           f'kept (`vib-estimator reindex {self.path}` makes it readable)') from None
 
     def open(self) -> 'BagWriter':
-        self._writer.open()
-        self._open = True
+        with self._writing():
+            self.path.mkdir(parents=True)
+            self._open_file()
         return self
+
+    def _file_name(self, index: int) -> str:
+        ext = STORAGES[self.storage]
+        return f'{self.path.name}_{index}{ext}' if any(self._limits) else self.path.name + ext
+
+    def _open_file(self) -> None:
+        name = self._file_name(len(self.files))
+        if self.storage == 'mcap':
+            self._file = mcap_file(self.path / name)
+        else:
+            self._file = _Sqlite3File(self.path / name)
+        self._types = set()
+        self._uncommitted = 0  # bytes of messages written to the file since the last flush
+        self.files.append(FileStats(name))
+        for connection in self._connections:
+            self._register(connection)
+        self._write_metadata()
+
+    def _register(self, connection: Connection) -> None:
+        if connection.msgtype not in self._types:
+            self._file.add_msgtype(connection)
+            self._types.add(connection.msgtype)
+        self._file.add_connection(connection, dump_qos_v8(connection.ext.offered_qos_profiles))
+
+    def _metadata(self) -> dict:
+        return bag_metadata(self.storage, self.files,
+                            [(c, self._counts[c.id]) for c in self._connections])
+
+    def _write_metadata(self) -> None:
+        write_metadata(self.path, self._metadata())
 
     def add_topic(self, topic: str, msgtype: str,
                   offered_qos: Sequence[Qos] = (RELIABLE_VOLATILE,)) -> Connection:
@@ -273,22 +500,79 @@ class BagWriter:
         if msgtype not in TYPESTORE.types:
             raise BagError(f'cannot record {topic}: message type {msgtype} is not a ROS 2 Jazzy '
                            f'type')
-        return self._writer.add_connection(topic, msgtype, typestore=TYPESTORE,
-                                           offered_qos_profiles=list(offered_qos))
+        connection = connection_for(topic, msgtype, offered_qos, len(self._connections) + 1)
+        with self._writing():
+            self._register(connection)
+        self._connections.append(connection)
+        self._counts[connection.id] = 0
+        return connection
+
+    def _file_full(self, log_time_ns: int) -> bool:
+        max_size, max_duration = self._limits
+        current = self.files[-1]
+        if max_duration and current.count and log_time_ns - current.start_ns >= max_duration:
+            return True
+        if not max_size or not current.count:
+            return False
+        if self.storage == 'mcap':
+            size = self._file.bio.tell() + self._file.chunk.bio.tell()
+        else:  # the file grows at each commit: add what was written since
+            size = self._file.path.stat().st_size + self._uncommitted
+        return size >= max_size
 
     def write(self, connection: Connection, log_time_ns: int, data: bytes) -> None:
         """Append serialized (CDR) ``data`` received at ``log_time_ns``."""
-        self._writer.write(connection, log_time_ns, data)
+        if self._failed:
+            raise BagError(f'bag {self.path} stopped writing after an error')
+        with self._writing():
+            if any(self._limits) and self._file_full(log_time_ns):
+                self._close_file()
+                self._open_file()
+            self._file.write(connection, log_time_ns, data)
+        self._uncommitted += len(data)
+        self._counts[connection.id] += 1
+        self.files[-1].add(log_time_ns)
 
     def write_message(self, connection: Connection, log_time_ns: int, msg) -> None:
         """Serialize the rosbags message ``msg`` and append it."""
         self.write(connection, log_time_ns, TYPESTORE.serialize_cdr(msg, connection.msgtype))
 
+    def flush(self) -> None:
+        """Put every message written so far into the storage file (see the class docstring)."""
+        if self._file is None or self._failed:
+            return
+        with self._writing():
+            if self.storage == 'mcap':
+                if self._file.chunk.bio.tell():
+                    self._file.close_chunk()
+                self._file.bio.flush()
+                os.fsync(self._file.bio.fileno())
+            else:
+                self._file.conn.commit()
+            self._uncommitted = 0
+
+    def _close_file(self) -> None:
+        self._file.close(METADATA_VERSION, _yaml_text(self._metadata()).strip())
+        self._file = None
+        self._write_metadata()
+
     def close(self) -> None:
-        """Finish the bag (index, statistics, ``metadata.yaml``); idempotent."""
-        if self._open:
-            self._open = False
-            self._writer.close()
+        """Finish the bag (index, statistics, ``metadata.yaml``); idempotent. After a write
+        error only the file handles are released (the bag then needs ``reindex``)."""
+        if self._file is None:
+            return
+        if self._failed:
+            self.abort()
+            return
+        with self._writing():
+            self._close_file()
+
+    def abort(self) -> None:
+        """Release the storage file without finishing it (what was flushed stays)."""
+        storage, self._file = self._file, None
+        if storage is not None:
+            with contextlib.suppress(Exception):
+                storage.abort() if self.storage == 'sqlite3' else storage.bio.close()
 
     def __enter__(self) -> 'BagWriter':
         return self.open()
@@ -297,8 +581,7 @@ class BagWriter:
         if exc_type is None:
             self.close()
         else:
-            self._open = False
-            self._writer.abort()
+            self.abort()
 
 
 def write_wrench_series(path, series: WrenchSeries, component: str = 'torque.z',

@@ -14,19 +14,37 @@ samples on the wire -- that is its contract.
 Stops on SIGINT (the bag is then closed, complete and readable), after ``duration`` seconds, or
 after ``max_messages`` messages.
 
+Crash safety. Every ``flush_period`` s (steady clock) the messages received so far are put into
+the storage file (MCAP: the pending chunk is closed, flushed and fsynced; sqlite3: a commit), and
+``metadata.yaml`` is written at start and each time a file is opened or closed. After SIGKILL,
+power loss or the OOM killer, at most the last ``flush_period`` s are lost;
+``vib-estimator reindex BAG`` then rebuilds the index and ``metadata.yaml`` from the storage files.
+A write that fails (disk full, file too large, I/O error) ends the recording with one ``error:``
+line and exit code 2; what was flushed before stays readable (after ``reindex``).
+
+Splitting, like ``ros2 bag record``: with ``max_bag_duration`` or ``max_bag_size`` > 0 the bag is
+written as ``<name>_0.mcap``, ``<name>_1.mcap``, ... (``.db3`` for sqlite3), a new file begun before
+a message that would go into a file already that long (log time) or that large.
+
 Parameters (all read-only):
     topics (string[]): topics to record (relative names resolve in the node's namespace).
     output (string): bag directory to create; must not exist.
     storage (string): ``mcap`` (default) or ``sqlite3``.
     duration (double): stop after this many seconds; 0 = until SIGINT.
     max_messages (int): stop after this many messages in all; 0 = no limit.
+    flush_period (double, 1.0): seconds between flushes to the storage file, > 0.
+    max_bag_duration (double, 0): split after this many seconds of log time per file; 0 = never.
+    max_bag_size (int, 0): split when a file reaches this many bytes; 0 = never.
 """
 from __future__ import annotations
 
 import importlib
+import math
+import sys
 from functools import partial
 from typing import Dict, Iterable, Tuple
 
+from rclpy.clock import Clock, ClockType
 from rclpy.duration import Duration
 from rclpy.node import Node
 from rclpy.parameter import Parameter
@@ -91,45 +109,67 @@ class BagRecorder(Node):
 
     def __init__(self, **kwargs) -> None:
         super().__init__('bag_recorder', **kwargs)
-
-        def param(name, default, description):
-            return declare(self, name, default, descriptor(description, read_only=True))
-
-        topics = param('topics', Parameter.Type.STRING_ARRAY, 'topics to record') or []
-        output = param('output', '', 'bag directory to create (must not exist)')
-        storage = param('storage', 'mcap', f'storage plugin: {" or ".join(STORAGES)}')
-        duration = param('duration', 0.0, 'stop after this many seconds; 0 = until SIGINT')
-        self.max_messages = param('max_messages', 0,
-                                    'stop after this many messages in all; 0 = no limit')
-        if not topics:
-            raise StartupError('parameter topics is empty: give the topics to record, e.g. '
-                               '-p topics:="[/coupling_torque]"')
-        if not output:
-            raise StartupError('parameter output is empty: give the bag directory to create')
-        if storage not in STORAGES:
-            raise StartupError(f'parameter storage must be one of {", ".join(STORAGES)}, '
-                               f'got {storage!r}')
-        if duration < 0 or self.max_messages < 0:
-            raise StartupError('parameters duration and max_messages must be >= 0')
+        settings = self._declare_parameters()
         try:
-            self._pending = {self.resolve_topic_name(t) for t in topics}
+            self._pending = {self.resolve_topic_name(t) for t in settings['topics']}
         except Exception as err:  # rclpy's RCLError, which it does not export
-            raise StartupError(f'invalid topic name in {topics}: {err}') from None
+            raise StartupError(f'invalid topic name in {settings["topics"]}: {err}') from None
+        output = settings['output']
         try:
-            self._bag = BagWriter(output, storage).open()
+            self._bag = BagWriter(output, settings['storage'], settings['max_bag_size'],
+                                  int(round(settings['max_bag_duration'] * 1e9))).open()
         except (BagError, OSError) as err:
             raise StartupError(f'cannot create bag {output}: {err}') from None
 
         #: messages recorded, per topic
         self.counts: Dict[str, int] = {}
         self.message_count = 0
-        #: set when ``duration`` or ``max_messages`` is reached; :func:`main` then exits
+        #: set when ``duration`` or ``max_messages`` is reached or writing failed; :func:`main`
+        #: then exits with ``exit_code``
         self.finished = False
+        self.exit_code = 0
         self._discovery = self.create_timer(DISCOVERY_PERIOD, self._discover)
-        if duration > 0:
-            self.create_timer(duration, self._stop)
+        self.create_timer(settings['flush_period'], self._flush,
+                          clock=Clock(clock_type=ClockType.STEADY_TIME))
+        if settings['duration'] > 0:
+            self.create_timer(settings['duration'], self._stop)
         self.get_logger().info(f'recording {", ".join(sorted(self._pending))} into {output} '
-                               f'({storage})')
+                               f'({settings["storage"]})')
+
+    def _declare_parameters(self) -> dict:
+        def param(name, default, description):
+            return declare(self, name, default, descriptor(description, read_only=True))
+
+        settings = {
+            'topics': param('topics', Parameter.Type.STRING_ARRAY, 'topics to record') or [],
+            'output': param('output', '', 'bag directory to create (must not exist)'),
+            'storage': param('storage', 'mcap', f'storage plugin: {" or ".join(STORAGES)}'),
+            'duration': param('duration', 0.0, 'stop after this many seconds; 0 = until SIGINT'),
+            'flush_period': param('flush_period', 1.0, 'seconds between flushes of the recorded '
+                                  'messages to the storage file (crash safety)'),
+            'max_bag_duration': param('max_bag_duration', 0.0, 'split the bag into files of at '
+                                      'most this many seconds; 0 = no split'),
+            'max_bag_size': param('max_bag_size', 0, 'split the bag into files of at most about '
+                                  'this many bytes; 0 = no split'),
+        }
+        self.max_messages = param('max_messages', 0,
+                                  'stop after this many messages in all; 0 = no limit')
+        if not settings['topics']:
+            raise StartupError('parameter topics is empty: give the topics to record, e.g. '
+                               '-p topics:="[/coupling_torque]"')
+        if not settings['output']:
+            raise StartupError('parameter output is empty: give the bag directory to create')
+        if settings['storage'] not in STORAGES:
+            raise StartupError(f'parameter storage must be one of {", ".join(STORAGES)}, '
+                               f'got {settings["storage"]!r}')
+        if min(settings['duration'], self.max_messages, settings['max_bag_duration'],
+               settings['max_bag_size']) < 0:
+            raise StartupError('parameters duration, max_messages, max_bag_duration and '
+                               'max_bag_size must be >= 0')
+        if not (math.isfinite(settings['flush_period']) and settings['flush_period'] > 0):
+            raise StartupError(f'parameter flush_period must be a finite number > 0, '
+                               f'got {settings["flush_period"]}')
+        return settings
 
     def _discover(self) -> None:
         """Subscribe to each pending topic that now has publishers."""
@@ -166,18 +206,38 @@ class BagRecorder(Node):
     def _on_message(self, connection, data: bytes) -> None:
         if self.finished:
             return
-        self._bag.write(connection, self.get_clock().now().nanoseconds, data)
+        try:
+            self._bag.write(connection, self.get_clock().now().nanoseconds, data)
+        except BagError as err:
+            self._fail(err)
+            return
         self.counts[connection.topic] += 1
         self.message_count += 1
         if self.max_messages and self.message_count >= self.max_messages:
             self._stop()
+
+    def _flush(self) -> None:
+        try:
+            self._bag.flush()
+        except BagError as err:
+            self._fail(err)
+
+    def _fail(self, err: BagError) -> None:
+        """Stop recording after a failed write: one ``error:`` line, exit code 2."""
+        if not self.finished:
+            print(f'error: {err}', file=sys.stderr, flush=True)
+        self.exit_code = 2
+        self.finished = True
 
     def _stop(self) -> None:
         self.finished = True
 
     def destroy_node(self) -> None:
         """Close the bag (index and metadata.yaml written), then destroy the node."""
-        self._bag.close()
+        try:
+            self._bag.close()
+        except BagError as err:
+            self._fail(err)
         self.get_logger().info(f'recorded {self.message_count} messages: '
                                + (', '.join(f'{t} {n}' for t, n in sorted(self.counts.items()))
                                   or 'no topic had a publisher'))

@@ -2,13 +2,23 @@
 
 A stand-in for ``ros2 bag play`` where only rclpy is installed; its parameters carry the names of
 ``ros2 bag play``'s options. The recorded CDR bytes are published as they are (header stamps
-untouched), each on a publisher of its recorded type, in recorded order and with the recorded
-spacing of log times divided by ``rate``.
+untouched), each on a publisher of its recorded type, in log-time order across the files of a
+split bag and with the recorded spacing of log times divided by ``rate``. Bags written by rosbag2
+itself play completely (see :class:`vib_estimator.io.bags.BagReader` for what it works around).
 
-Scheduling. A timer every :data:`TICK` s publishes every message whose due time has passed, so the
-timing error is at most one tick and high message rates (or rates x100) do not need one timer event
-per message. Playback time is ``bag_time = anchor_bag + (now - anchor_wall) * rate`` on the steady
-clock; pausing, resuming, changing ``rate`` and looping move the anchors.
+Types. A topic whose message type is not installed is skipped, with one warning naming every such
+topic; only a bag with nothing else to play is refused. Types written ``pkg/Name`` (older bags)
+are read as ``pkg/msg/Name``.
+
+Scheduling lives in :mod:`vib_estimator.nodes.playback` (no ROS): a timer every :data:`TICK` s
+publishes every message whose due time has passed, so the timing error is at most one tick and high
+message rates (or rates x100) do not need one timer event per message.
+
+Start. Before the first message the replayer waits until every played topic (with messages) has at
+least one matched subscription, or ``wait_timeout`` s have passed since it started -- then it plays
+anyway and says so. Cross-process discovery takes a second or two, so without this a consumer
+started first would miss the start of the bag. ``wait_timeout: 0`` plays at once; ``delay`` is a
+minimum wait on top.
 
 QoS. Each publisher offers what the bag recorded as offered for its topic (reliable unless every
 recorded publisher was best effort; transient-local only if every one was), keep-last 1000 deep;
@@ -25,6 +35,7 @@ Parameters:
     clock_hz (double, 0): publish ``/clock`` (the playback time) at this rate when > 0, for nodes
         with ``use_sim_time``.
     delay (double, 0): seconds to wait before playing.
+    wait_timeout (double, 5): seconds to wait at most for subscribers before playing; 0 = none.
     start_paused (bool, false): start paused (see the services).
 
 Services (``std_srvs/srv/Trigger``):
@@ -32,13 +43,14 @@ Services (``std_srvs/srv/Trigger``):
     ~/play_next: while paused, publish the next message at once.
 
 Exits 0 at the end of the bag (unless looping); a bag that cannot be played (missing, corrupt,
-truncated, empty, unknown topic or message type) gives one line on stderr and exit code 2.
+truncated, empty, no ``metadata.yaml``, unknown topic, no topic of an installed type) gives one
+line on stderr and exit code 2.
 """
 from __future__ import annotations
 
 import math
 import time
-from typing import Dict, List, Optional
+from typing import Dict, List
 
 from builtin_interfaces.msg import Time
 from rcl_interfaces.msg import SetParametersResult
@@ -52,6 +64,7 @@ from std_srvs.srv import Trigger
 
 from ..io.bags import BagError, BagReader, TopicInfo
 from .bag_recorder import adapted_qos, message_class
+from .playback import EmptyPlayback, Playback, StartGate
 from .runner import StartupError, run
 from .parameters import declare, descriptor
 
@@ -80,36 +93,26 @@ def parse_remaps(remap: List[str], bag: BagReader) -> Dict[str, str]:
     return rules
 
 
+def playable(bag: BagReader, topics: List[str]):
+    """``({topic: message class}, ['topic (type)', ...])``: the topics among ``topics`` whose type
+    is installed, and the others."""
+    classes, skipped = {}, []
+    for topic in topics:
+        try:
+            classes[topic] = message_class(bag.topics[topic].msgtype)
+        except ImportError:
+            skipped.append(f'{topic} ({bag.topics[topic].msgtype})')
+    return classes, skipped
+
+
 class BagReplayer(Node):
     """Plays the bag of parameter ``bag``; see the module docstring."""
 
     def __init__(self, **kwargs) -> None:
         super().__init__('bag_replayer', **kwargs)
-
-        def param(name, default, description, read_only=True):
-            return declare(self, name, default, descriptor(description, read_only=read_only))
-
-        path = param('bag', '', 'bag directory, or .mcap / .db3 file, to play')
-        self.rate = param('rate', 1.0, 'playback speed factor (> 0)', read_only=False)
-        self.loop = param('loop', False, 'start over at the end of the bag')
-        start_offset = param('start_offset', 0.0, 'seconds of the bag to skip from its start')
-        topics = param('topics', Parameter.Type.STRING_ARRAY,
-                         'topics to play (default: all)') or []
-        remap = param('remap', Parameter.Type.STRING_ARRAY, 'old:=new topic renames') or []
-        clock_hz = param('clock_hz', 0.0, 'publish /clock at this rate when > 0')
-        delay = param('delay', 0.0, 'seconds to wait before playing')
-        start_paused = param('start_paused', False, 'start paused')
-        if not path:
-            raise StartupError('parameter bag is required: the bag directory or .mcap/.db3 file')
-        for name, value in (('start_offset', start_offset), ('clock_hz', clock_hz),
-                            ('delay', delay)):
-            if not (math.isfinite(value) and value >= 0):
-                raise StartupError(f'parameter {name} must be a finite number >= 0, got {value}')
-        if not self._rate_ok(self.rate):
-            raise StartupError(f'parameter rate must be a finite number > 0, got {self.rate}')
-
+        settings = self._declare_parameters()
         try:
-            self._bag = BagReader(path)
+            self._bag = BagReader(settings['bag'])
         except BagError as err:
             raise StartupError(str(err)) from None
         #: number of messages published (all loops)
@@ -117,22 +120,72 @@ class BagReplayer(Node):
         #: set at the end of the bag when not looping; :func:`main` then exits with ``exit_code``
         self.finished = False
         self.exit_code = 0
-        self._paused = start_paused
         try:
-            self._topics = [self._bag.topic(t).topic for t in topics] or list(self._bag.topics)
-            remaps = parse_remaps(remap, self._bag)
-            self._outputs = {}
-            for topic in self._topics:
-                info = self._bag.topics[topic]
-                qos = adapted_qos(offered_policies(info), HistoryPolicy.KEEP_LAST, DEPTH)
-                self._outputs[topic] = self.create_publisher(
-                    message_class(info.msgtype), remaps.get(topic, topic), qos)
-            self._first_ns = self._bag.start_ns + int(round(start_offset * 1e9))
-            self._restart(time.monotonic_ns() + int(delay * 1e9))
-        except (BagError, ImportError, StartupError) as err:
+            names = self._create_publishers(settings)
+            first_ns = self._bag.start_ns + int(round(settings['start_offset'] * 1e9))
+            self._playback = Playback(
+                lambda: self._bag.messages(list(self._outputs), start_ns=first_ns), first_ns,
+                self.rate, settings['loop'], settings['start_paused'])
+        except EmptyPlayback:
+            self._bag.close()
+            raise StartupError(f'bag {self._bag.path} has no message to play after '
+                               f'start_offset') from None
+        except (BagError, StartupError) as err:
             self._bag.close()
             raise StartupError(str(err)) from None
+        self._gate = StartGate(time.monotonic_ns(), settings['delay'], settings['wait_timeout'])
+        self._create_timers_and_services(settings['clock_hz'])
+        self.get_logger().info(f'playing {settings["bag"]}: {", ".join(names)} at rate '
+                               f'{self.rate}' + (', paused' if settings['start_paused'] else ''))
 
+    def _declare_parameters(self) -> dict:
+        def param(name, default, description, read_only=True):
+            return declare(self, name, default, descriptor(description, read_only=read_only))
+
+        settings = {
+            'bag': param('bag', '', 'bag directory, or .mcap / .db3 file, to play'),
+            'loop': param('loop', False, 'start over at the end of the bag'),
+            'start_offset': param('start_offset', 0.0, 'seconds of the bag to skip from its start'),
+            'topics': param('topics', Parameter.Type.STRING_ARRAY,
+                            'topics to play (default: all)') or [],
+            'remap': param('remap', Parameter.Type.STRING_ARRAY, 'old:=new topic renames') or [],
+            'clock_hz': param('clock_hz', 0.0, 'publish /clock at this rate when > 0'),
+            'delay': param('delay', 0.0, 'seconds to wait before playing'),
+            'wait_timeout': param('wait_timeout', 5.0, 'seconds to wait at most for subscribers '
+                                  'before playing; 0 = do not wait'),
+            'start_paused': param('start_paused', False, 'start paused'),
+        }
+        self.rate = param('rate', 1.0, 'playback speed factor (> 0)', read_only=False)
+        if not settings['bag']:
+            raise StartupError('parameter bag is required: the bag directory or .mcap/.db3 file')
+        for name in ('start_offset', 'clock_hz', 'delay', 'wait_timeout'):
+            if not (math.isfinite(settings[name]) and settings[name] >= 0):
+                raise StartupError(f'parameter {name} must be a finite number >= 0, '
+                                   f'got {settings[name]}')
+        if not self._rate_ok(self.rate):
+            raise StartupError(f'parameter rate must be a finite number > 0, got {self.rate}')
+        return settings
+
+    def _create_publishers(self, settings: dict) -> List[str]:
+        """One publisher per played topic of an installed type; the names, for the log."""
+        topics = ([self._bag.topic(t).topic for t in settings['topics']]
+                  or list(self._bag.topics))
+        remaps = parse_remaps(settings['remap'], self._bag)
+        classes, skipped = playable(self._bag, topics)
+        if not classes:
+            raise StartupError(f'nothing to play in bag {self._bag.path}: the message types of '
+                               f'its topics are not installed: {", ".join(skipped)}')
+        if skipped:
+            self.get_logger().warn(f'skipping topics whose message type is not installed: '
+                                   f'{", ".join(skipped)}')
+        self._outputs = {}
+        for topic, cls in classes.items():
+            info = self._bag.topics[topic]
+            qos = adapted_qos(offered_policies(info), HistoryPolicy.KEEP_LAST, DEPTH)
+            self._outputs[topic] = self.create_publisher(cls, remaps.get(topic, topic), qos)
+        return [f'{t} -> {remaps[t]}' if t in remaps else t for t in classes]
+
+    def _create_timers_and_services(self, clock_hz: float) -> None:
         self.add_on_set_parameters_callback(self._validate_parameters)
         self.add_post_set_parameters_callback(self._apply_parameters)
         self._timer = self.create_timer(TICK, self._tick)
@@ -143,9 +196,6 @@ class BagReplayer(Node):
         self.create_service(Trigger, '~/pause', self._on_pause)
         self.create_service(Trigger, '~/resume', self._on_resume)
         self.create_service(Trigger, '~/play_next', self._on_play_next)
-        names = [f'{t} -> {remaps[t]}' if t in remaps else t for t in self._topics]
-        self.get_logger().info(f'playing {path}: {", ".join(names)} at rate {self.rate}'
-                               + (', paused' if start_paused else ''))
 
     @staticmethod
     def _rate_ok(rate) -> bool:
@@ -161,59 +211,54 @@ class BagReplayer(Node):
     def _apply_parameters(self, params) -> None:
         for param in params:
             if param.name == 'rate':
-                self._anchor(self.bag_time_ns())
+                self._playback.set_rate(param.value, time.monotonic_ns())
                 self.rate = param.value
-
-    # -- playback time ----------------------------------------------------------------------------
-
-    def _anchor(self, bag_ns: int, wall_ns: Optional[int] = None) -> None:
-        """Playback time is ``bag_ns`` at steady time ``wall_ns`` (default: now)."""
-        self._anchor_bag = bag_ns
-        self._anchor_wall = time.monotonic_ns() if wall_ns is None else wall_ns
 
     def bag_time_ns(self) -> int:
         """Current playback time on the bag's log-time axis, ns."""
-        elapsed = time.monotonic_ns() - self._anchor_wall
-        if self._paused or elapsed <= 0:
-            return self._anchor_bag
-        return self._anchor_bag + int(elapsed * self.rate)
-
-    def _restart(self, wall_ns: Optional[int] = None) -> None:
-        """Go back to ``start_offset`` of the bag, to be played from steady time ``wall_ns``.
-
-        Sets ``_messages`` (the iterator over the bag) and ``_next`` (the next message to play).
-        """
-        self._messages = self._bag.messages(self._topics, start_ns=self._first_ns)
-        self._next = next(self._messages, None)
-        if self._next is None:
-            raise StartupError(f'bag {self._bag.path} has no message to play after start_offset')
-        self._anchor(self._first_ns, wall_ns)
+        return self._playback.bag_time_ns(time.monotonic_ns())
 
     # -- publishing -------------------------------------------------------------------------------
 
-    def _publish_next(self) -> None:
-        message = self._next
+    def _subscribers_matched(self) -> bool:
+        return all(pub.get_subscription_count() > 0 for topic, pub in self._outputs.items()
+                   if self._bag.topics[topic].count)
+
+    def _begin_if_ready(self, now_ns: int) -> bool:
+        """Start the playback once the :class:`StartGate` opens; whether it has started."""
+        if self._playback.started:
+            return True
+        if not self._gate.is_open(now_ns, self._subscribers_matched()):
+            return False
+        if self._gate.timed_out:
+            missing = [t for t, p in self._outputs.items()
+                       if self._bag.topics[t].count and p.get_subscription_count() == 0]
+            self.get_logger().warn(f'no subscriber on {", ".join(missing)} after wait_timeout; '
+                                   f'playing anyway')
+        self._playback.start(now_ns)
+        return True
+
+    def _publish(self, message) -> None:
         self._outputs[message.topic].publish(message.data)
         self.published += 1
-        self._next = next(self._messages, None)
 
     def _tick(self) -> None:
         """Publish every message that is due; at the end, loop or finish."""
-        if self._paused or self.finished or time.monotonic_ns() < self._anchor_wall:
-            return  # paused, done, or still in the initial delay
+        now = time.monotonic_ns()
+        if self.finished or not self._begin_if_ready(now):
+            return
+        loops = self._playback.loops
         try:
-            now = self.bag_time_ns()
-            while self._next is not None and self._next.log_time_ns <= now:
-                self._publish_next()
-            if self._next is None:
-                if self.loop:
-                    self._restart()
-                    self.get_logger().info('end of bag, looping')
-                else:
-                    self._finish()
+            for message in self._playback.due(now):
+                self._publish(message)
         except BagError as err:
             self.get_logger().error(str(err))
             self.exit_code = 1
+            self._finish()
+            return
+        if self._playback.loops != loops:
+            self.get_logger().info('end of bag, looping')
+        if self._playback.finished:
             self._finish()
 
     def _finish(self) -> None:
@@ -232,19 +277,11 @@ class BagReplayer(Node):
 
     def pause(self) -> bool:
         """Pause playback; False if already paused."""
-        if self._paused:
-            return False
-        self._anchor(self.bag_time_ns())
-        self._paused = True
-        return True
+        return self._playback.pause(time.monotonic_ns())
 
     def resume(self) -> bool:
         """Resume playback where it was paused; False if not paused."""
-        if not self._paused:
-            return False
-        self._paused = False
-        self._anchor(self._anchor_bag)
-        return True
+        return self._playback.resume(time.monotonic_ns())
 
     def _on_pause(self, _request, response):
         response.success = self.pause()
@@ -257,20 +294,21 @@ class BagReplayer(Node):
         return response
 
     def _on_play_next(self, _request, response):
-        if not self._paused:
-            response.success, response.message = False, 'play_next needs playback paused'
-        elif self._next is None:
-            response.success, response.message = False, 'no message left'
-        else:
-            message = self._next
-            try:
-                self._publish_next()
-            except BagError as err:
-                response.success, response.message = False, str(err)
-                return response
-            self._anchor(message.log_time_ns)
-            response.success = True
-            response.message = f'published {message.topic} logged at {message.log_time_ns} ns'
+        response.success = False
+        if not self._playback.paused:
+            response.message = 'play_next needs playback paused'
+            return response
+        try:
+            message = self._playback.play_next(time.monotonic_ns())
+        except BagError as err:
+            response.message = str(err)
+            return response
+        if message is None:
+            response.message = 'no message left'
+            return response
+        self._publish(message)
+        response.success = True
+        response.message = f'published {message.topic} logged at {message.log_time_ns} ns'
         return response
 
     def destroy_node(self) -> None:

@@ -1,0 +1,281 @@
+"""Rebuild a bag's ``metadata.yaml`` from its storage files (what ``ros2 bag reindex`` does).
+
+:func:`reindex` takes a rosbag2 directory of ``.mcap`` or ``.db3`` files -- one or several (a split
+bag), with or without ``metadata.yaml`` -- and writes ``metadata.yaml`` from what the files hold:
+topics, types, offered QoS, counts and log-time spans per file. No rclpy import.
+
+A file cut short (the recorder was killed, the disk filled up) is repaired first:
+
+* MCAP: the records are scanned from the start; every complete schema, channel and message --
+  also the complete messages of a last, cut, uncompressed chunk -- is kept, and the file is
+  rewritten as a complete, indexed MCAP file (written beside it, then renamed over it). What was
+  cut is reported: the byte at which the first incomplete record starts and the file's size.
+* sqlite3: the database is opened read-write once, so that SQLite rolls back an interrupted
+  transaction from its journal (what was committed stays).
+"""
+from __future__ import annotations
+
+import sqlite3
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Dict, Iterator, List, Optional, Tuple
+
+from rosbags.interfaces import (Connection, ConnectionExtRosbag2, MessageDefinition,
+                                MessageDefinitionFormat)
+from rosbags.rosbag2.metadata import parse_qos
+from rosbags.rosbag2.storage_mcap import decompress
+
+from .bags import (METADATA_VERSION, TYPESTORE, BagError, FileStats, _as_bag_error, bag_metadata,
+                   mcap_file, storage_files, storage_reader, write_metadata)
+
+MAGIC = b'\x89MCAP0\r\n'
+_OP_SCHEMA, _OP_CHANNEL, _OP_MESSAGE, _OP_CHUNK, _OP_DATA_END = 0x03, 0x04, 0x05, 0x06, 0x0F
+
+
+class _Cut(Exception):
+    """A record runs past the end of the data."""
+
+
+class _Fields:
+    """Little-endian fields of an MCAP record, read in order; :class:`_Cut` past the end."""
+
+    def __init__(self, data: bytes, pos: int = 0, end: Optional[int] = None) -> None:
+        self.data, self.pos = data, pos
+        self.end = len(data) if end is None else end
+
+    def take(self, n: int) -> bytes:
+        if self.pos + n > self.end:
+            raise _Cut()
+        self.pos += n
+        return self.data[self.pos - n:self.pos]
+
+    def uint(self, size: int) -> int:
+        return int.from_bytes(self.take(size), 'little')
+
+    def string(self) -> str:
+        return self.take(self.uint(4)).decode()
+
+
+@dataclass
+class McapContent:
+    """What the complete records of an MCAP file hold."""
+
+    schemas: Dict[int, Tuple[str, str, bytes]] = field(default_factory=dict)  # name, encoding, data
+    channels: Dict[int, Tuple[str, int, str]] = field(default_factory=dict)  # topic, schema, QoS
+    messages: List[Tuple[int, int, bytes]] = field(default_factory=list)  # channel, log time, data
+    #: byte at which the first incomplete record starts (the file's size when none is)
+    complete_bytes: int = 0
+    #: whether the data section is complete (its DataEnd record was read)
+    data_end: bool = False
+
+
+def _records(data: bytes, pos: int, end: int) -> Iterator[Tuple[int, _Fields]]:
+    """``(opcode, fields of the body)`` of each complete record in ``data[pos:end]``; stops at
+    the first incomplete one, whose start :class:`_Cut` carries in ``args``."""
+    while pos < end:
+        head = _Fields(data, pos, end)
+        try:
+            op, length = head.uint(1), head.uint(8)
+        except _Cut:
+            raise _Cut(pos) from None
+        if head.pos + length > end:
+            raise _Cut(pos, op, head.pos)
+        yield op, _Fields(data, head.pos, head.pos + length)
+        pos = head.pos + length
+
+
+def _read_record(op: int, body: _Fields, content: McapContent) -> None:
+    """Keep a schema, channel or message record (others carry nothing to rebuild from)."""
+    if op == _OP_SCHEMA:
+        sid = body.uint(2)
+        content.schemas[sid] = (body.string(), body.string(), body.take(body.uint(4)))
+    elif op == _OP_CHANNEL:
+        cid, sid, topic, _encoding = body.uint(2), body.uint(2), body.string(), body.string()
+        meta = _Fields(body.take(body.uint(4)))
+        qos = ''
+        while meta.pos < meta.end:
+            key, value = meta.string(), meta.string()
+            qos = value if key == 'offered_qos_profiles' else qos
+        content.channels[cid] = (topic, sid, qos)
+    elif op == _OP_MESSAGE:
+        cid, _seq, log_time, _publish = body.uint(2), body.uint(4), body.uint(8), body.uint(8)
+        content.messages.append((cid, log_time, body.data[body.pos:body.end]))
+
+
+def _read_chunk(body: _Fields, content: McapContent, cut: bool) -> None:
+    """The records of a chunk; of a cut one (``cut``), those complete, if it is uncompressed."""
+    body.take(16)  # message start and end time
+    size, crc, compression = body.uint(8), body.uint(4), body.string()
+    length = body.uint(8)
+    if cut:
+        if compression:
+            return  # a compressed chunk cut short cannot be decoded
+        records, end = body.data, min(body.pos + length, len(body.data))
+        start = body.pos
+    else:
+        records = decompress(body.take(length), compression, size, crc)
+        start, end = 0, len(records)
+    try:
+        for op, inner in _records(records, start, end):
+            _read_record(op, inner, content)
+    except _Cut:
+        pass
+
+
+def scan_mcap(data: bytes) -> McapContent:
+    """The complete schemas, channels and messages of MCAP bytes (possibly cut anywhere)."""
+    content = McapContent(complete_bytes=len(data))
+    if not data.startswith(MAGIC):
+        content.complete_bytes = 0
+        return content
+    try:
+        for op, body in _records(data, len(MAGIC), len(data)):
+            if op == _OP_DATA_END:
+                content.data_end = True
+                break
+            if op == _OP_CHUNK:
+                _read_chunk(body, content, cut=False)
+            else:
+                _read_record(op, body, content)
+    except _Cut as cut:
+        if not cut.args:  # a field past the end of a complete record
+            raise BagError('corrupt MCAP data: a record is shorter than its fields') from None
+        content.complete_bytes = cut.args[0]
+        if len(cut.args) > 1 and cut.args[1] == _OP_CHUNK:
+            try:
+                _read_chunk(_Fields(data, cut.args[2]), content, cut=True)
+            except _Cut:
+                pass  # cut inside the chunk's header
+    except (UnicodeDecodeError, ValueError) as err:
+        raise BagError(f'corrupt MCAP data: {err}') from None
+    return content
+
+
+def _connections(content: McapContent) -> Dict[int, Connection]:
+    """rosbags connections for the channels of a scanned file (ids kept)."""
+    result = {}
+    for cid, (topic, sid, qos) in content.channels.items():
+        name, encoding, definition = content.schemas[sid]
+        fmt = MessageDefinitionFormat.IDL if encoding == 'ros2idl' else MessageDefinitionFormat.MSG
+        result[cid] = Connection(cid, topic, name, MessageDefinition(fmt, definition.decode()), '',
+                                 0, ConnectionExtRosbag2('cdr', parse_qos(qos)), None)
+    return result
+
+
+def repair_mcap(path: Path) -> Optional[str]:
+    """Rewrite a cut MCAP file as a complete one; what was cut (None if it was complete)."""
+    try:
+        storage_reader(path).close()
+        return None
+    except Exception:  # noqa: BLE001 -- any failure to open: scan it
+        pass
+    data = path.read_bytes()
+    content = scan_mcap(data)
+    connections = _connections(content)
+    writer = mcap_file(path.with_name(path.name + '.tmp'))
+    types = set()
+    for cid, conn in connections.items():
+        if conn.msgtype not in types:
+            writer.add_msgtype(conn)
+            types.add(conn.msgtype)
+        writer.add_connection(conn, content.channels[cid][2])
+    for cid, log_time, payload in content.messages:
+        writer.write(connections[cid], log_time, payload)
+    writer.close(METADATA_VERSION, '')
+    writer.path.replace(path)
+    if content.data_end:
+        cut = f'summary section cut or damaged (file of {len(data)} bytes)'
+    elif content.complete_bytes < len(data):
+        cut = (f'cut at byte {content.complete_bytes} of {len(data)} (the rest is an incomplete '
+               f'record, dropped)')
+    else:
+        cut = 'not closed (no index)'
+    return f'{path}: {cut}; kept {len(content.messages)} complete messages, index rebuilt'
+
+
+
+def recover_sqlite3(path: Path) -> None:
+    """Let SQLite roll back an interrupted transaction (its journal) before the file is read."""
+    conn = sqlite3.connect(path)
+    try:
+        conn.execute('SELECT count(*) FROM messages').fetchone()
+    finally:
+        conn.close()
+
+
+@dataclass
+class ReindexResult:
+    """What :func:`reindex` found: the storage, the files, per-topic counts, and what was cut."""
+
+    path: Path
+    storage: str
+    files: List[FileStats]
+    topics: List[Tuple[Connection, int]]
+    cuts: List[str]
+
+    def summary(self) -> str:
+        total = sum(f.count for f in self.files)
+        lines = [f'reindexed {self.path}: {len(self.files)} {self.storage} file(s), {total} '
+                 f'messages, topics: ' + (', '.join(f'{c.topic} ({c.msgtype}) {n}'
+                                                    for c, n in self.topics) or 'none')]
+        return '\n'.join(lines + [f'  {cut}' for cut in self.cuts])
+
+
+def _file_index(path: Path) -> Tuple[FileStats, List[Connection]]:
+    """Statistics and connections (with counts) of one storage file."""
+    with _as_bag_error(path, 'read storage file'):
+        storage = storage_reader(path)
+        try:
+            stats = FileStats(path.name)
+            if storage.metadata.message_count:
+                stats.add(storage.metadata.start_time, storage.metadata.message_count)
+                stats.add(storage.metadata.end_time - 1, 0)
+            return stats, list(storage.connections)
+        finally:
+            storage.close()
+
+
+def _merge(connections: List[Connection]) -> List[Tuple[Connection, int]]:
+    """One entry per (topic, type), counts summed; hashes of known (Jazzy) types filled in."""
+    merged: Dict[Tuple[str, str], List] = {}
+    for conn in connections:
+        key = (conn.topic, conn.msgtype)
+        if key not in merged:
+            digest = conn.digest or (TYPESTORE.hash_rihs01(conn.msgtype)
+                                     if conn.msgtype in TYPESTORE.types else '')
+            merged[key] = [conn._replace(digest=digest), 0]
+        merged[key][1] += conn.msgcount
+    return [(conn, count) for conn, count in merged.values()]
+
+
+def reindex(path) -> ReindexResult:
+    """Repair cut storage files of the bag directory ``path`` and rewrite its ``metadata.yaml``.
+
+    Raises :class:`BagError` for a path that is not a directory, holds no storage file, mixes MCAP
+    and sqlite3 files, or holds a file that cannot be read at all.
+    """
+    path = Path(path)
+    if not path.is_dir():
+        raise BagError(f'cannot reindex {path}: not a directory (reindex takes a bag directory)')
+    files = storage_files(path)
+    if not files:
+        raise BagError(f'cannot reindex {path}: it holds no .mcap or .db3 file')
+    suffixes = {f.suffix for f in files}
+    if len(suffixes) > 1:
+        raise BagError(f'cannot reindex {path}: it mixes .mcap and .db3 files')
+    storage = 'mcap' if suffixes == {'.mcap'} else 'sqlite3'
+    cuts = []
+    for file in files:
+        with _as_bag_error(file, 'repair storage file'):
+            if storage == 'mcap':
+                cuts.append(repair_mcap(file))
+            else:
+                recover_sqlite3(file)
+    indexed = [_file_index(f) for f in files]
+    topics = _merge([c for _, conns in indexed for c in conns])
+    stats = [s for s, _ in indexed]
+    try:
+        write_metadata(path, bag_metadata(storage, stats, topics))
+    except OSError as err:
+        raise BagError(f'cannot write {path / "metadata.yaml"}: {err}') from None
+    return ReindexResult(path, storage, stats, topics, [c for c in cuts if c])
