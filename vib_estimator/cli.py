@@ -20,7 +20,7 @@ COMMANDS = {
     'compare': ('vib_estimator.analysis.compare', 'algebraic vs adaptive/FFT estimators (Table 2, Figs. 6-7, '
                 'Cramer-Rao bound)'),
     'demo': ('vib_estimator.demo', 'live demo: simulator + estimator node, three tip masses'),
-    'reindex': ('vib_estimator.reindex', 'rebuild the metadata.yaml of a rosbag2 directory from its '
+    'reindex': ('vib_estimator.io.reindex', 'rebuild the metadata.yaml of a rosbag2 directory from its '
                 'storage files (repairs a cut last MCAP file)'),
 }
 

@@ -1,4 +1,4 @@
-"""Rebuild a bag's ``metadata.yaml`` from its storage files (what ``ros2 bag reindex`` does).
+"""``vib-estimator reindex BAG``: rebuild a bag's ``metadata.yaml`` from its storage files (``ros2 bag reindex``).
 
 :func:`reindex` takes a rosbag2 directory of ``.mcap`` or ``.db3`` files -- one or several (a split
 bag), with or without ``metadata.yaml`` -- and writes ``metadata.yaml`` from what the files hold:
@@ -15,7 +15,9 @@ A file cut short (the recorder was killed, the disk filled up) is repaired first
 """
 from __future__ import annotations
 
+import argparse
 import sqlite3
+import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Dict, Iterator, List, Optional, Tuple
@@ -279,3 +281,19 @@ def reindex(path) -> ReindexResult:
     except OSError as err:
         raise BagError(f'cannot write {path / "metadata.yaml"}: {err}') from None
     return ReindexResult(path, storage, stats, topics, [c for c in cuts if c])
+
+
+# ---- vib-estimator reindex BAG (prints what it found and what was cut; a directory it cannot
+# reindex gives one error: line and exit code 2) ----------------------------------------------
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument('bag', help='rosbag2 directory of .mcap or .db3 files')
+
+
+def run(args: argparse.Namespace) -> int:
+    try:
+        result = reindex(args.bag)
+    except BagError as err:
+        print(f'error: {err}', file=sys.stderr)
+        return 2
+    print(result.summary())
+    return 0
