@@ -223,8 +223,8 @@ class BagRecorder(Node):
             self._fail(err)
 
     def _fail(self, err: BagError) -> None:
-        """Stop recording after a failed write: one ``error:`` line, exit code 2."""
-        if not self.finished:
+        """Stop recording after a failed write: one ``error:`` line (the first failure), exit code 2."""
+        if self.exit_code != 2:
             print(f'error: {err}', file=sys.stderr, flush=True)
         self.exit_code = 2
         self.finished = True

@@ -48,7 +48,9 @@ def run(factory: Callable[[], Node], args: Optional[Sequence[str]] = None,
     """Initialise rclpy, build the node with ``factory`` and spin it until shutdown.
 
     ``done(node)``, when given, is polled between callbacks; spinning stops when it returns True
-    (the bag replayer uses it to exit 0 at the end of a bag). Returns the process exit code.
+    (the bag replayer uses it to exit 0 at the end of a bag). Returns the process exit code: 2 for
+    a :class:`StartupError`, else the node's ``exit_code`` read after it was destroyed (so an error
+    while closing, e.g. a bag that cannot be finished at SIGINT, still fails the process).
     """
     rclpy.init(args=args)
     node = None
@@ -59,7 +61,6 @@ def run(factory: Callable[[], Node], args: Optional[Sequence[str]] = None,
         executor.add_node(node)
         while rclpy.ok() and not (done is not None and done(node)):
             executor.spin_once(timeout_sec=0.1)
-        code = getattr(node, 'exit_code', 0)
     except StartupError as err:
         print(f'error: {err}', file=sys.stderr)
         code = 2
@@ -68,5 +69,6 @@ def run(factory: Callable[[], Node], args: Optional[Sequence[str]] = None,
     finally:
         if node is not None:
             node.destroy_node()
+            code = code or getattr(node, 'exit_code', 0)
         rclpy.try_shutdown()
     return code
