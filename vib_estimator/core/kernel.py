@@ -347,36 +347,45 @@ def _first_sample(p, s, c, t, y):
     return y
 
 
-@njit(cache=True)
-def step(p, s, c, seg, t, y, out):
-    """Feed one sample; return 1 and fill ``out`` when an estimate is published, else 0."""
+@njit(cache=True, inline='always')
+def _accept_time(p, s, c, t, y):
+    """Time handling: True if the sample is used, False if it is skipped (counted either way).
+
+    A non-finite sample, a duplicate stamp or a small step back is skipped; a gap, or a backward
+    jump, longer than ``max_gap`` restarts the estimator (counted), which then takes the sample as
+    its first.
+    """
     c[C_RECEIVED] += 1
-    h = 0.0
     if not (math.isfinite(t) and math.isfinite(y)):
         c[C_NONFINITE] += 1
-        return 0
+        return False
     if c[C_HIST_N] > 0:
         h = t - s[S_TLAST]
         if h == 0.0:
             c[C_DUPLICATE] += 1
-            return 0
+            return False
         if h < 0.0:
             if -h > p[P_MAXGAP]:
                 c[C_TIME_JUMP] += 1
                 _restart(s, c)
             else:
                 c[C_OUT_OF_ORDER] += 1
-                return 0
+                return False
         elif h > p[P_MAXGAP]:
             c[C_GAP] += 1
             _restart(s, c)
     c[C_USED] += 1
     s[S_TLAST] = t
-    if c[C_HIST_N] == 0:
-        _first_sample(p, s, c, t, y)
-        return 0
-    # discretisations for this interval, recomputed only when the step changes by more than
-    # rounding (a uniform stream's stamps differ in the last bits)
+    return True
+
+
+@njit(cache=True, inline='always')
+def _update_discretisations(p, s, h):
+    """Exact discretisations of the invariant filter (Eq. 11) and the prefilter for the step h.
+
+    Recomputed only when the step changes by more than rounding (a uniform stream's stamps differ
+    in the last bits).
+    """
     if abs(h - s[S_CACHE_H]) > 1e-9 * h:
         _discretise(p[P_WC], p[P_ZC], h, s, S_DISC)
         if p[P_BAND] > 0.0:
@@ -384,9 +393,15 @@ def step(p, s, c, seg, t, y, out):
                 _discretise(p[P_WHI] if k < 2 else p[P_WLO], BAND_DAMPING[k], h, s,
                             S_DISC + 8 * (k + 1))
         s[S_CACHE_H] = h
-    if p[P_BAND] > 0.0:
-        y = _prefilter(p, s, y)
-    # shift the interpolation history
+
+
+@njit(cache=True, inline='always')
+def _push_history(s, c, seg, t, y):
+    """Shift (t, y) into the interpolation stencil; True once the stencil holds NH samples.
+
+    The first segment after a (re)start begins when the stencil is full, so every interval of it is
+    integrated with the full-order rule.
+    """
     for i in range(NH - 1):
         s[S_HT + i] = s[S_HT + i + 1]
         s[S_HY + i] = s[S_HY + i + 1]
@@ -395,14 +410,19 @@ def step(p, s, c, seg, t, y, out):
     if c[C_HIST_N] < NH:
         c[C_HIST_N] += 1
         if c[C_HIST_N] == NH:
-            # every interval of the first segment is integrated with the full-order rule
             reset_segment(s, c, seg, t, y)
-        return 0
-    tau = t - s[S_T0]
-    a = s[S_HT + NH - 2] - s[S_T0]
-    model = int(p[P_MODEL])
-    kmax = 4 if model == MODEL_BIASED else 3
-    _interval_moments(s, kmax, a, h, int(p[P_RULE]))
+        return False
+    return True
+
+
+@njit(cache=True, inline='always')
+def _numerator_denominator(model, s, tau, y):
+    """Eq. 7 (with Eq. 8's corrected sign) in moments: n and d of omega^2 = n / d at time tau.
+
+    ``sinusoid`` / ``damped-sinusoid``: n = -(tau^2 y + 2 tau M0 - 6 M1), d = tau M2 - M3;
+    ``biased-sinusoid`` (offset eliminated by a third derivation in s): N = -tau^3 y + 3 tau^2 M0
+    - 24 tau M1 + 30 M2, D = -1.5 tau^2 M2 + 4 tau M3 - 2.5 M4.
+    """
     m0 = s[S_MOM]
     m1 = s[S_MOM + 1]
     m2 = s[S_MOM + 2]
@@ -414,7 +434,17 @@ def step(p, s, c, seg, t, y, out):
     else:
         num = -(tau * tau * y + 2.0 * tau * m0 - 6.0 * m1)
         den = tau * m2 - m3
-    # invariant filtering, Eq. 11 (same discretised filter for all)
+    return num, den
+
+
+@njit(cache=True, inline='always')
+def _invariant_filter(p, s, model, num, den, tau, h):
+    """Invariant filtering, Eqs. 9-11: n and d (and q of the damped model) through one low-pass.
+
+    The same exactly discretised second-order filter acts on every term, so n_f / d_f stays w^2
+    for a pure sine. The damped model also forms q = 3 M2 - 2 tau M1 and the running integrals of
+    n_f, q_f, d_f (its second equation).
+    """
     filtered = p[P_FILTER] > 0.0
     if filtered:
         _advance(s, S_NF, S_DISC, s[S_NPREV], num)
@@ -425,7 +455,7 @@ def step(p, s, c, seg, t, y, out):
     s[S_NPREV] = num
     s[S_DPREV] = den
     if model == MODEL_DAMPED:
-        q = 3.0 * m2 - 2.0 * tau * m1
+        q = 3.0 * s[S_MOM + 2] - 2.0 * tau * s[S_MOM + 1]
         if filtered:
             _advance(s, S_QF, S_DISC, s[S_QPREV], q)
         else:
@@ -434,29 +464,20 @@ def step(p, s, c, seg, t, y, out):
         s[S_INT] += h * s[S_NF]
         s[S_INT + 1] += h * s[S_QF]
         s[S_INT + 2] += h * s[S_DF]
-    nseg = c[C_SEG_N]
-    cap = seg.shape[1]
-    if nseg < cap:
-        seg[0, nseg] = tau
-        seg[1, nseg] = y
-    c[C_SEG_N] = nseg + 1
-    if tau > p[P_MAXWIN] or nseg + 1 >= cap:
-        # no convergence: say whether the signal was at rest or just never converged
-        if _spread(seg, min(nseg + 1, cap)) <= p[P_MINAMP]:
-            c[C_REST] += 1
-        else:
-            c[C_MAX_WINDOW] += 1
-        reset_segment(s, c, seg, t, y)
-        return 0
-    if tau <= p[P_EPS] or nseg + 1 < p[P_MINSAMP]:
-        return 0
-    # Eq. 12
+
+
+@njit(cache=True, inline='always')
+def _ratio(model, s):
+    """Eq. 12: (omega^2, damping ratio) from the filtered terms; omega^2 <= 0 when undefined.
+
+    ``damped-sinusoid``: n = 2 sigma q + w_n^2 d holds at every instant; filtered (F1) and then
+    integrated (F2) it gives two equations in (2 sigma, w_n^2), solved by Cramer's rule. The other
+    models: omega^2 = n_f / d_f (damping NaN).
+    """
     nf = s[S_NF]
     df = s[S_DF]
     damping = math.nan
     if model == MODEL_DAMPED:
-        # n = 2 sigma q + w_n^2 d holds at every instant; filtered (F1) and then integrated (F2)
-        # it gives two equations in (2 sigma, w_n^2)
         qf = s[S_QF]
         i_n = s[S_INT]
         i_q = s[S_INT + 1]
@@ -467,18 +488,23 @@ def step(p, s, c, seg, t, y, out):
             damping = 0.5 * (nf * i_d - df * i_n) / det / math.sqrt(w2)
     else:
         w2 = nf / df if df != 0.0 else -1.0
-    if not (w2 > 0.0 and math.isfinite(w2)):
-        c[C_MA_N] = 0
-        return 0
-    f = math.sqrt(w2) / TWO_PI
-    # Eqs. 16-17: moving average of the last M+1 estimates against the one M samples earlier
+    return w2, damping
+
+
+@njit(cache=True, inline='always')
+def _converged(p, s, c, f):
+    """Eqs. 16-17: the moving average of the last M+1 estimates against the one M samples earlier.
+
+    Pushes f into the ring of the last 2M+1 estimates; True when the relative change (its absolute
+    value unless ``one_sided_test``) is below the tolerance.
+    """
     m = int(p[P_M])
     size = 2 * m + 1
     k = c[C_MA_N]
     s[S_MA + (k % size)] = f
     c[C_MA_N] = k + 1
     if k + 1 < size:
-        return 0
+        return False
     ma_now = 0.0
     ma_then = 0.0
     for i in range(m + 1):
@@ -487,15 +513,17 @@ def step(p, s, c, seg, t, y, out):
     change = ma_now - ma_then
     if p[P_ONESIDED] == 0.0:
         change = abs(change)
-    if change >= p[P_TOL] * ma_now:
-        return 0
-    # the segment must span a fraction of the period it estimates
-    if tau * f < p[P_MINPER]:
-        return 0
-    # converged: quality gate, then publish and reset
-    n_fit = min(nseg + 1, cap)
-    r2, amp = _fit(seg, n_fit, TWO_PI * f)
-    published = 0
+    return change < p[P_TOL] * ma_now
+
+
+@njit(cache=True, inline='always')
+def _quality_gate(p, c, model, f, damping, h, r2, amp):
+    """True if the converged estimate may be published; else count why it is held back.
+
+    At rest (no variance, or amplitude at or below ``min_amplitude``), above Nyquist, a sinusoid
+    fit R^2 below ``min_fit``, or (damped model) |damping ratio| above ``max_damping``: a "lightly
+    damped vibration" with more damping is a transient, not a mode.
+    """
     if r2 < 0.0 or amp <= p[P_MINAMP]:
         c[C_REST] += 1
     elif f * 2.0 * h >= 1.0:
@@ -503,9 +531,71 @@ def step(p, s, c, seg, t, y, out):
     elif r2 < p[P_MINFIT]:
         c[C_FIT] += 1
     elif model == MODEL_DAMPED and not abs(damping) <= p[P_MAXDAMP]:
-        # a "lightly damped vibration" with |zeta| above this is a transient, not a mode
         c[C_DAMPING] += 1
     else:
+        return True
+    return False
+
+
+@njit(cache=True, inline='always')
+def _store_sample(p, s, c, seg, t, tau, y):
+    """Keep (tau, y) in the segment buffer; True if the segment ran out (``max_window`` or buffer).
+
+    A segment that runs out resets without publishing, counted as at rest or as not converged.
+    """
+    nseg = c[C_SEG_N]
+    cap = seg.shape[1]
+    if nseg < cap:
+        seg[0, nseg] = tau
+        seg[1, nseg] = y
+    c[C_SEG_N] = nseg + 1
+    if tau > p[P_MAXWIN] or nseg + 1 >= cap:
+        if _spread(seg, min(nseg + 1, cap)) <= p[P_MINAMP]:
+            c[C_REST] += 1
+        else:
+            c[C_MAX_WINDOW] += 1
+        reset_segment(s, c, seg, t, y)
+        return True
+    return False
+
+
+@njit(cache=True)
+def step(p, s, c, seg, t, y, out):
+    """Feed one sample; return 1 and fill ``out`` when an estimate is published, else 0."""
+    if not _accept_time(p, s, c, t, y):
+        return 0
+    if c[C_HIST_N] == 0:
+        _first_sample(p, s, c, t, y)
+        return 0
+    h = t - s[S_HT + NH - 1]      # the newest sample of the stencil is the previous one
+    _update_discretisations(p, s, h)
+    if p[P_BAND] > 0.0:
+        y = _prefilter(p, s, y)
+    if not _push_history(s, c, seg, t, y):
+        return 0
+    tau = t - s[S_T0]
+    model = int(p[P_MODEL])
+    _interval_moments(s, 4 if model == MODEL_BIASED else 3, s[S_HT + NH - 2] - s[S_T0], h,
+                      int(p[P_RULE]))
+    num, den = _numerator_denominator(model, s, tau, y)
+    _invariant_filter(p, s, model, num, den, tau, h)
+    nseg = c[C_SEG_N]
+    if _store_sample(p, s, c, seg, t, tau, y):
+        return 0
+    if tau <= p[P_EPS] or nseg + 1 < p[P_MINSAMP]:
+        return 0
+    w2, damping = _ratio(model, s)
+    if not (w2 > 0.0 and math.isfinite(w2)):
+        c[C_MA_N] = 0
+        return 0
+    f = math.sqrt(w2) / TWO_PI
+    # the segment must span a fraction of the period it estimates
+    if not _converged(p, s, c, f) or tau * f < p[P_MINPER]:
+        return 0
+    n_fit = min(nseg + 1, seg.shape[1])
+    r2, amp = _fit(seg, n_fit, TWO_PI * f)
+    published = _quality_gate(p, c, model, f, damping, h, r2, amp)
+    if published:
         out[O_T] = t
         out[O_F] = f
         out[O_CONV] = tau
@@ -516,9 +606,8 @@ def step(p, s, c, seg, t, y, out):
         out[O_FSTD] = math.nan
         out[O_DSTD] = math.nan
         c[C_ESTIMATES] += 1
-        published = 1
     reset_segment(s, c, seg, t, y)
-    return published
+    return 1 if published else 0
 
 
 @njit(cache=True)
