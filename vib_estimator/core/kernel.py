@@ -35,6 +35,14 @@ Mathematics (equation numbers are those of Trapero, Sira-Ramirez & Feliu):
   on the absolute value of the relative change. The test as printed is one-sided: any falling
   estimate passes it at once, which is how Fig. 2's convergence time can fall as damping grows;
   ``one_sided_test`` reproduces it.
+* Refinement and uncertainty (:mod:`vib_estimator.core.uncertainty`): a published estimate is the
+  starting point of ``refine`` Gauss-Newton (maximum-likelihood) steps of its model over the
+  segment's samples, and gets its standard deviation from the Fisher information of the model
+  over those samples with the segment's residual variance (``refine`` = 0: the paper's estimate
+  as it is, with its std). ``target_std_rel`` replaces the convergence test by that std; with
+  ``refine`` and ``min_periods`` >= 1 the window is set by ``min_periods`` alone (the test of Eqs.
+  16-17 watches the algebraic estimate, which wanders over many periods while the refined one
+  keeps improving).
 * The optional band-pass prefilter is a 4th-order Butterworth low-pass at ``f_hi`` (steep, against
   higher modes) followed by a 2nd-order Butterworth high-pass at ``f_lo`` (offset and drift), all
   with the same exact discretisation; it is never reset by an estimate.
@@ -43,12 +51,17 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
+
+from . import uncertainty as U
+from .uncertainty import MODEL_BIASED, MODEL_DAMPED, MODEL_SINUSOID  # noqa: F401 (P_MODEL values)
 
 # ---- parameter array layout (float64) -------------------------------------------------------
 P_MODEL, P_WC, P_ZC, P_M, P_TOL, P_EPS, P_MAXWIN, P_BAND, P_WLO, P_WHI, P_MINAMP, P_MINFIT, \
-    P_MAXGAP, P_MINSAMP, P_MINPER, P_FILTER, P_ONESIDED, P_RULE, P_MAXDAMP = range(19)
-N_PARAMS = 19
+    P_MAXGAP, P_MINSAMP, P_MINPER, P_FILTER, P_ONESIDED, P_RULE, P_MAXDAMP, P_REFINE, \
+    P_TARGET = range(21)
+N_PARAMS = 21
 
 # ---- counter array layout (int64) -----------------------------------------------------------
 (C_RECEIVED, C_USED, C_NONFINITE, C_DUPLICATE, C_OUT_OF_ORDER, C_TIME_JUMP, C_GAP, C_REST,
@@ -77,14 +90,17 @@ S_IM = S_SCR + 3 * NH    # the rule's integrals I_0..I_4 of the newest interval
 S_W = S_IM + 5           # cached weights of the rule on a uniform stencil (5 x NH)
 S_WH = S_W + 5 * NH      # step of the cached weights (-1: none)
 S_UNIT = S_WH + 1        # scratch unit vector
-S_MA = S_UNIT + NH       # moving-average ring (2M+1 values) starts here
+S_FLAST = S_UNIT + NH    # long windows: the segment's first converged half-period estimate
+S_NEXT = S_FLAST + 1     # segment length at which target_std_rel is checked next
+S_MA = S_NEXT + 1        # moving-average ring (2M+1 values) starts here
 N_STATE_FIXED = S_MA
 
 # ---- estimate row layout --------------------------------------------------------------------
 O_T, O_F, O_CONV, O_SAMPLES, O_FIT, O_AMP, O_DAMP, O_FSTD, O_DSTD = range(9)
 N_OUT = 9
-#: values of P_MODEL
-MODEL_SINUSOID, MODEL_BIASED, MODEL_DAMPED = 0, 1, 2
+#: automatic max_window: this long at least (s), and min_periods + this many periods
+AUTO_WINDOW_S = 10.0
+AUTO_WINDOW_PERIODS = 2.0
 
 TWO_PI = 2.0 * math.pi
 #: band-pass prefilter: 4th-order Butterworth low-pass at f_hi (two sections), then a 2nd-order
@@ -165,6 +181,8 @@ def reset_segment(s, c, seg, t0, y0):
     seg[1, 0] = y0
     s[S_MOM:S_MOM + 5] = 0.0
     s[S_NF:S_INT + 3] = 0.0
+    s[S_FLAST] = 0.0
+    s[S_NEXT] = 0.0
     c[C_SEG_N] = 1
     c[C_MA_N] = 0
 
@@ -542,6 +560,8 @@ def _store_sample(p, s, c, seg, t, tau, y):
     """Keep (tau, y) in the segment buffer; True if the segment ran out (``max_window`` or buffer).
 
     A segment that runs out resets without publishing, counted as at rest or as not converged.
+    ``max_window`` = 0 is automatic: 10 s, or min_periods + 2 periods of the segment's first
+    converged half-period estimate when that is longer (so long windows are never cut short).
     """
     nseg = c[C_SEG_N]
     cap = seg.shape[1]
@@ -549,7 +569,12 @@ def _store_sample(p, s, c, seg, t, tau, y):
         seg[0, nseg] = tau
         seg[1, nseg] = y
     c[C_SEG_N] = nseg + 1
-    if tau > p[P_MAXWIN] or nseg + 1 >= cap:
+    limit = p[P_MAXWIN]
+    if limit <= 0.0:
+        limit = AUTO_WINDOW_S
+        if s[S_FLAST] > 0.0:
+            limit = max(limit, (p[P_MINPER] + AUTO_WINDOW_PERIODS) / s[S_FLAST])
+    if tau > limit or nseg + 1 >= cap:
         if _spread(seg, min(nseg + 1, cap)) <= p[P_MINAMP]:
             c[C_REST] += 1
         else:
@@ -589,12 +614,29 @@ def step(p, s, c, seg, t, y, out):
         c[C_MA_N] = 0
         return 0
     f = math.sqrt(w2) / TWO_PI
-    # the segment must span a fraction of the period it estimates
-    if not _converged(p, s, c, f) or tau * f < p[P_MINPER]:
-        return 0
     n_fit = min(nseg + 1, seg.shape[1])
+    if p[P_TARGET] > 0.0:
+        if tau * f < p[P_MINPER] or not _target_reached(p, s, seg, n_fit, model, f, damping, h):
+            return 0
+    elif p[P_REFINE] > 0.0 and p[P_MINPER] >= 1.0:
+        # long window: its span in periods of the segment's first converged half-period
+        # estimate (what the default configuration publishes; the algebraic estimate wanders
+        # over many periods), from which the fit starts
+        if s[S_FLAST] == 0.0:
+            if _converged(p, s, c, f) and tau * f >= 0.5:
+                s[S_FLAST] = f
+            return 0
+        if tau * s[S_FLAST] < p[P_MINPER]:
+            return 0
+        f = s[S_FLAST]
+    # the segment must span a fraction of the period it estimates
+    elif not _converged(p, s, c, f) or tau * f < p[P_MINPER]:
+        return 0
+    res = np.empty(U.N_RESULT)
+    _refine(p, seg, n_fit, model, f, damping, h, res)
+    f = res[U.R_F]
     r2, amp = _fit(seg, n_fit, TWO_PI * f)
-    published = _quality_gate(p, c, model, f, damping, h, r2, amp)
+    published = _quality_gate(p, c, model, f, res[U.R_DAMP], h, r2, amp)
     if published:
         out[O_T] = t
         out[O_F] = f
@@ -602,12 +644,64 @@ def step(p, s, c, seg, t, y, out):
         out[O_SAMPLES] = nseg + 1
         out[O_FIT] = r2
         out[O_AMP] = amp
-        out[O_DAMP] = damping
-        out[O_FSTD] = math.nan
-        out[O_DSTD] = math.nan
+        out[O_DAMP] = res[U.R_DAMP]
+        out[O_FSTD] = res[U.R_FSTD]
+        out[O_DSTD] = res[U.R_DSTD]
         c[C_ESTIMATES] += 1
     reset_segment(s, c, seg, t, y)
     return 1 if published else 0
+
+
+@njit(cache=True)
+def _noise_scale(p, f, h):
+    """Residual-variance factor for the band prefilter's coloured noise (1 without it)."""
+    if p[P_BAND] > 0.0:
+        return U.band_noise_scale(f, p[P_WLO] / TWO_PI, p[P_WHI] / TWO_PI, h)
+    return 1.0
+
+
+@njit(cache=True)
+def _start(model, f, damping):
+    """Start of the refinement: (w, sigma) = (w_d, zeta w_n) from the algebraic (w_n, zeta)."""
+    wn = TWO_PI * f
+    if model == MODEL_DAMPED and abs(damping) < 1.0:
+        return wn * math.sqrt(1.0 - damping * damping), damping * wn
+    return wn, 0.0
+
+
+@njit(cache=True)
+def _refine(p, seg, n, model, f, damping, h, res):
+    """The estimate to gate and publish: ``res`` = (f, damping, their std), core.uncertainty.
+
+    ``refine`` = 0 keeps the paper's algebraic (f, damping) and adds their std; otherwise up to
+    ``refine`` Gauss-Newton steps of the model over the segment replace them (the quality gate
+    then judges the refined frequency).
+    """
+    w0, sigma0 = _start(model, f, damping)
+    iterations = int(p[P_REFINE])
+    res[:] = math.nan
+    if not U.refine(model, seg, n, w0, sigma0, iterations, _noise_scale(p, f, h), res) \
+            or iterations == 0:
+        res[U.R_F] = f
+        res[U.R_DAMP] = damping
+
+
+@njit(cache=True)
+def _target_reached(p, s, seg, n, model, f, damping, h):
+    """``target_std_rel``: True once the predicted relative std of f is at or below the target.
+
+    The std (the Fisher information of the model over the segment at the algebraic estimate, with
+    the residual variance) costs a pass over the segment, so it is checked at every sample up to
+    64 and then each time the segment has grown by 1/16 (an amortised 16 passes per sample).
+    """
+    if n < s[S_NEXT]:
+        return False
+    s[S_NEXT] = max(n + 1.0, n * (1.0 + 1.0 / 16.0)) if n >= 64 else n + 1.0
+    res = np.full(U.N_RESULT, math.nan)
+    w0, sigma0 = _start(model, f, damping)
+    if not U.refine(model, seg, n, w0, sigma0, 0, _noise_scale(p, f, h), res):
+        return False
+    return res[U.R_FSTD] <= p[P_TARGET] * f
 
 
 @njit(cache=True)
