@@ -359,3 +359,22 @@ def matrix_pencil(y: np.ndarray, ts: float, order: int = 2,
     poles = np.linalg.eigvals(np.linalg.pinv(v[:-1]) @ v[1:])
     s = np.log(poles[np.argmax(np.abs(poles.imag))].astype(complex)) / ts
     return abs(s) / TWO_PI, -s.real / abs(s)
+
+
+class SlidingMatrixPencil(SlidingDFT):
+    """A modal analyst's tracker: :func:`matrix_pencil` over the last ``window_s`` s every ``hop``
+    samples (damped-exponential model of ``order`` poles; pencil parameter at most ``max_pencil``,
+    64 by default to keep a sliding run cheap). Same stream handling as :class:`SlidingDFT`."""
+
+    name = 'Matrix pencil'
+
+    def __init__(self, rate_hz: float = 500.0, window_s: float = 2.0, hop: int = 25,
+                 order: int = 2, max_pencil: int = 64):
+        super().__init__(rate_hz, window_s, hop)
+        self._ts = 1.0 / rate_hz
+        self._order = int(order)
+        self._max_pencil = int(max_pencil)
+
+    def _peak_frequencies(self, frames: np.ndarray) -> np.ndarray:
+        return np.array([matrix_pencil(f, self._ts, self._order, self._max_pencil)[0]
+                         for f in frames])
