@@ -4,7 +4,7 @@ VENV    := .venv
 STAMP   := $(VENV)/.installed
 export ROS_AUTOMATIC_DISCOVERY_RANGE := LOCALHOST
 
-.PHONY: setup demo test bench reproduce compare bags clean
+.PHONY: setup demo shaping test bench reproduce compare bags survey clean
 
 setup: $(STAMP)
 
@@ -19,6 +19,9 @@ $(STAMP): requirements.txt setup.py setup.cfg package.xml
 
 demo: setup
 	$(VENV)/bin/vib-estimator demo
+
+shaping: setup
+	$(VENV)/bin/vib-estimator demo --shaping
 
 test: setup
 	$(VENV)/bin/python -m pytest -q test
@@ -37,6 +40,12 @@ compare: setup
 
 bags: setup
 	$(VENV)/bin/python scripts/make_bags.py
+
+# a simulated fleet of 40 daily recordings (stiffness 1 % lower from day 30), surveyed against day 0
+survey: setup
+	$(VENV)/bin/python scripts/make_fleet.py --out out/fleet
+	$(VENV)/bin/vib-estimator survey out/fleet --baseline out/fleet/day_00 --alarm-rel 0.0025 \
+		--out out/fleet_survey.csv --plot out/fleet_trend.png
 
 clean:
 	rm -rf $(VENV) build install log out *.egg-info

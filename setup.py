@@ -31,6 +31,7 @@ setup(
             'vib-estimator = vib_estimator.cli:main',
             'estimator_node = vib_estimator.nodes.estimator_node:main',
             'sim_node = vib_estimator.nodes.sim_node:main',
+            'shaper_node = vib_estimator.nodes.shaper_node:main',
             'bag_replayer = vib_estimator.nodes.bag_replayer:main',
             'bag_recorder = vib_estimator.nodes.bag_recorder:main',
         ],

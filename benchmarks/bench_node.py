@@ -1,8 +1,15 @@
 """Throughput and latency of estimator_node; prints figures (not a test). About 1-2 minutes.
 
     .venv/bin/python benchmarks/bench_node.py
+    .venv/bin/python benchmarks/bench_node.py --input-type all      # one line per input type
+    .venv/bin/python benchmarks/bench_node.py --input-type sensor_msgs/msg/Imu ...
 
-Loss test. A publisher in another process (reliable QoS, history 1000) sends WrenchStamped samples
+With ``--input-type`` (repeatable, or ``all``) the run is the per-type comparison only: for each
+type, the node (``input_type`` set, its default component; JointState: 3 joints, the middle one
+estimated) against an empty callback subscribed to the same type, EventsExecutor, one line per
+type. Without it, the executor comparison below on WrenchStamped.
+
+Loss test. A publisher in another process (reliable QoS, history 1000) sends samples
 of a 1.33 Hz sine (stamps of a notional 500 Hz stream) at a paced rate for one second; the
 subscriber in this process spins its executor until nothing more arrives and counts what its
 callback got. A rate passes when received == sent in REPEATS trials in a row. The subscription
@@ -21,6 +28,7 @@ executor, with the input at 1 kHz (stamps of a notional 100 Hz stream, for ~26 e
 """
 from __future__ import annotations
 
+import argparse
 import math
 import os
 import subprocess
@@ -35,29 +43,41 @@ os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
 
 # the node's own input history, used for the empty subscriber too (imported after the env is set)
 from vib_estimator.nodes.estimator_node import INPUT_DEPTH as DEPTH  # noqa: E402
+from vib_estimator.io.fields import INPUT_TYPES, WRENCH_STAMPED as WRENCH  # noqa: E402
+from vib_estimator.io.fields import check_input_type  # noqa: E402
 
 RATES = [1000, 2000, 3000, 4500, 6500, 9000, 11000, 13000, 15000, 17500, 20000, 25000, 35000]
 TRIAL_S = 1.0
 REPEATS = 2     # a rate passes when this many trials in a row lose nothing
+JOINTS = ['joint0', 'joint1', 'joint2']   # JointState: the default component is effort[joint1]
 
 
 # ---- publisher process --------------------------------------------------------------------
-def publisher(topic: str) -> None:
+def publisher(topic: str, input_type: str) -> None:
     """Read ``rate count fs`` lines on stdin; publish, paced; answer ``sent elapsed`` lines."""
     import rclpy
-    from geometry_msgs.msg import WrenchStamped
     from rclpy.qos import QoSProfile, ReliabilityPolicy
+
+    from vib_estimator.io.fields import (DEFAULT_COMPONENT, JOINT_STATE, component_setter,
+                                         has_header)
+    from vib_estimator.nodes.estimator_node import message_class
 
     rclpy.init()
     node = rclpy.create_node('bench_publisher')
-    pub = node.create_publisher(WrenchStamped, topic,
+    pub = node.create_publisher(message_class(input_type), topic,
                                 QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE))
     while pub.get_subscription_count() < 1:
         time.sleep(0.01)
     time.sleep(0.5)   # let discovery settle in both directions
     print('ready', flush=True)
-    msg = WrenchStamped()
-    msg.header.frame_id = 'bench'
+    msg = message_class(input_type)()
+    stamped = has_header(input_type)
+    if stamped:
+        msg.header.frame_id = 'bench'
+    if input_type == JOINT_STATE:
+        msg.name = JOINTS
+        msg.effort = [0.0] * len(JOINTS)
+    set_value = component_setter(DEFAULT_COMPONENT[input_type], input_type)
     k = 0
     for line in sys.stdin:
         rate, count, fs = (float(x) for x in line.split())
@@ -67,9 +87,10 @@ def publisher(topic: str) -> None:
             while time.perf_counter() < due:
                 pass
             k += 1
-            msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(
-                1_000_000_000_000_000_000 + round(k * 1e9 / fs), 10 ** 9)
-            msg.wrench.torque.z = math.sin(2 * math.pi * 1.33 * k / fs)
+            if stamped:
+                msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(
+                    1_000_000_000_000_000_000 + round(k * 1e9 / fs), 10 ** 9)
+            set_value(msg, math.sin(2 * math.pi * 1.33 * k / fs))
             pub.publish(msg)
         print(int(count), time.perf_counter() - start, flush=True)
     node.destroy_node()
@@ -77,9 +98,8 @@ def publisher(topic: str) -> None:
 
 
 # ---- subscriber side ----------------------------------------------------------------------
-def make_subscriber(kind, context, topic, depth):
+def make_subscriber(kind, context, topic, depth, input_type):
     """(node, received()) for kind 'node' (the estimator, timed) or 'empty'."""
-    from geometry_msgs.msg import WrenchStamped
     from rclpy.node import Node
     from rclpy.parameter import Parameter
     from rclpy.qos import QoSProfile, qos_profile_sensor_data
@@ -92,7 +112,7 @@ def make_subscriber(kind, context, topic, depth):
 
         def callback(msg):
             count[0] += 1
-        node.create_subscription(WrenchStamped, topic, callback, QoSProfile(
+        node.create_subscription(en.message_class(input_type), topic, callback, QoSProfile(
             depth=depth, reliability=qos_profile_sensor_data.reliability))
         return node, lambda: count[0]
 
@@ -102,25 +122,25 @@ def make_subscriber(kind, context, topic, depth):
         latencies = []
         entries = {}    # stamp ns of converging samples -> perf_counter at callback entry
 
-        def _on_wrench(self, msg):
+        def _on_stamped(self, msg):
             entry = time.perf_counter()
-            before = self._last_estimate
-            super()._on_wrench(msg)
-            if self._last_estimate is not before:
+            before = self._stream.health.last_estimate
+            super()._on_stamped(msg)
+            if self._stream.health.last_estimate is not before:
                 self.latencies.append(time.perf_counter() - entry)
                 self.entries[msg.header.stamp.sec * 10 ** 9 + msg.header.stamp.nanosec] = entry
 
     en.INPUT_DEPTH = depth
-    node = TimedNode(context=context,
-                     parameter_overrides=[Parameter('input_topic', value=topic)])
-    return node, lambda: node.counters['received']
+    node = TimedNode(context=context, parameter_overrides=[
+        Parameter('input_topic', value=topic), Parameter('input_type', value=input_type)])
+    return node, lambda: node.counters['received'] + node.counters['skipped_joint_missing']
 
 
 class Rig:
     """A subscriber in its own context and executor, spun by spin_once in a thread, and its
     publisher process."""
 
-    def __init__(self, kind, executor_name, depth, topic, extra_nodes=()):
+    def __init__(self, kind, executor_name, depth, topic, extra_nodes=(), input_type=WRENCH):
         import rclpy
         from rclpy.executors import SingleThreadedExecutor
         from rclpy.experimental import EventsExecutor
@@ -128,7 +148,7 @@ class Rig:
         self.label = f'{kind:5s} {executor_name:6s} depth {depth:3d}'
         self.context = rclpy.Context()
         rclpy.init(context=self.context)
-        self.node, self.received = make_subscriber(kind, self.context, topic, depth)
+        self.node, self.received = make_subscriber(kind, self.context, topic, depth, input_type)
         self.nodes = [self.node] + [make(self.context) for make in extra_nodes]
         self.executor = (EventsExecutor if executor_name == 'events'
                          else SingleThreadedExecutor)(context=self.context)
@@ -137,8 +157,8 @@ class Rig:
         self.running = True
         self.thread = threading.Thread(target=self._spin, daemon=True)
         self.thread.start()
-        self.pub = subprocess.Popen([sys.executable, __file__, '--publisher', topic], text=True,
-                                    stdin=subprocess.PIPE, stdout=subprocess.PIPE)
+        self.pub = subprocess.Popen([sys.executable, __file__, '--publisher', topic, input_type],
+                                    text=True, stdin=subprocess.PIPE, stdout=subprocess.PIPE)
         assert self.pub.stdout.readline().strip() == 'ready'
         # the subscriber must have matched the publisher too (best effort drops until then)
         while self.node.count_publishers(topic) < 1:
@@ -221,12 +241,44 @@ def percentiles(values):
     return f'p50 {np.percentile(v, 50):7.1f} us, p99 {np.percentile(v, 99):7.1f} us (n={len(v)})'
 
 
-def main():
-    def log(text):
-        print(text, flush=True)
+def cpu_per_message(rig, rate=1000, count=1000, trials=3):
+    """Process CPU seconds per message received while ``rig`` takes ``count`` messages at ``rate``
+    (median of ``trials``): the subscriber's whole cost (DDS threads, rclpy, the callback), far
+    less sensitive to other processes' load than the highest rate."""
+    costs = []
+    for _ in range(trials):
+        base, cpu = rig.received(), time.process_time()
+        rig.trial(rate, count)
+        costs.append((time.process_time() - cpu) / max(1, rig.received() - base))
+    return float(np.median(costs))
 
-    log(f'estimator_node benchmark, {os.cpu_count()} cores, ROS_DOMAIN_ID '
-        f'{os.environ["ROS_DOMAIN_ID"]}; trials of {TRIAL_S:.0f} s x {REPEATS}')
+
+def per_type(input_types, log):
+    """Node and empty callback of each input type (EventsExecutor): one line per type."""
+    results = {}
+    for input_type in input_types:
+        short = input_type.split('/')[-1].lower()
+        rigs = [Rig(kind, 'events', DEPTH, f'bench_{kind}_{short}', input_type=input_type)
+                for kind in ('empty', 'node')]
+        best = ramp(rigs, log)
+        results[input_type] = (best[rigs[1]], best[rigs[0]], cpu_per_message(rigs[1]),
+                               cpu_per_message(rigs[0]))
+        for rig in rigs:
+            rig.close()
+    log('')
+    log(f'highest input rate with zero loss per input type (msgs/s; EventsExecutor, best effort, '
+        f'history {DEPTH}; goal ratio >= 0.9):')
+    log(f'  {"input type":34s} {"estimator_node":>15s} {"empty callback":>15s} {"ratio":>6s}'
+        f'   CPU us/msg: {"node":>6s} {"empty":>6s} {"ratio":>6s}')
+    for input_type, (n, e, cpu_n, cpu_e) in results.items():
+        log(f'  {input_type:34s} {n:15d} {e:15d} {n / e if e else math.nan:6.2f}'
+            f'               {1e6 * cpu_n:6.1f} {1e6 * cpu_e:6.1f} {cpu_e / cpu_n:6.2f}')
+    log('  (CPU us/msg: process CPU time per message received at 1000/s, median of 3 trials; '
+        'its ratio empty/node is the rate ratio a saturated core would give)')
+
+
+def executors(log):
+    """The executor comparison on WrenchStamped, history 5, and the latencies."""
     results = {}
     for executor_name in ('single', 'events'):
         rigs = {kind: Rig(kind, executor_name, DEPTH, f'bench_{kind}_{executor_name}')
@@ -254,8 +306,30 @@ def main():
         log(f'  end to end, same-process subscriber, 1 kHz:  {percentiles(e2e)}')
 
 
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument('--input-type', action='append', metavar='TYPE',
+                        help=f'an input type ({", ".join(INPUT_TYPES)}) or all; repeatable')
+    args = parser.parse_args(argv)
+    try:
+        types = None if not args.input_type else list(INPUT_TYPES) if 'all' in args.input_type \
+            else list(dict.fromkeys(check_input_type(t) for t in args.input_type))
+    except ValueError as err:
+        parser.exit(2, f'error: {err}\n')
+
+    def log(text):
+        print(text, flush=True)
+
+    log(f'estimator_node benchmark, {os.cpu_count()} cores, ROS_DOMAIN_ID '
+        f'{os.environ["ROS_DOMAIN_ID"]}; trials of {TRIAL_S:.0f} s x {REPEATS}')
+    if types:
+        per_type(types, log)
+    else:
+        executors(log)
+
+
 if __name__ == '__main__':
     if sys.argv[1:2] == ['--publisher']:
-        publisher(sys.argv[2])
+        publisher(sys.argv[2], sys.argv[3])
     else:
         main()

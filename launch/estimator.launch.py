@@ -1,6 +1,9 @@
 """Launch the frequency estimator with the Section 5.3 parameters of config/estimator.yaml.
 
 ``ros2 launch vib_estimator estimator.launch.py`` (needs launch_ros, i.e. a full ROS 2 install).
+The input (``input_type``, ``input_topic``, ``component``) and every estimator parameter, ``modes``
+included, are in that file: copy it to use another sensor (e.g. ``sensor_msgs/msg/Imu``,
+``linear_acceleration.z``).
 """
 import os
 

@@ -14,6 +14,8 @@ from typing import Optional, Sequence
 COMMANDS = {
     'analyze': ('vib_estimator.analysis.analyze', 'estimate frequencies in a recorded signal (CSV, MCAP, '
                 'rosbag2)'),
+    'survey': ('vib_estimator.analysis.survey', 'many recordings: one summary row each, trend plot, '
+               'frequency-drift alarm; local or Dask-distributed'),
     'reproduce': ('vib_estimator.analysis.reproduce', "reproduce the paper's Figs. 1 and 2"),
     'compare': ('vib_estimator.analysis.compare', 'algebraic vs adaptive/FFT estimators (Table 2, Figs. 6-7, '
                 'Cramer-Rao bound)'),

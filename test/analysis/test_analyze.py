@@ -103,3 +103,46 @@ def test_unknown_topic_lists_the_available_ones(tmp_path, capsys, samples):
     assert main(['analyze', str(tmp_path / 'bag'), '--topic', '/nope']) == 2
     err = capsys.readouterr().err
     assert '/nope' in err and '/coupling_torque' in err
+
+
+def test_every_input_type_of_a_bag_and_the_topic_choice(tmp_path, capsys, samples):
+    """An Imu topic (component checked against its type), a Float64 topic (log time), and the
+    default topic refused when there are several."""
+    from vib_estimator.io.bags import BagWriter, TYPESTORE
+
+    t, y = samples
+    stamps = 1_700_000_000_000_000_000 + np.round(t * 1e9).astype(np.int64)
+    T = TYPESTORE.types
+    with BagWriter(tmp_path / 'bag') as bag:
+        imu = bag.add_topic('/imu', 'sensor_msgs/msg/Imu')
+        raw = bag.add_topic('/raw', 'std_msgs/msg/Float64')
+        for s, v in zip(stamps.tolist(), y.tolist()):
+            header = T['std_msgs/msg/Header'](stamp=T['builtin_interfaces/msg/Time'](
+                sec=s // 10 ** 9, nanosec=s % 10 ** 9), frame_id='imu_link')
+            vec = T['geometry_msgs/msg/Vector3']
+            msg = T['sensor_msgs/msg/Imu'](
+                header=header, orientation=T['geometry_msgs/msg/Quaternion'](0.0, 0.0, 0.0, 1.0),
+                orientation_covariance=np.zeros(9), angular_velocity=vec(0.0, 0.0, 0.0),
+                angular_velocity_covariance=np.zeros(9), linear_acceleration=vec(v, 0.0, 9.8),
+                linear_acceleration_covariance=np.zeros(9))
+            bag.write_message(imu, s + 123_456, msg)            # received later than stamped
+            bag.write_message(raw, s, T['std_msgs/msg/Float64'](data=v))
+    expected = estimate(seconds_since(stamps, stamps[0]), y).frequency_hz.tolist()
+    for args in (['--topic', '/imu', '--component', 'linear_acceleration.x'], ['--topic', '/raw']):
+        assert main(['analyze', str(tmp_path / 'bag')] + args) == 0
+        assert [r['frequency_hz'] for r in jsonl(capsys.readouterr().out)] == expected
+    assert main(['analyze', str(tmp_path / 'bag')]) == 2
+    assert 'choose one with --topic: /imu (sensor_msgs/msg/Imu), /raw' in capsys.readouterr().err
+    assert main(['analyze', str(tmp_path / 'bag'), '--topic', '/imu', '--component',
+                 'torque.z']) == 2
+    assert 'linear_acceleration.x' in capsys.readouterr().err
+
+
+def test_band_above_nyquist_is_an_error(tmp_path, capsys, samples):
+    t, y = samples                                   # 500 Hz: Nyquist 250 Hz
+    path = tmp_path / 'sig.csv'
+    np.savetxt(path, np.column_stack([t, y]), delimiter=',')
+    assert main(['analyze', str(path), '--band-hz', '1', '300']) == 2
+    err = capsys.readouterr().err
+    assert 'above the Nyquist frequency 250 Hz' in err and len(err.strip().splitlines()) == 1
+    assert main(['analyze', str(path), '--band-hz', '1', '200']) == 0

@@ -250,7 +250,8 @@ def test_replay_into_estimator_node_matches_analyze(ros_context, executor, monke
     from vib_estimator.cli import main
 
     series = read_wrench_series(BAGS / 'arm_5_3')
-    assert main(['analyze', str(BAGS / 'arm_5_3'), '--format', 'jsonl']) == 0
+    assert main(['analyze', str(BAGS / 'arm_5_3'), '--topic', '/coupling_torque',
+                 '--format', 'jsonl']) == 0
     offline = [json.loads(line)['frequency_hz'] for line in capsys.readouterr().out.splitlines()]
     assert len(offline) > 0
     # The input is best effort: when a loaded machine stalls this one-thread executor, the

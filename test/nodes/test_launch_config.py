@@ -13,6 +13,7 @@ import rclpy
 import yaml
 
 from vib_estimator.core import EstimatorConfig
+from vib_estimator.io.fields import DEFAULT_COMPONENT, INPUT_TYPES, WRENCH_STAMPED
 from vib_estimator.nodes.estimator_node import EstimatorNode
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -22,8 +23,9 @@ LAUNCH = ROOT / 'launch' / 'estimator.launch.py'
 
 def test_params_file_holds_the_defaults():
     params = yaml.safe_load(PARAMS.read_text())['estimator_node']['ros__parameters']
+    assert params.pop('input_type') == WRENCH_STAMPED
     assert params.pop('input_topic') == 'coupling_torque'
-    assert params.pop('component') == 'torque.z'
+    assert params.pop('component') == DEFAULT_COMPONENT[WRENCH_STAMPED]
     defaults = EstimatorConfig()
     assert set(params) == set(EstimatorConfig.names())
     for name, value in params.items():
@@ -39,8 +41,9 @@ def test_params_file_loads_into_the_node():
                args=['--ros-args', '--params-file', str(PARAMS)])
     try:
         node = EstimatorNode(context=context)
-        assert node._estimator.config == EstimatorConfig()
+        assert node._stream.config == EstimatorConfig()
         assert node.get_parameter('band_hz').value == []
+        assert node.get_parameter('input_type').value == WRENCH_STAMPED
         node.destroy_node()
     finally:
         context.try_shutdown()
@@ -57,6 +60,11 @@ def test_every_core_parameter_has_a_description_and_numbers_a_range(ros_context)
                 assert descriptor.integer_range or descriptor.floating_point_range, name
     finally:
         node.destroy_node()
+
+
+def test_params_file_comments_name_every_input_type():
+    text = PARAMS.read_text()
+    assert all(name in text for name in INPUT_TYPES)
 
 
 def test_launch_file_starts_the_node_with_the_params_file():

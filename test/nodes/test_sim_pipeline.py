@@ -147,3 +147,112 @@ def test_sim_node_parameters(ros_context, executor):
         for node in (sim, probe):
             executor.remove_node(node)
             node.destroy_node()
+
+
+def _collect(executor, node, msg_type, topic, n, get):
+    """Spin until ``n`` messages of ``topic`` arrived; return their ``get(msg)`` values."""
+    values = []
+    sub = node.create_subscription(msg_type, topic, lambda m: values.append(get(m)), 1000)
+    assert spin_until(executor, lambda: len(values) >= n, 30.0), f'{len(values)} of {n}'
+    node.destroy_subscription(sub)
+    return values[:n]
+
+
+def test_imu_output_carries_the_models_tip_acceleration(ros_context, executor):
+    """output_type Imu: linear_acceleration.z (the estimator's default Imu component) is the
+    model's tip acceleration, sample for sample, and the core estimator finds Eq. 23 in it."""
+    from sensor_msgs.msg import Imu
+
+    from vib_estimator.core import FrequencyEstimator
+    from vib_estimator.io.fields import DEFAULT_COMPONENT, IMU, component_getter
+    from vib_estimator.sim.arm_model import ArmParameters, ArmSimulator, Move
+
+    sim = sim_node(ros_context, namespace='imu_test', output_type='sensor_msgs/msg/Imu', seed=5,
+                   speed=20.0, wait_for_subscribers=1)
+    probe = Node('probe', context=ros_context)
+    for node in (sim, probe):
+        executor.add_node(node)
+    try:
+        get = component_getter(DEFAULT_COMPONENT[IMU], IMU)
+        rows = _collect(executor, probe, Imu, '/imu_test/tip_imu', 2000,
+                        lambda m: (m.header.stamp.sec * 10 ** 9 + m.header.stamp.nanosec,
+                                   get(m), m.orientation_covariance[0]))
+    finally:
+        for node in (sim, probe):
+            executor.remove_node(node)
+            node.destroy_node()
+    stamps, accel, orientation = map(np.array, zip(*rows))
+    model = ArmSimulator(ArmParameters(), seed=5, schedule=(Move(0.0, 1.0, 1.0),),
+                         output='tip_acceleration')
+    expected = [model.step()[1] for _ in range(len(accel))]
+    np.testing.assert_array_equal(accel, expected)
+    assert np.all(orientation == -1.0)
+    t = (stamps - stamps[0]) * 1e-9
+    estimates = FrequencyEstimator().process(t, accel)
+    free = estimates.t > 1.5                       # after the 1 s ramp
+    assert free.sum() >= 3
+    assert np.median(estimates.frequency_hz[free]) == pytest.approx(
+        natural_frequency_hz(0.04555), rel=0.01)
+
+
+def test_sim_follows_position_commands(ros_context, executor):
+    """The first position_command takes over from the schedule: the arm goes to it and holds it;
+    the schedule's tip-mass change still applies; a NaN command is skipped and counted."""
+    sim = sim_node(ros_context, namespace='cmd_test', speed=20.0, noise_std=0.0,
+                   schedule=[0.0, 1.0, 1.0, 0.0, 1.0, 0.0, 1.0, 0.030])
+    probe = Node('probe', context=ros_context)
+    pub = probe.create_publisher(Float64, '/cmd_test/position_command', 10)
+    for node in (sim, probe):
+        executor.add_node(node)
+    try:
+        assert spin_until(executor, lambda: pub.get_subscription_count() >= 1, 10.0)
+        pub.publish(Float64(data=-0.4))
+        pub.publish(Float64(data=float('nan')))
+        assert spin_until(executor, lambda: sim.commands_received == 1
+                          and sim.commands_skipped == 1, 10.0)
+        assert spin_until(executor, lambda: sim._sim.t > 4.0, 30.0)
+        assert sim._sim.command == -0.4                 # not the schedule's 1 rad, nor 0 at 1 s
+        assert sim._sim._x[0] == pytest.approx(-0.4, abs=2e-3)
+        assert sim._sim.params.tip_mass_kg == 0.030     # the schedule's mass change at 1 s
+    finally:
+        for node in (sim, probe):
+            executor.remove_node(node)
+            node.destroy_node()
+
+
+def test_lockstep_waits_for_the_commander(ros_context, executor):
+    """wait_for_command + lockstep: nothing is simulated before the first command; afterwards
+    each batch waits for shaper_node's answer to the previous /clock, so when the shaper stops
+    the arm stops (within one batch) and goes on when it is back."""
+    from vib_estimator.nodes.shaper_node import ShaperNode
+    from vib_estimator.nodes.sim_node import LOCKSTEP_BATCH_SECONDS
+
+    with pytest.raises(StartupError, match='lockstep needs simulated time'):
+        sim_node(ros_context, lockstep=True)
+    sim = sim_node(ros_context, namespace='lock', speed=20.0, lockstep=True,
+                   wait_for_command=True)
+    shaper = ShaperNode(context=ros_context, namespace='lock', parameter_overrides=[
+        Parameter('use_sim_time', value=True), Parameter('shaper', value='none')])
+    probe = Node('probe', context=ros_context)
+    ref = probe.create_publisher(Float64, '/lock/reference', 10)
+    for node in (sim, shaper, probe):
+        executor.add_node(node)
+    try:
+        spin_until(executor, lambda: False, 0.3)
+        assert sim._sim.t == 0.0 and sim.commands_received == 0
+        assert spin_until(executor, lambda: ref.get_subscription_count() >= 1, 10.0)
+        ref.publish(Float64(data=0.2))
+        assert spin_until(executor, lambda: sim._sim.t > 1.0, 30.0)
+        executor.remove_node(shaper)
+        spin_until(executor, lambda: False, 0.1)             # in flight
+        stopped_at = sim._sim.t
+        spin_until(executor, lambda: False, 0.5)
+        assert sim._sim.t - stopped_at <= LOCKSTEP_BATCH_SECONDS + 1e-9
+        executor.add_node(shaper)
+        assert spin_until(executor, lambda: sim._sim.t > stopped_at + 0.5, 30.0)
+        assert sim._sim.command == pytest.approx(0.2) and sim.lockstep_timeouts == 0
+    finally:
+        for node in (sim, shaper, probe):
+            if node in executor.get_nodes():
+                executor.remove_node(node)
+            node.destroy_node()

@@ -86,3 +86,43 @@ def test_schedule_and_abrupt_mass_change():
     assert samples[0][0] == 0.0 and samples[-1][0] == pytest.approx(399 / 500)
     sim.set_tip_mass(0.030)
     assert sim.step()[2] == pytest.approx(natural_frequency_hz(0.030))
+
+
+def test_commands_take_over_from_the_schedule_but_not_its_masses():
+    """set_command holds the motor reference; the schedule's later ramps no longer move it, its
+    tip-mass changes still apply."""
+    sim = ArmSimulator(schedule=(Move(0.0, 1.0, 1.0, 0.03), Move(1.0, -2.0, 1.0, 0.06117)),
+                       noise_std=0.0)
+    for _ in range(100):
+        sim.step()
+    assert 0 < sim.command < 0.25                    # the first ramp, 0.2 s in
+    sim.set_command(0.5)
+    assert sim.command == 0.5 and sim.commanded
+    for _ in range(1500):                            # past the second move's start
+        sim.step()
+    assert sim.command == 0.5
+    assert sim.params.tip_mass_kg == 0.06117         # the mass change applied
+    assert sim._x[0] == pytest.approx(0.5, abs=1e-3)  # the PD loop holds the motor there
+    with pytest.raises(ValueError):
+        sim.set_command(float('nan'))
+
+
+def test_tip_acceleration_output():
+    """L theta_t'' = (c (theta_m - theta_t) + b (theta_m' - theta_t')) / (m L): within the small
+    damping term of the torque over m L; same frequency; noise scaled by 1 / (m L)."""
+    m, length = 0.04555, 0.7
+    torque = simulate(6.0, (Move(0.0, 1.0, 1.0, m),), noise_std=0.0, quantum=0.0)
+    accel = simulate(6.0, (Move(0.0, 1.0, 1.0, m),), noise_std=0.0, quantum=0.0,
+                     output='tip_acceleration')
+    free = torque.t >= 2.0
+    scaled = torque.torque[free] / (m * length)
+    amplitude = np.max(np.abs(scaled))
+    assert np.max(np.abs(accel.torque[free] - scaled)) < 0.03 * amplitude
+    crossings = upward_crossings(accel.t[free], accel.torque[free])
+    f = (len(crossings) - 1) / (crossings[-1] - crossings[0])
+    assert f == pytest.approx(natural_frequency_hz(m), rel=1e-3)
+    noisy = simulate(2.0, noise_std=0.004, quantum=0.0, seed=1, output='tip_acceleration')
+    quiet = simulate(2.0, noise_std=0.0, quantum=0.0, output='tip_acceleration')
+    assert np.std(noisy.torque - quiet.torque) == pytest.approx(0.004 / (m * length), rel=0.1)
+    with pytest.raises(ValueError, match='output must be'):
+        ArmSimulator(output='strain')

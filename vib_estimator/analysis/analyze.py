@@ -1,23 +1,28 @@
 """``vib-estimator analyze``: run the estimator over a recorded signal (CSV, MCAP, rosbag2).
 
 The estimates are exactly those the estimator node publishes for the same samples: both use the
-batch/streaming core with time = header stamp - first stamp (``wrench.seconds_since``).
-Estimates go to stdout (jsonl, csv or a table); the sample counters go to stderr. Bad input gives
-one line on stderr and exit code 2.
+streaming core with time = header stamp - first stamp (``fields.seconds_since``; ``Float64``, which
+has no header: the log time). The recording is read block by block (:mod:`..io.streaming`), so
+memory does not grow with its length. A bag's topic may be of any input type of
+:mod:`..io.fields`; ``--component`` is checked against it. Estimates go to stdout (jsonl, csv or a
+table); the sample counters go to stderr. Bad input gives one line on stderr and exit code 2.
 """
 from __future__ import annotations
 
 import argparse
 import json
 import sys
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Optional, Tuple
 
 import numpy as np
 
-from ..io.csv_reader import CsvError, read_csv_series
-from ..core import MODELS, COUNTER_NAMES, EstimatorConfig
+from ..core import MODELS, COUNTER_NAMES, EstimateArrays, EstimatorConfig
 from ..core.modes import create_estimator
-from ..io.fields import COMPONENTS, seconds_since
+from ..io.csv_reader import CsvError
+from ..io.fields import INPUT_TYPES
+from ..io.streaming import Signal, open_signal
 
 #: CLI option -> EstimatorConfig field for the estimator's scalar parameters
 _CONFIG_OPTIONS = {
@@ -29,39 +34,96 @@ _CONFIG_OPTIONS = {
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    defaults = EstimatorConfig()
     parser.add_argument('input', help='CSV file, MCAP file, or rosbag2 directory')
-    parser.add_argument('--topic', help='WrenchStamped topic of a bag (default: the only one)')
-    parser.add_argument('--component', default='torque.z', choices=COMPONENTS,
-                        help='field of the WrenchStamped messages (default torque.z)')
+    parser.add_argument('--topic', help='topic of a bag (default: its only topic of a supported '
+                        f'type: {", ".join(t.split("/")[-1] for t in INPUT_TYPES)})')
+    parser.add_argument('--component', help='field of the messages, as the node\'s component '
+                        'parameter (default: the type\'s, e.g. torque.z of a WrenchStamped, '
+                        'linear_acceleration.z of an Imu)')
     parser.add_argument('--column', help='CSV signal column, by header name or 0-based index '
                         '(default: the second column)')
+    add_config_arguments(parser)
+    parser.add_argument('--format', choices=('jsonl', 'csv', 'table'), default='jsonl')
+    parser.add_argument('--plot', metavar='FILE.png', help='write a Fig. 5-like figure')
+
+
+def add_config_arguments(parser: argparse.ArgumentParser) -> None:
+    """The estimator options (``--model``, ``--band-hz``, one per scalar config field)."""
+    defaults = EstimatorConfig()
     parser.add_argument('--model', choices=MODELS, default=defaults.model)
     parser.add_argument('--band-hz', nargs=2, type=float, metavar=('LO', 'HI'),
                         help='band-pass prefilter [LO, HI] Hz (default off)')
     for name, kind in _CONFIG_OPTIONS.items():
         parser.add_argument('--' + name.replace('_', '-'), type=kind,
                             default=getattr(defaults, name), help=f'(default {getattr(defaults, name)})')
-    parser.add_argument('--format', choices=('jsonl', 'csv', 'table'), default='jsonl')
-    parser.add_argument('--plot', metavar='FILE.png', help='write a Fig. 5-like figure')
 
 
-def _load(args):
-    """(t, y, origin_ns or None, label) from the input, raising CsvError/BagError/ValueError."""
-    path = Path(args.input)
-    if path.suffix.lower() in ('.csv', '.txt'):
-        series = read_csv_series(path, args.column)
-        return series.t, series.y, None, series.name
-    if not path.exists():
-        raise ValueError(f'no such file or directory: {path}')
-    from ..io.bags import read_wrench_series
+def make_config(args: argparse.Namespace) -> EstimatorConfig:
+    """The estimator configuration of the command line (ValueError if out of range)."""
+    return EstimatorConfig().replace(
+        model=args.model, band_hz=tuple(args.band_hz) if args.band_hz else None,
+        **{name: getattr(args, name) for name in _CONFIG_OPTIONS})
 
-    series = read_wrench_series(path, args.topic, args.component)
-    if len(series) == 0:
-        raise ValueError(f'topic {series.topic} of {path} has no messages')
-    origin = int(series.stamps_ns[0])
-    return (seconds_since(series.stamps_ns, origin), series.values, origin,
-            f'{series.topic} {args.component}')
+
+def _check_times(t: np.ndarray, previous: float, count: int, name: str) -> None:
+    """ValueError unless ``t`` (after ``previous``, samples ``count`` on) strictly increases."""
+    bad = np.flatnonzero(~(np.diff(np.concatenate(([previous], t)) if count else t) > 0))
+    if bad.size:
+        i = int(bad[0]) + (0 if count else 1)
+        before = previous if i == 0 else t[i - 1]
+        raise ValueError(f'{name}: time is not strictly increasing at sample {count + i} '
+                         f'(t = {float(before)!r} then {float(t[i])!r})')
+
+
+def _check_nyquist(config: EstimatorConfig, t: np.ndarray, name: str) -> None:
+    """ValueError if the band-pass reaches above the Nyquist frequency of the samples ``t``."""
+    if config.band_hz is None or len(t) < 2:
+        return
+    nyquist = 0.5 / float(np.median(np.diff(t[:10_000])))
+    if config.band_hz[1] > nyquist:
+        raise ValueError(f'--band-hz upper edge {config.band_hz[1]:g} Hz is above the Nyquist '
+                         f'frequency {nyquist:g} Hz of {name} (sampled at {2 * nyquist:g} Hz)')
+
+
+@dataclass
+class Run:
+    """The result of :func:`estimate_signal`: the estimator (its counters), the estimates, the
+    first and last sample times, and (``keep_samples``) every ``(t, y)``."""
+
+    estimator: object
+    estimates: EstimateArrays
+    first_t: float
+    last_t: float
+    samples: Optional[Tuple[np.ndarray, np.ndarray]]
+
+
+def estimate_signal(signal: Signal, config: EstimatorConfig, keep_samples: bool = False) -> Run:
+    """Stream ``signal`` through a fresh estimator of ``config``, block by block.
+
+    Raises ValueError (no samples, time not increasing, band above Nyquist) and the readers'
+    CsvError/BagError.
+    """
+    estimator = create_estimator(config)
+    parts, kept = [], []
+    count, previous, first_t, nyquist_checked = 0, 0.0, None, False
+    for t, y in signal.blocks():
+        if len(t) == 0:
+            continue
+        _check_times(t, previous, count, str(signal.path))
+        if not nyquist_checked and count + len(t) >= 2:
+            _check_nyquist(config, np.concatenate(([previous], t)) if count else t,
+                           str(signal.path))
+            nyquist_checked = True
+        first_t = float(t[0]) if first_t is None else first_t
+        count, previous = count + len(t), float(t[-1])
+        parts.append(estimator.process(t, y))
+        if keep_samples:
+            kept.append((t, y))
+    if count == 0:
+        raise ValueError(f'{signal.path} holds no samples' if not signal.topic else
+                         f'topic {signal.topic} of {signal.path} has no messages')
+    samples = tuple(np.concatenate(p) for p in zip(*kept)) if keep_samples else None
+    return Run(estimator, EstimateArrays.concatenate(parts), first_t, previous, samples)
 
 
 def _print(estimates, origin, fmt) -> None:
@@ -91,30 +153,23 @@ def run(args: argparse.Namespace) -> int:
     from ..io.bags import BagError
 
     try:
-        config = EstimatorConfig().replace(
-            model=args.model, band_hz=tuple(args.band_hz) if args.band_hz else None,
-            **{name: getattr(args, name) for name in _CONFIG_OPTIONS})
-        t, y, origin, label = _load(args)
-        if len(t) == 0:
-            raise ValueError(f'{args.input} holds no samples')
-        bad = np.flatnonzero(~(np.diff(t) > 0))
-        if bad.size:
-            i = int(bad[0]) + 1
-            raise ValueError(f'{args.input}: time is not strictly increasing at sample {i} '
-                             f'(t = {float(t[i - 1])!r} then {float(t[i])!r})')
+        config = make_config(args)
+        signal = open_signal(args.input, args.topic, args.component, args.column)
+        result = estimate_signal(signal, config, bool(args.plot))
     except (CsvError, BagError, ValueError) as err:
         print(f'vib-estimator analyze: error: {err}', file=sys.stderr)
         return 2
-    estimator = create_estimator(config)
-    estimates = estimator.process(t, y)
-    _print(estimates, origin, args.format)
-    counters = estimator.counters
-    print('analyze: ' + ', '.join(f'{k}={counters[k]}' for k in COUNTER_NAMES),
+    estimates = result.estimates
+    _print(estimates, signal.origin_ns, args.format)
+    counters = result.estimator.counters
+    extra = f', messages_without_component={signal.skipped}' if signal.skipped else ''
+    print('analyze: ' + ', '.join(f'{k}={counters[k]}' for k in COUNTER_NAMES) + extra,
           file=sys.stderr)
     if args.plot:
         from .plotting import plot_estimates
 
         Path(args.plot).parent.mkdir(parents=True, exist_ok=True)
-        plot_estimates(args.plot, t, y, estimates.t, estimates.frequency_hz,
-                       estimates.convergence_time, title=f'{args.input}: {label}', ylabel=label)
+        plot_estimates(args.plot, *result.samples, estimates.t, estimates.frequency_hz,
+                       estimates.convergence_time, title=f'{args.input}: {signal.label}',
+                       ylabel=signal.label)
     return 0

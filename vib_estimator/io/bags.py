@@ -207,14 +207,11 @@ def read_wrench_series(path, topic: Optional[str] = None,
     value_of = component_getter(component)
     with BagReader(path) as bag:
         if topic is None:
-            wrench_topics = [t.topic for t in bag.topics.values() if t.msgtype == WRENCH_STAMPED]
-            if not wrench_topics:
-                raise BagError(f'bag {bag.path} has no {WRENCH_STAMPED} topic; its topics are '
-                               f'{bag.describe_topics()}')
-            if len(wrench_topics) > 1:
-                raise BagError(f'bag {bag.path} has several {WRENCH_STAMPED} topics, choose one: '
-                               f'{", ".join(wrench_topics)}')
-            topic = wrench_topics[0]
+            from .streaming import only_topic
+
+            topic = only_topic(bag.path, [t.topic for t in bag.topics.values()
+                                          if t.msgtype == WRENCH_STAMPED], WRENCH_STAMPED,
+                               bag.describe_topics())
         info = bag.topic(topic)
         if info.msgtype != WRENCH_STAMPED:
             raise BagError(f'topic {topic} of bag {bag.path} has type {info.msgtype}, '

@@ -111,6 +111,35 @@ def component_getter(component: str, input_type: str = WRENCH_STAMPED
     return joint_value
 
 
+def component_setter(component: str, input_type: str = WRENCH_STAMPED
+                     ) -> Callable[[object, float], None]:
+    """The inverse of :func:`component_getter`: a function ``set(msg, value)`` writing ``value``
+    into ``component`` of a message of ``input_type`` (for publishers: the simulator, tests,
+    benchmarks). For ``JointState`` the joint is appended to ``name`` when the message lacks it
+    and the array is extended to the names (with 0.0) when shorter."""
+    full = check_input_type(input_type)
+    check_component(component, full)
+    if full != JOINT_STATE:
+        *path, last = (('wrench.' if full == WRENCH_STAMPED else '') + component).split('.')
+        parent = attrgetter('.'.join(path)) if path else (lambda msg: msg)
+
+        def set_field(msg, value: float) -> None:
+            setattr(parent(msg), last, float(value))
+        return set_field
+    field, joint = _JOINT.match(component).groups()
+
+    def set_joint(msg, value: float) -> None:
+        names = list(msg.name)
+        if joint not in names:
+            names.append(joint)
+            msg.name = names
+        values = list(getattr(msg, field))
+        values += [0.0] * (len(names) - len(values))
+        values[names.index(joint)] = float(value)
+        setattr(msg, field, values)
+    return set_joint
+
+
 def stamp_ns(header) -> int:
     """A ``std_msgs/Header`` stamp as integer nanoseconds (exact)."""
     return int(header.stamp.sec) * 1_000_000_000 + int(header.stamp.nanosec)

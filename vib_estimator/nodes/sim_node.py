@@ -1,9 +1,15 @@
 """``sim_node``: the flexible arm of Section 5 (:mod:`vib_estimator.sim.arm_model`) as a ROS 2 node.
 
 Publishes the measured coupling torque (Eq. 21, scaled as in Fig. 5) as
-``geometry_msgs/WrenchStamped`` on ``coupling_torque`` (``torque.z``) at ``rate_hz``, and the Eq. 23
-frequency of the current tip mass as ``std_msgs/Float64`` on ``vibration/ground_truth`` (transient
-local, so a late subscriber gets the current value) at start and whenever it changes.
+``geometry_msgs/WrenchStamped`` on ``coupling_torque`` (``torque.z``) at ``rate_hz`` -- or, with
+``output_type`` ``sensor_msgs/msg/Imu``, the tip acceleration ``L theta_t''`` as
+``linear_acceleration.z`` on ``tip_imu`` -- and the Eq. 23 frequency of the current tip mass as
+``std_msgs/Float64`` on ``vibration/ground_truth`` (transient local, so a late subscriber gets the
+current value) at start and whenever it changes.
+
+Commands: ``position_command`` (``std_msgs/Float64``, the motor angle reference in rad) is held
+from the next sample until the next message; the first one takes over from the motion schedule
+for good (the schedule's tip-mass changes still apply).
 
 Time: with ``speed`` = 1 the node runs in real time and stamps sample ``k`` with
 ``start + k / rate_hz`` (``start`` read from the node clock), so stamps are exactly periodic. With
@@ -11,11 +17,13 @@ any other ``speed``, or with ``publish_clock`` set, it runs a simulated clock, `
 faster (or slower) than real time, publishes it on ``/clock`` and stamps samples with it
 (subscribers then set ``use_sim_time``); the simulated clock starts at :data:`SIM_TIME_ORIGIN_NS`
 (1 s) because ROS takes a zero stamp as unset.
-Samples are produced in batches by a 200 Hz steady-clock timer, as many as are due, so that high
+Samples are produced in batches by a 1 kHz steady-clock timer, as many as are due, so that high
 speeds work. Setting ``tip_mass_kg`` while running changes the frequency abruptly, as in
 Section 5.5. ``duration`` makes the node exit 0 after that much simulated time, and
 ``wait_for_subscribers`` holds the start until the consumers are matched (the demo and the tests
-use both).
+use both); ``wait_for_command`` until the first command. ``lockstep`` (simulated time) makes each
+batch wait for a command answering the previous ``/clock``, so a closed loop through other nodes
+behaves the same at any speed and load.
 """
 from __future__ import annotations
 
@@ -26,6 +34,7 @@ from typing import List, Sequence
 
 from geometry_msgs.msg import WrenchStamped
 from rcl_interfaces.msg import ParameterType, SetParametersResult
+from sensor_msgs.msg import Imu
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from rclpy.parameter import Parameter
@@ -33,19 +42,28 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock as ClockMsg
 from std_msgs.msg import Float64
 
+from ..io.fields import IMU, WRENCH_STAMPED, normalise_type
 from ..sim.arm_model import (DEFAULT_NOISE_STD, ArmParameters, ArmSimulator, Move,
-                        natural_frequency_hz)
+                             natural_frequency_hz)
 from .runner import StartupError, run
 from .parameters import declare, descriptor
 
-TICK_HZ = 200.0            # wall-clock rate of the publishing timer
+# wall-clock rate of the publishing timer: a command takes effect at the start of the next batch,
+# so a tick of 1 ms keeps that within 10 samples (20 ms simulated) at 10x (input shaping needs it)
+TICK_HZ = 1000.0
 # A tick produces at most the larger of MAX_BATCH_SECONDS of simulated time and BATCH_TICKS ticks'
 # worth: after a longer stall the node falls behind its speed (and says so) rather than bursting.
 MAX_BATCH_SECONDS = 0.1
 BATCH_TICKS = 4
 MIN_SAMPLES_PER_PERIOD = 20  # a tip mass is refused if f0 (Eq. 23) leaves fewer samples a period
 SIM_TIME_ORIGIN_NS = 1_000_000_000  # stamp of the first sample in simulated time (0 means unset)
+# lockstep: a batch is at most this much simulated time, and waits at most this long (wall) for
+# the command answering the previous batch's /clock
+LOCKSTEP_BATCH_SECONDS = 0.02
+LOCKSTEP_TIMEOUT = 1.0
 SCHEDULE_FIELDS = 4        # start, final_angle, slope, tip_mass_kg (0 = unchanged)
+#: output_type -> (message class, topic)
+OUTPUTS = {WRENCH_STAMPED: (WrenchStamped, 'coupling_torque'), IMU: (Imu, 'tip_imu')}
 
 GROUND_TRUTH_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                               durability=DurabilityPolicy.TRANSIENT_LOCAL)
@@ -115,15 +133,30 @@ PARAMETERS = {
         'default: the Section 5.3 ramp of slope 1 to 1 rad', read_only=True,
         type=ParameterType.PARAMETER_DOUBLE_ARRAY)),
     'wait_for_subscribers': (0, descriptor(
-        'the simulation starts when coupling_torque has this many subscribers (0 = at once), '
+        'the simulation starts when the output topic has this many subscribers (0 = at once), '
         'so that a sped-up run loses no sample to discovery', (0, 1000), read_only=True)),
     'duration': (0.0, descriptor('simulated seconds after which the node exits 0 '
                                   '(0 = run forever)', (0.0, 1e9), read_only=True)),
+    'wait_for_command': (False, descriptor(
+        'the simulation starts when the first position_command has arrived (in simulated time '
+        'the start of the clock is published meanwhile, so a use_sim_time commander can run)',
+        read_only=True)),
+    'lockstep': (False, descriptor(
+        'in simulated time, once commands flow, each batch of samples (at most '
+        f'{LOCKSTEP_BATCH_SECONDS * 1e3:g} ms) waits for a position_command received after the '
+        'previous /clock (at most 1 s): a commander answering every /clock (shaper_node with '
+        'use_sim_time) then acts at the simulated times it computed for, however loaded the '
+        'machine; the run goes as fast as that round trip allows, at most speed', read_only=True)),
+    'output_type': (WRENCH_STAMPED, descriptor(
+        'message of the measurement: geometry_msgs/msg/WrenchStamped (coupling torque, torque.z, '
+        'on coupling_torque) or sensor_msgs/msg/Imu (tip acceleration, linear_acceleration.z, on '
+        'tip_imu)', read_only=True)),
 }
 
 
 class SimNode(Node):
-    """The simulated arm publishing ``coupling_torque`` and ``vibration/ground_truth``."""
+    """The simulated arm publishing ``coupling_torque`` (or ``tip_imu``) and
+    ``vibration/ground_truth``, following ``position_command`` once it arrives."""
 
     def __init__(self, **kwargs):
         super().__init__('sim_node', **kwargs)
@@ -136,6 +169,10 @@ class SimNode(Node):
             raise StartupError(str(err)) from None
         if not p['frame_id']:
             raise StartupError('frame_id must not be empty')
+        self._output_type = normalise_type(p['output_type'])
+        if self._output_type not in OUTPUTS:
+            raise StartupError(f'output_type must be one of {", ".join(OUTPUTS)}, '
+                               f'got {p["output_type"]!r}')
         self._rate = p['rate_hz']
         masses = [p['tip_mass_kg']] + [mv.tip_mass_kg for mv in schedule if mv.tip_mass_kg]
         check = self._validate([Parameter('tip_mass_kg', value=m) for m in masses])
@@ -150,18 +187,32 @@ class SimNode(Node):
         self._sim_time = self._speed != 1.0 or p['publish_clock']
         self._duration = p['duration']
         self._wait_for_subscribers = p['wait_for_subscribers']
+        self._wait_for_command = p['wait_for_command']
+        self._lockstep = p['lockstep']
+        if self._lockstep and not self._sim_time:
+            raise StartupError('lockstep needs simulated time: speed other than 1 or '
+                               'publish_clock')
+        self._answered = True             # a command arrived since the last /clock (lockstep)
+        self._clock_at = 0.0              # monotonic time of the last batch's /clock
+        self.lockstep_timeouts = 0
         self._sim = ArmSimulator(
             ArmParameters(tip_mass_kg=p['tip_mass_kg'], damping_ratio=p['damping_ratio']),
-            rate_hz=self._rate, noise_std=p['noise_std'], seed=p['seed'], schedule=schedule)
+            rate_hz=self._rate, noise_std=p['noise_std'], seed=p['seed'], schedule=schedule,
+            output='torque' if self._output_type == WRENCH_STAMPED else 'tip_acceleration')
         self._sync_mass_parameter()
 
-        self._torque_pub = self.create_publisher(WrenchStamped, 'coupling_torque', 100)
+        msg_type, topic = OUTPUTS[self._output_type]
+        self._output_pub = self.create_publisher(msg_type, topic, 100)
         self._truth_pub = self.create_publisher(Float64, 'vibration/ground_truth',
                                                 GROUND_TRUTH_QOS)
         self._clock_pub = (self.create_publisher(ClockMsg, '/clock', 10)
                            if self._sim_time else None)
-        self._msg = WrenchStamped()
+        self._msg = msg_type()
         self._msg.header.frame_id = p['frame_id']
+        self._set_value = self._message_setter()
+        self.commands_received = 0
+        self.commands_skipped = 0
+        self.create_subscription(Float64, 'position_command', self._on_command, 10)
         self._clock_msg = ClockMsg()
         self._f_true = None
         self._origin_ns = (SIM_TIME_ORIGIN_NS if self._sim_time
@@ -174,7 +225,55 @@ class SimNode(Node):
                 else 'real time')
         self.get_logger().info(
             f'flexible arm: m = {p["tip_mass_kg"] * 1e3:.2f} g, f0 = {self._sim.f_true:.3f} Hz '
-            f'(Eq. 23), {self._rate:g} Hz, {mode}, {len(schedule)} move(s)')
+            f'(Eq. 23), {self._rate:g} Hz, {mode}, {len(schedule)} move(s), publishing '
+            f'{self._output_pub.topic_name} [{self._output_type}]')
+
+    def _message_setter(self):
+        """A function writing one measurement into the output message."""
+        if self._output_type == WRENCH_STAMPED:
+            torque = self._msg.wrench.torque
+
+            def set_torque(value: float) -> None:
+                torque.z = value
+            return set_torque
+        msg = self._msg
+        msg.orientation_covariance[0] = -1.0          # sensor_msgs/Imu: not provided
+        msg.angular_velocity_covariance[0] = -1.0
+        accel = msg.linear_acceleration               # covariance left 0: unknown
+
+        def set_acceleration(value: float) -> None:
+            accel.z = value
+        return set_acceleration
+
+    def _on_command(self, msg: Float64) -> None:
+        """Hold a motor-angle command from the next sample; a non-finite one is skipped, counted
+        and warned about."""
+        try:
+            self._sim.set_command(msg.data)
+        except ValueError as err:
+            self.commands_skipped += 1
+            self.get_logger().warning(f'position_command skipped: {err}',
+                                      throttle_duration_sec=5.0)
+            return
+        if not self.commands_received:
+            self.get_logger().info(f'position_command {msg.data:g} rad: commands take over from '
+                                   'the schedule')
+        self.commands_received += 1
+        was_waiting = not self._answered
+        self._answered = True
+        if self._lockstep and was_waiting:
+            self._tick()               # the answer came: the next batch now, not at the next tick
+
+    def _lockstep_wait(self) -> bool:
+        """In lockstep, whether the next batch must still wait for the commander's answer."""
+        if not self._lockstep or not self.commands_received or self._answered:
+            return False
+        if time.monotonic() - self._clock_at < LOCKSTEP_TIMEOUT:
+            return True
+        self.lockstep_timeouts += 1
+        self.get_logger().warning(f'lockstep: no position_command for {LOCKSTEP_TIMEOUT:g} s, '
+                                  'going on', throttle_duration_sec=5.0)
+        return False
 
     # ---- parameters ------------------------------------------------------------------------
     def _validate(self, params: List[Parameter]) -> SetParametersResult:
@@ -216,17 +315,28 @@ class SimNode(Node):
             self._f_true = f
             self._truth_pub.publish(Float64(data=f))
 
+    def _publish_clock(self, ns: int) -> None:
+        if self._clock_pub is not None:
+            self._clock_msg.clock.sec, self._clock_msg.clock.nanosec = divmod(ns, 1_000_000_000)
+            self._clock_pub.publish(self._clock_msg)
+
     def _tick(self) -> None:
         if self.finished:
             return
         if self._wall_start is None:
-            if self._torque_pub.get_subscription_count() < self._wait_for_subscribers:
+            if (self._output_pub.get_subscription_count() < self._wait_for_subscribers
+                    or (self._wait_for_command and not self.commands_received)):
+                self._publish_clock(self._origin_ns)
                 return
             self._wall_start = time.monotonic()
+        if self._lockstep_wait():
+            return
         due_t = (time.monotonic() - self._wall_start) * self._speed
         if self._duration > 0:
             due_t = min(due_t, self._duration)
         due = int(due_t * self._rate) + 1 - round(self._sim.t * self._rate)
+        if self._lockstep:
+            due = min(due, max(1, int(LOCKSTEP_BATCH_SECONDS * self._rate)))
         limit = int(max(MAX_BATCH_SECONDS, BATCH_TICKS * self._speed / TICK_HZ) * self._rate)
         if due > limit:
             self.get_logger().warning(
@@ -234,19 +344,18 @@ class SimNode(Node):
                 f'with speed {self._speed:g}', throttle_duration_sec=5.0)
             due = limit
         stamp = self._msg.header.stamp
-        torque = self._msg.wrench.torque
         t = None
         for _ in range(max(due, 0)):
-            t, torque.z, f = self._sim.step()
+            t, value, f = self._sim.step()
+            self._set_value(value)
             ns = self._origin_ns + round(t * 1e9)
             stamp.sec, stamp.nanosec = divmod(ns, 1_000_000_000)
-            self._torque_pub.publish(self._msg)
+            self._output_pub.publish(self._msg)
             self._publish_truth(f)
         if t is None:
             return
-        if self._clock_pub is not None:
-            self._clock_msg.clock.sec, self._clock_msg.clock.nanosec = stamp.sec, stamp.nanosec
-            self._clock_pub.publish(self._clock_msg)
+        self._publish_clock(ns)
+        self._answered, self._clock_at = False, time.monotonic()
         self._sync_mass_parameter()
         if 0 < self._duration <= self._sim.t:
             self.finished = True

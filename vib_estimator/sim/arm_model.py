@@ -20,10 +20,12 @@ Model (Trapero, Sira-Ramirez & Feliu, Section 5.1; Fig. 3):
 
       u = sat(kp (theta_m* - theta_m) - kd theta_m')
 
-  where the command ``theta_m*`` is a sequence of ramps (:class:`Move`);
-* measurement: the coupling torque at the base ``Gamma_coup = n Gamma^_coup`` as plotted in Fig. 5,
-  i.e. the bending moment ``c (theta_m - theta_t)`` seen by the strain gauges, plus seeded Gaussian
-  gauge noise, quantised.
+  where the command ``theta_m*`` is a sequence of ramps (:class:`Move`) or, once
+  :meth:`ArmSimulator.set_command` is called, the value it was last given (held);
+* measurement (``output``): the coupling torque at the base ``Gamma_coup = n Gamma^_coup`` as
+  plotted in Fig. 5, i.e. the bending moment ``c (theta_m - theta_t)`` seen by the strain gauges,
+  or the tangential acceleration of the tip ``L theta_t''`` an accelerometer there would read;
+  plus seeded Gaussian noise, quantised.
 
 With the stiff PD loop of :class:`ArmParameters` the base barely moves while the bar vibrates, so
 the observed frequency is the clamped-base one of Eq. 23 (within 0.02 %, checked by the tests).
@@ -115,6 +117,8 @@ class Move:
 
 DEFAULT_NOISE_STD = 0.004  # N m: 1.3 % of the 0.31 N m vibration of experiment_5_3
 DEFAULT_QUANTUM = 1e-4     # N m: the resolution of the torques quoted in Section 5.3
+#: what :class:`ArmSimulator` measures
+OUTPUTS = ('torque', 'tip_acceleration')
 
 
 class ArmSimulator:
@@ -124,14 +128,23 @@ class ArmSimulator:
     500 Hz = the 2 ms sample time of Section 5.2). ``schedule`` is a sequence of :class:`Move`
     applied in order of ``start`` (those at 0 s already by the constructor); the arm starts at rest
     at angle 0.
+
+    ``output`` is what :meth:`step` measures: ``'torque'`` (N m) or ``'tip_acceleration'``
+    (``L theta_t''``, m/s^2). ``noise_std`` and ``quantum`` are in N m of coupling torque; for the
+    acceleration they are divided by ``m L`` (the torque-to-acceleration factor of Eq. 19), so
+    both outputs have the same signal-to-noise ratio.
     """
 
     def __init__(self, params: ArmParameters = ArmParameters(), rate_hz: float = 500.0,
                  noise_std: float = DEFAULT_NOISE_STD, quantum: float = DEFAULT_QUANTUM,
                  seed: int = 0, schedule: Sequence[Move] = (Move(0.0, 1.0),),
-                 substeps: int = 8):
+                 substeps: int = 8, output: str = 'torque'):
         if not rate_hz > 0 or substeps < 1 or noise_std < 0 or quantum < 0:
             raise ValueError('rate_hz and substeps must be > 0, noise_std and quantum >= 0')
+        if output not in OUTPUTS:
+            raise ValueError(f'output must be one of {", ".join(OUTPUTS)}, got {output!r}')
+        self.output = output
+        self.commanded = False            # set_command took over from the schedule
         self.params = params
         self.rate_hz = float(rate_hz)
         self.noise_std = float(noise_std)
@@ -173,14 +186,32 @@ class ArmSimulator:
         self._tip_inertia = inertia
         self._bar_damping = 2 * p.damping_ratio * (2 * math.pi * f0) * inertia
 
+    def set_command(self, angle: float) -> None:
+        """Hold the motor command at ``angle`` rad from the next sample on; the schedule's ramps
+        stop for good (its tip-mass changes still apply)."""
+        angle = float(angle)
+        if not math.isfinite(angle):
+            raise ValueError(f'command must be finite, got {angle!r}')
+        self.commanded = True
+        self._command = self._target = angle
+
     def _apply_moves(self, t: float) -> None:
         while self._next_move < len(self._moves) and self._moves[self._next_move].start <= t:
             mv = self._moves[self._next_move]
             self._next_move += 1
-            self._target = float(mv.final_angle)
-            self._slope = abs(float(mv.slope))
+            if not self.commanded:
+                self._target = float(mv.final_angle)
+                self._slope = abs(float(mv.slope))
             if mv.tip_mass_kg is not None:
                 self.set_tip_mass(mv.tip_mass_kg)
+
+    def _measure(self, x, u) -> float:
+        """The noise-free output at state ``x`` under voltage ``u``, and its noise scale."""
+        p = self.params
+        if self.output == 'torque':
+            return p.stiffness * (x[0] - x[2]), 1.0
+        scale = 1.0 / (p.tip_mass_kg * p.length)
+        return p.length * self._derivatives(x, u)[3], scale
 
     def _derivatives(self, x, u):
         p = self.params
@@ -192,7 +223,8 @@ class ArmSimulator:
         return (wm, motor_torque / (p.inertia * n), wt, bend / self._tip_inertia)
 
     def step(self) -> Tuple[float, float, float]:
-        """Advance one sample: ``(t, measured coupling torque in N m, true f0 in Hz)``.
+        """Advance one sample: ``(t, measured output, true f0 in Hz)``; the output is the coupling
+        torque in N m or the tip acceleration in m/s^2 (``output``).
 
         The sample at ``t`` is taken before the state advances to ``t + 1/rate_hz``.
         """
@@ -200,14 +232,14 @@ class ArmSimulator:
         self._apply_moves(t)
         p = self.params
         x = self._x
-        torque = p.stiffness * (x[0] - x[2])
-        if self.noise_std:
-            torque += self.noise_std * self._rng.standard_normal()
-        if self.quantum:
-            torque = self.quantum * round(torque / self.quantum)
-        f_true = self.f_true
         u = p.kp * (self._command - x[0]) - p.kd * x[1]
         u = min(max(u, -p.max_voltage), p.max_voltage)
+        y, scale = self._measure(x, u)
+        if self.noise_std:
+            y += scale * self.noise_std * self._rng.standard_normal()
+        if self.quantum:
+            y = scale * self.quantum * round(y / (scale * self.quantum))
+        f_true = self.f_true
         h = self._h
         for _ in range(self._substeps):
             k1 = self._derivatives(x, u)
@@ -217,12 +249,16 @@ class ArmSimulator:
             x = [a + h / 6 * (b1 + 2 * b2 + 2 * b3 + b4)
                  for a, b1, b2, b3, b4 in zip(x, k1, k2, k3, k4)]
         self._x = x
+        return self._advance_command(t, y, f_true)
+
+    def _advance_command(self, t: float, y: float, f_true: float) -> Tuple[float, float, float]:
+        """Move the scheduled ramp one sample on (a held command stays) and count the sample."""
         step = self._slope / self.rate_hz
         err = self._target - self._command
         self._command = (self._target if abs(err) <= step
                          else self._command + math.copysign(step, err))
         self._k += 1
-        return t, torque, f_true
+        return t, y, f_true
 
 
 @dataclass
@@ -237,9 +273,10 @@ class Recording:
 def simulate(duration: float, schedule: Sequence[Move] = (Move(0.0, 1.0),),
              params: ArmParameters = ArmParameters(), rate_hz: float = 500.0,
              noise_std: float = DEFAULT_NOISE_STD, seed: int = 0,
-             quantum: float = DEFAULT_QUANTUM) -> Recording:
-    """Simulate ``duration`` s of the arm under ``schedule`` and return the :class:`Recording`."""
-    sim = ArmSimulator(params, rate_hz, noise_std, quantum, seed, schedule)
+             quantum: float = DEFAULT_QUANTUM, output: str = 'torque') -> Recording:
+    """Simulate ``duration`` s of the arm under ``schedule`` and return the :class:`Recording`
+    (its ``torque`` column holds the ``output``)."""
+    sim = ArmSimulator(params, rate_hz, noise_std, quantum, seed, schedule, output=output)
     rows = np.array([sim.step() for _ in range(int(round(duration * rate_hz)))]).reshape(-1, 3)
     return Recording(rows[:, 0].copy(), rows[:, 1].copy(), rows[:, 2].copy())
 

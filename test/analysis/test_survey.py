@@ -1,0 +1,118 @@
+"""``vib-estimator survey``: rows equal per-file analyze, bad recordings, the alarm, Dask."""
+import json
+import math
+
+import numpy as np
+import pytest
+
+from vib_estimator.analysis import survey as S
+from vib_estimator.cli import main
+from vib_estimator.core import EstimatorConfig
+from vib_estimator.io.bags import WrenchSeries, write_wrench_series
+
+EPOCH = 1_767_225_600 * 10 ** 9
+DAY = 86_400 * 10 ** 9
+
+
+def fleet(root, freqs, seed=0):
+    """One 6 s bag per day, a noisy sine of the day's frequency."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(0, 6, 0.002)
+    for day, f in enumerate(freqs):
+        y = 0.3 * np.sin(2 * np.pi * f * t + day) + 0.003 * rng.standard_normal(len(t))
+        stamps = EPOCH + day * DAY + np.round(t * 1e9).astype(np.int64)
+        write_wrench_series(root / f'day_{day:02d}', WrenchSeries(stamps, y, 'arm', '/torque'))
+    return sorted(root.glob('day_*'))
+
+
+def jsonl(text):
+    return [json.loads(line) for line in text.splitlines()]
+
+
+def test_rows_equal_per_file_analyze(tmp_path, capsys):
+    days = fleet(tmp_path, [1.3, 1.31, 1.32])
+    np.savetxt(tmp_path / 'sine.csv', np.column_stack([np.arange(3000) * 0.002,
+                                                       np.sin(np.arange(3000) * 0.002 * 9)]),
+               delimiter=',', header='t,y', comments='')
+    assert main(['survey', str(tmp_path), '--format', 'jsonl', '--jobs', '1']) == 0
+    rows = jsonl(capsys.readouterr().out)
+    assert [r['recording'] for r in rows] == [str(p) for p in days] + [str(tmp_path / 'sine.csv')]
+    for row in rows:
+        assert main(['analyze', row['recording'], '--format', 'jsonl']) == 0
+        out = capsys.readouterr()
+        estimates = jsonl(out.out)
+        freqs = np.array([e['frequency_hz'] for e in estimates])
+        assert row['estimates'] == len(estimates) > 5
+        assert row['frequency_hz'] == float(np.median(freqs))
+        assert row['frequency_lo_hz'] <= row['frequency_hz'] <= row['frequency_hi_hz']
+        assert f"received={row['samples']}," in out.err
+        assert f"rejected_fit={row['rejected_fit']}," in out.err
+    assert rows[0]['start_utc'] == '2026-01-01T00:00:00Z' and rows[1]['start_utc'][:10] == \
+        '2026-01-02'
+    assert rows[-1]['start_utc'] == '' and rows[-1]['topic'] == ''
+    assert math.isclose(rows[0]['duration_s'], 5.998)
+
+
+def test_a_corrupt_recording_is_one_error_row(tmp_path, capsys):
+    fleet(tmp_path, [1.3, 1.3])
+    (tmp_path / 'broken.mcap').write_bytes(b'\x89MCAP0\r\n garbage')
+    (tmp_path / 'bad.csv').write_text('t,y\n0,1\n0.1,x\n')
+    args = ['survey', str(tmp_path), '--format', 'csv', '--jobs', '2']
+    assert main(args) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].split(',')[:4] == ['recording', 'topic', 'component', 'mode']
+    errors = [line for line in lines[1:] if not line.endswith(',False,')]
+    assert len(lines) == 5 and len(errors) == 2
+    assert 'not numbers' in errors[0] and 'broken.mcap' in errors[1]
+    assert main(args + ['--strict']) == 1
+    capsys.readouterr()
+
+
+def test_alarm_on_a_seeded_drift_and_none_without(tmp_path, capsys):
+    drift = fleet(tmp_path / 'drift', [1.3] * 4 + [1.3 * 0.95] * 2)
+    steady = fleet(tmp_path / 'steady', [1.3] * 6, seed=1)
+    out = tmp_path / 'rows.parquet'
+    assert main(['survey', str(tmp_path / 'drift'), '--baseline', str(drift[0]), '--alarm-rel',
+                 '0.02', '--format', 'jsonl', '--jobs', '1', '--fail-on-alarm',
+                 '--out', str(out), '--plot', str(tmp_path / 'trend.png')]) == 3
+    rows = jsonl(capsys.readouterr().out)
+    assert [r['alarm'] for r in rows] == [False] * 4 + [True] * 2
+    assert all(-0.06 < r['change_rel'] < -0.04 for r in rows[4:])
+    import pyarrow.parquet as pq
+    assert pq.read_table(out).column('alarm').to_pylist() == [r['alarm'] for r in rows]
+    assert (tmp_path / 'trend.png').stat().st_size > 10_000
+    assert main(['survey', str(tmp_path / 'steady'), '--baseline', '1.3', '--alarm-rel', '0.02',
+                 '--format', 'jsonl', '--jobs', '1', '--fail-on-alarm']) == 0
+    assert not any(r['alarm'] for r in jsonl(capsys.readouterr().out))
+    assert steady
+
+
+@pytest.mark.parametrize('args, message', [
+    (['--baseline', 'nowhere'], 'neither a frequency'),
+    (['--out', 'x.xlsx'], '--out must end'),
+    (['--jobs', '0'], '--jobs'),
+])
+def test_bad_arguments_exit_2(tmp_path, capsys, args, message):
+    assert main(['survey', str(tmp_path)] + args) == 2
+    err = capsys.readouterr().err
+    assert message in err and len(err.strip().splitlines()) == 1
+
+
+def test_median_interval():
+    x = np.arange(100.0)
+    f, lo, hi = S.median_interval(x)
+    assert (f, lo, hi) == (49.5, 39.0, 60.0)
+    assert math.isnan(S.median_interval(np.arange(5.0))[1])
+
+
+def test_dask_cluster_gives_identical_rows(tmp_path):
+    distributed = pytest.importorskip('distributed')
+    recordings = S.find_recordings([str(p) for p in fleet(tmp_path, [1.3, 1.35, 1.4])]
+                                   + [str(tmp_path / 'missing.mcap')])
+    options = S.Options(EstimatorConfig())
+    local = S.survey(recordings, options, jobs=1)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster:
+        remote = S.survey(recordings, options, scheduler=cluster.scheduler_address)
+    assert json.dumps(remote) == json.dumps(local)
+    assert local[-1]['error'] and not local[0]['error']

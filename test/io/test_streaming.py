@@ -1,0 +1,212 @@
+"""Streaming readers: same samples as the reference readers, every input type, bounded blocks."""
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from vib_estimator.io import streaming
+from vib_estimator.io.bags import (TYPESTORE, BagError, BagWriter, WrenchSeries, read_wrench_series,
+                                   write_wrench_series)
+from vib_estimator.io.cdr import DOUBLE_INDEX
+from vib_estimator.io.csv_reader import CsvError, read_csv_series
+from vib_estimator.io.fields import INPUT_TYPES, JOINT_STATE, component_getter
+from vib_estimator.io.streaming import open_signal
+
+EPOCH = 1_700_000_000_000_000_000
+SHARED_BAGS = Path(__file__).resolve().parents[2].parent / 'shared' / 'ros2-bags'
+
+
+def collect(signal):
+    parts = list(signal.blocks())
+    return tuple(np.concatenate(p) for p in zip(*parts)), parts
+
+
+def make_message(msgtype, stamp, frame, value, k):
+    """A rosbags message of ``msgtype`` whose every double is distinct (value + index)."""
+    T = TYPESTORE.types
+    header = T['std_msgs/msg/Header'](stamp=T['builtin_interfaces/msg/Time'](
+        sec=stamp // 10 ** 9, nanosec=stamp % 10 ** 9), frame_id=frame)
+    v3 = lambda a: T['geometry_msgs/msg/Vector3'](x=a, y=a + 1, z=a + 2)  # noqa: E731
+    if msgtype == 'std_msgs/msg/Float64':
+        return T[msgtype](data=value)
+    if msgtype == 'geometry_msgs/msg/WrenchStamped':
+        return T[msgtype](header=header, wrench=T['geometry_msgs/msg/Wrench'](
+            force=v3(value), torque=v3(value + 3)))
+    if msgtype == 'geometry_msgs/msg/AccelStamped':
+        return T[msgtype](header=header, accel=T['geometry_msgs/msg/Accel'](
+            linear=v3(value), angular=v3(value + 3)))
+    if msgtype == 'geometry_msgs/msg/Vector3Stamped':
+        return T[msgtype](header=header, vector=v3(value))
+    if msgtype == 'sensor_msgs/msg/Imu':
+        q = T['geometry_msgs/msg/Quaternion'](x=0.0, y=0.0, z=0.0, w=1.0)
+        cov = np.arange(9, dtype=np.float64)
+        return T[msgtype](header=header, orientation=q, orientation_covariance=cov,
+                          angular_velocity=v3(value), angular_velocity_covariance=cov,
+                          linear_acceleration=v3(value + 3), linear_acceleration_covariance=cov)
+    names = ['joint1', 'joint2'] if k % 3 else ['joint2']          # joint1 absent every 3rd
+    arr = np.array([value, -value][:len(names)])
+    return T[JOINT_STATE](header=header, name=names, position=arr, velocity=arr, effort=arr)
+
+
+@pytest.mark.parametrize('storage', ['mcap', 'sqlite3'])
+@pytest.mark.parametrize('msgtype', INPUT_TYPES)
+def test_every_type_equals_the_rosbags_deserialiser(tmp_path, msgtype, storage):
+    frames = ['', 'a', 'arm_base', 'seven77', 'a_much_longer_frame_name']   # all alignments
+    n = 300
+    stamps = EPOCH + np.arange(n, dtype=np.int64) * 2_000_000 + 7
+    msgs = [make_message(msgtype, int(s), frames[k % 5], 0.1 * k, k) for k, s in enumerate(stamps)]
+    with BagWriter(tmp_path / 'bag', storage) as bag:
+        conn = bag.add_topic('/x', msgtype)
+        for k, (s, m) in enumerate(zip(stamps.tolist(), msgs)):
+            bag.write_message(conn, s + 1000, m)     # log time after the stamp
+    components = (['effort[joint1]', 'position[joint2]'] if msgtype == JOINT_STATE
+                  else list(DOUBLE_INDEX[msgtype]))
+    for component in components:
+        get = component_getter(component, msgtype)
+        keep = [k for k, m in enumerate(msgs) if get(m) is not None]
+        signal = open_signal(tmp_path / 'bag', component=component)
+        (t, y), _ = collect(signal)
+        assert y.tolist() == [float(get(msgs[k])) for k in keep]
+        base = stamps + 1000 if msgtype == 'std_msgs/msg/Float64' else stamps
+        assert signal.origin_ns == base[keep[0]]
+        assert t.tolist() == ((base[keep] - base[keep[0]]) * 1e-9).tolist()
+        assert signal.skipped == n - len(keep)
+
+
+def test_fast_path_is_taken_and_matches_the_reference_reader(tmp_path):
+    n = 50_000
+    stamps = EPOCH + np.arange(n, dtype=np.int64) * 2_000_000
+    y = np.sin(np.arange(n) * 0.01)
+    write_wrench_series(tmp_path / 'bag', WrenchSeries(stamps, y, 'arm', '/w'))
+    plan = streaming._mcap_plan(sorted((tmp_path / 'bag').glob('*.mcap')), '/w')
+    assert len(plan) > 1                                        # several chunks, indexed
+    (t, values), parts = collect(open_signal(tmp_path / 'bag'))
+    ref = read_wrench_series(tmp_path / 'bag')
+    assert np.array_equal(values, ref.values)
+    assert np.array_equal(t, (ref.stamps_ns - ref.stamps_ns[0]) * 1e-9)
+
+
+def test_blocks_are_bounded_whatever_the_length(tmp_path, monkeypatch):
+    """Constant memory by construction: no block exceeds the block size, however long the file."""
+    monkeypatch.setattr(streaming, 'BLOCK_SAMPLES', 4096)
+    monkeypatch.setattr(streaming, 'CSV_BLOCK_BYTES', 1 << 16)
+    n = 200_000
+    t = np.arange(n) * 0.001
+    path = tmp_path / 'big.csv'
+    np.savetxt(path, np.column_stack([t, np.cos(t)]), delimiter=',', header='t,y', comments='')
+    (tt, yy), parts = collect(open_signal(path))
+    assert len(parts) > 20 and max(len(p[0]) for p in parts) <= (1 << 16) // 10
+    assert np.array_equal(tt, t) and np.array_equal(yy, np.cos(t))
+    stamps = EPOCH + np.arange(60_000, dtype=np.int64) * 1_000_000
+    write_wrench_series(tmp_path / 'bag', WrenchSeries(stamps, np.zeros(60_000), 'f', '/w'))
+    _, parts = collect(open_signal(tmp_path / 'bag'))
+    # one chunk of the file (~13k messages of 1 MB) on top of a full block at most
+    assert len(parts) > 3 and max(len(p[0]) for p in parts) < 4096 + 20_000
+
+
+@pytest.mark.parametrize('text', [
+    '# comment\nt,y\n0,1\n# in between\n0.5, 2\n1,\n2,nan\n',     # exact-rules fallback
+    't,y,z\n0,1,9\n0.5,2,9\n1,3,9,extra\n',                         # ragged rows
+    '0,1\n0.5,2\n1,inf\n',                                          # no header
+])
+def test_csv_fast_and_exact_paths_agree(tmp_path, text):
+    path = tmp_path / 'a.csv'
+    path.write_text(text)
+    series = read_csv_series(path)
+    rows = [line.split(',') for line in text.splitlines()
+            if line and not line.startswith('#') and not line.startswith('t')]
+    expect = [float(r[1]) if r[1].strip() else float('nan') for r in rows]
+    assert np.array_equal(series.y, expect, equal_nan=True)
+
+
+def test_csv_error_in_a_late_block_names_the_row(tmp_path, monkeypatch):
+    monkeypatch.setattr(streaming, 'CSV_BLOCK_BYTES', 1 << 12)
+    lines = [f'{i * 0.01},{i}' for i in range(5000)]
+    lines[4000] = '40.0,oops'
+    path = tmp_path / 'a.csv'
+    path.write_text('t,y\n' + '\n'.join(lines))
+    with pytest.raises(CsvError, match='data row 4002 is not numbers'):
+        list(open_signal(path).blocks())
+
+
+def test_topic_choice_and_errors(tmp_path):
+    stamps = EPOCH + np.arange(10, dtype=np.int64)
+    with BagWriter(tmp_path / 'two') as bag:
+        a = bag.add_topic('/a', 'geometry_msgs/msg/WrenchStamped')
+        b = bag.add_topic('/b', 'std_msgs/msg/Float64')
+        for s in stamps.tolist():
+            bag.write_message(a, s, make_message('geometry_msgs/msg/WrenchStamped', s, 'f', 1.0, 0))
+            bag.write_message(b, s, make_message('std_msgs/msg/Float64', s, 'f', 2.0, 0))
+    with pytest.raises(BagError, match=r'several input-type topics, choose one with --topic: /a \(geometry_msgs/msg/WrenchStamped\)'
+                                       r'.*/b \(std_msgs/msg/Float64\)'):
+        open_signal(tmp_path / 'two')
+    assert open_signal(tmp_path / 'two', '/b').component == 'data'
+    with pytest.raises(ValueError, match='component of std_msgs/msg/Float64'):
+        open_signal(tmp_path / 'two', '/b', 'torque.z')
+    shutil.copytree(tmp_path / 'two', tmp_path / 'noindex')
+    (tmp_path / 'noindex' / 'metadata.yaml').unlink()
+    with pytest.raises(BagError, match='vib-estimator reindex'):
+        open_signal(tmp_path / 'noindex')
+
+
+@pytest.mark.parametrize('name', ['mcap_wbag', 'sqlite3_wbag'])
+def test_real_split_bags_list_their_topics(name):
+    """Split bags of the real rosbag2 (String topics only): the error names the topics."""
+    if not SHARED_BAGS.is_dir():
+        pytest.skip('shared/ros2-bags is absent')
+    with pytest.raises(BagError, match='no input-type topic; its topics are .*AAA'):
+        open_signal(SHARED_BAGS / name)
+
+
+def test_split_bag_is_read_across_its_files_in_log_time_order(tmp_path):
+    """Two storage files whose times interleave (as rosbag2's wbag): merged by log time."""
+    n = 400
+    stamps = EPOCH + np.arange(n, dtype=np.int64) * 1_000_000
+    halves = [stamps[0::2], stamps[1::2]]
+    for i, part in enumerate(halves):
+        write_wrench_series(tmp_path / f'p{i}', WrenchSeries(part, part * 1e-15, 'f', '/w'))
+    split = tmp_path / 'split'
+    split.mkdir()
+    import yaml
+    meta = yaml.safe_load((tmp_path / 'p0' / 'metadata.yaml').read_text())
+    info = meta['rosbag2_bagfile_information']
+    files = []
+    for i in range(2):
+        src = next((tmp_path / f'p{i}').glob('*.mcap'))
+        shutil.copy(src, split / f'split_{i}.mcap')
+        files.append(f'split_{i}.mcap')
+    info['relative_file_paths'] = files
+    info['files'] = [{'path': f, 'starting_time': info['starting_time'], 'duration':
+                      info['duration'], 'message_count': n // 2} for f in files]
+    info['message_count'] = n
+    info['topics_with_message_count'][0]['message_count'] = n
+    (split / 'metadata.yaml').write_text(yaml.safe_dump(meta))
+    signal = open_signal(split)
+    (t, y), _ = collect(signal)
+    assert np.array_equal(y, stamps * 1e-15)
+
+
+@pytest.mark.parametrize('mode', ['STORAGE', 'FILE', 'MESSAGE'])
+def test_compressed_bags(tmp_path, mode):
+    """zstd chunks (what rosbag2's MCAP writer does) on the fast path; whole-file and per-message
+    compression through rosbags."""
+    from rosbags.rosbag2 import CompressionFormat, CompressionMode, StoragePlugin, Writer
+    from vib_estimator.io.bags import WRENCH_STAMPED, wrench_message
+    n = 3000
+    stamps = EPOCH + np.arange(n, dtype=np.int64) * 2_000_000
+    values = np.cos(np.arange(n) * 0.1)
+    writer = Writer(tmp_path / 'bag', version=8, storage_plugin=StoragePlugin.MCAP)
+    writer.set_compression(getattr(CompressionMode, mode), CompressionFormat.ZSTD)
+    with writer:
+        conn = writer.add_connection('/w', WRENCH_STAMPED, typestore=TYPESTORE)
+        for s, v in zip(stamps.tolist(), values.tolist()):
+            writer.write(conn, s, TYPESTORE.serialize_cdr(wrench_message(s, 'f', 'torque.z', v),
+                                                         WRENCH_STAMPED))
+    (t, y), _ = collect(open_signal(tmp_path / 'bag'))
+    assert y.tolist() == values.tolist()
+    assert np.array_equal(t, (stamps - stamps[0]) * 1e-9)
+    if mode == 'STORAGE':
+        plan = streaming._mcap_plan(sorted((tmp_path / 'bag').glob('*.mcap')), '/w')
+        with plan[0].path.open('rb') as handle:        # zstd chunks, read by the fast path
+            assert streaming._read_chunk(handle, plan[0])[1].size > 0

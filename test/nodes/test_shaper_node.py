@@ -1,0 +1,194 @@
+"""shaper_node end to end, in process, on a simulated clock the test advances itself: a step
+reference in, the shaper's staircase out; a new estimate is switched in only at rest; damping and
+parameters; /diagnostics. Then the whole loop as processes: ``vib-estimator demo --shaping`` on a
+short run (its pass criterion)."""
+from __future__ import annotations
+
+import math
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from builtin_interfaces.msg import Time
+from diagnostic_msgs.msg import DiagnosticArray
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from rosgraph_msgs.msg import Clock
+from std_msgs.msg import Float64
+
+from vib_estimator.nodes.runner import StartupError, spin_until
+from vib_estimator.nodes.shaper_node import ShaperNode
+
+RATE = 500.0
+STEP_NS = 10_000_000        # the test's clock advances 10 ms (5 samples) a step
+
+
+def shaper_node(context, **params):
+    return ShaperNode(context=context, parameter_overrides=[
+        Parameter(name, value=value) for name, value in params.items()])
+
+
+class Rig:
+    """A probe node driving the shaper: /clock, reference, estimates; records the commands."""
+
+    def __init__(self, context, executor, node):
+        self.executor, self.node = executor, node
+        self.probe = Node('probe', context=context)
+        self.clock_pub = self.probe.create_publisher(Clock, '/clock', 10)
+        self.pubs = {topic: self.probe.create_publisher(Float64, topic, 10) for topic in
+                     ('reference', 'vibration/frequency', 'vibration/damping_ratio')}
+        self.commands = []                 # (clock ns when received, value)
+        self.diagnostics = []
+        self.now_ns = 1_000_000_000
+        self.sub = self.probe.create_subscription(
+            Float64, 'position_command', lambda m: self.commands.append((self.now_ns, m.data)), 100)
+        self.probe.create_subscription(DiagnosticArray, '/diagnostics',
+                                       lambda m: self.diagnostics.append(m.status[0]), 10)
+        for n in (node, self.probe):
+            executor.add_node(n)
+        assert spin_until(executor, lambda: self.sub.get_publisher_count() >= 1 and all(
+            p.get_subscription_count() >= 1 for p in self.pubs.values())
+            and self.clock_pub.get_subscription_count() >= 1, 10.0)
+        self.tick()
+
+    def publish(self, topic, value):
+        self.pubs[topic].publish(Float64(data=value))
+
+    def tick(self, steps=1):
+        """Advance the clock one step at a time, each time waiting for the command it causes."""
+        for _ in range(steps):
+            self.now_ns += STEP_NS
+            n = len(self.commands)
+            published = self.node.counters['commands_published']
+            sec, nsec = divmod(self.now_ns, 10 ** 9)
+            self.clock_pub.publish(Clock(clock=Time(sec=sec, nanosec=nsec)))
+            if self.node._reference is not None:
+                assert spin_until(self.executor, lambda: len(self.commands) > n
+                                  and self.node.counters['commands_published'] > published, 5.0)
+            else:
+                spin_until(self.executor, lambda: False, 0.02)
+
+    def wait(self, predicate):
+        assert spin_until(self.executor, predicate, 5.0)
+
+    def plateau(self, value, start):
+        """Seconds of clock over which the command held ``value`` after index ``start``."""
+        times = [t for t, v in self.commands[start:] if v == pytest.approx(value, abs=1e-9)]
+        return (times[-1] - times[0]) * 1e-9 + STEP_NS * 1e-9 if times else 0.0
+
+    def close(self):
+        for n in (self.node, self.probe):
+            self.executor.remove_node(n)
+            n.destroy_node()
+
+
+def test_step_reference_shaped_and_retuned_only_at_rest(ros_context, executor):
+    node = shaper_node(ros_context, use_sim_time=True, shaper='zv', rate_hz=RATE)
+    rig = Rig(ros_context, executor, node)
+    try:
+        rig.publish('reference', 0.0)
+        rig.wait(lambda: node.counters['references'] == 1)
+        rig.tick(3)
+        assert node.status().message.startswith('passing through')
+        # first estimate: ZV for 1.25 Hz has impulses 0.5 at 0 and 0.5 at 0.4 s
+        rig.publish('vibration/frequency', 1.25)
+        rig.publish('vibration/damping_ratio', math.nan)     # a model without damping: ignored
+        rig.wait(lambda: node.counters['frequency_estimates'] == 1)
+        rig.tick(2)
+        assert node._shaper.shaper.name == 'zv' and node._shaper.retunes == 1
+        start = len(rig.commands)
+        rig.publish('reference', 1.0)
+        rig.wait(lambda: node.counters['references'] == 2)
+        rig.tick(20)                                    # 0.2 s into the move
+        rig.publish('vibration/frequency', 2.5)          # mid-move: must wait for rest
+        rig.wait(lambda: node.counters['frequency_estimates'] == 2)
+        rig.tick(60)
+        values = {round(v, 9) for _, v in rig.commands[start:]}
+        assert values == {0.5, 1.0}, values              # the staircase, no other level
+        assert rig.plateau(0.5, start) == pytest.approx(0.4, abs=0.011)   # old design kept
+        assert node._shaper.shaper.frequency_hz == 2.5 and node._shaper.retunes == 2
+        # the next move uses the new design: ZV for 2.5 Hz, 0.2 s between impulses
+        start = len(rig.commands)
+        rig.publish('reference', 0.0)
+        rig.wait(lambda: node.counters['references'] == 3)
+        rig.tick(40)
+        assert {round(v, 9) for _, v in rig.commands[start:]} == {0.5, 0.0}
+        assert rig.plateau(0.5, start) == pytest.approx(0.2, abs=0.011)
+        status = node.status()
+        values = {kv.key: kv.value for kv in status.values}
+        assert values['shaper'] == 'zv' and float(values['design_frequency_hz']) == 2.5
+        assert values['damping_source'] == 'parameter' and values['retunes'] == '2'
+        # a damping estimate redesigns for it (at rest: at once)
+        rig.publish('vibration/damping_ratio', 0.05)
+        rig.wait(lambda: node.counters['damping_estimates'] == 1)
+        rig.tick(2)
+        assert node._shaper.shaper.damping == 0.05
+        assert node.design_mode()[2] == 'estimate'
+        rig.wait(lambda: rig.diagnostics and rig.diagnostics[-1].name == '/shaper_node')
+    finally:
+        rig.close()
+
+
+def test_initial_frequency_and_bad_inputs(ros_context, executor):
+    node = shaper_node(ros_context, use_sim_time=True, shaper='zvd', initial_frequency_hz=1.25,
+                       rate_hz=RATE)
+    rig = Rig(ros_context, executor, node)
+    try:
+        rig.publish('reference', 2.0)
+        rig.publish('reference', math.nan)
+        rig.publish('vibration/frequency', math.inf)
+        rig.publish('vibration/frequency', -1.0)
+        rig.publish('vibration/damping_ratio', 0.9)
+        rig.wait(lambda: node.counters['references_skipped'] == 1
+                 and node.counters['estimates_ignored'] == 3)
+        rig.tick(2)
+        assert node._shaper.shaper.name == 'zvd' and node._shaper.shaper.frequency_hz == 1.25
+        assert rig.commands[-1][1] == 2.0                 # at rest: the reference itself
+        start = len(rig.commands)
+        rig.publish('reference', 3.0)
+        rig.wait(lambda: node.counters['references'] == 2)
+        rig.tick(90)
+        assert {round(v, 9) for _, v in rig.commands[start:]} == {2.25, 2.75, 3.0}
+    finally:
+        rig.close()
+
+
+def test_parameters(ros_context, executor):
+    with pytest.raises(StartupError, match='shaper must be one of'):
+        shaper_node(ros_context, shaper='bang-bang')
+    with pytest.raises(StartupError):
+        shaper_node(ros_context, damping_ratio=0.9)
+    node = shaper_node(ros_context, initial_frequency_hz=2.0)
+    try:
+        for name, value in (('shaper', 'foo'), ('damping_ratio', -0.1), ('rate_hz', 100.0),
+                            ('median_of', 0), ('initial_frequency_hz', -1.0)):
+            result = node.set_parameters([Parameter(name, value=value)])[0]
+            assert not result.successful and result.reason, name
+        assert node.set_parameters([Parameter('shaper', value='ei')])[0].successful
+        assert node._shaper.pending.name == 'ei'          # waits for the first reference
+        assert node.set_parameters([Parameter('median_of', value=3)])[0].successful
+        for f in (1.0, 5.0, 1.2):
+            node._on_frequency(Float64(data=f))
+        assert node.design_mode()[0] == 1.2
+        node._on_frequency(Float64(data=1.4))
+        assert node.design_mode()[0] == 1.4               # median of 5.0, 1.2, 1.4
+    finally:
+        node.destroy_node()
+
+
+def test_live_demo_short_run(tmp_path):
+    """vib-estimator demo --shaping end to end (sim_node, estimator_node, shaper_node as
+    processes, in lockstep), on 6 simulated seconds per mass."""
+    exe = Path(sys.executable).parent / 'vib-estimator'
+    out = tmp_path / 'shaping.png'
+    proc = subprocess.run(
+        [str(exe), 'demo', '--shaping', '--seconds-per-mass', '6', '--speed', '20',
+         '--domain-id', os.environ['ROS_DOMAIN_ID'], '--out', str(out)],
+        capture_output=True, text=True, timeout=240)
+    assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
+    assert 'PASS' in proc.stdout and out.stat().st_size > 10_000
+    bad = subprocess.run([str(exe), 'demo', '--shaping', '--seconds-per-mass', '3'],
+                         capture_output=True, text=True, timeout=60)
+    assert bad.returncode == 2 and bad.stderr.startswith('error:')

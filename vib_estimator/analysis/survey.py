@@ -1,0 +1,444 @@
+"""``vib-estimator survey``: many recordings at once, one summary row each, and a health alarm.
+
+Inputs are files, directories (searched recursively: a directory with ``metadata.yaml`` is one
+rosbag2 bag; ``.mcap``, ``.db3`` and ``.csv`` files elsewhere are recordings) and globs. Each
+recording is streamed (:mod:`..io.streaming`) through the same estimator as ``analyze``; a row is
+written per recording x topic x component (x mode with ``--modes``): first stamp (ISO 8601 UTC),
+duration, samples, estimates, the median frequency and its distribution-free 95 % interval, the
+median damping ratio and amplitude, and the estimator's counters.
+
+Health monitoring: against ``--baseline`` (a recording, whose rows are matched by topic,
+component and mode, or a frequency in Hz), a row is flagged (``alarm``) when the relative change
+of its median frequency is beyond ``--alarm-rel`` with 95 % confidence, i.e. the whole interval
+of the change (both medians' intervals combined) lies outside [-R, R].
+
+Recordings are independent tasks: ``--jobs N`` runs them on a local process pool
+(``concurrent.futures``), ``--scheduler ADDRESS`` on a Dask distributed cluster (``dask scheduler``,
+``dask worker ADDRESS``; every worker must have this package and see the files). Rows come back in
+the order of the sorted recordings, whatever finished first, so every engine gives the same rows.
+A recording that fails is one row with ``error`` set. Exit status: 0; 3 when ``--fail-on-alarm``
+and a row is flagged; 1 when ``--strict`` and a row has an error; 2 for bad arguments.
+"""
+from __future__ import annotations
+
+import argparse
+import glob
+import json
+import math
+import os
+import sys
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import Dict, Iterable, List, Optional, Sequence, Tuple
+
+import numpy as np
+
+from ..core import COUNTER_NAMES, EstimatorConfig
+from ..io.csv_reader import CsvError
+from ..io.fields import DEFAULT_COMPONENT, check_component
+from ..io.streaming import bag_topics, is_csv, open_signal, supported_topics
+from .analyze import add_config_arguments, estimate_signal, make_config
+
+_STATS = ('start_utc', 'duration_s', 'samples', 'estimates', 'frequency_hz', 'frequency_lo_hz',
+          'frequency_hi_hz', 'damping', 'amplitude')
+_COUNTERS = tuple(c for c in COUNTER_NAMES if c not in ('received', 'estimates'))
+#: the columns of a row, in order
+COLUMNS = (('recording', 'topic', 'component', 'mode') + _STATS + _COUNTERS
+           + ('messages_without_component', 'change_rel', 'change_lo', 'change_hi', 'alarm',
+              'error'))
+_OUT_SUFFIXES = ('.csv', '.parquet', '.jsonl')
+_UNIX_2000 = 946_684_800.0   # a CSV time column at least this large is taken as Unix time
+
+
+@dataclass(frozen=True)
+class Options:
+    """What to read from each recording and how to estimate (picklable: sent to the workers)."""
+
+    config: EstimatorConfig
+    topics: Tuple[str, ...] = ()
+    components: Tuple[str, ...] = ()
+    column: Optional[str] = None
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument('inputs', nargs='+', metavar='INPUT',
+                        help='recordings: files, directories (searched recursively), globs')
+    parser.add_argument('--topic', action='append', default=[],
+                        help='topic to read (repeatable; default: every topic of a supported type)')
+    parser.add_argument('--component', action='append', default=[],
+                        help="component to read (repeatable; each topic takes those valid for its "
+                        "type; default: the type's default)")
+    parser.add_argument('--column', help='CSV signal column (default: the second)')
+    add_config_arguments(parser)
+    parser.add_argument('--format', choices=('table', 'csv', 'jsonl'), default='table')
+    parser.add_argument('--out', metavar='FILE', help='also write the rows to FILE (.csv, .parquet, '
+                        '.jsonl)')
+    parser.add_argument('--plot', metavar='FILE.png', help='frequency and damping vs recording time')
+    parser.add_argument('--baseline', help='a recording, or a frequency in Hz, to compare against')
+    parser.add_argument('--alarm-rel', type=float, default=0.01,
+                        help='relative frequency change that raises the alarm (default 0.01)')
+    parser.add_argument('--fail-on-alarm', action='store_true', help='exit 3 if any row is flagged')
+    parser.add_argument('--strict', action='store_true', help='exit 1 if any recording failed')
+    parser.add_argument('--jobs', type=int, default=os.cpu_count() or 1,
+                        help='local worker processes (default: the number of cores)')
+    parser.add_argument('--scheduler', metavar='ADDRESS',
+                        help='run on this Dask distributed scheduler (e.g. tcp://host:8786)')
+
+
+# ------------------------------------------------------------------------------ finding recordings
+
+def _is_bag_dir(path: Path) -> bool:
+    return (path / 'metadata.yaml').is_file()
+
+
+def _in_directory(root: Path) -> Iterable[Path]:
+    for folder, dirs, files in os.walk(root):
+        here = Path(folder)
+        if _is_bag_dir(here):
+            dirs.clear()
+            yield here
+            continue
+        dirs.sort()
+        for name in files:
+            if Path(name).suffix.lower() in ('.mcap', '.db3', '.csv'):
+                yield here / name
+
+
+def find_recordings(inputs: Sequence[str]) -> List[Path]:
+    """Every recording named by ``inputs``, sorted, once each; a name matching nothing is kept
+    (its row will say so)."""
+    found = set()
+    for name in inputs:
+        matches = sorted(glob.glob(name, recursive=True)) if glob.has_magic(name) else [name]
+        for match in (Path(m) for m in matches or [name]):
+            if match.is_dir() and not _is_bag_dir(match):
+                found.update(_in_directory(match))
+            else:
+                found.add(match)
+    return sorted(found)
+
+
+# ---------------------------------------------------------------------------------- one recording
+
+def median_interval(values: np.ndarray) -> Tuple[float, float, float]:
+    """Median of the finite values and its distribution-free 95 % interval (order statistics of
+    the binomial(n, 1/2) quantiles); the interval is NaN below 6 values, where none exists."""
+    from scipy.stats import binom
+
+    x = np.sort(values[np.isfinite(values)])
+    n = len(x)
+    if n == 0:
+        return math.nan, math.nan, math.nan
+    if n < 6:
+        return float(np.median(x)), math.nan, math.nan
+    j = int(binom.ppf(0.025, n, 0.5))
+    return float(np.median(x)), float(x[max(j - 1, 0)]), float(x[min(n - j, n - 1)])
+
+
+def _iso(seconds: Optional[float]) -> str:
+    if seconds is None or not seconds >= _UNIX_2000:
+        return ''
+    return datetime.fromtimestamp(seconds, timezone.utc).isoformat().replace('+00:00', 'Z')
+
+
+def _row(recording: Path, topic: str, component: str, mode: int, **fields) -> Dict:
+    row = dict.fromkeys(COLUMNS, math.nan)
+    row.update(recording=str(recording), topic=topic, component=component, mode=mode,
+               start_utc='', alarm=False, error='')
+    row.update(fields)
+    return row
+
+
+def _stat_rows(recording: Path, signal, result, modes: int) -> List[Dict]:
+    """The rows of one streamed signal: one, or one per mode."""
+    est = result.estimates
+    start = (signal.origin_ns * 1e-9 if signal.origin_ns is not None else result.first_t)
+    rows = []
+    for mode in (range(1, modes + 1) if modes else [0]):
+        take = est.mode == mode
+        counters = (result.estimator.mode_counters().get(mode, {}) if modes
+                    else result.estimator.counters)
+        f, lo, hi = median_interval(est.frequency_hz[take])
+        rows.append(_row(
+            recording, signal.topic, signal.component or signal.label, mode,
+            start_utc=_iso(start), duration_s=result.last_t - result.first_t,
+            samples=result.estimator.counters['received'], estimates=int(take.sum()),
+            frequency_hz=f, frequency_lo_hz=lo, frequency_hi_hz=hi,
+            damping=median_interval(est.damping[take])[0],
+            amplitude=median_interval(est.amplitude[take])[0],
+            messages_without_component=signal.skipped,
+            **{c: counters.get(c, 0) for c in _COUNTERS}))
+    return rows
+
+
+def _targets(path: Path, options: Options) -> List[Tuple[Optional[str], Optional[str]]]:
+    """(topic, component) pairs to read from a recording."""
+    if is_csv(path):
+        return [(None, None)]
+    topics = bag_topics(path)
+    chosen = ({t: topics.get(t, '') for t in options.topics} if options.topics
+              else supported_topics(topics))
+    if not chosen:
+        open_signal(path)                        # raises the error naming the bag's topics
+    pairs = []
+    for topic, kind in sorted(chosen.items()):
+        valid = [c for c in options.components if _valid(c, kind)]
+        if options.components and not valid and not options.topics:
+            continue
+        for component in valid or [options.components[0] if options.components
+                                   else DEFAULT_COMPONENT.get(kind)]:
+            pairs.append((topic, component))
+    return pairs
+
+
+def _valid(component: str, kind: str) -> bool:
+    try:
+        check_component(component, kind)
+        return True
+    except ValueError:
+        return False
+
+
+def survey_recording(path: Path, options: Options) -> List[Dict]:
+    """The rows of one recording; any failure is one row with ``error`` set (never raises)."""
+    try:
+        targets = _targets(path, options)
+    except Exception as err:  # noqa: BLE001 -- a bad recording is a row, not the end of the survey
+        return [_error_row(path, '', '', err)]
+    rows: List[Dict] = []
+    for topic, component in targets:
+        try:
+            signal = open_signal(path, topic, component, options.column)
+            rows.extend(_stat_rows(path, signal, estimate_signal(signal, options.config),
+                                   options.config.modes))
+        except Exception as err:  # noqa: BLE001 -- as above
+            rows.append(_error_row(path, topic or '', component or '', err))
+    return rows
+
+
+def _error_row(path: Path, topic: str, component: str, err: BaseException) -> Dict:
+    detail = (str(err).strip() or type(err).__name__).splitlines()[0]
+    return _row(path, topic, component, 0, error=detail)
+
+
+# ------------------------------------------------------------------------------- running them all
+
+def _progress(total: int):
+    from tqdm import tqdm
+
+    on_terminal = sys.stdout.isatty() and sys.stderr.isatty()
+    return tqdm(total=total, unit='recording', disable=not on_terminal, file=sys.stderr)
+
+
+def survey(recordings: Sequence[Path], options: Options, jobs: int = 1,
+           scheduler: Optional[str] = None) -> List[Dict]:
+    """The rows of every recording, in the order of ``recordings``: in this process
+    (``jobs`` 1), on a local process pool, or on the Dask scheduler at ``scheduler``."""
+    bar = _progress(len(recordings))
+    try:
+        if scheduler is None and jobs <= 1:
+            parts = []
+            for path in recordings:
+                parts.append(survey_recording(path, options))
+                bar.update()
+        else:
+            parts = _on_executor(recordings, options, jobs, scheduler, bar)
+    finally:
+        bar.close()
+    return [row for part in parts for row in part]
+
+
+def _on_executor(recordings, options, jobs, scheduler, bar) -> List[List[Dict]]:
+    client = None
+    if scheduler is not None:
+        from distributed import Client
+
+        client = Client(scheduler)
+        executor = client.get_executor(pure=False)
+    else:
+        executor = ProcessPoolExecutor(max_workers=jobs)
+    try:
+        futures = [executor.submit(survey_recording, path, options) for path in recordings]
+        for _ in as_completed(futures):
+            bar.update()
+        return [_result(future, path) for future, path in zip(futures, recordings)]
+    finally:
+        executor.shutdown()
+        if client is not None:
+            client.close()
+
+
+def _result(future, path: Path) -> List[Dict]:
+    try:
+        return future.result()
+    except Exception as err:  # noqa: BLE001 -- a worker that died: one error row
+        return [_error_row(path, '', '', err)]
+
+
+# ------------------------------------------------------------------------------ health monitoring
+
+def _key(row: Dict) -> Tuple[str, str, int]:
+    return row['topic'], row['component'], row['mode']
+
+
+def baseline_rows(baseline: str, options: Options) -> Dict[Tuple, Tuple[float, float, float]]:
+    """{(topic, component, mode) or None: (median, lo, hi)} of ``--baseline``; a number is one
+    exact frequency for every row. ValueError if the baseline gives no frequency."""
+    try:
+        hz = float(baseline)
+    except ValueError:
+        hz = None
+    if hz is not None:
+        if not hz > 0:
+            raise ValueError(f'--baseline frequency must be > 0 Hz, got {baseline}')
+        return {None: (hz, hz, hz)}
+    if not Path(baseline).exists():
+        raise ValueError(f'--baseline {baseline!r} is neither a frequency (Hz) nor a recording')
+    rows = [r for r in survey_recording(Path(baseline), options)
+            if not r['error'] and np.isfinite(r['frequency_hz'])]
+    if not rows:
+        raise ValueError(f'baseline {baseline} gives no frequency estimate')
+    table = {_key(r): (r['frequency_hz'], r['frequency_lo_hz'], r['frequency_hi_hz'])
+             for r in rows}
+    if len(rows) == 1:
+        table[None] = next(iter(table.values()))
+    return table
+
+
+def flag(rows: List[Dict], base: Dict, alarm_rel: float) -> None:
+    """Set the change columns and ``alarm`` of every row against the baseline ``base``."""
+    for row in rows:
+        ref = base.get(_key(row), base.get(None))
+        if ref is None or row['error']:
+            continue
+        f0, lo0, hi0 = ref
+        row['change_rel'] = row['frequency_hz'] / f0 - 1
+        row['change_lo'] = row['frequency_lo_hz'] / hi0 - 1
+        row['change_hi'] = row['frequency_hi_hz'] / lo0 - 1
+        row['alarm'] = bool(row['change_hi'] < -alarm_rel or row['change_lo'] > alarm_rel)
+
+
+# ------------------------------------------------------------------------------------- output
+
+def _plain(value):
+    """JSON/CSV-friendly scalar: NaN as None, numpy scalars as Python ones."""
+    if isinstance(value, (float, np.floating)):
+        return None if value != value else float(value)
+    return value.item() if isinstance(value, np.generic) else value
+
+
+def write_rows(rows: List[Dict], fmt: str, out) -> None:
+    """Rows as ``table``, ``csv`` or ``jsonl`` text on the stream ``out``."""
+    if fmt == 'jsonl':
+        for row in rows:
+            out.write(json.dumps({k: _plain(v) for k, v in row.items()}) + '\n')
+    elif fmt == 'csv':
+        import csv
+
+        writer = csv.writer(out, lineterminator='\n')
+        writer.writerow(COLUMNS)
+        for row in rows:
+            writer.writerow(['' if _plain(row[k]) is None else repr(_plain(row[k]))
+                             if isinstance(row[k], float) else row[k] for k in COLUMNS])
+    else:
+        out.write(f'{"recording":<28} {"topic":<18} {"component":<22} {"mode":>4} '
+                  f'{"start (UTC)":<20} {"dur (s)":>8} {"samples":>9} {"est":>5} '
+                  f'{"f (Hz)":>10} {"95% interval":>21} {"damping":>8} {"change":>8} alarm\n')
+        for r in rows:
+            if r['error']:
+                out.write(f'{_short(r["recording"]):<28} {r["topic"]:<18} error: {r["error"]}\n')
+                continue
+            out.write(f'{_short(r["recording"]):<28} {r["topic"]:<18} {r["component"]:<22} '
+                      f'{r["mode"]:>4} {r["start_utc"][:19]:<20} {r["duration_s"]:8.1f} '
+                      f'{r["samples"]:9d} {r["estimates"]:5d} {r["frequency_hz"]:10.5f} '
+                      f'[{r["frequency_lo_hz"]:9.5f},{r["frequency_hi_hz"]:9.5f}] '
+                      f'{r["damping"]:8.5f} {r["change_rel"]:+8.2%} '
+                      f'{"ALARM" if r["alarm"] else ""}\n')
+
+
+def _short(name: str, width: int = 28) -> str:
+    return name if len(name) <= width else '...' + name[-(width - 3):]
+
+
+def write_file(rows: List[Dict], path: Path) -> None:
+    """``--out``: the rows as .csv, .jsonl, or .parquet (pyarrow)."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if path.suffix == '.parquet':
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+
+        pq.write_table(pa.Table.from_pylist(rows), path)
+        return
+    with path.open('w', newline='') as handle:
+        write_rows(rows, 'csv' if path.suffix == '.csv' else 'jsonl', handle)
+
+
+def plot_trend(rows: List[Dict], path: Path) -> None:
+    """Frequency and damping against recording time, one line per topic/component/mode, with
+    the 95 % intervals as bars and the flagged recordings marked."""
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+
+    fig, (ax_f, ax_d) = plt.subplots(2, 1, sharex=True, figsize=(9, 6))
+    good = [r for r in rows if not r['error'] and np.isfinite(r['frequency_hz'])]
+    for key in sorted({_key(r) for r in good}):
+        line = [r for r in good if _key(r) == key]
+        x = [datetime.fromisoformat(r['start_utc'].replace('Z', '+00:00')) if r['start_utc']
+             else i for i, r in enumerate(line)]
+        f = np.array([r['frequency_hz'] for r in line])
+        err = np.abs(np.array([[r['frequency_lo_hz'] for r in line],
+                               [r['frequency_hi_hz'] for r in line]]) - f)
+        label = ' '.join(str(k) for k in key if k not in ('', 0))
+        ax_f.errorbar(x, f, yerr=np.nan_to_num(err), marker='o', ms=3, capsize=2, label=label)
+        alarmed = [i for i, r in enumerate(line) if r['alarm']]
+        ax_f.plot([x[i] for i in alarmed], f[alarmed], 'rx', ms=9,
+                  label='alarm' if alarmed else None)
+        ax_d.plot(x, [r['damping'] for r in line], marker='o', ms=3, label=label)
+    if not any(np.isfinite(r['damping']) for r in good):
+        ax_d.text(0.5, 0.5, 'no damping estimates: the model has no damping\n'
+                  '(--model damped-sinusoid estimates it)', transform=ax_d.transAxes,
+                  ha='center', va='center', color='0.4')
+    ax_f.set_ylabel('median frequency (Hz)')
+    ax_d.set_ylabel('median damping ratio')
+    ax_d.set_xlabel('recording start (UTC)')
+    ax_f.legend(fontsize=8)
+    ax_f.grid(alpha=0.3)
+    ax_d.grid(alpha=0.3)
+    fig.autofmt_xdate()
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def _options(args: argparse.Namespace) -> Options:
+    if args.out and Path(args.out).suffix not in _OUT_SUFFIXES:
+        raise ValueError(f'--out must end in {", ".join(_OUT_SUFFIXES)}, got {args.out}')
+    if args.jobs < 1:
+        raise ValueError(f'--jobs must be >= 1, got {args.jobs}')
+    if not args.alarm_rel >= 0:
+        raise ValueError(f'--alarm-rel must be >= 0, got {args.alarm_rel}')
+    return Options(make_config(args), tuple(args.topic), tuple(args.component), args.column)
+
+
+def run(args: argparse.Namespace) -> int:
+    try:
+        options = _options(args)
+        base = baseline_rows(args.baseline, options) if args.baseline else None
+    except (ValueError, CsvError) as err:
+        print(f'vib-estimator survey: error: {err}', file=sys.stderr)
+        return 2
+    rows = survey(find_recordings(args.inputs), options, args.jobs, args.scheduler)
+    if base is not None:
+        flag(rows, base, args.alarm_rel)
+    write_rows(rows, args.format, sys.stdout)
+    if args.out:
+        write_file(rows, Path(args.out))
+    if args.plot:
+        plot_trend(rows, Path(args.plot))
+    if args.fail_on_alarm and any(r['alarm'] for r in rows):
+        return 3
+    return 1 if args.strict and any(r['error'] for r in rows) else 0

@@ -1,0 +1,223 @@
+"""Diagnostics bookkeeping of ``estimator_node``, with no rclpy (tested alone).
+
+:class:`Health` keeps what ``/diagnostics`` reports: the counters since the node started (the core's,
+summed across the estimators that parameter changes replaced, and the node's own
+:data:`NODE_COUNTERS`), the last estimate of ``vibration/frequency`` and of each mode with the
+time it was published, the input and sampling rates, and the status level. The node calls
+:meth:`Health.record` on each published estimate and :meth:`Health.status` once per diagnostics
+period, and converts the returned :class:`Status` to a ``diagnostic_msgs/DiagnosticStatus``.
+
+Times ``now`` are seconds of a monotonic clock (the node passes ``time.monotonic()``); ``last_t``
+is the time base of the estimator (seconds since the first stamp).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Dict, Mapping, Optional, Sequence
+
+#: levels, equal to ``diagnostic_msgs/DiagnosticStatus``'s
+OK, WARN, ERROR, STALE = 0, 1, 2, 3
+#: the status goes STALE when no input arrived for this long, s
+STALE_AFTER = 2.0
+#: core counters that grow when the quality gate holds a converged estimate back, or none forms
+HELD_BACK = ('rejected_at_rest', 'rejected_fit', 'rejected_nyquist', 'rejected_damping',
+             'max_window_resets')
+#: the node's own counters: zero header stamps replaced by the receipt time; JointState messages
+#: without the configured joint (skipped); samples received while ``band_hz`` reached above the
+#: Nyquist frequency of the input's sampling rate
+NODE_COUNTERS = ('zero_stamps_replaced', 'skipped_joint_missing', 'band_above_nyquist')
+
+
+@dataclass(frozen=True)
+class Status:
+    """One diagnostics status: level (:data:`OK` ...), message, ordered key/values, and a
+    warning to log (once per condition; None when there is nothing new to say)."""
+
+    level: int
+    message: str
+    values: Dict[str, object]
+    log: Optional[str] = None
+
+
+@dataclass
+class _Tick:
+    """The state at the previous :meth:`Health.status` call."""
+
+    at: float
+    messages: int = 0       # received by the core + skipped by the node
+    joint_missing: int = 0
+    used: int = 0
+    last_t: Optional[float] = None
+
+
+@dataclass
+class _Last:
+    """An estimate and the monotonic time it was published."""
+
+    estimate: object
+    at: float
+
+
+def format_value(value) -> str:
+    """A diagnostics value: integers exactly, floats to 9 significant digits."""
+    return str(value) if isinstance(value, int) else f'{value:.9g}'
+
+
+class Health:
+    """Counters, last estimates, rates and status of the estimator node (see the module doc).
+
+    ``now``: the monotonic time at start (the first input rate is measured from it).
+    """
+
+    def __init__(self, now: float, stale_after: float = STALE_AFTER):
+        self.stale_after = stale_after
+        self.node_counters: Dict[str, int] = dict.fromkeys(NODE_COUNTERS, 0)
+        #: sampling rate of the input from its stamps (NaN until known), Hz
+        self.sample_rate_hz = math.nan
+        self._base: Dict[str, int] = {}          # core counters of the replaced estimators
+        self._last: Optional[_Last] = None       # what vibration/frequency carried last
+        self._modes: Dict[int, _Last] = {}
+        self._held_at: Dict[str, int] = dict.fromkeys(HELD_BACK, 0)
+        self._tick = _Tick(now)
+        self._input_at: Optional[float] = None
+        self._band_warned: Optional[tuple] = None
+
+    # ---- counters ----------------------------------------------------------------------------
+    def count(self, name: str, n: int = 1) -> int:
+        """Add ``n`` to one of :data:`NODE_COUNTERS`; return its new value."""
+        self.node_counters[name] += n
+        return self.node_counters[name]
+
+    def absorb(self, core_counters: Mapping[str, int]) -> None:
+        """Keep the counters of an estimator about to be replaced (they go on adding up)."""
+        for name, value in core_counters.items():
+            self._base[name] = self._base.get(name, 0) + value
+
+    def totals(self, core_counters: Mapping[str, int]) -> Dict[str, int]:
+        """The counters since start: the core's (live estimator + replaced ones), then the node's."""
+        totals = dict(self._base)
+        for name, value in core_counters.items():
+            totals[name] = totals.get(name, 0) + value
+        totals.update(self.node_counters)
+        return totals
+
+    # ---- estimates ---------------------------------------------------------------------------
+    def record(self, estimate, now: float, totals: Mapping[str, int]) -> None:
+        """An estimate was published at ``now``: mode 0 or 1 is the one of ``vibration/frequency``;
+        ``totals`` (:meth:`totals`) gives the held-back counters' values at that moment (an
+        estimate of any mode clears the WARN of estimates held back)."""
+        last = _Last(estimate, now)
+        if estimate.mode >= 1:
+            self._modes[estimate.mode] = last
+        if estimate.mode <= 1:
+            self._last = last
+        self._held_at = {name: totals.get(name, 0) for name in HELD_BACK}
+
+    @property
+    def last_estimate(self):
+        """The last estimate of ``vibration/frequency`` (None before the first)."""
+        return self._last.estimate if self._last else None
+
+    def forget_modes(self, modes: int) -> None:
+        """Drop the records of modes above ``modes`` (after a change of the parameter)."""
+        self._modes = {k: v for k, v in self._modes.items() if k <= modes}
+
+    # ---- status ------------------------------------------------------------------------------
+    def status(self, now: float, totals: Mapping[str, int], last_t: Optional[float],
+               band_hz: Optional[Sequence[float]] = None, modes: int = 0) -> Status:
+        """The status at ``now``; updates the rates and the ``band_above_nyquist`` counter.
+
+        STALE without input for :attr:`stale_after` s; WARN when a :data:`HELD_BACK` counter grew
+        since the last estimate, when JointState messages lacked the joint since the last call, or
+        when ``band_hz`` reaches the Nyquist frequency of the input; OK otherwise.
+        """
+        tick = self._tick
+        messages = totals.get('received', 0) + totals['skipped_joint_missing']
+        if messages > tick.messages:
+            self._input_at = now
+        input_rate = (messages - tick.messages) / (now - tick.at) if now > tick.at else math.nan
+        self._update_sample_rate(totals.get('used', 0), last_t)
+        nyquist, log = self._check_band(band_hz, messages - tick.messages)
+        missing = totals['skipped_joint_missing'] - tick.joint_missing
+        held = {name: totals.get(name, 0) - self._held_at[name] for name in HELD_BACK}
+        problems = []
+        if any(held.values()):
+            problems.append('held back since the last estimate: ' + ', '.join(
+                f'{name} {n}' for name, n in held.items() if n))
+        if missing:
+            problems.append(f'{missing} messages without the joint')
+        if nyquist:
+            problems.append(nyquist)
+        if self._input_at is None or now - self._input_at > self.stale_after:
+            level, message = STALE, 'no input'
+        elif problems:
+            level, message = WARN, '; '.join(problems)
+        elif self._last is None:
+            level, message = OK, 'waiting for a first estimate'
+        else:
+            level, message = OK, 'estimating'
+        self._tick = _Tick(now, messages, totals['skipped_joint_missing'], totals.get('used', 0),
+                           last_t)
+        values = {**self._estimate_values(now), 'input_rate_hz': input_rate,
+                  'sample_rate_hz': self.sample_rate_hz, **self._mode_values(now, modes),
+                  **totals, **self.node_counters}
+        return Status(level, message, values, log)
+
+    def _update_sample_rate(self, used: int, last_t: Optional[float]) -> None:
+        """The input's sampling rate from its stamps: samples used over the time they span since
+        the previous call (since the first stamp, t = 0, at the first call with input)."""
+        tick = self._tick
+        if last_t is None:
+            return
+        if tick.last_t is None:
+            n, span = used - 1, last_t
+        else:
+            n, span = used - tick.used, last_t - tick.last_t
+        if n > 0 and span > 0:
+            self.sample_rate_hz = n / span
+
+    def _check_band(self, band_hz, received: int):
+        """(problem text or None, warning to log or None) for ``band_hz`` against the Nyquist
+        frequency; counts the samples received while the band reaches above it. The warning is
+        logged once per band, again when the band changes to another one above Nyquist."""
+        if band_hz is None or not len(band_hz) or math.isnan(self.sample_rate_hz):
+            return None, None
+        nyquist = self.sample_rate_hz / 2
+        if band_hz[1] < nyquist:
+            self._band_warned = None
+            return None, None
+        self.count('band_above_nyquist', received)
+        text = (f'band_hz upper edge {band_hz[1]:g} Hz is at or above the Nyquist frequency '
+                f'{nyquist:.6g} Hz of the input (sampled at {self.sample_rate_hz:.6g} Hz): '
+                'no estimate can form')
+        key = tuple(band_hz)
+        log = None if self._band_warned == key else text
+        self._band_warned = key
+        return text, log
+
+    def _estimate_values(self, now: float) -> Dict[str, float]:
+        """The last estimate of ``vibration/frequency`` (NaN before the first)."""
+        e = self.last_estimate
+        nan = math.nan
+        return {
+            'last_frequency_hz': e.frequency_hz if e else nan,
+            'last_frequency_std_hz': e.frequency_std_hz if e else nan,
+            'last_convergence_time_s': e.convergence_time if e else nan,
+            'last_damping_ratio': e.damping if e else nan,
+            'last_damping_std': e.damping_std if e else nan,
+            'last_amplitude': e.amplitude if e else nan,
+            'last_estimate_age_s': now - self._last.at if e else nan,
+        }
+
+    def _mode_values(self, now: float, modes: int) -> Dict[str, float]:
+        """``mode<k>_frequency_hz``, ``mode<k>_frequency_std_hz``, ``mode<k>_age_s`` for k = 1..modes
+        (NaN for a mode not published yet)."""
+        values = {}
+        for k in range(1, modes + 1):
+            last = self._modes.get(k)
+            e = last.estimate if last else None
+            values[f'mode{k}_frequency_hz'] = e.frequency_hz if e else math.nan
+            values[f'mode{k}_frequency_std_hz'] = e.frequency_std_hz if e else math.nan
+            values[f'mode{k}_age_s'] = now - last.at if e else math.nan
+        return values

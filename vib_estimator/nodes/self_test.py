@@ -1,0 +1,106 @@
+"""The estimator node's self-test, with no rclpy: known tones through a fresh estimator.
+
+:func:`self_test` runs three seeded tones (a sine at 40 dB SNR each, one after the other, each
+through its own fresh estimator of the given configuration, batch path) and reports the median
+error of each tone's estimates. The tones sit across the configured ``band_hz`` (geometrically at
+1/4, 1/2 and 3/4 of it), or, without a band, across :func:`default_band` of the sampling rate. The
+node answers its ``~/self_test`` service with it, off the data path: the live estimator is not
+touched. (ArduPilot's GyroFFT has the same kind of check.)
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import List, Optional, Tuple
+
+import numpy as np
+
+from ..core.config import EstimatorConfig
+from ..core.modes import create_estimator
+
+#: sampling rate of the tones when the input's is not known yet, Hz
+DEFAULT_RATE_HZ = 500.0
+#: signal-to-noise ratio of the tones, dB
+SNR_DB = 40.0
+#: a tone passes when the median of its estimates is within this relative error
+TOLERANCE = 0.01
+#: each tone lasts this many of its periods (more when min_periods asks for longer segments)
+PERIODS = 10.0
+#: at most this many samples per tone
+MAX_SAMPLES = 200_000
+SEED = 0
+
+
+@dataclass(frozen=True)
+class ToneResult:
+    """One tone of the self-test."""
+
+    frequency_hz: float
+    estimates: int
+    median_hz: float          # NaN without estimates
+    note: str = ''            # why no estimate could be expected (e.g. above Nyquist)
+
+    @property
+    def error(self) -> float:
+        """Relative error of the median estimate (NaN without estimates)."""
+        return self.median_hz / self.frequency_hz - 1
+
+    @property
+    def passed(self) -> bool:
+        return self.estimates > 0 and abs(self.error) <= TOLERANCE
+
+    def describe(self) -> str:
+        if self.note:
+            return f'{self.frequency_hz:.4g} Hz: {self.note}'
+        if not self.estimates:
+            return f'{self.frequency_hz:.4g} Hz: no estimate'
+        return (f'{self.frequency_hz:.4g} Hz: median {self.median_hz:.6g} Hz of '
+                f'{self.estimates} estimates, error {100 * self.error:+.4f} %')
+
+
+def default_band(sample_rate_hz: float) -> Tuple[float, float]:
+    """The band the tones span without ``band_hz``: fs/250 to fs/25 (2 to 20 Hz at 500 Hz), where
+    the default configuration resolves a tone in about half a period with >= 25 samples a period."""
+    return sample_rate_hz / 250, sample_rate_hz / 25
+
+
+def tone_frequencies(band_hz: Optional[Tuple[float, float]],
+                     sample_rate_hz: float) -> List[float]:
+    """Three tones at 1/4, 1/2 and 3/4 of the band on a logarithmic scale."""
+    lo, hi = band_hz if band_hz is not None else default_band(sample_rate_hz)
+    return [lo * (hi / lo) ** q for q in (0.25, 0.5, 0.75)]
+
+
+def run_tone(config: EstimatorConfig, frequency_hz: float, sample_rate_hz: float,
+             seed: int = SEED) -> ToneResult:
+    """One tone through a fresh estimator of ``config``."""
+    if frequency_hz >= sample_rate_hz / 2:
+        return ToneResult(frequency_hz, 0, math.nan,
+                          f'above the Nyquist frequency {sample_rate_hz / 2:.6g} Hz of the input')
+    periods = max(PERIODS, 4 * (config.min_periods + 1))
+    n = min(MAX_SAMPLES, int(math.ceil(periods * sample_rate_hz / frequency_hz)))
+    rng = np.random.default_rng(seed)
+    amplitude = max(1.0, 10 * config.min_amplitude)
+    t = np.arange(n) / sample_rate_hz
+    y = amplitude * np.sin(2 * np.pi * frequency_hz * t + rng.uniform(0, 2 * np.pi))
+    y += rng.normal(0.0, amplitude / math.sqrt(2) * 10 ** (-SNR_DB / 20), n)
+    estimates = create_estimator(config).process(t, y)
+    median = float(np.median(estimates.frequency_hz)) if len(estimates) else math.nan
+    return ToneResult(frequency_hz, len(estimates), median)
+
+
+def self_test(config: EstimatorConfig, sample_rate_hz: Optional[float] = None
+              ) -> Tuple[bool, str]:
+    """(all tones passed, one line per tone) for ``config`` at the input's sampling rate
+    (:data:`DEFAULT_RATE_HZ` when not known)."""
+    rate = sample_rate_hz if sample_rate_hz and math.isfinite(sample_rate_hz) \
+        else DEFAULT_RATE_HZ
+    results = [run_tone(config, f, rate, SEED + i)
+               for i, f in enumerate(tone_frequencies(config.band_hz, rate))]
+    ok = all(r.passed for r in results)
+    head = (f'{"passed" if ok else "FAILED"}: 3 tones at {rate:.6g} Hz sampling, SNR '
+            f'{SNR_DB:g} dB, tolerance {100 * TOLERANCE:g} % of the median')
+    if config.band_hz is not None and config.band_hz[1] >= rate / 2:
+        head += (f' (band_hz upper edge {config.band_hz[1]:g} Hz is at or above the Nyquist frequency '
+                 f'{rate / 2:.6g} Hz)')
+    return ok, '\n'.join([head] + [r.describe() for r in results])
