@@ -7,8 +7,8 @@ zeta = 0.01), each window (``min_periods`` = 0.25, 0.5, 1, 2, 5, 20 periods) and
 phase). Printed: the number of estimates, the RMS error of the published frequencies, the exact
 bound (RMS over the estimates of :func:`vib_estimator.analysis.bounds.model_crb` on the samples
 each used), the ratio RMS(error / bound) over the estimates (the std in units of each
-estimate's own bound; the bound changes from window to window), the calibration RMS of error / ``frequency_std_hz`` (1 = calibrated),
-the median convergence time in periods, and a sliding matrix pencil
+estimate's own bound; the bound changes from window to window), the calibration RMS of
+error / ``frequency_std_hz`` (1 = calibrated), the median convergence time in periods, and a sliding matrix pencil
 (:func:`vib_estimator.analysis.baselines.matrix_pencil`, damped-exponential model, order 2, +1
 with an offset) on the same windows: its RMS(error / bound). Same run, same signals.
 Usage: ``python benchmarks/bench_precision.py [--quick]`` (--quick: 0.5, 2 and 20 periods, 40 dB).
@@ -70,7 +70,7 @@ def main() -> None:
     windows = (0.5, 2, 20) if quick else (0.25, 0.5, 1, 2, 5, 20)
     snrs = (40,) if quick else (20, 40, 60)
     print(f'{"model":>16} {"periods":>7} {"SNR":>4} {"n":>5} {"std Hz":>9} {"bound Hz":>9} '
-          f'{"ratio":>6} {"calib":>6} {"conv":>6} {"pencil":>7}   (ratio, pencil: std / bound)')
+          f'{"ratio":>6} {"calib":>6} {"conv":>6} {"pencil":>7}   (ratio, pencil: RMS error/bound)')
     start = time.perf_counter()
     for model, (zeta, offset) in MODELS.items():
         for periods in windows:
