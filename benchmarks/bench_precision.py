@@ -8,7 +8,8 @@ phase). Printed: the number of estimates, the RMS error of the published frequen
 bound (RMS over the estimates of :func:`vib_estimator.analysis.bounds.model_crb` on the samples
 each used), the ratio RMS(error / bound) over the estimates (the std in units of each
 estimate's own bound; the bound changes from window to window), the calibration RMS of
-error / ``frequency_std_hz`` (1 = calibrated), the median convergence time in periods, and a sliding matrix pencil
+error / ``frequency_std_hz`` (1 = calibrated), the median convergence time in periods, and a
+sliding matrix pencil
 (:func:`vib_estimator.analysis.baselines.matrix_pencil`, damped-exponential model, order 2, +1
 with an offset) on the same windows: its RMS(error / bound). Same run, same signals.
 Usage: ``python benchmarks/bench_precision.py [--quick]`` (--quick: 0.5, 2 and 20 periods, 40 dB).

@@ -1,8 +1,8 @@
 """Seeded Monte Carlo: refined estimates at the exact Cramer-Rao bound, calibrated std, targets.
 
 Signals: the simulated arm's second mode (1.33 Hz, A = 0.1, Ts = 2 ms) at 40 dB SNR, random phase
-per record; the bound is :func:`vib_estimator.analysis.bounds.model_crb` on the samples each estimate
-used. Seeds are fixed; the tolerances leave the ~10 % sampling error of a ratio over >= 50
+per record; the bound is :func:`vib_estimator.analysis.bounds.model_crb` on the samples each
+estimate used. Seeds are fixed; the tolerances leave the ~10 % sampling error of a ratio over >= 50
 estimates (measured ratios 0.9-1.1, ``benchmarks/bench_precision.py``).
 """
 import math
