@@ -1,4 +1,4 @@
-"""Cramer-Rao lower bound on the frequency of a real sinusoid in white Gaussian noise.
+"""Cramer-Rao lower bounds on the frequency (and damping) of the estimator's signal models.
 
 For ``N`` samples ``y_n = A sin(w n Ts + phi) + e_n``, ``e_n ~ N(0, sigma^2)``, with A, w and phi
 unknown, the bound on any unbiased estimator of w is (Rife & Boorstyn 1974; Kay 1993, Ex. 3.14)::
@@ -7,11 +7,14 @@ unknown, the bound on any unbiased estimator of w is (Rife & Boorstyn 1974; Kay 
 
 which is asymptotic (it drops terms of relative order 1/N and assumes the frequency is not near 0
 or Nyquist). :func:`fisher_frequency_std` computes the exact bound for given parameters from the
-Fisher information matrix, to check it.
+Fisher information matrix, to check it; :func:`model_crb` is the exact bound of each of the
+estimator's models (sinusoid; with an offset; damped, bounding the natural frequency and the
+damping ratio) over the samples an estimate used.
 """
 from __future__ import annotations
 
 import math
+from typing import Tuple
 
 import numpy as np
 
@@ -71,3 +74,47 @@ def window_crlb_std(y: np.ndarray, ts: float, frequency_hz: float, noise_std: fl
     basis = np.column_stack((np.sin(w * t), np.cos(w * t), np.ones(n)))
     (a, b, _), *_ = np.linalg.lstsq(basis, y, rcond=None)
     return fisher_frequency_std(math.hypot(a, b), frequency_hz, math.atan2(b, a), noise_std, ts, n)
+
+
+def model_crb(model: str, t: np.ndarray, amplitude: float, frequency_hz: float, phase: float,
+              noise_std: float, damping: float = 0.0) -> Tuple[float, float]:
+    """Exact CRB (std of the natural frequency in Hz, std of the damping ratio) for one window.
+
+    The signal is the model's, at its true parameters, on the sample times ``t`` (the samples the
+    estimate used)::
+
+        sinusoid:         A sin(w t + phi)                                  (A, phi, w)
+        biased-sinusoid:  A sin(w t + phi) + B                              (A, phi, w, B)
+        damped-sinusoid:  A exp(-zeta w_n t) sin(w_d t + phi), w_d = w_n sqrt(1 - zeta^2)
+                                                                            (A, phi, w_d, sigma)
+
+    with white Gaussian noise of std ``noise_std``; every parameter unknown (the offset's value
+    does not enter the bound). ``FIM = J^T J / noise_std^2`` from the analytic Jacobian, on
+    centred time (amplitude and phase moved to the window's centre, which leaves the bound
+    unchanged and the matrix well conditioned); for the damped model the bounds on
+    w_n = sqrt(w_d^2 + sigma^2) and zeta = sigma / w_n follow from the (w_d, sigma) block.
+    The damping-ratio bound is NaN for the models without damping.
+    """
+    t = np.asarray(t, dtype=float)
+    wn = 2 * math.pi * frequency_hz
+    sigma = damping * wn if model == 'damped-sinusoid' else 0.0
+    wd = math.sqrt(wn * wn - sigma * sigma)
+    tm = 0.5 * (t[0] + t[-1])
+    u = t - tm
+    amp = amplitude * math.exp(-sigma * tm)
+    env = amp * np.exp(-sigma * u)
+    arg = wd * u + phase + wd * tm
+    cols = [env / amp * np.sin(arg), env * np.cos(arg), u * env * np.cos(arg)]
+    if model == 'biased-sinusoid':
+        cols.append(np.ones_like(u))
+    elif model == 'damped-sinusoid':
+        cols.append(-u * env * np.sin(arg))
+    jac = np.column_stack(cols)
+    scale = 1.0 / np.sqrt(np.sum(jac * jac, axis=0))
+    cov = np.linalg.inv((jac * scale).T @ (jac * scale)) * np.outer(scale, scale) * noise_std ** 2
+    if model != 'damped-sinusoid':
+        return math.sqrt(cov[2, 2]) / (2 * math.pi), math.nan
+    g_w = np.array([wd / wn, sigma / wn])
+    g_z = np.array([-sigma * wd / wn ** 3, wd * wd / wn ** 3])
+    block = cov[2:4, 2:4]
+    return (math.sqrt(g_w @ block @ g_w) / (2 * math.pi), math.sqrt(g_z @ block @ g_z))

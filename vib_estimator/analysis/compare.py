@@ -1,9 +1,11 @@
 """``vib-estimator compare``: the algebraic estimator against the trackers of Section 5.4.
 
-Every method -- the algebraic estimator with its default :class:`EstimatorConfig` and with the
-``damped-sinusoid`` model (``Algebraic-damped``), Ziarani-Konrad
-(Eqs. 25-26), Hou (Eqs. 27-29), Mojiri-Bakhshai (Eqs. 30-33), all with the paper's gains, and the
-flight-controller-style :class:`SlidingDFT` -- runs on the same signals:
+Every method -- the paper's algebraic estimator (``refine`` = 0) with the sinusoid model and with
+the ``damped-sinusoid`` model (``Algebraic-damped``), this package's default configuration (the
+same estimates refined by maximum likelihood over their segments, ``Algebraic-ML``),
+Ziarani-Konrad (Eqs. 25-26), Hou (Eqs. 27-29), Mojiri-Bakhshai (Eqs. 30-33), all with the paper's
+gains, the flight-controller-style :class:`SlidingDFT` and a sliding matrix pencil
+(:class:`SlidingMatrixPencil`, 2 s windows) -- runs on the same signals:
 
 * ``5.3``: the simulated arm of Section 5.3 (Figs. 5-6, 45.55 g, ramp to 1 rad, 10 s);
 * ``5.5``: the three tip masses of Section 5.5 (Fig. 7, 30 -> 45.55 -> 61.17 g, 6 s each);
@@ -46,7 +48,8 @@ from typing import Callable, Dict, List, Optional, Sequence, Tuple
 import numpy as np
 
 from ..sim import arm_model
-from .baselines import Hou, MojiriBakhshai, SlidingDFT, ZiaraniKonrad, hold_last
+from .baselines import (Hou, MojiriBakhshai, SlidingDFT, SlidingMatrixPencil, ZiaraniKonrad,
+                        hold_last)
 from .bounds import window_crlb_std
 from ..core import EstimatorConfig, FrequencyEstimator
 from ..sim.signals import fig1_signal
@@ -56,10 +59,12 @@ OUTLIER = 0.05
 #: Table 2 of the paper (algebraic method, Section 5.5): f (Hz) -> (bias Hz, variance Hz^2)
 PAPER_TABLE_2 = {1.64: (7.0e-2, 1.2e-4), 1.33: (3.0e-2, 3.1e-5), 1.15: (1.5e-2, 7.1e-5)}
 ALGEBRAIC = 'Algebraic'
-#: the algebraic estimator as configured by default (the paper's model) and with the damped model
-ALGEBRAIC_CONFIGS = {ALGEBRAIC: EstimatorConfig(),
-                     'Algebraic-damped': EstimatorConfig(model='damped-sinusoid')}
-TRACKERS = (ZiaraniKonrad, Hou, MojiriBakhshai, SlidingDFT)
+#: the paper's algebraic estimator (refine = 0; the sinusoid model and the damped model) and this
+#: package's default, its maximum-likelihood refinement over the same segments
+ALGEBRAIC_CONFIGS = {ALGEBRAIC: EstimatorConfig(refine=0),
+                     'Algebraic-damped': EstimatorConfig(model='damped-sinusoid', refine=0),
+                     'Algebraic-ML': EstimatorConfig()}
+TRACKERS = (ZiaraniKonrad, Hou, MojiriBakhshai, SlidingDFT, SlidingMatrixPencil)
 METHODS = tuple(ALGEBRAIC_CONFIGS) + tuple(cls.name for cls in TRACKERS)
 
 
@@ -125,7 +130,7 @@ def run_method(name: str, t: np.ndarray, y: np.ndarray) -> Run:
         return Run(hold_last(marks), idx, e.frequency_hz, e.samples, e.t - e.convergence_time,
                    seconds)
     cls = next(c for c in TRACKERS if c.name == name)
-    tracker = cls(rate_hz=1.0 / np.median(np.diff(t))) if cls is SlidingDFT else cls()
+    tracker = cls(rate_hz=1.0 / np.median(np.diff(t))) if issubclass(cls, SlidingDFT) else cls()
     t0 = time.perf_counter()
     out = tracker.process(t, y)
     return Run(out, empty.astype(int), empty, empty.astype(int), empty, time.perf_counter() - t0)

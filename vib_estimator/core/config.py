@@ -56,8 +56,13 @@ class EstimatorConfig:
                                   'tolerance, which accepts any falling estimate')
     rule_points: int = _param(K.NH, 'samples of the interpolating polynomial the moments are '
                               'integrated over (2 = trapezoid, for comparison)', 2, K.NH)
-    max_window: float = _param(10.0, 'seconds without convergence after which the estimator '
-                               'resets without publishing', 0.0, INF, open_lo=True, open_hi=True)
+    max_window: float = _param(0.0, 'seconds without convergence after which the estimator '
+                               'resets without publishing (0 = automatic: 10 s, or min_periods '
+                               '+ 2 periods of the running estimate if longer)', 0.0, INF,
+                               open_hi=True)
+    refine: int = _param(4, 'Gauss-Newton (maximum-likelihood) steps of the model over the '
+                         'segment, started from the algebraic estimate (0 = the paper\'s '
+                         'algebraic estimate as it is)', 0, 50)
     band_hz: Optional[Tuple[float, float]] = _param(
         None, 'band-pass prefilter [f_lo, f_hi] Hz on the signal (4th-order Butterworth '
         'low-pass at f_hi, 2nd-order high-pass at f_lo), never reset; none = off')
@@ -107,9 +112,10 @@ class EstimatorConfig:
                                      f'{hi}{")" if open_hi else "]"}, got {value!r}')
         if self.model not in MODELS:
             raise ValueError(f'model must be one of {", ".join(MODELS)}, got {self.model!r}')
-        if self.min_time >= self.max_window:
+        window = self.max_window or K.AUTO_WINDOW_S
+        if self.min_time >= window:
             raise ValueError(f'min_time ({self.min_time}) must be below max_window '
-                             f'({self.max_window})')
+                             f'({window}{" when automatic" if not self.max_window else ""})')
         if self.band_hz is not None:
             band = tuple(self.band_hz)
             if len(band) != 2 or not all(isinstance(b, (int, float)) and math.isfinite(b)
@@ -154,4 +160,6 @@ class EstimatorConfig:
         p[K.P_ONESIDED] = 1.0 if self.one_sided_test else 0.0
         p[K.P_RULE] = self.rule_points
         p[K.P_MAXDAMP] = self.max_damping
+        p[K.P_REFINE] = self.refine
+        p[K.P_TARGET] = self.target_std_rel
         return p

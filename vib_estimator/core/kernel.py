@@ -35,6 +35,14 @@ Mathematics (equation numbers are those of Trapero, Sira-Ramirez & Feliu):
   on the absolute value of the relative change. The test as printed is one-sided: any falling
   estimate passes it at once, which is how Fig. 2's convergence time can fall as damping grows;
   ``one_sided_test`` reproduces it.
+* Refinement and uncertainty (:mod:`vib_estimator.core.uncertainty`): a published estimate is the
+  starting point of ``refine`` Gauss-Newton (maximum-likelihood) steps of its model over the
+  segment's samples, and gets its standard deviation from the Fisher information of the model
+  over those samples with the segment's residual variance (``refine`` = 0: the paper's estimate
+  as it is, with its std). ``target_std_rel`` replaces the convergence test by that std; with
+  ``refine`` and ``min_periods`` >= 1 the window is set by ``min_periods`` alone (the test of Eqs.
+  16-17 watches the algebraic estimate, which wanders over many periods while the refined one
+  keeps improving).
 * The optional band-pass prefilter is a 4th-order Butterworth low-pass at ``f_hi`` (steep, against
   higher modes) followed by a 2nd-order Butterworth high-pass at ``f_lo`` (offset and drift), all
   with the same exact discretisation; it is never reset by an estimate.
@@ -43,12 +51,17 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
+
+from . import uncertainty as U
+from .uncertainty import MODEL_BIASED, MODEL_DAMPED, MODEL_SINUSOID  # noqa: F401 (P_MODEL values)
 
 # ---- parameter array layout (float64) -------------------------------------------------------
 P_MODEL, P_WC, P_ZC, P_M, P_TOL, P_EPS, P_MAXWIN, P_BAND, P_WLO, P_WHI, P_MINAMP, P_MINFIT, \
-    P_MAXGAP, P_MINSAMP, P_MINPER, P_FILTER, P_ONESIDED, P_RULE, P_MAXDAMP = range(19)
-N_PARAMS = 19
+    P_MAXGAP, P_MINSAMP, P_MINPER, P_FILTER, P_ONESIDED, P_RULE, P_MAXDAMP, P_REFINE, \
+    P_TARGET = range(21)
+N_PARAMS = 21
 
 # ---- counter array layout (int64) -----------------------------------------------------------
 (C_RECEIVED, C_USED, C_NONFINITE, C_DUPLICATE, C_OUT_OF_ORDER, C_TIME_JUMP, C_GAP, C_REST,
@@ -77,14 +90,17 @@ S_IM = S_SCR + 3 * NH    # the rule's integrals I_0..I_4 of the newest interval
 S_W = S_IM + 5           # cached weights of the rule on a uniform stencil (5 x NH)
 S_WH = S_W + 5 * NH      # step of the cached weights (-1: none)
 S_UNIT = S_WH + 1        # scratch unit vector
-S_MA = S_UNIT + NH       # moving-average ring (2M+1 values) starts here
+S_FLAST = S_UNIT + NH    # long windows: the segment's first converged half-period estimate
+S_NEXT = S_FLAST + 1     # segment length at which target_std_rel is checked next
+S_MA = S_NEXT + 1        # moving-average ring (2M+1 values) starts here
 N_STATE_FIXED = S_MA
 
 # ---- estimate row layout --------------------------------------------------------------------
 O_T, O_F, O_CONV, O_SAMPLES, O_FIT, O_AMP, O_DAMP, O_FSTD, O_DSTD = range(9)
 N_OUT = 9
-#: values of P_MODEL
-MODEL_SINUSOID, MODEL_BIASED, MODEL_DAMPED = 0, 1, 2
+#: automatic max_window: this long at least (s), and min_periods + this many periods
+AUTO_WINDOW_S = 10.0
+AUTO_WINDOW_PERIODS = 2.0
 
 TWO_PI = 2.0 * math.pi
 #: band-pass prefilter: 4th-order Butterworth low-pass at f_hi (two sections), then a 2nd-order
@@ -165,6 +181,8 @@ def reset_segment(s, c, seg, t0, y0):
     seg[1, 0] = y0
     s[S_MOM:S_MOM + 5] = 0.0
     s[S_NF:S_INT + 3] = 0.0
+    s[S_FLAST] = 0.0
+    s[S_NEXT] = 0.0
     c[C_SEG_N] = 1
     c[C_MA_N] = 0
 
@@ -347,36 +365,45 @@ def _first_sample(p, s, c, t, y):
     return y
 
 
-@njit(cache=True)
-def step(p, s, c, seg, t, y, out):
-    """Feed one sample; return 1 and fill ``out`` when an estimate is published, else 0."""
+@njit(cache=True, inline='always')
+def _accept_time(p, s, c, t, y):
+    """Time handling: True if the sample is used, False if it is skipped (counted either way).
+
+    A non-finite sample, a duplicate stamp or a small step back is skipped; a gap, or a backward
+    jump, longer than ``max_gap`` restarts the estimator (counted), which then takes the sample as
+    its first.
+    """
     c[C_RECEIVED] += 1
-    h = 0.0
     if not (math.isfinite(t) and math.isfinite(y)):
         c[C_NONFINITE] += 1
-        return 0
+        return False
     if c[C_HIST_N] > 0:
         h = t - s[S_TLAST]
         if h == 0.0:
             c[C_DUPLICATE] += 1
-            return 0
+            return False
         if h < 0.0:
             if -h > p[P_MAXGAP]:
                 c[C_TIME_JUMP] += 1
                 _restart(s, c)
             else:
                 c[C_OUT_OF_ORDER] += 1
-                return 0
+                return False
         elif h > p[P_MAXGAP]:
             c[C_GAP] += 1
             _restart(s, c)
     c[C_USED] += 1
     s[S_TLAST] = t
-    if c[C_HIST_N] == 0:
-        _first_sample(p, s, c, t, y)
-        return 0
-    # discretisations for this interval, recomputed only when the step changes by more than
-    # rounding (a uniform stream's stamps differ in the last bits)
+    return True
+
+
+@njit(cache=True, inline='always')
+def _update_discretisations(p, s, h):
+    """Exact discretisations of the invariant filter (Eq. 11) and the prefilter for the step h.
+
+    Recomputed only when the step changes by more than rounding (a uniform stream's stamps differ
+    in the last bits).
+    """
     if abs(h - s[S_CACHE_H]) > 1e-9 * h:
         _discretise(p[P_WC], p[P_ZC], h, s, S_DISC)
         if p[P_BAND] > 0.0:
@@ -384,9 +411,15 @@ def step(p, s, c, seg, t, y, out):
                 _discretise(p[P_WHI] if k < 2 else p[P_WLO], BAND_DAMPING[k], h, s,
                             S_DISC + 8 * (k + 1))
         s[S_CACHE_H] = h
-    if p[P_BAND] > 0.0:
-        y = _prefilter(p, s, y)
-    # shift the interpolation history
+
+
+@njit(cache=True, inline='always')
+def _push_history(s, c, seg, t, y):
+    """Shift (t, y) into the interpolation stencil; True once the stencil holds NH samples.
+
+    The first segment after a (re)start begins when the stencil is full, so every interval of it is
+    integrated with the full-order rule.
+    """
     for i in range(NH - 1):
         s[S_HT + i] = s[S_HT + i + 1]
         s[S_HY + i] = s[S_HY + i + 1]
@@ -395,14 +428,19 @@ def step(p, s, c, seg, t, y, out):
     if c[C_HIST_N] < NH:
         c[C_HIST_N] += 1
         if c[C_HIST_N] == NH:
-            # every interval of the first segment is integrated with the full-order rule
             reset_segment(s, c, seg, t, y)
-        return 0
-    tau = t - s[S_T0]
-    a = s[S_HT + NH - 2] - s[S_T0]
-    model = int(p[P_MODEL])
-    kmax = 4 if model == MODEL_BIASED else 3
-    _interval_moments(s, kmax, a, h, int(p[P_RULE]))
+        return False
+    return True
+
+
+@njit(cache=True, inline='always')
+def _numerator_denominator(model, s, tau, y):
+    """Eq. 7 (with Eq. 8's corrected sign) in moments: n and d of omega^2 = n / d at time tau.
+
+    ``sinusoid`` / ``damped-sinusoid``: n = -(tau^2 y + 2 tau M0 - 6 M1), d = tau M2 - M3;
+    ``biased-sinusoid`` (offset eliminated by a third derivation in s): N = -tau^3 y + 3 tau^2 M0
+    - 24 tau M1 + 30 M2, D = -1.5 tau^2 M2 + 4 tau M3 - 2.5 M4.
+    """
     m0 = s[S_MOM]
     m1 = s[S_MOM + 1]
     m2 = s[S_MOM + 2]
@@ -414,7 +452,17 @@ def step(p, s, c, seg, t, y, out):
     else:
         num = -(tau * tau * y + 2.0 * tau * m0 - 6.0 * m1)
         den = tau * m2 - m3
-    # invariant filtering, Eq. 11 (same discretised filter for all)
+    return num, den
+
+
+@njit(cache=True, inline='always')
+def _invariant_filter(p, s, model, num, den, tau, h):
+    """Invariant filtering, Eqs. 9-11: n and d (and q of the damped model) through one low-pass.
+
+    The same exactly discretised second-order filter acts on every term, so n_f / d_f stays w^2
+    for a pure sine. The damped model also forms q = 3 M2 - 2 tau M1 and the running integrals of
+    n_f, q_f, d_f (its second equation).
+    """
     filtered = p[P_FILTER] > 0.0
     if filtered:
         _advance(s, S_NF, S_DISC, s[S_NPREV], num)
@@ -425,7 +473,7 @@ def step(p, s, c, seg, t, y, out):
     s[S_NPREV] = num
     s[S_DPREV] = den
     if model == MODEL_DAMPED:
-        q = 3.0 * m2 - 2.0 * tau * m1
+        q = 3.0 * s[S_MOM + 2] - 2.0 * tau * s[S_MOM + 1]
         if filtered:
             _advance(s, S_QF, S_DISC, s[S_QPREV], q)
         else:
@@ -434,29 +482,20 @@ def step(p, s, c, seg, t, y, out):
         s[S_INT] += h * s[S_NF]
         s[S_INT + 1] += h * s[S_QF]
         s[S_INT + 2] += h * s[S_DF]
-    nseg = c[C_SEG_N]
-    cap = seg.shape[1]
-    if nseg < cap:
-        seg[0, nseg] = tau
-        seg[1, nseg] = y
-    c[C_SEG_N] = nseg + 1
-    if tau > p[P_MAXWIN] or nseg + 1 >= cap:
-        # no convergence: say whether the signal was at rest or just never converged
-        if _spread(seg, min(nseg + 1, cap)) <= p[P_MINAMP]:
-            c[C_REST] += 1
-        else:
-            c[C_MAX_WINDOW] += 1
-        reset_segment(s, c, seg, t, y)
-        return 0
-    if tau <= p[P_EPS] or nseg + 1 < p[P_MINSAMP]:
-        return 0
-    # Eq. 12
+
+
+@njit(cache=True, inline='always')
+def _ratio(model, s):
+    """Eq. 12: (omega^2, damping ratio) from the filtered terms; omega^2 <= 0 when undefined.
+
+    ``damped-sinusoid``: n = 2 sigma q + w_n^2 d holds at every instant; filtered (F1) and then
+    integrated (F2) it gives two equations in (2 sigma, w_n^2), solved by Cramer's rule. The other
+    models: omega^2 = n_f / d_f (damping NaN).
+    """
     nf = s[S_NF]
     df = s[S_DF]
     damping = math.nan
     if model == MODEL_DAMPED:
-        # n = 2 sigma q + w_n^2 d holds at every instant; filtered (F1) and then integrated (F2)
-        # it gives two equations in (2 sigma, w_n^2)
         qf = s[S_QF]
         i_n = s[S_INT]
         i_q = s[S_INT + 1]
@@ -467,18 +506,23 @@ def step(p, s, c, seg, t, y, out):
             damping = 0.5 * (nf * i_d - df * i_n) / det / math.sqrt(w2)
     else:
         w2 = nf / df if df != 0.0 else -1.0
-    if not (w2 > 0.0 and math.isfinite(w2)):
-        c[C_MA_N] = 0
-        return 0
-    f = math.sqrt(w2) / TWO_PI
-    # Eqs. 16-17: moving average of the last M+1 estimates against the one M samples earlier
+    return w2, damping
+
+
+@njit(cache=True, inline='always')
+def _converged(p, s, c, f):
+    """Eqs. 16-17: the moving average of the last M+1 estimates against the one M samples earlier.
+
+    Pushes f into the ring of the last 2M+1 estimates; True when the relative change (its absolute
+    value unless ``one_sided_test``) is below the tolerance.
+    """
     m = int(p[P_M])
     size = 2 * m + 1
     k = c[C_MA_N]
     s[S_MA + (k % size)] = f
     c[C_MA_N] = k + 1
     if k + 1 < size:
-        return 0
+        return False
     ma_now = 0.0
     ma_then = 0.0
     for i in range(m + 1):
@@ -487,15 +531,17 @@ def step(p, s, c, seg, t, y, out):
     change = ma_now - ma_then
     if p[P_ONESIDED] == 0.0:
         change = abs(change)
-    if change >= p[P_TOL] * ma_now:
-        return 0
-    # the segment must span a fraction of the period it estimates
-    if tau * f < p[P_MINPER]:
-        return 0
-    # converged: quality gate, then publish and reset
-    n_fit = min(nseg + 1, cap)
-    r2, amp = _fit(seg, n_fit, TWO_PI * f)
-    published = 0
+    return change < p[P_TOL] * ma_now
+
+
+@njit(cache=True, inline='always')
+def _quality_gate(p, c, model, f, damping, h, r2, amp):
+    """True if the converged estimate may be published; else count why it is held back.
+
+    At rest (no variance, or amplitude at or below ``min_amplitude``), above Nyquist, a sinusoid
+    fit R^2 below ``min_fit``, or (damped model) |damping ratio| above ``max_damping``: a "lightly
+    damped vibration" with more damping is a transient, not a mode.
+    """
     if r2 < 0.0 or amp <= p[P_MINAMP]:
         c[C_REST] += 1
     elif f * 2.0 * h >= 1.0:
@@ -503,22 +549,159 @@ def step(p, s, c, seg, t, y, out):
     elif r2 < p[P_MINFIT]:
         c[C_FIT] += 1
     elif model == MODEL_DAMPED and not abs(damping) <= p[P_MAXDAMP]:
-        # a "lightly damped vibration" with |zeta| above this is a transient, not a mode
         c[C_DAMPING] += 1
     else:
+        return True
+    return False
+
+
+@njit(cache=True, inline='always')
+def _store_sample(p, s, c, seg, t, tau, y):
+    """Keep (tau, y) in the segment buffer; True if the segment ran out (``max_window`` or buffer).
+
+    A segment that runs out resets without publishing, counted as at rest or as not converged.
+    ``max_window`` = 0 is automatic: 10 s, or min_periods + 2 periods of the segment's first
+    converged half-period estimate when that is longer (so long windows are never cut short).
+    """
+    nseg = c[C_SEG_N]
+    cap = seg.shape[1]
+    if nseg < cap:
+        seg[0, nseg] = tau
+        seg[1, nseg] = y
+    c[C_SEG_N] = nseg + 1
+    limit = p[P_MAXWIN]
+    if limit <= 0.0:
+        limit = AUTO_WINDOW_S
+        if s[S_FLAST] > 0.0:
+            limit = max(limit, (p[P_MINPER] + AUTO_WINDOW_PERIODS) / s[S_FLAST])
+    if tau > limit or nseg + 1 >= cap:
+        if _spread(seg, min(nseg + 1, cap)) <= p[P_MINAMP]:
+            c[C_REST] += 1
+        else:
+            c[C_MAX_WINDOW] += 1
+        reset_segment(s, c, seg, t, y)
+        return True
+    return False
+
+
+@njit(cache=True)
+def step(p, s, c, seg, t, y, out):
+    """Feed one sample; return 1 and fill ``out`` when an estimate is published, else 0."""
+    if not _accept_time(p, s, c, t, y):
+        return 0
+    if c[C_HIST_N] == 0:
+        _first_sample(p, s, c, t, y)
+        return 0
+    h = t - s[S_HT + NH - 1]      # the newest sample of the stencil is the previous one
+    _update_discretisations(p, s, h)
+    if p[P_BAND] > 0.0:
+        y = _prefilter(p, s, y)
+    if not _push_history(s, c, seg, t, y):
+        return 0
+    tau = t - s[S_T0]
+    model = int(p[P_MODEL])
+    _interval_moments(s, 4 if model == MODEL_BIASED else 3, s[S_HT + NH - 2] - s[S_T0], h,
+                      int(p[P_RULE]))
+    num, den = _numerator_denominator(model, s, tau, y)
+    _invariant_filter(p, s, model, num, den, tau, h)
+    nseg = c[C_SEG_N]
+    if _store_sample(p, s, c, seg, t, tau, y):
+        return 0
+    if tau <= p[P_EPS] or nseg + 1 < p[P_MINSAMP]:
+        return 0
+    w2, damping = _ratio(model, s)
+    if not (w2 > 0.0 and math.isfinite(w2)):
+        c[C_MA_N] = 0
+        return 0
+    f = math.sqrt(w2) / TWO_PI
+    n_fit = min(nseg + 1, seg.shape[1])
+    if p[P_TARGET] > 0.0:
+        if tau * f < p[P_MINPER] or not _target_reached(p, s, seg, n_fit, model, f, damping, h):
+            return 0
+    elif p[P_REFINE] > 0.0 and p[P_MINPER] >= 1.0:
+        # long window: its span in periods of the segment's first converged half-period
+        # estimate (what the default configuration publishes; the algebraic estimate wanders
+        # over many periods), from which the fit starts
+        if s[S_FLAST] == 0.0:
+            if _converged(p, s, c, f) and tau * f >= 0.5:
+                s[S_FLAST] = f
+            return 0
+        if tau * s[S_FLAST] < p[P_MINPER]:
+            return 0
+        f = s[S_FLAST]
+    # the segment must span a fraction of the period it estimates
+    elif not _converged(p, s, c, f) or tau * f < p[P_MINPER]:
+        return 0
+    res = np.empty(U.N_RESULT)
+    _refine(p, seg, n_fit, model, f, damping, h, res)
+    f = res[U.R_F]
+    r2, amp = _fit(seg, n_fit, TWO_PI * f)
+    published = _quality_gate(p, c, model, f, res[U.R_DAMP], h, r2, amp)
+    if published:
         out[O_T] = t
         out[O_F] = f
         out[O_CONV] = tau
         out[O_SAMPLES] = nseg + 1
         out[O_FIT] = r2
         out[O_AMP] = amp
-        out[O_DAMP] = damping
-        out[O_FSTD] = math.nan
-        out[O_DSTD] = math.nan
+        out[O_DAMP] = res[U.R_DAMP]
+        out[O_FSTD] = res[U.R_FSTD]
+        out[O_DSTD] = res[U.R_DSTD]
         c[C_ESTIMATES] += 1
-        published = 1
     reset_segment(s, c, seg, t, y)
-    return published
+    return 1 if published else 0
+
+
+@njit(cache=True)
+def _noise_scale(p, f, h):
+    """Residual-variance factor for the band prefilter's coloured noise (1 without it)."""
+    if p[P_BAND] > 0.0:
+        return U.band_noise_scale(f, p[P_WLO] / TWO_PI, p[P_WHI] / TWO_PI, h)
+    return 1.0
+
+
+@njit(cache=True)
+def _start(model, f, damping):
+    """Start of the refinement: (w, sigma) = (w_d, zeta w_n) from the algebraic (w_n, zeta)."""
+    wn = TWO_PI * f
+    if model == MODEL_DAMPED and abs(damping) < 1.0:
+        return wn * math.sqrt(1.0 - damping * damping), damping * wn
+    return wn, 0.0
+
+
+@njit(cache=True)
+def _refine(p, seg, n, model, f, damping, h, res):
+    """The estimate to gate and publish: ``res`` = (f, damping, their std), core.uncertainty.
+
+    ``refine`` = 0 keeps the paper's algebraic (f, damping) and adds their std; otherwise up to
+    ``refine`` Gauss-Newton steps of the model over the segment replace them (the quality gate
+    then judges the refined frequency).
+    """
+    w0, sigma0 = _start(model, f, damping)
+    iterations = int(p[P_REFINE])
+    res[:] = math.nan
+    if not U.refine(model, seg, n, w0, sigma0, iterations, _noise_scale(p, f, h), res) \
+            or iterations == 0:
+        res[U.R_F] = f
+        res[U.R_DAMP] = damping
+
+
+@njit(cache=True)
+def _target_reached(p, s, seg, n, model, f, damping, h):
+    """``target_std_rel``: True once the predicted relative std of f is at or below the target.
+
+    The std (the Fisher information of the model over the segment at the algebraic estimate, with
+    the residual variance) costs a pass over the segment, so it is checked at every sample up to
+    64 and then each time the segment has grown by 1/16 (an amortised 16 passes per sample).
+    """
+    if n < s[S_NEXT]:
+        return False
+    s[S_NEXT] = max(n + 1.0, n * (1.0 + 1.0 / 16.0)) if n >= 64 else n + 1.0
+    res = np.full(U.N_RESULT, math.nan)
+    w0, sigma0 = _start(model, f, damping)
+    if not U.refine(model, seg, n, w0, sigma0, 0, _noise_scale(p, f, h), res):
+        return False
+    return res[U.R_FSTD] <= p[P_TARGET] * f
 
 
 @njit(cache=True)

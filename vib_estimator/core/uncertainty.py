@@ -1,0 +1,282 @@
+"""Maximum-likelihood refinement of an estimate over its segment, and its standard deviation (numba).
+
+The algebraic estimate (Eqs. 7-12) is exact for a clean signal of its model but, with noise, its
+spread grows with the window instead of falling (the moments weight the samples by powers of t,
+not by their information). This module turns it into the maximum-likelihood estimate of the same
+model over the samples the estimate used (the segment buffer the quality gate already holds), and
+gives the standard deviation of the result from the Fisher information.
+
+Models, on centred segment time u = tau - (tau_0 + tau_{n-1}) / 2 (centring decorrelates the
+frequency from the phase and keeps the normal equations well conditioned)::
+
+    sinusoid:          y = a sin(w u) + b cos(w u)                         theta = (a, b, w)
+    biased-sinusoid:   y = a sin(w u) + b cos(w u) + c                     theta = (a, b, w, c)
+    damped-sinusoid:   y = exp(-sigma u) (a sin(w_d u) + b cos(w_d u))     theta = (a, b, w_d, sigma)
+
+(the damped model's natural frequency is w_n = sqrt(w_d^2 + sigma^2), its damping ratio
+zeta = sigma / w_n: the quantities of the algebraic damped estimator.)
+
+:func:`refine`: the linear parameters are first solved for at the algebraic (w, sigma) (variable
+projection), then Gauss-Newton steps on all of theta (continued over growing prefixes of a long
+segment, see :func:`refine`): ``J^T J delta = J^T r`` (J the Jacobian of
+the model over the samples, r the residual). A step is kept only if it lowers the residual sum of
+squares, so the result is never worse (in the likelihood) than the algebraic estimate it starts
+from; with 0 iterations the algebraic estimate is returned untouched and only its std is computed.
+
+Standard deviation: ``cov(theta) = s^2 (J^T J)^-1`` at the returned theta, with the residual
+variance ``s^2 = RSS / (n - p)`` (p parameters): the exact Cramer-Rao bound of the model over those
+samples with the noise variance estimated from the segment itself. For the damped model the std of
+f_n and zeta follow by the delta method from the (w_d, sigma) block.
+
+Coloured noise: the optional band-pass prefilter leaves white noise white inside its pass band
+but removes it outside, so the residual variance underestimates the noise density at the signal's
+frequency (which is what the Fisher information of a sinusoid depends on). :func:`band_noise_scale`
+restores it with the Butterworth filters' noise-equivalent bandwidth (valid when the window is long
+against the filter's correlation time 1/(f_hi - f_lo)).
+
+Sines and cosines over the segment are advanced by a rotation (exact on uniform sampling, resynced
+every 256 samples and whenever the step changes), so a pass costs a few multiplications a sample.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+#: values of the kernel's model parameter
+MODEL_SINUSOID, MODEL_BIASED, MODEL_DAMPED = 0, 1, 2
+#: refine() result layout: frequency (Hz), damping ratio, their standard deviations
+R_F, R_DAMP, R_FSTD, R_DSTD = range(4)
+N_RESULT = 4
+TWO_PI = 2.0 * math.pi
+_RESYNC = 256
+
+
+@njit(cache=True)
+def _accumulate(model, seg, n, tc, th, jtj, jtr):
+    """One pass over the segment at theta: J^T J, J^T r into ``jtj``, ``jtr``; returns the RSS.
+
+    Columns of J: d/da = E sin, d/db = E cos, d/dw = u E (a cos - b sin), and d/dc = 1 (biased) or
+    d/dsigma = -u E (a sin + b cos) (damped), with E = exp(-sigma u) (1 for the other models).
+    """
+    npar = 3 if model == MODEL_SINUSOID else 4
+    jtj[:, :] = 0.0
+    jtr[:] = 0.0
+    a, b, w = th[0], th[1], th[2]
+    sig = th[3] if model == MODEL_DAMPED else 0.0
+    off = th[3] if model == MODEL_BIASED else 0.0
+    jac = np.zeros(4)
+    rss = 0.0
+    sn = cs = e = rc = rs = re = 0.0
+    d_prev = -1.0
+    for i in range(n):
+        u = seg[0, i] - tc
+        d = seg[0, i] - seg[0, i - 1] if i > 0 else 0.0
+        if i % _RESYNC == 0:
+            sn, cs, e = math.sin(w * u), math.cos(w * u), math.exp(-sig * u)
+        else:
+            if abs(d - d_prev) > 1e-9 * d:
+                rc, rs, re, d_prev = math.cos(w * d), math.sin(w * d), math.exp(-sig * d), d
+            sn, cs = sn * rc + cs * rs, cs * rc - sn * rs
+            e *= re
+        osc = e * (a * sn + b * cs)
+        r = seg[1, i] - osc - off
+        jac[0] = e * sn
+        jac[1] = e * cs
+        jac[2] = u * e * (a * cs - b * sn)
+        jac[3] = 1.0 if model == MODEL_BIASED else -u * osc
+        for j in range(npar):
+            jtr[j] += jac[j] * r
+            for k in range(j, npar):
+                jtj[j, k] += jac[j] * jac[k]
+        rss += r * r
+    for j in range(npar):
+        for k in range(j):
+            jtj[j, k] = jtj[k, j]
+    return rss
+
+
+@njit(cache=True)
+def _invert(a, idx, m, out):
+    """Inverse of the symmetric block a[idx][:, idx] (m x m) into out[:m, :m]; False if singular.
+
+    Gauss-Jordan with partial pivoting on the Jacobi-scaled matrix (the columns of J have different
+    units, so scaling keeps the pivots meaningful).
+    """
+    w = np.zeros((m, 2 * m))
+    scale = np.zeros(m)
+    for i in range(m):
+        dii = a[idx[i], idx[i]]
+        if not dii > 0.0:
+            return False
+        scale[i] = 1.0 / math.sqrt(dii)
+    for i in range(m):
+        for j in range(m):
+            w[i, j] = a[idx[i], idx[j]] * scale[i] * scale[j]
+        w[i, m + i] = 1.0
+    for col in range(m):
+        piv = col
+        for r in range(col + 1, m):
+            if abs(w[r, col]) > abs(w[piv, col]):
+                piv = r
+        if not abs(w[piv, col]) > 1e-14:
+            return False
+        for j in range(2 * m):
+            w[col, j], w[piv, j] = w[piv, j], w[col, j]
+        inv_p = 1.0 / w[col, col]
+        for j in range(2 * m):
+            w[col, j] *= inv_p
+        for r in range(m):
+            if r != col and w[r, col] != 0.0:
+                fac = w[r, col]
+                for j in range(2 * m):
+                    w[r, j] -= fac * w[col, j]
+    for i in range(m):
+        for j in range(m):
+            out[i, j] = w[i, m + j] * scale[i] * scale[j]
+    return True
+
+
+@njit(cache=True)
+def _solve_linear(model, seg, n, tc, th, jtj, jtr, cov):
+    """Variable projection: the least-squares a, b (and c) at theta's w (and sigma)."""
+    th[0] = th[1] = 0.0
+    if model == MODEL_BIASED:
+        th[3] = 0.0
+    _accumulate(model, seg, n, tc, th, jtj, jtr)
+    idx = np.array([0, 1, 3])
+    m = 3 if model == MODEL_BIASED else 2
+    if not _invert(jtj, idx, m, cov):
+        return False
+    for i in range(m):
+        acc = 0.0
+        for j in range(m):
+            acc += cov[i, j] * jtr[idx[j]]
+        th[idx[i]] = acc
+    return True
+
+
+@njit(cache=True)
+def _gauss_newton(model, seg, n, th, iterations, best_cov):
+    """Fit theta over seg[:, :n]: variable projection at theta's (w, sigma), then Gauss-Newton.
+
+    A step is kept only if it lowers the RSS. Returns the best RSS (inf if no fit) and leaves the
+    best theta in ``th`` and its (J^T J)^-1 in ``best_cov``.
+    """
+    npar = 3 if model == MODEL_SINUSOID else 4
+    tc = 0.5 * (seg[0, 0] + seg[0, n - 1])
+    jtj = np.zeros((4, 4))
+    jtr = np.zeros(4)
+    cov = np.zeros((4, 4))
+    if not _solve_linear(model, seg, n, tc, th, jtj, jtr, cov):
+        return math.inf
+    idx = np.arange(4)
+    best = th.copy()
+    best_rss = math.inf
+    for k in range(iterations + 1):
+        rss = _accumulate(model, seg, n, tc, th, jtj, jtr)
+        if not (rss < best_rss and _invert(jtj, idx, npar, cov)):
+            break
+        best_rss = rss
+        best[:] = th
+        best_cov[:, :] = cov
+        if k == iterations:
+            break
+        step_w = 0.0
+        for i in range(npar):
+            delta = 0.0
+            for j in range(npar):
+                delta += cov[i, j] * jtr[j]
+            th[i] += delta
+            if i == 2:
+                step_w = delta
+        if not (th[2] > 0.0 and math.isfinite(th[2])) or abs(step_w) <= 1e-13 * th[2]:
+            break
+    th[:] = best
+    return best_rss
+
+
+@njit(cache=True)
+def refine(model, seg, n, w0, sigma0, iterations, noise_scale, res):
+    """Refine the algebraic estimate over the segment ``seg[:, :n]`` (rows: tau, y); fill ``res``.
+
+    ``w0`` (rad/s) and ``sigma0`` (1/s, damped model) start the fit; ``iterations`` Gauss-Newton
+    steps at most, each kept only if it lowers the RSS. Over more than a period the fit is
+    continued: first over the segment's first half period (where the algebraic estimate is near
+    the bound, well inside the likelihood's main lobe), then over prefixes doubling in length up to
+    the whole segment, each started from the last, so the start always lies in the main lobe of the
+    next window's likelihood. ``noise_scale`` multiplies the residual variance
+    (:func:`band_noise_scale`). ``res``: frequency (Hz; the natural frequency for the damped
+    model), damping ratio (NaN unless damped) and their std. Returns False (res untouched) when no
+    fit is possible.
+    """
+    npar = 3 if model == MODEL_SINUSOID else 4
+    if n <= npar + 1 or not w0 > 0.0:
+        return False
+    th = np.zeros(4)
+    th[2] = w0
+    if model == MODEL_DAMPED:
+        th[3] = sigma0
+    cov = np.zeros((4, 4))
+    m = n
+    if iterations > 0:
+        half = math.pi / w0
+        m = 2 * npar + 2
+        while m < n and seg[0, m - 1] - seg[0, 0] < half:
+            m += 1
+    while True:
+        rss = _gauss_newton(model, seg, m, th, iterations, cov)
+        if m >= n or rss == math.inf:
+            break
+        m = min(2 * m, n)
+    if rss == math.inf:
+        return False
+    _moments_of_result(model, th, cov, rss * noise_scale / (n - npar), res)
+    return True
+
+
+@njit(cache=True)
+def _moments_of_result(model, th, cov, s2, res):
+    """Frequency, damping ratio and their std from theta and s^2 (J^T J)^-1 (delta method)."""
+    w = th[2]
+    if model == MODEL_DAMPED:
+        sig = th[3]
+        wn = math.sqrt(w * w + sig * sig)
+        # gradients of w_n and zeta = sigma / w_n with respect to (w_d, sigma)
+        gw = (w / wn, sig / wn)
+        gz = (-sig * w / wn ** 3, w * w / wn ** 3)
+        var_w = s2 * (gw[0] * gw[0] * cov[2, 2] + 2 * gw[0] * gw[1] * cov[2, 3]
+                      + gw[1] * gw[1] * cov[3, 3])
+        var_z = s2 * (gz[0] * gz[0] * cov[2, 2] + 2 * gz[0] * gz[1] * cov[2, 3]
+                      + gz[1] * gz[1] * cov[3, 3])
+        res[R_F] = wn / TWO_PI
+        res[R_DAMP] = sig / wn
+        res[R_DSTD] = math.sqrt(var_z) if var_z >= 0.0 else math.nan
+    else:
+        var_w = s2 * cov[2, 2]
+        res[R_F] = w / TWO_PI
+        res[R_DAMP] = math.nan
+        res[R_DSTD] = math.nan
+    res[R_FSTD] = math.sqrt(var_w) / TWO_PI if var_w >= 0.0 else math.nan
+
+
+@njit(cache=True)
+def band_noise_scale(f, f_lo, f_hi, h):
+    """Factor restoring the white-noise density at f from the residual of band-passed samples.
+
+    Band-passed white noise of density N0 has the variance N0 * ENBW (one-sided, the filter's
+    noise-equivalent bandwidth) and the density N0 |H(f)|^2 at f; the Fisher information of a
+    sinusoid needs the latter, i.e. the variance of white noise with that density sampled at 1/h:
+    N0 |H(f)|^2 / (2 h). Butterworth: ENBW = 1.026 f_hi (4th-order low-pass) minus 1.111 f_lo
+    (the band a 2nd-order high-pass removes), |H|^2 = 1/(1 + (f/f_hi)^8) (f/f_lo)^4/(1 + (f/f_lo)^4).
+    """
+    nyquist = 0.5 / h
+    enbw = min(f_hi * (math.pi / 8) / math.sin(math.pi / 8), nyquist) \
+        - f_lo * (math.pi / 4) / math.sin(math.pi / 4)
+    if not enbw > 0.0:
+        return 1.0
+    x_hi = (f / f_hi) ** 8
+    x_lo = (f / f_lo) ** 4
+    gain2 = 1.0 / (1.0 + x_hi) * x_lo / (1.0 + x_lo)
+    return gain2 * nyquist / enbw
