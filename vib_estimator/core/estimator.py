@@ -40,6 +40,15 @@ COUNTER_NAMES = ('received', 'used', 'skipped_non_finite', 'skipped_duplicate',
                  'rejected_damping')
 
 
+def as_series(t: Sequence[float], y: Sequence[float]) -> Tuple[np.ndarray, np.ndarray]:
+    """``t``, ``y`` as contiguous float64 arrays of one length (``ValueError`` otherwise)."""
+    t = np.ascontiguousarray(t, dtype=np.float64)
+    y = np.ascontiguousarray(y, dtype=np.float64)
+    if t.shape != y.shape or t.ndim != 1:
+        raise ValueError(f't and y must be 1-D arrays of one length, got {t.shape}, {y.shape}')
+    return t, y
+
+
 @dataclass(frozen=True)
 class Estimate:
     """One published estimate.
@@ -177,10 +186,7 @@ class FrequencyEstimator:
 
     def process(self, t: Sequence[float], y: Sequence[float]) -> EstimateArrays:
         """Feed arrays of samples (continuing the stream); return the estimates as columns."""
-        t = np.ascontiguousarray(t, dtype=np.float64)
-        y = np.ascontiguousarray(y, dtype=np.float64)
-        if t.shape != y.shape or t.ndim != 1:
-            raise ValueError(f't and y must be 1-D arrays of one length, got {t.shape}, {y.shape}')
+        t, y = as_series(t, y)
         chunks = []
         start = 0
         size = max(16, len(t) // 100)

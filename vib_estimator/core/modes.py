@@ -59,7 +59,7 @@ import numpy as np
 from numba import njit
 
 from .config import EstimatorConfig
-from .estimator import COUNTER_NAMES, Estimate, EstimateArrays, FrequencyEstimator
+from .estimator import COUNTER_NAMES, Estimate, EstimateArrays, FrequencyEstimator, as_series
 from .kernel import BAND_DAMPING, NH, _advance, _discretise
 
 KMAX = 8                 # most modes a tracker follows (the range of ``modes``)
@@ -738,10 +738,7 @@ class ModeTracker:
 
     def process(self, t: Sequence[float], y: Sequence[float]) -> EstimateArrays:
         """Feed arrays of samples (continuing the stream); the estimates as columns, by time."""
-        t = np.ascontiguousarray(t, dtype=np.float64)
-        y = np.ascontiguousarray(y, dtype=np.float64)
-        if t.shape != y.shape or t.ndim != 1:
-            raise ValueError(f't and y must be 1-D arrays of one length, got {t.shape}, {y.shape}')
+        t, y = as_series(t, y)
         out = np.empty((KMAX, min(BLOCK, len(t))))
         parts = []
         i = 0
