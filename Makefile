@@ -4,7 +4,7 @@ VENV    := .venv
 STAMP   := $(VENV)/.installed
 export ROS_AUTOMATIC_DISCOVERY_RANGE := LOCALHOST
 
-.PHONY: setup demo shaping test bench reproduce compare bags survey clean
+.PHONY: setup demo shaping test bench bench-all reproduce compare bags survey clean
 
 setup: $(STAMP)
 
@@ -30,6 +30,13 @@ bench: setup
 	$(VENV)/bin/python benchmarks/bench_estimator.py
 	$(VENV)/bin/python benchmarks/bench_accuracy.py
 	$(VENV)/bin/python benchmarks/bench_node.py
+
+# every benchmark (long: the precision, modes and survey studies take minutes each)
+bench-all: bench
+	$(VENV)/bin/python benchmarks/bench_precision.py
+	$(VENV)/bin/python benchmarks/bench_modes.py
+	$(VENV)/bin/python benchmarks/bench_survey.py
+	$(VENV)/bin/python benchmarks/real_data.py
 
 reproduce: setup
 	$(VENV)/bin/vib-estimator reproduce fig1 --out out/fig1.png
