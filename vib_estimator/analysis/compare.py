@@ -4,7 +4,8 @@ Every method -- the paper's algebraic estimator (``refine`` = 0) with the sinuso
 the ``damped-sinusoid`` model (``Algebraic-damped``), this package's default configuration (the
 same estimates refined by maximum likelihood over their segments, ``Algebraic-ML``),
 Ziarani-Konrad (Eqs. 25-26), Hou (Eqs. 27-29), Mojiri-Bakhshai (Eqs. 30-33), all with the paper's
-gains, the flight-controller-style :class:`SlidingDFT` and a sliding matrix pencil
+gains and again (``-A`` rows) with the gains tuned for the signal's amplitude (:func:`tuned_gains`),
+the flight-controller-style :class:`SlidingDFT` and a sliding matrix pencil
 (:class:`SlidingMatrixPencil`, 2 s windows) -- runs on the same signals:
 
 * ``5.3``: the simulated arm of Section 5.3 (Figs. 5-6, 45.55 g, ramp to 1 rad, 10 s);
@@ -39,6 +40,8 @@ Plots like Figs. 6-7 (signal; every method's estimate; truth dashed; zoom) are w
 from __future__ import annotations
 
 import argparse
+import functools
+import inspect
 import math
 import os
 import time
@@ -65,7 +68,15 @@ ALGEBRAIC_CONFIGS = {ALGEBRAIC: EstimatorConfig(refine=0),
                      'Algebraic-damped': EstimatorConfig(model='damped-sinusoid', refine=0),
                      'Algebraic-ML': EstimatorConfig()}
 TRACKERS = (ZiaraniKonrad, Hou, MojiriBakhshai, SlidingDFT, SlidingMatrixPencil)
-METHODS = tuple(ALGEBRAIC_CONFIGS) + tuple(cls.name for cls in TRACKERS)
+#: the adaptive trackers with amplitude-tuned gains: name -> (tracker, the gain that multiplies
+#: the signal's amplitude squared in its frequency adaptation law)
+AMPLITUDE_TUNED = {f'{cls.name}-A': (cls, gain) for cls, gain in
+                   ((ZiaraniKonrad, 'mu2'), (Hou, 'alpha2'), (MojiriBakhshai, 'xi2'))}
+#: noise seeds the tuning measures the amplitude on (never used for scoring: those are 0, 1, ...)
+TUNING_SEEDS = (1000, 1001)
+#: the grid of the tuned gain, as factors of the paper's
+GAIN_FACTORS = (0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0)
+METHODS = tuple(ALGEBRAIC_CONFIGS) + tuple(cls.name for cls in TRACKERS) + tuple(AMPLITUDE_TUNED)
 
 
 #: a record: sample times (s), signal, true frequency of each sample (Hz)
@@ -116,8 +127,41 @@ class Run:
     seconds: float
 
 
-def run_method(name: str, t: np.ndarray, y: np.ndarray) -> Run:
-    """Run method ``name`` (one of :data:`METHODS`) fresh over a record."""
+@functools.lru_cache(maxsize=None)
+def tuned_gains(case: 'Case') -> Dict[str, Dict[str, float]]:
+    """Gains of the ``-A`` rows for ``case``, chosen on the records of :data:`TUNING_SEEDS`.
+
+    The paper's gains are for a ~1 N m signal (Section 5.4). In each adaptation law the frequency
+    update scales with the amplitude squared (omega' ~ mu2 A^2, eta' ~ alpha2 A^2,
+    theta' ~ xi2 A^2; the other gains set rates independent of A), so that gain is the one to
+    tune: it is the paper's times the factor of :data:`GAIN_FACTORS` (1/A^2 is ~15-25 on the
+    arm's 0.2-0.3 N m) with the least mean squared error of the per-sample estimate over the last
+    half of each segment (the statistic the table scores), summed over the tuning records.
+    """
+    records = [case.record(seed) for seed in TUNING_SEEDS]
+    best = {}
+    for name, (cls, gain) in AMPLITUDE_TUNED.items():
+        paper = inspect.signature(cls).parameters[gain].default
+        scores = [sum(_tuning_error(name, {gain: paper * k}, rec) for rec in records)
+                  for k in GAIN_FACTORS]
+        best[name] = {gain: paper * GAIN_FACTORS[int(np.argmin(scores))]}
+    return best
+
+
+def _tuning_error(name: str, gains: Dict[str, float], record: Record) -> float:
+    t, y, f_true = record
+    out = run_method(name, t, y, gains).output
+    err = 0.0
+    for i0, i1, f in segments(f_true):
+        tail = out[(i0 + i1) // 2:i1]
+        err += float(np.mean(np.square(tail - f))) if np.isfinite(tail).all() else math.inf
+    return err
+
+
+def run_method(name: str, t: np.ndarray, y: np.ndarray,
+               gains: Optional[Dict[str, float]] = None) -> Run:
+    """Run method ``name`` (one of :data:`METHODS`) fresh over a record; ``gains``: keyword
+    arguments of an ``-A`` tracker (:func:`tuned_gains`; default the paper's gains)."""
     empty = np.empty(0)
     if name in ALGEBRAIC_CONFIGS:
         est = FrequencyEstimator(ALGEBRAIC_CONFIGS[name])
@@ -129,8 +173,11 @@ def run_method(name: str, t: np.ndarray, y: np.ndarray) -> Run:
         marks[idx] = e.frequency_hz
         return Run(hold_last(marks), idx, e.frequency_hz, e.samples, e.t - e.convergence_time,
                    seconds)
-    cls = next(c for c in TRACKERS if c.name == name)
-    tracker = cls(rate_hz=1.0 / np.median(np.diff(t))) if issubclass(cls, SlidingDFT) else cls()
+    if name in AMPLITUDE_TUNED:
+        tracker = AMPLITUDE_TUNED[name][0](**(gains or {}))
+    else:
+        cls = next(c for c in TRACKERS if c.name == name)
+        tracker = cls(rate_hz=1.0 / np.median(np.diff(t))) if issubclass(cls, SlidingDFT) else cls()
     t0 = time.perf_counter()
     out = tracker.process(t, y)
     return Run(out, empty.astype(int), empty, empty.astype(int), empty, time.perf_counter() - t0)
@@ -233,12 +280,13 @@ def compare(seeds: int, cases: Sequence[Case] = CASES,
         seconds = dict.fromkeys(METHODS, 0.0)
         samples = 0
         segs = None
+        gains = tuned_gains(case)
         for seed in range(seeds):
             t, y, f_true = case.record(seed)
             segs = segments(f_true)
             samples += len(t)
             for name in METHODS:
-                run = run_method(name, t, y)
+                run = run_method(name, t, y, gains.get(name))
                 seconds[name] += run.seconds
                 if seed == 0 and keep is not None:
                     keep.setdefault(case.key, ((t, y, f_true), {}))[1][name] = run
@@ -316,6 +364,17 @@ def format_markdown(rows: Sequence[Row], seeds: int) -> str:
     return '\n'.join(lines) + '\n'
 
 
+def format_gains(cases: Sequence[Case] = CASES) -> str:
+    """One line per case: the gains of the ``-A`` rows (:func:`tuned_gains`)."""
+    lines = [f'amplitude-tuned gains (least MSE on seeds {TUNING_SEEDS[0]}-{TUNING_SEEDS[-1]}, '
+             'grid of the paper gain x ' + '/'.join(f'{k:g}' for k in GAIN_FACTORS) + '):']
+    for case in cases:
+        gains = tuned_gains(case)
+        lines.append(f'  {case.key}: ' + ', '.join(
+            f'{name} {k} = {v:.4g}' for name, kw in gains.items() for k, v in kw.items()))
+    return '\n'.join(lines) + '\n'
+
+
 def plot_case(path: str, case: Case, record: Record, runs: Dict[str, Run]) -> None:
     """Figs. 6-7 layout: signal; every method's estimate with the truth dashed; a +-10 % zoom."""
     from .plotting import pyplot
@@ -330,7 +389,8 @@ def plot_case(path: str, case: Case, record: Record, runs: Dict[str, Run]) -> No
         for i, (a, b, f) in enumerate(segments(f_true)):
             ax.hlines(f, t[a], t[b - 1], colors='k', linestyles='--', zorder=4,
                       label='true f' if i == 0 else None)
-        for name, color in zip(METHODS, ('C3', 'C5', 'C0', 'C1', 'C2', 'C4')):
+        for name, color in zip(METHODS, ('C3', 'C5', 'C0', 'C1', 'C2', 'C4', 'C6', 'C7', 'C8',
+                                         'C9', 'y')):
             run = runs[name]
             if name in ALGEBRAIC_CONFIGS:
                 ax.plot(t[run.est_index], run.est_f, '*', ms=8, mec='k', mew=0.4, color=color,
@@ -367,6 +427,7 @@ def run(args: argparse.Namespace) -> int:
     print(f'{seeds} noise seeds per case; estimates within {100 * TOLERANCE:.0f} % count as '
           'converged (definitions: vib_estimator/compare.py)')
     print(format_table(rows))
+    print(format_gains(), end='')
     os.makedirs(args.out, exist_ok=True)
     for case in CASES:
         path = os.path.join(args.out, f'compare_{case.key.replace(".", "_")}.png')
@@ -374,7 +435,7 @@ def run(args: argparse.Namespace) -> int:
         print(f'wrote {path}')
     if args.markdown:
         with open(args.markdown, 'w') as fh:
-            fh.write(format_markdown(rows, seeds))
+            fh.write(format_markdown(rows, seeds) + '\n' + format_gains())
         print(f'wrote {args.markdown}')
     print(f'wall time {time.perf_counter() - start:.1f} s')
     return 0

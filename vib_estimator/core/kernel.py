@@ -538,8 +538,8 @@ def _converged(p, s, c, f):
 def _quality_gate(p, c, model, f, damping, h, r2, amp):
     """True if the converged estimate may be published; else count why it is held back.
 
-    At rest (no variance, or amplitude at or below ``min_amplitude``), above Nyquist, a sinusoid
-    fit R^2 below ``min_fit``, or (damped model) |damping ratio| above ``max_damping``: a "lightly
+    At rest (no variance, or amplitude at or below ``min_amplitude``), above Nyquist, a fit R^2
+    below ``min_fit`` (of the refined model; with ``refine`` = 0 of a sinusoid and offset at f), or (damped model) |damping ratio| above ``max_damping``: a "lightly
     damped vibration" with more damping is a transient, not a mode.
     """
     if r2 < 0.0 or amp <= p[P_MINAMP]:
@@ -635,7 +635,10 @@ def step(p, s, c, seg, t, y, out):
     res = np.empty(U.N_RESULT)
     _refine(p, seg, n_fit, model, f, damping, h, res)
     f = res[U.R_F]
-    r2, amp = _fit(seg, n_fit, TWO_PI * f)
+    if p[P_REFINE] > 0.0 and math.isfinite(res[U.R_FIT]):
+        r2, amp = res[U.R_FIT], res[U.R_AMP]     # the refined model's own residual
+    else:
+        r2, amp = _fit(seg, n_fit, TWO_PI * f)
     published = _quality_gate(p, c, model, f, res[U.R_DAMP], h, r2, amp)
     if published:
         out[O_T] = t

@@ -46,9 +46,10 @@ from numba import njit
 
 #: values of the kernel's model parameter
 MODEL_SINUSOID, MODEL_BIASED, MODEL_DAMPED = 0, 1, 2
-#: refine() result layout: frequency (Hz), damping ratio, their standard deviations
-R_F, R_DAMP, R_FSTD, R_DSTD = range(4)
-N_RESULT = 4
+#: refine() result layout: frequency (Hz), damping ratio, their standard deviations, and the
+#: fitted model's R^2 (about the segment's mean) and amplitude (at the segment's centre)
+R_F, R_DAMP, R_FSTD, R_DSTD, R_FIT, R_AMP = range(6)
+N_RESULT = 6
 TWO_PI = 2.0 * math.pi
 _RESYNC = 256
 
@@ -208,8 +209,8 @@ def refine(model, seg, n, w0, sigma0, iterations, noise_scale, res):
     the whole segment, each started from the last, so the start always lies in the main lobe of the
     next window's likelihood. ``noise_scale`` multiplies the residual variance
     (:func:`band_noise_scale`). ``res``: frequency (Hz; the natural frequency for the damped
-    model), damping ratio (NaN unless damped) and their std. Returns False (res untouched) when no
-    fit is possible.
+    model), damping ratio (NaN unless damped), their std, and the fitted model's R^2 and amplitude
+    (:func:`_goodness`). Returns False (res untouched) when no fit is possible.
     """
     npar = 3 if model == MODEL_SINUSOID else 4
     if n <= npar + 1 or not w0 > 0.0:
@@ -233,7 +234,26 @@ def refine(model, seg, n, w0, sigma0, iterations, noise_scale, res):
     if rss == math.inf:
         return False
     _moments_of_result(model, th, cov, rss * noise_scale / (n - npar), res)
+    _goodness(seg, n, th, rss, res)
     return True
+
+
+@njit(cache=True)
+def _goodness(seg, n, th, rss, res):
+    """R^2 = 1 - RSS / (sum of squares about the mean) of the fitted model, and its amplitude.
+
+    The quality gate judges the refined model by these (the damped model's own residual, so a
+    decaying sine over many periods passes). R^2 = -1 when the segment has no variance.
+    """
+    ymean = 0.0
+    for i in range(n):
+        ymean += seg[1, i]
+    ymean /= n
+    sstot = 0.0
+    for i in range(n):
+        sstot += (seg[1, i] - ymean) ** 2
+    res[R_FIT] = 1.0 - rss / sstot if sstot > 0.0 else -1.0
+    res[R_AMP] = math.hypot(th[0], th[1])
 
 
 @njit(cache=True)
