@@ -68,8 +68,9 @@ class EstimatorConfig:
         'low-pass at f_hi, 2nd-order high-pass at f_lo), never reset; none = off')
     min_amplitude: float = _param(0.0, 'quality gate: a segment whose half range is at or '
                                   'below this is at rest (signal units)', 0.0, INF, open_hi=True)
-    min_fit: float = _param(0.9, 'quality gate: R^2 a sinusoid at the estimated frequency must '
-                            'reach over the segment for the estimate to be published', 0.0, 1.0)
+    min_fit: float = _param(0.9, 'quality gate: R^2 the refined model (with refine = 0: a '
+                            'sinusoid at the estimated frequency) must reach over the segment for '
+                            'the estimate to be published', 0.0, 1.0)
     max_damping: float = _param(0.1, 'quality gate of the damped-sinusoid model: an estimate '
                                 'whose |damping ratio| exceeds this is a transient, not published',
                                 0.0, 1.0, open_lo=True)
