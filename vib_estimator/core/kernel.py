@@ -498,13 +498,12 @@ def _ratio(model, nf, df, qf, i_n, i_q, i_d):
 
 
 @njit(cache=True, inline='always')
-def _converged(p, s, c, f):
+def _converged(m, one_sided, tol, s, c, f):
     """Eqs. 16-17: the moving average of the last M+1 estimates against the one M samples earlier.
 
     Pushes f into the ring of the last 2M+1 estimates; True when the relative change (its absolute
     value unless ``one_sided_test``) is below the tolerance.
     """
-    m = int(p[P_M])
     size = 2 * m + 1
     k = c[C_MA_N]
     s[S_MA + (k % size)] = f
@@ -517,9 +516,9 @@ def _converged(p, s, c, f):
         ma_now += s[S_MA + ((k - i) % size)]
         ma_then += s[S_MA + ((k - m - i) % size)]
     change = ma_now - ma_then
-    if p[P_ONESIDED] == 0.0:
+    if not one_sided:
         change = abs(change)
-    return change < p[P_TOL] * ma_now
+    return change < tol * ma_now
 
 
 @njit(cache=True, inline='always')
@@ -604,6 +603,8 @@ def step(p, s, c, seg, t, y, out):
         c[C_MA_N] = 0
         return 0
     f = math.sqrt(w2) / TWO_PI
+    m = int(p[P_M])
+    one_sided = p[P_ONESIDED] != 0.0
     n_fit = min(nseg + 1, seg.shape[1])
     if p[P_TARGET] > 0.0:
         if tau * f < p[P_MINPER] or not _target_reached(p, s, seg, n_fit, model, f, damping, h):
@@ -613,14 +614,14 @@ def step(p, s, c, seg, t, y, out):
         # estimate (what the default configuration publishes; the algebraic estimate wanders
         # over many periods), from which the fit starts
         if s[S_FLAST] == 0.0:
-            if _converged(p, s, c, f) and tau * f >= 0.5:
+            if _converged(m, one_sided, p[P_TOL], s, c, f) and tau * f >= 0.5:
                 s[S_FLAST] = f
             return 0
         if tau * s[S_FLAST] < p[P_MINPER]:
             return 0
         f = s[S_FLAST]
     # the segment must span a fraction of the period it estimates
-    elif not _converged(p, s, c, f) or tau * f < p[P_MINPER]:
+    elif not _converged(m, one_sided, p[P_TOL], s, c, f) or tau * f < p[P_MINPER]:
         return 0
     res = np.empty(U.N_RESULT)
     _refine(p, seg, n_fit, model, f, damping, h, res)
