@@ -7,9 +7,18 @@ Prints (one run, same machine, same signal: 2 M samples of a noisy 1.33 Hz sine 
   function call with the same arguments (the floor of any per-sample Python API) and the ratio;
 - batch cost of other configurations against the default: the paper's estimator (``refine`` = 0)
   and long windows (``min_periods`` = 5, 20; ``target_std_rel`` = 1e-4).
+- the previous kernel (``PREVIOUS``, before the split into per-equation functions and before
+  refinement; loaded at run time with ``git show`` into a temporary package, "skipped" without git)
+  on the same signal, ``refine`` = 0 against it (it also computes each estimate's std), timed
+  alternately.
 Numba compiles once before timing; each figure is the best of 3 repeats.
 """
+import importlib
+import subprocess
+import sys
+import tempfile
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -18,6 +27,46 @@ from vib_estimator.core import EstimatorConfig, FrequencyEstimator
 VARIANTS = {'refine=0 (paper)': dict(refine=0), 'min_periods=5': dict(min_periods=5.0),
             'min_periods=20': dict(min_periods=20.0), 'target_std_rel=1e-4': dict(
                 target_std_rel=1e-4, min_periods=0.0)}
+
+
+#: the commit whose kernel (one 169-line step, no refinement) is the speed baseline of issue 14
+PREVIOUS = '627a108'
+
+
+def load_previous():
+    """The previous kernel's FrequencyEstimator and EstimatorConfig, or None without git."""
+    root = Path(__file__).resolve().parents[1]
+    folder = Path(tempfile.mkdtemp(prefix='vib_previous_')) / 'vib_previous'
+    folder.mkdir()
+    (folder / '__init__.py').write_text('')
+    for name in ('kernel', 'estimator', 'config'):
+        try:
+            text = subprocess.run(['git', 'show', f'{PREVIOUS}:vib_estimator/core/{name}.py'],
+                                  cwd=root, capture_output=True, text=True, check=True).stdout
+        except (OSError, subprocess.CalledProcessError):
+            return None
+        (folder / f'{name}.py').write_text(text)
+    sys.path.insert(0, str(folder.parent))
+    return (importlib.import_module('vib_previous.estimator').FrequencyEstimator,
+            importlib.import_module('vib_previous.config').EstimatorConfig)
+
+
+def compare_previous(t, y):
+    """Batch rate of the previous kernel beside today's refine = 0, alternating, best of 3."""
+    previous = load_previous()
+    if previous is None:
+        print(f'previous kernel ({PREVIOUS})   skipped (git or the commit is not available)')
+        return
+    old_estimator, old_config = previous
+    cfg = EstimatorConfig(refine=0)
+    old_estimator(old_config()).process(t[:5000], y[:5000])
+    now, old = [], []
+    for _ in range(3):
+        now.append(best(lambda: FrequencyEstimator(cfg).process(t, y), 1))
+        old.append(best(lambda: old_estimator(old_config()).process(t, y), 1))
+    n = len(t)
+    print(f'previous kernel ({PREVIOUS}) {n / min(old) / 1e6:8.2f} M samples/s   refine=0 today '
+          f'{n / min(now) / 1e6:8.2f} M samples/s   today/previous {min(old) / min(now):5.2f}')
 
 
 def best(fn, repeats=3):
@@ -66,6 +115,7 @@ def main() -> None:
         v = best(lambda: FrequencyEstimator(cfg).process(t, y))
         print(f'batch {name:>20} {n / v / 1e6:8.2f} M samples/s   '
               f'ratio to default {batch / v:6.2f}')
+    compare_previous(t, y)
 
 
 if __name__ == '__main__':

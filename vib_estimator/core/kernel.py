@@ -366,7 +366,7 @@ def _first_sample(p, s, c, t, y):
 
 
 @njit(cache=True, inline='always')
-def _accept_time(p, s, c, t, y):
+def _accept_time(max_gap, s, c, t, y):
     """Time handling: True if the sample is used, False if it is skipped (counted either way).
 
     A non-finite sample, a duplicate stamp or a small step back is skipped; a gap, or a backward
@@ -383,13 +383,13 @@ def _accept_time(p, s, c, t, y):
             c[C_DUPLICATE] += 1
             return False
         if h < 0.0:
-            if -h > p[P_MAXGAP]:
+            if -h > max_gap:
                 c[C_TIME_JUMP] += 1
                 _restart(s, c)
             else:
                 c[C_OUT_OF_ORDER] += 1
                 return False
-        elif h > p[P_MAXGAP]:
+        elif h > max_gap:
             c[C_GAP] += 1
             _restart(s, c)
     c[C_USED] += 1
@@ -401,16 +401,15 @@ def _accept_time(p, s, c, t, y):
 def _update_discretisations(p, s, h):
     """Exact discretisations of the invariant filter (Eq. 11) and the prefilter for the step h.
 
-    Recomputed only when the step changes by more than rounding (a uniform stream's stamps differ
-    in the last bits).
+    Called only when the step changes by more than rounding (a uniform stream's stamps differ in
+    the last bits), see :func:`step`.
     """
-    if abs(h - s[S_CACHE_H]) > 1e-9 * h:
-        _discretise(p[P_WC], p[P_ZC], h, s, S_DISC)
-        if p[P_BAND] > 0.0:
-            for k in range(3):
-                _discretise(p[P_WHI] if k < 2 else p[P_WLO], BAND_DAMPING[k], h, s,
-                            S_DISC + 8 * (k + 1))
-        s[S_CACHE_H] = h
+    _discretise(p[P_WC], p[P_ZC], h, s, S_DISC)
+    if p[P_BAND] > 0.0:
+        for k in range(3):
+            _discretise(p[P_WHI] if k < 2 else p[P_WLO], BAND_DAMPING[k], h, s,
+                        S_DISC + 8 * (k + 1))
+    s[S_CACHE_H] = h
 
 
 @njit(cache=True, inline='always')
@@ -434,19 +433,15 @@ def _push_history(s, c, seg, t, y):
 
 
 @njit(cache=True, inline='always')
-def _numerator_denominator(model, s, tau, y):
+def _numerator_denominator(model, tau, y, m0, m1, m2, m3, m4):
     """Eq. 7 (with Eq. 8's corrected sign) in moments: n and d of omega^2 = n / d at time tau.
 
     ``sinusoid`` / ``damped-sinusoid``: n = -(tau^2 y + 2 tau M0 - 6 M1), d = tau M2 - M3;
     ``biased-sinusoid`` (offset eliminated by a third derivation in s): N = -tau^3 y + 3 tau^2 M0
-    - 24 tau M1 + 30 M2, D = -1.5 tau^2 M2 + 4 tau M3 - 2.5 M4.
+    - 24 tau M1 + 30 M2, D = -1.5 tau^2 M2 + 4 tau M3 - 2.5 M4 (moments as scalars: arrays
+    passed to an inlined helper cost reference counting per sample).
     """
-    m0 = s[S_MOM]
-    m1 = s[S_MOM + 1]
-    m2 = s[S_MOM + 2]
-    m3 = s[S_MOM + 3]
     if model == MODEL_BIASED:
-        m4 = s[S_MOM + 4]
         num = -tau * tau * tau * y + 3.0 * tau * tau * m0 - 24.0 * tau * m1 + 30.0 * m2
         den = -1.5 * tau * tau * m2 + 4.0 * tau * m3 - 2.5 * m4
     else:
@@ -456,14 +451,13 @@ def _numerator_denominator(model, s, tau, y):
 
 
 @njit(cache=True, inline='always')
-def _invariant_filter(p, s, model, num, den, tau, h):
+def _invariant_filter(filtered, s, model, num, den, tau, h):
     """Invariant filtering, Eqs. 9-11: n and d (and q of the damped model) through one low-pass.
 
     The same exactly discretised second-order filter acts on every term, so n_f / d_f stays w^2
     for a pure sine. The damped model also forms q = 3 M2 - 2 tau M1 and the running integrals of
     n_f, q_f, d_f (its second equation).
     """
-    filtered = p[P_FILTER] > 0.0
     if filtered:
         _advance(s, S_NF, S_DISC, s[S_NPREV], num)
         _advance(s, S_DF, S_DISC, s[S_DPREV], den)
@@ -485,21 +479,15 @@ def _invariant_filter(p, s, model, num, den, tau, h):
 
 
 @njit(cache=True, inline='always')
-def _ratio(model, s):
+def _ratio(model, nf, df, qf, i_n, i_q, i_d):
     """Eq. 12: (omega^2, damping ratio) from the filtered terms; omega^2 <= 0 when undefined.
 
     ``damped-sinusoid``: n = 2 sigma q + w_n^2 d holds at every instant; filtered (F1) and then
     integrated (F2) it gives two equations in (2 sigma, w_n^2), solved by Cramer's rule. The other
     models: omega^2 = n_f / d_f (damping NaN).
     """
-    nf = s[S_NF]
-    df = s[S_DF]
     damping = math.nan
     if model == MODEL_DAMPED:
-        qf = s[S_QF]
-        i_n = s[S_INT]
-        i_q = s[S_INT + 1]
-        i_d = s[S_INT + 2]
         det = qf * i_d - df * i_q
         w2 = (qf * i_n - nf * i_q) / det if det != 0.0 else -1.0
         if w2 > 0.0:
@@ -510,13 +498,12 @@ def _ratio(model, s):
 
 
 @njit(cache=True, inline='always')
-def _converged(p, s, c, f):
+def _converged(m, one_sided, tol, s, c, f):
     """Eqs. 16-17: the moving average of the last M+1 estimates against the one M samples earlier.
 
     Pushes f into the ring of the last 2M+1 estimates; True when the relative change (its absolute
     value unless ``one_sided_test``) is below the tolerance.
     """
-    m = int(p[P_M])
     size = 2 * m + 1
     k = c[C_MA_N]
     s[S_MA + (k % size)] = f
@@ -529,9 +516,9 @@ def _converged(p, s, c, f):
         ma_now += s[S_MA + ((k - i) % size)]
         ma_then += s[S_MA + ((k - m - i) % size)]
     change = ma_now - ma_then
-    if p[P_ONESIDED] == 0.0:
+    if not one_sided:
         change = abs(change)
-    return change < p[P_TOL] * ma_now
+    return change < tol * ma_now
 
 
 @njit(cache=True, inline='always')
@@ -587,13 +574,14 @@ def _store_sample(p, s, c, seg, t, tau, y):
 @njit(cache=True)
 def step(p, s, c, seg, t, y, out):
     """Feed one sample; return 1 and fill ``out`` when an estimate is published, else 0."""
-    if not _accept_time(p, s, c, t, y):
+    if not _accept_time(p[P_MAXGAP], s, c, t, y):
         return 0
     if c[C_HIST_N] == 0:
         _first_sample(p, s, c, t, y)
         return 0
     h = t - s[S_HT + NH - 1]      # the newest sample of the stencil is the previous one
-    _update_discretisations(p, s, h)
+    if abs(h - s[S_CACHE_H]) > 1e-9 * h:
+        _update_discretisations(p, s, h)
     if p[P_BAND] > 0.0:
         y = _prefilter(p, s, y)
     if not _push_history(s, c, seg, t, y):
@@ -602,18 +590,21 @@ def step(p, s, c, seg, t, y, out):
     model = int(p[P_MODEL])
     _interval_moments(s, 4 if model == MODEL_BIASED else 3, s[S_HT + NH - 2] - s[S_T0], h,
                       int(p[P_RULE]))
-    num, den = _numerator_denominator(model, s, tau, y)
-    _invariant_filter(p, s, model, num, den, tau, h)
+    num, den = _numerator_denominator(model, tau, y, s[S_MOM], s[S_MOM + 1], s[S_MOM + 2],
+                                      s[S_MOM + 3], s[S_MOM + 4])
+    _invariant_filter(p[P_FILTER] > 0.0, s, model, num, den, tau, h)
     nseg = c[C_SEG_N]
     if _store_sample(p, s, c, seg, t, tau, y):
         return 0
     if tau <= p[P_EPS] or nseg + 1 < p[P_MINSAMP]:
         return 0
-    w2, damping = _ratio(model, s)
+    w2, damping = _ratio(model, s[S_NF], s[S_DF], s[S_QF], s[S_INT], s[S_INT + 1], s[S_INT + 2])
     if not (w2 > 0.0 and math.isfinite(w2)):
         c[C_MA_N] = 0
         return 0
     f = math.sqrt(w2) / TWO_PI
+    m = int(p[P_M])
+    one_sided = p[P_ONESIDED] != 0.0
     n_fit = min(nseg + 1, seg.shape[1])
     if p[P_TARGET] > 0.0:
         if tau * f < p[P_MINPER] or not _target_reached(p, s, seg, n_fit, model, f, damping, h):
@@ -623,14 +614,14 @@ def step(p, s, c, seg, t, y, out):
         # estimate (what the default configuration publishes; the algebraic estimate wanders
         # over many periods), from which the fit starts
         if s[S_FLAST] == 0.0:
-            if _converged(p, s, c, f) and tau * f >= 0.5:
+            if _converged(m, one_sided, p[P_TOL], s, c, f) and tau * f >= 0.5:
                 s[S_FLAST] = f
             return 0
         if tau * s[S_FLAST] < p[P_MINPER]:
             return 0
         f = s[S_FLAST]
     # the segment must span a fraction of the period it estimates
-    elif not _converged(p, s, c, f) or tau * f < p[P_MINPER]:
+    elif not _converged(m, one_sided, p[P_TOL], s, c, f) or tau * f < p[P_MINPER]:
         return 0
     res = np.empty(U.N_RESULT)
     _refine(p, seg, n_fit, model, f, damping, h, res)
