@@ -13,7 +13,9 @@ Prints (one run, same machine, same signal: 2 M samples of a noisy 1.33 Hz sine 
   alternately.
 Numba compiles once before timing; each figure is the best of 3 repeats.
 """
+import atexit
 import importlib
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -37,6 +39,7 @@ def load_previous():
     """The previous kernel's FrequencyEstimator and EstimatorConfig, or None without git."""
     root = Path(__file__).resolve().parents[1]
     folder = Path(tempfile.mkdtemp(prefix='vib_previous_')) / 'vib_previous'
+    atexit.register(shutil.rmtree, folder.parent, True)
     folder.mkdir()
     (folder / '__init__.py').write_text('')
     for name in ('kernel', 'estimator', 'config'):
