@@ -161,7 +161,7 @@ def bench_survey(work: Path) -> None:
     from distributed import LocalCluster
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                       dashboard_address=None) as cluster:
-        S.survey(recordings[:2], options, scheduler=cluster.scheduler_address)   # warm up
+        S.survey(recordings, options, scheduler=cluster.scheduler_address)   # warm every worker
         dask = best(lambda: S.survey(recordings, options, scheduler=cluster.scheduler_address))
     print(f'survey 8 recordings  --jobs 1 {one:6.2f} s ({cpu_one:5.2f} CPU s)   --jobs 2 '
           f'{two:6.2f} s ({cpu_two:5.2f} CPU s, workers included)   speed-up {one / two:5.2f}x '
