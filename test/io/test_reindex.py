@@ -68,7 +68,7 @@ def test_reindex_of_a_truncated_mcap_keeps_what_is_complete(tmp_path, fraction):
         BagReader(tmp_path / 'bag')
     result = reindex(tmp_path / 'bag')
     (cut,) = result.cuts
-    assert (f'cut at byte' in cut or 'summary section cut' in cut) and \
+    assert ('cut at byte' in cut or 'summary section cut' in cut) and \
         f'of {int(len(data) * fraction)}' in cut or f'{int(len(data) * fraction)} bytes' in cut
     kept = rosbags_payloads(tmp_path / 'bag')
     assert kept == payloads[:len(kept)]

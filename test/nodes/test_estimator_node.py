@@ -24,7 +24,6 @@ from std_msgs.msg import Float64, Header
 from std_srvs.srv import Trigger
 
 from vib_estimator.core import Estimate, EstimatorConfig, FrequencyEstimator
-from vib_estimator.core import modes as core_modes
 from vib_estimator.io import fields
 from vib_estimator.nodes.estimator_node import EstimatorNode, message_class
 from vib_estimator.nodes import stream
@@ -513,11 +512,6 @@ def test_modes_one_publishes_mode1_topics(make_probe):
         '/vibration/mode1/frequency') == 0, 5.0)
 
 
-PLACEHOLDER = 'INTERFACE PLACEHOLDER' in (core_modes.__doc__ or '')
-
-
-@pytest.mark.skipif(PLACEHOLDER, reason='core/modes.py is still the interface placeholder '
-                    '(one estimator, mode 1 only); runs by itself once the tracker lands')
 def test_two_separated_modes_get_their_own_topics(make_probe):
     p = make_probe(modes=2)
     n = 5000                                                    # 10 s at 500 Hz

@@ -55,7 +55,7 @@ import numpy as np
 from numba import njit
 
 from . import uncertainty as U
-from .uncertainty import MODEL_BIASED, MODEL_DAMPED, MODEL_SINUSOID  # noqa: F401 (P_MODEL values)
+from .uncertainty import MODEL_BIASED, MODEL_DAMPED
 
 # ---- parameter array layout (float64) -------------------------------------------------------
 P_MODEL, P_WC, P_ZC, P_M, P_TOL, P_EPS, P_MAXWIN, P_BAND, P_WLO, P_WHI, P_MINAMP, P_MINFIT, \

@@ -35,7 +35,7 @@ from typing import Callable, Dict, Iterable, Iterator, List, Optional, Tuple
 import numpy as np
 
 from . import cdr
-from .csv_reader import CsvError, csv_layout, iter_csv_rows
+from .csv_reader import csv_layout, iter_csv_rows
 from .fields import (DEFAULT_COMPONENT, FLOAT64, INPUT_TYPES, check_component, component_getter,
                      normalise_type, seconds_since, stamp_ns)
 
