@@ -53,7 +53,7 @@ def wait_for_subscriber(executor, publisher, timeout=15.0):
         'the recorder never subscribed'
 
 
-def test_records_every_message_byte_for_byte(ros_context, executor, tmp_path):
+def test_records_every_message_exactly(ros_context, executor, tmp_path):
     """N messages published at 10x the sensor's 500 Hz into the real executable: all N recorded."""
     n, batch, period = 10_000, 10, 0.002  # 5000 messages/s
     topic = f'/rec_all_{os.getpid()}'
@@ -75,7 +75,11 @@ def test_records_every_message_byte_for_byte(ros_context, executor, tmp_path):
     assert f'recorded {n} messages' in err
     with BagReader(tmp_path / 'bag') as bag:
         assert bag.topics[topic].msgtype == WRENCH_STAMPED
-        assert [m.data for m in bag.messages()] == sent
+        recorded = [m.data for m in bag.messages()]
+    # the bytes as received; only the CDR alignment padding (3 bytes after the frame_id here, plus
+    # the wire's padding to a multiple of 4) is left uninitialised by the publisher's serializer
+    assert [len(d) for d in recorded] == [len(d) for d in sent]
+    assert [serialize_message(deserialize_message(d, WrenchStamped)) for d in recorded] == sent
 
 
 def test_sigint_leaves_a_complete_bag(ros_context, executor, tmp_path):
@@ -99,7 +103,7 @@ def test_sigint_leaves_a_complete_bag(ros_context, executor, tmp_path):
     # the bytes received: the serialized message plus the wire's padding to a multiple of 4
     for i, data in enumerate(recorded):
         sent = serialize_message(String(data=f'message {i}'))
-        assert data[:len(sent)] == sent and not any(data[len(sent):]) and len(data) % 4 == 0
+        assert data[:len(sent)] == sent and len(data) % 4 == 0  # padding bytes: unspecified
         assert deserialize_message(data, String).data == f'message {i}'
     assert len(recorded) == 50
 
