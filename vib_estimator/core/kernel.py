@@ -51,7 +51,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 from numba import njit
 
 from . import uncertainty as U
@@ -92,7 +91,9 @@ S_WH = S_W + 5 * NH      # step of the cached weights (-1: none)
 S_UNIT = S_WH + 1        # scratch unit vector
 S_FLAST = S_UNIT + NH    # long windows: the segment's first converged half-period estimate
 S_NEXT = S_FLAST + 1     # segment length at which target_std_rel is checked next
-S_MA = S_NEXT + 1        # moving-average ring (2M+1 values) starts here
+S_RES = S_NEXT + 1       # result of the refinement (core.uncertainty's layout)
+S_WORK = S_RES + U.N_RESULT  # the refinement's scratch
+S_MA = S_WORK + U.N_WORK     # moving-average ring (2M+1 values) starts here
 N_STATE_FIXED = S_MA
 
 # ---- estimate row layout --------------------------------------------------------------------
@@ -632,8 +633,8 @@ def step(p, s, c, seg, t, y, out, row):
     # the segment must span a fraction of the period it estimates
     elif not _converged(m, one_sided, p[P_TOL], s, c, f) or tau * f < p[P_MINPER]:
         return 0
-    res = np.empty(U.N_RESULT)
-    _refine(p, seg, n_fit, model, f, damping, h, res)
+    res = s[S_RES:S_RES + U.N_RESULT]
+    _refine(p, s, seg, n_fit, model, f, damping, h, res)
     f = res[U.R_F]
     if p[P_REFINE] > 0.0 and math.isfinite(res[U.R_FIT]):
         r2, amp = res[U.R_FIT], res[U.R_AMP]     # the refined model's own residual
@@ -673,7 +674,7 @@ def _start(model, f, damping):
 
 
 @njit(cache=True)
-def _refine(p, seg, n, model, f, damping, h, res):
+def _refine(p, s, seg, n, model, f, damping, h, res):
     """The estimate to gate and publish: ``res`` = (f, damping, their std), core.uncertainty.
 
     ``refine`` = 0 keeps the paper's algebraic (f, damping) and adds their std; otherwise up to
@@ -683,8 +684,8 @@ def _refine(p, seg, n, model, f, damping, h, res):
     w0, sigma0 = _start(model, f, damping)
     iterations = int(p[P_REFINE])
     res[:] = math.nan
-    if not U.refine(model, seg, n, w0, sigma0, iterations, _noise_scale(p, f, h), res) \
-            or iterations == 0:
+    if not U.refine(model, seg, n, w0, sigma0, iterations, _noise_scale(p, f, h), res,
+                    s[S_WORK:S_WORK + U.N_WORK]) or iterations == 0:
         res[U.R_F] = f
         res[U.R_DAMP] = damping
 
@@ -700,9 +701,11 @@ def _target_reached(p, s, seg, n, model, f, damping, h):
     if n < s[S_NEXT]:
         return False
     s[S_NEXT] = max(n + 1.0, n * (1.0 + 1.0 / 16.0)) if n >= 64 else n + 1.0
-    res = np.full(U.N_RESULT, math.nan)
+    res = s[S_RES:S_RES + U.N_RESULT]
+    res[:] = math.nan
     w0, sigma0 = _start(model, f, damping)
-    if not U.refine(model, seg, n, w0, sigma0, 0, _noise_scale(p, f, h), res):
+    if not U.refine(model, seg, n, w0, sigma0, 0, _noise_scale(p, f, h), res,
+                    s[S_WORK:S_WORK + U.N_WORK]):
         return False
     return res[U.R_FSTD] <= p[P_TARGET] * f
 
