@@ -67,52 +67,58 @@ def _workspace(work):
 
 
 @njit(cache=True)
-def _accumulate(model, seg, n, tc, th, jtj, jtr):
+def _accumulate(model, seg, n, tc, th, jtj, jtr, linear=False):
     """One pass over the segment at theta: J^T J, J^T r into ``jtj``, ``jtr``; returns the RSS.
 
     Columns of J: d/da = E sin, d/db = E cos, d/dw = u E (a cos - b sin), and d/dc = 1 (biased) or
     d/dsigma = -u E (a sin + b cos) (damped), with E = exp(-sigma u) (1 for the other models).
-    The sums are scalars (registers) until the end of the pass.
+    ``linear``: only the columns of the linear parameters (a, b, c; variable projection). The sums
+    are scalars (registers) until the end of the pass, and the sines advance by rotation within
+    blocks of ``_RESYNC`` samples.
     """
     a, b, w = th[0], th[1], th[2]
     sig = th[3] if model == MODEL_DAMPED else 0.0
     off = th[3] if model == MODEL_BIASED else 0.0
-    biased = model == MODEL_BIASED
+    col3 = model == MODEL_BIASED or (model == MODEL_DAMPED and not linear)
     a00 = a01 = a02 = a03 = a11 = a12 = a13 = a22 = a23 = a33 = 0.0
     r0 = r1 = r2 = r3 = rss = 0.0
-    sn = cs = e = rc = rs = re = 0.0
+    rc = rs = re = 0.0
     d_prev = -1.0
-    for i in range(n):
-        u = seg[0, i] - tc
-        d = seg[0, i] - seg[0, i - 1] if i > 0 else 0.0
-        if i % _RESYNC == 0:
-            sn, cs, e = math.sin(w * u), math.cos(w * u), math.exp(-sig * u)
-        else:
-            if abs(d - d_prev) > 1e-9 * d:
-                rc, rs, re, d_prev = math.cos(w * d), math.sin(w * d), math.exp(-sig * d), d
-            sn, cs = sn * rc + cs * rs, cs * rc - sn * rs
-            e *= re
-        osc = e * (a * sn + b * cs)
-        r = seg[1, i] - osc - off
-        j0 = e * sn
-        j1 = e * cs
-        j2 = u * e * (a * cs - b * sn)
-        j3 = 1.0 if biased else -u * osc
-        r0 += j0 * r
-        r1 += j1 * r
-        r2 += j2 * r
-        r3 += j3 * r
-        a00 += j0 * j0
-        a01 += j0 * j1
-        a02 += j0 * j2
-        a03 += j0 * j3
-        a11 += j1 * j1
-        a12 += j1 * j2
-        a13 += j1 * j3
-        a22 += j2 * j2
-        a23 += j2 * j3
-        a33 += j3 * j3
-        rss += r * r
+    for block in range(0, n, _RESYNC):
+        u = seg[0, block] - tc
+        sn, cs, e = math.sin(w * u), math.cos(w * u), math.exp(-sig * u)
+        for i in range(block, min(block + _RESYNC, n)):
+            if i > block:
+                u = seg[0, i] - tc
+                d = seg[0, i] - seg[0, i - 1]
+                if abs(d - d_prev) > 1e-9 * d:
+                    rc, rs, re, d_prev = math.cos(w * d), math.sin(w * d), math.exp(-sig * d), d
+                sn, cs = sn * rc + cs * rs, cs * rc - sn * rs
+                e *= re
+            osc = e * (a * sn + b * cs)
+            r = seg[1, i] - osc - off
+            j0 = e * sn
+            j1 = e * cs
+            r0 += j0 * r
+            r1 += j1 * r
+            a00 += j0 * j0
+            a01 += j0 * j1
+            a11 += j1 * j1
+            rss += r * r
+            if not linear:
+                j2 = u * e * (a * cs - b * sn)
+                r2 += j2 * r
+                a02 += j0 * j2
+                a12 += j1 * j2
+                a22 += j2 * j2
+            if col3:
+                j3 = 1.0 if model == MODEL_BIASED else -u * osc
+                r3 += j3 * r
+                a03 += j0 * j3
+                a13 += j1 * j3
+                a33 += j3 * j3
+                if not linear:
+                    a23 += j2 * j3
     _store_normal_equations(model, jtj, jtr, (a00, a01, a02, a03, a11, a12, a13, a22, a23, a33),
                             (r0, r1, r2, r3))
     return rss
@@ -185,7 +191,7 @@ def _solve_linear(model, seg, n, tc, work):
     th[0] = th[1] = 0.0
     if model == MODEL_BIASED:
         th[3] = 0.0
-    _accumulate(model, seg, n, tc, th, jtj, jtr)
+    _accumulate(model, seg, n, tc, th, jtj, jtr, True)
     idx = (0, 1, 3)
     m = 3 if model == MODEL_BIASED else 2
     if not _invert(jtj, idx, m, cov, aug, scale):
