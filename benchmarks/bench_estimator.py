@@ -9,8 +9,8 @@ Prints (one run, same machine, same signal: 2 M samples of a noisy 1.33 Hz sine 
   and long windows (``min_periods`` = 5, 20; ``target_std_rel`` = 1e-4).
 - the previous kernel (``PREVIOUS``, before the split into per-equation functions and before
   refinement; loaded at run time with ``git show`` into a temporary package, "skipped" without git)
-  on the same signal, ``refine`` = 0 against it (it also computes each estimate's std), timed
-  alternately.
+  on the same signal, ``refine`` = 0 (it also computes each estimate's std) and the default
+  against it, timed alternately (the ratios hold when the machine is loaded; the rates do not).
 Numba compiles once before timing; each figure is the best of 3 repeats.
 """
 import atexit
@@ -55,21 +55,25 @@ def load_previous():
 
 
 def compare_previous(t, y):
-    """Batch rate of the previous kernel beside today's refine = 0, alternating, best of 3."""
+    """Batch rate of the previous kernel beside today's refine = 0 and default, alternating, best
+    of 3 (the ratios hold on a loaded machine, where the absolute rates do not)."""
     previous = load_previous()
     if previous is None:
         print(f'previous kernel ({PREVIOUS})   skipped (git or the commit is not available)')
         return
     old_estimator, old_config = previous
-    cfg = EstimatorConfig(refine=0)
+    paper = EstimatorConfig(refine=0)
     old_estimator(old_config()).process(t[:5000], y[:5000])
-    now, old = [], []
+    now, default, old = [], [], []
     for _ in range(3):
-        now.append(best(lambda: FrequencyEstimator(cfg).process(t, y), 1))
+        now.append(best(lambda: FrequencyEstimator(paper).process(t, y), 1))
+        default.append(best(lambda: FrequencyEstimator().process(t, y), 1))
         old.append(best(lambda: old_estimator(old_config()).process(t, y), 1))
     n = len(t)
     print(f'previous kernel ({PREVIOUS}) {n / min(old) / 1e6:8.2f} M samples/s   refine=0 today '
           f'{n / min(now) / 1e6:8.2f} M samples/s   today/previous {min(old) / min(now):5.2f}')
+    print(f'{"":27}{"":22}   default today  {n / min(default) / 1e6:8.2f} M samples/s   '
+          f'today/previous {min(old) / min(default):5.2f}')
 
 
 def best(fn, repeats=3):

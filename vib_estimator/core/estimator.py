@@ -147,7 +147,7 @@ class FrequencyEstimator:
         self._s = np.zeros(K.N_STATE_FIXED + 2 * config.window + 1)
         self._c = np.zeros(K.N_COUNTERS, dtype=np.int64)
         self._seg = np.zeros((2, config.buffer_samples))
-        self._row = np.zeros(K.N_OUT)
+        self._row = np.zeros((1, K.N_OUT))
         self.restart()
 
     @property
@@ -179,9 +179,9 @@ class FrequencyEstimator:
 
     def update(self, t: float, y: float) -> Optional[Estimate]:
         """Feed one sample (time in s, any origin); return an estimate when one is published."""
-        if K.step(self._p, self._s, self._c, self._seg, float(t), float(y), self._row):
+        if K.step(self._p, self._s, self._c, self._seg, float(t), float(y), self._row, 0):
             return Estimate(*(int(v) if i == K.O_SAMPLES else float(v)
-                              for i, v in enumerate(self._row)))
+                              for i, v in enumerate(self._row[0])))
         return None
 
     def process(self, t: Sequence[float], y: Sequence[float]) -> EstimateArrays:

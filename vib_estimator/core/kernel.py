@@ -51,7 +51,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 from numba import njit
 
 from . import uncertainty as U
@@ -92,7 +91,9 @@ S_WH = S_W + 5 * NH      # step of the cached weights (-1: none)
 S_UNIT = S_WH + 1        # scratch unit vector
 S_FLAST = S_UNIT + NH    # long windows: the segment's first converged half-period estimate
 S_NEXT = S_FLAST + 1     # segment length at which target_std_rel is checked next
-S_MA = S_NEXT + 1        # moving-average ring (2M+1 values) starts here
+S_RES = S_NEXT + 1       # result of the refinement (core.uncertainty's layout)
+S_WORK = S_RES + U.N_RESULT  # the refinement's scratch
+S_MA = S_WORK + U.N_WORK     # moving-average ring (2M+1 values) starts here
 N_STATE_FIXED = S_MA
 
 # ---- estimate row layout --------------------------------------------------------------------
@@ -106,6 +107,9 @@ TWO_PI = 2.0 * math.pi
 #: band-pass prefilter: 4th-order Butterworth low-pass at f_hi (two sections), then a 2nd-order
 #: Butterworth high-pass at f_lo
 BAND_DAMPING = (math.cos(math.pi / 8), math.cos(3 * math.pi / 8), math.sqrt(0.5))
+#: C(k, j) for the moments M_0..M_4 (a table: no division per sample)
+BINOMIAL = ((1.0, 0.0, 0.0, 0.0, 0.0), (1.0, 1.0, 0.0, 0.0, 0.0), (1.0, 2.0, 1.0, 0.0, 0.0),
+            (1.0, 3.0, 3.0, 1.0, 0.0), (1.0, 4.0, 6.0, 4.0, 1.0))
 
 
 @njit(cache=True)
@@ -272,11 +276,9 @@ def _interval_moments(s, kmax, a, h, npts):
     # M_k += sum_m C(k, m) a^(k-m) I_m
     for k in range(kmax + 1):
         acc = 0.0
-        binom = 1.0
         ap = 1.0
         for j in range(k + 1):
-            acc += binom * ap * s[S_IM + k - j]
-            binom = binom * (k - j) / (j + 1)
+            acc += BINOMIAL[k][j] * ap * s[S_IM + k - j]
             ap = ap * a
         s[S_MOM + k] += acc
 
@@ -506,15 +508,20 @@ def _converged(m, one_sided, tol, s, c, f):
     """
     size = 2 * m + 1
     k = c[C_MA_N]
-    s[S_MA + (k % size)] = f
+    newest = k % size            # ring positions by wrapping, not by a modulo per term
+    s[S_MA + newest] = f
     c[C_MA_N] = k + 1
     if k + 1 < size:
         return False
     ma_now = 0.0
     ma_then = 0.0
-    for i in range(m + 1):
-        ma_now += s[S_MA + ((k - i) % size)]
-        ma_then += s[S_MA + ((k - m - i) % size)]
+    i_now = newest
+    i_then = newest - m if newest >= m else newest - m + size
+    for _ in range(m + 1):
+        ma_now += s[S_MA + i_now]
+        ma_then += s[S_MA + i_then]
+        i_now = i_now - 1 if i_now > 0 else size - 1
+        i_then = i_then - 1 if i_then > 0 else size - 1
     change = ma_now - ma_then
     if not one_sided:
         change = abs(change)
@@ -572,8 +579,11 @@ def _store_sample(p, s, c, seg, t, tau, y):
 
 
 @njit(cache=True)
-def step(p, s, c, seg, t, y, out):
-    """Feed one sample; return 1 and fill ``out`` when an estimate is published, else 0."""
+def step(p, s, c, seg, t, y, out, row):
+    """Feed one sample; return 1 and fill ``out[row]`` when an estimate is published, else 0.
+
+    (The row index rather than a view of it: a view per sample costs its reference counting.)
+    """
     if not _accept_time(p[P_MAXGAP], s, c, t, y):
         return 0
     if c[C_HIST_N] == 0:
@@ -623,8 +633,8 @@ def step(p, s, c, seg, t, y, out):
     # the segment must span a fraction of the period it estimates
     elif not _converged(m, one_sided, p[P_TOL], s, c, f) or tau * f < p[P_MINPER]:
         return 0
-    res = np.empty(U.N_RESULT)
-    _refine(p, seg, n_fit, model, f, damping, h, res)
+    res = s[S_RES:S_RES + U.N_RESULT]
+    _refine(p, s, seg, n_fit, model, f, damping, h, res)
     f = res[U.R_F]
     if p[P_REFINE] > 0.0 and math.isfinite(res[U.R_FIT]):
         r2, amp = res[U.R_FIT], res[U.R_AMP]     # the refined model's own residual
@@ -632,15 +642,15 @@ def step(p, s, c, seg, t, y, out):
         r2, amp = _fit(seg, n_fit, TWO_PI * f)
     published = _quality_gate(p, c, model, f, res[U.R_DAMP], h, r2, amp)
     if published:
-        out[O_T] = t
-        out[O_F] = f
-        out[O_CONV] = tau
-        out[O_SAMPLES] = nseg + 1
-        out[O_FIT] = r2
-        out[O_AMP] = amp
-        out[O_DAMP] = res[U.R_DAMP]
-        out[O_FSTD] = res[U.R_FSTD]
-        out[O_DSTD] = res[U.R_DSTD]
+        out[row, O_T] = t
+        out[row, O_F] = f
+        out[row, O_CONV] = tau
+        out[row, O_SAMPLES] = nseg + 1
+        out[row, O_FIT] = r2
+        out[row, O_AMP] = amp
+        out[row, O_DAMP] = res[U.R_DAMP]
+        out[row, O_FSTD] = res[U.R_FSTD]
+        out[row, O_DSTD] = res[U.R_DSTD]
         c[C_ESTIMATES] += 1
     reset_segment(s, c, seg, t, y)
     return 1 if published else 0
@@ -664,7 +674,7 @@ def _start(model, f, damping):
 
 
 @njit(cache=True)
-def _refine(p, seg, n, model, f, damping, h, res):
+def _refine(p, s, seg, n, model, f, damping, h, res):
     """The estimate to gate and publish: ``res`` = (f, damping, their std), core.uncertainty.
 
     ``refine`` = 0 keeps the paper's algebraic (f, damping) and adds their std; otherwise up to
@@ -674,8 +684,8 @@ def _refine(p, seg, n, model, f, damping, h, res):
     w0, sigma0 = _start(model, f, damping)
     iterations = int(p[P_REFINE])
     res[:] = math.nan
-    if not U.refine(model, seg, n, w0, sigma0, iterations, _noise_scale(p, f, h), res) \
-            or iterations == 0:
+    if not U.refine(model, seg, n, w0, sigma0, iterations, _noise_scale(p, f, h), res,
+                    s[S_WORK:S_WORK + U.N_WORK]) or iterations == 0:
         res[U.R_F] = f
         res[U.R_DAMP] = damping
 
@@ -691,9 +701,11 @@ def _target_reached(p, s, seg, n, model, f, damping, h):
     if n < s[S_NEXT]:
         return False
     s[S_NEXT] = max(n + 1.0, n * (1.0 + 1.0 / 16.0)) if n >= 64 else n + 1.0
-    res = np.full(U.N_RESULT, math.nan)
+    res = s[S_RES:S_RES + U.N_RESULT]
+    res[:] = math.nan
     w0, sigma0 = _start(model, f, damping)
-    if not U.refine(model, seg, n, w0, sigma0, 0, _noise_scale(p, f, h), res):
+    if not U.refine(model, seg, n, w0, sigma0, 0, _noise_scale(p, f, h), res,
+                    s[S_WORK:S_WORK + U.N_WORK]):
         return False
     return res[U.R_FSTD] <= p[P_TARGET] * f
 
@@ -711,7 +723,7 @@ def run(p, s, c, seg, t, y, out, start):
     while i < n:
         if n_out >= out.shape[0]:
             return n_out, i
-        if step(p, s, c, seg, t[i], y[i], out[n_out]):
+        if step(p, s, c, seg, t[i], y[i], out, n_out):
             n_out += 1
         i += 1
     return n_out, i

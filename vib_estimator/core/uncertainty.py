@@ -21,7 +21,9 @@ projection), then Gauss-Newton steps on all of theta (continued over growing pre
 segment, see :func:`refine`): ``J^T J delta = J^T r`` (J the Jacobian of
 the model over the samples, r the residual). A step is kept only if it lowers the residual sum of
 squares, so the result is never worse (in the likelihood) than the algebraic estimate it starts
-from; with 0 iterations the algebraic estimate is returned untouched and only its std is computed.
+from; they stop once the step of the frequency (and of sigma or c) is below ``STEP_TOL`` of its
+std (from a start near the bound, after one or two steps); with 0 iterations the algebraic
+estimate is returned untouched and only its std is computed.
 
 Standard deviation: ``cov(theta) = s^2 (J^T J)^-1`` at the returned theta, with the residual
 variance ``s^2 = RSS / (n - p)`` (p parameters): the exact Cramer-Rao bound of the model over those
@@ -34,14 +36,16 @@ frequency (which is what the Fisher information of a sinusoid depends on). :func
 restores it with the Butterworth filters' noise-equivalent bandwidth (valid when the window is long
 against the filter's correlation time 1/(f_hi - f_lo)).
 
-Sines and cosines over the segment are advanced by a rotation (exact on uniform sampling, resynced
-every 256 samples and whenever the step changes), so a pass costs a few multiplications a sample.
+Cost: sines and cosines over the segment are advanced by a rotation (exact on uniform sampling,
+resynced every 256 samples and whenever the step changes), the sums of a pass stay in registers,
+variable projection sums only the linear columns, and the scratch arrays are the caller's (in the
+kernel's state, allocated once): a default estimate over half a period costs one projection and
+about two Gauss-Newton passes over its samples.
 """
 from __future__ import annotations
 
 import math
 
-import numpy as np
 from numba import njit
 
 #: values of the kernel's model parameter
@@ -52,61 +56,106 @@ R_F, R_DAMP, R_FSTD, R_DSTD, R_FIT, R_AMP = range(6)
 N_RESULT = 6
 TWO_PI = 2.0 * math.pi
 _RESYNC = 256
+#: Gauss-Newton stops once the step of the nonlinear parameters is below this fraction of their std
+STEP_TOL = 1e-3
+#: floats of scratch :func:`refine` needs (allocated once by the caller, see :func:`_workspace`)
+N_WORK = 96
 
 
 @njit(cache=True)
-def _accumulate(model, seg, n, tc, th, jtj, jtr):
+def _workspace(work):
+    """Named views of the caller's scratch (``N_WORK`` floats): theta, the best theta, J^T r, J^T J,
+    its inverse, the best theta's inverse, Gauss-Jordan's augmented matrix and its scaling."""
+    return (work[0:4], work[4:8], work[8:12], work[12:28].reshape((4, 4)),
+            work[28:44].reshape((4, 4)), work[44:60].reshape((4, 4)),
+            work[60:92].reshape((4, 8)), work[92:96])
+
+
+@njit(cache=True)
+def _accumulate(model, seg, n, tc, th, jtj, jtr, linear=False):
     """One pass over the segment at theta: J^T J, J^T r into ``jtj``, ``jtr``; returns the RSS.
 
     Columns of J: d/da = E sin, d/db = E cos, d/dw = u E (a cos - b sin), and d/dc = 1 (biased) or
     d/dsigma = -u E (a sin + b cos) (damped), with E = exp(-sigma u) (1 for the other models).
+    ``linear``: only the columns of the linear parameters (a, b, c; variable projection). The sums
+    are scalars (registers) until the end of the pass, and the sines advance by rotation within
+    blocks of ``_RESYNC`` samples.
     """
-    npar = 3 if model == MODEL_SINUSOID else 4
-    jtj[:, :] = 0.0
-    jtr[:] = 0.0
     a, b, w = th[0], th[1], th[2]
     sig = th[3] if model == MODEL_DAMPED else 0.0
     off = th[3] if model == MODEL_BIASED else 0.0
-    jac = np.zeros(4)
-    rss = 0.0
-    sn = cs = e = rc = rs = re = 0.0
+    col3 = model == MODEL_BIASED or (model == MODEL_DAMPED and not linear)
+    a00 = a01 = a02 = a03 = a11 = a12 = a13 = a22 = a23 = a33 = 0.0
+    r0 = r1 = r2 = r3 = rss = 0.0
+    rc = rs = re = 0.0
     d_prev = -1.0
-    for i in range(n):
-        u = seg[0, i] - tc
-        d = seg[0, i] - seg[0, i - 1] if i > 0 else 0.0
-        if i % _RESYNC == 0:
-            sn, cs, e = math.sin(w * u), math.cos(w * u), math.exp(-sig * u)
-        else:
-            if abs(d - d_prev) > 1e-9 * d:
-                rc, rs, re, d_prev = math.cos(w * d), math.sin(w * d), math.exp(-sig * d), d
-            sn, cs = sn * rc + cs * rs, cs * rc - sn * rs
-            e *= re
-        osc = e * (a * sn + b * cs)
-        r = seg[1, i] - osc - off
-        jac[0] = e * sn
-        jac[1] = e * cs
-        jac[2] = u * e * (a * cs - b * sn)
-        jac[3] = 1.0 if model == MODEL_BIASED else -u * osc
-        for j in range(npar):
-            jtr[j] += jac[j] * r
-            for k in range(j, npar):
-                jtj[j, k] += jac[j] * jac[k]
-        rss += r * r
-    for j in range(npar):
-        for k in range(j):
-            jtj[j, k] = jtj[k, j]
+    for block in range(0, n, _RESYNC):
+        u = seg[0, block] - tc
+        sn, cs, e = math.sin(w * u), math.cos(w * u), math.exp(-sig * u)
+        for i in range(block, min(block + _RESYNC, n)):
+            if i > block:
+                u = seg[0, i] - tc
+                d = seg[0, i] - seg[0, i - 1]
+                if abs(d - d_prev) > 1e-9 * d:
+                    rc, rs, re, d_prev = math.cos(w * d), math.sin(w * d), math.exp(-sig * d), d
+                sn, cs = sn * rc + cs * rs, cs * rc - sn * rs
+                e *= re
+            osc = e * (a * sn + b * cs)
+            r = seg[1, i] - osc - off
+            j0 = e * sn
+            j1 = e * cs
+            r0 += j0 * r
+            r1 += j1 * r
+            a00 += j0 * j0
+            a01 += j0 * j1
+            a11 += j1 * j1
+            rss += r * r
+            if not linear:
+                j2 = u * e * (a * cs - b * sn)
+                r2 += j2 * r
+                a02 += j0 * j2
+                a12 += j1 * j2
+                a22 += j2 * j2
+            if col3:
+                j3 = 1.0 if model == MODEL_BIASED else -u * osc
+                r3 += j3 * r
+                a03 += j0 * j3
+                a13 += j1 * j3
+                a33 += j3 * j3
+                if not linear:
+                    a23 += j2 * j3
+    _store_normal_equations(model, jtj, jtr, (a00, a01, a02, a03, a11, a12, a13, a22, a23, a33),
+                            (r0, r1, r2, r3))
     return rss
 
 
 @njit(cache=True)
-def _invert(a, idx, m, out):
+def _store_normal_equations(model, jtj, jtr, upper, rhs):
+    """J^T J (symmetric, from its upper triangle row by row) and J^T r; the sinusoid's 4th column
+    (not a parameter of it) stays zero."""
+    npar = 3 if model == MODEL_SINUSOID else 4
+    jtj[:, :] = 0.0
+    jtr[:] = 0.0
+    k = 0
+    for i in range(4):
+        for j in range(i, 4):
+            if j < npar:
+                jtj[i, j] = upper[k]
+                jtj[j, i] = upper[k]
+            k += 1
+        if i < npar:
+            jtr[i] = rhs[i]
+
+
+@njit(cache=True)
+def _invert(a, idx, m, out, aug, scale):
     """Inverse of the symmetric block a[idx][:, idx] (m x m) into out[:m, :m]; False if singular.
 
     Gauss-Jordan with partial pivoting on the Jacobi-scaled matrix (the columns of J have different
-    units, so scaling keeps the pivots meaningful).
+    units, so scaling keeps the pivots meaningful); ``aug`` (m x 2m used) and ``scale`` (m) are
+    scratch.
     """
-    w = np.zeros((m, 2 * m))
-    scale = np.zeros(m)
+    w = aug
     for i in range(m):
         dii = a[idx[i], idx[i]]
         if not dii > 0.0:
@@ -115,6 +164,7 @@ def _invert(a, idx, m, out):
     for i in range(m):
         for j in range(m):
             w[i, j] = a[idx[i], idx[j]] * scale[i] * scale[j]
+            w[i, m + j] = 0.0
         w[i, m + i] = 1.0
     for col in range(m):
         piv = col
@@ -140,15 +190,16 @@ def _invert(a, idx, m, out):
 
 
 @njit(cache=True)
-def _solve_linear(model, seg, n, tc, th, jtj, jtr, cov):
+def _solve_linear(model, seg, n, tc, work):
     """Variable projection: the least-squares a, b (and c) at theta's w (and sigma)."""
+    th, _, jtr, jtj, cov, _, aug, scale = _workspace(work)
     th[0] = th[1] = 0.0
     if model == MODEL_BIASED:
         th[3] = 0.0
-    _accumulate(model, seg, n, tc, th, jtj, jtr)
-    idx = np.array([0, 1, 3])
+    _accumulate(model, seg, n, tc, th, jtj, jtr, True)
+    idx = (0, 1, 3)
     m = 3 if model == MODEL_BIASED else 2
-    if not _invert(jtj, idx, m, cov):
+    if not _invert(jtj, idx, m, cov, aug, scale):
         return False
     for i in range(m):
         acc = 0.0
@@ -159,82 +210,100 @@ def _solve_linear(model, seg, n, tc, th, jtj, jtr, cov):
 
 
 @njit(cache=True)
-def _gauss_newton(model, seg, n, th, iterations, best_cov):
-    """Fit theta over seg[:, :n]: variable projection at theta's (w, sigma), then Gauss-Newton.
+def _newton_step(npar, th, cov, jtr, s2):
+    """theta += (J^T J)^-1 J^T r; True if the step of the nonlinear parameters (w, and sigma or c)
+    is below ``STEP_TOL`` of their std (s^2 (J^T J)^-1 with the current residual variance ``s2``)
+    or rounding: theta is then converged and the step is not worth a pass."""
+    small = True
+    for i in range(npar):
+        delta = 0.0
+        for j in range(npar):
+            delta += cov[i, j] * jtr[j]
+        if i >= 2 and abs(delta) > max(STEP_TOL * math.sqrt(s2 * cov[i, i]),
+                                       1e-13 * abs(th[i])):
+            small = False
+        th[i] += delta
+    return small
 
-    A step is kept only if it lowers the RSS. Returns the best RSS (inf if no fit) and leaves the
-    best theta in ``th`` and its (J^T J)^-1 in ``best_cov``.
+
+@njit(cache=True)
+def _gauss_newton(model, seg, n, iterations, work):
+    """Fit theta (``work``) over seg[:, :n]: variable projection at theta's (w, sigma), then
+    Gauss-Newton.
+
+    A step is kept only if it lowers the RSS; the iterations stop early once a step is negligible
+    (:func:`_newton_step`). Returns the best RSS (inf if no fit) and leaves the best theta in
+    theta and its (J^T J)^-1 in the best inverse of the workspace.
     """
+    th, best, jtr, jtj, cov, best_cov, aug, scale = _workspace(work)
     npar = 3 if model == MODEL_SINUSOID else 4
     tc = 0.5 * (seg[0, 0] + seg[0, n - 1])
-    jtj = np.zeros((4, 4))
-    jtr = np.zeros(4)
-    cov = np.zeros((4, 4))
-    if not _solve_linear(model, seg, n, tc, th, jtj, jtr, cov):
+    if not _solve_linear(model, seg, n, tc, work):
         return math.inf
-    idx = np.arange(4)
-    best = th.copy()
+    best[:] = th
     best_rss = math.inf
     for k in range(iterations + 1):
         rss = _accumulate(model, seg, n, tc, th, jtj, jtr)
-        if not (rss < best_rss and _invert(jtj, idx, npar, cov)):
+        if not (rss < best_rss and _invert(jtj, (0, 1, 2, 3), npar, cov, aug, scale)):
             break
         best_rss = rss
         best[:] = th
         best_cov[:, :] = cov
-        if k == iterations:
+        if k == iterations or _newton_step(npar, th, cov, jtr, rss / (n - npar)):
             break
-        step_w = 0.0
-        for i in range(npar):
-            delta = 0.0
-            for j in range(npar):
-                delta += cov[i, j] * jtr[j]
-            th[i] += delta
-            if i == 2:
-                step_w = delta
-        if not (th[2] > 0.0 and math.isfinite(th[2])) or abs(step_w) <= 1e-13 * th[2]:
+        if not (th[2] > 0.0 and math.isfinite(th[2])):
             break
     th[:] = best
     return best_rss
 
 
 @njit(cache=True)
-def refine(model, seg, n, w0, sigma0, iterations, noise_scale, res):
+def _first_prefix(seg, n, npar, w0):
+    """Length of the continuation's first window: n halved while it spans at least half a period
+    (and 2 npar + 2 samples), so the prefixes double up to n exactly."""
+    shortest = 2 * npar + 2
+    while shortest < n and seg[0, shortest - 1] - seg[0, 0] < math.pi / w0:
+        shortest += 1
+    m = n
+    while m >= 2 * shortest:
+        m //= 2
+    return m
+
+
+@njit(cache=True)
+def refine(model, seg, n, w0, sigma0, iterations, noise_scale, res, work):
     """Refine the algebraic estimate over the segment ``seg[:, :n]`` (rows: tau, y); fill ``res``.
 
     ``w0`` (rad/s) and ``sigma0`` (1/s, damped model) start the fit; ``iterations`` Gauss-Newton
     steps at most, each kept only if it lowers the RSS. Over more than a period the fit is
-    continued: first over the segment's first half period (where the algebraic estimate is near
-    the bound, well inside the likelihood's main lobe), then over prefixes doubling in length up to
-    the whole segment, each started from the last, so the start always lies in the main lobe of the
-    next window's likelihood. ``noise_scale`` multiplies the residual variance
-    (:func:`band_noise_scale`). ``res``: frequency (Hz; the natural frequency for the damped
-    model), damping ratio (NaN unless damped), their std, and the fitted model's R^2 and amplitude
-    (:func:`_goodness`). Returns False (res untouched) when no fit is possible.
+    continued: first over a prefix of the segment between half a period and a period long (where
+    the algebraic estimate is near the bound, well inside the likelihood's main lobe), then over
+    prefixes doubling in length up to the whole segment, each started from the last, so the start
+    always lies in the main lobe of the next window's likelihood. ``noise_scale`` multiplies the
+    residual variance (:func:`band_noise_scale`). ``res``: frequency (Hz; the natural frequency
+    for the damped model), damping ratio (NaN unless damped), their std, and (iterations > 0) the
+    fitted model's R^2 and amplitude (:func:`_goodness`). ``work``: ``N_WORK`` floats of scratch.
+    Returns False (res untouched) when no fit is possible.
     """
     npar = 3 if model == MODEL_SINUSOID else 4
     if n <= npar + 1 or not w0 > 0.0:
         return False
-    th = np.zeros(4)
+    th, _, _, _, _, cov, _, _ = _workspace(work)
+    th[:] = 0.0
     th[2] = w0
     if model == MODEL_DAMPED:
         th[3] = sigma0
-    cov = np.zeros((4, 4))
-    m = n
-    if iterations > 0:
-        half = math.pi / w0
-        m = 2 * npar + 2
-        while m < n and seg[0, m - 1] - seg[0, 0] < half:
-            m += 1
+    m = _first_prefix(seg, n, npar, w0) if iterations > 0 else n
     while True:
-        rss = _gauss_newton(model, seg, m, th, iterations, cov)
+        rss = _gauss_newton(model, seg, m, iterations, work)
         if m >= n or rss == math.inf:
             break
-        m = min(2 * m, n)
+        m = n if 4 * m > n else 2 * m
     if rss == math.inf:
         return False
     _moments_of_result(model, th, cov, rss * noise_scale / (n - npar), res)
-    _goodness(seg, n, th, rss, res)
+    if iterations > 0:
+        _goodness(seg, n, th, rss, res)
     return True
 
 
