@@ -61,12 +61,13 @@ NS = 2 * NLEV            # scales
 M_A, M_B = 48, 68        # window lengths of the even and odd scales (level samples)
 NQ = M_B // 3 + 1        # rows of a scale's subspace
 PCOL = 14                # most subspace columns
-HOP = 12                 # level samples between two analyses of a scale
+HOP = 12                 # level samples between two analyses of a scale that a mode publishes
+HOP_IDLE = 24            # ... from (or may soon: the next longer one), and of the others
 DEC_CUTOFF = 0.12        # anti-alias low-pass before each decimation by 2, cycles per sample
 EIG_RATIO = 6.0          # signal eigenvalues: this factor above the noise's
 NU_HI = 0.2              # highest pole counted at a scale, cycles per level sample
-C_TRACK = 0.9            # cycles in the window for a pole to count ...
-C_DETECT = 1.3           # ... for it to become a candidate
+C_TRACK = 0.7            # cycles in the window for a pole to count ...
+C_DETECT = 1.0           # ... for it to become a candidate
 C_CAP = 2.8              # publishing windows hold at most this many periods of the lowest mode
 SIG_TRACK = 100.0        # energy / residual variance of a counted pole (20 dB) ...
 SIG_DETECT = 300.0       # ... and of a candidate (25 dB)
@@ -79,8 +80,8 @@ MAX_HARMONIC = 5
 HARMONIC_RATIO = 2.0     # a harmonic's parent is at least this much stronger (amplitude)
 CONSISTENCY = 0.01       # a published pole lies this close to the mode's previous pole
 LOSE_PERIODS = 3.0       # a mode unseen for this many of its periods is lost
-GAP_STEPS = 1.5          # an interval this many mean intervals long is a gap ...
-MAX_FILL = 64            # ... bridged by at most this many interpolated steps
+N_STEP = 15              # intervals whose median is the grid step
+MAX_FILL = 64            # grid steps interpolated between two samples at most (else a restart)
 NPEND = 16               # candidates kept
 BLOCK = 1 << 15          # samples per block of the batch path
 
@@ -88,17 +89,20 @@ BLOCK = 1 << 15          # samples per block of the batch path
 DEC_N = 22               # per level: two sections' Phi G0 G1 (16), states (2 + 2), inputs (2)
 B_DEC = 0
 B_RING = B_DEC + DEC_N * NLEV
-B_DT = B_RING + M_B * NLEV       # mean sampling interval, s
+B_DT = B_RING + M_B * NLEV       # step of the uniform grid, s
 B_TLAST = B_DT + 1
 B_Y = B_TLAST + 1                # last accepted input
-N_B = B_Y + 1
+B_TG = B_Y + 1                   # time of the last grid sample
+B_HBUF = B_TG + 1                # the first N_STEP intervals (their median is the grid step)
+N_B = B_HBUF + 16
 # ---- int array ic ------------------------------------------------------------------------------
 (I_N, I_NDT, I_NB, I_RECEIVED, I_USED, I_NONFINITE, I_DUPLICATE, I_OUT_OF_ORDER, I_TIME_JUMP,
  I_GAP, I_FOUND, I_LOST, I_REJ_HARM, I_REJ_NOISE, I_REJ_UNRES, I_REJ_EDGE, I_NPEND,
  I_UID, I_NOUT) = range(19)
 I_LEV = 19                        # NLEV samples since the (re)start, per level
 I_RET = I_LEV + NLEV              # the lost modes' counters (MODE_COUNTERS, in order)
-N_I = I_RET + 4
+I_BUSY = I_RET + 4                # NS flags: a mode publishes from the scale or the one below
+N_I = I_BUSY + NS
 #: input counters, named as the estimator's
 STAGE_COUNTERS = {'received': I_RECEIVED, 'used': I_USED, 'skipped_non_finite': I_NONFINITE,
                   'skipped_duplicate': I_DUPLICATE, 'skipped_out_of_order': I_OUT_OF_ORDER,
@@ -398,9 +402,14 @@ def _analysis(b, ic, sl, pd, qs, lams, pa, s, t, out):
         else:
             _publish(b, ic, sl, k, s, t, pp, best, r2, out)
     _candidates(ic, sl, pd, pa, pp, n, used, t, t - _scale_len(s) * b[B_DT])
+    ic[I_BUSY:I_BUSY + NS] = 0
     for k in range(KMAX):
         if sl[k, SL_ACTIVE] != 0.0 and (t - sl[k, SL_SEEN]) * sl[k, SL_F] > LOSE_PERIODS:
             _remove(ic, sl, k)
+        elif sl[k, SL_ACTIVE] != 0.0:
+            o = _owner(b, sl, k, t)
+            for j in range(max(o, 0), min(o + 2, NS)):
+                ic[I_BUSY + j] = 1
 
 
 # ---- input, one sample, a run of samples --------------------------------------------------
@@ -426,11 +435,8 @@ def _input_ok(b, ic, pa, t, y):
     if h > pa[PA_MAXGAP]:
         ic[I_GAP] += 1
         return 2
-    # the mean interval (a running mean over the first 4096 intervals, then an average of that
-    # length) of the intervals that are not gaps
-    if ic[I_NDT] < 4 or h < GAP_STEPS * b[B_DT]:
-        m = min(ic[I_NDT], 4095)
-        b[B_DT] = (b[B_DT] * m + h) / (m + 1)
+    if ic[I_NDT] < N_STEP:
+        b[B_HBUF + ic[I_NDT]] = h
         ic[I_NDT] += 1
     return 1
 
@@ -439,51 +445,86 @@ def _input_ok(b, ic, pa, t, y):
 def _feed(b, ic, sl, pd, qs, lams, pa, t, y, out):
     """One (possibly interpolated) sample through the levels and the analyses it completes."""
     top = _levels_step(b, ic, y)
-    if ic[I_NDT] < 4:
-        return
     for d in range(top + 1):
         n = ic[I_LEV + d]
         for half in range(2):
-            if n >= (M_A, M_B)[half] and (n + half * (HOP // 2)) % HOP == 0:
+            hop = HOP if ic[I_BUSY + 2 * d + half] else HOP_IDLE
+            if n >= (M_A, M_B)[half] and (n + half * (HOP // 2)) % hop == 0:
                 _analysis(b, ic, sl, pd, qs, lams, pa, 2 * d + half, t, out)
 
 
 @njit(cache=True)
 def _step(b, ic, sl, pd, qs, lams, pa, t, y, out):
-    """One input sample (counted, gaps bridged or restarting the levels); estimates into out."""
+    """One input sample (counted; restarting the levels, or resampled onto the uniform grid by
+    linear interpolation); estimates into out."""
     kind = _input_ok(b, ic, pa, t, y)
     if kind == 0:
         return
     ic[I_USED] += 1
     if kind == 2:
+        ic[I_NDT] = 0
+    elif ic[I_NDT] == N_STEP and b[B_DT] == 0.0:
+        # the grid: the median of the first intervals as its step, from this sample on
+        b[B_DT] = np.median(b[B_HBUF:B_HBUF + N_STEP])
         _levels_settle(b, ic, y)
-    elif ic[I_NDT] >= 4:
-        # a gap of m steps is bridged by linear interpolation (the levels assume uniform steps)
-        m = min(int(round((t - b[B_TLAST]) / b[B_DT])), MAX_FILL)
-        for i in range(1, m):
-            _feed(b, ic, sl, pd, qs, lams, pa, b[B_TLAST] + (t - b[B_TLAST]) * i / m,
-                  b[B_Y] + (y - b[B_Y]) * i / m, out)
-    _feed(b, ic, sl, pd, qs, lams, pa, t, y, out)
+        b[B_TG] = t
+        _feed(b, ic, sl, pd, qs, lams, pa, t, y, out)
+    elif b[B_DT] > 0.0:
+        h = b[B_DT]
+        if (t - b[B_TG]) / h > MAX_FILL:
+            _levels_settle(b, ic, y)
+            b[B_TG] = t - h
+        t0 = b[B_TLAST]
+        while b[B_TG] + h <= t + 1e-9 * h:
+            tg = b[B_TG] + h
+            b[B_TG] = tg
+            _feed(b, ic, sl, pd, qs, lams, pa, tg, b[B_Y] + (y - b[B_Y]) * (tg - t0) / (t - t0),
+                  out)
     b[B_TLAST] = t
     b[B_Y] = y
     ic[I_N] += 1
+    if kind == 2:
+        b[B_DT] = 0.0
 
 
 #: rows one sample can publish at most (a bridged gap of MAX_FILL steps completes fewer than
 #: NS + 2 MAX_FILL analyses, each publishing at most KMAX modes)
 ROOM = KMAX * (NS + 2 * MAX_FILL)
+# ---- the float state in one array (one argument per call: numba's dispatch costs per argument)
+F_SL = N_B
+F_PD = F_SL + KMAX * N_SL
+F_LAM = F_PD + NPEND * 4
+F_PA = F_LAM + NS * PCOL
+N_F = F_PA + 7
 
 
 @njit(cache=True)
-def _run(b, ic, sl, pd, qs, lams, pa, t, y, out, start, stop):
-    """Feed t[start:stop] until out may not hold another sample's estimates; returns the next
-    index to feed."""
+def _unpack(fs):
+    """The views b, sl, pd, lams, pa of the float state."""
+    return (fs[:N_B], fs[F_SL:F_PD].reshape((KMAX, N_SL)), fs[F_PD:F_LAM].reshape((NPEND, 4)),
+            fs[F_LAM:F_PA].reshape((NS, PCOL)), fs[F_PA:N_F])
+
+
+@njit(cache=True)
+def _update(fs, ic, qs, t, y, out):
+    """One sample (the streaming path); returns the number of estimates in out."""
+    b, sl, pd, lams, pa = _unpack(fs)
+    ic[I_NOUT] = 0
+    _step(b, ic, sl, pd, qs, lams, pa, t, y, out)
+    return ic[I_NOUT]
+
+
+@njit(cache=True)
+def _run(fs, ic, qs, t, y, out, start):
+    """Feed t[start:] until out may not hold another sample's estimates; returns the next index
+    to feed (the batch path)."""
+    b, sl, pd, lams, pa = _unpack(fs)
+    ic[I_NOUT] = 0
     i = start
-    while i < stop and ic[I_NOUT] + ROOM <= len(out):
+    while i < len(t) and ic[I_NOUT] + ROOM <= len(out):
         _step(b, ic, sl, pd, qs, lams, pa, t[i], y[i], out)
         i += 1
     return i
-
 
 
 @dataclass(frozen=True)
@@ -504,16 +545,17 @@ class ModeTracker:
         if config.modes < 1:
             raise ValueError('ModeTracker needs modes >= 1 (FrequencyEstimator for modes = 0)')
         self._config = config
-        self._b = np.zeros(N_B)
+        self._fs = np.zeros(N_F)
+        self._b, self._sl, self._pd, self._lams, pa = (
+            self._fs[:N_B], self._fs[F_SL:F_PD].reshape((KMAX, N_SL)),
+            self._fs[F_PD:F_LAM].reshape((NPEND, 4)), self._fs[F_LAM:F_PA].reshape((NS, PCOL)),
+            self._fs[F_PA:N_F])
         self._ic = np.zeros(N_I, dtype=np.int64)
-        self._sl = np.zeros((KMAX, N_SL))
-        self._pd = np.zeros((NPEND, 4))
         self._qs = np.zeros((NS, NQ, PCOL))
-        self._lams = np.zeros((NS, PCOL))
         band = config.band_hz or (0.0, math.inf)
         self._npc = min(2 * config.modes + 4, M_A // 3 + 1 - 3)
-        self._pa = np.array([config.max_gap, config.modes, band[0], band[1], config.max_damping,
-                             config.min_fit, self._npc], dtype=np.float64)
+        pa[:] = (config.max_gap, config.modes, band[0], band[1], config.max_damping,
+                 config.min_fit, self._npc)
         self._out = np.empty((ROOM, N_O))
         _levels_init(self._b)
         self.restart()
@@ -523,17 +565,15 @@ class ModeTracker:
         return self._config
 
     # ---- streaming and batch ---------------------------------------------------------------
-    def _args(self):
-        return self._b, self._ic, self._sl, self._pd, self._qs, self._lams, self._pa
-
     def update(self, t: float, y: float) -> List[Estimate]:
         """Feed one sample; return the estimates published at it (ascending mode)."""
-        self._ic[I_NOUT] = 0
-        _step(*self._args(), float(t), float(y), self._out)
-        rows = self._out[:self._ic[I_NOUT]]
+        n = _update(self._fs, self._ic, self._qs, float(t), float(y), self._out)
+        if n == 0:
+            return []
+        rows = self._out[:n]
         return [Estimate(*row[:O_SAMPLES], int(row[O_SAMPLES]), *row[O_FIT:O_MODE],
-                         mode=int(row[O_MODE])) for row in rows[np.argsort(rows[:, O_MODE],
-                                                                           kind='stable')]]
+                         mode=int(row[O_MODE]))
+                for row in rows[np.argsort(rows[:, O_MODE], kind='stable')]]
 
     def process(self, t: Sequence[float], y: Sequence[float]) -> EstimateArrays:
         """Feed arrays of samples (continuing the stream); the estimates as columns, by time."""
@@ -542,8 +582,7 @@ class ModeTracker:
         parts = []
         i = 0
         while i < len(t):
-            self._ic[I_NOUT] = 0
-            i = _run(*self._args(), t, y, out, i, len(t))
+            i = _run(self._fs, self._ic, self._qs, t, y, out, i)
             parts.append(out[:self._ic[I_NOUT]].copy())
         rows = np.concatenate(parts) if parts else np.empty((0, N_O))
         cols = [rows[:, j].astype(np.int64) if j in (O_SAMPLES, O_MODE) else rows[:, j].copy()

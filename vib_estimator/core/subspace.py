@@ -92,37 +92,49 @@ def orthogonal_iteration(r, n, q, lam):
 
 @njit(cache=True)
 def cholesky_solve(a, b):
-    """Solve a x = b for a symmetric positive (semi)definite a (a tiny ridge keeps it regular)."""
-    n = len(b)
-    c = a.copy()
-    ridge = 1e-13 * max(np.trace(c) / max(n, 1), 1e-300)
-    for i in range(n):
-        c[i, i] += ridge
+    """Solve a x = b (b: one or more columns) for a symmetric positive (semi)definite a (a tiny
+    ridge keeps it regular)."""
+    n = a.shape[0]
+    c = np.zeros((n, n))
+    ridge = 1e-13 * max(np.trace(a) / max(n, 1), 1e-300)
     for j in range(n):
-        s = c[j, j] - np.sum(c[j, :j] ** 2)
+        s = a[j, j] + ridge
+        for k in range(j):
+            s -= c[j, k] * c[j, k]
         c[j, j] = math.sqrt(max(s, ridge))
         for i in range(j + 1, n):
-            c[i, j] = (c[i, j] - np.sum(c[i, :j] * c[j, :j])) / c[j, j]
-    y = np.empty(n)
+            s = a[i, j]
+            for k in range(j):
+                s -= c[i, k] * c[j, k]
+            c[i, j] = s / c[j, j]
+    x = b.copy()
     for i in range(n):
-        y[i] = (b[i] - np.sum(c[i, :i] * y[:i])) / c[i, i]
-    out = np.empty(n)
+        for k in range(i):
+            x[i] -= c[i, k] * x[k]
+        x[i] /= c[i, i]
     for i in range(n - 1, -1, -1):
-        out[i] = (y[i] - np.sum(c[i + 1:, i] * out[i + 1:])) / c[i, i]
-    return out
+        for k in range(i + 1, n):
+            x[i] -= c[k, i] * x[k]
+        x[i] /= c[i, i]
+    return x
 
 
 @njit(cache=True)
 def esprit_poly(q, n, p):
     """Characteristic polynomial (monic, low coefficients first) of the rotation Phi of the signal
     subspace, Q[:-1] Phi = Q[1:] in least squares (Faddeev-LeVerrier recursion)."""
-    q1 = q[:n - 1, :p]
-    q2 = q[1:n, :p]
-    g = q1.T @ q1
-    phi = np.empty((p, p))
-    rhs = q1.T @ q2
-    for k in range(p):
-        phi[:, k] = cholesky_solve(g, np.ascontiguousarray(rhs[:, k]))
+    g = np.zeros((p, p))
+    rhs = np.zeros((p, p))
+    for i in range(p):
+        for j in range(p):
+            sg = 0.0
+            sr = 0.0
+            for r in range(n - 1):
+                sg += q[r, i] * q[r, j]
+                sr += q[r, i] * q[r + 1, j]
+            g[i, j] = sg
+            rhs[i, j] = sr
+    phi = cholesky_solve(g, rhs)
     c = np.zeros(p + 1)
     c[p] = 1.0
     mk = np.zeros((p, p))
@@ -130,7 +142,11 @@ def esprit_poly(q, n, p):
         mk = phi @ mk
         for i in range(p):
             mk[i, i] += c[p - k + 1]
-        c[p - k] = -np.trace(phi @ mk) / k
+        tr = 0.0
+        for i in range(p):
+            for j in range(p):
+                tr += phi[i, j] * mk[j, i]
+        c[p - k] = -tr / k
     return c[:p]
 
 
@@ -180,12 +196,13 @@ def _basis(m, poles):
     for i in range(len(poles)):
         if kind[i] == 0:
             continue
-        lz = np.log(poles[i])
+        z = poles[i]
+        w = np.exp(np.log(z) * (1 - m))
         for n in range(m):
-            w = np.exp(lz * (n - m + 1))
             basis[n, col] = w.real
             if kind[i] == 2:
                 basis[n, col + 1] = w.imag
+            w *= z
         col += kind[i]
     return basis, kind
 
@@ -199,7 +216,7 @@ def fit_poles(x, poles, rows):
     ncol = basis.shape[1]
     if ncol == 0 or ncol >= m:
         return 0, math.nan, math.nan
-    c = cholesky_solve(basis.T @ basis, basis.T @ x)
+    c = cholesky_solve(basis.T @ basis, np.ascontiguousarray(basis.T @ x))
     resid = x - basis @ c
     total = np.sum((x - np.mean(x)) ** 2)
     rss = np.sum(resid ** 2)
