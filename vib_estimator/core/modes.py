@@ -26,7 +26,7 @@ How the modes are found and estimated (everything compiled, one call per sample)
   variance (the noise rule).
 * **Finding**: a counted pole no mode explains (none within ``MATCH_TOL``) with ``C_DETECT`` cycles
   and ``SIG_DETECT`` of energy is a candidate, unless it is a harmonic (within ``HARMONIC_TOL`` of
-  2..5 times a pole or mode ``HARMONIC_RATIO`` stronger in amplitude: ``rejected_harmonic``) or
+  2..9 times a pole or mode ``HARMONIC_RATIO`` stronger in amplitude: ``rejected_harmonic``) or
   within ``DUPLICATE_TOL`` of a mode (``rejected_unresolved``); a candidate seen again within
   ``PENDING_TOL`` by a later analysis becomes a mode (``modes_found``), one not seen again within
   a period is ``rejected_noise``. With K modes a new one replaces the weakest only if twice as
@@ -75,8 +75,8 @@ MIN_DAMPING = -0.02      # poles growing faster than this are not modes
 MATCH_TOL = 0.06         # a pole within this of a mode is the mode's
 DUPLICATE_TOL = 0.12     # a candidate this close to a mode is not a mode of its own
 PENDING_TOL = 0.02       # a candidate seen again within this is confirmed
-HARMONIC_TOL = 0.015     # relative distance to n f of a stronger pole or mode (n = 2..5)
-MAX_HARMONIC = 5
+HARMONIC_TOL = 0.015     # relative distance to n f of a stronger pole or mode (n = 2..9)
+MAX_HARMONIC = 9
 HARMONIC_RATIO = 2.0     # a harmonic's parent is at least this much stronger (amplitude)
 CONSISTENCY = 0.01       # a published pole lies this close to the mode's previous pole
 LOSE_PERIODS = 3.0       # a mode unseen for this many of its periods is lost
@@ -221,7 +221,7 @@ def _poles(b, ic, qs, lams, pa, s, pp):
 
 @njit(cache=True)
 def _harmonic(f, amp, pp, n, sl):
-    """Whether f lies within HARMONIC_TOL of 2..5 times a pole of pp[:n] or an active mode
+    """Whether f lies within HARMONIC_TOL of 2..9 times a pole of pp[:n] or an active mode
     HARMONIC_RATIO times stronger than amp."""
     for i in range(n + KMAX):
         if i < n:
@@ -573,7 +573,7 @@ class ModeTracker:
         rows = self._out[:n]
         return [Estimate(*row[:O_SAMPLES], int(row[O_SAMPLES]), *row[O_FIT:O_MODE],
                          mode=int(row[O_MODE]))
-                for row in rows[np.argsort(rows[:, O_MODE], kind='stable')]]
+                for row in rows[np.lexsort((rows[:, O_MODE], rows[:, O_T]))]]
 
     def process(self, t: Sequence[float], y: Sequence[float]) -> EstimateArrays:
         """Feed arrays of samples (continuing the stream); the estimates as columns, by time."""
@@ -585,6 +585,7 @@ class ModeTracker:
             i = _run(self._fs, self._ic, self._qs, t, y, out, i)
             parts.append(out[:self._ic[I_NOUT]].copy())
         rows = np.concatenate(parts) if parts else np.empty((0, N_O))
+        rows = rows[np.lexsort((rows[:, O_MODE], rows[:, O_T]))]
         cols = [rows[:, j].astype(np.int64) if j in (O_SAMPLES, O_MODE) else rows[:, j].copy()
                 for j in range(N_O)]
         return EstimateArrays(*cols)
