@@ -26,7 +26,9 @@ How the modes are found and estimated (everything compiled, one call per sample)
   variance (the noise rule).
 * **Finding**: a counted pole no mode explains (none within ``MATCH_TOL``) with ``C_DETECT`` cycles
   and ``SIG_DETECT`` of energy is a candidate, unless it is a harmonic (within ``HARMONIC_TOL`` of
-  2..9 times a pole or mode ``HARMONIC_RATIO`` stronger in amplitude: ``rejected_harmonic``) or
+  2..9 times a pole or mode ``HARMONIC_RATIO`` stronger in amplitude, or within ``SUSPECT_TOL``
+  of one ``SUSPECT_RATIO`` stronger while seen over fewer than ``SUSPECT_CYCLES`` cycles, when
+  its frequency is too rough to tell: ``rejected_harmonic``) or
   within ``DUPLICATE_TOL`` of a mode (``rejected_unresolved``); a candidate seen again within
   ``PENDING_TOL`` by a later analysis becomes a mode (``modes_found``), one not seen again within
   a period is ``rejected_noise``. With K modes a new one replaces the weakest only if twice as
@@ -78,6 +80,9 @@ PENDING_TOL = 0.02       # a candidate seen again within this is confirmed
 HARMONIC_TOL = 0.015     # relative distance to n f of a stronger pole or mode (n = 2..9)
 MAX_HARMONIC = 9
 HARMONIC_RATIO = 2.0     # a harmonic's parent is at least this much stronger (amplitude)
+SUSPECT_TOL = 0.06       # a pole this near n f of a pole SUSPECT_RATIO times stronger ...
+SUSPECT_RATIO = 5.0
+SUSPECT_CYCLES = 5.0     # ... is a harmonic unless seen over this many cycles
 CONSISTENCY = 0.01       # a published pole lies this close to the mode's previous pole
 LOSE_PERIODS = 3.0       # a mode unseen for this many of its periods is lost
 N_STEP = 15              # intervals whose median is the grid step
@@ -220,9 +225,10 @@ def _poles(b, ic, qs, lams, pa, s, pp):
 
 
 @njit(cache=True)
-def _harmonic(f, amp, pp, n, sl):
+def _harmonic(f, amp, cycles, pp, n, sl):
     """Whether f lies within HARMONIC_TOL of 2..9 times a pole of pp[:n] or an active mode
-    HARMONIC_RATIO times stronger than amp."""
+    HARMONIC_RATIO times stronger than amp, or, seen over fewer than ``SUSPECT_CYCLES`` cycles,
+    within ``SUSPECT_TOL`` of such a multiple of one ``SUSPECT_RATIO`` times stronger."""
     for i in range(n + KMAX):
         if i < n:
             g, a = pp[i, 0], pp[i, 1]
@@ -230,9 +236,11 @@ def _harmonic(f, amp, pp, n, sl):
             g, a = sl[i - n, SL_F], sl[i - n, SL_AMP]
         else:
             continue
-        if a >= HARMONIC_RATIO * amp:
-            r = round(f / g)
-            if 2 <= r <= MAX_HARMONIC and abs(f / (r * g) - 1.0) < HARMONIC_TOL:
+        r = round(f / g)
+        if 2 <= r <= MAX_HARMONIC:
+            off = abs(f / (r * g) - 1.0)
+            if (a >= HARMONIC_RATIO * amp and off < HARMONIC_TOL) or (
+                    a >= SUSPECT_RATIO * amp and off < SUSPECT_TOL and cycles < SUSPECT_CYCLES):
                 return True
     return False
 
@@ -307,7 +315,7 @@ def _admit(ic, sl, pa, f, amp, start, t):
             weakest = k if weakest < 0 or sl[k, SL_AMP] < sl[weakest, SL_AMP] else weakest
     if count >= pa[PA_K]:
         if amp < HARMONIC_RATIO * sl[weakest, SL_AMP]:
-            return
+            return -1
         _remove(ic, sl, weakest)
         free = weakest
     ic[I_UID] += 1
@@ -323,16 +331,20 @@ def _admit(ic, sl, pa, f, amp, start, t):
     sl[free, SL_LAST_F] = math.nan
     sl[free, SL_LAST_T] = math.nan
     sl[free, SL_PREV] = f
+    return free
 
 
 @njit(cache=True)
-def _candidates(ic, sl, pd, pa, pp, n, used, t, start):
-    """The poles no mode explains (module docstring): candidates, confirmed or expired."""
+def _candidates(b, ic, sl, pd, pa, pp, n, used, t, s, r2, out):
+    """The poles no mode explains (module docstring): candidates, confirmed or expired. A
+    confirming pole whose window starts after the candidate's first one and lies within
+    ``CONSISTENCY`` of it is the new mode's first estimate."""
+    start = t - _scale_len(s) * b[B_DT]
     for i in range(n):
         f = pp[i, 0]
         if used[i] or pp[i, 3] < C_DETECT or pp[i, 4] < SIG_DETECT:
             continue
-        if _harmonic(f, pp[i, 1], pp, n, sl):
+        if _harmonic(f, pp[i, 1], pp[i, 3], pp, n, sl):
             ic[I_REJ_HARM] += 1
             continue
         near = False
@@ -346,7 +358,10 @@ def _candidates(ic, sl, pd, pa, pp, n, used, t, start):
             j += 1
         if j < ic[I_NPEND]:
             if pd[j, PD_SEEN] < t:
-                _admit(ic, sl, pa, f, pp[i, 1], pd[j, PD_START], t)
+                k = _admit(ic, sl, pa, f, pp[i, 1], pd[j, PD_START], t)
+                if k >= 0 and start >= pd[j, PD_START] and r2 >= pa[PA_MINFIT] and \
+                        abs(f / pd[j, PD_F] - 1.0) < CONSISTENCY:
+                    _publish(b, ic, sl, k, s, t, pp, i, r2, out)
                 pd[j, PD_SEEN] = -math.inf           # taken: dropped below, not as noise
             continue
         if j < NPEND:
@@ -395,13 +410,13 @@ def _analysis(b, ic, sl, pd, qs, lams, pa, s, t, out):
         sl[k, SL_AMP] = pp[best, 1]
         if not r2 >= pa[PA_MINFIT]:
             sl[k, SL_FIT] += 1
-        elif _harmonic(f, pp[best, 1], pp, n, sl):
+        elif _harmonic(f, pp[best, 1], pp[best, 3], pp, n, sl):
             sl[k, SL_HARM] += 1
         elif not abs(f / prev - 1.0) < CONSISTENCY:
             sl[k, SL_INCONS] += 1
         else:
             _publish(b, ic, sl, k, s, t, pp, best, r2, out)
-    _candidates(ic, sl, pd, pa, pp, n, used, t, t - _scale_len(s) * b[B_DT])
+    _candidates(b, ic, sl, pd, pa, pp, n, used, t, s, r2, out)
     ic[I_BUSY:I_BUSY + NS] = 0
     for k in range(KMAX):
         if sl[k, SL_ACTIVE] != 0.0 and (t - sl[k, SL_SEEN]) * sl[k, SL_F] > LOSE_PERIODS:
