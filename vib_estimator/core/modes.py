@@ -80,8 +80,8 @@ PENDING_TOL = 0.02       # a candidate seen again within this is confirmed
 HARMONIC_TOL = 0.015     # relative distance to n f of a stronger pole or mode (n = 2..9)
 MAX_HARMONIC = 9
 HARMONIC_RATIO = 2.0     # a harmonic's parent is at least this much stronger (amplitude)
-SUSPECT_TOL = 0.06       # a pole this near n f of a pole SUSPECT_RATIO times stronger ...
-SUSPECT_RATIO = 5.0
+SUSPECT_TOL = 0.08       # a pole this near n f of a pole SUSPECT_RATIO times stronger ...
+SUSPECT_RATIO = 3.0
 SUSPECT_CYCLES = 5.0     # ... is a harmonic unless seen over this many cycles
 CONSISTENCY = 0.01       # a published pole lies this close to the mode's previous pole
 LOSE_PERIODS = 3.0       # a mode unseen for this many of its periods is lost
