@@ -198,7 +198,8 @@ def _scale_len(s):
 @njit(cache=True)
 def _poles(b, ic, qs, lams, pa, s, pp):
     """Analyse scale s; the poles that count (module docstring) as rows of pp: frequency (Hz),
-    amplitude, damping, cycles in the window, energy / residual variance. Returns (count, R^2)."""
+    amplitude, damping, cycles in the window, energy / residual variance, frequency std (Hz).
+    Returns (count, R^2)."""
     d = s // 2
     m = M_A if s % 2 == 0 else M_B
     npc = int(pa[PA_P])
@@ -220,6 +221,8 @@ def _poles(b, ic, qs, lams, pa, s, pp):
         pp[n, 2] = z
         pp[n, 3] = nu * m
         pp[n, 4] = sig
+        # the Cramer-Rao bound of a sinusoid's frequency over m samples of residual variance var
+        pp[n, 5] = math.sqrt(24.0 * var / (rows[i, R_AMP] ** 2 * m ** 3)) / (2.0 * math.pi * h)
         n += 1
     return n, r2
 
@@ -292,7 +295,7 @@ def _publish(b, ic, sl, k, s, t, pp, i, r2, out):
     row[O_FIT] = r2
     row[O_AMP] = pp[i, 1]
     row[O_DAMP] = pp[i, 2]
-    row[O_FSTD] = math.nan
+    row[O_FSTD] = pp[i, 5]
     row[O_DSTD] = math.nan
     row[O_MODE] = mode
     sl[k, SL_FIRST] = min(sl[k, SL_FIRST], t)
@@ -385,7 +388,7 @@ def _candidates(b, ic, sl, pd, pa, pp, n, used, t, s, r2, out):
 @njit(cache=True)
 def _analysis(b, ic, sl, pd, qs, lams, pa, s, t, out):
     """Scale s's analysis at t: match the modes, publish those it owns, find, lose."""
-    pp = np.empty((PCOL, 5))
+    pp = np.empty((PCOL, 6))
     n, r2 = _poles(b, ic, qs, lams, pa, s, pp)
     used = np.zeros(n, dtype=np.int64)
     for k in range(KMAX):
