@@ -30,10 +30,14 @@ def ros_context():
 
 @pytest.fixture
 def executor(ros_context):
-    """The package's executor, bound to the test's context."""
+    """The package's executor, bound to the test's context; the nodes added to it are destroyed
+    afterwards (their subscriptions would stay visible to the next test's processes)."""
     from vib_estimator.nodes.runner import make_executor
 
     ex = make_executor(context=ros_context)
     yield ex
+    nodes = ex.get_nodes()
     ex.shutdown()
+    for node in nodes:
+        node.destroy_node()   # idempotent: a test may have destroyed it already
 

@@ -116,3 +116,43 @@ def test_dask_cluster_gives_identical_rows(tmp_path):
         remote = S.survey(recordings, options, scheduler=cluster.scheduler_address)
     assert json.dumps(remote) == json.dumps(local)
     assert local[-1]['error'] and not local[0]['error']
+
+
+FAULTS = '''
+import resource, sys
+from pathlib import Path
+from vib_estimator.analysis import survey as S
+from vib_estimator.core import EstimatorConfig
+path, options = Path(sys.argv[1]), S.Options(EstimatorConfig())
+def faults(task):
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
+    assert task(path, options)[0]['error'] == ''
+    return resource.getrusage(resource.RUSAGE_SELF).ru_minflt - before
+S.survey_recording(path, options)                       # compile, import everything
+print(faults(S._recording_rows), faults(S.survey_recording))
+'''
+
+
+def test_a_worker_started_with_a_malloc_trim_threshold_streams_without_remapping(tmp_path):
+    """Dask's nanny starts workers with MALLOC_TRIM_THRESHOLD_=65536, which also fixes glibc's
+    mmap threshold at 128 KiB: without the survey task's own thresholds, every block-sized array
+    is mapped and faulted in again."""
+    import os
+    import subprocess
+    import sys
+    t = np.arange(400_000) * 0.002
+    np.savetxt(tmp_path / 'long.csv', np.column_stack([t, np.sin(9 * t)]), delimiter=',',
+               header='t,y', comments='', fmt='%.6f')
+    env = {k: v for k, v in os.environ.items() if not k.startswith('MALLOC_')}
+    env['MALLOC_TRIM_THRESHOLD_'] = '65536'
+    out = subprocess.run([sys.executable, '-c', FAULTS, str(tmp_path / 'long.csv')], env=env,
+                         capture_output=True, text=True, check=True).stdout
+    plain, tuned = map(int, out.split())
+    assert tuned < 0.5 * plain, (plain, tuned)
+
+
+def test_malloc_is_left_alone_in_a_plain_process(monkeypatch):
+    monkeypatch.delenv('MALLOC_TRIM_THRESHOLD_', raising=False)
+    monkeypatch.setattr(S.ctypes, 'CDLL', lambda *a: pytest.fail('mallopt called'))
+    with S._streaming_malloc():
+        pass

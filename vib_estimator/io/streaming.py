@@ -112,7 +112,10 @@ def _csv_blocks(layout) -> Iterator[Block]:
     wanted = [names[0], names[layout.index]]
     done = 0
     try:
-        with layout.path.open('rb') as handle:
+        # read by arrow itself, not through a Python file: a Python read allocates a fresh 2 MB
+        # bytes object per block, which a process tuned to return memory at once (Dask's nanny
+        # sets MALLOC_TRIM_THRESHOLD_) maps and unmaps every time (4x the page faults)
+        with pa.OSFile(str(layout.path)) as handle:
             handle.seek(layout.data_offset)
             reader = pacsv.open_csv(
                 handle, memory_pool=pa.system_memory_pool(),
