@@ -34,12 +34,15 @@ How the modes are found and estimated (everything compiled, one call per sample)
   a period is ``rejected_noise``. With K modes a new one replaces the weakest only if twice as
   strong. A mode no analysis sees for ``LOSE_PERIODS`` periods is lost (``modes_lost``).
 * **Publishing**: each mode publishes from one scale, the longest window that (a) holds no more
-  than ``C_CAP`` periods of the lowest mode, (b) keeps the mode below ``NU_HI`` and (c) starts
-  after the window in which the mode was first seen (so that no published window straddles the
-  excitation); every analysis of that scale publishes the mode's pole if its window fit's R^2 is
-  ``min_fit`` (``rejected_fit``), it is no harmonic of a stronger pole (``rejected_harmonic``) and
-  within ``CONSISTENCY`` of the mode's previous pole (``rejected_inconsistent``). Modes are numbered
-  by ascending frequency among the modes that have published.
+  than ``C_CAP`` periods of the lowest mode (``C_CAP_CLOSE`` when two modes lie within
+  ``CLOSE_RATIO``: resolving them takes longer windows, which react later to a change), (b) keeps
+  the mode below ``NU_HI`` and (c) starts after the window in which the mode was first seen (so
+  that no published window straddles the excitation); every analysis of that scale publishes the
+  mode's pole if its window fit's R^2 is ``min_fit`` (``rejected_fit``), it is no harmonic of a
+  stronger pole (``rejected_harmonic``) and within ``CONSISTENCY`` of the mode's previous pole
+  (``rejected_inconsistent``). The pole that confirms a new mode is its first estimate when its
+  window starts after the candidate's first one and it lies within ``CONSISTENCY`` of it. Modes are
+  numbered by ascending frequency among the modes that have published.
 
 Streaming and batch run the same compiled step, so they give the same floats.
 """
@@ -70,7 +73,9 @@ EIG_RATIO = 6.0          # signal eigenvalues: this factor above the noise's
 NU_HI = 0.2              # highest pole counted at a scale, cycles per level sample
 C_TRACK = 0.7            # cycles in the window for a pole to count ...
 C_DETECT = 1.0           # ... for it to become a candidate
-C_CAP = 2.8              # publishing windows hold at most this many periods of the lowest mode
+C_CAP = 2.0              # publishing windows hold at most this many periods of the lowest mode,
+C_CAP_CLOSE = 2.8        # ... this many when two modes lie within CLOSE_RATIO (to resolve them)
+CLOSE_RATIO = 1.5
 SIG_TRACK = 100.0        # energy / residual variance of a counted pole (20 dB) ...
 SIG_DETECT = 300.0       # ... and of a candidate (25 dB)
 MIN_DAMPING = -0.02      # poles growing faster than this are not modes
@@ -252,14 +257,19 @@ def _harmonic(f, amp, cycles, pp, n, sl):
 def _owner(b, sl, k, t):
     """The scale mode k publishes from (module docstring), -1 for none yet."""
     fmin = math.inf
+    cap = C_CAP
     for j in range(KMAX):
         if sl[j, SL_ACTIVE] != 0.0:
             fmin = min(fmin, sl[j, SL_F])
+            for i in range(j):
+                if sl[i, SL_ACTIVE] != 0.0 and max(sl[i, SL_F] / sl[j, SL_F],
+                                                   sl[j, SL_F] / sl[i, SL_F]) < CLOSE_RATIO:
+                    cap = C_CAP_CLOSE
     f = sl[k, SL_F]
     best = -1
     for s in range(NS):
         w = _scale_len(s) * b[B_DT]
-        if fmin * w > C_CAP or f * b[B_DT] * (1 << (s // 2)) > NU_HI or \
+        if fmin * w > cap or f * b[B_DT] * (1 << (s // 2)) > NU_HI or \
                 t - w < sl[k, SL_START]:
             break
         if f * w >= C_DETECT:
