@@ -7,7 +7,10 @@ import math
 import numpy as np
 import pytest
 
-from vib_estimator.analysis.baselines import Hou, MojiriBakhshai, SlidingDFT, ZiaraniKonrad, hold_last
+from vib_estimator.analysis import baselines
+from vib_estimator.analysis.baselines import (Hou, MojiriBakhshai, SlidingDFT,
+                                              SlidingMatrixPencil, ZiaraniKonrad, hold_last,
+                                              matrix_pencil)
 from vib_estimator.analysis.bounds import crlb_frequency_std, fisher_frequency_std, window_crlb_std
 
 FS = 500.0
@@ -112,3 +115,29 @@ def test_window_crlb_uses_the_windows_amplitude_and_phase():
     # scaling of the closed form: std ~ sigma / (A N^1.5)
     assert crlb_frequency_std(0.4, 0.004, 2e-3, 4000) == pytest.approx(
         crlb_frequency_std(0.2, 0.004, 2e-3, 2000) / 2 / 2 ** 1.5, rel=1e-3)
+
+
+@pytest.mark.parametrize('zeta', [0.0, 0.004, 0.02])
+def test_matrix_pencil_is_exact_on_a_clean_damped_sine_and_nan_on_too_short_a_window(zeta):
+    t = np.arange(400) / FS
+    wn = 2 * np.pi * 1.33
+    y = 0.1 * np.exp(-zeta * wn * t) * np.sin(wn * math.sqrt(1 - zeta ** 2) * t + 0.4)
+    f, z = matrix_pencil(y, 1 / FS)
+    assert f == pytest.approx(1.33, rel=1e-9) and z == pytest.approx(zeta, abs=1e-9)
+    assert math.isnan(matrix_pencil(y[:8], 1 / FS)[0])
+
+
+def test_the_pencils_svd_runs_on_one_blas_thread(monkeypatch):
+    """OpenBLAS's threads made a sliding pencil 20x slower on a busy 2-core machine."""
+    threads = []
+    svd = np.linalg.svd
+
+    def spy(*args, **kwargs):
+        threads.extend(lib['num_threads'] for lib in baselines._blas_controller().info()
+                       if lib['user_api'] == 'blas')
+        return svd(*args, **kwargs)
+    monkeypatch.setattr(np.linalg, 'svd', spy)
+    t, y = sine(0.1, seconds=3.0)
+    f = SlidingMatrixPencil(FS, window_s=1.0, hop=250).process(t, y)
+    assert threads and set(threads) == {1}
+    assert f[-1] == pytest.approx(1.33, rel=1e-6)

@@ -30,6 +30,7 @@ search band refined by two-bin interpolation.
 """
 from __future__ import annotations
 
+import functools
 import math
 from typing import Optional, Sequence, Tuple
 
@@ -338,6 +339,15 @@ def hold_last(values: np.ndarray, initial: float = math.nan) -> np.ndarray:
     return np.where(idx >= 0, values[np.maximum(idx, 0)], initial)
 
 
+@functools.lru_cache(maxsize=None)
+def _blas_controller():
+    """The BLAS libraries loaded (numpy's OpenBLAS). A pencil's SVD is small: with OpenBLAS's
+    threads it ran 20x slower on a 2-core machine busy with other work (88 s instead of 0.9 s for
+    one 10 s record), so it runs on one thread."""
+    from threadpoolctl import ThreadpoolController
+    return ThreadpoolController()
+
+
 def matrix_pencil(y: np.ndarray, ts: float, order: int = 2,
                   max_pencil: int = 256) -> Tuple[float, float]:
     """Matrix-pencil estimate (Hua & Sarkar 1990) of one damped mode: (natural frequency Hz, zeta).
@@ -354,9 +364,10 @@ def matrix_pencil(y: np.ndarray, ts: float, order: int = 2,
     if pencil < order + 1:
         return math.nan, math.nan
     hankel = np.lib.stride_tricks.sliding_window_view(y, pencil + 1)
-    _, _, vt = np.linalg.svd(hankel, full_matrices=False)
-    v = vt[:order].T
-    poles = np.linalg.eigvals(np.linalg.pinv(v[:-1]) @ v[1:])
+    with _blas_controller().limit(limits=1, user_api='blas'):
+        _, _, vt = np.linalg.svd(hankel, full_matrices=False)
+        v = vt[:order].T
+        poles = np.linalg.eigvals(np.linalg.pinv(v[:-1]) @ v[1:])
     s = np.log(poles[np.argmax(np.abs(poles.imag))].astype(complex)) / ts
     return abs(s) / TWO_PI, -s.real / abs(s)
 
