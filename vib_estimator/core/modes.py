@@ -128,8 +128,8 @@ N_SL = 14
 #: per-mode counters: name -> column of sl (and, for the lost modes' sums, of ic after I_RET)
 MODE_COUNTERS = {'estimates': SL_EST, 'rejected_inconsistent': SL_INCONS,
                  'rejected_harmonic': SL_HARM, 'rejected_fit': SL_FIT}
-# ---- candidates pd[i]: frequency (Hz), amplitude, start of the first window, last seen ----------
-PD_F, PD_AMP, PD_START, PD_SEEN = range(4)
+# ---- candidates pd[i]: frequency (Hz), start of the first window, last seen ---------------------
+PD_F, PD_START, PD_SEEN = range(3)
 # ---- parameters pa -----------------------------------------------------------------------------
 PA_MAXGAP, PA_K, PA_BLO, PA_BHI, PA_MAXDAMP, PA_MINFIT, PA_P = range(7)
 # ---- output rows: the estimate's fields (EstimateArrays order), then the mode -------------------
@@ -379,7 +379,6 @@ def _candidates(b, ic, sl, pd, pa, pp, n, used, t, s, r2, out):
             continue
         if j < NPEND:
             pd[j, PD_F] = f
-            pd[j, PD_AMP] = pp[i, 1]
             pd[j, PD_START] = start
             pd[j, PD_SEEN] = t
             ic[I_NPEND] += 1
@@ -521,7 +520,7 @@ ROOM = KMAX * (NS + 2 * MAX_FILL)
 # ---- the float state in one array (one argument per call: numba's dispatch costs per argument)
 F_SL = N_B
 F_PD = F_SL + KMAX * N_SL
-F_LAM = F_PD + NPEND * 4
+F_LAM = F_PD + NPEND * 3
 F_PA = F_LAM + NS * PCOL
 N_F = F_PA + 7
 
@@ -529,7 +528,7 @@ N_F = F_PA + 7
 @njit(cache=True)
 def _unpack(fs):
     """The views b, sl, pd, lams, pa of the float state."""
-    return (fs[:N_B], fs[F_SL:F_PD].reshape((KMAX, N_SL)), fs[F_PD:F_LAM].reshape((NPEND, 4)),
+    return (fs[:N_B], fs[F_SL:F_PD].reshape((KMAX, N_SL)), fs[F_PD:F_LAM].reshape((NPEND, 3)),
             fs[F_LAM:F_PA].reshape((NS, PCOL)), fs[F_PA:N_F])
 
 
@@ -576,7 +575,7 @@ class ModeTracker:
         self._fs = np.zeros(N_F)
         self._b, self._sl, self._pd, self._lams, pa = (
             self._fs[:N_B], self._fs[F_SL:F_PD].reshape((KMAX, N_SL)),
-            self._fs[F_PD:F_LAM].reshape((NPEND, 4)), self._fs[F_LAM:F_PA].reshape((NS, PCOL)),
+            self._fs[F_PD:F_LAM].reshape((NPEND, 3)), self._fs[F_LAM:F_PA].reshape((NS, PCOL)),
             self._fs[F_PA:N_F])
         self._ic = np.zeros(N_I, dtype=np.int64)
         self._qs = np.zeros((NS, NQ, PCOL))
