@@ -150,6 +150,7 @@ def test_plot_colours_the_modes(tmp_path):
 
 
 REFERENCE = {30: 16.360, 40: 9.392, 50: 6.054, 60: 4.268}
+REAL_F2 = {50: 39.63, 60: 27.35}          # the authors' second modes (benchmarks/bench_modes.py)
 
 
 @pytest.mark.skipif(not REAL.is_dir(), reason='../shared/real-data is not beside the repository')
@@ -163,7 +164,12 @@ def test_real_beams_mode_1_without_a_band(length):
         m1 = e.frequency_hz[e.mode == 1]
         assert len(m1) > 100
         assert abs(np.median(m1) / f1 - 1) < 0.003
-        # every other published estimate is the second mode (6.4 f1), early, while it rings
+        # the other published estimates are higher modes of the beam (6.45 f1, 17-19 f1, ...):
+        # at most 1 % of all lies neither near f1 nor above 5 f1
+        r = e.frequency_hz / f1
+        assert np.mean((np.abs(r - 1) > 0.03) & (r < 5)) <= 0.01
         others = e.frequency_hz[e.mode >= 2]
-        assert np.all(np.abs(others / (6.45 * f1) - 1) < 0.1)
-        assert np.all(e.t[e.mode >= 2] < 3.0)
+        near2 = np.abs(others / (6.45 * f1) - 1) < 0.03
+        if length >= 50:                # the second mode rings for seconds on the longer beams
+            assert np.sum(near2) > 50
+            assert abs(np.median(others[near2]) / REAL_F2[length] - 1) < 0.02

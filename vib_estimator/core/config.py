@@ -80,8 +80,9 @@ class EstimatorConfig:
     target_std_rel: float = _param(0.0, 'publish as soon as the predicted relative standard '
                                    'deviation of the frequency is at or below this, whatever the '
                                    'period fraction (0 = off)', 0.0, 1.0)
-    modes: int = _param(0, 'modes to find and track, each with its own estimator (0 = one '
-                        'estimator on the whole, optionally band-limited, signal)', 0, 8)
+    modes: int = _param(0, 'modes to find and track by a multi-scale subspace fit, each '
+                        'numbered by ascending frequency (0 = one estimator on the whole, '
+                        'optionally band-limited, signal)', 0, 8)
     buffer_samples: int = _param(200_000, 'segment buffer of the quality gate; a longer segment '
                                  'resets', 1, 10 ** 8)
 

@@ -1,0 +1,73 @@
+"""The subspace analysis of one window (pure core)."""
+import numpy as np
+import pytest
+
+from vib_estimator.core.subspace import (R_AMP, R_NU, R_ZETA, analyse, cholesky_solve,
+                                         hankel_cov, init_subspace, poly_roots)
+
+
+def window(m, parts, noise=0.0, seed=0):
+    """Sum of damped cosines (nu cycles/sample, damping ratio, amplitude, phase) plus noise."""
+    n = np.arange(m)
+    x = np.zeros(m)
+    for nu, zeta, amp, phase in parts:
+        w = 2 * np.pi * nu
+        x += amp * np.exp(-zeta * w / np.sqrt(1 - zeta ** 2) * (n - m + 1)) * np.cos(w * n + phase)
+    return x + noise * np.random.default_rng(seed).standard_normal(m)
+
+
+def run(x, npc=10, steps=4):
+    """analyse() on the same window a few times (the subspace is warm-started)."""
+    lag = len(x) // 3
+    q = np.zeros((lag + 1, npc))
+    init_subspace(q)
+    lam = np.zeros(npc)
+    rows = np.zeros((npc, 4))
+    for _ in range(steps):
+        k, var, r2 = analyse(x, q, lam, 6.0, rows)
+    order = np.argsort(rows[:k, R_NU])
+    return rows[:k][order], var, r2
+
+
+def test_building_blocks():
+    rng = np.random.default_rng(1)
+    x = rng.standard_normal(48)
+    r = np.zeros((17, 17))
+    hankel_cov(x, 16, r)
+    h = np.array([x[i:i + 17] for i in range(32)])
+    np.testing.assert_allclose(r, h.T @ h, rtol=1e-12, atol=1e-12)
+    a = rng.standard_normal((6, 6))
+    a = a @ a.T + np.eye(6)
+    b = rng.standard_normal(6)
+    np.testing.assert_allclose(cholesky_solve(a, b), np.linalg.solve(a, b), rtol=1e-9)
+    roots = np.array([0.9 + 0.3j, 0.9 - 0.3j, 0.5, -0.2])
+    coef = np.poly(roots)[::-1].real[:-1]                 # monic, low coefficients first
+    got = poly_roots(coef)
+    assert np.max(np.min(np.abs(got[:, None] - roots[None, :]), axis=1)) < 1e-9
+
+
+def test_a_clean_window_gives_its_sinusoids_exactly():
+    parts = [(0.03, 0.01, 1.0, 0.3), (0.041, 0.0, 0.5, 1.0), (0.15, 0.02, 0.05, 2.0)]
+    x = window(68, parts) + 0.2                               # an offset: a real pole
+    rows, var, r2 = run(x)
+    assert len(rows) == 3 and r2 > 1 - 1e-12
+    for row, (nu, zeta, amp, _) in zip(rows, parts):
+        assert row[R_NU] == pytest.approx(nu, rel=1e-7)
+        assert row[R_ZETA] == pytest.approx(zeta, abs=1e-7)
+        assert row[R_AMP] == pytest.approx(amp, rel=1e-5)
+
+
+@pytest.mark.parametrize('seed', [0, 1, 2])
+def test_close_sinusoids_in_noise(seed):
+    """Two sinusoids 30 % apart, 1.9 cycles of the lower in the window, SNR 30 dB (weaker)."""
+    parts = [(1.9 / 48, 0.0, 1.0, 0.4 + seed), (1.3 * 1.9 / 48, 0.0, 0.5, 2.0 - seed)]
+    x = window(48, parts, noise=0.5 / np.sqrt(2) * 10 ** (-30 / 20), seed=seed)
+    rows, var, r2 = run(x)
+    assert len(rows) == 2
+    for row, (nu, *_) in zip(rows, parts):
+        assert abs(row[R_NU] / nu - 1) < 0.02
+
+
+def test_noise_alone_has_few_sinusoids():
+    counts = [len(run(np.random.default_rng(s).standard_normal(68))[0]) for s in range(20)]
+    assert np.mean(counts) <= 0.2         # the gap rule keeps the noise eigenvalues out

@@ -1,0 +1,264 @@
+"""Subspace analysis of one short window: the damped sinusoids it holds (compiled, numba).
+
+A window ``x[0..m-1]`` of uniformly spaced samples is modelled as a sum of damped complex
+exponentials ``x[n] = sum_i c_i z_i^n`` (each real damped sinusoid a conjugate pair, an offset or
+a slow trend a real pole). Everything is written out in loops (no LAPACK call: at these sizes a
+call costs more than the arithmetic):
+
+* **Covariance** (:func:`hankel_cov`): ``R = H^T H`` of the ``(m - L) x (L + 1)`` Hankel matrix of
+  the window (``L = m // 3``), built from its first row and the shift recursion
+  ``R[i+1, j+1] = R[i, j] + x[i+m-L] x[j+m-L] - x[i] x[j]``.
+* **Signal subspace** (:func:`orthogonal_iteration`): one step of orthogonal iteration
+  ``Q <- orth(R Q)`` on ``P`` columns, warm-started from the previous window of the same scale
+  (the eigenvalues of the signal are decades above the noise's, so one step per window tracks
+  them); the column norms are the eigenvalue estimates ``lam``. The last column is noise (``P``
+  exceeds twice the modes sought), the order is the number of columns ``ratio`` times above it
+  (and above ``1e-12`` of the largest: a noise-free window).
+* **Poles** (:func:`esprit_poly`, :func:`poly_roots`): the signal subspace is spanned by the
+  vectors ``z_i^n``, so shifting it by one sample is a rotation ``Phi`` whose eigenvalues are the
+  poles (ESPRIT, least squares ``Q[:-1] Phi = Q[1:]``); they are found as the roots of its
+  characteristic polynomial (Faddeev-LeVerrier) by the Aberth-Ehrlich iteration.
+* **Amplitudes and fit** (:func:`fit_poles`): the real basis ``Re z^n, Im z^n`` per pair (one
+  column per real pole), ``n`` counted back from the window's last sample, fitted to the window by
+  least squares; each pair gives its frequency (cycles per sample), damping ratio, amplitude at the
+  last sample and energy in the window, the window its residual variance and R^2.
+
+:func:`analyse` chains them and writes one row per pair (``R_NU``, ``R_ZETA``, ``R_AMP``,
+``R_ENERGY``).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+R_NU, R_ZETA, R_AMP, R_ENERGY = range(4)
+N_R = 4
+DECAY_MAX = 12.0      # poles decaying (or growing) more than e^12 over the window are dropped
+REAL_TOL = 1e-7       # |Im z| below this: a real pole
+ROOT_ITER = 40
+
+
+@njit(cache=True)
+def hankel_cov(x, lag, r):
+    """R = H^T H of the window's Hankel matrix (module docstring) into r[:lag+1, :lag+1]."""
+    m = len(x)
+    rows = m - lag
+    for j in range(lag + 1):
+        s = 0.0
+        for k in range(rows):
+            s += x[k] * x[k + j]
+        r[0, j] = s
+        r[j, 0] = s
+    for i in range(lag):
+        for j in range(i, lag):
+            v = r[i, j] + x[i + rows] * x[j + rows] - x[i] * x[j]
+            r[i + 1, j + 1] = v
+            r[j + 1, i + 1] = v
+
+
+@njit(cache=True)
+def orthogonal_iteration(r, n, q, lam):
+    """One step Q <- orth(R Q) on q[:n, :P] (modified Gram-Schmidt), columns sorted by their
+    eigenvalue estimates lam (descending)."""
+    npc = q.shape[1]
+    w = np.zeros((n, npc))
+    for k in range(npc):
+        for i in range(n):
+            s = 0.0
+            for j in range(n):
+                s += r[i, j] * q[j, k]
+            w[i, k] = s
+    for k in range(npc):
+        for j in range(k):
+            d = 0.0
+            for i in range(n):
+                d += w[i, j] * w[i, k]
+            for i in range(n):
+                w[i, k] -= d * w[i, j]
+        norm = math.sqrt(np.sum(w[:, k] ** 2))
+        lam[k] = norm
+        if norm > 0.0:
+            w[:, k] /= norm
+        else:
+            w[:, k] = 0.0
+            w[k % n, k] = 1.0
+    order = np.argsort(-lam)
+    lam[:] = lam[order]
+    for k in range(npc):
+        q[:n, k] = w[:, order[k]]
+
+
+@njit(cache=True)
+def cholesky_solve(a, b):
+    """Solve a x = b (b: one or more columns) for a symmetric positive (semi)definite a (a tiny
+    ridge keeps it regular)."""
+    n = a.shape[0]
+    c = np.zeros((n, n))
+    ridge = 1e-13 * max(np.trace(a) / max(n, 1), 1e-300)
+    for j in range(n):
+        s = a[j, j] + ridge
+        for k in range(j):
+            s -= c[j, k] * c[j, k]
+        c[j, j] = math.sqrt(max(s, ridge))
+        for i in range(j + 1, n):
+            s = a[i, j]
+            for k in range(j):
+                s -= c[i, k] * c[j, k]
+            c[i, j] = s / c[j, j]
+    x = b.copy()
+    for i in range(n):
+        for k in range(i):
+            x[i] -= c[i, k] * x[k]
+        x[i] /= c[i, i]
+    for i in range(n - 1, -1, -1):
+        for k in range(i + 1, n):
+            x[i] -= c[k, i] * x[k]
+        x[i] /= c[i, i]
+    return x
+
+
+@njit(cache=True)
+def esprit_poly(q, n, p):
+    """Characteristic polynomial (monic, low coefficients first) of the rotation Phi of the signal
+    subspace, Q[:-1] Phi = Q[1:] in least squares (Faddeev-LeVerrier recursion)."""
+    g = np.zeros((p, p))
+    rhs = np.zeros((p, p))
+    for i in range(p):
+        for j in range(p):
+            sg = 0.0
+            sr = 0.0
+            for r in range(n - 1):
+                sg += q[r, i] * q[r, j]
+                sr += q[r, i] * q[r + 1, j]
+            g[i, j] = sg
+            rhs[i, j] = sr
+    phi = cholesky_solve(g, rhs)
+    c = np.zeros(p + 1)
+    c[p] = 1.0
+    mk = np.zeros((p, p))
+    for k in range(1, p + 1):
+        mk = phi @ mk
+        for i in range(p):
+            mk[i, i] += c[p - k + 1]
+        tr = 0.0
+        for i in range(p):
+            for j in range(p):
+                tr += phi[i, j] * mk[j, i]
+        c[p - k] = -tr / k
+    return c[:p]
+
+
+@njit(cache=True)
+def poly_roots(a):
+    """Roots of z^p + a[p-1] z^(p-1) + ... + a[0] (Aberth-Ehrlich iteration)."""
+    p = len(a)
+    z = np.empty(p, dtype=np.complex128)
+    for k in range(p):
+        z[k] = 0.9 * np.exp(1j * (2.0 * math.pi * (k + 0.25) / p + 0.1))
+    for _ in range(ROOT_ITER):
+        moved = 0.0
+        for k in range(p):
+            f = 1.0 + 0.0j
+            df = 0.0 + 0.0j
+            for j in range(p - 1, -1, -1):
+                df = df * z[k] + f
+                f = f * z[k] + a[j]
+            if f == 0.0:
+                continue
+            ratio = f / df
+            s = 0.0 + 0.0j
+            for j in range(p):
+                if j != k:
+                    s += 1.0 / (z[k] - z[j])
+            step = ratio / (1.0 - ratio * s)
+            z[k] -= step
+            moved = max(moved, abs(step))
+        if moved < 1e-12:
+            break
+    return z
+
+
+@njit(cache=True)
+def _basis(m, poles):
+    """The real least-squares basis of the poles (module docstring) and each pole's columns
+    (0: dropped, 1: real, 2: a pair; a pole with negative imaginary part is its pair's twin)."""
+    kind = np.zeros(len(poles), dtype=np.int64)
+    ncol = 0
+    for i in range(len(poles)):
+        z = poles[i]
+        if z.imag >= -REAL_TOL and abs(z) > 0.0 and abs(math.log(abs(z))) * m <= DECAY_MAX:
+            kind[i] = 2 if z.imag > REAL_TOL else 1
+            ncol += kind[i]
+    basis = np.empty((m, ncol))
+    col = 0
+    for i in range(len(poles)):
+        if kind[i] == 0:
+            continue
+        z = poles[i]
+        w = np.exp(np.log(z) * (1 - m))
+        for n in range(m):
+            basis[n, col] = w.real
+            if kind[i] == 2:
+                basis[n, col + 1] = w.imag
+            w *= z
+        col += kind[i]
+    return basis, kind
+
+
+@njit(cache=True)
+def fit_poles(x, poles, rows):
+    """Least-squares amplitudes of the poles (module docstring); returns (pairs written to rows,
+    residual variance, R^2)."""
+    m = len(x)
+    basis, kind = _basis(m, poles)
+    ncol = basis.shape[1]
+    if ncol == 0 or ncol >= m:
+        return 0, math.nan, math.nan
+    c = cholesky_solve(basis.T @ basis, np.ascontiguousarray(basis.T @ x))
+    resid = x - basis @ c
+    total = np.sum((x - np.mean(x)) ** 2)
+    rss = np.sum(resid ** 2)
+    npair = 0
+    col = 0
+    for i in range(len(poles)):
+        if kind[i] == 2:
+            lz = np.log(poles[i])
+            part = basis[:, col] * c[col] + basis[:, col + 1] * c[col + 1]
+            rows[npair, R_NU] = lz.imag / (2.0 * math.pi)
+            rows[npair, R_ZETA] = -lz.real / abs(lz)
+            rows[npair, R_AMP] = math.hypot(c[col], c[col + 1])
+            rows[npair, R_ENERGY] = np.sum(part * part)
+            npair += 1
+        col += kind[i]
+    return npair, rss / (m - ncol), 1.0 - rss / total if total > 0.0 else math.nan
+
+
+@njit(cache=True)
+def init_subspace(q):
+    """A start for the orthogonal iteration: orthonormal cosines of spread frequencies."""
+    n, npc = q.shape
+    for k in range(npc):
+        for i in range(n):
+            q[i, k] = math.cos(math.pi * (k + 0.5) * (i + 0.5) / n)
+        q[:, k] /= math.sqrt(np.sum(q[:, k] ** 2))
+
+
+@njit(cache=True)
+def analyse(x, q, lam, ratio, rows):
+    """The damped sinusoids of window x (module docstring), updating its scale's subspace q and
+    eigenvalues lam: (pairs in rows, residual variance, R^2); (0, nan, nan) for none."""
+    lag = len(x) // 3
+    n = lag + 1
+    r = np.empty((n, n))
+    hankel_cov(x, lag, r)
+    orthogonal_iteration(r, n, q, lam)
+    npc = q.shape[1]
+    noise = lam[npc - 1]
+    p = 0
+    while p < npc and lam[p] > ratio * noise and lam[p] > 1e-12 * lam[0]:
+        p += 1
+    if p == 0:
+        return 0, math.nan, math.nan
+    return fit_poles(x, poly_roots(esprit_poly(q, n, p)), rows)
