@@ -102,6 +102,10 @@ N_OUT = 9
 #: automatic max_window: this long at least (s), and min_periods + this many periods
 AUTO_WINDOW_S = 10.0
 AUTO_WINDOW_PERIODS = 2.0
+#: the quality gate's limit on how far the refinement may move the algebraic estimate: this many
+#: of its stds, and never less than this fraction of f (a clean or coarsely sampled signal:
+#: std ~ 0, the algebraic estimate's discretisation error up to ~1e-3)
+MAX_REFINE_MOVE, MIN_REFINE_MOVE_REL = 8.0, 0.02
 
 TWO_PI = 2.0 * math.pi
 #: band-pass prefilter: 4th-order Butterworth low-pass at f_hi (two sections), then a 2nd-order
@@ -529,18 +533,22 @@ def _converged(m, one_sided, tol, s, c, f):
 
 
 @njit(cache=True, inline='always')
-def _quality_gate(p, c, model, f, damping, h, r2, amp):
+def _quality_gate(p, c, model, f, damping, h, r2, amp, consistent):
     """True if the converged estimate may be published; else count why it is held back.
 
     At rest (no variance, or amplitude at or below ``min_amplitude``), above Nyquist, a fit R^2
-    below ``min_fit`` (of the refined model; with ``refine`` = 0 of a sinusoid and offset at f), or (damped model) |damping ratio| above ``max_damping``: a "lightly
-    damped vibration" with more damping is a transient, not a mode.
+    below ``min_fit`` (of the refined model; with ``refine`` = 0 of a sinusoid and offset at f)
+    or a refinement that moved the segment's own algebraic estimate by more than
+    ``MAX_REFINE_MOVE`` of its std and 2 % (both fit one model to the same samples, so on data the model
+    describes they differ by about one std: a forced motion, not a free vibration; counted with
+    the fit), or (damped model) |damping ratio| above ``max_damping``: a "lightly damped
+    vibration" with more damping is a transient, not a mode.
     """
     if r2 < 0.0 or amp <= p[P_MINAMP]:
         c[C_REST] += 1
     elif f * 2.0 * h >= 1.0:
         c[C_NYQUIST] += 1
-    elif r2 < p[P_MINFIT]:
+    elif r2 < p[P_MINFIT] or not consistent:
         c[C_FIT] += 1
     elif model == MODEL_DAMPED and not abs(damping) <= p[P_MAXDAMP]:
         c[C_DAMPING] += 1
@@ -616,6 +624,7 @@ def step(p, s, c, seg, t, y, out, row):
     m = int(p[P_M])
     one_sided = p[P_ONESIDED] != 0.0
     n_fit = min(nseg + 1, seg.shape[1])
+    local_start = True          # the refinement starts at this segment's own algebraic estimate
     if p[P_TARGET] > 0.0:
         if tau * f < p[P_MINPER] or not _target_reached(p, s, seg, n_fit, model, f, damping, h):
             return 0
@@ -629,18 +638,21 @@ def step(p, s, c, seg, t, y, out, row):
             return 0
         if tau * s[S_FLAST] < p[P_MINPER]:
             return 0
-        f = s[S_FLAST]
+        f, local_start = s[S_FLAST], False
     # the segment must span a fraction of the period it estimates
     elif not _converged(m, one_sided, p[P_TOL], s, c, f) or tau * f < p[P_MINPER]:
         return 0
     res = s[S_RES:S_RES + U.N_RESULT]
     _refine(p, s, seg, n_fit, model, f, damping, h, res)
-    f = res[U.R_F]
+    start, f = f, res[U.R_F]
+    consistent = True
     if p[P_REFINE] > 0.0 and math.isfinite(res[U.R_FIT]):
         r2, amp = res[U.R_FIT], res[U.R_AMP]     # the refined model's own residual
+        allowed = max(MAX_REFINE_MOVE * res[U.R_FSTD], MIN_REFINE_MOVE_REL * f)
+        consistent = not local_start or abs(f - start) <= allowed
     else:
         r2, amp = _fit(seg, n_fit, TWO_PI * f)
-    published = _quality_gate(p, c, model, f, res[U.R_DAMP], h, r2, amp)
+    published = _quality_gate(p, c, model, f, res[U.R_DAMP], h, r2, amp, consistent)
     if published:
         out[row, O_T] = t
         out[row, O_F] = f
