@@ -41,9 +41,11 @@ from .fields import (DEFAULT_COMPONENT, FLOAT64, INPUT_TYPES, check_component, c
 
 #: samples per block handed to the estimator (bags: chunks are grouped up to this size)
 BLOCK_SAMPLES = 1 << 18
-#: bytes of CSV text per parsed block (2 MB: ~100 k rows; larger blocks parse no faster per CPU
-#: second and raise the peak memory, see benchmarks/bench_survey.py)
-CSV_BLOCK_BYTES = 1 << 21
+#: bytes of CSV text per parsed block (512 kB: ~20 k rows). Arrow's streaming reader reads up to
+#: 32 blocks ahead on its I/O thread, so this sets the reader's memory (~16 MB in flight; 2 MB
+#: blocks held ~70 MB) while larger blocks parse no faster per CPU second
+#: (benchmarks/bench_survey.py)
+CSV_BLOCK_BYTES = 1 << 19
 
 Block = Tuple[np.ndarray, np.ndarray]
 
