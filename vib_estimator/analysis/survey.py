@@ -207,7 +207,7 @@ def _valid(component: str, kind: str) -> bool:
 
 _M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD = -1, -3     # glibc's mallopt parameters
 _GLIBC_DEFAULT_MMAP = 128 * 1024
-_tuned_tasks = [0]
+_tuned_tasks = 0                  # survey tasks running with raised thresholds
 _tuned_lock = threading.Lock()
 
 
@@ -225,16 +225,17 @@ def _streaming_malloc():
     if mallopt is None:
         yield
         return
+    global _tuned_tasks
     with _tuned_lock:
-        _tuned_tasks[0] += 1
+        _tuned_tasks += 1
         mallopt(_M_MMAP_THRESHOLD, 32 << 20)
         mallopt(_M_TRIM_THRESHOLD, 64 << 20)
     try:
         yield
     finally:
         with _tuned_lock:
-            _tuned_tasks[0] -= 1
-            if _tuned_tasks[0] == 0:
+            _tuned_tasks -= 1
+            if _tuned_tasks == 0:
                 mallopt(_M_MMAP_THRESHOLD,
                         int(os.environ.get('MALLOC_MMAP_THRESHOLD_', _GLIBC_DEFAULT_MMAP)))
                 mallopt(_M_TRIM_THRESHOLD, int(trim))

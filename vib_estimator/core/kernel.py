@@ -538,11 +538,11 @@ def _quality_gate(p, c, model, f, damping, h, r2, amp, consistent):
 
     At rest (no variance, or amplitude at or below ``min_amplitude``), above Nyquist, a fit R^2
     below ``min_fit`` (of the refined model; with ``refine`` = 0 of a sinusoid and offset at f)
-    or a refinement that moved the segment's own algebraic estimate by more than
-    ``MAX_REFINE_MOVE`` of its std and 2 % (both fit one model to the same samples, so on data the model
-    describes they differ by about one std: a forced motion, not a free vibration; counted with
-    the fit), or (damped model) |damping ratio| above ``max_damping``: a "lightly damped
-    vibration" with more damping is a transient, not a mode.
+    or not ``consistent`` (the refinement moved the segment's own algebraic estimate by more than
+    ``MAX_REFINE_MOVE`` stds and ``MIN_REFINE_MOVE_REL``: both fit one model to the same
+    samples, so on data the model describes they differ by about one std; a forced motion, not a
+    free vibration; counted with the fit), or (damped model) |damping ratio| above
+    ``max_damping``: a "lightly damped vibration" with more damping is a transient, not a mode.
     """
     if r2 < 0.0 or amp <= p[P_MINAMP]:
         c[C_REST] += 1
