@@ -38,7 +38,7 @@ def test_building_blocks():
     np.testing.assert_allclose(r, h.T @ h, rtol=1e-12, atol=1e-12)
     a = rng.standard_normal((6, 6))
     a = a @ a.T + np.eye(6)
-    b = rng.standard_normal(6)
+    b = rng.standard_normal((6, 2))
     np.testing.assert_allclose(cholesky_solve(a, b), np.linalg.solve(a, b), rtol=1e-9)
     roots = np.array([0.9 + 0.3j, 0.9 - 0.3j, 0.5, -0.2])
     coef = np.poly(roots)[::-1].real[:-1]                 # monic, low coefficients first

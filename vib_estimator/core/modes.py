@@ -66,8 +66,9 @@ NS = 2 * NLEV            # scales
 M_A, M_B = 48, 68        # window lengths of the even and odd scales (level samples)
 NQ = M_B // 3 + 1        # rows of a scale's subspace
 PCOL = 14                # most subspace columns
-HOP = 12                 # level samples between two analyses of a scale that a mode publishes
-HOP_IDLE = 24            # ... from (or may soon: the next longer one), and of the others
+HOP = 12                 # level samples between two analyses of a scale that a mode publishes from,
+HOP_IDLE = 48            # ... of the others at levels >= 1,
+HOP_TOP = 192            # ... of the others at level 0 (above 0.1 fs only level 0 counts a pole)
 DEC_CUTOFF = 0.12        # anti-alias low-pass before each decimation by 2, cycles per sample
 EIG_RATIO = 6.0          # signal eigenvalues: this factor above the noise's
 NU_HI = 0.2              # highest pole counted at a scale, cycles per level sample
@@ -254,8 +255,9 @@ def _harmonic(f, amp, cycles, pp, n, sl):
 
 
 @njit(cache=True)
-def _owner(b, sl, k, t):
-    """The scale mode k publishes from (module docstring), -1 for none yet."""
+def _cap(sl):
+    """(lowest active mode's frequency, longest publishing window in its periods): ``C_CAP``, or
+    ``C_CAP_CLOSE`` when two active modes lie within ``CLOSE_RATIO``."""
     fmin = math.inf
     cap = C_CAP
     for j in range(KMAX):
@@ -265,16 +267,24 @@ def _owner(b, sl, k, t):
                 if sl[i, SL_ACTIVE] != 0.0 and max(sl[i, SL_F] / sl[j, SL_F],
                                                    sl[j, SL_F] / sl[i, SL_F]) < CLOSE_RATIO:
                     cap = C_CAP_CLOSE
+    return fmin, cap
+
+
+@njit(cache=True)
+def _owner(b, sl, k, t, fmin, cap):
+    """(the scale mode k publishes from (module docstring), the next longer one if only its start
+    keeps it from publishing: the owner soon), -1 for none; fmin, cap from :func:`_cap`."""
     f = sl[k, SL_F]
     best = -1
     for s in range(NS):
         w = _scale_len(s) * b[B_DT]
-        if fmin * w > cap or f * b[B_DT] * (1 << (s // 2)) > NU_HI or \
-                t - w < sl[k, SL_START]:
+        if fmin * w > cap or f * b[B_DT] * (1 << (s // 2)) > NU_HI:
             break
+        if t - w < sl[k, SL_START]:
+            return best, s
         if f * w >= C_DETECT:
             best = s
-    return best
+    return best, -1
 
 
 @njit(cache=True)
@@ -400,6 +410,7 @@ def _analysis(b, ic, sl, pd, qs, lams, pa, s, t, out):
     pp = np.empty((PCOL, 6))
     n, r2 = _poles(b, ic, qs, lams, pa, s, pp)
     used = np.zeros(n, dtype=np.int64)
+    fmin, cap = _cap(sl)
     for k in range(KMAX):
         if sl[k, SL_ACTIVE] == 0.0:
             continue
@@ -413,7 +424,7 @@ def _analysis(b, ic, sl, pd, qs, lams, pa, s, t, out):
             continue
         used[best] = 1
         sl[k, SL_SEEN] = t
-        if _owner(b, sl, k, t) != s:
+        if _owner(b, sl, k, t, fmin, cap)[0] != s:
             continue
         f = pp[best, 0]
         prev = sl[k, SL_PREV]
@@ -430,13 +441,14 @@ def _analysis(b, ic, sl, pd, qs, lams, pa, s, t, out):
             _publish(b, ic, sl, k, s, t, pp, best, r2, out)
     _candidates(b, ic, sl, pd, pa, pp, n, used, t, s, r2, out)
     ic[I_BUSY:I_BUSY + NS] = 0
+    fmin, cap = _cap(sl)
     for k in range(KMAX):
         if sl[k, SL_ACTIVE] != 0.0 and (t - sl[k, SL_SEEN]) * sl[k, SL_F] > LOSE_PERIODS:
             _remove(ic, sl, k)
         elif sl[k, SL_ACTIVE] != 0.0:
-            o = _owner(b, sl, k, t)
-            for j in range(max(o, 0), min(o + 2, NS)):
-                ic[I_BUSY + j] = 1
+            for o in _owner(b, sl, k, t, fmin, cap):
+                if o >= 0:
+                    ic[I_BUSY + o] = 1
 
 
 # ---- input, one sample, a run of samples --------------------------------------------------
@@ -475,7 +487,8 @@ def _feed(b, ic, sl, pd, qs, lams, pa, t, y, out):
     for d in range(top + 1):
         n = ic[I_LEV + d]
         for half in range(2):
-            hop = HOP if ic[I_BUSY + 2 * d + half] else HOP_IDLE
+            hop = HOP if ic[I_BUSY + 2 * d + half] or ic[I_NPEND] > 0 else \
+                HOP_IDLE if d > 0 else HOP_TOP
             if n >= (M_A, M_B)[half] and (n + half * (HOP // 2)) % hop == 0:
                 _analysis(b, ic, sl, pd, qs, lams, pa, 2 * d + half, t, out)
 

@@ -38,9 +38,11 @@ N_R = 4
 DECAY_MAX = 12.0      # poles decaying (or growing) more than e^12 over the window are dropped
 REAL_TOL = 1e-7       # |Im z| below this: a real pole
 ROOT_ITER = 40
+#: reassociated sums (vectorised loops); no assumption about NaN or infinities
+FAST = {'reassoc', 'contract', 'nsz', 'arcp'}
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=FAST)
 def hankel_cov(x, lag, r):
     """R = H^T H of the window's Hankel matrix (module docstring) into r[:lag+1, :lag+1]."""
     m = len(x)
@@ -58,42 +60,53 @@ def hankel_cov(x, lag, r):
             r[j + 1, i + 1] = v
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=FAST)
 def orthogonal_iteration(r, n, q, lam):
     """One step Q <- orth(R Q) on q[:n, :P] (modified Gram-Schmidt), columns sorted by their
-    eigenvalue estimates lam (descending)."""
+    eigenvalue estimates lam (descending); returns the new columns as the rows of a contiguous
+    (P, n) array (the loops run over contiguous rows)."""
     npc = q.shape[1]
-    w = np.zeros((n, npc))
+    qt = np.empty((npc, n))
     for k in range(npc):
         for i in range(n):
-            s = 0.0
-            for j in range(n):
-                s += r[i, j] * q[j, k]
-            w[i, k] = s
+            qt[k, i] = q[i, k]
+    w = np.zeros((npc, n))
+    for k in range(npc):
+        for j in range(n):
+            a = qt[k, j]
+            for i in range(n):
+                w[k, i] += r[j, i] * a          # R is symmetric: row j of R is its column j
     for k in range(npc):
         for j in range(k):
             d = 0.0
             for i in range(n):
-                d += w[i, j] * w[i, k]
+                d += w[j, i] * w[k, i]
             for i in range(n):
-                w[i, k] -= d * w[i, j]
-        norm = math.sqrt(np.sum(w[:, k] ** 2))
+                w[k, i] -= d * w[j, i]
+        norm = 0.0
+        for i in range(n):
+            norm += w[k, i] * w[k, i]
+        norm = math.sqrt(norm)
         lam[k] = norm
         if norm > 0.0:
-            w[:, k] /= norm
+            for i in range(n):
+                w[k, i] /= norm
         else:
-            w[:, k] = 0.0
-            w[k % n, k] = 1.0
+            w[k, :] = 0.0
+            w[k, k % n] = 1.0
     order = np.argsort(-lam)
     lam[:] = lam[order]
     for k in range(npc):
-        q[:n, k] = w[:, order[k]]
+        for i in range(n):
+            qt[k, i] = w[order[k], i]
+            q[i, k] = qt[k, i]
+    return qt
 
 
 @njit(cache=True)
 def cholesky_solve(a, b):
-    """Solve a x = b (b: one or more columns) for a symmetric positive (semi)definite a (a tiny
-    ridge keeps it regular)."""
+    """Solve a x = b (b: a matrix of right-hand columns) for a symmetric positive (semi)definite
+    a (a tiny ridge keeps it regular)."""
     n = a.shape[0]
     c = np.zeros((n, n))
     ridge = 1e-13 * max(np.trace(a) / max(n, 1), 1e-300)
@@ -108,21 +121,25 @@ def cholesky_solve(a, b):
                 s -= c[i, k] * c[j, k]
             c[i, j] = s / c[j, j]
     x = b.copy()
-    for i in range(n):
-        for k in range(i):
-            x[i] -= c[i, k] * x[k]
-        x[i] /= c[i, i]
-    for i in range(n - 1, -1, -1):
-        for k in range(i + 1, n):
-            x[i] -= c[k, i] * x[k]
-        x[i] /= c[i, i]
+    for col in range(x.shape[1]):
+        for i in range(n):
+            v = x[i, col]
+            for k in range(i):
+                v -= c[i, k] * x[k, col]
+            x[i, col] = v / c[i, i]
+        for i in range(n - 1, -1, -1):
+            v = x[i, col]
+            for k in range(i + 1, n):
+                v -= c[k, i] * x[k, col]
+            x[i, col] = v / c[i, i]
     return x
 
 
-@njit(cache=True)
-def esprit_poly(q, n, p):
+@njit(cache=True, fastmath=FAST)
+def esprit_poly(qt, n, p):
     """Characteristic polynomial (monic, low coefficients first) of the rotation Phi of the signal
-    subspace, Q[:-1] Phi = Q[1:] in least squares (Faddeev-LeVerrier recursion)."""
+    subspace (the first p rows of qt, each a column of Q), Q[:-1] Phi = Q[1:] in least squares
+    (Faddeev-LeVerrier recursion)."""
     g = np.zeros((p, p))
     rhs = np.zeros((p, p))
     for i in range(p):
@@ -130,16 +147,23 @@ def esprit_poly(q, n, p):
             sg = 0.0
             sr = 0.0
             for r in range(n - 1):
-                sg += q[r, i] * q[r, j]
-                sr += q[r, i] * q[r + 1, j]
+                sg += qt[i, r] * qt[j, r]
+                sr += qt[i, r] * qt[j, r + 1]
             g[i, j] = sg
             rhs[i, j] = sr
     phi = cholesky_solve(g, rhs)
     c = np.zeros(p + 1)
     c[p] = 1.0
     mk = np.zeros((p, p))
+    nxt = np.empty((p, p))
     for k in range(1, p + 1):
-        mk = phi @ mk
+        for i in range(p):
+            for j in range(p):
+                v = 0.0
+                for l in range(p):
+                    v += phi[i, l] * mk[l, j]
+                nxt[i, j] = v
+        mk, nxt = nxt, mk
         for i in range(p):
             mk[i, i] += c[p - k + 1]
         tr = 0.0
@@ -180,10 +204,11 @@ def poly_roots(a):
     return z
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=FAST)
 def _basis(m, poles):
-    """The real least-squares basis of the poles (module docstring) and each pole's columns
-    (0: dropped, 1: real, 2: a pair; a pole with negative imaginary part is its pair's twin)."""
+    """The real least-squares basis of the poles (module docstring), one row per column, and
+    each pole's columns (0: dropped, 1: real, 2: a pair; a pole with negative imaginary part is
+    its pair's twin)."""
     kind = np.zeros(len(poles), dtype=np.int64)
     ncol = 0
     for i in range(len(poles)):
@@ -191,7 +216,7 @@ def _basis(m, poles):
         if z.imag >= -REAL_TOL and abs(z) > 0.0 and abs(math.log(abs(z))) * m <= DECAY_MAX:
             kind[i] = 2 if z.imag > REAL_TOL else 1
             ncol += kind[i]
-    basis = np.empty((m, ncol))
+    basis = np.empty((ncol, m))
     col = 0
     for i in range(len(poles)):
         if kind[i] == 0:
@@ -199,37 +224,59 @@ def _basis(m, poles):
         z = poles[i]
         w = np.exp(np.log(z) * (1 - m))
         for n in range(m):
-            basis[n, col] = w.real
+            basis[col, n] = w.real
             if kind[i] == 2:
-                basis[n, col + 1] = w.imag
+                basis[col + 1, n] = w.imag
             w *= z
         col += kind[i]
     return basis, kind
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=FAST)
 def fit_poles(x, poles, rows):
     """Least-squares amplitudes of the poles (module docstring); returns (pairs written to rows,
     residual variance, R^2)."""
     m = len(x)
     basis, kind = _basis(m, poles)
-    ncol = basis.shape[1]
+    ncol = basis.shape[0]
     if ncol == 0 or ncol >= m:
         return 0, math.nan, math.nan
-    c = cholesky_solve(basis.T @ basis, np.ascontiguousarray(basis.T @ x))
-    resid = x - basis @ c
-    total = np.sum((x - np.mean(x)) ** 2)
-    rss = np.sum(resid ** 2)
+    gram = np.empty((ncol, ncol))
+    bx = np.empty((ncol, 1))
+    for i in range(ncol):
+        for j in range(i + 1):
+            v = 0.0
+            for n in range(m):
+                v += basis[i, n] * basis[j, n]
+            gram[i, j] = v
+            gram[j, i] = v
+        v = 0.0
+        for n in range(m):
+            v += basis[i, n] * x[n]
+        bx[i, 0] = v
+    c = cholesky_solve(gram, bx)[:, 0]
+    mean = np.mean(x)
+    total = 0.0
+    rss = 0.0
+    for n in range(m):
+        v = x[n]
+        for i in range(ncol):
+            v -= basis[i, n] * c[i]
+        rss += v * v
+        total += (x[n] - mean) ** 2
     npair = 0
     col = 0
     for i in range(len(poles)):
         if kind[i] == 2:
             lz = np.log(poles[i])
-            part = basis[:, col] * c[col] + basis[:, col + 1] * c[col + 1]
+            energy = 0.0
+            for n in range(m):
+                v = basis[col, n] * c[col] + basis[col + 1, n] * c[col + 1]
+                energy += v * v
             rows[npair, R_NU] = lz.imag / (2.0 * math.pi)
             rows[npair, R_ZETA] = -lz.real / abs(lz)
             rows[npair, R_AMP] = math.hypot(c[col], c[col + 1])
-            rows[npair, R_ENERGY] = np.sum(part * part)
+            rows[npair, R_ENERGY] = energy
             npair += 1
         col += kind[i]
     return npair, rss / (m - ncol), 1.0 - rss / total if total > 0.0 else math.nan
@@ -253,7 +300,7 @@ def analyse(x, q, lam, ratio, rows):
     n = lag + 1
     r = np.empty((n, n))
     hankel_cov(x, lag, r)
-    orthogonal_iteration(r, n, q, lam)
+    qt = orthogonal_iteration(r, n, q, lam)
     npc = q.shape[1]
     noise = lam[npc - 1]
     p = 0
@@ -261,4 +308,4 @@ def analyse(x, q, lam, ratio, rows):
         p += 1
     if p == 0:
         return 0, math.nan, math.nan
-    return fit_poles(x, poly_roots(esprit_poly(q, n, p)), rows)
+    return fit_poles(x, poly_roots(esprit_poly(qt, n, p)), rows)
