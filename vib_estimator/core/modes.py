@@ -15,9 +15,13 @@ How the modes are found and estimated (everything compiled, one call per sample)
 * **Scales**: the input is decimated by 2 per level (``NLEV`` levels, each behind a 4th-order
   Butterworth anti-alias low-pass at 0.12 of the previous rate) and each level keeps its last
   samples; scale s looks at the last ``M_A`` (even s) or ``M_B`` (odd s) samples of level s // 2,
-  so the scales' windows grow by ~sqrt(2) from 48 input samples to 68 * 2^7. Each scale's window is
-  analysed every ``HOP`` of its samples by :func:`vib_estimator.core.subspace.analyse` (a subspace
-  / ESPRIT fit of damped sinusoids whose order comes from the eigenvalue gap above the noise). The
+  so the scales' windows grow by ~sqrt(2) from 48 input samples to 68 * 2^7. A scale's window is
+  analysed by :func:`vib_estimator.core.subspace.analyse` (a subspace / ESPRIT fit of damped
+  sinusoids whose order comes from the eigenvalue gap above the noise) every ``HOP`` of its
+  samples when a mode publishes from it, or will as soon as the mode is old enough (its start,
+  below), and every scale so while a candidate waits for confirmation; else every ``HOP_IDLE``
+  samples (the search for new modes), ``HOP_TOP`` at level 0 (only it counts poles above
+  0.1 fs). The
   frequencies work in cycles per sample, converted to Hz with the measured mean interval; gaps up
   to ``MAX_FILL`` steps are bridged by interpolation.
 * **A pole counts** at a scale when it has ``C_TRACK`` cycles in the window, lies below ``NU_HI``
@@ -112,7 +116,7 @@ N_B = B_HBUF + 16
  I_UID, I_NOUT) = range(19)
 I_LEV = 19                        # NLEV samples since the (re)start, per level
 I_RET = I_LEV + NLEV              # the lost modes' counters (MODE_COUNTERS, in order)
-I_BUSY = I_RET + 4                # NS flags: a mode publishes from the scale or the one below
+I_BUSY = I_RET + 4                # NS flags: a mode publishes from the scale (or soon will)
 N_I = I_BUSY + NS
 #: input counters, named as the estimator's
 STAGE_COUNTERS = {'received': I_RECEIVED, 'used': I_USED, 'skipped_non_finite': I_NONFINITE,
@@ -593,7 +597,8 @@ class ModeTracker:
         self._ic = np.zeros(N_I, dtype=np.int64)
         self._qs = np.zeros((NS, NQ, PCOL))
         band = config.band_hz or (0.0, math.inf)
-        self._npc = min(2 * config.modes + 4, M_A // 3 + 1 - 3)
+        # subspace columns: a pair per mode, an offset, a noise column (at least 6, at most PCOL)
+        self._npc = min(max(2 * config.modes + 2, 6), M_A // 3 + 1 - 3)
         pa[:] = (config.max_gap, config.modes, band[0], band[1], config.max_damping,
                  config.min_fit, self._npc)
         self._out = np.empty((ROOM, N_O))

@@ -2,8 +2,9 @@
 
 A window ``x[0..m-1]`` of uniformly spaced samples is modelled as a sum of damped complex
 exponentials ``x[n] = sum_i c_i z_i^n`` (each real damped sinusoid a conjugate pair, an offset or
-a slow trend a real pole). Everything is written out in loops (no LAPACK call: at these sizes a
-call costs more than the arithmetic):
+a slow trend a real pole). Everything is written out in loops over contiguous rows, without
+temporaries, their sums reassociated (``FAST``) so that they vectorise (no BLAS or LAPACK call: at
+these sizes a call costs more than the arithmetic):
 
 * **Covariance** (:func:`hankel_cov`): ``R = H^T H`` of the ``(m - L) x (L + 1)`` Hankel matrix of
   the window (``L = m // 3``), built from its first row and the shift recursion
@@ -38,6 +39,7 @@ N_R = 4
 DECAY_MAX = 12.0      # poles decaying (or growing) more than e^12 over the window are dropped
 REAL_TOL = 1e-7       # |Im z| below this: a real pole
 ROOT_ITER = 40
+ROOT_TOL = 1e-10      # Aberth steps below this: converged
 #: reassociated sums (vectorised loops); no assumption about NaN or infinities
 FAST = {'reassoc', 'contract', 'nsz', 'arcp'}
 
@@ -199,7 +201,7 @@ def poly_roots(a):
             step = ratio / (1.0 - ratio * s)
             z[k] -= step
             moved = max(moved, abs(step))
-        if moved < 1e-12:
+        if moved < ROOT_TOL:
             break
     return z
 
