@@ -19,7 +19,9 @@ How the modes are found and estimated (everything compiled, one call per sample)
   analysed by :func:`vib_estimator.core.subspace.analyse` (a subspace / ESPRIT fit of damped
   sinusoids whose order comes from the eigenvalue gap above the noise) every ``HOP`` of its
   samples when a mode publishes from it, or will as soon as the mode is old enough (its start,
-  below), and every scale so while a candidate waits for confirmation; else every ``HOP_IDLE``
+  below), and every scale so while a candidate waits for confirmation and for ``WAKE_N``
+  samples after a block of the input jumps in energy (a mode excited: :func:`_wake`); else every
+  ``HOP_IDLE``
   samples (the search for new modes), ``HOP_TOP`` at level 0 (only it counts poles above
   0.1 fs). The
   frequencies work in cycles per sample, converted to Hz with the measured mean interval; gaps up
@@ -98,6 +100,10 @@ LOSE_PERIODS = 3.0       # a mode unseen for this many of its periods is lost
 N_STEP = 15              # intervals whose median is the grid step
 MAX_FILL = 64            # grid steps interpolated between two samples at most (else a restart)
 NPEND = 16               # candidates kept
+WAKE_BLOCK = 32          # an input block WAKE_RATIO times more energetic than the largest of the
+WAKE_RATIO = 8.0         # previous ones (fading by WAKE_FADE per block) ...
+WAKE_FADE = 0.97
+WAKE_N = M_B << 3        # ... makes every scale fast for this many samples
 BLOCK = 1 << 15          # samples per block of the batch path
 
 # ---- float array b: decimators, level rings, time base -------------------------------------
@@ -109,7 +115,8 @@ B_TLAST = B_DT + 1
 B_Y = B_TLAST + 1                # last accepted input
 B_TG = B_Y + 1                   # time of the last grid sample
 B_HBUF = B_TG + 1                # the first N_STEP intervals (their median is the grid step)
-N_B = B_HBUF + 16
+B_E = B_HBUF + 16                # energy of the current WAKE_BLOCK samples, the reference
+N_B = B_E + 2
 # ---- int array ic ------------------------------------------------------------------------------
 (I_N, I_NDT, I_NB, I_RECEIVED, I_USED, I_NONFINITE, I_DUPLICATE, I_OUT_OF_ORDER, I_TIME_JUMP,
  I_GAP, I_FOUND, I_LOST, I_REJ_HARM, I_REJ_NOISE, I_REJ_UNRES, I_REJ_EDGE, I_NPEND,
@@ -117,7 +124,8 @@ N_B = B_HBUF + 16
 I_LEV = 19                        # NLEV samples since the (re)start, per level
 I_RET = I_LEV + NLEV              # the lost modes' counters (MODE_COUNTERS, in order)
 I_BUSY = I_RET + 4                # NS flags: a mode publishes from the scale (or soon will)
-N_I = I_BUSY + NS
+I_WAKE = I_BUSY + NS             # input samples of fast analyses left (a change in the signal)
+N_I = I_WAKE + 1
 #: input counters, named as the estimator's
 STAGE_COUNTERS = {'received': I_RECEIVED, 'used': I_USED, 'skipped_non_finite': I_NONFINITE,
                   'skipped_duplicate': I_DUPLICATE, 'skipped_out_of_order': I_OUT_OF_ORDER,
@@ -161,6 +169,8 @@ def _levels_settle(b, ic, y):
         b[o + 17] = 0.0
         b[o + 19] = 0.0
         ic[I_LEV + d] = 0
+    b[B_E:B_E + 2] = 0.0
+    ic[I_WAKE] = 0
 
 
 @njit(cache=True)
@@ -485,14 +495,30 @@ def _input_ok(b, ic, pa, t, y):
 
 
 @njit(cache=True)
+def _wake(b, ic, y):
+    """The energy of the input's blocks of WAKE_BLOCK samples against a reference (the largest
+    block's, fading by WAKE_FADE per block, so that the blocks of a slow sine, a fraction of its
+    period, do not count): a block WAKE_RATIO times above it (a mode excited) makes every scale
+    fast for the next WAKE_N samples."""
+    b[B_E] += y * y
+    ic[I_WAKE] = max(ic[I_WAKE] - 1, 0)
+    if ic[I_LEV] % WAKE_BLOCK == 0:
+        if b[B_E] > WAKE_RATIO * b[B_E + 1]:
+            ic[I_WAKE] = WAKE_N
+        b[B_E + 1] = max(b[B_E + 1] * WAKE_FADE, b[B_E])
+        b[B_E] = 0.0
+
+
+@njit(cache=True)
 def _feed(b, ic, sl, pd, qs, lams, pa, t, y, out):
     """One (possibly interpolated) sample through the levels and the analyses it completes."""
     top = _levels_step(b, ic, y)
+    _wake(b, ic, y)
+    fast = ic[I_NPEND] > 0 or ic[I_WAKE] > 0
     for d in range(top + 1):
         n = ic[I_LEV + d]
         for half in range(2):
-            hop = HOP if ic[I_BUSY + 2 * d + half] or ic[I_NPEND] > 0 else \
-                HOP_IDLE if d > 0 else HOP_TOP
+            hop = HOP if fast or ic[I_BUSY + 2 * d + half] else HOP_IDLE if d > 0 else HOP_TOP
             if n >= (M_A, M_B)[half] and (n + half * (HOP // 2)) % hop == 0:
                 _analysis(b, ic, sl, pd, qs, lams, pa, 2 * d + half, t, out)
 
