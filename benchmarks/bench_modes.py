@@ -194,8 +194,8 @@ def cost():
     t, y = decay(freqs, amps, zetas, clip, 0, duration=21.0)
     ModeTracker(CONFIG).process(t[:3000], y[:3000])
     single = CONFIG.replace(modes=0)
-    tb = best(lambda: ModeTracker(CONFIG).process(t, y))
-    sb = best(lambda: FrequencyEstimator(single).process(t, y))
+    tb = best(lambda: ModeTracker(CONFIG).process(t, y), repeats=10)
+    sb = best(lambda: FrequencyEstimator(single).process(t, y), repeats=10)
     fb = best(lambda: FftPeaks(FS).process(t, y))
     tl, yl = t[:10000].tolist(), y[:10000].tolist()
 

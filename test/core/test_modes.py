@@ -57,6 +57,19 @@ def test_two_modes_numbered_by_frequency(seed):
     assert tr.counters['modes_found'] >= 2
 
 
+@pytest.mark.parametrize('seed', [0, 1, 2])
+def test_excited_modes_are_estimated_within_two_periods(seed):
+    """Silence, then two modes: the first estimate of each lies within 2 % and comes less than 2
+    periods of the lower one after the excitation (the scales go fast when the energy jumps)."""
+    t = np.arange(0, 4, 1 / FS)
+    y = decay(t, 1.0, 8.0, 1.0) + decay(t, 1.0, 21.0, 0.3, 0.001) + noise(t, 0.003, seed)
+    e = ModeTracker(CFG).process(t, y)
+    for f in (8.0, 21.0):
+        near = np.abs(e.frequency_hz / f - 1) < 0.06
+        assert abs(e.frequency_hz[near][0] / f - 1) < 0.02
+        assert (e.t[near][0] - 1.0) * 8.0 < 2.0
+
+
 def test_a_mode_appears_and_one_disappears():
     t = np.arange(0, 16, 1 / FS)
     first = decay(t, 0.5, 9.0, 1.0, 0.0) * (t < 7.0)          # stops at 7 s (into the noise)
