@@ -73,8 +73,8 @@ M_A, M_B = 48, 68        # window lengths of the even and odd scales (level samp
 NQ = M_B // 3 + 1        # rows of a scale's subspace
 PCOL = 14                # most subspace columns
 HOP = 12                 # level samples between two analyses of a scale that a mode publishes from,
-HOP_IDLE = 48            # ... of the others at levels >= 1,
-HOP_TOP = 192            # ... of the others at level 0 (above 0.1 fs only level 0 counts a pole)
+HOP_IDLE = 96            # ... of the others at levels >= 1,
+HOP_TOP = 384            # ... of the others at level 0 (above 0.1 fs only level 0 counts a pole)
 DEC_CUTOFF = 0.12        # anti-alias low-pass before each decimation by 2, cycles per sample
 EIG_RATIO = 6.0          # signal eigenvalues: this factor above the noise's
 NU_HI = 0.2              # highest pole counted at a scale, cycles per level sample
