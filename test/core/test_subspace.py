@@ -23,8 +23,9 @@ def run(x, npc=10, steps=4):
     init_subspace(q)
     lam = np.zeros(npc)
     rows = np.zeros((npc, 4))
+    roots = np.full((2, npc), np.nan)
     for _ in range(steps):
-        k, var, r2 = analyse(x, q, lam, 6.0, rows)
+        k, var, r2 = analyse(x, q, lam, roots, 6.0, rows)
     order = np.argsort(rows[:k, R_NU])
     return rows[:k][order], var, r2
 
@@ -42,8 +43,10 @@ def test_building_blocks():
     np.testing.assert_allclose(cholesky_solve(a, b), np.linalg.solve(a, b), rtol=1e-9)
     roots = np.array([0.9 + 0.3j, 0.9 - 0.3j, 0.5, -0.2])
     coef = np.poly(roots)[::-1].real[:-1]                 # monic, low coefficients first
-    got = poly_roots(coef)
-    assert np.max(np.min(np.abs(got[:, None] - roots[None, :]), axis=1)) < 1e-9
+    for start in (np.full((2, 4), np.nan), np.array([[0.89, 0.89, 0.5, -0.2], [0.3, -0.3, 0, 0]])):
+        got = poly_roots(coef, start)
+        assert np.max(np.min(np.abs(got[:, None] - roots[None, :]), axis=1)) < 1e-9
+        np.testing.assert_allclose(start[0] + 1j * start[1], got)     # kept for the next window
 
 
 def test_a_clean_window_gives_its_sinusoids_exactly():

@@ -224,8 +224,8 @@ def _poles(b, ic, qs, lams, pa, s, pp):
     m = M_A if s % 2 == 0 else M_B
     npc = int(pa[PA_P])
     rows = np.empty((PCOL, N_R))
-    k, var, r2 = analyse(_window(b, ic, d, m), qs[s, :m // 3 + 1, :npc], lams[s, :npc],
-                         EIG_RATIO, rows)
+    k, var, r2 = analyse(_window(b, ic, d, m), qs[s, :m // 3 + 1, :npc], lams[s, 0, :npc],
+                         lams[s, 1:], EIG_RATIO, rows)
     h = b[B_DT] * (1 << d)
     n = 0
     for i in range(k):
@@ -564,7 +564,7 @@ ROOM = KMAX * (NS + 2 * MAX_FILL)
 F_SL = N_B
 F_PD = F_SL + KMAX * N_SL
 F_LAM = F_PD + NPEND * 3
-F_PA = F_LAM + NS * PCOL
+F_PA = F_LAM + NS * 3 * PCOL    # per scale: eigenvalues, poles (re, im) of its last analysis
 N_F = F_PA + 7
 
 
@@ -572,7 +572,7 @@ N_F = F_PA + 7
 def _unpack(fs):
     """The views b, sl, pd, lams, pa of the float state."""
     return (fs[:N_B], fs[F_SL:F_PD].reshape((KMAX, N_SL)), fs[F_PD:F_LAM].reshape((NPEND, 3)),
-            fs[F_LAM:F_PA].reshape((NS, PCOL)), fs[F_PA:N_F])
+            fs[F_LAM:F_PA].reshape((NS, 3, PCOL)), fs[F_PA:N_F])
 
 
 @njit(cache=True)
@@ -618,7 +618,7 @@ class ModeTracker:
         self._fs = np.zeros(N_F)
         self._b, self._sl, self._pd, self._lams, pa = (
             self._fs[:N_B], self._fs[F_SL:F_PD].reshape((KMAX, N_SL)),
-            self._fs[F_PD:F_LAM].reshape((NPEND, 3)), self._fs[F_LAM:F_PA].reshape((NS, PCOL)),
+            self._fs[F_PD:F_LAM].reshape((NPEND, 3)), self._fs[F_LAM:F_PA].reshape((NS, 3, PCOL)),
             self._fs[F_PA:N_F])
         self._ic = np.zeros(N_I, dtype=np.int64)
         self._qs = np.zeros((NS, NQ, PCOL))
@@ -718,7 +718,8 @@ class ModeTracker:
         for s in range(NS):
             m = M_A if s % 2 == 0 else M_B
             init_subspace(self._qs[s, :m // 3 + 1, :self._npc])
-        self._lams[:] = 0.0
+        self._lams[:, 0] = 0.0
+        self._lams[:, 1:] = math.nan
 
 
 def create_estimator(config: EstimatorConfig) -> Union[FrequencyEstimator, ModeTracker]:

@@ -18,7 +18,8 @@ these sizes a call costs more than the arithmetic):
 * **Poles** (:func:`esprit_poly`, :func:`poly_roots`): the signal subspace is spanned by the
   vectors ``z_i^n``, so shifting it by one sample is a rotation ``Phi`` whose eigenvalues are the
   poles (ESPRIT, least squares ``Q[:-1] Phi = Q[1:]``); they are found as the roots of its
-  characteristic polynomial (Faddeev-LeVerrier) by the Aberth-Ehrlich iteration.
+  characteristic polynomial (Faddeev-LeVerrier) by the Aberth-Ehrlich iteration, started from the
+  scale's previous poles (a sliding window keeps its signal's poles: a few steps suffice).
 * **Amplitudes and fit** (:func:`fit_poles`): the real basis ``Re z^n, Im z^n`` per pair (one
   column per real pole), ``n`` counted back from the window's last sample, fitted to the window by
   least squares; each pair gives its frequency (cycles per sample), damping ratio, amplitude at the
@@ -177,12 +178,19 @@ def esprit_poly(qt, n, p):
 
 
 @njit(cache=True)
-def poly_roots(a):
-    """Roots of z^p + a[p-1] z^(p-1) + ... + a[0] (Aberth-Ehrlich iteration)."""
+def poly_roots(a, start):
+    """Roots of z^p + a[p-1] z^(p-1) + ... + a[0] (Aberth-Ehrlich iteration), started from
+    start[:, k] = (re, im) where finite and distinct from the others (the previous window's
+    poles: a sliding window keeps them), else from a circle; the roots are written back to
+    start."""
     p = len(a)
     z = np.empty(p, dtype=np.complex128)
     for k in range(p):
         z[k] = 0.9 * np.exp(1j * (2.0 * math.pi * (k + 0.25) / p + 0.1))
+        if k < start.shape[1] and math.isfinite(start[0, k]) and math.isfinite(start[1, k]):
+            w = start[0, k] + 1j * start[1, k]
+            if all_apart(z, k, w):
+                z[k] = w
     for _ in range(ROOT_ITER):
         moved = 0.0
         for k in range(p):
@@ -203,7 +211,20 @@ def poly_roots(a):
             moved = max(moved, abs(step))
         if moved < ROOT_TOL:
             break
+    start[:] = math.nan
+    for k in range(min(p, start.shape[1])):
+        start[0, k] = z[k].real
+        start[1, k] = z[k].imag
     return z
+
+
+@njit(cache=True)
+def all_apart(z, k, w):
+    """Whether w lies apart (1e-9) from z[:k]."""
+    for j in range(k):
+        if abs(z[j] - w) < 1e-9:
+            return False
+    return True
 
 
 @njit(cache=True, fastmath=FAST)
@@ -295,9 +316,10 @@ def init_subspace(q):
 
 
 @njit(cache=True)
-def analyse(x, q, lam, ratio, rows):
-    """The damped sinusoids of window x (module docstring), updating its scale's subspace q and
-    eigenvalues lam: (pairs in rows, residual variance, R^2); (0, nan, nan) for none."""
+def analyse(x, q, lam, roots, ratio, rows):
+    """The damped sinusoids of window x (module docstring), updating its scale's subspace q,
+    eigenvalues lam and poles roots (rows re and im, NaN: none): (pairs in rows, residual variance,
+    R^2); (0, nan, nan) for none."""
     lag = len(x) // 3
     n = lag + 1
     r = np.empty((n, n))
@@ -310,4 +332,4 @@ def analyse(x, q, lam, ratio, rows):
         p += 1
     if p == 0:
         return 0, math.nan, math.nan
-    return fit_poles(x, poly_roots(esprit_poly(qt, n, p)), rows)
+    return fit_poles(x, poly_roots(esprit_poly(qt, n, p), roots), rows)
