@@ -90,7 +90,8 @@ S_W = S_IM + 5           # cached weights of the rule on a uniform stencil (5 x 
 S_WH = S_W + 5 * NH      # step of the cached weights (-1: none)
 S_UNIT = S_WH + 1        # scratch unit vector
 S_FLAST = S_UNIT + NH    # long windows: the segment's first converged half-period estimate
-S_NEXT = S_FLAST + 1     # segment length at which target_std_rel is checked next
+S_DLAST = S_FLAST + 1    # ... and its damping ratio (damped model), where the fit starts
+S_NEXT = S_DLAST + 1     # segment length at which target_std_rel is checked next
 S_RES = S_NEXT + 1       # result of the refinement (core.uncertainty's layout)
 S_WORK = S_RES + U.N_RESULT  # the refinement's scratch
 S_MA = S_WORK + U.N_WORK     # moving-average ring (2M+1 values) starts here
@@ -190,6 +191,7 @@ def reset_segment(s, c, seg, t0, y0):
     s[S_MOM:S_MOM + 5] = 0.0
     s[S_NF:S_INT + 3] = 0.0
     s[S_FLAST] = 0.0
+    s[S_DLAST] = 0.0
     s[S_NEXT] = 0.0
     c[C_SEG_N] = 1
     c[C_MA_N] = 0
@@ -587,6 +589,26 @@ def _store_sample(p, s, c, seg, t, tau, y):
 
 
 @njit(cache=True)
+def _long_window_spanned(p, s, c, m, one_sided, model, tau, f, damping):
+    """Long window (``refine`` and ``min_periods`` >= 1): True once the segment spans
+    ``min_periods`` periods of its first converged half-period estimate.
+
+    That estimate (what the default configuration publishes; the algebraic estimate wanders over
+    many periods) is kept in ``S_FLAST``, with its damping ratio (damped model, clipped to
+    ``max_damping``) in ``S_DLAST``: the refinement starts from both. The algebraic damping of a
+    long segment is meaningless (|zeta| ~ 0.5): started there, a fit once settled in a wrong
+    minimum 27 stds off.
+    """
+    if s[S_FLAST] == 0.0:
+        if _converged(m, one_sided, p[P_TOL], s, c, f) and tau * f >= 0.5:
+            s[S_FLAST] = f
+            s[S_DLAST] = min(max(damping, -p[P_MAXDAMP]), p[P_MAXDAMP]) \
+                if model == MODEL_DAMPED else 0.0
+        return False
+    return tau * s[S_FLAST] >= p[P_MINPER]
+
+
+@njit(cache=True)
 def step(p, s, c, seg, t, y, out, row):
     """Feed one sample; return 1 and fill ``out[row]`` when an estimate is published, else 0.
 
@@ -629,16 +651,9 @@ def step(p, s, c, seg, t, y, out, row):
         if tau * f < p[P_MINPER] or not _target_reached(p, s, seg, n_fit, model, f, damping, h):
             return 0
     elif p[P_REFINE] > 0.0 and p[P_MINPER] >= 1.0:
-        # long window: its span in periods of the segment's first converged half-period
-        # estimate (what the default configuration publishes; the algebraic estimate wanders
-        # over many periods), from which the fit starts
-        if s[S_FLAST] == 0.0:
-            if _converged(m, one_sided, p[P_TOL], s, c, f) and tau * f >= 0.5:
-                s[S_FLAST] = f
+        if not _long_window_spanned(p, s, c, m, one_sided, model, tau, f, damping):
             return 0
-        if tau * s[S_FLAST] < p[P_MINPER]:
-            return 0
-        f, local_start = s[S_FLAST], False
+        f, damping, local_start = s[S_FLAST], s[S_DLAST], False
     # the segment must span a fraction of the period it estimates
     elif not _converged(m, one_sided, p[P_TOL], s, c, f) or tau * f < p[P_MINPER]:
         return 0
