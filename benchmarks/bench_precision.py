@@ -14,8 +14,9 @@ sliding matrix pencil
 with an offset) on the same windows: its RMS(error / bound). Same run, same signals.
 
 A last block, ``sinusoid+band``, runs the sinusoid with ``band_hz`` = [f/2, 2f]: the prefilter
-colours the noise, so its std is rescaled by the filters' noise bandwidth, which holds for windows
-long against 1 / (f_hi - f_lo) = 0.5 s (``calib``, here, shows where). Its records start
+colours the noise, so its std is the least-squares sandwich under the prefilter's noise
+covariance, with the noise level from the window's residual, which is rough over windows short
+against 1 / (f_hi - f_lo) = 0.5 s (``calib``, here, shows where). Its records start
 ``SETTLE`` s earlier and the estimates of windows that begin in that prefilter start-up are
 dropped; its bound is the sinusoid's on the unfiltered white noise.
 Usage: ``python benchmarks/bench_precision.py [--quick]`` (--quick: 0.5, 2 and 20 periods, 40 dB).

@@ -149,16 +149,34 @@ def test_long_damped_windows_start_from_the_half_period_damping():
     assert np.max(np.abs(norm)) < 5
 
 
-def test_band_prefilter_std_is_calibrated_on_windows_long_against_its_correlation_time():
-    """band_hz colours the noise: the residual sees only the pass band's share of it, so the std is
-    rescaled by the filters' noise-equivalent bandwidth (x ~130 in variance here; without it
-    error/std would have an RMS ~11). Windows of 5 periods (3.8 s, against 1 / (f_hi - f_lo) =
-    0.5 s) that start after the prefilter's start-up transient."""
+def _band_calibration(periods, records):
+    """RMS of error / std with band_hz [f/2, 2f], windows that start after the prefilter's
+    start-up (3 s), 40 dB."""
     z = []
-    for t, y, _ in _records(0.0, SD, 5, 12, seed=11):
-        e = estimate(t, y, EstimatorConfig(min_periods=5, band_hz=(F0 / 2, 2 * F0)))
+    for t, y, _ in _records(0.0, SD, periods, records, seed=11):
+        e = estimate(t, y, EstimatorConfig(min_periods=periods, band_hz=(F0 / 2, 2 * F0)))
         for k in range(len(e)):
             if e.t[k] - e.convergence_time[k] > 3.0:
                 z.append((e.frequency_hz[k] - F0) / e.frequency_std_hz[k])
-    assert len(z) >= 20
-    assert 0.75 < math.sqrt(np.mean(np.square(z))) < 1.3
+    return len(z), math.sqrt(np.mean(np.square(z))), np.median(np.abs(z)) / 0.6745
+
+
+def test_band_prefilter_std_is_calibrated_on_windows_long_against_its_correlation_time():
+    """band_hz colours the noise: the std is the least-squares sandwich under the prefilter's
+    noise covariance, with the input noise level from the residual (white-noise std of the
+    band-passed residual: error/std RMS ~13). 5 periods (3.8 s, against 1 / (f_hi - f_lo) =
+    0.5 s)."""
+    n, calib, _ = _band_calibration(5, 12)
+    assert n >= 20
+    assert 0.75 < calib < 1.3
+
+
+def test_band_prefilter_std_over_half_a_period_is_within_a_factor_2():
+    """Half a period of band-passed noise leaves the residual ~0.16 degrees of freedom, so the
+    noise level is rough and error/std heavy-tailed: RMS 1.4-2.3 over six seeds (2.8-3.0 in
+    bench_precision with the noise-bandwidth rescaling this replaced; 0.98 with the true noise
+    level), its robust scale (median |error/std| / 0.6745) 1.25-1.6."""
+    n, rms, scale = _band_calibration(0.5, 16)
+    assert n >= 100
+    assert 0.9 < scale < 2.0
+    assert rms < 2.6
