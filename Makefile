@@ -34,6 +34,7 @@ bench: setup
 # every benchmark (long: the precision, modes and survey studies take minutes each)
 bench-all: bench
 	$(VENV)/bin/python benchmarks/bench_precision.py
+	$(VENV)/bin/python benchmarks/bench_target.py
 	$(VENV)/bin/python benchmarks/bench_modes.py
 	$(VENV)/bin/python benchmarks/bench_survey.py
 	$(VENV)/bin/python benchmarks/real_data.py

@@ -6,7 +6,8 @@ Prints (one run, same machine, same signal: 2 M samples of a noisy 1.33 Hz sine 
 - streaming: ``FrequencyEstimator.update`` in us per sample (goal <= 3), next to an empty Python
   function call with the same arguments (the floor of any per-sample Python API) and the ratio;
 - batch cost of other configurations against the default: the paper's estimator (``refine`` = 0)
-  and long windows (``min_periods`` = 5, 20; ``target_std_rel`` = 1e-4).
+  long windows (``min_periods`` = 5, 20; ``target_std_rel`` = 1e-4) and the band prefilter
+  (``band_hz`` = [f/2, 2f]: its std is a sandwich over the prefilter's noise covariance).
 - the previous kernel (``PREVIOUS``, before the split into per-equation functions and before
   refinement; loaded at run time with ``git show`` into a temporary package, "skipped" without git)
   on the same signal, ``refine`` = 0 (it also computes each estimate's std) and the default
@@ -28,7 +29,8 @@ from vib_estimator.core import EstimatorConfig, FrequencyEstimator
 
 VARIANTS = {'refine=0 (paper)': dict(refine=0), 'min_periods=5': dict(min_periods=5.0),
             'min_periods=20': dict(min_periods=20.0), 'target_std_rel=1e-4': dict(
-                target_std_rel=1e-4, min_periods=0.0)}
+                target_std_rel=1e-4, min_periods=0.0), 'band_hz=[f/2, 2f]': dict(
+                band_hz=(0.665, 2.66))}
 
 
 #: the commit whose kernel (one 169-line step, no refinement) is the speed baseline of issue 14

@@ -55,23 +55,36 @@ def test_the_paper_estimator_alone_loses_precision_over_long_windows():
     assert ratio > 3
 
 
+def _fig1_first_estimates(target):
+    t = np.arange(0.0, 1.0, 0.002)
+    first, errors, rel_std = [], [], []
+    for seed in range(20):
+        est = FrequencyEstimator(EstimatorConfig(target_std_rel=target, min_periods=0.0))
+        e = est.process(t, fig1_signal(t, seed=seed))
+        first.append(e.t[0])
+        errors.append(abs(2 * math.pi * e.frequency_hz[0] / 10 - 1))
+        rel_std.append(e.frequency_std_hz[0] * 2 * math.pi / 10)
+    return np.array(first), np.array(errors), np.array(rel_std)
+
+
 def test_target_std_rel_publishes_fig1_within_a_fraction_of_a_period():
     """Fig. 1 (sin(10 t + 1) + U(-0.01, 0.01) per 2 ms sample): first estimate by t = 0.12 s.
 
     Published when its predicted relative std reaches 1 %, so its error is within 1 % at one
-    sigma: within 1 % on most seeds and within 3 % (3 sigma) on all.
+    sigma (the exact bound over the samples up to 0.12 s is 0.90 %: an unbiased estimator is
+    within 1 % on at most 73 % of seeds): within 1 % on most seeds and within 3 % on all.
     """
-    t = np.arange(0.0, 1.0, 0.002)
-    first, errors = [], []
-    for seed in range(20):
-        est = FrequencyEstimator(EstimatorConfig(target_std_rel=0.01, min_periods=0.0))
-        e = est.process(t, fig1_signal(t, seed=seed))
-        first.append(e.t[0])
-        errors.append(abs(2 * math.pi * e.frequency_hz[0] / 10 - 1))
-        assert e.frequency_std_hz[0] * 2 * math.pi / 10 <= 0.0105
-    assert max(first) <= 0.12
-    assert max(errors) < 0.03
-    assert np.mean(np.array(errors) < 0.01) >= 0.55
+    first, errors, rel_std = _fig1_first_estimates(0.01)
+    assert np.all(rel_std <= 0.0105)
+    assert first.max() <= 0.12
+    assert errors.max() < 0.03
+    assert np.mean(errors < 0.01) >= 0.55
+
+
+def test_a_three_sigma_target_puts_every_fig1_seed_within_1_percent_in_a_third_of_a_period():
+    first, errors, _ = _fig1_first_estimates(0.003)
+    assert first.max() <= 0.21              # 0.33 periods of 10 rad/s
+    assert errors.max() < 0.01
 
 
 @pytest.mark.parametrize('model', ['sinusoid', 'biased-sinusoid', 'damped-sinusoid'])
@@ -105,3 +118,65 @@ def test_damped_model_publishes_long_decaying_windows_at_the_bound():
     assert ratio < 1.5
     assert 0.8 < calib < 1.25
 
+
+
+def _records(zeta, sd, periods, records, seed):
+    """Seeded records of the mode, 4 windows (at least 6 s) long, random phase (as the benchmark)."""
+    rng = np.random.default_rng(seed)
+    wn = 2 * math.pi * F0
+    for _ in range(records):
+        t = np.arange(0.0, max(6.0, 4 * periods / F0), TS)
+        phase = rng.uniform(0, 2 * math.pi)
+        y = AMP * np.exp(-zeta * wn * t) * np.sin(wn * math.sqrt(1 - zeta ** 2) * t + phase)
+        yield t, y + rng.normal(0.0, sd, len(t)), phase
+
+
+def test_long_damped_windows_start_from_the_half_period_damping():
+    """5 periods of a decaying mode at 20 dB: the long-window fit starts at the segment's first
+    converged half-period (f, zeta). The algebraic damping of the whole long segment is
+    meaningless (|zeta| ~ 0.5 here); started there, the 8th record's fit settled 27 stds off
+    (-1.7 %, R^2 0.94; the optimum from any sensible start has R^2 0.987)."""
+    sd = AMP / math.sqrt(2 * 100.0)
+    norm = []
+    for t, y, phase in _records(0.01, sd, 5, 8, seed=520):
+        e = estimate(t, y, EstimatorConfig(model='damped-sinusoid', min_periods=5))
+        for k in range(len(e)):
+            i1 = int(round(e.t[k] / TS))
+            b, _ = model_crb('damped-sinusoid', t[i1 - int(e.samples[k]) + 1:i1 + 1], AMP, F0,
+                             phase, sd, 0.01)
+            norm.append((e.frequency_hz[k] - F0) / b)
+    assert len(norm) >= 20
+    assert np.max(np.abs(norm)) < 5
+
+
+def _band_calibration(periods, records):
+    """RMS of error / std with band_hz [f/2, 2f], windows that start after the prefilter's
+    start-up (3 s), 40 dB."""
+    z = []
+    for t, y, _ in _records(0.0, SD, periods, records, seed=11):
+        e = estimate(t, y, EstimatorConfig(min_periods=periods, band_hz=(F0 / 2, 2 * F0)))
+        for k in range(len(e)):
+            if e.t[k] - e.convergence_time[k] > 3.0:
+                z.append((e.frequency_hz[k] - F0) / e.frequency_std_hz[k])
+    return len(z), math.sqrt(np.mean(np.square(z))), np.median(np.abs(z)) / 0.6745
+
+
+def test_band_prefilter_std_is_calibrated_on_windows_long_against_its_correlation_time():
+    """band_hz colours the noise: the std is the least-squares sandwich under the prefilter's
+    noise covariance, with the input noise level from the residual (white-noise std of the
+    band-passed residual: error/std RMS ~13). 5 periods (3.8 s, against 1 / (f_hi - f_lo) =
+    0.5 s)."""
+    n, calib, _ = _band_calibration(5, 12)
+    assert n >= 20
+    assert 0.75 < calib < 1.3
+
+
+def test_band_prefilter_std_over_half_a_period_is_within_a_factor_2():
+    """Half a period of band-passed noise leaves the residual ~0.16 degrees of freedom, so the
+    noise level is rough and error/std heavy-tailed: RMS 1.4-2.3 over six seeds (2.8-3.0 in
+    bench_precision with the noise-bandwidth rescaling this replaced; 0.98 with the true noise
+    level), its robust scale (median |error/std| / 0.6745) 1.25-1.6."""
+    n, rms, scale = _band_calibration(0.5, 16)
+    assert n >= 100
+    assert 0.9 < scale < 2.0
+    assert rms < 2.6

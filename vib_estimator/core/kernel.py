@@ -51,10 +51,11 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
 from . import uncertainty as U
-from .uncertainty import MODEL_BIASED, MODEL_DAMPED
+from .uncertainty import MODEL_BIASED, MODEL_DAMPED, MODEL_SINUSOID
 
 # ---- parameter array layout (float64) -------------------------------------------------------
 P_MODEL, P_WC, P_ZC, P_M, P_TOL, P_EPS, P_MAXWIN, P_BAND, P_WLO, P_WHI, P_MINAMP, P_MINFIT, \
@@ -90,10 +91,16 @@ S_W = S_IM + 5           # cached weights of the rule on a uniform stencil (5 x 
 S_WH = S_W + 5 * NH      # step of the cached weights (-1: none)
 S_UNIT = S_WH + 1        # scratch unit vector
 S_FLAST = S_UNIT + NH    # long windows: the segment's first converged half-period estimate
-S_NEXT = S_FLAST + 1     # segment length at which target_std_rel is checked next
+S_DLAST = S_FLAST + 1    # ... and its damping ratio (damped model), where the fit starts
+S_NEXT = S_DLAST + 1     # segment length at which target_std_rel is checked next
 S_RES = S_NEXT + 1       # result of the refinement (core.uncertainty's layout)
 S_WORK = S_RES + U.N_RESULT  # the refinement's scratch
-S_MA = S_WORK + U.N_WORK     # moving-average ring (2M+1 values) starts here
+NBJ = 4                      # band std: prefilter states of the Jacobian's 4 columns
+S_BANDJ = S_WORK + U.N_WORK  # ... (3 sections x (2 states, previous input) each)
+S_JROW = S_BANDJ + 9 * NBJ   # ... the inputs of one step
+S_TAILW = S_JROW + NBJ       # ... the Gramian of the prefilter's free response (9 x 9)
+S_TAILH = S_TAILW + 81       # ... the step it was computed for, and rho(0) = sum g^2
+S_MA = S_TAILH + 2           # moving-average ring (2M+1 values) starts here
 N_STATE_FIXED = S_MA
 
 # ---- estimate row layout --------------------------------------------------------------------
@@ -106,6 +113,8 @@ AUTO_WINDOW_PERIODS = 2.0
 #: of its stds, and never less than this fraction of f (a clean or coarsely sampled signal:
 #: std ~ 0, the algebraic estimate's discretisation error up to ~1e-3)
 MAX_REFINE_MOVE, MIN_REFINE_MOVE_REL = 8.0, 0.02
+#: band std: most steps of the prefilter's free response summed in its Gramian
+MAX_BAND_TAIL = 1 << 22
 
 TWO_PI = 2.0 * math.pi
 #: band-pass prefilter: 4th-order Butterworth low-pass at f_hi (two sections), then a 2nd-order
@@ -190,6 +199,7 @@ def reset_segment(s, c, seg, t0, y0):
     s[S_MOM:S_MOM + 5] = 0.0
     s[S_NF:S_INT + 3] = 0.0
     s[S_FLAST] = 0.0
+    s[S_DLAST] = 0.0
     s[S_NEXT] = 0.0
     c[C_SEG_N] = 1
     c[C_MA_N] = 0
@@ -343,17 +353,18 @@ def _fit(seg, n, omega):
 
 
 @njit(cache=True)
-def _prefilter(p, s, y):
-    """Band-pass the raw sample (never reset by an estimate); returns the filtered value."""
+def _prefilter(p, s, y, xb):
+    """Band-pass one sample through the prefilter whose states are at s[xb:xb+9]; returns the
+    filtered value (the signal's prefilter, at S_BAND, is never reset by an estimate)."""
     u = y
     for k in range(3):
-        x = S_BAND + 3 * k
+        x = xb + 3 * k
         _advance(s, x, S_DISC + 8 * (k + 1), s[x + 2], u)
         s[x + 2] = u
         if k < 2:
             u = s[x]
     # high-pass output from the internal low-pass states: u - x - (2 zeta / w) x'
-    x = S_BAND + 6
+    x = xb + 6
     return u - s[x] - (2.0 * BAND_DAMPING[2] / p[P_WLO]) * s[x + 1]
 
 
@@ -587,6 +598,26 @@ def _store_sample(p, s, c, seg, t, tau, y):
 
 
 @njit(cache=True)
+def _long_window_spanned(p, s, c, m, one_sided, model, tau, f, damping):
+    """Long window (``refine`` and ``min_periods`` >= 1): True once the segment spans
+    ``min_periods`` periods of its first converged half-period estimate.
+
+    That estimate (what the default configuration publishes; the algebraic estimate wanders over
+    many periods) is kept in ``S_FLAST``, with its damping ratio (damped model, clipped to
+    ``max_damping``) in ``S_DLAST``: the refinement starts from both. The algebraic damping of a
+    long segment is meaningless (|zeta| ~ 0.5): started there, a fit once settled in a wrong
+    minimum 27 stds off.
+    """
+    if s[S_FLAST] == 0.0:
+        if _converged(m, one_sided, p[P_TOL], s, c, f) and tau * f >= 0.5:
+            s[S_FLAST] = f
+            s[S_DLAST] = min(max(damping, -p[P_MAXDAMP]), p[P_MAXDAMP]) \
+                if model == MODEL_DAMPED else 0.0
+        return False
+    return tau * s[S_FLAST] >= p[P_MINPER]
+
+
+@njit(cache=True)
 def step(p, s, c, seg, t, y, out, row):
     """Feed one sample; return 1 and fill ``out[row]`` when an estimate is published, else 0.
 
@@ -601,7 +632,7 @@ def step(p, s, c, seg, t, y, out, row):
     if abs(h - s[S_CACHE_H]) > 1e-9 * h:
         _update_discretisations(p, s, h)
     if p[P_BAND] > 0.0:
-        y = _prefilter(p, s, y)
+        y = _prefilter(p, s, y, S_BAND)
     if not _push_history(s, c, seg, t, y):
         return 0
     tau = t - s[S_T0]
@@ -626,24 +657,17 @@ def step(p, s, c, seg, t, y, out, row):
     n_fit = min(nseg + 1, seg.shape[1])
     local_start = True          # the refinement starts at this segment's own algebraic estimate
     if p[P_TARGET] > 0.0:
-        if tau * f < p[P_MINPER] or not _target_reached(p, s, seg, n_fit, model, f, damping, h):
+        if tau * f < p[P_MINPER] or not _target_reached(p, s, seg, n_fit, model, f, damping):
             return 0
     elif p[P_REFINE] > 0.0 and p[P_MINPER] >= 1.0:
-        # long window: its span in periods of the segment's first converged half-period
-        # estimate (what the default configuration publishes; the algebraic estimate wanders
-        # over many periods), from which the fit starts
-        if s[S_FLAST] == 0.0:
-            if _converged(m, one_sided, p[P_TOL], s, c, f) and tau * f >= 0.5:
-                s[S_FLAST] = f
+        if not _long_window_spanned(p, s, c, m, one_sided, model, tau, f, damping):
             return 0
-        if tau * s[S_FLAST] < p[P_MINPER]:
-            return 0
-        f, local_start = s[S_FLAST], False
+        f, damping, local_start = s[S_FLAST], s[S_DLAST], False
     # the segment must span a fraction of the period it estimates
     elif not _converged(m, one_sided, p[P_TOL], s, c, f) or tau * f < p[P_MINPER]:
         return 0
     res = s[S_RES:S_RES + U.N_RESULT]
-    _refine(p, s, seg, n_fit, model, f, damping, h, res)
+    _refine(p, s, seg, n_fit, model, f, damping, res)
     start, f = f, res[U.R_F]
     consistent = True
     if p[P_REFINE] > 0.0 and math.isfinite(res[U.R_FIT]):
@@ -669,11 +693,87 @@ def step(p, s, c, seg, t, y, out, row):
 
 
 @njit(cache=True)
-def _noise_scale(p, f, h):
-    """Residual-variance factor for the band prefilter's coloured noise (1 without it)."""
-    if p[P_BAND] > 0.0:
-        return U.band_noise_scale(f, p[P_WLO] / TWO_PI, p[P_WHI] / TWO_PI, h)
-    return 1.0
+def _tail_gramian(p, s):
+    """W = sum_(k>=1) (C A^k)^T C A^k of the prefilter's free response, and rho(0) = sum g^2.
+
+    The prefilter's 9 states (3 sections x (2 states, previous input)) evolve as X' = A X with
+    output C X' once its input is zero; A and CA are probed with unit states through
+    :func:`_prefilter` itself. Cached for the step of the current discretisation.
+    """
+    if s[S_TAILH] == s[S_CACHE_H]:
+        return
+    base = S_BANDJ
+    a = np.empty((9, 9))
+    v = np.empty(9)
+    for k in range(9):
+        s[base:base + 9] = 0.0
+        s[base + k] = 1.0
+        v[k] = _prefilter(p, s, 0.0, base)
+        a[:, k] = s[base:base + 9]
+    w = s[S_TAILW:S_TAILW + 81].reshape((9, 9))
+    w[:, :] = 0.0
+    peak = 0.0
+    nxt = np.empty(9)
+    for _ in range(MAX_BAND_TAIL):
+        energy = 0.0
+        for i in range(9):
+            energy += v[i] * v[i]
+            for j in range(9):
+                w[i, j] += v[i] * v[j]
+        peak = max(peak, energy)
+        if energy <= 1e-16 * peak:
+            break
+        for j in range(9):
+            acc = 0.0
+            for i in range(9):
+                acc += v[i] * a[i, j]
+            nxt[j] = acc
+        v[:] = nxt
+    s[base:base + 9] = 0.0
+    g0 = _prefilter(p, s, 1.0, base)
+    s[S_TAILH] = s[S_CACHE_H]
+    s[S_TAILH + 1] = g0 * g0 + _quadratic(w, s, base, base)
+
+
+@njit(cache=True)
+def _quadratic(w, s, xi, xj):
+    """s[xi:xi+9]^T w s[xj:xj+9]."""
+    acc = 0.0
+    for i in range(9):
+        for j in range(9):
+            acc += s[xi + i] * w[i, j] * s[xj + j]
+    return acc
+
+
+@njit(cache=True)
+def _band_std(p, s, seg, n, model, res):
+    """With ``band_hz``: the std of the fit under the prefilter's coloured noise (sandwich).
+
+    J^T R J = sum over m of q_m q_m^T with q_m = sum_i g_(i - m) J_i (g: the prefilter's impulse
+    response): the columns of J, time-reversed, filtered by the prefilter from rest, summed over
+    the window, plus the filter's free response after it in closed form (X_i^T W X_j,
+    :func:`_tail_gramian`). Exact on uniform sampling (the prefilter's discretisation at the
+    latest step); :func:`core.uncertainty.coloured_std`.
+    """
+    _tail_gramian(p, s)
+    work = s[S_WORK:S_WORK + U.N_WORK]
+    th, gram = work[0:4], work[12:28].reshape((4, 4))
+    npar = 3 if model == MODEL_SINUSOID else 4
+    s[S_BANDJ:S_JROW + NBJ] = 0.0
+    gram[:, :] = 0.0
+    tc = 0.5 * (seg[0, 0] + seg[0, n - 1])
+    for r in range(n):
+        U.jacobian_row(model, th, seg[0, n - 1 - r] - tc, s[S_JROW:S_JROW + 4])
+        for col in range(npar):
+            s[S_JROW + col] = _prefilter(p, s, s[S_JROW + col], S_BANDJ + 9 * col)
+        for i in range(npar):
+            for j in range(npar):
+                gram[i, j] += s[S_JROW + i] * s[S_JROW + j]
+    w = s[S_TAILW:S_TAILW + 81].reshape((9, 9))
+    for i in range(npar):
+        for j in range(npar):
+            gram[i, j] += _quadratic(w, s, S_BANDJ + 9 * i, S_BANDJ + 9 * j)
+    U.coloured_std(model, n, gram, s[S_TAILH + 1], res, work)
 
 
 @njit(cache=True)
@@ -686,7 +786,7 @@ def _start(model, f, damping):
 
 
 @njit(cache=True)
-def _refine(p, s, seg, n, model, f, damping, h, res):
+def _refine(p, s, seg, n, model, f, damping, res):
     """The estimate to gate and publish: ``res`` = (f, damping, their std), core.uncertainty.
 
     ``refine`` = 0 keeps the paper's algebraic (f, damping) and adds their std; otherwise up to
@@ -696,14 +796,16 @@ def _refine(p, s, seg, n, model, f, damping, h, res):
     w0, sigma0 = _start(model, f, damping)
     iterations = int(p[P_REFINE])
     res[:] = math.nan
-    if not U.refine(model, seg, n, w0, sigma0, iterations, _noise_scale(p, f, h), res,
-                    s[S_WORK:S_WORK + U.N_WORK]) or iterations == 0:
+    fitted = U.refine(model, seg, n, w0, sigma0, iterations, res, s[S_WORK:S_WORK + U.N_WORK])
+    if fitted and p[P_BAND] > 0.0:
+        _band_std(p, s, seg, n, model, res)
+    if not fitted or iterations == 0:
         res[U.R_F] = f
         res[U.R_DAMP] = damping
 
 
 @njit(cache=True)
-def _target_reached(p, s, seg, n, model, f, damping, h):
+def _target_reached(p, s, seg, n, model, f, damping):
     """``target_std_rel``: True once the predicted relative std of f is at or below the target.
 
     The std (the Fisher information of the model over the segment at the algebraic estimate, with
@@ -716,9 +818,10 @@ def _target_reached(p, s, seg, n, model, f, damping, h):
     res = s[S_RES:S_RES + U.N_RESULT]
     res[:] = math.nan
     w0, sigma0 = _start(model, f, damping)
-    if not U.refine(model, seg, n, w0, sigma0, 0, _noise_scale(p, f, h), res,
-                    s[S_WORK:S_WORK + U.N_WORK]):
+    if not U.refine(model, seg, n, w0, sigma0, 0, res, s[S_WORK:S_WORK + U.N_WORK]):
         return False
+    if p[P_BAND] > 0.0:
+        _band_std(p, s, seg, n, model, res)
     return res[U.R_FSTD] <= p[P_TARGET] * f
 
 

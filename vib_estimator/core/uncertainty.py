@@ -30,11 +30,17 @@ variance ``s^2 = RSS / (n - p)`` (p parameters): the exact Cramer-Rao bound of t
 samples with the noise variance estimated from the segment itself. For the damped model the std of
 f_n and zeta follow by the delta method from the (w_d, sigma) block.
 
-Coloured noise: the optional band-pass prefilter leaves white noise white inside its pass band
-but removes it outside, so the residual variance underestimates the noise density at the signal's
-frequency (which is what the Fisher information of a sinusoid depends on). :func:`band_noise_scale`
-restores it with the Butterworth filters' noise-equivalent bandwidth (valid when the window is long
-against the filter's correlation time 1/(f_hi - f_lo)).
+Coloured noise (:func:`coloured_std`): the optional band-pass prefilter turns white input noise w
+(variance N0) into e = F w, whose covariance over the segment is N0 R (R_ij = rho(i - j), the
+autocorrelation of the prefilter's impulse response). The least-squares fit is then still
+unbiased, but ``cov(theta) = N0 G^-1 (J^T R J) G^-1`` (G = J^T J: the sandwich), and the residual
+estimates N0 through ``E[RSS] = N0 (n rho(0) - tr(G^-1 J^T R J))``. The caller supplies
+``J^T R J`` and rho(0) (the kernel filters the Jacobian's columns through the prefilter,
+:func:`jacobian_row`). Over windows long against the filter's correlation time this tends to the
+white-noise bound with the in-band noise density. Over a window short against it the residual has
+a fraction of one degree of freedom (``n rho(0) - tr(...)`` ~ 0.16 over half a period of a
+[f/2, 2f] band), so N0, and the std with it, can only be estimated roughly from the window: with
+the true N0 the sandwich is calibrated there too (RMS error/std 0.98), with the estimated one ~1.7.
 
 Cost: sines and cosines over the segment are advanced by a rotation (exact on uniform sampling,
 resynced every 256 samples and whenever the step changes), the sums of a pass stay in registers,
@@ -50,10 +56,10 @@ from numba import njit
 
 #: values of the kernel's model parameter
 MODEL_SINUSOID, MODEL_BIASED, MODEL_DAMPED = 0, 1, 2
-#: refine() result layout: frequency (Hz), damping ratio, their standard deviations, and the
-#: fitted model's R^2 (about the segment's mean) and amplitude (at the segment's centre)
-R_F, R_DAMP, R_FSTD, R_DSTD, R_FIT, R_AMP = range(6)
-N_RESULT = 6
+#: refine() result layout: frequency (Hz), damping ratio, their standard deviations, the fitted
+#: model's R^2 (about the segment's mean) and amplitude (at the segment's centre), and its RSS
+R_F, R_DAMP, R_FSTD, R_DSTD, R_FIT, R_AMP, R_RSS = range(7)
+N_RESULT = 7
 TWO_PI = 2.0 * math.pi
 _RESYNC = 256
 #: Gauss-Newton stops once the step of the nonlinear parameters is below this fraction of their std
@@ -271,7 +277,7 @@ def _first_prefix(seg, n, npar, w0):
 
 
 @njit(cache=True)
-def refine(model, seg, n, w0, sigma0, iterations, noise_scale, res, work):
+def refine(model, seg, n, w0, sigma0, iterations, res, work):
     """Refine the algebraic estimate over the segment ``seg[:, :n]`` (rows: tau, y); fill ``res``.
 
     ``w0`` (rad/s) and ``sigma0`` (1/s, damped model) start the fit; ``iterations`` Gauss-Newton
@@ -279,11 +285,12 @@ def refine(model, seg, n, w0, sigma0, iterations, noise_scale, res, work):
     continued: first over a prefix of the segment between half a period and a period long (where
     the algebraic estimate is near the bound, well inside the likelihood's main lobe), then over
     prefixes doubling in length up to the whole segment, each started from the last, so the start
-    always lies in the main lobe of the next window's likelihood. ``noise_scale`` multiplies the
-    residual variance (:func:`band_noise_scale`). ``res``: frequency (Hz; the natural frequency
-    for the damped model), damping ratio (NaN unless damped), their std, and (iterations > 0) the
-    fitted model's R^2 and amplitude (:func:`_goodness`). ``work``: ``N_WORK`` floats of scratch.
-    Returns False (res untouched) when no fit is possible.
+    always lies in the main lobe of the next window's likelihood. ``res``: frequency (Hz; the
+    natural frequency for the damped model), damping ratio (NaN unless damped), their std (white
+    noise), the RSS, and (iterations > 0) the fitted model's R^2 and amplitude (:func:`_goodness`).
+    ``work``: ``N_WORK`` floats of scratch; on return it holds the fitted theta and its
+    (J^T J)^-1 (:func:`coloured_std` uses them). Returns False (res untouched) when no fit is
+    possible.
     """
     npar = 3 if model == MODEL_SINUSOID else 4
     if n <= npar + 1 or not w0 > 0.0:
@@ -301,7 +308,8 @@ def refine(model, seg, n, w0, sigma0, iterations, noise_scale, res, work):
         m = n if 4 * m > n else 2 * m
     if rss == math.inf:
         return False
-    _moments_of_result(model, th, cov, rss * noise_scale / (n - npar), res)
+    _moments_of_result(model, th, cov, rss / (n - npar), res)
+    res[R_RSS] = rss
     if iterations > 0:
         _goodness(seg, n, th, rss, res)
     return True
@@ -351,21 +359,40 @@ def _moments_of_result(model, th, cov, s2, res):
 
 
 @njit(cache=True)
-def band_noise_scale(f, f_lo, f_hi, h):
-    """Factor restoring the white-noise density at f from the residual of band-passed samples.
+def jacobian_row(model, th, u, row):
+    """The Jacobian's row at centred time u (the columns of :func:`_accumulate`) into row[:4]."""
+    a, b, w = th[0], th[1], th[2]
+    sig = th[3] if model == MODEL_DAMPED else 0.0
+    e = math.exp(-sig * u)
+    sn, cs = math.sin(w * u), math.cos(w * u)
+    row[0] = e * sn
+    row[1] = e * cs
+    row[2] = u * e * (a * cs - b * sn)
+    row[3] = 1.0 if model == MODEL_BIASED else -u * e * (a * sn + b * cs)
 
-    Band-passed white noise of density N0 has the variance N0 * ENBW (one-sided, the filter's
-    noise-equivalent bandwidth) and the density N0 |H(f)|^2 at f; the Fisher information of a
-    sinusoid needs the latter, i.e. the variance of white noise with that density sampled at 1/h:
-    N0 |H(f)|^2 / (2 h). Butterworth: ENBW = 1.026 f_hi (4th-order low-pass) minus 1.111 f_lo
-    (the band a 2nd-order high-pass removes), |H|^2 = 1/(1 + (f/f_hi)^8) (f/f_lo)^4/(1 + (f/f_lo)^4).
+
+@njit(cache=True)
+def coloured_std(model, n, gram, rho0, res, work):
+    """Replace the std in ``res`` by the sandwich under coloured noise (module docstring).
+
+    ``gram`` = J^T R J at the fitted theta, ``rho0`` = rho(0), ``work`` as :func:`refine` left
+    it (theta and G^-1), ``res[R_RSS]`` the fit's RSS. False (res unchanged) if degenerate.
     """
-    nyquist = 0.5 / h
-    enbw = min(f_hi * (math.pi / 8) / math.sin(math.pi / 8), nyquist) \
-        - f_lo * (math.pi / 4) / math.sin(math.pi / 4)
-    if not enbw > 0.0:
-        return 1.0
-    x_hi = (f / f_hi) ** 8
-    x_lo = (f / f_lo) ** 4
-    gain2 = 1.0 / (1.0 + x_hi) * x_lo / (1.0 + x_lo)
-    return gain2 * nyquist / enbw
+    th, _, _, _, out, gi, _, _ = _workspace(work)
+    npar = 3 if model == MODEL_SINUSOID else 4
+    trace = 0.0
+    for i in range(npar):
+        for j in range(npar):
+            trace += gi[i, j] * gram[j, i]
+    dof = n * rho0 - trace
+    if not dof > 0.0:
+        return False
+    for i in range(npar):
+        for j in range(npar):
+            acc = 0.0
+            for k in range(npar):
+                for m in range(npar):
+                    acc += gi[i, k] * gram[k, m] * gi[m, j]
+            out[i, j] = acc
+    _moments_of_result(model, th, out, res[R_RSS] / dof, res)
+    return True
