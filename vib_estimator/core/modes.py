@@ -21,11 +21,9 @@ How the modes are found and estimated (everything compiled, one call per sample)
   samples when a mode publishes from it, or will as soon as the mode is old enough (its start,
   below), and every scale so while a candidate waits for confirmation and for ``WAKE_N``
   samples after a block of the input jumps in energy (a mode excited: :func:`_wake`); else every
-  ``HOP_IDLE``
-  samples (the search for new modes), ``HOP_TOP`` at level 0 (only it counts poles above
-  0.1 fs). The
-  frequencies work in cycles per sample, converted to Hz with the measured mean interval; gaps up
-  to ``MAX_FILL`` steps are bridged by interpolation.
+  ``HOP_IDLE`` samples (the search for new modes), ``HOP_TOP`` at level 0 (only it counts poles
+  above 0.1 fs). The frequencies work in cycles per sample, converted to Hz with the measured
+  mean interval; gaps up to ``MAX_FILL`` steps are bridged by interpolation.
 * **A pole counts** at a scale when it has ``C_TRACK`` cycles in the window, lies below ``NU_HI``
   cycles per (decimated) sample (the anti-alias edge: ``rejected_band_edge`` otherwise), is damped
   within ``max_damping`` and its energy in the window is ``SIG_TRACK`` above the fit's residual
@@ -72,7 +70,7 @@ NS = 2 * NLEV            # scales
 M_A, M_B = 48, 68        # window lengths of the even and odd scales (level samples)
 NQ = M_B // 3 + 1        # rows of a scale's subspace
 PCOL = 14                # most subspace columns
-HOP = 12                 # level samples between two analyses of a scale that a mode publishes from,
+HOP = 12                 # level samples between two analyses of a scale a mode publishes from,
 HOP_IDLE = 96            # ... of the others at levels >= 1,
 HOP_TOP = 384            # ... of the others at level 0 (above 0.1 fs only level 0 counts a pole)
 DEC_CUTOFF = 0.12        # anti-alias low-pass before each decimation by 2, cycles per sample
