@@ -70,6 +70,25 @@ def test_excited_modes_are_estimated_within_two_periods(seed):
         assert (e.t[near][0] - 1.0) * 8.0 < 2.0
 
 
+def test_a_close_pair_is_estimated_within_two_periods():
+    """Two modes 30 % apart (10 / 13 Hz, 1 : 0.5, SNR 30 dB for the weaker), 5 seeds: over the
+    seeds the median time from the excitation to each mode's first estimate within 2 % is below 2
+    periods of the lower one (the undamped refinement publishes from windows of 1.4 periods; the
+    previous rule waited for 2.6) and the early estimates stay near a mode."""
+    t = np.arange(0, 4, 1 / FS)
+    firsts = []
+    for seed in range(5):
+        phases = np.random.default_rng(seed).uniform(0, 6.28, 2)
+        y = decay(t, 1.0, 10.0, 1.0, 0.003, phases[0]) + \
+            decay(t, 1.0, 13.0, 0.5, 0.003, phases[1]) + noise(t, 0.5 / math.sqrt(2) * 10 ** -1.5,
+                                                               seed)
+        e = ModeTracker(CFG).process(t, y)
+        rel = np.abs(e.frequency_hz[:, None] / np.array([10.0, 13.0]) - 1)
+        assert np.mean(np.min(rel, axis=1) > 0.03) <= 0.05
+        firsts.append([(e.t[rel[:, k] < 0.02][0] - 1.0) * 10.0 for k in range(2)])
+    assert np.all(np.median(firsts, axis=0) < 2.0)
+
+
 def test_a_mode_appears_and_one_disappears():
     t = np.arange(0, 16, 1 / FS)
     first = decay(t, 0.5, 9.0, 1.0, 0.0) * (t < 7.0)          # stops at 7 s (into the noise)

@@ -3,7 +3,8 @@ import numpy as np
 import pytest
 
 from vib_estimator.core.subspace import (R_AMP, R_NU, R_ZETA, analyse, cholesky_solve,
-                                         hankel_cov, init_subspace, poly_roots)
+                                         fit_poles, hankel_cov, init_subspace, poly_roots,
+                                         refine_undamped)
 
 
 def window(m, parts, noise=0.0, seed=0):
@@ -74,3 +75,42 @@ def test_close_sinusoids_in_noise(seed):
 def test_noise_alone_has_few_sinusoids():
     counts = [len(run(np.random.default_rng(s).standard_normal(68))[0]) for s in range(20)]
     assert np.mean(counts) <= 0.2         # the gap rule keeps the noise eigenvalues out
+
+
+def residual_variance(x, poles):
+    return fit_poles(x, poles, np.zeros((len(poles), 4)))[1]
+
+
+def test_undamped_refinement_of_a_close_pair():
+    """1.4 cycles of the lower of two light modes 30 % apart (SNR 30 dB, the weaker), 8 noise
+    seeds: the refined poles lie on the unit circle and fit no worse than an ESPRIT-like start
+    (1.5 % off), two starts reach the same fit, and the frequencies are off by 0.5 % at the median,
+    2 % in most windows (the bound, dampings unknown, is 1.1 / 1.6 % at 1 sigma; the undamped
+    model's outliers at this length are a few %)."""
+    nu = 1.4 / 136
+    errors = []
+    for seed in range(8):
+        parts = [(nu, 0.003, 1.0, 0.4 + seed), (1.3 * nu, 0.003, 0.5, 2.0 - seed)]
+        x = window(136, parts, noise=0.5 / np.sqrt(2) * 10 ** (-30 / 20), seed=seed)
+        fits = []
+        for off in (0.015, -0.01):
+            pair = np.array([np.exp(2j * np.pi * p[0] * (1 + off * (-1) ** k)) * 0.999
+                             for k, p in enumerate(parts)])
+            start = np.concatenate([pair, pair.conj(), [1.0 + 0j]])     # twins, an offset
+            got = refine_undamped(x, start)
+            assert np.all(np.abs(np.abs(got[:2]) - 1) < 1e-12)
+            assert got[4] == start[4] and np.all(got[2:4] == start[2:4])
+            assert residual_variance(x, got) <= residual_variance(x, start)
+            fits.append(np.sort(np.angle(got[:2])) / (2 * np.pi))
+        np.testing.assert_allclose(fits[0], fits[1], rtol=1e-6)
+        errors.append(np.abs(fits[0] / np.array([nu, 1.3 * nu]) - 1))
+    assert np.median(errors) < 0.005
+    assert np.mean(np.array(errors) < 0.02) >= 0.75
+
+
+def test_undamped_refinement_leaves_lone_or_damped_pairs():
+    x = window(68, [(0.03, 0.003, 1.0, 0.3)], noise=0.01)
+    lone = np.array([np.exp(2j * np.pi * 0.031) * 0.99, np.exp(-2j * np.pi * 0.031) * 0.99])
+    assert np.all(refine_undamped(x, lone) == lone)
+    damped = np.array([np.exp(2j * np.pi * 0.03) * 0.99, np.exp(2j * np.pi * 0.039) * 0.5])
+    assert np.all(refine_undamped(x, damped) == damped)    # the second is damped: no pair

@@ -47,6 +47,12 @@ How the modes are found and estimated (everything compiled, one call per sample)
   (``rejected_inconsistent``). The pole that confirms a new mode is its first estimate when its
   window starts after the candidate's first one and it lies within ``CONSISTENCY`` of it. Modes are
   numbered by ascending frequency among the modes that have published.
+* **First estimates**: until its first estimate a mode publishes under ``C_CAP`` even in a close
+  pair, and while the scales are fast after an excitation or the analysed scale is such a mode's,
+  the analysis refines its close pairs as undamped
+  (:func:`vib_estimator.core.subspace.refine_undamped`: with their dampings free, windows under
+  ~1.6 periods cannot tell them apart within 2 %); a first estimate from such a pair needs only
+  ``CONSISTENCY_FIRST``.
 
 Streaming and batch run the same compiled step, so they give the same floats.
 """
@@ -93,7 +99,8 @@ HARMONIC_RATIO = 2.0     # a harmonic's parent is at least this much stronger (a
 SUSPECT_TOL = 0.08       # a pole this near n f of a pole SUSPECT_RATIO times stronger ...
 SUSPECT_RATIO = 3.0
 SUSPECT_CYCLES = 5.0     # ... is a harmonic unless seen over this many cycles
-CONSISTENCY = 0.01       # a published pole lies this close to the mode's previous pole
+CONSISTENCY = 0.01       # a published pole lies this close to the mode's previous pole,
+CONSISTENCY_FIRST = 0.03  # ... a close pair's first one (undamped refinement) this close
 LOSE_PERIODS = 3.0       # a mode unseen for this many of its periods is lost
 N_STEP = 15              # intervals whose median is the grid step
 MAX_FILL = 64            # grid steps interpolated between two samples at most (else a restart)
@@ -214,16 +221,16 @@ def _scale_len(s):
 
 
 @njit(cache=True)
-def _poles(b, ic, qs, lams, pa, s, pp):
-    """Analyse scale s; the poles that count (module docstring) as rows of pp: frequency (Hz),
-    amplitude, damping, cycles in the window, energy / residual variance, frequency std (Hz).
-    Returns (count, R^2)."""
+def _poles(b, ic, qs, lams, pa, s, pp, undamped):
+    """Analyse scale s (its light pairs refined as undamped if ``undamped``); the poles that count
+    (module docstring) as rows of pp: frequency (Hz), amplitude, damping, cycles in the window,
+    energy / residual variance, frequency std (Hz). Returns (count, R^2)."""
     d = s // 2
     m = M_A if s % 2 == 0 else M_B
     npc = int(pa[PA_P])
     rows = np.empty((PCOL, N_R))
     k, var, r2 = analyse(_window(b, ic, d, m), qs[s, :m // 3 + 1, :npc], lams[s, 0, :npc],
-                         lams[s, 1:], EIG_RATIO, rows)
+                         lams[s, 1:], EIG_RATIO, rows, undamped)
     h = b[B_DT] * (1 << d)
     n = 0
     for i in range(k):
@@ -280,6 +287,24 @@ def _cap(sl):
                                                    sl[j, SL_F] / sl[i, SL_F]) < CLOSE_RATIO:
                     cap = C_CAP_CLOSE
     return fmin, cap
+
+
+@njit(cache=True)
+def _first_tol(undamped, pp, n, i):
+    """Consistency a first estimate (pole i of pp[:n]) needs: ``CONSISTENCY_FIRST`` from an
+    undamped refinement (:func:`vib_estimator.core.subspace.refine_undamped`) when another pole
+    lies within ``CLOSE_RATIO`` (a close pair), else ``CONSISTENCY``."""
+    for j in range(n if undamped else 0):
+        if j != i and max(pp[i, 0] / pp[j, 0], pp[j, 0] / pp[i, 0]) < CLOSE_RATIO:
+            return CONSISTENCY_FIRST
+    return CONSISTENCY
+
+
+@njit(cache=True)
+def _mode_cap(sl, k, cap):
+    """Mode k's publishing cap: ``C_CAP`` until its first estimate (a close pair's first estimates
+    come from the undamped refinement of a shorter window), then cap (:func:`_cap`)."""
+    return min(cap, C_CAP) if sl[k, SL_FIRST] == math.inf else cap
 
 
 @njit(cache=True)
@@ -370,7 +395,7 @@ def _admit(ic, sl, pa, f, amp, start, t):
 
 
 @njit(cache=True)
-def _candidates(b, ic, sl, pd, pa, pp, n, used, t, s, r2, out):
+def _candidates(b, ic, sl, pd, pa, pp, n, used, t, s, r2, undamped, out):
     """The poles no mode explains (module docstring): candidates, confirmed or expired. A
     confirming pole whose window starts after the candidate's first one and lies within
     ``CONSISTENCY`` of it is the new mode's first estimate."""
@@ -395,7 +420,7 @@ def _candidates(b, ic, sl, pd, pa, pp, n, used, t, s, r2, out):
             if pd[j, PD_SEEN] < t:
                 k = _admit(ic, sl, pa, f, pp[i, 1], pd[j, PD_START], t)
                 if k >= 0 and start >= pd[j, PD_START] and r2 >= pa[PA_MINFIT] and \
-                        abs(f / pd[j, PD_F] - 1.0) < CONSISTENCY:
+                        abs(f / pd[j, PD_F] - 1.0) < _first_tol(undamped, pp, n, i):
                     _publish(b, ic, sl, k, s, t, pp, i, r2, out)
                 pd[j, PD_SEEN] = -math.inf           # taken: dropped below, not as noise
             continue
@@ -420,9 +445,13 @@ def _candidates(b, ic, sl, pd, pa, pp, n, used, t, s, r2, out):
 def _analysis(b, ic, sl, pd, qs, lams, pa, s, t, out):
     """Scale s's analysis at t: match the modes, publish those it owns, find, lose."""
     pp = np.empty((PCOL, 6))
-    n, r2 = _poles(b, ic, qs, lams, pa, s, pp)
-    used = np.zeros(n, dtype=np.int64)
     fmin, cap = _cap(sl)
+    undamped = ic[I_WAKE] > 0
+    for k in range(KMAX):
+        undamped = undamped or (sl[k, SL_ACTIVE] != 0.0 and sl[k, SL_FIRST] == math.inf and
+                                _owner(b, sl, k, t, fmin, C_CAP)[0] == s)
+    n, r2 = _poles(b, ic, qs, lams, pa, s, pp, undamped)
+    used = np.zeros(n, dtype=np.int64)
     for k in range(KMAX):
         if sl[k, SL_ACTIVE] == 0.0:
             continue
@@ -436,7 +465,7 @@ def _analysis(b, ic, sl, pd, qs, lams, pa, s, t, out):
             continue
         used[best] = 1
         sl[k, SL_SEEN] = t
-        if _owner(b, sl, k, t, fmin, cap)[0] != s:
+        if _owner(b, sl, k, t, fmin, _mode_cap(sl, k, cap))[0] != s:
             continue
         f = pp[best, 0]
         prev = sl[k, SL_PREV]
@@ -447,18 +476,19 @@ def _analysis(b, ic, sl, pd, qs, lams, pa, s, t, out):
             sl[k, SL_FIT] += 1
         elif _harmonic(f, pp[best, 1], pp[best, 3], pp, n, sl):
             sl[k, SL_HARM] += 1
-        elif not abs(f / prev - 1.0) < CONSISTENCY:
+        elif not abs(f / prev - 1.0) < (CONSISTENCY if sl[k, SL_FIRST] < math.inf
+                                        else _first_tol(undamped, pp, n, best)):
             sl[k, SL_INCONS] += 1
         else:
             _publish(b, ic, sl, k, s, t, pp, best, r2, out)
-    _candidates(b, ic, sl, pd, pa, pp, n, used, t, s, r2, out)
+    _candidates(b, ic, sl, pd, pa, pp, n, used, t, s, r2, undamped, out)
     ic[I_BUSY:I_BUSY + NS] = 0
     fmin, cap = _cap(sl)
     for k in range(KMAX):
         if sl[k, SL_ACTIVE] != 0.0 and (t - sl[k, SL_SEEN]) * sl[k, SL_F] > LOSE_PERIODS:
             _remove(ic, sl, k)
         elif sl[k, SL_ACTIVE] != 0.0:
-            for o in _owner(b, sl, k, t, fmin, cap):
+            for o in _owner(b, sl, k, t, fmin, _mode_cap(sl, k, cap)):
                 if o >= 0:
                     ic[I_BUSY + o] = 1
 

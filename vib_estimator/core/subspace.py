@@ -24,6 +24,12 @@ these sizes a call costs more than the arithmetic):
   column per real pole), ``n`` counted back from the window's last sample, fitted to the window by
   least squares; each pair gives its frequency (cycles per sample), damping ratio, amplitude at the
   last sample and energy in the window, the window its residual variance and R^2.
+* **Undamped refinement** (:func:`refine_undamped`, on request): over 1-3 cycles two modes closer
+  than 1.5 in frequency trade their frequencies against their dampings (with the dampings unknown
+  the Cramer-Rao bound of 10 / 13 Hz, 1 : 0.5, SNR 30 dB is 1.1 / 1.6 % at 1.4 periods, 0.23 /
+  0.36 % at 2; with them known 0.25 / 0.38 % at 1.4), so such pairs are moved onto the unit circle
+  and their frequencies refined by Gauss-Newton on the least-squares residual, the amplitudes
+  eliminated (variable projection).
 
 :func:`analyse` chains them and writes one row per pair (``R_NU``, ``R_ZETA``, ``R_AMP``,
 ``R_ENERGY``).
@@ -41,6 +47,11 @@ DECAY_MAX = 12.0      # poles decaying (or growing) more than e^12 over the wind
 REAL_TOL = 1e-7       # |Im z| below this: a real pole
 ROOT_ITER = 40
 ROOT_TOL = 1e-10      # Aberth steps below this: converged
+REFINE_ZETA = 0.1     # pairs damped less than this, with another within REFINE_RATIO in
+REFINE_RATIO = 1.5    # frequency (a close pair), are refined as undamped ...
+REFINE_CYCLES = (1.0, 3.0)  # ... when they hold this many cycles in the window,
+REFINE_ITER = 4       # ... by at most this many Gauss-Newton steps,
+REFINE_STEP = 1e-7    # forward differences of this many radians per sample
 #: reassociated sums (vectorised loops); no assumption about NaN or infinities
 FAST = {'reassoc', 'contract', 'nsz', 'arcp'}
 
@@ -256,14 +267,10 @@ def _basis(m, poles):
 
 
 @njit(cache=True, fastmath=FAST)
-def fit_poles(x, poles, rows):
-    """Least-squares amplitudes of the poles (module docstring); returns (pairs written to rows,
-    residual variance, R^2)."""
+def _lsq(x, basis):
+    """Least-squares coefficients of the basis rows to x and the residual x - basis^T c."""
     m = len(x)
-    basis, kind = _basis(m, poles)
     ncol = basis.shape[0]
-    if ncol == 0 or ncol >= m:
-        return 0, math.nan, math.nan
     gram = np.empty((ncol, ncol))
     bx = np.empty((ncol, 1))
     for i in range(ncol):
@@ -278,14 +285,28 @@ def fit_poles(x, poles, rows):
             v += basis[i, n] * x[n]
         bx[i, 0] = v
     c = cholesky_solve(gram, bx)[:, 0]
+    res = x.copy()
+    for n in range(m):
+        for i in range(ncol):
+            res[n] -= basis[i, n] * c[i]
+    return c, res
+
+
+@njit(cache=True, fastmath=FAST)
+def fit_poles(x, poles, rows):
+    """Least-squares amplitudes of the poles (module docstring); returns (pairs written to rows,
+    residual variance, R^2)."""
+    m = len(x)
+    basis, kind = _basis(m, poles)
+    ncol = basis.shape[0]
+    if ncol == 0 or ncol >= m:
+        return 0, math.nan, math.nan
+    c, res = _lsq(x, basis)
     mean = np.mean(x)
     total = 0.0
     rss = 0.0
     for n in range(m):
-        v = x[n]
-        for i in range(ncol):
-            v -= basis[i, n] * c[i]
-        rss += v * v
+        rss += res[n] * res[n]
         total += (x[n] - mean) ** 2
     npair = 0
     col = 0
@@ -305,6 +326,114 @@ def fit_poles(x, poles, rows):
     return npair, rss / (m - ncol), 1.0 - rss / total if total > 0.0 else math.nan
 
 
+# ---- undamped refinement of a short window (the first estimates of a close pair) --------------
+@njit(cache=True)
+def _circle_residual(x, poles, idx, theta):
+    """Residual of the least-squares fit of x with poles[idx[i]] replaced by e^(j theta[i])
+    (undamped); empty when the basis is degenerate."""
+    z = poles.copy()
+    for i in range(len(idx)):
+        z[idx[i]] = math.cos(theta[i]) + 1j * math.sin(theta[i])
+    basis = _basis(len(x), z)[0]
+    if basis.shape[0] == 0 or basis.shape[0] >= len(x):
+        return np.empty(0)
+    return _lsq(x, basis)[1]
+
+
+@njit(cache=True)
+def _close_pairs(poles, m):
+    """Indices of the poles refined over m samples (:func:`refine_undamped`): upper pairs damped
+    below ``REFINE_ZETA`` with ``REFINE_CYCLES`` in the window and another such within
+    ``REFINE_RATIO`` in frequency."""
+    light = np.empty(len(poles), dtype=np.int64)
+    k = 0
+    for i in range(len(poles)):
+        z = poles[i]
+        if z.imag > REAL_TOL and abs(z) > 0.0:
+            lz = np.log(z)
+            cycles = lz.imag * m / (2.0 * math.pi)
+            if abs(lz.real) < REFINE_ZETA * abs(lz) and \
+                    REFINE_CYCLES[0] <= cycles <= REFINE_CYCLES[1]:
+                light[k] = i
+                k += 1
+    close = np.empty(k, dtype=np.int64)
+    nc = 0
+    for i in range(k):
+        for j in range(k):
+            a = np.angle(poles[light[i]]) / np.angle(poles[light[j]])
+            if i != j and max(a, 1.0 / a) < REFINE_RATIO:
+                close[nc] = light[i]
+                nc += 1
+                break
+    return close[:nc]
+
+
+@njit(cache=True, fastmath=FAST)
+def _gauss_newton_step(jac, res):
+    """The step d minimising |res + jac d| (normal equations, written out)."""
+    m, k = jac.shape
+    a = np.empty((k, k))
+    g = np.empty((k, 1))
+    for i in range(k):
+        for j in range(i + 1):
+            v = 0.0
+            for n in range(m):
+                v += jac[n, i] * jac[n, j]
+            a[i, j] = v
+            a[j, i] = v
+        v = 0.0
+        for n in range(m):
+            v -= jac[n, i] * res[n]
+        g[i, 0] = v
+    return cholesky_solve(a, g)[:, 0]
+
+
+@njit(cache=True)
+def refine_undamped(x, poles):
+    """The close pairs of poles (:func:`_close_pairs`) moved onto the unit circle, their angles
+    refined by Gauss-Newton on the variable-projection residual of window x
+    (amplitudes eliminated, Jacobian by forward differences), a step kept only if it
+    lowers the residual sum of squares; returns the new poles, or poles themselves when the
+    refined fit is not better than the undamped start (the fallback: ESPRIT's poles)."""
+    idx = _close_pairs(poles, len(x))
+    k = len(idx)
+    if k == 0:
+        return poles
+    theta = np.empty(k)
+    for i in range(k):
+        theta[i] = np.angle(poles[idx[i]])
+    res = _circle_residual(x, poles, idx, theta)
+    if len(res) == 0:
+        return poles
+    rss = np.sum(res * res)
+    rss0 = rss
+    jac = np.empty((len(x), k))
+    for _ in range(REFINE_ITER):
+        for i in range(k):
+            up = theta.copy()
+            up[i] += REFINE_STEP
+            ru = _circle_residual(x, poles, idx, up)
+            if len(ru) == 0:
+                return poles
+            jac[:, i] = (ru - res) / REFINE_STEP
+        step = _gauss_newton_step(jac, res)
+        trial = theta + step
+        rt = _circle_residual(x, poles, idx, trial)
+        if len(rt) == 0 or not np.sum(rt * rt) < rss:
+            break
+        theta = trial
+        res = rt
+        rss = np.sum(rt * rt)
+        if np.max(np.abs(step)) < ROOT_TOL:
+            break
+    if not rss < rss0:
+        return poles
+    z = poles.copy()
+    for i in range(k):
+        z[idx[i]] = math.cos(theta[i]) + 1j * math.sin(theta[i])
+    return z
+
+
 @njit(cache=True)
 def init_subspace(q):
     """A start for the orthogonal iteration: orthonormal cosines of spread frequencies."""
@@ -316,10 +445,11 @@ def init_subspace(q):
 
 
 @njit(cache=True)
-def analyse(x, q, lam, roots, ratio, rows):
+def analyse(x, q, lam, roots, ratio, rows, undamped=False):
     """The damped sinusoids of window x (module docstring), updating its scale's subspace q,
-    eigenvalues lam and poles roots (rows re and im, NaN: none): (pairs in rows, residual variance,
-    R^2); (0, nan, nan) for none."""
+    eigenvalues lam and poles roots (rows re and im, NaN: none), their lightly damped pairs
+    refined as undamped (:func:`refine_undamped`) if ``undamped``: (pairs in rows, residual
+    variance, R^2); (0, nan, nan) for none."""
     lag = len(x) // 3
     n = lag + 1
     r = np.empty((n, n))
@@ -332,4 +462,5 @@ def analyse(x, q, lam, roots, ratio, rows):
         p += 1
     if p == 0:
         return 0, math.nan, math.nan
-    return fit_poles(x, poly_roots(esprit_poly(qt, n, p), roots), rows)
+    poles = poly_roots(esprit_poly(qt, n, p), roots)
+    return fit_poles(x, refine_undamped(x, poles) if undamped else poles, rows)
