@@ -267,8 +267,8 @@ def _basis(m, poles):
 
 
 @njit(cache=True, fastmath=FAST)
-def _lsq(x, basis):
-    """Least-squares coefficients of the basis rows to x and the residual x - basis^T c."""
+def _normal_solve(basis, x):
+    """Least-squares coefficients c of the basis rows (ncol x m) to x: (B B^T) c = B x."""
     m = len(x)
     ncol = basis.shape[0]
     gram = np.empty((ncol, ncol))
@@ -284,10 +284,16 @@ def _lsq(x, basis):
         for n in range(m):
             v += basis[i, n] * x[n]
         bx[i, 0] = v
-    c = cholesky_solve(gram, bx)[:, 0]
+    return cholesky_solve(gram, bx)[:, 0]
+
+
+@njit(cache=True, fastmath=FAST)
+def _lsq(x, basis):
+    """Least-squares coefficients of the basis rows to x and the residual x - basis^T c."""
+    c = _normal_solve(basis, x)
     res = x.copy()
-    for n in range(m):
-        for i in range(ncol):
+    for n in range(len(x)):
+        for i in range(basis.shape[0]):
             res[n] -= basis[i, n] * c[i]
     return c, res
 
@@ -370,22 +376,8 @@ def _close_pairs(poles, m):
 
 @njit(cache=True, fastmath=FAST)
 def _gauss_newton_step(jac, res):
-    """The step d minimising |res + jac d| (normal equations, written out)."""
-    m, k = jac.shape
-    a = np.empty((k, k))
-    g = np.empty((k, 1))
-    for i in range(k):
-        for j in range(i + 1):
-            v = 0.0
-            for n in range(m):
-                v += jac[n, i] * jac[n, j]
-            a[i, j] = v
-            a[j, i] = v
-        v = 0.0
-        for n in range(m):
-            v -= jac[n, i] * res[n]
-        g[i, 0] = v
-    return cholesky_solve(a, g)[:, 0]
+    """The step d minimising |res + jac^T d| (``jac``: one row per parameter)."""
+    return -_normal_solve(jac, res)
 
 
 @njit(cache=True)
@@ -407,7 +399,7 @@ def refine_undamped(x, poles):
         return poles
     rss = np.sum(res * res)
     rss0 = rss
-    jac = np.empty((len(x), k))
+    jac = np.empty((k, len(x)))
     for _ in range(REFINE_ITER):
         for i in range(k):
             up = theta.copy()
@@ -415,7 +407,7 @@ def refine_undamped(x, poles):
             ru = _circle_residual(x, poles, idx, up)
             if len(ru) == 0:
                 return poles
-            jac[:, i] = (ru - res) / REFINE_STEP
+            jac[i, :] = (ru - res) / REFINE_STEP
         step = _gauss_newton_step(jac, res)
         trial = theta + step
         rt = _circle_residual(x, poles, idx, trial)
