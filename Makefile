@@ -36,6 +36,7 @@ bench-all: bench
 	$(VENV)/bin/python benchmarks/bench_precision.py
 	$(VENV)/bin/python benchmarks/bench_target.py
 	$(VENV)/bin/python benchmarks/bench_modes.py
+	$(VENV)/bin/python benchmarks/bound_modes.py
 	$(VENV)/bin/python benchmarks/bench_survey.py
 	$(VENV)/bin/python benchmarks/real_data.py
 
