@@ -16,12 +16,13 @@ from scipy.stats import norm
 
 from vib_estimator.analysis.bounds import model_crb
 from vib_estimator.core import EstimatorConfig, FrequencyEstimator
+from vib_estimator.core.kernel import NH
 from vib_estimator.sim.signals import fig1_signal
 
 TS, OMEGA, SEEDS = 0.002, 10.0, 100
 F0 = OMEGA / (2 * math.pi)
 SD = 0.01 / math.sqrt(3)          # uniform noise in [-0.01, 0.01]
-FIRST = 7                         # first sample of the first segment (stencil of 8)
+FIRST = NH - 1                    # first sample of the first segment (once the stencil is full)
 
 
 def main() -> None:

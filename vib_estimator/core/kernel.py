@@ -757,7 +757,7 @@ def _band_std(p, s, seg, n, model, res):
     """
     _tail_gramian(p, s)
     work = s[S_WORK:S_WORK + U.N_WORK]
-    th, gram = work[0:4], work[12:28].reshape((4, 4))
+    th, _, _, gram, _, _, _, _ = U._workspace(work)      # J^T J's scratch, free after the fit
     npar = 3 if model == MODEL_SINUSOID else 4
     s[S_BANDJ:S_JROW + NBJ] = 0.0
     gram[:, :] = 0.0
@@ -786,6 +786,20 @@ def _start(model, f, damping):
 
 
 @njit(cache=True)
+def _fit_with_std(p, s, seg, n, model, f, damping, iterations, res):
+    """``iterations`` Gauss-Newton steps of the model over the segment from the algebraic (f,
+    damping) and the std of the result (:func:`core.uncertainty.refine`; with ``band_hz`` the
+    coloured-noise std, :func:`_band_std`) into ``res``; False if no fit is possible."""
+    w0, sigma0 = _start(model, f, damping)
+    res[:] = math.nan
+    if not U.refine(model, seg, n, w0, sigma0, iterations, res, s[S_WORK:S_WORK + U.N_WORK]):
+        return False
+    if p[P_BAND] > 0.0:
+        _band_std(p, s, seg, n, model, res)
+    return True
+
+
+@njit(cache=True)
 def _refine(p, s, seg, n, model, f, damping, res):
     """The estimate to gate and publish: ``res`` = (f, damping, their std), core.uncertainty.
 
@@ -793,13 +807,8 @@ def _refine(p, s, seg, n, model, f, damping, res):
     ``refine`` Gauss-Newton steps of the model over the segment replace them (the quality gate
     then judges the refined frequency).
     """
-    w0, sigma0 = _start(model, f, damping)
     iterations = int(p[P_REFINE])
-    res[:] = math.nan
-    fitted = U.refine(model, seg, n, w0, sigma0, iterations, res, s[S_WORK:S_WORK + U.N_WORK])
-    if fitted and p[P_BAND] > 0.0:
-        _band_std(p, s, seg, n, model, res)
-    if not fitted or iterations == 0:
+    if not _fit_with_std(p, s, seg, n, model, f, damping, iterations, res) or iterations == 0:
         res[U.R_F] = f
         res[U.R_DAMP] = damping
 
@@ -816,13 +825,8 @@ def _target_reached(p, s, seg, n, model, f, damping):
         return False
     s[S_NEXT] = max(n + 1.0, n * (1.0 + 1.0 / 16.0)) if n >= 64 else n + 1.0
     res = s[S_RES:S_RES + U.N_RESULT]
-    res[:] = math.nan
-    w0, sigma0 = _start(model, f, damping)
-    if not U.refine(model, seg, n, w0, sigma0, 0, res, s[S_WORK:S_WORK + U.N_WORK]):
-        return False
-    if p[P_BAND] > 0.0:
-        _band_std(p, s, seg, n, model, res)
-    return res[U.R_FSTD] <= p[P_TARGET] * f
+    return _fit_with_std(p, s, seg, n, model, f, damping, 0, res) and \
+        res[U.R_FSTD] <= p[P_TARGET] * f
 
 
 @njit(cache=True)

@@ -376,7 +376,8 @@ def coloured_std(model, n, gram, rho0, res, work):
     """Replace the std in ``res`` by the sandwich under coloured noise (module docstring).
 
     ``gram`` = J^T R J at the fitted theta, ``rho0`` = rho(0), ``work`` as :func:`refine` left
-    it (theta and G^-1), ``res[R_RSS]`` the fit's RSS. False (res unchanged) if degenerate.
+    it (theta and G^-1), ``res[R_RSS]`` the fit's RSS. A degenerate case (no residual degree of
+    freedom left) gives NaN stds: the white-noise ones would be wrong, not merely rough.
     """
     th, _, _, _, out, gi, _, _ = _workspace(work)
     npar = 3 if model == MODEL_SINUSOID else 4
@@ -386,7 +387,8 @@ def coloured_std(model, n, gram, rho0, res, work):
             trace += gi[i, j] * gram[j, i]
     dof = n * rho0 - trace
     if not dof > 0.0:
-        return False
+        res[R_FSTD] = res[R_DSTD] = math.nan
+        return
     for i in range(npar):
         for j in range(npar):
             acc = 0.0
@@ -395,4 +397,3 @@ def coloured_std(model, n, gram, rho0, res, work):
                     acc += gi[i, k] * gram[k, m] * gi[m, j]
             out[i, j] = acc
     _moments_of_result(model, th, out, res[R_RSS] / dof, res)
-    return True
