@@ -20,6 +20,8 @@ COMMANDS = {
     'compare': ('vib_estimator.analysis.compare', 'algebraic vs adaptive/FFT estimators (Table 2, Figs. 6-7, '
                 'Cramer-Rao bound)'),
     'demo': ('vib_estimator.demo', 'live demo: simulator + estimator node, three tip masses'),
+    'warmup': ('vib_estimator.analysis.warm', 'compile the estimator kernels now (make setup runs it; '
+               'a first start then takes a second, not half a minute)'),
     'reindex': ('vib_estimator.io.reindex', 'rebuild the metadata.yaml of a rosbag2 directory from its '
                 'storage files (repairs a cut last MCAP file)'),
 }

@@ -27,6 +27,7 @@ from __future__ import annotations
 import importlib
 import sys
 import time
+from typing import Optional
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from rcl_interfaces.msg import SetParametersResult
@@ -42,7 +43,7 @@ from ..io.fields import check_component, check_input_type, component_getter, has
 from . import health as H
 from .parameters import config_of, config_value, declare_config, declare_input
 from .runner import StartupError, run
-from .stream import EstimatorStream
+from .stream import WARMUP_BUFFER, WARMUP_MESSAGE, EstimatorStream
 
 #: input history: sensor-data QoS (best effort) but 1000 deep instead of 5, so that a scheduling
 #: hiccup of up to 2 s at 500 Hz, or a player's burst after a stall, drops nothing
@@ -50,6 +51,9 @@ from .stream import EstimatorStream
 INPUT_DEPTH = 1000
 #: period of /diagnostics, s
 DIAGNOSTICS_PERIOD = 1.0
+#: how often the end of a warm-up is looked for, and after how long it is announced, s
+WARMUP_POLL = 0.05
+WARMUP_NOTICE = 1.0
 #: the ROS parameters that configure the core, one per EstimatorConfig field
 CORE_NAMES = frozenset(EstimatorConfig.names())
 #: the Float64 outputs of each estimate, in publication order: (topic under vibration/, field)
@@ -118,10 +122,11 @@ class EstimatorNode(Node):
             self._component = check_component(self.get_parameter('component').value,
                                               self._input_type)
             self._value = component_getter(self._component, self._input_type)
-            self._stream = EstimatorStream(config_of(self), time.monotonic())
+            self._stream = EstimatorStream(config_of(self), time.monotonic(), background=True)
         except ValueError as err:
             raise StartupError(str(err)) from None
         self._feed = self._stream.feed     # bound once (data path)
+        self._ready = self._stream.ready
         self._clock = self.get_clock()
         self._outputs = Outputs(self)
         self._outputs.set_modes(self._stream.config.modes)
@@ -136,8 +141,11 @@ class EstimatorNode(Node):
         self.create_service(Trigger, '~/self_test', self._on_self_test)
         self._diagnostics_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
         # on the steady clock: diagnostics go on (and can say STALE) when sim time stops
-        self.create_timer(DIAGNOSTICS_PERIOD, self._publish_diagnostics,
-                          clock=Clock(clock_type=ClockType.STEADY_TIME))
+        steady = Clock(clock_type=ClockType.STEADY_TIME)
+        self.create_timer(DIAGNOSTICS_PERIOD, self._publish_diagnostics, clock=steady)
+        # while the kernels compile (a first start: see .stream), look for the end of the warm-up
+        self._warmup_timer = self.create_timer(WARMUP_POLL, self._poll_warmup, clock=steady)
+        self._warmup_logged = False
         self.get_logger().info(f'estimating on {self._subscription.topic_name} '
                                f'({self._input_type} [{self._component}]) with '
                                f'{self._stream.config}')
@@ -164,6 +172,10 @@ class EstimatorNode(Node):
         self._value = component_getter(self._component, self._input_type)
         self._stream.configure(config_of(self))
         self._outputs.set_modes(self._stream.config.modes)
+        self._ready = self._stream.ready
+        if not self._ready:
+            self._warmup_logged = False
+            self._warmup_timer.reset()
         self.get_logger().info(f'parameters {", ".join(sorted(names))} changed: estimator '
                                f'restarted on [{self._component}] with {self._stream.config}')
 
@@ -177,6 +189,9 @@ class EstimatorNode(Node):
         header = msg.header
         if header.stamp.sec == 0 and header.stamp.nanosec == 0:
             self._replace_zero_stamp(header)
+        if not self._ready:
+            self._hold(stamp_ns(header), value, header)
+            return
         estimates = self._feed(stamp_ns(header), value)
         if estimates:
             self._publish(estimates, header)
@@ -187,6 +202,9 @@ class EstimatorNode(Node):
         handle = self._clock.handle
         with handle:
             now = handle.get_now().nanoseconds
+        if not self._ready:
+            self._hold(now, self._value(msg), None)
+            return
         estimates = self._feed(now, self._value(msg))
         if estimates:
             self._publish(estimates, Header(stamp=Time(nanoseconds=now).to_msg()))
@@ -196,6 +214,41 @@ class EstimatorNode(Node):
         for estimate in estimates:
             self._outputs.publish(estimate, header)
             self._stream.published(estimate, time.monotonic())
+
+    # ---- warm-up (the kernels compile in a thread; see .stream) -------------------------------
+    def _hold(self, stamp: int, value: float, header: Optional[Header]) -> None:
+        """Keep a sample until the kernels are ready (the first drop is logged once)."""
+        if self._stream.hold(stamp, value, header):
+            self.get_logger().warn(
+                f'{self._subscription.topic_name}: more than {WARMUP_BUFFER} samples arrived '
+                'while the estimator kernels compiled: the oldest are dropped (counted as '
+                'dropped_warmup; `vib-estimator warmup` compiles them ahead of a start)')
+
+    def _poll_warmup(self) -> None:
+        """At the end of a warm-up: install the estimator, estimate on the held samples (in order)
+        and say how long it took."""
+        try:
+            drained = self._stream.poll()
+        except Exception as err:     # a compile that failed: say so, never a silent node
+            self._warmup_timer.cancel()
+            self.get_logger().error(f'the estimator kernels failed to compile: {err}')
+            raise StartupError(f'the estimator kernels failed to compile: {err}') from None
+        if drained is None:
+            if not self._warmup_logged and \
+                    self._stream.warmup_elapsed(time.monotonic()) > WARMUP_NOTICE:
+                self._warmup_logged = True
+                self.get_logger().info(f'{WARMUP_MESSAGE}: samples are held until they are '
+                                       'ready (`vib-estimator warmup` compiles them ahead)')
+            return
+        self._warmup_timer.cancel()
+        held = self._stream.held_samples
+        for header, estimates in drained:
+            self._publish(estimates, header if header is not None else
+                          Header(stamp=Time(nanoseconds=self._stream.origin).to_msg()))
+        self._ready = True
+        self.get_logger().info(f'estimator kernels ready after {self._stream.warmup_seconds:.1f} s'
+                               f' ({held} samples held meanwhile, '
+                               f'{self._stream.health.node_counters["dropped_warmup"]} dropped)')
 
     def _replace_zero_stamp(self, header: Header) -> None:
         """Stamp a message that came without one with its receipt time (node clock)."""
@@ -215,10 +268,8 @@ class EstimatorNode(Node):
     # ---- services --------------------------------------------------------------------------
     def _on_reset(self, request, response):
         """``~/reset``: start a new segment at the last sample; counters kept."""
-        self._stream.reset()
-        response.success = True
-        response.message = 'new segment started'
-        self.get_logger().info('reset requested: new segment started')
+        response.success, response.message = self._stream.reset()
+        self.get_logger().info(f'reset requested: {response.message}')
         return response
 
     def _on_self_test(self, request, response):

@@ -25,8 +25,10 @@ HELD_BACK = ('rejected_at_rest', 'rejected_fit', 'rejected_nyquist', 'rejected_d
              'max_window_resets')
 #: the node's own counters: zero header stamps replaced by the receipt time; JointState messages
 #: without the configured joint (skipped); samples received while ``band_hz`` reached above the
-#: Nyquist frequency of the input's sampling rate
-NODE_COUNTERS = ('zero_stamps_replaced', 'skipped_joint_missing', 'band_above_nyquist')
+#: Nyquist frequency of the input's sampling rate; samples dropped while the kernels compiled (the
+#: oldest beyond the warm-up buffer of :mod:`.stream`)
+NODE_COUNTERS = ('zero_stamps_replaced', 'skipped_joint_missing', 'band_above_nyquist',
+                 'dropped_warmup')
 
 
 @dataclass(frozen=True)

@@ -5,45 +5,117 @@ the stamp time base (``t = seconds_since(stamp, first stamp)``, exactly as the o
 ``vib-estimator analyze``), the estimator of the live configuration (``create_estimator``: one
 :class:`~vib_estimator.core.FrequencyEstimator`, or a mode tracker with ``modes`` >= 1; replaced
 on a change of configuration, its counters kept), and the :class:`~.health.Health` bookkeeping.
+
+Warm-up. A configuration whose kernels are not compiled in this process yet (the first start, or a
+change to a configuration that runs other kernels) is built in a background thread
+(:func:`~vib_estimator.core.warmup.warm`: seconds from numba's cache, tens of seconds on a first
+start after an install). Meanwhile :attr:`EstimatorStream.ready` is False, the node stays live
+(services, diagnostics) and :meth:`EstimatorStream.hold` keeps the samples that arrive, in order,
+up to :data:`WARMUP_BUFFER` (the oldest beyond it are dropped and counted in ``dropped_warmup``);
+:meth:`EstimatorStream.poll` installs the estimator once it is built and feeds it the held samples.
 """
 from __future__ import annotations
 
-from typing import Dict, Sequence, Tuple
+import threading
+import time
+from collections import deque
+from typing import Any, Dict, Iterator, Optional, Sequence, Tuple
 
 from ..core.config import EstimatorConfig
-from ..core.estimator import Estimate
+from ..core.estimator import COUNTER_NAMES, Estimate
 from ..core.modes import create_estimator
+from ..core.warmup import is_warm, warm
 from ..io.fields import seconds_since
-from .health import Health, Status
+from .health import WARN, Health, Status
 from .self_test import self_test
 
 _NONE: Tuple[Estimate, ...] = ()
+#: the core counters while no estimator runs (a warm-up): nothing received yet
+_IDLE_COUNTERS = dict.fromkeys(COUNTER_NAMES, 0)
+#: samples held while the kernels compile: a minute at 1 kHz (a cold compile takes seconds)
+WARMUP_BUFFER = 60_000
+#: the diagnostics message while the kernels compile
+WARMUP_MESSAGE = 'compiling estimator kernels (first start)'
+
+
+class _Build:
+    """An estimator of ``config`` built in a daemon thread (its kernels compiled first)."""
+
+    def __init__(self, config: EstimatorConfig):
+        self.config = config
+        self.started = time.monotonic()
+        self.seconds = 0.0
+        self.estimator = None
+        self.error: Optional[BaseException] = None
+        self._thread = threading.Thread(target=self._run, name='vib_estimator warm-up',
+                                        daemon=True)
+        self._thread.start()
+
+    def _run(self) -> None:
+        try:
+            warm(self.config)
+            self.estimator = create_estimator(self.config)
+        except Exception as err:       # reported by the node, never lost in a thread
+            self.error = err
+        self.seconds = time.monotonic() - self.started
+
+    @property
+    def done(self) -> bool:
+        return not self._thread.is_alive()
 
 
 class EstimatorStream:
-    """Samples in, estimates out, with the node's counters and status (see the module doc)."""
+    """Samples in, estimates out, with the node's counters and status (see the module doc).
 
-    def __init__(self, config: EstimatorConfig, now: float):
+    ``background``: build an estimator whose kernels are not compiled yet in a thread (the node);
+    False builds it at once (tests, tools).
+    """
+
+    def __init__(self, config: EstimatorConfig, now: float, background: bool = False):
+        config.validate()
         self.health = Health(now)
         self.origin = None     # first stamp, ns: t = 0
         self.last_t = None     # time of the last sample, s
         self.estimator = None
+        self._config = config
+        self._background = background
+        self._build: Optional[_Build] = None
+        self._held: deque = deque()
+        #: seconds the last warm-up took (None before one ended)
+        self.warmup_seconds: Optional[float] = None
         self.configure(config)
 
     @property
     def config(self) -> EstimatorConfig:
-        return self.estimator.config
+        """The live configuration (the one being built during a warm-up)."""
+        return self._config
+
+    @property
+    def ready(self) -> bool:
+        """False while a configuration's kernels compile (samples are held, not estimated)."""
+        return self._build is None
 
     def configure(self, config: EstimatorConfig) -> None:
-        """A fresh estimator of ``config`` (a new segment, same time origin, counters kept)."""
+        """A fresh estimator of ``config`` (a new segment, same time origin, counters kept); built
+        in the background when its kernels are not compiled yet and ``background`` was asked."""
         if self.estimator is not None:
             self.health.absorb(self.estimator.counters)
-        self.estimator = create_estimator(config)
-        self._update = self.estimator.update     # bound once: the data path's one call
+            self.estimator = None
+        self._config = config
         self.health.forget_modes(config.modes)
+        if self._background and not is_warm(config):
+            self._build = _Build(config)
+        else:
+            self._install(create_estimator(config))
+
+    def _install(self, estimator) -> None:
+        self.estimator = estimator
+        self._update = estimator.update     # bound once: the data path's one call
+        self._build = None
 
     def feed(self, stamp_ns: int, value: float) -> Sequence[Estimate]:
-        """One sample (stamp in integer ns); the estimates it completes (usually none)."""
+        """One sample (stamp in integer ns); the estimates it completes (usually none).
+        Only while :attr:`ready` (see :meth:`hold`)."""
         if self.origin is None:
             self.origin = stamp_ns
         self.last_t = t = seconds_since(stamp_ns, self.origin)
@@ -52,6 +124,48 @@ class EstimatorStream:
             return _NONE
         return result if isinstance(result, list) else (result,)
 
+    @property
+    def held_samples(self) -> int:
+        """Samples held, waiting for the end of the warm-up."""
+        return len(self._held)
+
+    def warmup_elapsed(self, now: float) -> float:
+        """Seconds since the running warm-up started (0 when ready)."""
+        return 0.0 if self._build is None else now - self._build.started
+
+    def hold(self, stamp_ns: int, value: float, tag: Any = None) -> bool:
+        """Keep a sample that arrived during a warm-up, with ``tag`` (the node's header), until
+        :meth:`poll`; True when this is the first sample dropped (the buffer is full: the oldest
+        goes), so the caller can warn once."""
+        held = self._held
+        held.append((stamp_ns, value, tag))
+        if len(held) > WARMUP_BUFFER:
+            held.popleft()
+            return self.health.count('dropped_warmup') == 1
+        return False
+
+    def poll(self) -> Optional[Iterator[Tuple[Any, Sequence[Estimate]]]]:
+        """None while the warm-up goes on (or when there is none); once it has ended, install the
+        estimator and return an iterator of (tag, estimates) over the held samples, in order,
+        for those that complete estimates. Raises the build's error if it failed."""
+        build = self._build
+        if build is None or not build.done:
+            return None
+        if build.error is not None:
+            self._build = None
+            raise build.error
+        self.warmup_seconds = build.seconds
+        self._install(build.estimator)
+        return self._drain()
+
+    def _drain(self) -> Iterator[Tuple[Any, Sequence[Estimate]]]:
+        held = self._held
+        while held:
+            stamp_ns, value, tag = held.popleft()
+            estimates = self.feed(stamp_ns, value)
+            if estimates:
+                yield tag, estimates
+
     def published(self, estimate: Estimate, now: float) -> None:
         """``estimate`` was published at ``now`` (monotonic s)."""
         self.health.record(estimate, now, self.counters)
@@ -59,17 +173,28 @@ class EstimatorStream:
     @property
     def counters(self) -> Dict[str, int]:
         """The core counters since start (across configurations) and the node's own."""
-        return self.health.totals(self.estimator.counters)
+        core = self.estimator.counters if self.estimator is not None else _IDLE_COUNTERS
+        return self.health.totals(core)
 
     def status(self, now: float) -> Status:
         """The diagnostics status at ``now`` (monotonic s)."""
+        if not self.ready:
+            values: Dict[str, object] = {'warmup_s': self.warmup_elapsed(now),
+                                         'held_samples': self.held_samples, **self.counters}
+            return Status(WARN, WARMUP_MESSAGE, values)
         config = self.config
         return self.health.status(now, self.counters, self.last_t, config.band_hz, config.modes)
 
-    def reset(self) -> None:
-        """Start a new segment at the last sample; counters kept."""
+    def reset(self) -> Tuple[bool, str]:
+        """Start a new segment at the last sample; counters kept. (False, why) during a warm-up."""
+        if not self.ready:
+            return False, f'not ready: {WARMUP_MESSAGE}; the held samples start the first segment'
         self.estimator.reset()
+        return True, 'new segment started'
 
     def self_test(self) -> Tuple[bool, str]:
-        """:func:`~.self_test.self_test` of the live configuration at the input's sampling rate."""
+        """:func:`~.self_test.self_test` of the live configuration at the input's sampling rate;
+        (False, busy) during a warm-up."""
+        if not self.ready:
+            return False, f'busy: {WARMUP_MESSAGE}'
         return self_test(self.config, self.health.sample_rate_hz)
