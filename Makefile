@@ -15,6 +15,9 @@ $(STAMP): requirements.txt setup.py setup.cfg package.xml
 	@# setup.cfg puts the executables where ros2 run looks (<prefix>/lib/vib_estimator); link them
 	@# into .venv/bin as well so they are on the PATH of an activated environment.
 	for exe in $(VENV)/lib/vib_estimator/*; do ln -sf ../lib/vib_estimator/$$(basename $$exe) $(VENV)/bin/; done
+	@# compile the estimator kernels once, now, into numba's cache (a first node start then takes
+	@# a second instead of half a minute)
+	$(VENV)/bin/vib-estimator warmup
 	touch $(STAMP)
 
 demo: setup

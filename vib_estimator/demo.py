@@ -26,7 +26,7 @@ import time
 from collections import deque
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import List, Tuple
+from typing import List, Optional, Tuple
 
 import numpy as np
 
@@ -37,6 +37,12 @@ from .sim.arm_model import MASSES_5_5, natural_frequency_hz, schedule_5_5
 MAX_MEDIAN_ERROR_PCT = 3.0
 #: seconds allowed for the nodes to start and see each other
 STARTUP_TIMEOUT = 30.0
+#: seconds allowed for the estimator node to compile its kernels (a first start after an install
+#: that skipped ``make setup``'s warm-up; the node says so on /diagnostics meanwhile)
+WARMUP_TIMEOUT = 300.0
+#: the domains the demo picks from when neither --domain-id nor ROS_DOMAIN_ID says: Jazzy's
+#: 0-101 on Linux, without 0 (every ROS user's default)
+DOMAINS = range(1, 102)
 #: a subprocess gets this long to exit on SIGINT before it is killed, s
 STOP_TIMEOUT = 5.0
 #: --shaping: each shaped move must cut the vibration a move adds by this fraction (the issue's
@@ -59,7 +65,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--out', default=None,
                         help='figure path (default out/demo.png, with --shaping out/shaping.png)')
     parser.add_argument('--domain-id', type=int, default=None,
-                        help='ROS domain of the demo (default: 120 + pid %% 100)')
+                        help='ROS domain of the demo, 0-232 (default: ROS_DOMAIN_ID when set, '
+                             'else one of 1-101 from the process id)')
     parser.add_argument('--shaping', action='store_true',
                         help='input shaping: per mass a move unshaped, then the same move shaped '
                              'by shaper_node for the estimate (figure out/shaping.png)')
@@ -128,12 +135,16 @@ class Listener:
     """The demo's own node: records the four topics into a :class:`Record`, printing estimates."""
 
     def __init__(self, context, truth: List[Tuple[float, float, float]]):
+        from diagnostic_msgs.msg import DiagnosticArray
         from geometry_msgs.msg import WrenchStamped
         from rclpy.node import Node
         from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
         from std_msgs.msg import Float64, Header
 
         from .nodes.sim_node import SIM_TIME_ORIGIN_NS
+        from .nodes.stream import WARMUP_MESSAGE
+
+        self._warmup_message = WARMUP_MESSAGE
         from .io.fields import seconds_since, stamp_ns
 
         self._stamp_ns, self._seconds_since = stamp_ns, seconds_since
@@ -152,6 +163,20 @@ class Listener:
         self.node.create_subscription(Float64, 'vibration/frequency', self._on_frequency,
                                       reliable)
         self.node.create_subscription(Header, 'vibration/reset', self._on_reset, reliable)
+        self.node.create_subscription(DiagnosticArray, '/diagnostics', self._on_diagnostics, 10)
+        #: node names whose /diagnostics say they estimate (not warming up)
+        self.ready: set = set()
+        self._warming: set = set()
+
+    def _on_diagnostics(self, msg) -> None:
+        for status in msg.status:
+            if status.message == self._warmup_message:
+                if status.name not in self._warming:
+                    self._warming.add(status.name)
+                    print(f'{status.name}: {status.message}; the demo starts the simulator when '
+                          'it is ready', flush=True)
+            else:
+                self.ready.add(status.name)
 
     def _seconds(self, header) -> float:
         return self._seconds_since(self._stamp_ns(header), self._origin)
@@ -221,7 +246,7 @@ class Session:
 
         from .nodes.runner import make_executor
 
-        self.domain = args.domain_id if args.domain_id is not None else 120 + os.getpid() % 100
+        self.domain = demo_domain(args.domain_id, os.environ.get('ROS_DOMAIN_ID'))
         os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'   # read by rclpy.init below
         self.env = dict(os.environ, ROS_DOMAIN_ID=str(self.domain))
         self.context = rclpy.Context()
@@ -235,14 +260,24 @@ class Session:
         from .nodes.runner import spin_until
         return spin_until(self.executor, predicate, timeout)
 
-    def start(self, exe: str, params: List[str], ready) -> subprocess.Popen:
+    def start(self, exe: str, params: List[str], ready,
+              timeout: float = STARTUP_TIMEOUT) -> subprocess.Popen:
         """Start a node; wait until ``ready()`` (or its exit); raise RuntimeError if it failed."""
         proc = _start(exe, params, self.env)
         self.procs.append(proc)
-        up = self.spin_until(lambda: proc.poll() is not None or ready(), STARTUP_TIMEOUT)
+        up = self.spin_until(lambda: proc.poll() is not None or ready(), timeout)
         if not up or proc.poll() is not None:
-            raise RuntimeError(f'{exe} did not come up')
+            raise RuntimeError(f'{exe} did not come up' if proc.poll() is None
+                               else f'{exe} exited with {proc.returncode}')
         return proc
+
+    def start_estimator(self) -> subprocess.Popen:
+        """Start estimator_node (sim time) and wait until its kernels are compiled (its
+        /diagnostics stop saying it warms up) and it sees the demo's topics."""
+        listener = self.listener
+        return self.start('estimator_node', ['use_sim_time:=true'], lambda: (
+            '/estimator_node' in listener.ready and listener.counts('vibration/frequency')[0]
+            and listener.counts('coupling_torque')[1]), WARMUP_TIMEOUT)
 
     def start_sim(self, params: List[str]) -> subprocess.Popen:
         sim = _start('sim_node', params, self.env)
@@ -263,6 +298,18 @@ class Session:
         self.executor.shutdown()
         self.listener.node.destroy_node()
         self.context.try_shutdown()
+
+
+def demo_domain(asked: Optional[int], env: Optional[str]) -> int:
+    """The demo's ROS domain: ``--domain-id`` if given (0-232: ValueError otherwise), else
+    ``ROS_DOMAIN_ID`` when set to one, else one of :data:`DOMAINS` from the process id."""
+    if asked is not None:
+        if not 0 <= asked <= 232:
+            raise ValueError(f'--domain-id must be in 0-232, got {asked}')
+        return asked
+    if env and env.strip().isdigit() and 0 <= int(env) <= 232:
+        return int(env)
+    return DOMAINS[os.getpid() % len(DOMAINS)]
 
 
 def sim_params(speed: float, duration: float, schedule, subscribers: int) -> List[str]:
@@ -286,6 +333,11 @@ def run(args: argparse.Namespace) -> int:
         return 2
     truth = [(i * args.seconds_per_mass, (i + 1) * args.seconds_per_mass, natural_frequency_hz(m))
              for i, m in enumerate(MASSES_5_5)]
+    try:
+        demo_domain(args.domain_id, None)
+    except ValueError as err:
+        print(f'error: {err}', file=sys.stderr)
+        return 2
     wall_start = time.monotonic()
     session = Session(args, truth)
     try:
@@ -311,8 +363,7 @@ def _run_estimation(session: Session, args: argparse.Namespace, wall_start: floa
     duration = 3 * args.seconds_per_mass
     print(f'demo: ROS domain {session.domain}, {duration:g} s simulated at {args.speed:g}x, tip '
           'masses ' + ' -> '.join(f'{m * 1e3:g} g' for m in MASSES_5_5), flush=True)
-    session.start('estimator_node', ['use_sim_time:=true'], lambda: (
-        listener.counts('vibration/frequency')[0] and listener.counts('coupling_torque')[1]))
+    session.start_estimator()
     sim = session.start_sim(sim_params(args.speed, duration,
                                        schedule_to_array(schedule_5_5(args.seconds_per_mass)), 2))
     session.finish_sim(sim, duration, args.speed)
@@ -540,8 +591,7 @@ def _run_shaping(session: 'Session', args: argparse.Namespace, wall_start: float
     print(f'demo --shaping: ROS domain {session.domain}, {3 * p:g} s simulated at '
           f'{args.speed:g}x, {args.shaper}, steps of {args.step:g} rad, tip masses '
           + ' -> '.join(f'{m * 1e3:g} g' for m in MASSES_5_5), flush=True)
-    session.start('estimator_node', ['use_sim_time:=true'], lambda: (
-        listener.counts('vibration/frequency')[0] and listener.counts('coupling_torque')[1]))
+    session.start_estimator()
     driver = ShapingDriver(session)
     session.start('shaper_node', ['use_sim_time:=true', 'shaper:=none'], lambda: (
         driver.reference_pub.get_subscription_count()
