@@ -15,7 +15,8 @@ ROOT = Path(__file__).resolve().parents[1]
 EXECUTABLES = ['vib-estimator', 'estimator_node', 'sim_node', 'bag_replayer', 'bag_recorder']
 #: ROS packages the code may import, by the name package.xml must declare
 ROS_PACKAGES = {'rclpy', 'std_msgs', 'geometry_msgs', 'sensor_msgs', 'diagnostic_msgs', 'rosgraph_msgs',
-                'std_srvs', 'rcl_interfaces', 'builtin_interfaces'}
+                'std_srvs', 'rcl_interfaces', 'builtin_interfaces', 'launch', 'launch_ros',
+                'ament_index_python'}
 
 
 def test_package_xml_declares_every_ros_package_the_code_imports():
@@ -23,13 +24,7 @@ def test_package_xml_declares_every_ros_package_the_code_imports():
     assert root.get('format') == '3' and root.findtext('name') == 'vib_estimator'
     assert root.find('export/build_type').text == 'ament_python'
     declared = {e.text for e in root if e.tag in ('exec_depend', 'depend')}
-    imported = set()
-    for path in (ROOT / 'vib_estimator').rglob('*.py'):
-        for node in ast.walk(ast.parse(path.read_text())):
-            if isinstance(node, ast.Import):
-                imported |= {a.name.split('.')[0] for a in node.names}
-            elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
-                imported.add(node.module.split('.')[0])
+    imported = _imported_by('vib_estimator') | _imported_by('launch')   # both are installed
     missing = (imported & ROS_PACKAGES) - declared
     assert not missing, f'package.xml lacks exec_depend on {sorted(missing)}'
 
@@ -39,7 +34,9 @@ def test_package_xml_declares_every_ros_package_the_code_imports():
 def test_colcon_build_installs_the_executables_where_ros2_run_looks(tmp_path):
     colcon = Path(sys.executable).parent / 'colcon'
     result = subprocess.run(
-        [str(colcon), 'build', '--base-paths', str(ROOT), '--build-base', str(tmp_path / 'build'),
+        # the README's line: colcon build --packages-select vib_estimator
+        [str(colcon), 'build', '--packages-select', 'vib_estimator', '--base-paths', str(ROOT),
+         '--build-base', str(tmp_path / 'build'),
          '--install-base', str(tmp_path / 'install'), '--event-handlers', 'console_direct-'],
         cwd=tmp_path, capture_output=True, text=True, timeout=300)
     assert result.returncode == 0, result.stderr + result.stdout
@@ -69,7 +66,7 @@ ROSDEP_KEYS = {'numpy': 'python3-numpy', 'numba': 'python3-numba', 'scipy': 'pyt
 #: import name of requirements whose distribution name differs
 IMPORT_NAMES = {'pyyaml': 'yaml'}
 #: requirements for building and proving the package here, not for using it
-DEVELOPMENT_ONLY = {'wheel', 'colcon-core', 'colcon-ros'}
+DEVELOPMENT_ONLY = {'wheel', 'colcon-core', 'colcon-ros', 'colcon-package-selection'}
 
 
 def _requirements():

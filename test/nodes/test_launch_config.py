@@ -83,6 +83,21 @@ def test_launch_file_starts_the_node_with_the_params_file():
     assert PARAMS.is_file()
 
 
+def test_launch_file_declares_the_arguments_a_deployment_needs():
+    """params_file, namespace, use_sim_time and the input, each declared and each used."""
+    tree = ast.parse(LAUNCH.read_text())
+    calls = [n for n in ast.walk(tree) if isinstance(n, ast.Call)]
+    declared = {ast.literal_eval(n.args[0]) for n in calls
+                if getattr(n.func, 'id', None) == 'DeclareLaunchArgument'}
+    assert declared == {'params_file', 'namespace', 'use_sim_time', 'input_type', 'input_topic'}
+    used = {ast.literal_eval(n.args[0]) for n in calls
+            if getattr(n.func, 'id', None) == 'LaunchConfiguration'
+            and isinstance(n.args[0], ast.Constant)}
+    inputs = next(ast.literal_eval(n.value) for n in tree.body if isinstance(n, ast.Assign)
+                  and n.targets[0].id == 'INPUT_ARGUMENTS')
+    assert used | set(inputs) == declared
+
+
 def test_readme_parameter_table_states_the_defaults():
     """The README's estimator-parameter table lists every EstimatorConfig field with its default."""
     text = (ROOT / 'README.md').read_text()

@@ -21,6 +21,8 @@ from operator import attrgetter
 from typing import Callable, Dict, Optional, Tuple
 
 WRENCH_STAMPED = 'geometry_msgs/msg/WrenchStamped'
+#: the topic estimator_node reads by default (and ``analyze`` picks in a bag of several inputs)
+DEFAULT_INPUT_TOPIC = 'coupling_torque'
 IMU = 'sensor_msgs/msg/Imu'
 ACCEL_STAMPED = 'geometry_msgs/msg/AccelStamped'
 VECTOR3_STAMPED = 'geometry_msgs/msg/Vector3Stamped'

@@ -36,8 +36,8 @@ import numpy as np
 
 from . import cdr
 from .csv_reader import csv_layout, iter_csv_rows
-from .fields import (DEFAULT_COMPONENT, FLOAT64, INPUT_TYPES, check_component, component_getter,
-                     normalise_type, seconds_since, stamp_ns)
+from .fields import (DEFAULT_COMPONENT, DEFAULT_INPUT_TOPIC, FLOAT64, INPUT_TYPES,
+                     check_component, component_getter, normalise_type, seconds_since, stamp_ns)
 
 #: samples per block handed to the estimator (bags: chunks are grouped up to this size)
 BLOCK_SAMPLES = 1 << 18
@@ -106,9 +106,14 @@ def csv_signal(path: Path, column: Optional[str]) -> Signal:
 
 
 def _csv_blocks(layout) -> Iterator[Block]:
-    """Blocks by pyarrow; on a file it refuses, the rest by the csv_reader rules."""
-    import pyarrow as pa
-    import pyarrow.csv as pacsv
+    """Blocks by pyarrow; on a file it refuses, the rest by the csv_reader rules (all of it when
+    pyarrow is not installed: rosdep alone does not bring it)."""
+    try:
+        import pyarrow as pa
+        import pyarrow.csv as pacsv
+    except ImportError:
+        yield from _csv_blocks_exact(layout, skip=0)
+        return
 
     names = [f'c{i}' for i in range(layout.width)]
     wanted = [names[0], names[layout.index]]
@@ -208,8 +213,12 @@ def choose_topic(path: Path, topics: Dict[str, str], topic: Optional[str]) -> st
     BagError = _bag_error()
     listing = ', '.join(f'{n} ({k})' for n, k in topics.items()) or 'none'
     if topic is None:
-        return only_topic(path, [f'{n} ({k})' for n, k in supported_topics(topics).items()],
-                          'input-type', listing, ' with --topic')
+        candidates = supported_topics(topics)
+        if len(candidates) > 1 and '/' + DEFAULT_INPUT_TOPIC in candidates:
+            return '/' + DEFAULT_INPUT_TOPIC       # what estimator_node subscribes to by default
+        return only_topic(path, [f'{n} ({k})' for n, k in candidates.items()], 'input-type',
+                          listing, f' with --topic, e.g. `vib-estimator analyze {path} --topic '
+                          f'{next(iter(candidates), "")}`')
     if topic not in topics:
         raise BagError(f'bag {path} has no topic {topic!r}; its topics are {listing}')
     if topics[topic] not in INPUT_TYPES:

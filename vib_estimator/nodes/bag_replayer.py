@@ -15,8 +15,10 @@ publishes every message whose due time has passed, so the timing error is at mos
 message rates (or rates x100) do not need one timer event per message.
 
 Start. Before the first message the replayer waits until every played topic (with messages) has at
-least one matched subscription, or ``wait_timeout`` s have passed since it started -- then it plays
-anyway and says so. Cross-process discovery takes a second or two, so without this a consumer
+least one matched subscription -- or, once one of them has, :data:`~.playback.SETTLE_S` more for
+the others (a topic nobody subscribes to, say ``/vibration/ground_truth``, does not hold back the
+ones someone does), or ``wait_timeout`` s since it started with no subscriber at all -- then it
+plays, and names the topics still without one. Cross-process discovery takes a second or two, so without this a consumer
 started first would miss the start of the bag. ``wait_timeout: 0`` plays at once; ``delay`` is a
 minimum wait on top.
 
@@ -220,21 +222,24 @@ class BagReplayer(Node):
 
     # -- publishing -------------------------------------------------------------------------------
 
-    def _subscribers_matched(self) -> bool:
-        return all(pub.get_subscription_count() > 0 for topic, pub in self._outputs.items()
-                   if self._bag.topics[topic].count)
+    def _unmatched(self):
+        """The played topics (with messages) without a subscriber, and how many are played."""
+        played = [t for t in self._outputs if self._bag.topics[t].count]
+        return [t for t in played if self._outputs[t].get_subscription_count() == 0], len(played)
 
     def _begin_if_ready(self, now_ns: int) -> bool:
         """Start the playback once the :class:`StartGate` opens; whether it has started."""
         if self._playback.started:
             return True
-        if not self._gate.is_open(now_ns, self._subscribers_matched()):
+        missing, played = self._unmatched()
+        if not self._gate.is_open(now_ns, not missing, len(missing) < played):
             return False
         if self._gate.timed_out:
-            missing = [t for t, p in self._outputs.items()
-                       if self._bag.topics[t].count and p.get_subscription_count() == 0]
             self.get_logger().warn(f'no subscriber on {", ".join(missing)} after wait_timeout; '
                                    f'playing anyway')
+        elif self._gate.partial:
+            self.get_logger().info(f'playing: no subscriber on {", ".join(missing)} (yet); the '
+                                   'topics with one do not wait for them')
         self._playback.start(now_ns)
         return True
 

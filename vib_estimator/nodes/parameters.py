@@ -12,8 +12,8 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 
 from ..core.config import EstimatorConfig
-from ..io.fields import (DEFAULT_COMPONENT, INPUT_TYPES, WRENCH_STAMPED, check_input_type,
-                         describe_components)
+from ..io.fields import (DEFAULT_COMPONENT, DEFAULT_INPUT_TOPIC, INPUT_TYPES, WRENCH_STAMPED,
+                         check_input_type, describe_components)
 from .runner import StartupError
 
 
@@ -73,7 +73,7 @@ def config_of(node: Node) -> EstimatorConfig:
                                         for name in EstimatorConfig.names()})
 
 
-def declare_input(node: Node, default_topic: str = 'coupling_torque'):
+def declare_input(node: Node, default_topic: str = DEFAULT_INPUT_TOPIC):
     """Declare ``input_type`` and ``input_topic`` (read-only) and ``component`` (its default
     that of the type); return (the type's full name, the topic)."""
     input_type = declare(node, 'input_type', WRENCH_STAMPED, descriptor(

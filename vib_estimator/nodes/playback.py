@@ -28,22 +28,39 @@ class EmptyPlayback(Exception):
     """Nothing to play from the chosen start of the bag."""
 
 
+#: once one played topic has a subscriber, the others get this long to match too (a consumer's
+#: subscriptions are discovered together, within tens of ms), s; a topic nobody subscribes to
+#: never holds the others back longer
+SETTLE_S = 0.5
+
+
 class StartGate:
-    """When to begin playing: after ``delay_s``, and once subscribers match or ``wait_timeout_s``
-    (counted from ``now_ns``, concurrently with the delay) has passed."""
+    """When to begin playing: after ``delay_s``, and once every played topic has a subscriber,
+    or :data:`SETTLE_S` after the first one has, or when ``wait_timeout_s`` (counted from
+    ``now_ns``, concurrently with the delay) has passed with none."""
 
     def __init__(self, now_ns: int, delay_s: float, wait_timeout_s: float) -> None:
         self.not_before_ns = now_ns + int(round(delay_s * 1e9))
         self.deadline_ns = now_ns + int(round(wait_timeout_s * 1e9))
         #: set when the gate opened on the timeout, with subscribers still missing
         self.timed_out = False
+        #: set when the gate opened with some played topics still without a subscriber
+        self.partial = False
+        self._first_match_ns: Optional[int] = None
 
-    def is_open(self, now_ns: int, subscribers_matched: bool) -> bool:
-        """Whether playing may begin at ``now_ns``; sets :attr:`timed_out` when it opens only
-        because the wait is over."""
+    def is_open(self, now_ns: int, subscribers_matched: bool, any_matched: bool = False) -> bool:
+        """Whether playing may begin at ``now_ns`` (``subscribers_matched``: every played topic
+        has a subscriber; ``any_matched``: at least one has); sets :attr:`timed_out` or
+        :attr:`partial` when it opens with subscribers missing."""
+        if any_matched and self._first_match_ns is None:
+            self._first_match_ns = now_ns
         if now_ns < self.not_before_ns:
             return False
         if subscribers_matched:
+            return True
+        if self._first_match_ns is not None and \
+                now_ns >= self._first_match_ns + int(SETTLE_S * 1e9):
+            self.partial = True
             return True
         if now_ns >= self.deadline_ns:
             self.timed_out = True

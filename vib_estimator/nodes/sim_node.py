@@ -224,7 +224,8 @@ class SimNode(Node):
         mode = (f'simulated time at {self._speed:g}x, /clock published' if self._sim_time
                 else 'real time')
         self.get_logger().info(
-            f'flexible arm: m = {p["tip_mass_kg"] * 1e3:.2f} g, f0 = {self._sim.f_true:.3f} Hz '
+            f'flexible arm: m = {self._sim.params.tip_mass_kg * 1e3:.2f} g, '
+            f'f0 = {self._sim.f_true:.3f} Hz '
             f'(Eq. 23), {self._rate:g} Hz, {mode}, {len(schedule)} move(s), publishing '
             f'{self._output_pub.topic_name} [{self._output_type}]')
 

@@ -1,0 +1,290 @@
+"""Start-to-ready of the nodes and of ``analyze``, cold and warm, beside a reference commit.
+
+    .venv/bin/python benchmarks/bench_startup.py                 # this tree vs 7374e6d
+    .venv/bin/python benchmarks/bench_startup.py --ref HEAD~1 --only estimator_node
+
+Prints figures, asserts nothing (a few minutes: every cold case compiles from nothing).
+
+Each case runs as a new process, first **cold** (``NUMBA_CACHE_DIR`` an empty folder: a fresh
+install that skipped ``make setup``'s warm-up) then **warm** (the same folder, filled by the cold
+run). The reference is the same case run from ``git archive REF`` (``PYTHONPATH`` first), in the
+same run, on the same machine state.
+
+* ``estimator_node`` (default configuration, ``modes: 3``, ``band_hz: [1, 20]``): this process
+  publishes a 5 Hz sine on ``coupling_torque`` (WrenchStamped, 500 samples/s of stamps, paced in
+  real time) from one second after the node subscribes (discovery settled both ways). *live*:
+  spawn to the node's first ``/diagnostics``; *ready*: spawn to the first ``~/self_test`` answer
+  that is not "busy" (called every 0.1 s: the kernels are compiled and the tones ran); *first estimate*: from the first sample
+  sent to the first ``vibration/frequency``; *lost*: samples sent that the node never counted (its
+  ``received`` + ``dropped_warmup`` against what was sent). Then SIGINT: the exit code.
+* ``shaper_node``: spawn to its first ``/diagnostics``.
+* ``analyze``: the whole ``vib-estimator analyze`` of a 20 s CSV (500 Hz).
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import signal
+import subprocess
+import sys
+import tarfile
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+os.environ.setdefault('ROS_DOMAIN_ID', str(1 + os.getpid() % 101))
+os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+
+ROOT = Path(__file__).resolve().parents[1]
+RATE_HZ = 500.0
+TONE_HZ = 5.0
+TIMEOUT_S = 180.0
+ESTIMATOR_CASES = {
+    'estimator_node (default)': [],
+    'estimator_node (modes: 3)': ['modes:=3'],
+    'estimator_node (band_hz)': ['band_hz:=[1.0, 20.0]'],
+}
+GOALS = 'goals: warm ready <= 2 s, cold ready <= 10 s'
+
+
+def node_command(tree: Path, module: str, params):
+    code = f'import sys; from {module} import main; sys.exit(main())'
+    cmd = [sys.executable, '-c', code, '--ros-args']
+    for p in params:
+        cmd += ['-p', p]
+    return cmd
+
+
+def environment(tree: Path, cache: str) -> dict:
+    env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+    env['PYTHONPATH'] = os.pathsep.join([str(tree)] + [p for p in [env.get('PYTHONPATH')] if p])
+    return env
+
+
+class Probe:
+    """This process's ROS side: the sine publisher, and subscribers to what the node says."""
+
+    def __init__(self):
+        import rclpy
+        from diagnostic_msgs.msg import DiagnosticArray
+        from geometry_msgs.msg import WrenchStamped
+        from rclpy.qos import qos_profile_sensor_data
+        from std_msgs.msg import Float64
+
+        from vib_estimator.nodes.runner import make_executor
+
+        self.context = rclpy.Context()
+        rclpy.init(context=self.context, domain_id=int(os.environ['ROS_DOMAIN_ID']))
+        self.node = rclpy.create_node('bench_startup', context=self.context)
+        self.executor = make_executor(self.context)
+        self.executor.add_node(self.node)
+        self.msg_type = WrenchStamped
+        self.pub = self.node.create_publisher(WrenchStamped, 'coupling_torque',
+                                              qos_profile_sensor_data)
+        self.node.create_subscription(Float64, 'vibration/frequency', self._on_frequency, 10)
+        self.node.create_subscription(DiagnosticArray, '/diagnostics', self._on_diagnostics, 10)
+        from std_srvs.srv import Trigger
+        self.self_test = self.node.create_client(Trigger, '/estimator_node/self_test')
+        self.trigger = Trigger.Request
+        self.reset()
+
+    def reset(self):
+        self.first_estimate = None
+        self.first_diag = {}
+        self.last_values = {}
+
+    def _on_frequency(self, msg):
+        if self.first_estimate is None:
+            self.first_estimate = time.monotonic()
+
+    def _on_diagnostics(self, msg):
+        for status in msg.status:
+            self.first_diag.setdefault(status.name, time.monotonic())
+            self.last_values[status.name] = {kv.key: kv.value for kv in status.values}
+
+    def spin(self, seconds):
+        end = time.monotonic() + seconds
+        while time.monotonic() < end:
+            self.executor.spin_once(timeout_sec=min(0.005, max(0.0, end - time.monotonic())))
+
+    def _ask_self_test(self, state):
+        """Keep calling ~/self_test until it answers (not busy compiling, whatever the tones
+        gave); state['ready'] = the time it did."""
+        future = state.get('future')
+        if future is not None and future.done():
+            result = future.result()
+            if result is not None and not result.message.startswith('busy'):
+                state['ready'] = time.monotonic()
+            state['future'] = None
+            state['next'] = time.monotonic() + 0.1
+        elif future is None and time.monotonic() >= state.get('next', 0.0) \
+                and self.self_test.service_is_ready():
+            state['future'] = self.self_test.call_async(self.trigger())
+
+    def estimator(self, cmd, env):
+        """(live s, ready s, first estimate s after the first sample, lost samples, exit code)
+        of one estimator_node start."""
+        self.reset()
+        start = time.monotonic()
+        proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL,
+                                stderr=subprocess.DEVNULL)
+        sent = 0
+        msg = self.msg_type()
+        state = {}
+        matched = None
+        try:
+            while (self.first_estimate is None or 'ready' not in state) \
+                    and time.monotonic() - start < TIMEOUT_S:
+                if proc.poll() is not None:
+                    break
+                if 'ready' not in state:
+                    self._ask_self_test(state)
+                if matched is None and self.pub.get_subscription_count():
+                    matched = time.monotonic()
+                # one second after the match, discovery has settled both ways: send, real time
+                if matched is not None and time.monotonic() > matched + 1.0:
+                    first = matched + 1.0
+                    due = int((time.monotonic() - first) * RATE_HZ)
+                    while sent < due:
+                        ns = 1_000_000_000 + int(sent * 1e9 / RATE_HZ)
+                        msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(ns, 10 ** 9)
+                        msg.wrench.torque.z = math.sin(2 * math.pi * TONE_HZ * sent / RATE_HZ)
+                        self.pub.publish(msg)
+                        sent += 1
+                self.spin(0.002)
+            ready = state['ready'] - start if 'ready' in state else math.nan
+            latency = self.first_estimate - first if self.first_estimate else math.nan
+            self.spin(1.5)             # a diagnostics period after the first estimate
+            live = min(self.first_diag.values(), default=math.nan) - start
+            values = next(iter(self.last_values.values()), {})
+            counted = int(values.get('received', 0)) + int(values.get('dropped_warmup', 0))
+            lost = sent - counted if values else -1
+        finally:
+            code = stop(proc)
+        return live, ready, latency, lost, code
+
+    def first_diagnostics(self, cmd, env):
+        """(spawn to first /diagnostics s, exit code) of a node."""
+        self.reset()
+        start = time.monotonic()
+        proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL,
+                                stderr=subprocess.DEVNULL)
+        try:
+            while not self.first_diag and time.monotonic() - start < TIMEOUT_S \
+                    and proc.poll() is None:
+                self.spin(0.005)
+            live = min(self.first_diag.values(), default=math.nan) - start
+        finally:
+            code = stop(proc)
+        return live, code
+
+    def close(self):
+        self.executor.shutdown()
+        self.node.destroy_node()
+        self.context.try_shutdown()
+
+
+def stop(proc) -> int:
+    if proc.poll() is None:
+        proc.send_signal(signal.SIGINT)
+        try:
+            return proc.wait(10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
+            return -9
+    return proc.returncode
+
+
+def analyze_seconds(tree: Path, env: dict, csv: Path) -> float:
+    code = 'import sys; from vib_estimator.cli import main; sys.exit(main())'
+    start = time.monotonic()
+    done = subprocess.run([sys.executable, '-c', code, 'analyze', str(csv)], env=env,
+                          stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    if done.returncode:
+        return math.nan
+    return time.monotonic() - start
+
+
+def checkout(ref: str, where: Path) -> Path:
+    """``git archive ref`` unpacked into ``where``."""
+    archive = where / 'ref.tar'
+    subprocess.run(['git', '-C', str(ROOT), 'archive', '-o', str(archive), ref], check=True)
+    with tarfile.open(archive) as tar:
+        tar.extractall(where / 'tree', filter='data')
+    return where / 'tree'
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument('--ref', default='7374e6d', help='reference commit (default 7374e6d)')
+    parser.add_argument('--only', choices=['estimator_node', 'shaper_node', 'analyze'],
+                        action='append', help='run only these cases (repeatable)')
+    args = parser.parse_args(argv)
+    only = set(args.only or ['estimator_node', 'shaper_node', 'analyze'])
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        trees = {'today': ROOT, args.ref: checkout(args.ref, tmp)}
+        csv = tmp / 'tone.csv'
+        t = np.arange(int(20 * RATE_HZ)) / RATE_HZ
+        np.savetxt(csv, np.column_stack([t, np.sin(2 * np.pi * TONE_HZ * t)]), delimiter=',',
+                   header='t,y', comments='', fmt='%.9g')
+        probe = Probe()
+        rows = []
+        try:
+            for case, params in ESTIMATOR_CASES.items():
+                if 'estimator_node' not in only:
+                    break
+                for label, tree in trees.items():
+                    cache = tempfile.mkdtemp(dir=tmp)
+                    cmd = node_command(tree, 'vib_estimator.nodes.estimator_node', params)
+                    for kind in ('cold', 'warm'):
+                        live, ready, latency, lost, code = probe.estimator(
+                            cmd, environment(tree, cache))
+                        rows.append((case, label, kind, live, ready, lost, code, latency))
+                        print(f'{case:28s} {label:8s} {kind}: live {live:6.2f} s, ready '
+                              f'{ready:6.2f} s, first estimate {latency:6.2f} s after the '
+                              f'first sample, lost {lost}, exit {code}', flush=True)
+            if 'shaper_node' in only:
+                for label, tree in trees.items():
+                    cache = tempfile.mkdtemp(dir=tmp)
+                    cmd = node_command(tree, 'vib_estimator.nodes.shaper_node', [])
+                    for kind in ('cold', 'warm'):
+                        live, code = probe.first_diagnostics(cmd, environment(tree, cache))
+                        rows.append(('shaper_node', label, kind, live, live, 0, code, math.nan))
+                        print(f'{"shaper_node":28s} {label:8s} {kind}: live {live:6.2f} s, '
+                              f'exit {code}', flush=True)
+            if 'analyze' in only:
+                for label, tree in trees.items():
+                    cache = tempfile.mkdtemp(dir=tmp)
+                    for kind in ('cold', 'warm'):
+                        seconds = analyze_seconds(tree, environment(tree, cache), csv)
+                        rows.append(('analyze (20 s CSV)', label, kind, math.nan, seconds, 0, 0,
+                                     math.nan))
+                        print(f'{"analyze (20 s CSV)":28s} {label:8s} {kind}: {seconds:6.2f} s',
+                              flush=True)
+        finally:
+            probe.close()
+    print(f'\n| case | cold ready, today | cold, {args.ref} | warm ready, today | warm, '
+          f'{args.ref} | live (first /diagnostics), cold today / {args.ref} | first estimate after '
+          f'the first sample, cold today / {args.ref} | samples lost, cold today / {args.ref} | '
+          'exit on SIGINT |')
+    print('|---|---|---|---|---|---|---|---|---|')
+    cases = list(dict.fromkeys(r[0] for r in rows))
+    for case in cases:
+        get = {(r[1], r[2]): r for r in rows if r[0] == case}
+        today_c, ref_c = get.get(('today', 'cold')), get.get((args.ref, 'cold'))
+        today_w, ref_w = get.get(('today', 'warm')), get.get((args.ref, 'warm'))
+        codes = sorted({r[6] for r in get.values()})
+        print(f'| {case} | {today_c[4]:.1f} s | {ref_c[4]:.1f} s | {today_w[4]:.2f} s | '
+              f'{ref_w[4]:.2f} s | {today_c[3]:.1f} / {ref_c[3]:.1f} s | '
+              f'{today_c[7]:.1f} / {ref_c[7]:.1f} s | {today_c[5]} / {ref_c[5]} | {codes} |')
+    print(GOALS)
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
