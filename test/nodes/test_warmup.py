@@ -1,0 +1,168 @@
+"""A node is live from its first second: a cold start (empty numba cache) answers its services and
+publishes /diagnostics while its kernels compile, holds its input, and Ctrl-C leaves a cache the
+next start uses. The warm-up's bookkeeping itself is tested without ROS below."""
+from __future__ import annotations
+
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+from vib_estimator.core import EstimatorConfig
+from vib_estimator.core.estimator import FrequencyEstimator
+from vib_estimator.io.fields import seconds_since
+from vib_estimator.nodes.stream import WARMUP_BUFFER, WARMUP_MESSAGE, EstimatorStream
+
+
+def _tone(n, rate=500.0, f=4.0):
+    t = np.arange(n) / rate
+    return t, np.sin(2 * np.pi * f * t) + 0.01 * np.cos(3 * t)
+
+
+def test_held_samples_are_drained_in_order_into_the_estimator():
+    config = EstimatorConfig(refine=0)          # a compile key the session fixture did not warm
+    stream = EstimatorStream(config, time.monotonic(), background=True)
+    assert not stream.ready
+    ok, why = stream.self_test()
+    assert not ok and why.startswith('busy')
+    ok, why = stream.reset()
+    assert not ok and WARMUP_MESSAGE in why
+    assert stream.status(time.monotonic()).message == WARMUP_MESSAGE
+    t, y = _tone(2000)
+    stamps = (1_000_000_000 + np.round(t * 1e9)).astype(np.int64)
+    for k in range(len(t)):
+        stream.hold(int(stamps[k]), float(y[k]), k)
+    deadline = time.monotonic() + 120
+    drained = None
+    while drained is None and time.monotonic() < deadline:
+        drained = stream.poll()
+        time.sleep(0.005)
+    assert drained is not None and stream.ready
+    got = [(tag, e.frequency_hz) for tag, estimates in drained for e in estimates]
+    base = np.array([seconds_since(int(s), int(stamps[0])) for s in stamps])   # the node's base
+    direct = FrequencyEstimator(config).process(base, y)
+    assert [f for _, f in got] == list(direct.frequency_hz)      # the same floats, in order
+    tags = [tag for tag, _ in got]
+    assert tags == sorted(tags) and len(tags) == len(direct) > 10
+    assert stream.counters['received'] == len(t) and stream.counters['dropped_warmup'] == 0
+
+
+def test_a_full_warmup_buffer_drops_the_oldest_and_counts_them():
+    stream = EstimatorStream(EstimatorConfig(refine=0, model='damped-sinusoid'), time.monotonic(),
+                             background=True)
+    first_drop = [stream.hold(k, 0.0, k) for k in range(WARMUP_BUFFER + 3)]
+    assert first_drop.count(True) == 1 and first_drop[WARMUP_BUFFER]
+    assert stream.health.node_counters['dropped_warmup'] == 3
+    assert stream.held_samples == WARMUP_BUFFER
+
+
+# ---- a real cold start, in a subprocess with an empty NUMBA_CACHE_DIR ----------------------------
+class Watcher:
+    """This test's ROS side: the node's /diagnostics, its services, and an input publisher."""
+
+    def __init__(self, context):
+        import rclpy
+        from diagnostic_msgs.msg import DiagnosticArray
+        from geometry_msgs.msg import WrenchStamped
+        from std_srvs.srv import Trigger
+
+        from vib_estimator.nodes.runner import make_executor
+
+        self.node = rclpy.create_node('warmup_watcher', context=context)
+        self.executor = make_executor(context)
+        self.executor.add_node(self.node)
+        self.statuses = []
+        self.node.create_subscription(DiagnosticArray, '/diagnostics',
+                                      lambda m: self.statuses.extend(m.status), 10)
+        self.pub = self.node.create_publisher(WrenchStamped, 'coupling_torque', 1000)
+        self.msg = WrenchStamped()
+        self.self_test = self.node.create_client(Trigger, '/estimator_node/self_test')
+        self.reset = self.node.create_client(Trigger, '/estimator_node/reset')
+        self.request = Trigger.Request
+        self.sent = 0
+
+    def spin_until(self, predicate, timeout):
+        from vib_estimator.nodes.runner import spin_until
+        return spin_until(self.executor, predicate, timeout)
+
+    def call(self, client):
+        assert self.spin_until(client.service_is_ready, 30)
+        future = client.call_async(self.request())
+        assert self.spin_until(future.done, 30), 'the service did not answer'
+        return future.result()
+
+    def publish(self, n):
+        for _ in range(n):
+            ns = 1_000_000_000 + self.sent * 2_000_000
+            self.msg.header.stamp.sec, self.msg.header.stamp.nanosec = divmod(ns, 10 ** 9)
+            self.msg.wrench.torque.z = math.sin(2 * math.pi * 4.0 * self.sent / 500.0)
+            self.pub.publish(self.msg)
+            self.sent += 1
+
+    def last(self, name='/estimator_node'):
+        mine = [s for s in self.statuses if s.name == name]
+        return (mine[-1], {kv.key: kv.value for kv in mine[-1].values}) if mine else (None, {})
+
+    def close(self):
+        self.executor.shutdown()
+        self.node.destroy_node()
+
+
+def _start_node(cache):
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache))
+    code = 'import sys; from vib_estimator.nodes.estimator_node import main; sys.exit(main())'
+    return subprocess.Popen([sys.executable, '-c', code], env=env, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+
+
+def _interrupt(proc):
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=30)
+    return proc.returncode, out + err
+
+
+def test_a_cold_node_is_live_while_it_compiles_and_ctrl_c_keeps_the_cache(ros_context, tmp_path):
+    from diagnostic_msgs.msg import DiagnosticStatus
+
+    watcher = Watcher(ros_context)
+    try:
+        # first start, interrupted while it compiles: exit 0, no traceback, a partial cache
+        proc = _start_node(tmp_path)
+        assert watcher.spin_until(lambda: watcher.last()[0] is not None, 30)
+        status, _ = watcher.last()
+        assert status.level == DiagnosticStatus.WARN and status.message == WARMUP_MESSAGE
+        code, output = _interrupt(proc)
+        assert code == 0 and 'Traceback' not in output, output
+        assert any(tmp_path.rglob('*.nbi')), 'nothing of the compile was kept'
+        # second start on that cache: live at once, services answer, input held, then estimates
+        watcher.statuses.clear()
+        proc = _start_node(tmp_path)
+        try:
+            result = watcher.call(watcher.self_test)
+            warming = watcher.last()[0] is None or watcher.last()[0].message == WARMUP_MESSAGE
+            if warming and not result.success:
+                assert result.message.startswith('busy'), result.message
+            assert watcher.spin_until(lambda: watcher.pub.get_subscription_count() > 0, 30)
+            watcher.spin_until(lambda: False, 1.0)     # discovery settles both ways
+            watcher.publish(400)
+            ready = watcher.spin_until(
+                lambda: watcher.last()[0] is not None
+                and watcher.last()[0].message != WARMUP_MESSAGE, 240)
+            assert ready, 'the kernels never became ready'
+            watcher.publish(400)
+            assert watcher.spin_until(
+                lambda: int(watcher.last()[1].get('received', 0)) >= watcher.sent, 10)
+            values = watcher.last()[1]
+            assert int(values['received']) == watcher.sent and values['dropped_warmup'] == '0'
+            assert int(values['estimates']) > 0
+            assert watcher.call(watcher.reset).success
+        finally:
+            code, output = _interrupt(proc)
+        assert code == 0 and 'Traceback' not in output, output
+    finally:
+        watcher.close()
