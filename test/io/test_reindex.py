@@ -2,6 +2,7 @@
 files repaired, independent readers (rosbags, mcap) agree."""
 from __future__ import annotations
 
+import os
 import shutil
 from pathlib import Path
 
@@ -13,7 +14,9 @@ from vib_estimator.cli import main
 from vib_estimator.io.bags import TYPESTORE, BagError, BagReader, BagWriter
 from vib_estimator.io.reindex import reindex, scan_mcap
 
-SHARED_BAGS = Path(__file__).resolve().parents[3] / 'shared' / 'ros2-bags'
+# ../shared relative to the repo; VIB_SHARED names it elsewhere (a worktree)
+SHARED_BAGS = Path(os.environ.get('VIB_SHARED', Path(__file__).resolve().parents[3] / 'shared')
+                   ) / 'ros2-bags'
 STRING = 'std_msgs/msg/String'
 
 

@@ -308,7 +308,9 @@ def test_looping_bag_resets_the_estimator_and_estimates_go_on(ros_context, execu
 
 # -- bags written by rosbag2, types not installed, waiting for subscribers, split recordings -----
 
-SHARED_BAGS = Path(__file__).resolve().parents[3] / 'shared' / 'ros2-bags'
+# ../shared relative to the repo; VIB_SHARED names it elsewhere (a worktree)
+SHARED_BAGS = Path(os.environ.get('VIB_SHARED', Path(__file__).resolve().parents[3] / 'shared')
+                   ) / 'ros2-bags'
 #: SOURCE.md of ../shared/ros2-bags: messages per bag, counted in the storage files
 ROSBAG2_COUNTS = {'mcap_talker': 20, 'sqlite3_talker': 20, 'mcap_wbag': 6074, 'sqlite3_wbag': 6074}
 

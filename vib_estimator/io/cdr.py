@@ -22,13 +22,12 @@ from typing import Dict, Optional, Tuple
 
 import numpy as np
 
-from .fields import (ACCEL_STAMPED, FLOAT64, IMU, VECTOR3_STAMPED, WRENCH_STAMPED,
+from ..errors import CdrLayoutError
+from .fields import (ACCEL_STAMPED, FLOAT64, IMU, VECTOR3_STAMPED, WRENCH_STAMPED, XYZ,
                      check_component)
 
-_XYZ = ('x', 'y', 'z')
 
-
-def _indices(prefix: str, start: int, names=_XYZ) -> Dict[str, int]:
+def _indices(prefix: str, start: int, names=XYZ) -> Dict[str, int]:
     return {f'{prefix}{a}': start + i for i, a in enumerate(names)}
 
 
@@ -44,10 +43,6 @@ DOUBLE_INDEX: Dict[str, Dict[str, int]] = {
 }
 #: number of doubles after the header of each fixed-layout type
 N_DOUBLES = {WRENCH_STAMPED: 6, IMU: 37, ACCEL_STAMPED: 6, VECTOR3_STAMPED: 3, FLOAT64: 1}
-
-
-class CdrLayoutError(Exception):
-    """A batch the vectorised decoder cannot take (not little-endian CDR, or too short)."""
 
 
 def is_fixed_layout(msgtype: str) -> bool:

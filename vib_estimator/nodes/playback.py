@@ -17,15 +17,13 @@ from __future__ import annotations
 
 from typing import Callable, Iterator, Optional, Protocol
 
+from ..errors import EmptyPlayback
+
 
 class Message(Protocol):
     """What the schedule needs of a recorded message (``vib_estimator.io.bags.BagMessage``)."""
 
     log_time_ns: int
-
-
-class EmptyPlayback(Exception):
-    """Nothing to play from the chosen start of the bag."""
 
 
 class StartGate:
