@@ -154,5 +154,5 @@ def test_a_worker_started_with_a_malloc_trim_threshold_streams_without_remapping
 def test_malloc_is_left_alone_in_a_plain_process(monkeypatch):
     monkeypatch.delenv('MALLOC_TRIM_THRESHOLD_', raising=False)
     monkeypatch.setattr(S.ctypes, 'CDLL', lambda *a: pytest.fail('mallopt called'))
-    with S._streaming_malloc():
+    with S.streaming_malloc():
         pass

@@ -221,18 +221,26 @@ class BagReader:
         order across all storage files (ties: in file order). ``check``: decode each payload as
         its type (a Jazzy type) and skip those that do not decode, as damaged records."""
         names = set(self.topics) if topics is None else {self.topic(t).topic for t in topics}
+        found, before, undecodable = 0, self.corrupt, 0
         with as_bag_error(self.path, 'read messages of bag'):
             streams = [self._stream(s, names, start_ns) for s in self._storages
                        if any(c.topic in names for c in s.connections)]
             for topic, log_time, data in heapq.merge(*streams, key=itemgetter(1)):
+                found += 1
                 if self._decompress is not None:
                     data = self._decompress(data)
                 msgtype = self.topics[topic].msgtype
                 if check and not _decodes(data, msgtype):
+                    undecodable += 1
                     self.count_damage(1, f'a {topic} message logged at {log_time} ns does not '
                                       f'decode as {msgtype}')
                     continue
                 yield BagMessage(topic, msgtype, log_time, bytes(data))
+        if start_ns is None:  # the whole bag: what its statistics count but no read found
+            skipped_unread = self.corrupt - before - undecodable  # damaged chunks, entries
+            missing = sum(self.topics[t].count for t in names) - found - skipped_unread
+            self.count_damage(max(missing, 0), f'{missing} messages counted by the bag were not '
+                              f'found in it')
 
     def close(self) -> None:
         self._stack.close()

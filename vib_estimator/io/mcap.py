@@ -378,21 +378,34 @@ def iter_messages(path: Path, topics: Collection[str], start_ns: Optional[int] =
     return _merged(path, chunks, names, start_ns, on_skip)
 
 
+def _chunk_messages(handle, chunk: ChunkRead, names: Dict[int, str], start_ns, on_skip
+                    ) -> Iterator[Tuple[int, str, bytes]]:
+    """``(log time, topic, payload)`` of one chunk's messages from ``start_ns`` on."""
+    messages = read_chunk(handle, chunk)
+    if messages.skipped and on_skip is not None:
+        on_skip(messages.skipped, messages.damage)
+    for channel, log_time, payload in messages.payloads():
+        if start_ns is None or log_time >= start_ns:
+            yield log_time, names[channel], payload
+
+
 def _merged(path: Path, chunks: List[ChunkRead], names: Dict[int, str], start_ns, on_skip):
-    heap: List[Tuple[int, int, str, bytes]] = []
-    order = 0
     with Path(path).open('rb') as handle:
-        i = 0
+        if all(b.first_ns > a.last_ns for a, b in zip(chunks, chunks[1:])):
+            for chunk in chunks:  # one after the other: no merge needed
+                for log_time, topic, payload in _chunk_messages(handle, chunk, names, start_ns,
+                                                                on_skip):
+                    yield topic, log_time, payload
+            return
+        heap: List[Tuple[int, int, str, bytes]] = []
+        order, i = 0, 0
         while i < len(chunks) or heap:
             while i < len(chunks) and (not heap or chunks[i].first_ns <= heap[0][0]):
-                messages = read_chunk(handle, chunks[i])
+                for log_time, topic, payload in _chunk_messages(handle, chunks[i], names,
+                                                                start_ns, on_skip):
+                    heapq.heappush(heap, (log_time, order, topic, payload))
+                    order += 1
                 i += 1
-                if messages.skipped and on_skip is not None:
-                    on_skip(messages.skipped, messages.damage)
-                for channel, log_time, payload in messages.payloads():
-                    if start_ns is None or log_time >= start_ns:
-                        heapq.heappush(heap, (log_time, order, names[channel], payload))
-                        order += 1
             if heap:
                 log_time, _, topic, payload = heapq.heappop(heap)
                 yield topic, log_time, payload

@@ -161,10 +161,11 @@ def bag_signal(path: Path, topic: Optional[str], component: Optional[str],
         msgtype = topics[topic]
         component = check_component(component or DEFAULT_COMPONENT[msgtype], msgtype)
         files = _storage_files(reader, path)
+        expected = sum(c.msgcount for c in reader.connections if c.topic == topic)
     finally:
         reader.close()
     signal = Signal(path, f'{topic} {component}', topic, msgtype, component, strict=strict)
-    signal._source = lambda: _bag_blocks(signal, files)
+    signal._source = lambda: _counted(signal, _bag_blocks(signal, files), expected)
     return signal
 
 
@@ -188,6 +189,18 @@ def _bag_blocks(signal: Signal, files: List[Path]) -> Iterator[Block]:
         batches = (_mcap_batches(plan, signal) if plan is not None
                    else _rosbags_batches(files, signal))
         yield from _group(_decode(batches, signal))
+
+
+def _counted(signal: Signal, blocks: Iterator[Block], expected: int) -> Iterator[Block]:
+    """``blocks``; at their end, the messages the bag's statistics count but no read found (a
+    damaged index or summary) are counted as damaged records too."""
+    read = 0
+    for block in blocks:
+        read += len(block[0])
+        yield block
+    missing = expected - read - signal.skipped - signal.corrupt
+    signal.count_damage(max(missing, 0), f'{missing} messages of {signal.topic} counted by the '
+                        f'bag were not found in it')
 
 
 def _group(blocks: Iterable[Block]) -> Iterator[Block]:

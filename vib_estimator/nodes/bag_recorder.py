@@ -52,7 +52,8 @@ from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPo
 from rosbags.interfaces import (Qos, QosDurability, QosHistory, QosLiveliness, QosReliability,
                                 QosTime)
 
-from ..io.bags import BagError, BagWriter, STORAGES
+from ..errors import BagError
+from ..io.bags import STORAGES, BagWriter
 from .runner import StartupError, run
 from .parameters import declare, descriptor
 
@@ -118,7 +119,9 @@ class BagRecorder(Node):
         try:
             self._bag = BagWriter(output, settings['storage'], settings['max_bag_size'],
                                   int(round(settings['max_bag_duration'] * 1e9))).open()
-        except (BagError, OSError) as err:
+        except BagError as err:
+            raise StartupError(str(err)) from None
+        except OSError as err:
             raise StartupError(f'cannot create bag {output}: {err}') from None
 
         #: messages recorded, per topic

@@ -59,13 +59,18 @@ class Playback:
         rate: speed factor (> 0).
         loop: start over at the end instead of finishing.
         paused: start paused.
+        loop_gap_ns: bag time between the last message and the first one again when looping
+            (the node gives one mean message spacing, so a one-message bag is not replayed at
+            every tick).
 
     Raises :class:`EmptyPlayback` when ``open_messages()`` yields nothing.
     """
 
     def __init__(self, open_messages: Callable[[], Iterator[Message]], first_ns: int,
-                 rate: float = 1.0, loop: bool = False, paused: bool = False) -> None:
+                 rate: float = 1.0, loop: bool = False, paused: bool = False,
+                 loop_gap_ns: int = 0) -> None:
         self._open = open_messages
+        self.loop_gap_ns = max(0, int(loop_gap_ns))
         self.first_ns = first_ns
         self.rate = rate
         self.loop = loop
@@ -117,7 +122,7 @@ class Playback:
         if self.next is None:
             if self.loop:
                 self._rewind()
-                self._anchor(self.first_ns, now_ns)
+                self._anchor(self.first_ns - self.loop_gap_ns, now_ns)
                 self.loops += 1
             else:
                 self.finished = True
