@@ -61,7 +61,9 @@ def _read_record(op: int, body: Fields, content: McapContent) -> None:
 
 
 def _read_chunk(body: Fields, content: McapContent, cut: bool) -> None:
-    """The records of a chunk; of a cut one (``cut``), those complete, if it is uncompressed."""
+    """The records of a chunk; of a cut one (``cut``), those complete, if it is uncompressed; of
+    a damaged one (CRC, size), only its schemas and channels."""
+    keep = None
     body.take(16)  # message start and end time
     size, crc, compression = body.uint(8), body.uint(4), body.string()
     length = body.uint(8)
@@ -70,15 +72,18 @@ def _read_chunk(body: Fields, content: McapContent, cut: bool) -> None:
             return  # a compressed chunk cut short cannot be decoded
         data, start, end = body.data, body.pos, min(body.pos + length, len(body.data))
     else:
-        data = decompress(compression, body.take(length), size, crc)
-        if data is None:
+        raw = body.take(length)
+        data = decompress(compression, raw, size, crc)
+        start, end = 0, len(data or raw)
+        if data is None:  # damaged: keep its schemas and channels (the rest refers to them)
             content.damaged_chunks += 1
-            return
-        start, end = 0, len(data)
+            data = raw if not compression else b''
+            keep = (OP_SCHEMA, OP_CHANNEL)
     try:
-        for op, inner in records(data, start, end):
-            _read_record(op, inner, content)
-    except McapCut:
+        for op, inner in records(data, start, min(end, len(data))):
+            if keep is None or op in keep:
+                _read_record(op, inner, content)
+    except (McapCut, McapFormatError):
         pass
 
 
@@ -115,6 +120,8 @@ def _connections(content: McapContent) -> Dict[int, Connection]:
     """rosbags connections for the channels of a scanned file (ids kept)."""
     result = {}
     for cid, (topic, sid, qos) in content.channels.items():
+        if sid not in content.schemas:
+            continue  # its schema was in a damaged chunk: its messages cannot be kept
         name, encoding, definition = content.schemas[sid]
         fmt = MessageDefinitionFormat.IDL if encoding == 'ros2idl' else MessageDefinitionFormat.MSG
         result[cid] = Connection(cid, topic, name, MessageDefinition(fmt, definition.decode()), '',
@@ -144,7 +151,11 @@ def repair_mcap(path: Path) -> Optional[str]:
             writer.add_msgtype(conn)
             types.add(conn.msgtype)
         writer.add_connection(conn, content.channels[cid][2])
+    lost = 0
     for cid, log_time, payload in content.messages:
+        if cid not in connections:
+            lost += 1
+            continue
         writer.write(connections[cid], log_time, payload)
     writer.close(METADATA_VERSION, '')
     writer.path.replace(path)
@@ -157,7 +168,9 @@ def repair_mcap(path: Path) -> Optional[str]:
         cut = 'not closed (no index)'
     if content.damaged_chunks:
         cut += f'; {content.damaged_chunks} damaged chunk(s) dropped'
-    return f'{path}: {cut}; kept {len(content.messages)} complete messages, index rebuilt'
+    if lost:
+        cut += f'; {lost} messages of channels without a schema dropped'
+    return f'{path}: {cut}; kept {len(content.messages) - lost} complete messages, index rebuilt'
 
 
 
