@@ -115,3 +115,34 @@ def test_no_private_name_is_imported_from_another_module():
     private = {(m, f'{target}.{name}') for m in MODULES
                for target, name in _imports(m, False) if name.startswith('_')}
     assert private - KNOWN_PRIVATE == set()
+
+
+def _constants(module: str) -> Set[str]:
+    """The upper-case constants ``module`` assigns at top level (leading ``_`` dropped)."""
+    names = set()
+    for node in ast.parse(MODULES[module].read_text()).body:
+        targets = node.targets if isinstance(node, ast.Assign) else (
+            [node.target] if isinstance(node, ast.AnnAssign) else [])
+        for target in targets:
+            elts = target.elts if isinstance(target, ast.Tuple) else [target]
+            names.update(e.id.lstrip('_') for e in elts if isinstance(e, ast.Name))
+    return {n for n in names if n.replace('_', '').isupper()}
+
+
+def _defined_in(modules) -> Dict[str, List[str]]:
+    where: Dict[str, List[str]] = {}
+    for module in modules:
+        for name in _constants(module):
+            where.setdefault(name, []).append(module)
+    return where
+
+
+def test_constants_are_defined_once():
+    """The MCAP magic and opcodes, message type names, axes, 2 pi, the diagnostics period: one
+    definition each (issue 23); and no constant is defined in two io/ modules."""
+    where = _defined_in(MODULES)
+    for name in ('MAGIC', 'OP_CHUNK', 'OP_CHANNEL', 'WRENCH_STAMPED', 'XYZ', 'TWO_PI',
+                 'DIAGNOSTICS_PERIOD'):
+        assert len(where.get(name, [])) == 1, (name, where.get(name))
+    io = _defined_in(m for m in MODULES if m.startswith(f'{NAME}.io'))
+    assert {n: m for n, m in io.items() if len(m) > 1} == {}

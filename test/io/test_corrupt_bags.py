@@ -16,8 +16,7 @@ from hypothesis import strategies as st
 
 from vib_estimator.errors import BagError, CorruptRecordError, VibEstimatorError
 from vib_estimator.io import mcap
-from vib_estimator.io.bags import (BagReader, WrenchSeries, read_wrench_series,
-                                   write_wrench_series)
+from vib_estimator.io.bags import BagReader, WrenchSeries, read_wrench_series, write_wrench_series
 from vib_estimator.io.streaming import open_signal
 
 REPO = Path(__file__).resolve().parents[2]

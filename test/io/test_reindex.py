@@ -127,8 +127,8 @@ def test_reindex_of_rosbag2_bags_counts_every_message(tmp_path, name, count):
     assert len(rosbags_payloads(tmp_path / name)) == count  # rosbags trusts the new metadata
 
 
-@pytest.mark.parametrize('content, message', [(b'', 'is empty (0 bytes)'),
-                                              (b'not an mcap file', 'does not start with the MCAP')])
+@pytest.mark.parametrize('content, message', [
+    (b'', 'is empty (0 bytes)'), (b'not an mcap file', 'does not start with the MCAP')])
 def test_reindex_of_a_file_that_is_not_mcap_is_an_error_and_leaves_it(tmp_path, capsys, content,
                                                                      message):
     """A 0-byte .mcap used to be "0 messages, index rebuilt" and rewritten (issue 22, case 8)."""

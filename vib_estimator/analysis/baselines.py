@@ -37,7 +37,7 @@ from typing import Optional, Sequence, Tuple
 import numpy as np
 from numba import njit
 
-TWO_PI = 2.0 * math.pi
+from ..core.uncertainty import TWO_PI
 
 ZIARANI, HOU, MOJIRI = 0, 1, 2
 

@@ -45,7 +45,7 @@ from typing import Dict, Iterable, List, Optional, Sequence, Tuple
 import numpy as np
 
 from ..core import COUNTER_NAMES, EstimatorConfig
-from ..io.csv_reader import CsvError
+from ..errors import VibEstimatorError, report
 from ..io.fields import DEFAULT_COMPONENT, check_component
 from ..io.streaming import bag_topics, is_csv, open_signal, supported_topics
 from .analyze import add_config_arguments, estimate_signal, make_config
@@ -512,9 +512,8 @@ def run(args: argparse.Namespace) -> int:
     try:
         options = _options(args)
         base = baseline_rows(args.baseline, options) if args.baseline else None
-    except (ValueError, CsvError) as err:
-        print(f'vib-estimator survey: error: {err}', file=sys.stderr)
-        return 2
+    except (ValueError, VibEstimatorError) as err:
+        return report(err, 'vib-estimator survey')
     ignored: List[Path] = []
     rows = survey(find_recordings(args.inputs, ignored), options, args.jobs, args.scheduler)
     report_entries(rows, ignored, sys.stderr)

@@ -19,8 +19,8 @@ index entry that does not point at a whole message record of its channel and log
 too (and two entries at one offset give one message). Damaged records are counted in
 :class:`ChunkMessages.skipped`, never raised: the callers count, report and (``strict``) refuse.
 So a damaged file never yields more messages than the intact one. Anything else wrong with the
-layout (no summary, a summary that does not parse) is :class:`McapFormatError`: the caller reads the
-file another way (``rosbags``) or reports it.
+layout (no summary, a summary that does not parse) is :class:`McapFormatError`: the caller reads
+the file another way (``rosbags``) or reports it.
 """
 from __future__ import annotations
 
@@ -47,7 +47,8 @@ FOOTER_BYTES = RECORD_HEAD + 8 + 8 + 4
 #: the fields of a message record before its payload: channel (2), sequence (4), log time (8),
 #: publish time (8)
 MESSAGE_HEAD = 2 + 4 + 8 + 8
-#: byte of a chunk record at which its CRC-32 is: head + message start, end times + uncompressed size
+#: byte of a chunk record at which its CRC-32 is: after the head, message start and end times and
+#: the uncompressed size
 CHUNK_CRC_AT = RECORD_HEAD + 8 + 8 + 8
 #: a message index entry: log time (u64), record offset in the chunk (u64)
 INDEX_ENTRY = np.dtype([('t', '<u8'), ('o', '<u8')])

@@ -17,20 +17,19 @@ from __future__ import annotations
 
 import argparse
 import sqlite3
-import sys
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Dict, Iterator, List, Optional, Tuple
+from typing import Dict, List, Optional, Tuple
 
 from rosbags.interfaces import (Connection, ConnectionExtRosbag2, MessageDefinition,
                                 MessageDefinitionFormat)
 from rosbags.rosbag2.metadata import parse_qos
 
-from ..errors import BagError, McapCut, McapFormatError, as_bag_error
+from ..errors import BagError, McapCut, McapFormatError, as_bag_error, report
 from .bags import (METADATA_VERSION, TYPESTORE, FileStats, bag_metadata, mcap_file, storage_files,
                    storage_reader, write_metadata)
-from .mcap import (MAGIC, OP_CHANNEL, OP_CHUNK, OP_DATA_END, OP_MESSAGE, OP_SCHEMA,
-                   Fields, decompress, read_channel, read_message, read_schema, records)
+from .mcap import (MAGIC, OP_CHANNEL, OP_CHUNK, OP_DATA_END, OP_MESSAGE, OP_SCHEMA, Fields,
+                   decompress, read_channel, read_message, read_schema, records)
 
 
 @dataclass
@@ -271,7 +270,6 @@ def run(args: argparse.Namespace) -> int:
     try:
         result = reindex(args.bag)
     except BagError as err:
-        print(f'error: {err}', file=sys.stderr)
-        return 2
+        return report(err)
     print(result.summary())
     return 0

@@ -54,8 +54,8 @@ from rosbags.interfaces import (Qos, QosDurability, QosHistory, QosLiveliness, Q
 
 from ..errors import BagError
 from ..io.bags import STORAGES, BagWriter
-from .runner import StartupError, run
 from .parameters import declare, descriptor
+from .runner import StartupError, run
 
 DISCOVERY_PERIOD = 0.05  # s between looks at the graph for publishers of topics not yet recorded
 

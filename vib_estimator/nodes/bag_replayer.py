@@ -76,9 +76,9 @@ from std_srvs.srv import Trigger
 from ..errors import BagError, EmptyPlayback
 from ..io.bags import BagReader, TopicInfo
 from .bag_recorder import adapted_qos, message_class
+from .parameters import declare, descriptor
 from .playback import Playback, StartGate
 from .runner import StartupError, run
-from .parameters import declare, descriptor
 
 TICK = 0.001  # s, period of the scheduling timer
 DEPTH = 1000  # history depth of the publishers

@@ -48,8 +48,6 @@ from .stream import EstimatorStream
 #: hiccup of up to 2 s at 500 Hz, or a player's burst after a stall, drops nothing
 #: (benchmarks/bench_node.py measures the effect of the depth)
 INPUT_DEPTH = 1000
-#: period of /diagnostics, s
-DIAGNOSTICS_PERIOD = 1.0
 #: the ROS parameters that configure the core, one per EstimatorConfig field
 CORE_NAMES = frozenset(EstimatorConfig.names())
 #: the Float64 outputs of each estimate, in publication order: (topic under vibration/, field)
@@ -136,7 +134,7 @@ class EstimatorNode(Node):
         self.create_service(Trigger, '~/self_test', self._on_self_test)
         self._diagnostics_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
         # on the steady clock: diagnostics go on (and can say STALE) when sim time stops
-        self.create_timer(DIAGNOSTICS_PERIOD, self._publish_diagnostics,
+        self.create_timer(H.DIAGNOSTICS_PERIOD, self._publish_diagnostics,
                           clock=Clock(clock_type=ClockType.STEADY_TIME))
         self.get_logger().info(f'estimating on {self._subscription.topic_name} '
                                f'({self._input_type} [{self._component}]) with '
