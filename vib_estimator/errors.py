@@ -62,6 +62,26 @@ class CdrLayoutError(VibEstimatorError):
     """A batch the vectorised decoder cannot take (not little-endian CDR, or too short)."""
 
 
+class DamageCount:
+    """Mixin of a reader that skips damaged records: :meth:`count_damage` adds them to ``corrupt``
+    and keeps the first description in ``damage`` -- or, with ``strict``, raises
+    :class:`CorruptRecordError` naming ``path``."""
+
+    path: Path
+    strict: bool
+    corrupt: int
+    damage: str
+
+    def count_damage(self, count: int, damage: str) -> None:
+        """Count ``count`` damaged records (``damage`` says what); raise if ``strict``."""
+        if count <= 0:
+            return
+        if self.strict:
+            raise CorruptRecordError(f'{self.path}: {damage}')
+        self.corrupt += count
+        self.damage = self.damage or damage
+
+
 #: exception class -> exit code of the command-line tools (the first match in order wins)
 EXIT_CODES = ((VibEstimatorError, EXIT_BAD_INPUT), (ValueError, EXIT_BAD_INPUT))
 

@@ -53,7 +53,7 @@ from rosbags.rosbag2.storage_mcap import DECOMPRESSORS, McapReader, McapWriter
 from rosbags.rosbag2.storage_sqlite3 import Sqlite3Reader, Sqlite3Writer
 from rosbags.typesys import Stores, get_typestore
 
-from ..errors import BagError, CorruptRecordError, McapFormatError, as_bag_error
+from ..errors import BagError, DamageCount, McapFormatError, as_bag_error
 from . import mcap
 from .fields import (WRENCH_STAMPED, XYZ, check_component, component_getter, normalise_type,
                      stamp_ns)
@@ -124,7 +124,7 @@ def storage_reader(path: Path):
     return storage
 
 
-class BagReader:
+class BagReader(DamageCount):
     """An open bag: an MCAP file, an sqlite3 ``.db3`` file, or a rosbag2 directory of either.
 
     Use as a context manager. Raises :class:`BagError` if the path is missing or not a readable bag,
@@ -193,15 +193,6 @@ class BagReader:
             raise BagError(f'bag {self.path} has no topic {name!r}; its topics are '
                            f'{self.describe_topics()}')
         return self.topics[name]
-
-    def count_damage(self, count: int, damage: str) -> None:
-        """Count ``count`` damaged records (``damage`` says what); raise if ``strict``."""
-        if not count:
-            return
-        if self.strict:
-            raise CorruptRecordError(f'bag {self.path}: {damage}')
-        self.corrupt += count
-        self.damage = self.damage or damage
 
     def _stream(self, storage, names: set, start_ns: Optional[int]):
         """``(topic, log time, data)`` of one storage file: MCAP by :mod:`.mcap` (checked), else

@@ -36,7 +36,7 @@ from typing import Callable, Dict, Iterable, Iterator, List, Optional, Tuple
 import numpy as np
 from rosbags.rosbag2 import Reader
 
-from ..errors import BagError, CdrLayoutError, CorruptRecordError, McapFormatError, as_bag_error
+from ..errors import BagError, CdrLayoutError, DamageCount, McapFormatError, as_bag_error
 from . import cdr, mcap
 from .bags import TYPESTORE, check_bag_path, only_topic
 from .csv_reader import csv_blocks, csv_layout
@@ -50,7 +50,7 @@ Block = Tuple[np.ndarray, np.ndarray]
 
 
 @dataclass
-class Signal:
+class Signal(DamageCount):
     """An opened recording: where the samples come from and how to stream them.
 
     ``blocks()`` yields ``(t, y)``: time in s (bags: since the first stamp, ``origin_ns``; CSV: the
@@ -82,15 +82,6 @@ class Signal:
             if self.origin_ns is None:
                 self.origin_ns = int(stamps[0])
             yield seconds_since(stamps, self.origin_ns), values
-
-    def count_damage(self, count: int, damage: str) -> None:
-        """Count ``count`` damaged records (``damage`` says what); raise if ``strict``."""
-        if not count:
-            return
-        if self.strict:
-            raise CorruptRecordError(f'{self.path}: {damage}')
-        self.corrupt += count
-        self.damage = self.damage or damage
 
 
 def is_csv(path) -> bool:
