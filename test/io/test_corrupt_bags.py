@@ -189,7 +189,7 @@ def intact_payloads(intact):
         return [m.data for m in bag.messages()]
 
 
-@settings(max_examples=40, deadline=None, derandomize=True,
+@settings(max_examples=100, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(edits=st.lists(st.tuples(st.floats(0, 1), st.integers(1, 64), st.binary(min_size=1,
                                                                                 max_size=64)),
@@ -220,3 +220,17 @@ def test_fuzz_damaged_mcap_never_crashes_nor_adds_messages(tmp_path_factory, int
     assert not Counter(played) - Counter(intact_payloads)
     assert len(values) + corrupt >= N or mode == 'truncate'   # every loss counted
     assert len(played) + played_corrupt >= N or mode == 'truncate'
+
+
+@settings(max_examples=30, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(data=st.one_of(st.binary(max_size=4096),
+                      st.binary(max_size=4096).map(lambda b: mcap.MAGIC + b),
+                      st.binary(max_size=4096).map(lambda b: mcap.MAGIC + b + mcap.MAGIC)))
+def test_fuzz_random_bytes_as_an_mcap_file_are_refused_in_one_sentence(tmp_path_factory, data):
+    path = tmp_path_factory.mktemp('random') / 'x.mcap'
+    path.write_bytes(data)
+    for read in (lambda: read_signal(path), lambda: list(BagReader(path).messages())):
+        with pytest.raises(BagError) as err:
+            read()
+        assert '\n' not in str(err.value) and str(path) in str(err.value)
