@@ -146,3 +146,18 @@ def test_constants_are_defined_once():
         assert len(where.get(name, [])) == 1, (name, where.get(name))
     io = _defined_in(m for m in MODULES if m.startswith(f'{NAME}.io'))
     assert {n: m for n, m in io.items() if len(m) > 1} == {}
+
+
+def test_the_exceptions_module_is_a_leaf_that_every_reader_uses():
+    """errors.py imports nothing of the package (so anything can import it) and holds every
+    exception class of the library outside the node runner (``StartupError``)."""
+    assert _graph(top_level_only=False)[f'{NAME}.errors'] == set()
+    classes = {}
+    for module, path in MODULES.items():
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ClassDef) and any(
+                    getattr(b, 'id', getattr(b, 'attr', '')).endswith(('Error', 'Exception'))
+                    for b in node.bases):
+                classes[node.name] = module
+    outside = {n: m for n, m in classes.items() if m != f'{NAME}.errors'}
+    assert outside == {'StartupError': f'{NAME}.nodes.runner'}

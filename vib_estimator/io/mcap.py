@@ -35,7 +35,6 @@ import numpy as np
 from rosbags.rosbag2.storage_mcap import DECOMPRESSORS
 
 from ..errors import McapCut, McapFormatError
-from .cdr import gather
 
 MAGIC = b'\x89MCAP0\r\n'
 OP_HEADER, OP_FOOTER, OP_SCHEMA, OP_CHANNEL, OP_MESSAGE = 0x01, 0x02, 0x03, 0x04, 0x05
@@ -314,22 +313,25 @@ def _index_entries(handle, chunk: ChunkRead) -> Tuple[np.ndarray, np.ndarray, in
     return np.concatenate(entries), np.concatenate(channels), damaged
 
 
-def _valid_entries(records: np.ndarray, index: np.ndarray, channels: np.ndarray) -> np.ndarray:
-    """Which index entries point at a whole message record of their channel and log time."""
+def _valid_entries(records: np.ndarray, index: np.ndarray, channels: np.ndarray
+                   ) -> Tuple[np.ndarray, np.ndarray]:
+    """Which index entries point at a whole message record of their channel and log time, and
+    the length of each such record (one gather of the records' heads)."""
     size = len(records)
-    off = index['o']
-    ok = off <= np.uint64(max(size - RECORD_HEAD - MESSAGE_HEAD, 0))
-    ok &= size >= RECORD_HEAD + MESSAGE_HEAD
-    at = np.where(ok, off, 0).astype(np.int64)
+    head = RECORD_HEAD + MESSAGE_HEAD - 8          # up to the end of the log time
+    ok = index['o'] <= np.uint64(max(size - RECORD_HEAD - MESSAGE_HEAD, 0))
     if size < RECORD_HEAD + MESSAGE_HEAD:
-        return ok
-    ok &= records[at] == OP_MESSAGE
-    length = gather(records, at + 1, '<u8')
+        return ok & False, np.zeros(len(index), np.int64)
+    at = np.where(ok, index['o'], 0).astype(np.int64)
+    window = records[at[:, None] + np.arange(head)]
+    length = window[:, 1:RECORD_HEAD].copy().view('<u8').ravel()
+    ok &= window[:, 0] == OP_MESSAGE
     ok &= (length >= MESSAGE_HEAD) & (length <= np.uint64(size))
-    ok &= at + RECORD_HEAD + length.astype(np.int64) <= size
-    ok &= gather(records, at + RECORD_HEAD, '<u2').astype(np.int64) == channels
-    ok &= gather(records, at + RECORD_HEAD + 6, '<u8') == index['t']
-    return ok
+    length = np.where(ok, length, 0).astype(np.int64)
+    ok &= at + RECORD_HEAD + length <= size
+    ok &= window[:, RECORD_HEAD:RECORD_HEAD + 2].copy().view('<u2').ravel() == channels
+    ok &= window[:, head - 8:head].copy().view('<u8').ravel() == index['t']
+    return ok, length
 
 
 def read_chunk(handle, chunk: ChunkRead) -> ChunkMessages:
@@ -349,15 +351,16 @@ def read_chunk(handle, chunk: ChunkRead) -> ChunkMessages:
         return _empty(len(index) + damaged, f'chunk at byte {chunk.start} of {chunk.path.name} '
                       f'is damaged (checksum, size or compression)')
     buf = np.frombuffer(records, np.uint8)
-    ok = _valid_entries(buf, index, channels)
-    at = index['o'][ok].astype(np.int64)
-    _, first = np.unique(at, return_index=True)          # one message per record offset
-    keep = np.flatnonzero(ok)[first]
+    ok, record_lengths = _valid_entries(buf, index, channels)
+    keep = np.flatnonzero(ok)
+    at = index['o'][keep].astype(np.int64)
+    if len(at) > 1 and not np.all(at[1:] > at[:-1]):   # not in record order: drop repeats
+        keep = keep[np.unique(at, return_index=True)[1]]
     keep = keep[np.argsort(index['t'][keep], kind='stable')]
     rec = index['o'][keep].astype(np.int64)
     skipped = len(index) - len(keep) + damaged
-    lengths = gather(buf, rec + 1, '<u8').astype(np.int64) - MESSAGE_HEAD if len(rec) else rec
-    return ChunkMessages(buf, rec + RECORD_HEAD + MESSAGE_HEAD, lengths,
+    return ChunkMessages(buf, rec + RECORD_HEAD + MESSAGE_HEAD,
+                         record_lengths[keep] - MESSAGE_HEAD,
                          index['t'][keep].astype(np.int64), channels[keep], skipped,
                          f'{skipped} message index entries of the chunk at byte {chunk.start} of '
                          f'{chunk.path.name} do not point at a message' if skipped else '')
