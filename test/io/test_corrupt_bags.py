@@ -234,3 +234,31 @@ def test_fuzz_random_bytes_as_an_mcap_file_are_refused_in_one_sentence(tmp_path_
         with pytest.raises(BagError) as err:
             read()
         assert '\n' not in str(err.value) and str(path) in str(err.value)
+
+
+def test_the_layout_check_refuses_what_rosbags_cannot_decode():
+    """``cdr.fits_layout`` (the replayer's per-message check of fixed layouts) accepts every
+    payload rosbags writes, and refuses cut payloads, the wrong endianness, a frame_id past the
+    end or not NUL-terminated (rosbags refuses the cut ones too)."""
+    from vib_estimator.io import cdr
+    from vib_estimator.io.bags import TYPESTORE, wrench_message
+    from vib_estimator.io.fields import WRENCH_STAMPED
+
+    def rosbags_decodes(payload) -> bool:
+        try:
+            TYPESTORE.deserialize_cdr(payload, WRENCH_STAMPED)
+            return True
+        except Exception:  # noqa: BLE001 -- whatever its parser raises
+            return False
+
+    for frame in ('', 'a', 'arm_base', 'a_much_longer_frame_name'):
+        good = bytes(TYPESTORE.serialize_cdr(wrench_message(EPOCH, frame, 'torque.z', 1.5),
+                                             WRENCH_STAMPED))
+        end = 16 + len(frame)                      # the frame_id's NUL
+        bad = [good[:-1], good[:20], b'\x00\x00' + good[2:],
+               good[:12] + (999).to_bytes(4, 'little') + good[16:],
+               good[:end] + b'x' + good[end + 1:]]
+        assert cdr.fits_layout(good, WRENCH_STAMPED) and rosbags_decodes(good)
+        for payload in bad:
+            assert not cdr.fits_layout(payload, WRENCH_STAMPED), (frame, payload)
+        assert not any(rosbags_decodes(p) for p in bad[:2])       # cut: rosbags refuses too

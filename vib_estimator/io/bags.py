@@ -54,7 +54,7 @@ from rosbags.rosbag2.storage_sqlite3 import Sqlite3Reader, Sqlite3Writer
 from rosbags.typesys import Stores, get_typestore
 
 from ..errors import BagError, DamageCount, McapFormatError, as_bag_error
-from . import mcap
+from . import cdr, mcap
 from .fields import (WRENCH_STAMPED, XYZ, check_component, component_getter, normalise_type,
                      stamp_ns)
 
@@ -244,7 +244,10 @@ class BagReader(DamageCount):
 
 
 def _decodes(data: bytes, msgtype: str) -> bool:
-    """Whether ``data`` deserialises as ``msgtype`` (True for a type rosbags does not know)."""
+    """Whether ``data`` deserialises as ``msgtype`` (True for a type rosbags does not know);
+    fixed-layout types by :func:`.cdr.fits_layout` (the same answer, ~10x faster)."""
+    if cdr.is_fixed_layout(msgtype):
+        return cdr.fits_layout(data, msgtype)
     if msgtype not in TYPESTORE.types:
         return True
     try:

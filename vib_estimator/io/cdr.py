@@ -50,6 +50,22 @@ def is_fixed_layout(msgtype: str) -> bool:
     return msgtype in DOUBLE_INDEX
 
 
+def fits_layout(data: bytes, msgtype: str) -> bool:
+    """Whether one payload decodes as the fixed layout of ``msgtype``: little-endian CDR, the
+    ``frame_id`` NUL-terminated inside it, long enough for the type's doubles (what a decoder can
+    check of such a message: the doubles themselves may hold anything)."""
+    if len(data) < 4 + 8 or data[0] != 0 or data[1] != 1:
+        return False
+    if msgtype == FLOAT64:
+        return True
+    if len(data) < 16:
+        return False
+    name_len = int.from_bytes(data[12:16], 'little')
+    if not 1 <= name_len <= len(data) - 16 or data[15 + name_len] != 0:
+        return False
+    return 4 + ((12 + name_len + 7) & ~7) + 8 * N_DOUBLES[msgtype] <= len(data)
+
+
 def gather(buf: np.ndarray, offsets: np.ndarray, dtype: str) -> np.ndarray:
     """The little-endian scalar of ``dtype`` at each byte offset of ``buf`` (any alignment)."""
     size = np.dtype(dtype).itemsize
