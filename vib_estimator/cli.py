@@ -1,7 +1,9 @@
 """``vib-estimator``: the package's command line (offline analysis, paper figures, comparison, demo).
 
 Each sub-command lives in its own module exposing ``add_arguments(parser)`` and ``run(args) -> int``;
-this module only dispatches, importing the chosen one lazily so ``--help`` stays fast.
+this module only dispatches, importing the chosen one lazily so ``--help`` stays fast. Input a
+command refuses (:mod:`vib_estimator.errors`) ends as one ``error:`` line and the exit code
+:func:`vib_estimator.errors.exit_code` gives it (2), here if the command does not report it itself.
 """
 from __future__ import annotations
 
@@ -10,6 +12,8 @@ import importlib
 import os
 import sys
 from typing import Optional, Sequence
+
+from .errors import VibEstimatorError, report
 
 COMMANDS = {
     'analyze': ('vib_estimator.analysis.analyze', 'estimate frequencies in a recorded signal (CSV, MCAP, '
@@ -40,6 +44,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     args = parser.parse_args(argv)
     try:
         return modules[args.command].run(args)
+    except VibEstimatorError as err:
+        return report(err, f'vib-estimator {args.command}')
     except BrokenPipeError:
         # the reader of stdout went away (e.g. `| head`): stop quietly, as Unix tools do
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())

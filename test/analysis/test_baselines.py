@@ -133,7 +133,7 @@ def test_the_pencils_svd_runs_on_one_blas_thread(monkeypatch):
     svd = np.linalg.svd
 
     def spy(*args, **kwargs):
-        threads.extend(lib['num_threads'] for lib in baselines._blas_controller().info()
+        threads.extend(lib['num_threads'] for lib in baselines.blas_controller().info()
                        if lib['user_api'] == 'blas')
         return svd(*args, **kwargs)
     monkeypatch.setattr(np.linalg, 'svd', spy)

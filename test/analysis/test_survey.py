@@ -1,6 +1,7 @@
 """``vib-estimator survey``: rows equal per-file analyze, bad recordings, the alarm, Dask."""
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -154,5 +155,45 @@ def test_a_worker_started_with_a_malloc_trim_threshold_streams_without_remapping
 def test_malloc_is_left_alone_in_a_plain_process(monkeypatch):
     monkeypatch.delenv('MALLOC_TRIM_THRESHOLD_', raising=False)
     monkeypatch.setattr(S.ctypes, 'CDLL', lambda *a: pytest.fail('mallopt called'))
-    with S._streaming_malloc():
+    with S.streaming_malloc():
         pass
+
+
+def test_every_entry_of_a_folder_is_accounted_for(tmp_path, capsys):
+    """Corrupt, empty and non-bag entries each get an error row (or a counted skip) and a stderr
+    line; a plain folder and stray files are no longer silent (issue 22, case 8)."""
+    from vib_estimator.io import mcap
+
+    (good,) = fleet(tmp_path, [1.3])
+    damaged = tmp_path / 'damaged'
+    fleet(damaged, [1.3])
+    file = next((damaged / 'day_00').glob('*.mcap'))
+    _, _, start, length, _ = mcap.read_summary(file).chunks[1]
+    data = bytearray(file.read_bytes())
+    data[start + length // 2] ^= 0xFF
+    file.write_bytes(bytes(data))
+    (tmp_path / 'empty.mcap').write_bytes(b'')
+    (tmp_path / 'docs').mkdir()
+    (tmp_path / 'docs' / 'notes.txt').write_text('not a recording')
+    (tmp_path / 'nothing').mkdir()
+    (tmp_path / 'README.md').write_text('fleet')
+    args = ['survey', str(tmp_path), '--format', 'jsonl', '--jobs', '1']
+    assert main(args) == 0
+    out = capsys.readouterr()
+    rows = {Path(r['recording']).relative_to(tmp_path).as_posix(): r for r in jsonl(out.out)}
+    assert set(rows) == {'day_00', 'damaged/day_00', 'empty.mcap', 'docs', 'nothing'}
+    assert rows['day_00']['error'] == '' and rows['day_00']['corrupt_records'] == 0
+    hurt = rows['damaged/day_00']
+    assert hurt['error'] == '' and hurt['corrupt_records'] > 0
+    assert hurt['samples'] + hurt['corrupt_records'] == rows['day_00']['samples']
+    for name in ('empty.mcap', 'docs', 'nothing'):
+        assert rows[name]['error'], name
+    assert 'not a rosbag2 bag' in rows['docs']['error']
+    err = out.err.splitlines()
+    assert sum('error:' in line for line in err) == 3
+    assert sum('warning:' in line and 'damaged/day_00' in line for line in err) == 1
+    assert any('notes.txt' in line for line in err) and any('README.md' in line for line in err)
+    assert main(args + ['--strict']) == 1
+    strict = {Path(r['recording']).relative_to(tmp_path).as_posix(): r
+              for r in jsonl(capsys.readouterr().out)}
+    assert 'damaged' in strict['damaged/day_00']['error']

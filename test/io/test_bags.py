@@ -1,6 +1,7 @@
 """bag_io: round trips through every storage layout, clear BagErrors, the shipped bags."""
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
@@ -207,7 +208,9 @@ def test_make_bags_is_deterministic(tmp_path):
 
 # -- bags written by rosbag2 itself, split bags, crash safety -------------------------------------
 
-SHARED_BAGS = Path(__file__).resolve().parents[3] / 'shared' / 'ros2-bags'
+# ../shared relative to the repo; VIB_SHARED names it elsewhere (a worktree)
+SHARED_BAGS = Path(os.environ.get('VIB_SHARED', Path(__file__).resolve().parents[3] / 'shared')
+                   ) / 'ros2-bags'
 needs_shared = pytest.mark.skipif(not SHARED_BAGS.is_dir(), reason='../shared/ros2-bags is absent')
 ROSBAG2_BAGS = ['mcap_talker', 'sqlite3_talker', 'mcap_wbag', 'sqlite3_wbag']
 

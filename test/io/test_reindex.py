@@ -2,6 +2,7 @@
 files repaired, independent readers (rosbags, mcap) agree."""
 from __future__ import annotations
 
+import os
 import shutil
 from pathlib import Path
 
@@ -13,7 +14,9 @@ from vib_estimator.cli import main
 from vib_estimator.io.bags import TYPESTORE, BagError, BagReader, BagWriter
 from vib_estimator.io.reindex import reindex, scan_mcap
 
-SHARED_BAGS = Path(__file__).resolve().parents[3] / 'shared' / 'ros2-bags'
+# ../shared relative to the repo; VIB_SHARED names it elsewhere (a worktree)
+SHARED_BAGS = Path(os.environ.get('VIB_SHARED', Path(__file__).resolve().parents[3] / 'shared')
+                   ) / 'ros2-bags'
 STRING = 'std_msgs/msg/String'
 
 
@@ -122,3 +125,41 @@ def test_reindex_of_rosbag2_bags_counts_every_message(tmp_path, name, count):
     result = reindex(tmp_path / name)
     assert sum(f.count for f in result.files) == count
     assert len(rosbags_payloads(tmp_path / name)) == count  # rosbags trusts the new metadata
+
+
+@pytest.mark.parametrize('content, message', [
+    (b'', 'is empty (0 bytes)'), (b'not an mcap file', 'does not start with the MCAP')])
+def test_reindex_of_a_file_that_is_not_mcap_is_an_error_and_leaves_it(tmp_path, capsys, content,
+                                                                     message):
+    """A 0-byte .mcap used to be "0 messages, index rebuilt" and rewritten (issue 22, case 8)."""
+    (tmp_path / 'bag').mkdir()
+    file = tmp_path / 'bag' / 'bag_0.mcap'
+    file.write_bytes(content)
+    assert main(['reindex', str(tmp_path / 'bag')]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == '' and captured.err.count('\n') == 1
+    assert captured.err.startswith('error: ') and message in captured.err
+    assert file.read_bytes() == content and not (tmp_path / 'bag' / 'metadata.yaml').exists()
+
+
+def test_reindex_drops_a_damaged_chunk_and_says_so(tmp_path):
+    """A cut file whose first chunk's CRC fails: its messages are not rewritten as good ones."""
+    from vib_estimator.io import mcap
+
+    with BagWriter(tmp_path / 'bag') as bag:
+        conn = bag.add_topic('/a', 'std_msgs/msg/String')
+        for i in range(3000):
+            bag.write_message(conn, 1000 + i, TYPESTORE.types['std_msgs/msg/String'](
+                data=f'message {i:04d} ' + 'x' * 40))
+    file = mcap_file(tmp_path / 'bag')
+    _, _, start, length, _ = mcap.read_summary(file).chunks[0]
+    data = bytearray(file.read_bytes())
+    data[start + length // 2] ^= 0xFF
+    file.write_bytes(bytes(data[:len(data) - 100]))        # cut: reindex must scan it
+    result = reindex(tmp_path / 'bag')
+    assert 'damaged chunk(s) dropped' in result.summary()
+    with BagReader(tmp_path / 'bag') as bag:
+        kept = [m.data for m in bag.messages()]
+        assert 0 < len(kept) < 3000 and bag.corrupt == 0
+    texts = {TYPESTORE.deserialize_cdr(d, 'std_msgs/msg/String').data[:12] for d in kept}
+    assert texts <= {f'message {i:04d}' for i in range(3000)}

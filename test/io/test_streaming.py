@@ -1,11 +1,12 @@
 """Streaming readers: same samples as the reference readers, every input type, bounded blocks."""
+import os
 import shutil
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from vib_estimator.io import streaming
+from vib_estimator.io import csv_reader, mcap, streaming
 from vib_estimator.io.bags import (TYPESTORE, BagError, BagWriter, WrenchSeries, read_wrench_series,
                                    write_wrench_series)
 from vib_estimator.io.cdr import DOUBLE_INDEX
@@ -14,7 +15,9 @@ from vib_estimator.io.fields import INPUT_TYPES, JOINT_STATE, component_getter
 from vib_estimator.io.streaming import open_signal
 
 EPOCH = 1_700_000_000_000_000_000
-SHARED_BAGS = Path(__file__).resolve().parents[2].parent / 'shared' / 'ros2-bags'
+# ../shared relative to the repo; VIB_SHARED names it elsewhere (a worktree)
+SHARED_BAGS = Path(os.environ.get('VIB_SHARED', Path(__file__).resolve().parents[3] / 'shared')
+                   ) / 'ros2-bags'
 
 
 def collect(signal):
@@ -79,7 +82,7 @@ def test_fast_path_is_taken_and_matches_the_reference_reader(tmp_path):
     stamps = EPOCH + np.arange(n, dtype=np.int64) * 2_000_000
     y = np.sin(np.arange(n) * 0.01)
     write_wrench_series(tmp_path / 'bag', WrenchSeries(stamps, y, 'arm', '/w'))
-    plan = streaming._mcap_plan(sorted((tmp_path / 'bag').glob('*.mcap')), '/w')
+    plan = mcap.read_plan(sorted((tmp_path / 'bag').glob('*.mcap')), '/w')
     assert len(plan) > 1                                        # several chunks, indexed
     (t, values), parts = collect(open_signal(tmp_path / 'bag'))
     ref = read_wrench_series(tmp_path / 'bag')
@@ -90,7 +93,7 @@ def test_fast_path_is_taken_and_matches_the_reference_reader(tmp_path):
 def test_blocks_are_bounded_whatever_the_length(tmp_path, monkeypatch):
     """Constant memory by construction: no block exceeds the block size, however long the file."""
     monkeypatch.setattr(streaming, 'BLOCK_SAMPLES', 4096)
-    monkeypatch.setattr(streaming, 'CSV_BLOCK_BYTES', 1 << 16)
+    monkeypatch.setattr(csv_reader, 'CSV_BLOCK_BYTES', 1 << 16)
     n = 200_000
     t = np.arange(n) * 0.001
     path = tmp_path / 'big.csv'
@@ -121,7 +124,7 @@ def test_csv_fast_and_exact_paths_agree(tmp_path, text):
 
 
 def test_csv_error_in_a_late_block_names_the_row(tmp_path, monkeypatch):
-    monkeypatch.setattr(streaming, 'CSV_BLOCK_BYTES', 1 << 12)
+    monkeypatch.setattr(csv_reader, 'CSV_BLOCK_BYTES', 1 << 12)
     lines = [f'{i * 0.01},{i}' for i in range(5000)]
     lines[4000] = '40.0,oops'
     path = tmp_path / 'a.csv'
@@ -207,6 +210,6 @@ def test_compressed_bags(tmp_path, mode):
     assert y.tolist() == values.tolist()
     assert np.array_equal(t, (stamps - stamps[0]) * 1e-9)
     if mode == 'STORAGE':
-        plan = streaming._mcap_plan(sorted((tmp_path / 'bag').glob('*.mcap')), '/w')
+        plan = mcap.read_plan(sorted((tmp_path / 'bag').glob('*.mcap')), '/w')
         with plan[0].path.open('rb') as handle:        # zstd chunks, read by the fast path
-            assert streaming._read_chunk(handle, plan[0])[1].size > 0
+            assert mcap.read_chunk(handle, plan[0]).offsets.size > 0

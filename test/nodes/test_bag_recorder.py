@@ -259,3 +259,15 @@ def test_file_too_large_is_one_error_line_exit_2_and_the_bag_stays_readable(ros_
         recorded = [deserialize_message(m.data, String).data for m in bag.messages()]
     assert len(recorded) == sum(f.count for f in result.files) > 100
     assert recorded == [f'message {i}' for i in range(len(recorded))]
+
+
+def test_an_output_that_cannot_be_created_is_one_plain_error_before_recording(tmp_path):
+    """``output:=/proc/newbag`` used to say "what was written before is kept" (issue 22, case 8)."""
+    result = subprocess.run(RECORDER + ['--ros-args', '-p', 'topics:=[/x]', '-p',
+                                        'output:=/proc/newbag'],
+                            capture_output=True, text=True, timeout=30)
+    assert result.returncode == 2 and 'Traceback' not in result.stderr
+    errors = [line for line in result.stderr.splitlines() if line.startswith('error: ')]
+    assert len(errors) == 1 and 'cannot create bag directory /proc/newbag' in errors[0]
+    assert 'kept' not in result.stderr and 'reindex' not in result.stderr
+    assert 'recording' not in result.stdout + result.stderr

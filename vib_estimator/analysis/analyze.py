@@ -6,6 +6,11 @@ has no header: the log time). The recording is read block by block (:mod:`..io.s
 memory does not grow with its length. A bag's topic may be of any input type of
 :mod:`..io.fields`; ``--component`` is checked against it. Estimates go to stdout (jsonl, csv or a
 table); the sample counters go to stderr. Bad input gives one line on stderr and exit code 2.
+
+Damaged bag records (an MCAP chunk whose checksum fails, an index entry that points at no message,
+a payload that does not decode as its type) are skipped: one ``warning:`` line on stderr says how
+many and what the first was, the counters line ends with ``corrupt_records=N``, and the exit code
+stays 0. With ``--strict`` the first one is an error instead (one ``error:`` line, exit code 2).
 """
 from __future__ import annotations
 
@@ -20,7 +25,7 @@ import numpy as np
 
 from ..core import MODELS, EstimateArrays, EstimatorConfig
 from ..core.modes import create_estimator
-from ..io.csv_reader import CsvError
+from ..errors import VibEstimatorError, report
 from ..io.fields import INPUT_TYPES
 from ..io.streaming import Signal, open_signal
 
@@ -45,6 +50,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_config_arguments(parser)
     parser.add_argument('--format', choices=('jsonl', 'csv', 'table'), default='jsonl')
     parser.add_argument('--plot', metavar='FILE.png', help='write a Fig. 5-like figure')
+    parser.add_argument('--strict', action='store_true', help='a damaged bag record is an error '
+                        '(exit 2) instead of a counted skip')
 
 
 def add_config_arguments(parser: argparse.ArgumentParser) -> None:
@@ -153,20 +160,28 @@ def _print(estimates, origin, fmt, modes: int = 0) -> None:
                       f'{row["convergence_time_s"]:9.4f} {row["samples"]:8d} {row["fit"]:6.3f}\n')
 
 
-def run(args: argparse.Namespace) -> int:
-    from ..io.bags import BagError
+def damage_warning(signal: Signal, prog: str) -> None:
+    """The one ``warning:`` line on stderr for the damaged records a read skipped, if any."""
+    if signal.corrupt:
+        print(f'{prog}: warning: skipped {signal.corrupt} damaged record(s) of {signal.topic} in '
+              f'{signal.path} (first: {signal.damage}); --strict makes this an error',
+              file=sys.stderr)
 
+
+def run(args: argparse.Namespace) -> int:
     try:
         config = make_config(args)
-        signal = open_signal(args.input, args.topic, args.component, args.column)
+        signal = open_signal(args.input, args.topic, args.component, args.column,
+                             strict=getattr(args, 'strict', False))
         result = estimate_signal(signal, config, bool(args.plot))
-    except (CsvError, BagError, ValueError) as err:
-        print(f'vib-estimator analyze: error: {err}', file=sys.stderr)
-        return 2
+    except (VibEstimatorError, ValueError) as err:
+        return report(err, 'vib-estimator analyze')
+    damage_warning(signal, 'vib-estimator analyze')
     estimates = result.estimates
     _print(estimates, signal.origin_ns, args.format, config.modes)
     counters = result.estimator.counters
     extra = f', messages_without_component={signal.skipped}' if signal.skipped else ''
+    extra += f', corrupt_records={signal.corrupt}' if signal.topic else ''
     print('analyze: ' + ', '.join(f'{k}={v}' for k, v in counters.items()) + extra,
           file=sys.stderr)
     if args.plot:

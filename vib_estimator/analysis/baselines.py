@@ -37,7 +37,7 @@ from typing import Optional, Sequence, Tuple
 import numpy as np
 from numba import njit
 
-TWO_PI = 2.0 * math.pi
+from ..core.uncertainty import TWO_PI
 
 ZIARANI, HOU, MOJIRI = 0, 1, 2
 
@@ -340,7 +340,7 @@ def hold_last(values: np.ndarray, initial: float = math.nan) -> np.ndarray:
 
 
 @functools.lru_cache(maxsize=None)
-def _blas_controller():
+def blas_controller():
     """The BLAS libraries loaded (numpy's OpenBLAS). A pencil's SVD is small: with OpenBLAS's
     threads it ran 20x slower on a 2-core machine busy with other work (88 s instead of 0.9 s for
     one 10 s record), so it runs on one thread."""
@@ -364,7 +364,7 @@ def matrix_pencil(y: np.ndarray, ts: float, order: int = 2,
     if pencil < order + 1:
         return math.nan, math.nan
     hankel = np.lib.stride_tricks.sliding_window_view(y, pencil + 1)
-    with _blas_controller().limit(limits=1, user_api='blas'):
+    with blas_controller().limit(limits=1, user_api='blas'):
         _, _, vt = np.linalg.svd(hankel, full_matrices=False)
         v = vt[:order].T
         poles = np.linalg.eigvals(np.linalg.pinv(v[:-1]) @ v[1:])

@@ -16,8 +16,13 @@ Recordings are independent tasks: ``--jobs N`` runs them on a local process pool
 (``concurrent.futures``), ``--scheduler ADDRESS`` on a Dask distributed cluster (``dask scheduler``,
 ``dask worker ADDRESS``; every worker must have this package and see the files). Rows come back in
 the order of the sorted recordings, whatever finished first, so every engine gives the same rows.
-A recording that fails is one row with ``error`` set. Exit status: 0; 3 when ``--fail-on-alarm``
-and a row is flagged; 1 when ``--strict`` and a row has an error; 2 for bad arguments.
+A recording that fails is one row with ``error`` set, and one line on stderr. Every entry of a
+searched directory is accounted for: a recording gives rows, a folder holding no recording (not a
+bag, nothing in it) an error row, and files that are not recordings are listed on stderr, one line
+per folder. Damaged bag records are skipped and counted (column ``corrupt_records``, one
+``warning:`` line on stderr per recording); with ``--strict`` they make the recording an error row.
+Exit status: 0; 3 when ``--fail-on-alarm`` and a row is flagged; 1 when ``--strict`` and a row has
+an error; 2 for bad arguments.
 """
 from __future__ import annotations
 
@@ -40,7 +45,7 @@ from typing import Dict, Iterable, List, Optional, Sequence, Tuple
 import numpy as np
 
 from ..core import COUNTER_NAMES, EstimatorConfig
-from ..io.csv_reader import CsvError
+from ..errors import VibEstimatorError, report
 from ..io.fields import DEFAULT_COMPONENT, check_component
 from ..io.streaming import bag_topics, is_csv, open_signal, supported_topics
 from .analyze import add_config_arguments, estimate_signal, make_config
@@ -50,7 +55,7 @@ _STATS = ('start_utc', 'duration_s', 'samples', 'estimates', 'frequency_hz', 'fr
 _COUNTERS = tuple(c for c in COUNTER_NAMES if c not in ('received', 'estimates'))
 #: the columns of a row, in order
 COLUMNS = (('recording', 'topic', 'component', 'mode') + _STATS + _COUNTERS
-           + ('messages_without_component', 'change_rel', 'change_lo', 'change_hi', 'alarm',
+           + ('messages_without_component', 'corrupt_records', 'change_rel', 'change_lo', 'change_hi', 'alarm',
               'error'))
 _OUT_SUFFIXES = ('.csv', '.parquet', '.jsonl')
 _UNIX_2000 = 946_684_800.0   # a CSV time column at least this large is taken as Unix time
@@ -64,6 +69,8 @@ class Options:
     topics: Tuple[str, ...] = ()
     components: Tuple[str, ...] = ()
     column: Optional[str] = None
+    #: a damaged bag record makes the recording an error row (instead of a counted skip)
+    strict: bool = False
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -84,7 +91,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--alarm-rel', type=float, default=0.01,
                         help='relative frequency change that raises the alarm (default 0.01)')
     parser.add_argument('--fail-on-alarm', action='store_true', help='exit 3 if any row is flagged')
-    parser.add_argument('--strict', action='store_true', help='exit 1 if any recording failed')
+    parser.add_argument('--strict', action='store_true', help='a damaged bag record fails its '
+                        'recording; exit 1 if any recording failed')
     parser.add_argument('--jobs', type=int, default=os.cpu_count() or 1,
                         help='local worker processes (default: the number of cores)')
     parser.add_argument('--scheduler', metavar='ADDRESS',
@@ -97,7 +105,12 @@ def _is_bag_dir(path: Path) -> bool:
     return (path / 'metadata.yaml').is_file()
 
 
-def _in_directory(root: Path) -> Iterable[Path]:
+_RECORDING_SUFFIXES = ('.mcap', '.db3', '.csv')
+
+
+def _in_directory(root: Path, ignored: List[Path]) -> Iterable[Path]:
+    """The recordings under ``root``; a folder without any (no recording file, no subfolder) is
+    yielded itself (its row says it is not a bag), other files are appended to ``ignored``."""
     for folder, dirs, files in os.walk(root):
         here = Path(folder)
         if _is_bag_dir(here):
@@ -105,20 +118,26 @@ def _in_directory(root: Path) -> Iterable[Path]:
             yield here
             continue
         dirs.sort()
-        for name in files:
-            if Path(name).suffix.lower() in ('.mcap', '.db3', '.csv'):
-                yield here / name
+        recordings = [here / n for n in sorted(files)
+                      if Path(n).suffix.lower() in _RECORDING_SUFFIXES]
+        ignored.extend(here / n for n in sorted(files)
+                       if Path(n).suffix.lower() not in _RECORDING_SUFFIXES)
+        if not recordings and not dirs:
+            yield here
+        yield from recordings
 
 
-def find_recordings(inputs: Sequence[str]) -> List[Path]:
-    """Every recording named by ``inputs``, sorted, once each; a name matching nothing is kept
-    (its row will say so)."""
+def find_recordings(inputs: Sequence[str], ignored: Optional[List[Path]] = None) -> List[Path]:
+    """Every recording named by ``inputs``, sorted, once each; a name matching nothing, and a
+    folder holding no recording, is kept (its row will say so). Files of searched folders that
+    are not recordings are appended to ``ignored``."""
     found = set()
+    ignored = [] if ignored is None else ignored
     for name in inputs:
         matches = sorted(glob.glob(name, recursive=True)) if glob.has_magic(name) else [name]
         for match in (Path(m) for m in matches or [name]):
             if match.is_dir() and not _is_bag_dir(match):
-                found.update(_in_directory(match))
+                found.update(_in_directory(match, ignored))
             else:
                 found.add(match)
     return sorted(found)
@@ -172,7 +191,7 @@ def _stat_rows(recording: Path, signal, result, modes: int) -> List[Dict]:
             frequency_hz=f, frequency_lo_hz=lo, frequency_hi_hz=hi,
             damping=median_interval(est.damping[take])[0],
             amplitude=median_interval(est.amplitude[take])[0],
-            messages_without_component=signal.skipped,
+            messages_without_component=signal.skipped, corrupt_records=signal.corrupt,
             **{c: counters.get(c, 0) for c in _COUNTERS}))
     return rows
 
@@ -212,7 +231,7 @@ _tuned_lock = threading.Lock()
 
 
 @contextlib.contextmanager
-def _streaming_malloc():
+def streaming_malloc():
     """Let glibc keep freed blocks for the next one while a recording streams, in a process
     started with ``MALLOC_TRIM_THRESHOLD_`` (a Dask nanny's workers: 65536). That setting also
     fixes the mmap threshold at 128 KiB, so every block-sized array is mapped, faulted in and
@@ -243,7 +262,7 @@ def _streaming_malloc():
 
 def survey_recording(path: Path, options: Options) -> List[Dict]:
     """The rows of one recording; any failure is one row with ``error`` set (never raises)."""
-    with _streaming_malloc():
+    with streaming_malloc():
         return _recording_rows(path, options)
 
 
@@ -255,7 +274,7 @@ def _recording_rows(path: Path, options: Options) -> List[Dict]:
     rows: List[Dict] = []
     for topic, component in targets:
         try:
-            signal = open_signal(path, topic, component, options.column)
+            signal = open_signal(path, topic, component, options.column, options.strict)
             rows.extend(_stat_rows(path, signal, estimate_signal(signal, options.config),
                                    options.config.modes))
         except Exception as err:  # noqa: BLE001 -- as above
@@ -459,6 +478,25 @@ def plot_trend(rows: List[Dict], path: Path) -> None:
     plt.close(fig)
 
 
+def report_entries(rows: List[Dict], ignored: Sequence[Path], out) -> None:
+    """One stderr line per failed recording, per recording with damaged records skipped, and per
+    folder with files that are not recordings."""
+    prog = 'vib-estimator survey'
+    for row in rows:
+        if row['error']:
+            out.write(f'{prog}: error: {row["recording"]}: {row["error"]}\n')
+        elif row['corrupt_records']:
+            out.write(f'{prog}: warning: {row["recording"]}: skipped {row["corrupt_records"]} '
+                      f'damaged record(s) of {row["topic"]} (`vib-estimator analyze` says '
+                      f'which); --strict makes this an error\n')
+    folders: Dict[Path, List[str]] = {}
+    for path in ignored:
+        folders.setdefault(path.parent, []).append(path.name)
+    for folder, names in sorted(folders.items()):
+        out.write(f'{prog}: {folder}: {len(names)} file(s) not a recording (not .mcap, .db3, '
+                  f'.csv), ignored: {", ".join(names)}\n')
+
+
 def _options(args: argparse.Namespace) -> Options:
     if args.out and Path(args.out).suffix not in _OUT_SUFFIXES:
         raise ValueError(f'--out must end in {", ".join(_OUT_SUFFIXES)}, got {args.out}')
@@ -466,17 +504,19 @@ def _options(args: argparse.Namespace) -> Options:
         raise ValueError(f'--jobs must be >= 1, got {args.jobs}')
     if not args.alarm_rel >= 0:
         raise ValueError(f'--alarm-rel must be >= 0, got {args.alarm_rel}')
-    return Options(make_config(args), tuple(args.topic), tuple(args.component), args.column)
+    return Options(make_config(args), tuple(args.topic), tuple(args.component), args.column,
+                   args.strict)
 
 
 def run(args: argparse.Namespace) -> int:
     try:
         options = _options(args)
         base = baseline_rows(args.baseline, options) if args.baseline else None
-    except (ValueError, CsvError) as err:
-        print(f'vib-estimator survey: error: {err}', file=sys.stderr)
-        return 2
-    rows = survey(find_recordings(args.inputs), options, args.jobs, args.scheduler)
+    except (ValueError, VibEstimatorError) as err:
+        return report(err, 'vib-estimator survey')
+    ignored: List[Path] = []
+    rows = survey(find_recordings(args.inputs, ignored), options, args.jobs, args.scheduler)
+    report_entries(rows, ignored, sys.stderr)
     if base is not None:
         flag(rows, base, args.alarm_rel)
     write_rows(rows, args.format, sys.stdout)

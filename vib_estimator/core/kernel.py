@@ -55,7 +55,7 @@ import numpy as np
 from numba import njit
 
 from . import uncertainty as U
-from .uncertainty import MODEL_BIASED, MODEL_DAMPED, MODEL_SINUSOID
+from .uncertainty import MODEL_BIASED, MODEL_DAMPED, MODEL_SINUSOID, TWO_PI
 
 # ---- parameter array layout (float64) -------------------------------------------------------
 P_MODEL, P_WC, P_ZC, P_M, P_TOL, P_EPS, P_MAXWIN, P_BAND, P_WLO, P_WHI, P_MINAMP, P_MINFIT, \
@@ -116,7 +116,6 @@ MAX_REFINE_MOVE, MIN_REFINE_MOVE_REL = 8.0, 0.02
 #: band std: most steps of the prefilter's free response summed in its Gramian
 MAX_BAND_TAIL = 1 << 22
 
-TWO_PI = 2.0 * math.pi
 #: band-pass prefilter: 4th-order Butterworth low-pass at f_hi (two sections), then a 2nd-order
 #: Butterworth high-pass at f_lo
 BAND_DAMPING = (math.cos(math.pi / 8), math.cos(3 * math.pi / 8), math.sqrt(0.5))

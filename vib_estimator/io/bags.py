@@ -12,8 +12,14 @@ and the tests work without a ROS graph. Three things live here:
   recorder and ``make_bags.py`` write).
 
 Every problem with a bag -- missing path, not a bag, corrupt or truncated file, no messages, unknown
-topic, wrong or unknown message type -- is raised as :class:`BagError` with one sentence that names
-the path (and the topics available, where that helps).
+topic, wrong or unknown message type -- is raised as :class:`~vib_estimator.errors.BagError` with
+one sentence that names the path (and the topics available, where that helps).
+
+Damaged records. MCAP storage files are read by :mod:`.mcap`, which checks each chunk (its CRC-32,
+which :class:`BagWriter` writes, and its size) and each message index entry; every message is also
+decoded as its type (CDR). A damaged record is skipped and counted (``BagReader.corrupt``, the
+first described in ``BagReader.damage``); with ``strict`` it raises
+:class:`~vib_estimator.errors.CorruptRecordError`.
 
 Metadata version. :class:`BagWriter` writes rosbag2 metadata version 8. That version stores
 ``type_description_hash`` and ``ros_distro`` and keeps ``offered_qos_profiles`` as a YAML string
@@ -29,6 +35,7 @@ import contextlib
 import heapq
 import os
 import sqlite3
+import zlib
 from dataclasses import dataclass
 from functools import partial
 from operator import itemgetter
@@ -46,9 +53,10 @@ from rosbags.rosbag2.storage_mcap import DECOMPRESSORS, McapReader, McapWriter
 from rosbags.rosbag2.storage_sqlite3 import Sqlite3Reader, Sqlite3Writer
 from rosbags.typesys import Stores, get_typestore
 
-from .fields import check_component, component_getter, normalise_type, stamp_ns
-
-WRENCH_STAMPED = 'geometry_msgs/msg/WrenchStamped'
+from ..errors import BagError, DamageCount, McapFormatError, as_bag_error
+from . import cdr, mcap
+from .fields import (WRENCH_STAMPED, XYZ, check_component, component_getter, normalise_type,
+                     stamp_ns)
 
 #: message types of the ROS 2 Jazzy distribution (serialisation, message definitions, hashes)
 TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
@@ -67,10 +75,6 @@ _INFINITE = QosTime(9223372036, 854775807)  # RMW_DURATION_INFINITE, as rosbag2 
 #: reliable, volatile publisher (history and depth are not visible on the graph, hence UNKNOWN / 0)
 RELIABLE_VOLATILE = Qos(QosHistory.UNKNOWN, 0, QosReliability.RELIABLE, QosDurability.VOLATILE,
                         _INFINITE, _INFINITE, QosLiveliness.AUTOMATIC, _INFINITE, False)
-
-
-class BagError(Exception):
-    """A bag that cannot be read as asked; the message is one sentence naming the path."""
 
 
 @dataclass(frozen=True)
@@ -113,27 +117,6 @@ class BagMessage:
     data: bytes
 
 
-@contextlib.contextmanager
-def _as_bag_error(path: Path, doing: str):
-    """Turn any failure of the bag parser into one :class:`BagError` sentence.
-
-    A corrupt or truncated file makes ``rosbags`` fail with whatever its parsing step raises
-    (``ReaderError``, ``struct.error``, ``KeyError``, ``sqlite3.DatabaseError``, ...), so every
-    exception is caught here, once, and reported with the path. For a bag directory the sentence
-    names the repair: ``vib-estimator reindex`` (a recorder killed mid-file leaves such a bag).
-    """
-    try:
-        yield
-    except BagError:
-        raise
-    except Exception as err:  # noqa: BLE001 -- see docstring
-        detail = str(err).strip().rstrip('.') or type(err).__name__
-        repair = (f'; `vib-estimator reindex {path}` rebuilds it from what is complete'
-                  if path.is_dir() else '')
-        raise BagError(f'cannot {doing} {path}: {detail} (corrupt or truncated bag?{repair})'
-                       ) from None
-
-
 def storage_reader(path: Path):
     """The rosbags reader of one storage file (``.mcap`` or ``.db3``), opened."""
     storage = _STORAGE_READERS[path.suffix](path)
@@ -141,7 +124,7 @@ def storage_reader(path: Path):
     return storage
 
 
-class BagReader:
+class BagReader(DamageCount):
     """An open bag: an MCAP file, an sqlite3 ``.db3`` file, or a rosbag2 directory of either.
 
     Use as a context manager. Raises :class:`BagError` if the path is missing or not a readable bag,
@@ -155,14 +138,23 @@ class BagReader:
     differs from the one in the storage file (it matches connections on the whole QoS list) -- the
     case of rosbag2's own ``talker`` bags. Messages of split bags are merged across files in log
     time. Types written ``pkg/Name`` (older bags) are reported as ``pkg/msg/Name``.
+
+    Damaged records (see the module docstring) are skipped: :attr:`corrupt` counts them,
+    :attr:`damage` describes the first; ``strict`` makes the first one raise
+    :class:`~vib_estimator.errors.CorruptRecordError`.
     """
 
-    def __init__(self, path) -> None:
+    def __init__(self, path, strict: bool = False) -> None:
         self.path = Path(path)
+        self.strict = strict
+        #: damaged records skipped so far (chunks' messages, index entries, payloads)
+        self.corrupt = 0
+        #: the first damage, described ('' if none)
+        self.damage = ''
         check_bag_path(self.path)
         self._stack = contextlib.ExitStack()
         self._decompress = None
-        with _as_bag_error(self.path, 'open bag'):
+        with as_bag_error(self.path, 'open bag'):
             try:
                 self._storages = self._open_storages()
             except BaseException:
@@ -202,21 +194,44 @@ class BagReader:
                            f'{self.describe_topics()}')
         return self.topics[name]
 
-    def messages(self, topics: Optional[Sequence[str]] = None,
-                 start_ns: Optional[int] = None) -> Iterator[BagMessage]:
+    def _stream(self, storage, names: set, start_ns: Optional[int]):
+        """``(topic, log time, data)`` of one storage file: MCAP by :mod:`.mcap` (checked), else
+        (sqlite3, unindexed MCAP, compressed messages) by rosbags."""
+        path = Path(storage.path)
+        if path.suffix == '.mcap' and self._decompress is None:
+            try:
+                return mcap.iter_messages(path, names, start_ns, self.count_damage)
+            except (McapFormatError, OSError):
+                pass
+        conns = [c for c in storage.connections if c.topic in names]
+        return ((c.topic, t, d) for c, t, d in storage.messages(conns, start_ns, None))
+
+    def messages(self, topics: Optional[Sequence[str]] = None, start_ns: Optional[int] = None,
+                 check: bool = True) -> Iterator[BagMessage]:
         """The messages of ``topics`` (default: all), from log time ``start_ns`` on, in log-time
-        order across all storage files (ties: in file order)."""
+        order across all storage files (ties: in file order). ``check``: decode each payload as
+        its type (a Jazzy type) and skip those that do not decode, as damaged records."""
         names = set(self.topics) if topics is None else {self.topic(t).topic for t in topics}
-        streams = []
-        for storage in self._storages:
-            conns = [c for c in storage.connections if c.topic in names]
-            if conns:
-                streams.append(storage.messages(conns, start_ns, None))
-        with _as_bag_error(self.path, 'read messages of bag'):
-            for conn, log_time, data in heapq.merge(*streams, key=itemgetter(1)):
+        found, before, undecodable = 0, self.corrupt, 0
+        with as_bag_error(self.path, 'read messages of bag'):
+            streams = [self._stream(s, names, start_ns) for s in self._storages
+                       if any(c.topic in names for c in s.connections)]
+            for topic, log_time, data in heapq.merge(*streams, key=itemgetter(1)):
+                found += 1
                 if self._decompress is not None:
                     data = self._decompress(data)
-                yield BagMessage(conn.topic, normalise_type(conn.msgtype), log_time, bytes(data))
+                msgtype = self.topics[topic].msgtype
+                if check and not _decodes(data, msgtype):
+                    undecodable += 1
+                    self.count_damage(1, f'a {topic} message logged at {log_time} ns does not '
+                                      f'decode as {msgtype}')
+                    continue
+                yield BagMessage(topic, msgtype, log_time, bytes(data))
+        if start_ns is None:  # the whole bag: what its statistics count but no read found
+            skipped_unread = self.corrupt - before - undecodable  # damaged chunks, entries
+            missing = sum(self.topics[t].count for t in names) - found - skipped_unread
+            self.count_damage(max(missing, 0), f'{missing} messages counted by the bag were not '
+                              f'found in it')
 
     def close(self) -> None:
         self._stack.close()
@@ -226,6 +241,31 @@ class BagReader:
 
     def __exit__(self, *exc) -> None:
         self.close()
+
+
+def _decodes(data: bytes, msgtype: str) -> bool:
+    """Whether ``data`` deserialises as ``msgtype`` (True for a type rosbags does not know);
+    fixed-layout types by :func:`.cdr.fits_layout` (the same answer, ~10x faster)."""
+    if cdr.is_fixed_layout(msgtype):
+        return cdr.fits_layout(data, msgtype)
+    if msgtype not in TYPESTORE.types:
+        return True
+    try:
+        TYPESTORE.deserialize_cdr(data, msgtype)
+        return True
+    except Exception:  # noqa: BLE001 -- rosbags raises what its parsing step does
+        return False
+
+
+def only_topic(path: Path, candidates: List[str], what: str, listing: str, how: str = '') -> str:
+    """The one topic of ``candidates`` (shown as they are given), else BagError: none (with the
+    bag's ``listing``) or several (choose one, ``how``)."""
+    if not candidates:
+        raise BagError(f'bag {path} has no {what} topic; its topics are {listing}')
+    if len(candidates) > 1:
+        raise BagError(f'bag {path} has several {what} topics, choose one{how}: '
+                       f'{", ".join(candidates)}')
+    return candidates[0].split(' ')[0]
 
 
 def check_bag_path(path: Path) -> None:
@@ -279,8 +319,6 @@ def read_wrench_series(path, topic: Optional[str] = None,
     value_of = component_getter(component)
     with BagReader(path) as bag:
         if topic is None:
-            from .streaming import only_topic
-
             topic = only_topic(bag.path, [t.topic for t in bag.topics.values()
                                           if t.msgtype == WRENCH_STAMPED], WRENCH_STAMPED,
                                bag.describe_topics())
@@ -291,9 +329,14 @@ def read_wrench_series(path, topic: Optional[str] = None,
         stamps: List[int] = []
         values: List[float] = []
         frame_id = ''
-        with _as_bag_error(bag.path, f'decode {topic} in'):
-            for message in bag.messages([topic]):
-                msg = TYPESTORE.deserialize_cdr(message.data, WRENCH_STAMPED)
+        with as_bag_error(bag.path, f'decode {topic} in'):
+            for message in bag.messages([topic], check=False):
+                try:
+                    msg = TYPESTORE.deserialize_cdr(message.data, WRENCH_STAMPED)
+                except Exception:  # noqa: BLE001 -- as in BagReader.messages
+                    bag.count_damage(1, f'a {topic} message logged at {message.log_time_ns} ns '
+                                     f'does not decode as {WRENCH_STAMPED}')
+                    continue
                 if not stamps:
                     frame_id = msg.header.frame_id
                 stamps.append(stamp_ns(msg.header))
@@ -307,7 +350,7 @@ def wrench_message(stamp: int, frame_id: str, component: str, value: float):
     types = TYPESTORE.types
     vec = {'force': [0.0, 0.0, 0.0], 'torque': [0.0, 0.0, 0.0]}
     part, axis = check_component(component).split('.')
-    vec[part]['xyz'.index(axis)] = float(value)
+    vec[part][XYZ.index(axis)] = float(value)
     header = types['std_msgs/msg/Header'](
         stamp=types['builtin_interfaces/msg/Time'](sec=stamp // 1_000_000_000,
                                                    nanosec=stamp % 1_000_000_000),
@@ -383,15 +426,40 @@ def write_metadata(directory: Path, info: dict) -> None:
     tmp.replace(directory / 'metadata.yaml')
 
 
+#: bytes of records per MCAP chunk written (rosbags: 1 MiB). A damaged chunk loses all its messages,
+#: so smaller chunks lose less: 64 KiB is ~600 WrenchStamped messages, for an index of 0.4 %
+CHUNK_BYTES = 1 << 16
+
+
+class _ChecksummedMcap(McapWriter):
+    """rosbags' MCAP writer, with each chunk's CRC-32 (of its uncompressed records) set, so that
+    readers (:mod:`.mcap`, the ``mcap`` tools, rosbag2) detect a damaged chunk, and chunks of
+    :data:`CHUNK_BYTES`."""
+
+    def write(self, connection: Connection, timestamp: int, data: bytes) -> None:
+        super().write(connection, timestamp, data)
+        if self.chunk.bio.tell() > CHUNK_BYTES:
+            self.close_chunk()
+
+    def close_chunk(self) -> None:
+        crc = zlib.crc32(self.chunk.bio.getvalue())
+        start = self.bio.tell()
+        super().close_chunk()
+        end = self.bio.tell()
+        self.bio.seek(start + mcap.CHUNK_CRC_AT)
+        self.bio.write(crc.to_bytes(4, 'little'))
+        self.bio.seek(end)
+
+
 def mcap_file(path: Path) -> McapWriter:
-    """rosbags' MCAP storage writer, writing the new file ``path``.
+    """rosbags' MCAP storage writer (chunk CRCs set), writing the new file ``path``.
 
     That writer names its file after the directory it is given, so it is given a scratch directory
     and its open file is then moved to ``path`` (an open file keeps its data when renamed).
     """
     scratch = path.with_name(path.name + '.tmpdir')
     scratch.mkdir()
-    writer = McapWriter(scratch, CompressionMode.NONE)
+    writer = _ChecksummedMcap(scratch, CompressionMode.NONE)
     writer.path = writer.path.rename(path)
     scratch.rmdir()
     return writer
@@ -459,8 +527,12 @@ class BagWriter:
                            f'kept (`vib-estimator reindex {self.path}` makes it readable)') from None
 
     def open(self) -> 'BagWriter':
-        with self._writing():
+        try:
             self.path.mkdir(parents=True)
+        except OSError as err:
+            raise BagError(f'cannot create bag directory {self.path}: '
+                           f'{err.strerror or err}') from None
+        with self._writing():
             self._open_file()
         return self
 

@@ -22,13 +22,12 @@ from typing import Dict, Optional, Tuple
 
 import numpy as np
 
-from .fields import (ACCEL_STAMPED, FLOAT64, IMU, VECTOR3_STAMPED, WRENCH_STAMPED,
+from ..errors import CdrLayoutError
+from .fields import (ACCEL_STAMPED, FLOAT64, IMU, VECTOR3_STAMPED, WRENCH_STAMPED, XYZ,
                      check_component)
 
-_XYZ = ('x', 'y', 'z')
 
-
-def _indices(prefix: str, start: int, names=_XYZ) -> Dict[str, int]:
+def _indices(prefix: str, start: int, names=XYZ) -> Dict[str, int]:
     return {f'{prefix}{a}': start + i for i, a in enumerate(names)}
 
 
@@ -46,13 +45,25 @@ DOUBLE_INDEX: Dict[str, Dict[str, int]] = {
 N_DOUBLES = {WRENCH_STAMPED: 6, IMU: 37, ACCEL_STAMPED: 6, VECTOR3_STAMPED: 3, FLOAT64: 1}
 
 
-class CdrLayoutError(Exception):
-    """A batch the vectorised decoder cannot take (not little-endian CDR, or too short)."""
-
-
 def is_fixed_layout(msgtype: str) -> bool:
     """Whether :func:`decode_fixed` handles messages of ``msgtype`` (full name)."""
     return msgtype in DOUBLE_INDEX
+
+
+def fits_layout(data: bytes, msgtype: str) -> bool:
+    """Whether one payload decodes as the fixed layout of ``msgtype``: little-endian CDR, the
+    ``frame_id`` NUL-terminated inside it, long enough for the type's doubles (what a decoder can
+    check of such a message: the doubles themselves may hold anything)."""
+    if len(data) < 4 + 8 or data[0] != 0 or data[1] != 1:
+        return False
+    if msgtype == FLOAT64:
+        return True
+    if len(data) < 16:
+        return False
+    name_len = int.from_bytes(data[12:16], 'little')
+    if not 1 <= name_len <= len(data) - 16 or data[15 + name_len] != 0:
+        return False
+    return 4 + ((12 + name_len + 7) & ~7) + 8 * N_DOUBLES[msgtype] <= len(data)
 
 
 def gather(buf: np.ndarray, offsets: np.ndarray, dtype: str) -> np.ndarray:

@@ -5,8 +5,11 @@ time in seconds. The signal is a named column (header) or a column index; by def
 Empty cells and ``nan`` are kept as NaN (the estimator skips and counts them).
 
 This module holds the rules (:func:`csv_layout` finds the header, the column and where the data
-start; :func:`iter_csv_rows` is the exact row-by-row reading, with the error messages). The fast
-path, block by block, is :mod:`.streaming`; :func:`read_csv_series` collects its blocks.
+start; :func:`iter_csv_rows` is the exact row-by-row reading, with the error messages) and the fast
+path, block by block (:func:`csv_blocks`: ``pyarrow.csv``'s streaming reader; a file it refuses --
+comment lines between the data, cells with spaces, ragged rows, a cell that is not a number -- is
+read by the exact rules instead, so the result and the error messages are those of the rules).
+:func:`read_csv_series` collects the blocks; :mod:`.streaming` streams them.
 """
 from __future__ import annotations
 
@@ -17,9 +20,15 @@ from typing import Iterator, List, Optional, Tuple
 
 import numpy as np
 
+from ..errors import CsvError
 
-class CsvError(Exception):
-    """A CSV file that cannot be read as asked; the message is one sentence naming the file."""
+#: bytes of CSV text per parsed block (512 kB: ~20 k rows). Arrow's streaming reader reads up to
+#: 32 blocks ahead on its I/O thread, so this sets the reader's memory (~16 MB in flight; 2 MB
+#: blocks held ~70 MB) while larger blocks parse no faster per CPU second
+#: (benchmarks/bench_survey.py)
+CSV_BLOCK_BYTES = 1 << 19
+#: rows per block of the exact (row-by-row) path when no block size is given
+EXACT_BLOCK_ROWS = 1 << 18
 
 
 @dataclass(frozen=True)
@@ -122,6 +131,60 @@ def iter_csv_rows(layout: CsvLayout) -> Iterator[Tuple[float, float]]:
         raise CsvError(f'cannot read {layout.path} as CSV: {err}') from None
 
 
+def csv_blocks(layout: CsvLayout, block_rows: int = EXACT_BLOCK_ROWS
+               ) -> Iterator[Tuple[np.ndarray, np.ndarray]]:
+    """``(t, y)`` blocks of the file by pyarrow; on a file it refuses, the rest by the exact rules
+    (``block_rows`` rows per block); all of it by the exact rules where pyarrow is not installed
+    (rosdep alone does not bring it)."""
+    try:
+        import pyarrow as pa
+        import pyarrow.csv as pacsv
+    except ImportError:
+        yield from _exact_blocks(layout, 0, block_rows)
+        return
+
+    names = [f'c{i}' for i in range(layout.width)]
+    wanted = [names[0], names[layout.index]]
+    done = 0
+    try:
+        # read by arrow itself, not through a Python file: a Python read allocates a fresh 2 MB
+        # bytes object per block, which a process tuned to return memory at once (Dask's nanny
+        # sets MALLOC_TRIM_THRESHOLD_) maps and unmaps every time (4x the page faults)
+        with pa.OSFile(str(layout.path)) as handle:
+            handle.seek(layout.data_offset)
+            reader = pacsv.open_csv(
+                handle, memory_pool=pa.system_memory_pool(),
+                read_options=pacsv.ReadOptions(column_names=names, use_threads=False,
+                                               block_size=CSV_BLOCK_BYTES),
+                parse_options=pacsv.ParseOptions(newlines_in_values=False),
+                convert_options=pacsv.ConvertOptions(
+                    column_types={n: pa.float64() for n in wanted}, include_columns=wanted,
+                    null_values=[''], strings_can_be_null=False, quoted_strings_can_be_null=True))
+            for batch in reader:
+                t, y = (batch.column(i).to_numpy(zero_copy_only=False) for i in range(2))
+                done += len(t)
+                yield np.asarray(t, np.float64), np.asarray(y, np.float64)
+    except (pa.ArrowInvalid, pa.ArrowTypeError, pa.ArrowNotImplementedError):
+        yield from _exact_blocks(layout, done, block_rows)
+
+
+def _exact_blocks(layout: CsvLayout, skip: int, block_rows: int
+                  ) -> Iterator[Tuple[np.ndarray, np.ndarray]]:
+    """The exact rules, block by block, after the first ``skip`` data rows."""
+    t: List[float] = []
+    y: List[float] = []
+    for i, (ti, yi) in enumerate(iter_csv_rows(layout)):
+        if i < skip:
+            continue
+        t.append(ti)
+        y.append(yi)
+        if len(t) == block_rows:
+            yield np.array(t), np.array(y)
+            t, y = [], []
+    if t:
+        yield np.array(t), np.array(y)
+
+
 def read_csv_series(path, column: Optional[str] = None) -> Series:
     """Read time (first column) and the signal column of a CSV file, all at once.
 
@@ -129,9 +192,7 @@ def read_csv_series(path, column: Optional[str] = None) -> Series:
     Raises :class:`CsvError` for a missing file, an unknown column, a cell that is not a number,
     or a file with no data rows.
     """
-    from .streaming import csv_signal
-
-    signal = csv_signal(Path(path), column)
-    parts = list(signal.blocks()) or [(np.empty(0), np.empty(0))]
+    layout = csv_layout(path, column)
+    parts = list(csv_blocks(layout)) or [(np.empty(0), np.empty(0))]
     t, y = (np.concatenate(p) for p in zip(*parts))
-    return Series(t, y, signal.label)
+    return Series(t, y, layout.name)

@@ -29,13 +29,14 @@ VECTOR3_STAMPED = 'geometry_msgs/msg/Vector3Stamped'
 JOINT_STATE = 'sensor_msgs/msg/JointState'
 FLOAT64 = 'std_msgs/msg/Float64'
 
-_XYZ = ('x', 'y', 'z')
+#: the axes of a Vector3, in order
+XYZ = ('x', 'y', 'z')
 #: fixed components of each type, as attribute paths from the message
 _FIXED: Dict[str, Tuple[str, ...]] = {
-    WRENCH_STAMPED: tuple(f'{v}.{a}' for v in ('force', 'torque') for a in _XYZ),
-    IMU: tuple(f'{v}.{a}' for v in ('linear_acceleration', 'angular_velocity') for a in _XYZ),
-    ACCEL_STAMPED: tuple(f'accel.{v}.{a}' for v in ('linear', 'angular') for a in _XYZ),
-    VECTOR3_STAMPED: tuple(f'vector.{a}' for a in _XYZ),
+    WRENCH_STAMPED: tuple(f'{v}.{a}' for v in ('force', 'torque') for a in XYZ),
+    IMU: tuple(f'{v}.{a}' for v in ('linear_acceleration', 'angular_velocity') for a in XYZ),
+    ACCEL_STAMPED: tuple(f'accel.{v}.{a}' for v in ('linear', 'angular') for a in XYZ),
+    VECTOR3_STAMPED: tuple(f'vector.{a}' for a in XYZ),
     JOINT_STATE: (),
     FLOAT64: ('data',),
 }

@@ -17,45 +17,19 @@ from __future__ import annotations
 
 import argparse
 import sqlite3
-import sys
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Dict, Iterator, List, Optional, Tuple
+from typing import Dict, List, Optional, Tuple
 
 from rosbags.interfaces import (Connection, ConnectionExtRosbag2, MessageDefinition,
                                 MessageDefinitionFormat)
 from rosbags.rosbag2.metadata import parse_qos
-from rosbags.rosbag2.storage_mcap import decompress
 
-from .bags import (METADATA_VERSION, TYPESTORE, BagError, FileStats, _as_bag_error, bag_metadata,
-                   mcap_file, storage_files, storage_reader, write_metadata)
-
-MAGIC = b'\x89MCAP0\r\n'
-_OP_SCHEMA, _OP_CHANNEL, _OP_MESSAGE, _OP_CHUNK, _OP_DATA_END = 0x03, 0x04, 0x05, 0x06, 0x0F
-
-
-class _Cut(Exception):
-    """A record runs past the end of the data."""
-
-
-class _Fields:
-    """Little-endian fields of an MCAP record, read in order; :class:`_Cut` past the end."""
-
-    def __init__(self, data: bytes, pos: int = 0, end: Optional[int] = None) -> None:
-        self.data, self.pos = data, pos
-        self.end = len(data) if end is None else end
-
-    def take(self, n: int) -> bytes:
-        if self.pos + n > self.end:
-            raise _Cut()
-        self.pos += n
-        return self.data[self.pos - n:self.pos]
-
-    def uint(self, size: int) -> int:
-        return int.from_bytes(self.take(size), 'little')
-
-    def string(self) -> str:
-        return self.take(self.uint(4)).decode()
+from ..errors import BagError, McapCut, McapFormatError, as_bag_error, report
+from .bags import (METADATA_VERSION, TYPESTORE, FileStats, bag_metadata, mcap_file, storage_files,
+                   storage_reader, write_metadata)
+from .mcap import (MAGIC, OP_CHANNEL, OP_CHUNK, OP_DATA_END, OP_MESSAGE, OP_SCHEMA, Fields,
+                   decompress, read_channel, read_message, read_schema, records)
 
 
 @dataclass
@@ -69,58 +43,46 @@ class McapContent:
     complete_bytes: int = 0
     #: whether the data section is complete (its DataEnd record was read)
     data_end: bool = False
+    #: chunks that are damaged (checksum, size or compression): their records are not kept
+    damaged_chunks: int = 0
 
 
-def _records(data: bytes, pos: int, end: int) -> Iterator[Tuple[int, _Fields]]:
-    """``(opcode, fields of the body)`` of each complete record in ``data[pos:end]``; stops at
-    the first incomplete one, whose start :class:`_Cut` carries in ``args``."""
-    while pos < end:
-        head = _Fields(data, pos, end)
-        try:
-            op, length = head.uint(1), head.uint(8)
-        except _Cut:
-            raise _Cut(pos) from None
-        if head.pos + length > end:
-            raise _Cut(pos, op, head.pos)
-        yield op, _Fields(data, head.pos, head.pos + length)
-        pos = head.pos + length
-
-
-def _read_record(op: int, body: _Fields, content: McapContent) -> None:
+def _read_record(op: int, body: Fields, content: McapContent) -> None:
     """Keep a schema, channel or message record (others carry nothing to rebuild from)."""
-    if op == _OP_SCHEMA:
-        sid = body.uint(2)
-        content.schemas[sid] = (body.string(), body.string(), body.take(body.uint(4)))
-    elif op == _OP_CHANNEL:
-        cid, sid, topic, _encoding = body.uint(2), body.uint(2), body.string(), body.string()
-        meta = _Fields(body.take(body.uint(4)))
-        qos = ''
-        while meta.pos < meta.end:
-            key, value = meta.string(), meta.string()
-            qos = value if key == 'offered_qos_profiles' else qos
-        content.channels[cid] = (topic, sid, qos)
-    elif op == _OP_MESSAGE:
-        cid, _seq, log_time, _publish = body.uint(2), body.uint(4), body.uint(8), body.uint(8)
-        content.messages.append((cid, log_time, body.data[body.pos:body.end]))
+    if op == OP_SCHEMA:
+        sid, name, encoding, data = read_schema(body)
+        content.schemas[sid] = (name, encoding, data)
+    elif op == OP_CHANNEL:
+        cid, sid, topic, metadata = read_channel(body)
+        content.channels[cid] = (topic, sid, metadata.get('offered_qos_profiles', ''))
+    elif op == OP_MESSAGE:
+        content.messages.append(read_message(body))
 
 
-def _read_chunk(body: _Fields, content: McapContent, cut: bool) -> None:
-    """The records of a chunk; of a cut one (``cut``), those complete, if it is uncompressed."""
+def _read_chunk(body: Fields, content: McapContent, cut: bool) -> None:
+    """The records of a chunk; of a cut one (``cut``), those complete, if it is uncompressed; of
+    a damaged one (CRC, size), only its schemas and channels."""
+    keep = None
     body.take(16)  # message start and end time
     size, crc, compression = body.uint(8), body.uint(4), body.string()
     length = body.uint(8)
     if cut:
         if compression:
             return  # a compressed chunk cut short cannot be decoded
-        records, end = body.data, min(body.pos + length, len(body.data))
-        start = body.pos
+        data, start, end = body.data, body.pos, min(body.pos + length, len(body.data))
     else:
-        records = decompress(body.take(length), compression, size, crc)
-        start, end = 0, len(records)
+        raw = body.take(length)
+        data = decompress(compression, raw, size, crc)
+        start, end = 0, len(data or raw)
+        if data is None:  # damaged: keep its schemas and channels (the rest refers to them)
+            content.damaged_chunks += 1
+            data = raw if not compression else b''
+            keep = (OP_SCHEMA, OP_CHANNEL)
     try:
-        for op, inner in _records(records, start, end):
-            _read_record(op, inner, content)
-    except _Cut:
+        for op, inner in records(data, start, min(end, len(data))):
+            if keep is None or op in keep:
+                _read_record(op, inner, content)
+    except (McapCut, McapFormatError):
         pass
 
 
@@ -131,24 +93,24 @@ def scan_mcap(data: bytes) -> McapContent:
         content.complete_bytes = 0
         return content
     try:
-        for op, body in _records(data, len(MAGIC), len(data)):
-            if op == _OP_DATA_END:
+        for op, body in records(data, len(MAGIC), len(data)):
+            if op == OP_DATA_END:
                 content.data_end = True
                 break
-            if op == _OP_CHUNK:
+            if op == OP_CHUNK:
                 _read_chunk(body, content, cut=False)
             else:
                 _read_record(op, body, content)
-    except _Cut as cut:
+    except McapCut as cut:
         if not cut.args:  # a field past the end of a complete record
             raise BagError('corrupt MCAP data: a record is shorter than its fields') from None
         content.complete_bytes = cut.args[0]
-        if len(cut.args) > 1 and cut.args[1] == _OP_CHUNK:
+        if len(cut.args) > 1 and cut.args[1] == OP_CHUNK:
             try:
-                _read_chunk(_Fields(data, cut.args[2]), content, cut=True)
-            except _Cut:
+                _read_chunk(Fields(data, cut.args[2]), content, cut=True)
+            except McapCut:
                 pass  # cut inside the chunk's header
-    except (UnicodeDecodeError, ValueError) as err:
+    except McapFormatError as err:
         raise BagError(f'corrupt MCAP data: {err}') from None
     return content
 
@@ -157,6 +119,8 @@ def _connections(content: McapContent) -> Dict[int, Connection]:
     """rosbags connections for the channels of a scanned file (ids kept)."""
     result = {}
     for cid, (topic, sid, qos) in content.channels.items():
+        if sid not in content.schemas:
+            continue  # its schema was in a damaged chunk: its messages cannot be kept
         name, encoding, definition = content.schemas[sid]
         fmt = MessageDefinitionFormat.IDL if encoding == 'ros2idl' else MessageDefinitionFormat.MSG
         result[cid] = Connection(cid, topic, name, MessageDefinition(fmt, definition.decode()), '',
@@ -172,6 +136,11 @@ def repair_mcap(path: Path) -> Optional[str]:
     except Exception:  # noqa: BLE001 -- any failure to open: scan it
         pass
     data = path.read_bytes()
+    if not data.startswith(MAGIC):
+        what = 'is empty (0 bytes)' if not data else (f'does not start with the MCAP magic '
+                                                      f'({len(data)} bytes)')
+        raise BagError(f'cannot reindex {path}: it {what}; it is not an MCAP file, so nothing '
+                       f'can be recovered (left unchanged)')
     content = scan_mcap(data)
     connections = _connections(content)
     writer = mcap_file(path.with_name(path.name + '.tmp'))
@@ -181,7 +150,11 @@ def repair_mcap(path: Path) -> Optional[str]:
             writer.add_msgtype(conn)
             types.add(conn.msgtype)
         writer.add_connection(conn, content.channels[cid][2])
+    lost = 0
     for cid, log_time, payload in content.messages:
+        if cid not in connections:
+            lost += 1
+            continue
         writer.write(connections[cid], log_time, payload)
     writer.close(METADATA_VERSION, '')
     writer.path.replace(path)
@@ -192,7 +165,11 @@ def repair_mcap(path: Path) -> Optional[str]:
                f'record, dropped)')
     else:
         cut = 'not closed (no index)'
-    return f'{path}: {cut}; kept {len(content.messages)} complete messages, index rebuilt'
+    if content.damaged_chunks:
+        cut += f'; {content.damaged_chunks} damaged chunk(s) dropped'
+    if lost:
+        cut += f'; {lost} messages of channels without a schema dropped'
+    return f'{path}: {cut}; kept {len(content.messages) - lost} complete messages, index rebuilt'
 
 
 
@@ -225,7 +202,7 @@ class ReindexResult:
 
 def _file_index(path: Path) -> Tuple[FileStats, List[Connection]]:
     """Statistics and connections (with counts) of one storage file."""
-    with _as_bag_error(path, 'read storage file'):
+    with as_bag_error(path, 'read storage file'):
         storage = storage_reader(path)
         try:
             stats = FileStats(path.name)
@@ -268,7 +245,7 @@ def reindex(path) -> ReindexResult:
     storage = 'mcap' if suffixes == {'.mcap'} else 'sqlite3'
     cuts = []
     for file in files:
-        with _as_bag_error(file, 'repair storage file'):
+        with as_bag_error(file, 'repair storage file'):
             if storage == 'mcap':
                 cuts.append(repair_mcap(file))
             else:
@@ -293,7 +270,6 @@ def run(args: argparse.Namespace) -> int:
     try:
         result = reindex(args.bag)
     except BagError as err:
-        print(f'error: {err}', file=sys.stderr)
-        return 2
+        return report(err)
     print(result.summary())
     return 0

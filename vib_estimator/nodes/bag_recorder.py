@@ -52,9 +52,10 @@ from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPo
 from rosbags.interfaces import (Qos, QosDurability, QosHistory, QosLiveliness, QosReliability,
                                 QosTime)
 
-from ..io.bags import BagError, BagWriter, STORAGES
-from .runner import StartupError, run
+from ..errors import BagError
+from ..io.bags import STORAGES, BagWriter
 from .parameters import declare, descriptor
+from .runner import StartupError, run
 
 DISCOVERY_PERIOD = 0.05  # s between looks at the graph for publishers of topics not yet recorded
 
@@ -118,7 +119,9 @@ class BagRecorder(Node):
         try:
             self._bag = BagWriter(output, settings['storage'], settings['max_bag_size'],
                                   int(round(settings['max_bag_duration'] * 1e9))).open()
-        except (BagError, OSError) as err:
+        except BagError as err:
+            raise StartupError(str(err)) from None
+        except OSError as err:
             raise StartupError(f'cannot create bag {output}: {err}') from None
 
         #: messages recorded, per topic

@@ -39,6 +39,17 @@ Parameters:
     delay (double, 0): seconds to wait before playing.
     wait_timeout (double, 5): seconds to wait at most for subscribers before playing; 0 = none.
     start_paused (bool, false): start paused (see the services).
+    strict (bool, false): refuse a bag with a damaged record (checked before playing) instead of
+        skipping it.
+
+Damaged records (an MCAP chunk whose CRC-32 or size does not match, an index entry that points at
+no message, a payload that does not decode as its type): skipped and counted; the first gives one
+WARN naming it, the end-of-bag line says how many were skipped, and the exit code stays 0. With
+``strict`` the whole bag is read once before playing and a damaged record is one ``error:`` line
+and exit code 2.
+
+Looping waits one mean message spacing of the bag (1 s for a one-message bag) between the last
+message and the first one again, and logs "looping" at most every 10 s.
 
 Services (``std_srvs/srv/Trigger``):
     ~/pause: pause playback (and ``/clock``). ~/resume: resume it.
@@ -64,15 +75,18 @@ from rosbags.interfaces import QosDurability, QosReliability
 from rosgraph_msgs.msg import Clock
 from std_srvs.srv import Trigger
 
-from ..io.bags import BagError, BagReader, TopicInfo
+from ..errors import BagError, EmptyPlayback
+from ..io.bags import BagReader, TopicInfo
 from .bag_recorder import adapted_qos, message_class
-from .playback import EmptyPlayback, Playback, StartGate
-from .runner import StartupError, run
 from .parameters import declare, descriptor
+from .playback import Playback, StartGate
+from .runner import StartupError, run
 
 TICK = 0.001  # s, period of the scheduling timer
 DEPTH = 1000  # history depth of the publishers
 ACK_TIMEOUT = 2.0  # s to wait at the end for reliable subscribers to acknowledge everything
+LOOP_GAP_ONE_MESSAGE = 1.0  # s of bag time between passes of a one-message bag
+LOOP_LOG_PERIOD = 10.0  # s, the "looping" line at most this often
 
 
 def offered_policies(info: TopicInfo):
@@ -114,7 +128,7 @@ class BagReplayer(Node):
         super().__init__('bag_replayer', **kwargs)
         settings = self._declare_parameters()
         try:
-            self._bag = BagReader(settings['bag'])
+            self._bag = BagReader(settings['bag'], strict=settings['strict'])
         except BagError as err:
             raise StartupError(str(err)) from None
         #: number of messages published (all loops)
@@ -125,9 +139,11 @@ class BagReplayer(Node):
         try:
             names = self._create_publishers(settings)
             first_ns = self._bag.start_ns + int(round(settings['start_offset'] * 1e9))
+            if settings['strict']:
+                self._check_records(first_ns)
             self._playback = Playback(
                 lambda: self._bag.messages(list(self._outputs), start_ns=first_ns), first_ns,
-                self.rate, settings['loop'], settings['start_paused'])
+                self.rate, settings['loop'], settings['start_paused'], self._loop_gap_ns())
         except EmptyPlayback:
             self._bag.close()
             raise StartupError(f'bag {self._bag.path} has no message to play after '
@@ -135,6 +151,8 @@ class BagReplayer(Node):
         except (BagError, StartupError) as err:
             self._bag.close()
             raise StartupError(str(err)) from None
+        #: damaged records already reported (one WARN, at the first)
+        self._warned_damage = False
         self._gate = StartGate(time.monotonic_ns(), settings['delay'], settings['wait_timeout'])
         self._create_timers_and_services(settings['clock_hz'])
         self.get_logger().info(f'playing {settings["bag"]}: {", ".join(names)} at rate '
@@ -156,6 +174,8 @@ class BagReplayer(Node):
             'wait_timeout': param('wait_timeout', 5.0, 'seconds to wait at most for subscribers '
                                   'before playing; 0 = do not wait'),
             'start_paused': param('start_paused', False, 'start paused'),
+            'strict': param('strict', False, 'refuse a bag with a damaged record (checked before '
+                            'playing) instead of skipping it'),
         }
         self.rate = param('rate', 1.0, 'playback speed factor (> 0)', read_only=False)
         if not settings['bag']:
@@ -186,6 +206,26 @@ class BagReplayer(Node):
             qos = adapted_qos(offered_policies(info), HistoryPolicy.KEEP_LAST, DEPTH)
             self._outputs[topic] = self.create_publisher(cls, remaps.get(topic, topic), qos)
         return [f'{t} -> {remaps[t]}' if t in remaps else t for t in classes]
+
+    def _check_records(self, first_ns: int) -> None:
+        """``strict``: read every message to be played once; BagError at a damaged one."""
+        for _ in self._bag.messages(list(self._outputs), start_ns=first_ns):
+            pass
+
+    def _loop_gap_ns(self) -> int:
+        """Bag time from the last message to the first one again: one mean message spacing."""
+        count, span = self._bag.message_count, self._bag.end_ns - self._bag.start_ns
+        if count < 2 or span <= 0:
+            return int(LOOP_GAP_ONE_MESSAGE * 1e9)
+        return span // (count - 1)
+
+    def _report_damage(self) -> None:
+        """The one WARN at the first damaged record skipped."""
+        if self._bag.corrupt and not self._warned_damage:
+            self._warned_damage = True
+            self.get_logger().warn(f'skipping damaged records of {self._bag.path} (first: '
+                                   f'{self._bag.damage}); they are counted, and strict:=true '
+                                   f'refuses such a bag')
 
     def _create_timers_and_services(self, clock_hz: float) -> None:
         self.add_on_set_parameters_callback(self._validate_parameters)
@@ -261,15 +301,19 @@ class BagReplayer(Node):
             self.exit_code = 1
             self._finish()
             return
+        self._report_damage()
         if self._playback.loops != loops:
-            self.get_logger().info('end of bag, looping')
+            self.get_logger().info(f'end of bag, looping (pass {self._playback.loops + 1})',
+                                   throttle_duration_sec=LOOP_LOG_PERIOD)
         if self._playback.finished:
             self._finish()
 
     def _finish(self) -> None:
         for publisher in self._outputs.values():
             publisher.wait_for_all_acked(Duration(seconds=ACK_TIMEOUT))
-        self.get_logger().info(f'end of bag: {self.published} messages published')
+        skipped = (f', {self._bag.corrupt} damaged records skipped' if self._bag.corrupt
+                   else '')
+        self.get_logger().info(f'end of bag: {self.published} messages published{skipped}')
         self.finished = True
         self._timer.cancel()
 

@@ -49,8 +49,6 @@ from .stream import WARMUP_BUFFER, WARMUP_MESSAGE, EstimatorStream
 #: hiccup of up to 2 s at 500 Hz, or a player's burst after a stall, drops nothing
 #: (benchmarks/bench_node.py measures the effect of the depth)
 INPUT_DEPTH = 1000
-#: period of /diagnostics, s
-DIAGNOSTICS_PERIOD = 1.0
 #: how often the end of a warm-up is looked for, and after how long it is announced, s
 WARMUP_POLL = 0.05
 WARMUP_NOTICE = 1.0
@@ -142,7 +140,7 @@ class EstimatorNode(Node):
         self._diagnostics_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
         # on the steady clock: diagnostics go on (and can say STALE) when sim time stops
         steady = Clock(clock_type=ClockType.STEADY_TIME)
-        self.create_timer(DIAGNOSTICS_PERIOD, self._publish_diagnostics, clock=steady)
+        self.create_timer(H.DIAGNOSTICS_PERIOD, self._publish_diagnostics, clock=steady)
         # while the kernels compile (a first start: see .stream), look for the end of the warm-up
         self._warmup_timer = self.create_timer(WARMUP_POLL, self._poll_warmup, clock=steady)
         self._warmup_logged = False

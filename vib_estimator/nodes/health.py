@@ -18,6 +18,8 @@ from typing import Dict, Mapping, Optional, Sequence
 
 #: levels, equal to ``diagnostic_msgs/DiagnosticStatus``'s
 OK, WARN, ERROR, STALE = 0, 1, 2, 3
+#: period of /diagnostics of every node, s
+DIAGNOSTICS_PERIOD = 1.0
 #: the status goes STALE when no input arrived for this long, s
 STALE_AFTER = 2.0
 #: core counters that grow when the quality gate holds a converged estimate back, or none forms

@@ -17,15 +17,13 @@ from __future__ import annotations
 
 from typing import Callable, Iterator, Optional, Protocol
 
+from ..errors import EmptyPlayback
+
 
 class Message(Protocol):
     """What the schedule needs of a recorded message (``vib_estimator.io.bags.BagMessage``)."""
 
     log_time_ns: int
-
-
-class EmptyPlayback(Exception):
-    """Nothing to play from the chosen start of the bag."""
 
 
 #: once one played topic has a subscriber, the others get this long to match too (a consumer's
@@ -78,13 +76,18 @@ class Playback:
         rate: speed factor (> 0).
         loop: start over at the end instead of finishing.
         paused: start paused.
+        loop_gap_ns: bag time between the last message and the first one again when looping
+            (the node gives one mean message spacing, so a one-message bag is not replayed at
+            every tick).
 
     Raises :class:`EmptyPlayback` when ``open_messages()`` yields nothing.
     """
 
     def __init__(self, open_messages: Callable[[], Iterator[Message]], first_ns: int,
-                 rate: float = 1.0, loop: bool = False, paused: bool = False) -> None:
+                 rate: float = 1.0, loop: bool = False, paused: bool = False,
+                 loop_gap_ns: int = 0) -> None:
         self._open = open_messages
+        self.loop_gap_ns = max(0, int(loop_gap_ns))
         self.first_ns = first_ns
         self.rate = rate
         self.loop = loop
@@ -136,7 +139,7 @@ class Playback:
         if self.next is None:
             if self.loop:
                 self._rewind()
-                self._anchor(self.first_ns, now_ns)
+                self._anchor(self.first_ns - self.loop_gap_ns, now_ns)
                 self.loops += 1
             else:
                 self.finished = True

@@ -37,11 +37,10 @@ from rosgraph_msgs.msg import Clock as ClockMsg
 from std_msgs.msg import Float64
 
 from ..control.shaping import MAX_DAMPING, SHAPERS, Shaper, StreamingShaper, design, none
+from .health import DIAGNOSTICS_PERIOD
 from .parameters import declare, descriptor
 from .runner import StartupError, run
 
-#: period of /diagnostics, s
-DIAGNOSTICS_PERIOD = 1.0
 #: the status goes WARN when a new design has waited this long for the reference to rest, s
 PENDING_WARN_AFTER = 10.0
 #: frequency estimates outside [MIN_FREQUENCY_HZ, rate_hz / 4] are ignored (counted)
