@@ -1,4 +1,5 @@
 """Streaming readers: same samples as the reference readers, every input type, bounded blocks."""
+import sys
 import os
 import shutil
 from pathlib import Path
@@ -133,6 +134,20 @@ def test_csv_error_in_a_late_block_names_the_row(tmp_path, monkeypatch):
         list(open_signal(path).blocks())
 
 
+def test_a_bag_of_several_inputs_gives_the_topic_the_node_reads_by_default(tmp_path):
+    """bags/README's example: the simulator's bag holds coupling_torque and the ground truth."""
+    stamps = EPOCH + np.arange(10, dtype=np.int64)
+    with BagWriter(tmp_path / 'sim') as bag:
+        truth = bag.add_topic('/vibration/ground_truth', 'std_msgs/msg/Float64')
+        torque = bag.add_topic('/coupling_torque', 'geometry_msgs/msg/WrenchStamped')
+        for s in stamps.tolist():
+            bag.write_message(truth, s, make_message('std_msgs/msg/Float64', s, 'f', 2.0, 0))
+            bag.write_message(torque, s, make_message('geometry_msgs/msg/WrenchStamped', s, 'f',
+                                                      1.0, 0))
+    signal = open_signal(tmp_path / 'sim')
+    assert signal.topic == '/coupling_torque' and signal.component == 'torque.z'
+
+
 def test_topic_choice_and_errors(tmp_path):
     stamps = EPOCH + np.arange(10, dtype=np.int64)
     with BagWriter(tmp_path / 'two') as bag:
@@ -141,7 +156,9 @@ def test_topic_choice_and_errors(tmp_path):
         for s in stamps.tolist():
             bag.write_message(a, s, make_message('geometry_msgs/msg/WrenchStamped', s, 'f', 1.0, 0))
             bag.write_message(b, s, make_message('std_msgs/msg/Float64', s, 'f', 2.0, 0))
-    with pytest.raises(BagError, match=r'several input-type topics, choose one with --topic: /a \(geometry_msgs/msg/WrenchStamped\)'
+    with pytest.raises(BagError, match=r'several input-type topics, choose one with --topic, '
+                                       r'e\.g\. `vib-estimator analyze \S+ --topic /a`: '
+                                       r'/a \(geometry_msgs/msg/WrenchStamped\)'
                                        r'.*/b \(std_msgs/msg/Float64\)'):
         open_signal(tmp_path / 'two')
     assert open_signal(tmp_path / 'two', '/b').component == 'data'
@@ -213,3 +230,15 @@ def test_compressed_bags(tmp_path, mode):
         plan = mcap.read_plan(sorted((tmp_path / 'bag').glob('*.mcap')), '/w')
         with plan[0].path.open('rb') as handle:        # zstd chunks, read by the fast path
             assert mcap.read_chunk(handle, plan[0]).offsets.size > 0
+
+
+def test_a_csv_reads_the_same_without_pyarrow(tmp_path, monkeypatch):
+    """rosdep alone installs no pyarrow: the exact reader gives the same samples."""
+    path = tmp_path / 'a.csv'
+    path.write_text('t,y\n' + '\n'.join(f'{i * 0.002},{np.sin(i / 7):.12g}' for i in range(3000)))
+    with_arrow = [np.concatenate(c) for c in zip(*open_signal(path).blocks())]
+    monkeypatch.setitem(sys.modules, 'pyarrow', None)       # import pyarrow -> ImportError
+    monkeypatch.setitem(sys.modules, 'pyarrow.csv', None)
+    without = [np.concatenate(c) for c in zip(*open_signal(path).blocks())]
+    assert len(without[0]) == 3000
+    assert all(np.array_equal(a, b) for a, b in zip(with_arrow, without))
