@@ -1,7 +1,7 @@
 """Streaming readers: same samples as the reference readers, every input type, bounded blocks."""
-import sys
 import os
 import shutil
+import sys
 from pathlib import Path
 
 import numpy as np
