@@ -1,7 +1,8 @@
 """``vib-estimator demo``: the simulated arm and the estimator node live, through three tip masses.
 
 Starts ``sim_node`` (Section 5.5's masses 30 -> 45.55 -> 61.17 g, :func:`arm_model.schedule_5_5`,
-sped up, publishing ``/clock``) and ``estimator_node`` (``use_sim_time``) as subprocesses of the
+sped up, publishing ``/clock``) and ``estimator_node`` (``use_sim_time``, the paper's configuration
+:data:`PAPER_PARAMS`) as subprocesses of the
 same environment on a private ROS domain, and listens in this process to ``coupling_torque``,
 ``vibration/ground_truth``, ``vibration/frequency`` and ``vibration/reset``. Each estimate is
 printed as it arrives next to the true (Eq. 23) frequency; at the end a Fig. 5/7-like PNG is written
@@ -31,8 +32,12 @@ from typing import List, Tuple
 import numpy as np
 
 from .control.shaping import SHAPERS
+from .core.config import PAPER
 from .sim.arm_model import MASSES_5_5, natural_frequency_hz, schedule_5_5
 
+#: estimator_node's parameters of the paper's configuration: the demo replays the paper's Section 5
+#: (a simulated arm without offset), so its figures stay those of the paper's estimator
+PAPER_PARAMS = tuple(f'{name}:={value}' for name, value in PAPER.items())
 #: exit criterion: every mass's median |error| within this (%)
 MAX_MEDIAN_ERROR_PCT = 3.0
 #: seconds allowed for the nodes to start and see each other
@@ -311,7 +316,7 @@ def _run_estimation(session: Session, args: argparse.Namespace, wall_start: floa
     duration = 3 * args.seconds_per_mass
     print(f'demo: ROS domain {session.domain}, {duration:g} s simulated at {args.speed:g}x, tip '
           'masses ' + ' -> '.join(f'{m * 1e3:g} g' for m in MASSES_5_5), flush=True)
-    session.start('estimator_node', ['use_sim_time:=true'], lambda: (
+    session.start('estimator_node', ['use_sim_time:=true', *PAPER_PARAMS], lambda: (
         listener.counts('vibration/frequency')[0] and listener.counts('coupling_torque')[1]))
     sim = session.start_sim(sim_params(args.speed, duration,
                                        schedule_to_array(schedule_5_5(args.seconds_per_mass)), 2))
@@ -540,7 +545,7 @@ def _run_shaping(session: 'Session', args: argparse.Namespace, wall_start: float
     print(f'demo --shaping: ROS domain {session.domain}, {3 * p:g} s simulated at '
           f'{args.speed:g}x, {args.shaper}, steps of {args.step:g} rad, tip masses '
           + ' -> '.join(f'{m * 1e3:g} g' for m in MASSES_5_5), flush=True)
-    session.start('estimator_node', ['use_sim_time:=true'], lambda: (
+    session.start('estimator_node', ['use_sim_time:=true', *PAPER_PARAMS], lambda: (
         listener.counts('vibration/frequency')[0] and listener.counts('coupling_torque')[1]))
     driver = ShapingDriver(session)
     session.start('shaper_node', ['use_sim_time:=true', 'shaper:=none'], lambda: (
