@@ -15,6 +15,7 @@ from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Float64, Header
 
+from vib_estimator.core.config import PAPER
 from vib_estimator.sim.arm_model import MASSES_5_5, natural_frequency_hz, schedule_5_5
 from vib_estimator.nodes.estimator_node import EstimatorNode
 from vib_estimator.nodes.runner import StartupError, make_executor, spin_until
@@ -61,7 +62,9 @@ def pipeline_run():
     rclpy.init(context=context, domain_id=int(os.environ['ROS_DOMAIN_ID']))
     executor = make_executor(context)
     listener = Listener(context)
-    estimator = EstimatorNode(context=context)
+    # the demo's pipeline: the paper's configuration on Section 5.5 (vib_estimator.demo)
+    estimator = EstimatorNode(context=context, parameter_overrides=[
+        Parameter(name, value=value) for name, value in PAPER.items()])
     sim = sim_node(context, speed=SPEED, duration=3 * SECONDS_PER_MASS, wait_for_subscribers=1,
                    schedule=schedule_to_array(schedule_5_5(SECONDS_PER_MASS)))
     for node in (listener.node, estimator, sim):
