@@ -266,22 +266,30 @@ def test_replay_into_estimator_node_matches_analyze(ros_context, executor, monke
     # input history, and a dropped sample changes the estimates. This test is about the
     # arithmetic, so the input is made deep enough for any burst.
     monkeypatch.setattr(estimator_node, 'INPUT_DEPTH', len(series))
-    estimator = estimator_node.EstimatorNode(context=ros_context)
-    node = replayer(ros_context, BAGS / 'arm_5_3', rate=2.0)
+    estimator, online = replay_into_estimator(ros_context, executor, BAGS / 'arm_5_3', 2.0,
+                                              len(series), len(offline))
+    assert online == offline  # same floats
+    estimator.destroy_node()  # off the graph (see the looping test)
+
+
+def replay_into_estimator(ros_context, executor, bag, rate, samples, estimates, timeout=20):
+    """Replay ``bag`` at ``rate`` into a default ``estimator_node``; once it has received
+    ``samples`` and published ``estimates`` frequencies, return the node and those floats."""
+    from vib_estimator.nodes.estimator_node import EstimatorNode
+
+    estimator = EstimatorNode(context=ros_context)
+    node = replayer(ros_context, bag, rate=rate)
     listener = Listener(ros_context, ['/vibration/frequency'], Float64)
-    executor.add_node(estimator)
-    executor.add_node(node)
-    executor.add_node(listener)
+    for n in (estimator, node, listener):
+        executor.add_node(n)
     assert spin_until(executor, lambda: listener.matched() and
                       estimator.count_publishers('/coupling_torque') > 0, 10)
     node.resume()
-    assert spin_until(executor, lambda: node.finished, 20)
+    assert spin_until(executor, lambda: node.finished, timeout)
     frequencies = listener.received['/vibration/frequency']
-    assert spin_until(executor, lambda: len(frequencies) == len(offline), 5)
-    assert spin_until(executor, lambda: estimator.counters['received'] == len(series), 5)
-    online = [deserialize_message(d, Float64).data for d in frequencies]
-    assert online == offline  # same floats
-    estimator.destroy_node()  # off the graph (see the looping test)
+    assert spin_until(executor, lambda: len(frequencies) == estimates, 5)
+    assert spin_until(executor, lambda: estimator.counters['received'] == samples, 5)
+    return estimator, [deserialize_message(d, Float64).data for d in frequencies]
 
 
 def test_looping_bag_resets_the_estimator_and_estimates_go_on(ros_context, executor, tmp_path):

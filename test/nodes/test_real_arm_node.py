@@ -9,12 +9,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from rclpy.serialization import deserialize_message
-from std_msgs.msg import Float64
 
 from vib_estimator.io.bags import WrenchSeries, write_wrench_series
 from vib_estimator.io.csv_reader import read_csv_series
-from vib_estimator.nodes.runner import spin_until
 
 ROOT = Path(__file__).resolve().parents[2]
 SHARED = next((p / 'shared' for p in ROOT.parents if (p / 'shared' / 'real-data').is_dir()),
@@ -27,9 +24,10 @@ LIMIT_CYCLE_HZ = 1.812
 @pytest.mark.skipif(not FLEX8.is_file(), reason='../shared/real-data is absent')
 def test_recording_replayed_as_a_bag_through_the_node(ros_context, executor, tmp_path,
                                                       monkeypatch, capsys):
+    from test_bag_replayer import replay_into_estimator
+
     from vib_estimator.cli import main
     from vib_estimator.nodes import estimator_node
-    from test_bag_replayer import Listener, replayer
 
     s = read_csv_series(FLEX8, column='tip_deflection_m')
     stamps = EPOCH_NS + np.round(s.t * 1e9).astype(np.int64)
@@ -44,18 +42,8 @@ def test_recording_replayed_as_a_bag_through_the_node(ros_context, executor, tmp
 
     # deep input: a stalled executor's burst must not drop samples (see test_bag_replayer)
     monkeypatch.setattr(estimator_node, 'INPUT_DEPTH', len(stamps))
-    estimator = estimator_node.EstimatorNode(context=ros_context)
-    node = replayer(ros_context, bag, rate=5.0)
-    listener = Listener(ros_context, ['/vibration/frequency'], Float64)
-    for n in (estimator, node, listener):
-        executor.add_node(n)
-    assert spin_until(executor, lambda: listener.matched() and
-                      estimator.count_publishers('/coupling_torque') > 0, 10)
-    node.resume()
-    assert spin_until(executor, lambda: node.finished, 30)
-    frequencies = listener.received['/vibration/frequency']
-    assert spin_until(executor, lambda: len(frequencies) == len(offline), 5)
-    assert spin_until(executor, lambda: estimator.counters['received'] == len(stamps), 5)
-    assert [deserialize_message(d, Float64).data for d in frequencies] == offline
+    estimator, online = replay_into_estimator(ros_context, executor, bag, 5.0, len(stamps),
+                                              len(offline), timeout=30)
+    assert online == offline    # the node publishes analyze's floats
     assert estimator.counters['rejected_inconsistent'] > 0     # the ringing, held back
     estimator.destroy_node()  # off the graph (see test_bag_replayer's looping test)
