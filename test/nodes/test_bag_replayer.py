@@ -1,5 +1,5 @@
 """bag_replayer: timing and rate, loop, topic filter and remap, services, /clock, refusals, and
-replay -> estimator node parity with the offline estimator."""
+replay -> estimator node parity with the offline estimator, on the real flexible-link arm too."""
 from __future__ import annotations
 
 import json
@@ -311,6 +311,43 @@ def test_looping_bag_resets_the_estimator_and_estimates_go_on(ros_context, execu
     assert per_loop >= 2
     # the context's shutdown leaves the subscription visible to later tests' processes
     # (test_estimator_node counts subscribers of /coupling_torque): take it off the graph
+    estimator.destroy_node()
+
+
+# -- the real flexible-link arm (issue 25) through the node ---------------------------------------
+
+ROOT = Path(__file__).resolve().parents[2]
+#: ``../shared`` of the repository (a worktree may sit one level deeper: the nearest one above)
+SHARED = next((p / 'shared' for p in ROOT.parents if (p / 'shared' / 'real-data').is_dir()),
+              ROOT.parent / 'shared')
+FLEX8 = SHARED / 'real-data' / 'flexible_link_arm' / 'flex8.csv'
+
+
+@pytest.mark.skipif(not FLEX8.is_file(), reason='../shared/real-data is absent')
+def test_real_arm_replayed_as_a_bag_through_the_node(ros_context, executor, tmp_path,
+                                                    monkeypatch, capsys):
+    """``flex8.csv`` written as a bag, replayed into ``estimator_node`` with its default
+    parameters, gives ``vib-estimator analyze``'s floats on that bag, and those are all within
+    2 % of the 1.812 Hz limit cycle after 4.5 s (``test/analysis/test_real_arm.py`` checks every
+    goal of the issue on the CSV); the ringing is held back as inconsistent."""
+    from vib_estimator.cli import main
+    from vib_estimator.io.csv_reader import read_csv_series
+    from vib_estimator.nodes import estimator_node
+
+    s = read_csv_series(FLEX8, column='tip_deflection_m')
+    stamps = 1_700_000_000 * 10 ** 9 + np.round(s.t * 1e9).astype(np.int64)
+    bag = tmp_path / 'flex8'
+    write_wrench_series(bag, WrenchSeries(stamps, s.y, 'link', '/coupling_torque'))
+    assert main(['analyze', str(bag), '--format', 'jsonl']) == 0
+    rows = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    offline = [r['frequency_hz'] for r in rows]
+    late = np.array([r['frequency_hz'] for r in rows if r['t'] >= 4.5])
+    assert len(late) >= 5 and np.all(np.abs(late / 1.812 - 1) <= 0.02)
+    monkeypatch.setattr(estimator_node, 'INPUT_DEPTH', len(stamps))   # see above
+    estimator, online = replay_into_estimator(ros_context, executor, bag, 5.0, len(stamps),
+                                              len(offline), timeout=30)
+    assert online == offline
+    assert estimator.counters['rejected_inconsistent'] > 0
     estimator.destroy_node()
 
 

@@ -300,7 +300,7 @@ def test_parameter_changes(make_probe):
     assert p.node.get_parameter('window').value == 5
     later = sine_stamps(3000)[1500:]
     p.feed(later, values[1500:])
-    expected = offline(later, values[1500:], EstimatorConfig().replace(window=5),
+    expected = offline(later, values[1500:], PAPER_CONFIG.replace(window=5),
                        origin=stamps[0])
     assert len(expected) >= 2
     assert p.frequencies()[before:] == expected.frequency_hz.tolist()
@@ -465,7 +465,7 @@ def test_reset_service_starts_a_new_segment_counters_kept(make_probe):
     assert response.success and 'new segment' in response.message
     p.feed(stamps[420:], values[420:])
     t = seconds_since(np.asarray(stamps), stamps[0])
-    est = FrequencyEstimator()
+    est = FrequencyEstimator(PAPER_CONFIG)
     first = est.process(t[:420], values[:420])
     est.reset()
     with_reset = first.frequency_hz.tolist() + est.process(t[420:], values[420:]) \
