@@ -235,3 +235,12 @@ def test_refinement_that_moves_far_from_the_algebraic_estimate_is_held_back(seed
         error = e.frequency_hz / np.interp(e.t, rec.t, rec.f_true) - 1
         assert len(e) > 20 and np.max(np.abs(error)) < 0.05, (config.refine, e.t[np.argmax(
             np.abs(error))], np.max(np.abs(error)))
+
+
+def test_a_flat_quantised_segment_is_at_rest_whatever_its_fit():
+    """A strain gauge at rest reads one ADC level: the biased model 'fitted' it with R^2 = 1 at an
+    amplitude of 1e-19 and published 3-19 Hz (flex8.csv before its step, issue 25)."""
+    t = np.arange(0.0, 3.0, 0.001)
+    est = FrequencyEstimator(EstimatorConfig.paper(model='biased-sinusoid'))
+    assert len(est.process(t, np.full(len(t), -0.004))) == 0
+    assert est.counters['rejected_at_rest'] > 0

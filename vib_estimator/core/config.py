@@ -85,7 +85,8 @@ class EstimatorConfig:
                                 'within this fraction of the estimate of the segment just before '
                                 'it (none after a restart, a timeout or a rejected segment): two '
                                 'consecutive estimates of one mode that differ more cannot both '
-                                'be right (0 = off, the paper)', 0.0, 1.0)
+                                'be right (0 = off, the paper; modes >= 1 have their own rule)',
+                                0.0, 1.0)
     max_gap: float = _param(0.5, 'a gap, or a backward jump, between stamps longer than this '
                             '(s) restarts the estimator; a smaller step back is skipped',
                             0.0, INF, open_lo=True, open_hi=True)
