@@ -73,5 +73,5 @@ def test_defaults_meet_the_goals_on_the_real_arm_and_the_paper_configuration_doe
 def test_the_consistency_gate_holds_back_contradicting_half_periods(capsys):
     """The paper's model with the consistency gate on: its lobe estimates contradict each other,
     so none is published after 4.5 s (rather than a confident wrong number)."""
-    t, f = analyze(capsys, '--paper', '--consistency', '0.03')
+    t, _ = analyze(capsys, '--paper', '--consistency', '0.03')
     assert np.sum(t >= RINGING_S[1]) == 0

@@ -268,7 +268,7 @@ def test_realism_parameters_reach_the_published_torque(ros_context, executor):
 
     from vib_estimator.sim.arm_model import ArmParameters, ArmSimulator, Move
 
-    realism = dict(offset=-0.15, quantum=0.03, limit_cycle_voltage=0.3)
+    realism = {'offset': -0.15, 'quantum': 0.03, 'limit_cycle_voltage': 0.3}
     sim = sim_node(ros_context, namespace='real_test', seed=3, speed=20.0, wait_for_subscribers=1,
                    **realism)
     probe = Node('probe', context=ros_context)
