@@ -2,8 +2,8 @@
 
 For each model (sinusoid; biased-sinusoid with an offset of 3 amplitudes; damped-sinusoid with
 zeta = 0.01), each window (``min_periods`` = 0.25, 0.5, 1, 2, 5, 20 periods) and each SNR (20, 40,
-60 dB; SNR = A^2 / (2 sigma^2)), the estimator (default configuration but ``model`` and
-``min_periods``) runs over seeded records of a 1.33 Hz mode sampled at 2 ms (A = 0.1, random
+60 dB; SNR = A^2 / (2 sigma^2)), the estimator (the paper's configuration,
+``EstimatorConfig.paper``, but ``model`` and ``min_periods``) runs over seeded records of a 1.33 Hz mode sampled at 2 ms (A = 0.1, random
 phase). Printed: the number of estimates, the RMS error of the published frequencies, the exact
 bound (RMS over the estimates of :func:`vib_estimator.analysis.bounds.model_crb` on the samples
 each used), the ratio RMS(error / bound) over the estimates (the std in units of each
@@ -58,7 +58,7 @@ def records(zeta, offset, sd, periods, seed, lead=0.0):
 
 def cell(model, zeta, offset, band, snr_db, periods):
     sd = AMP / math.sqrt(2 * 10 ** (snr_db / 10))
-    cfg = EstimatorConfig(model=model, min_periods=periods, band_hz=band)
+    cfg = EstimatorConfig.paper(model=model, min_periods=periods, band_hz=band)
     lead = SETTLE if band else 0.0
     err, bound, z, per, mp, norm, mpn = [], [], [], [], [], [], []
     for t, y, phase, zeta in records(zeta, offset, sd, periods, int(periods * 100 + snr_db), lead):

@@ -1,7 +1,8 @@
 """``vib-estimator demo``: the simulated arm and the estimator node live, through three tip masses.
 
 Starts ``sim_node`` (Section 5.5's masses 30 -> 45.55 -> 61.17 g, :func:`arm_model.schedule_5_5`,
-sped up, publishing ``/clock``) and ``estimator_node`` (``use_sim_time``) as subprocesses of the
+sped up, publishing ``/clock``) and ``estimator_node`` (``use_sim_time``, the paper's configuration
+:data:`PAPER_PARAMS`) as subprocesses of the
 same environment on a private ROS domain, and listens in this process to ``coupling_torque``,
 ``vibration/ground_truth``, ``vibration/frequency`` and ``vibration/reset``. Each estimate is
 printed as it arrives next to the true (Eq. 23) frequency; at the end a Fig. 5/7-like PNG is written
@@ -26,13 +27,21 @@ import time
 from collections import deque
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import List, Optional, Tuple
+from typing import List, Optional, Sequence, Tuple
 
 import numpy as np
 
 from .control.shaping import SHAPERS
+from .core.config import PAPER
 from .sim.arm_model import MASSES_5_5, natural_frequency_hz, schedule_5_5
 
+#: estimator_node's parameters of the paper's configuration: the demo replays the paper's Section 5
+#: (a simulated arm without offset), so its figures stay those of the paper's estimator
+PAPER_PARAMS = tuple(f'{name}:={value}' for name, value in PAPER.items())
+#: --real-arm: sim_node's realism of a real rig (docs/real_arm.md): a strain-gauge offset of half
+#: the vibration's amplitude, a quantum of a tenth of it, a closed-loop limit cycle of ~0.3 N m;
+#: estimator_node then runs with its defaults
+REAL_ARM_SIM_PARAMS = ('offset:=-0.15', 'quantum:=0.03', 'limit_cycle_voltage:=0.3')
 #: exit criterion: every mass's median |error| within this (%)
 MAX_MEDIAN_ERROR_PCT = 3.0
 #: seconds allowed for the nodes to start and see each other
@@ -67,6 +76,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--domain-id', type=int, default=None,
                         help='ROS domain of the demo, 0-232 (default: ROS_DOMAIN_ID when set, '
                              'else one of 1-101 from the process id)')
+    parser.add_argument('--real-arm', action='store_true',
+                        help='the same schedule on a realistic rig (strain-gauge offset, coarse '
+                             'quantisation, a closed-loop limit cycle) with the estimator\'s '
+                             'defaults instead of the paper\'s configuration (docs/real_arm.md)')
     parser.add_argument('--shaping', action='store_true',
                         help='input shaping: per mass a move unshaped, then the same move shaped '
                              'by shaper_node for the estimate (figure out/shaping.png)')
@@ -271,11 +284,11 @@ class Session:
                                else f'{exe} exited with {proc.returncode}')
         return proc
 
-    def start_estimator(self) -> subprocess.Popen:
-        """Start estimator_node (sim time) and wait until its kernels are compiled (its
+    def start_estimator(self, params: Sequence[str] = ()) -> subprocess.Popen:
+        """Start estimator_node (sim time, ``params`` on top) and wait until its kernels are compiled (its
         /diagnostics stop saying it warms up) and it sees the demo's topics."""
         listener = self.listener
-        return self.start('estimator_node', ['use_sim_time:=true'], lambda: (
+        return self.start('estimator_node', ['use_sim_time:=true', *params], lambda: (
             '/estimator_node' in listener.ready and listener.counts('vibration/frequency')[0]
             and listener.counts('coupling_torque')[1]), WARMUP_TIMEOUT)
 
@@ -361,11 +374,15 @@ def _run_estimation(session: Session, args: argparse.Namespace, wall_start: floa
 
     listener = session.listener
     duration = 3 * args.seconds_per_mass
+    real = getattr(args, 'real_arm', False)
     print(f'demo: ROS domain {session.domain}, {duration:g} s simulated at {args.speed:g}x, tip '
-          'masses ' + ' -> '.join(f'{m * 1e3:g} g' for m in MASSES_5_5), flush=True)
-    session.start_estimator()
+          'masses ' + ' -> '.join(f'{m * 1e3:g} g' for m in MASSES_5_5)
+          + (' on a realistic rig (' + ', '.join(REAL_ARM_SIM_PARAMS) + '), estimator defaults'
+             if real else ''), flush=True)
+    session.start_estimator([] if real else PAPER_PARAMS)
     sim = session.start_sim(sim_params(args.speed, duration,
-                                       schedule_to_array(schedule_5_5(args.seconds_per_mass)), 2))
+                                       schedule_to_array(schedule_5_5(args.seconds_per_mass)), 2)
+                            + list(REAL_ARM_SIM_PARAMS if real else ()))
     session.finish_sim(sim, duration, args.speed)
     rec = listener.record
     rows, ok = summarise(rec)
@@ -591,7 +608,7 @@ def _run_shaping(session: 'Session', args: argparse.Namespace, wall_start: float
     print(f'demo --shaping: ROS domain {session.domain}, {3 * p:g} s simulated at '
           f'{args.speed:g}x, {args.shaper}, steps of {args.step:g} rad, tip masses '
           + ' -> '.join(f'{m * 1e3:g} g' for m in MASSES_5_5), flush=True)
-    session.start_estimator()
+    session.start_estimator(PAPER_PARAMS)
     driver = ShapingDriver(session)
     session.start('shaper_node', ['use_sim_time:=true', 'shaper:=none'], lambda: (
         driver.reference_pub.get_subscription_count()

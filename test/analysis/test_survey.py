@@ -16,9 +16,9 @@ DAY = 86_400 * 10 ** 9
 
 
 def fleet(root, freqs, seed=0):
-    """One 6 s bag per day, a noisy sine of the day's frequency."""
+    """One 9 s bag per day, a noisy sine of the day's frequency (>= 6 estimates of 1.25 periods)."""
     rng = np.random.default_rng(seed)
-    t = np.arange(0, 6, 0.002)
+    t = np.arange(0, 9, 0.002)
     for day, f in enumerate(freqs):
         y = 0.3 * np.sin(2 * np.pi * f * t + day) + 0.003 * rng.standard_normal(len(t))
         stamps = EPOCH + day * DAY + np.round(t * 1e9).astype(np.int64)
@@ -32,8 +32,8 @@ def jsonl(text):
 
 def test_rows_equal_per_file_analyze(tmp_path, capsys):
     days = fleet(tmp_path, [1.3, 1.31, 1.32])
-    np.savetxt(tmp_path / 'sine.csv', np.column_stack([np.arange(3000) * 0.002,
-                                                       np.sin(np.arange(3000) * 0.002 * 9)]),
+    np.savetxt(tmp_path / 'sine.csv', np.column_stack([np.arange(4500) * 0.002,
+                                                       np.sin(np.arange(4500) * 0.002 * 9)]),
                delimiter=',', header='t,y', comments='')
     assert main(['survey', str(tmp_path), '--format', 'jsonl', '--jobs', '1']) == 0
     rows = jsonl(capsys.readouterr().out)
@@ -51,7 +51,7 @@ def test_rows_equal_per_file_analyze(tmp_path, capsys):
     assert rows[0]['start_utc'] == '2026-01-01T00:00:00Z' and rows[1]['start_utc'][:10] == \
         '2026-01-02'
     assert rows[-1]['start_utc'] == '' and rows[-1]['topic'] == ''
-    assert math.isclose(rows[0]['duration_s'], 5.998)
+    assert math.isclose(rows[0]['duration_s'], 8.998)
 
 
 def test_a_corrupt_recording_is_one_error_row(tmp_path, capsys):

@@ -8,6 +8,9 @@ from hypothesis import given, settings, strategies as st
 from vib_estimator.core import EstimatorConfig, FrequencyEstimator, estimate
 from vib_estimator.sim.signals import fig1_signal
 
+#: the paper's estimator (Eq. 1 over half-period windows), which these tests check
+PAPER = EstimatorConfig.paper()
+
 
 def sine(t, f, amplitude=1.0, phase=0.0, offset=0.0):
     return amplitude * np.sin(2 * np.pi * f * t + phase) + offset
@@ -19,7 +22,7 @@ def sine(t, f, amplitude=1.0, phase=0.0, offset=0.0):
 def test_clean_sine_every_estimate_is_exact(f, amplitude, phase, ratio):
     fs = ratio * f
     t = np.arange(0, 6 / f, 1 / fs)
-    e = estimate(t, sine(t, f, amplitude, phase))
+    e = estimate(t, sine(t, f, amplitude, phase), PAPER)
     assert len(e) >= 3
     bound = 1e-5 if ratio >= 100 else 1e-3
     assert np.max(np.abs(e.frequency_hz / f - 1)) < bound
@@ -31,7 +34,7 @@ def test_batch_and_streaming_give_the_same_floats(model):
     t = np.cumsum(rng.uniform(0.0015, 0.0025, 20000))
     y = sine(t, 1.7, 0.3, 0.4, 0.05) + 0.01 * rng.standard_normal(len(t))
     y[500] = np.nan
-    cfg = EstimatorConfig(model=model, band_hz=(0.5, 5.0))
+    cfg = EstimatorConfig.paper(model=model, band_hz=(0.5, 5.0))
     batch = estimate(t, y, cfg)
     stream = FrequencyEstimator(cfg)
     got = [e for e in (stream.update(a, b) for a, b in zip(t, y)) if e is not None]
@@ -44,8 +47,8 @@ def test_batch_and_streaming_give_the_same_floats(model):
 def test_batch_continues_a_stream_and_grows_its_output():
     t = np.arange(0, 100, 0.002)
     y = sine(t, 5.0)
-    whole = estimate(t, y)
-    est = FrequencyEstimator()
+    whole = estimate(t, y, PAPER)
+    est = FrequencyEstimator(PAPER)
     parts = [est.process(t[:7001], y[:7001]), est.process(t[7001:], y[7001:])]
     assert sum(len(p) for p in parts) == len(whole) > 500
     np.testing.assert_array_equal(np.concatenate([p.frequency_hz for p in parts]),
@@ -54,7 +57,7 @@ def test_batch_continues_a_stream_and_grows_its_output():
 
 def test_fig1_noisy_sine_within_one_percent():
     t = np.arange(0, 3, 0.001)
-    e = estimate(t, fig1_signal(t, seed=3), EstimatorConfig(lowpass_cutoff_hz=15 / (2 * np.pi)))
+    e = estimate(t, fig1_signal(t, seed=3), EstimatorConfig.paper(lowpass_cutoff_hz=15 / (2 * np.pi)))
     assert len(e) >= 5
     assert np.max(np.abs(2 * np.pi * e.frequency_hz / 10 - 1)) < 0.01
 
@@ -66,7 +69,7 @@ def test_irregular_sampling_uses_the_real_intervals(jitter):
     t = np.cumsum(dt)
     keep = rng.uniform(size=len(t)) > 0.05          # 5 % dropped samples
     t = t[keep]
-    e = estimate(t, sine(t, 1.33, 2.0, 0.3))
+    e = estimate(t, sine(t, 1.33, 2.0, 0.3), PAPER)
     assert len(e) > 50
     assert np.max(np.abs(e.frequency_hz / 1.33 - 1)) < 5e-4
 
@@ -74,8 +77,8 @@ def test_irregular_sampling_uses_the_real_intervals(jitter):
 def test_biased_model_removes_an_offset_the_paper_model_cannot():
     t = np.arange(0, 10, 0.002)
     y = sine(t, 2.0, 1.0, 0.7, offset=0.8)
-    paper = estimate(t, y)
-    biased = estimate(t, y, EstimatorConfig(model='biased-sinusoid'))
+    paper = estimate(t, y, PAPER)
+    biased = estimate(t, y, EstimatorConfig.paper(model='biased-sinusoid'))
     assert np.max(np.abs(biased.frequency_hz / 2.0 - 1)) < 1e-5
     assert len(paper) == 0 or np.max(np.abs(paper.frequency_hz / 2.0 - 1)) > 0.01
 
@@ -87,11 +90,11 @@ def test_damped_model_gives_natural_frequency_and_damping_exactly(zeta, phase):
     t = np.arange(0, 4, 0.002)
     omega_d = 2 * np.pi * f_n * np.sqrt(1 - zeta ** 2)
     y = 0.2 * np.exp(-zeta * 2 * np.pi * f_n * t) * np.sin(omega_d * t + phase)
-    e = estimate(t, y, EstimatorConfig(model='damped-sinusoid'))
+    e = estimate(t, y, EstimatorConfig.paper(model='damped-sinusoid'))
     assert len(e) >= 5
     assert np.max(np.abs(e.frequency_hz / f_n - 1)) < 1e-8
     assert np.max(np.abs(e.damping - zeta)) < 1e-6
-    undamped = estimate(t, y)                   # the paper's model: biased by the damping
+    undamped = estimate(t, y, PAPER)                   # the paper's model: biased by the damping
     assert np.isnan(undamped.damping).all()
 
 
@@ -99,17 +102,17 @@ def test_damped_model_holds_back_heavily_damped_transients():
     t = np.arange(0, 4, 0.002)
     w_n = 2 * np.pi * 1.33
     y = np.exp(-0.3 * w_n * t) * np.sin(w_n * np.sqrt(1 - 0.3 ** 2) * t + 0.5)
-    est = FrequencyEstimator(EstimatorConfig(model='damped-sinusoid'))
+    est = FrequencyEstimator(EstimatorConfig.paper(model='damped-sinusoid'))
     assert len(est.process(t, y)) == 0 and est.counters['rejected_damping'] > 0
-    lenient = estimate(t, y, EstimatorConfig(model='damped-sinusoid', max_damping=0.5))
+    lenient = estimate(t, y, EstimatorConfig.paper(model='damped-sinusoid', max_damping=0.5))
     assert len(lenient) > 0 and np.allclose(lenient.damping, 0.3)
 
 
 def test_band_prefilter_isolates_the_first_mode():
     t = np.arange(0, 20, 0.001)
     y = sine(t, 2.0, 1.0, 0.2) + sine(t, 13.0, 0.5, 1.0) + 0.3
-    plain = estimate(t, y)
-    banded = estimate(t, y, EstimatorConfig(band_hz=(1.0, 4.0)))
+    plain = estimate(t, y, PAPER)
+    banded = estimate(t, y, EstimatorConfig.paper(band_hz=(1.0, 4.0)))
     late = banded.t > 3.0                          # after the prefilter's start-up transient
     assert late.sum() > 10
     assert np.max(np.abs(banded.frequency_hz[late] / 2.0 - 1)) < 0.01
@@ -117,7 +120,7 @@ def test_band_prefilter_isolates_the_first_mode():
 
 
 def test_non_finite_duplicate_and_out_of_order_samples_are_skipped_and_counted():
-    est = FrequencyEstimator()
+    est = FrequencyEstimator(PAPER)
     t = np.arange(0, 3, 0.002)
     y = sine(t, 1.0)
     for i, (a, b) in enumerate(zip(t, y)):
@@ -136,7 +139,7 @@ def test_non_finite_duplicate_and_out_of_order_samples_are_skipped_and_counted()
 
 
 def test_gap_and_backward_jump_restart_and_estimates_resume():
-    est = FrequencyEstimator(EstimatorConfig(max_gap=0.5))
+    est = FrequencyEstimator(EstimatorConfig.paper(max_gap=0.5))
     t = np.arange(0, 4, 0.002)
     first = est.process(t, sine(t, 1.5))
     second = est.process(t + 10, sine(t + 10, 1.5))    # a 6 s gap
@@ -155,14 +158,14 @@ def test_gap_and_backward_jump_restart_and_estimates_resume():
 ])
 def test_signals_without_a_vibration_publish_nothing_and_say_why(name, make):
     t = np.arange(0, 30, 0.002)
-    est = FrequencyEstimator()
+    est = FrequencyEstimator(PAPER)
     assert len(est.process(t, make(t, np.random.default_rng(4)))) == 0
     assert est.counters[name] > 0
 
 
 def test_max_window_resets_without_publishing():
     t = np.arange(0, 20, 0.002)
-    est = FrequencyEstimator(EstimatorConfig(max_window=1.0))
+    est = FrequencyEstimator(EstimatorConfig.paper(max_window=1.0))
     assert len(est.process(t, sine(t, 0.05))) == 0      # 20 s period never fits in 1 s
     assert est.counters['max_window_resets'] >= 15
 
@@ -170,7 +173,7 @@ def test_max_window_resets_without_publishing():
 def test_a_day_long_stream_stays_exact():
     """24 h at 100 Hz: 8.6 M samples; the integrals restart at every estimate, stamps grow."""
     t = np.arange(0, 86400, 0.01)
-    est = FrequencyEstimator()
+    est = FrequencyEstimator(PAPER)
     e = est.process(t, sine(t, 0.8))
     assert e.t[-1] > 86390
     assert np.max(np.abs(e.frequency_hz / 0.8 - 1)) < 1e-5
@@ -179,7 +182,7 @@ def test_a_day_long_stream_stays_exact():
 
 
 def test_public_reset_starts_a_new_segment():
-    est = FrequencyEstimator()
+    est = FrequencyEstimator(PAPER)
     t = np.arange(0, 2, 0.002)
     y = sine(t, 1.0)
     out = []
@@ -199,20 +202,21 @@ def test_public_reset_starts_a_new_segment():
     dict(band_hz=(5.0, 1.0)), dict(band_hz=(0.0, 1.0)), dict(band_hz=(1.0,)),
     dict(min_fit=1.5), dict(min_amplitude=-1.0), dict(max_gap=0.0), dict(min_periods=-0.1),
     dict(rule_points=1), dict(rule_points=9), dict(one_sided_test='yes'),
+    dict(consistency=-0.1), dict(consistency=1.5),
 ])
 def test_invalid_parameters_are_refused_with_a_reason(changes):
     name = next(iter(changes))
     with pytest.raises(ValueError, match=name):
-        EstimatorConfig().replace(**changes)
+        EstimatorConfig.paper().replace(**changes)
     with pytest.raises(ValueError, match=name):
-        FrequencyEstimator(EstimatorConfig(**changes))
+        FrequencyEstimator(EstimatorConfig.paper(**changes))
 
 
 def test_unfiltered_estimate_is_noisier_than_invariant_filtering():
     """Fig. 1: without the invariant filter the paper's estimates (refine = 0) scatter more."""
     t = np.arange(0, 6, 0.001)
     y = fig1_signal(t, seed=0)
-    cfg = EstimatorConfig(lowpass_cutoff_hz=15 / (2 * np.pi), refine=0)
+    cfg = EstimatorConfig.paper(lowpass_cutoff_hz=15 / (2 * np.pi), refine=0)
     filtered = estimate(t, y, cfg)
     raw = estimate(t, y, cfg.replace(invariant_filter=False))
     err = [np.sqrt(np.mean((2 * np.pi * e.frequency_hz - 10) ** 2)) for e in (filtered, raw)]
@@ -226,8 +230,17 @@ def test_refinement_that_moves_far_from_the_algebraic_estimate_is_held_back(seed
     default configuration (the refinement moved its start by ~10 %)."""
     from vib_estimator.sim import arm_model
     rec = arm_model.experiment_5_3(seed)
-    for config in (EstimatorConfig(refine=0), EstimatorConfig()):
+    for config in (EstimatorConfig.paper(refine=0), EstimatorConfig.paper()):
         e = FrequencyEstimator(config).process(rec.t, rec.torque)
         error = e.frequency_hz / np.interp(e.t, rec.t, rec.f_true) - 1
         assert len(e) > 20 and np.max(np.abs(error)) < 0.05, (config.refine, e.t[np.argmax(
             np.abs(error))], np.max(np.abs(error)))
+
+
+def test_a_flat_quantised_segment_is_at_rest_whatever_its_fit():
+    """A strain gauge at rest reads one ADC level: the biased model 'fitted' it with R^2 = 1 at an
+    amplitude of 1e-19 and published 3-19 Hz (flex8.csv before its step, issue 25)."""
+    t = np.arange(0.0, 3.0, 0.001)
+    est = FrequencyEstimator(EstimatorConfig.paper(model='biased-sinusoid'))
+    assert len(est.process(t, np.full(len(t), -0.004))) == 0
+    assert est.counters['rejected_at_rest'] > 0

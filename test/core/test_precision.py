@@ -14,6 +14,9 @@ from vib_estimator.analysis.bounds import model_crb
 from vib_estimator.core import EstimatorConfig, FrequencyEstimator, estimate
 from vib_estimator.sim.signals import fig1_signal
 
+#: the paper's estimator (Eq. 1 over half-period windows), which these tests check
+PAPER = EstimatorConfig.paper()
+
 F0, AMP, TS = 1.33, 0.1, 0.002
 SD = AMP / math.sqrt(2 * 1e4)      # 40 dB
 
@@ -27,7 +30,7 @@ def _runs(model, periods, zeta=0.0, offset=0.0, records=12, refine=4):
         wn = 2 * math.pi * F0
         y = AMP * np.exp(-zeta * wn * t) * np.sin(wn * math.sqrt(1 - zeta ** 2) * t + phase)
         y = y + offset + rng.normal(0, SD, len(t))
-        e = estimate(t, y, EstimatorConfig(model=model, min_periods=periods, refine=refine))
+        e = estimate(t, y, EstimatorConfig.paper(model=model, min_periods=periods, refine=refine))
         for k in range(len(e)):
             i1 = int(round(e.t[k] / TS))
             b, _ = model_crb(model, t[i1 - int(e.samples[k]) + 1:i1 + 1], AMP, F0, phase, SD, zeta)
@@ -59,7 +62,7 @@ def _fig1_first_estimates(target):
     t = np.arange(0.0, 1.0, 0.002)
     first, errors, rel_std = [], [], []
     for seed in range(20):
-        est = FrequencyEstimator(EstimatorConfig(target_std_rel=target, min_periods=0.0))
+        est = FrequencyEstimator(EstimatorConfig.paper(target_std_rel=target, min_periods=0.0))
         e = est.process(t, fig1_signal(t, seed=seed))
         first.append(e.t[0])
         errors.append(abs(2 * math.pi * e.frequency_hz[0] / 10 - 1))
@@ -96,7 +99,7 @@ def test_clean_signals_stay_exact_with_and_without_refinement(model, refine):
         * np.sin(2 * math.pi * f * math.sqrt(1 - 1e-4 * (model == 'damped-sinusoid')) * t + 0.4)
     if model == 'biased-sinusoid':
         y = y + 0.5
-    e = estimate(t, y, EstimatorConfig(model=model, refine=refine))
+    e = estimate(t, y, EstimatorConfig.paper(model=model, refine=refine))
     assert len(e) >= 10
     assert np.max(np.abs(e.frequency_hz / f - 1)) < 1e-5
 
@@ -104,7 +107,7 @@ def test_clean_signals_stay_exact_with_and_without_refinement(model, refine):
 def test_long_windows_are_not_cut_short_by_default():
     t = np.arange(0.0, 60.0, TS)
     y = np.sin(2 * math.pi * 0.4 * t) + np.random.default_rng(0).normal(0, 0.01, len(t))
-    est = FrequencyEstimator(EstimatorConfig(min_periods=20))
+    est = FrequencyEstimator(EstimatorConfig.paper(min_periods=20))
     e = est.process(t, y)
     assert len(e) >= 1 and np.all(e.convergence_time * 0.4 >= 19)
     assert est.counters['max_window_resets'] == 0
@@ -139,7 +142,7 @@ def test_long_damped_windows_start_from_the_half_period_damping():
     sd = AMP / math.sqrt(2 * 100.0)
     norm = []
     for t, y, phase in _records(0.01, sd, 5, 8, seed=520):
-        e = estimate(t, y, EstimatorConfig(model='damped-sinusoid', min_periods=5))
+        e = estimate(t, y, EstimatorConfig.paper(model='damped-sinusoid', min_periods=5))
         for k in range(len(e)):
             i1 = int(round(e.t[k] / TS))
             b, _ = model_crb('damped-sinusoid', t[i1 - int(e.samples[k]) + 1:i1 + 1], AMP, F0,
@@ -154,7 +157,7 @@ def _band_calibration(periods, records):
     start-up (3 s), 40 dB."""
     z = []
     for t, y, _ in _records(0.0, SD, periods, records, seed=11):
-        e = estimate(t, y, EstimatorConfig(min_periods=periods, band_hz=(F0 / 2, 2 * F0)))
+        e = estimate(t, y, EstimatorConfig.paper(min_periods=periods, band_hz=(F0 / 2, 2 * F0)))
         for k in range(len(e)):
             if e.t[k] - e.convergence_time[k] > 3.0:
                 z.append((e.frequency_hz[k] - F0) / e.frequency_std_hz[k])

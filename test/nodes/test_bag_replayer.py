@@ -1,5 +1,5 @@
 """bag_replayer: timing and rate, loop, topic filter and remap, services, /clock, refusals, and
-replay -> estimator node parity with the offline estimator."""
+replay -> estimator node parity with the offline estimator, on the real flexible-link arm too."""
 from __future__ import annotations
 
 import json
@@ -267,22 +267,30 @@ def test_replay_into_estimator_node_matches_analyze(ros_context, executor, monke
     # input history, and a dropped sample changes the estimates. This test is about the
     # arithmetic, so the input is made deep enough for any burst.
     monkeypatch.setattr(estimator_node, 'INPUT_DEPTH', len(series))
-    estimator = estimator_node.EstimatorNode(context=ros_context)
-    node = replayer(ros_context, BAGS / 'arm_5_3', rate=2.0)
+    estimator, online = replay_into_estimator(ros_context, executor, BAGS / 'arm_5_3', 2.0,
+                                              len(series), len(offline))
+    assert online == offline  # same floats
+    estimator.destroy_node()  # off the graph (see the looping test)
+
+
+def replay_into_estimator(ros_context, executor, bag, rate, samples, estimates, timeout=20):
+    """Replay ``bag`` at ``rate`` into a default ``estimator_node``; once it has received
+    ``samples`` and published ``estimates`` frequencies, return the node and those floats."""
+    from vib_estimator.nodes.estimator_node import EstimatorNode
+
+    estimator = EstimatorNode(context=ros_context)
+    node = replayer(ros_context, bag, rate=rate)
     listener = Listener(ros_context, ['/vibration/frequency'], Float64)
-    executor.add_node(estimator)
-    executor.add_node(node)
-    executor.add_node(listener)
+    for n in (estimator, node, listener):
+        executor.add_node(n)
     assert spin_until(executor, lambda: listener.matched() and
                       estimator.count_publishers('/coupling_torque') > 0, 10)
     node.resume()
-    assert spin_until(executor, lambda: node.finished, 20)
+    assert spin_until(executor, lambda: node.finished, timeout)
     frequencies = listener.received['/vibration/frequency']
-    assert spin_until(executor, lambda: len(frequencies) == len(offline), 5)
-    assert spin_until(executor, lambda: estimator.counters['received'] == len(series), 5)
-    online = [deserialize_message(d, Float64).data for d in frequencies]
-    assert online == offline  # same floats
-    estimator.destroy_node()  # off the graph (see the looping test)
+    assert spin_until(executor, lambda: len(frequencies) == estimates, 5)
+    assert spin_until(executor, lambda: estimator.counters['received'] == samples, 5)
+    return estimator, [deserialize_message(d, Float64).data for d in frequencies]
 
 
 def test_looping_bag_resets_the_estimator_and_estimates_go_on(ros_context, executor, tmp_path):
@@ -304,6 +312,43 @@ def test_looping_bag_resets_the_estimator_and_estimates_go_on(ros_context, execu
     assert per_loop >= 2
     # the context's shutdown leaves the subscription visible to later tests' processes
     # (test_estimator_node counts subscribers of /coupling_torque): take it off the graph
+    estimator.destroy_node()
+
+
+# -- the real flexible-link arm (issue 25) through the node ---------------------------------------
+
+ROOT = Path(__file__).resolve().parents[2]
+#: ``../shared`` of the repository (a worktree may sit one level deeper: the nearest one above)
+SHARED = next((p / 'shared' for p in ROOT.parents if (p / 'shared' / 'real-data').is_dir()),
+              ROOT.parent / 'shared')
+FLEX8 = SHARED / 'real-data' / 'flexible_link_arm' / 'flex8.csv'
+
+
+@pytest.mark.skipif(not FLEX8.is_file(), reason='../shared/real-data is absent')
+def test_real_arm_replayed_as_a_bag_through_the_node(ros_context, executor, tmp_path,
+                                                    monkeypatch, capsys):
+    """``flex8.csv`` written as a bag, replayed into ``estimator_node`` with its default
+    parameters, gives ``vib-estimator analyze``'s floats on that bag, and those are all within
+    2 % of the 1.812 Hz limit cycle after 4.5 s (``test/analysis/test_real_arm.py`` checks every
+    goal of the issue on the CSV); the ringing is held back as inconsistent."""
+    from vib_estimator.cli import main
+    from vib_estimator.io.csv_reader import read_csv_series
+    from vib_estimator.nodes import estimator_node
+
+    s = read_csv_series(FLEX8, column='tip_deflection_m')
+    stamps = 1_700_000_000 * 10 ** 9 + np.round(s.t * 1e9).astype(np.int64)
+    bag = tmp_path / 'flex8'
+    write_wrench_series(bag, WrenchSeries(stamps, s.y, 'link', '/coupling_torque'))
+    assert main(['analyze', str(bag), '--format', 'jsonl']) == 0
+    rows = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    offline = [r['frequency_hz'] for r in rows]
+    late = np.array([r['frequency_hz'] for r in rows if r['t'] >= 4.5])
+    assert len(late) >= 5 and np.all(np.abs(late / 1.812 - 1) <= 0.02)
+    monkeypatch.setattr(estimator_node, 'INPUT_DEPTH', len(stamps))   # see above
+    estimator, online = replay_into_estimator(ros_context, executor, bag, 5.0, len(stamps),
+                                              len(offline), timeout=30)
+    assert online == offline
+    assert estimator.counters['rejected_inconsistent'] > 0
     estimator.destroy_node()
 
 

@@ -24,6 +24,7 @@ from std_msgs.msg import Float64, Header
 from std_srvs.srv import Trigger
 
 from vib_estimator.core import Estimate, EstimatorConfig, FrequencyEstimator
+from vib_estimator.core.config import PAPER
 from vib_estimator.io import fields
 from vib_estimator.nodes.estimator_node import EstimatorNode, message_class
 from vib_estimator.nodes import stream
@@ -157,7 +158,12 @@ def sine_stamps(n, start_ns=EPOCH_NS, fs=FS):
     return [start_ns + round(i * 1e9 / fs) for i in range(n)]
 
 
-def offline(stamps_ns, values, config=EstimatorConfig(), origin=None):
+#: the node's mechanics are checked on short signals with the paper's half-period windows
+#: (the defaults through the node: test_real_arm_node.py, test_launch_config.py)
+PAPER_CONFIG = EstimatorConfig.paper()
+
+
+def offline(stamps_ns, values, config=PAPER_CONFIG, origin=None):
     """What ``vib-estimator analyze`` computes for these samples."""
     stamps = np.asarray(stamps_ns, dtype=np.int64)
     t = seconds_since(stamps, stamps[0] if origin is None else origin)
@@ -172,6 +178,7 @@ def make_probe(ros_context, executor):
     def make(modes=0, **overrides):
         if modes:
             overrides['modes'] = modes
+        overrides = {**PAPER, **overrides}
         node = EstimatorNode(context=ros_context, parameter_overrides=[
             Parameter(k, value=v) for k, v in overrides.items()])
         made.append(node)
@@ -293,7 +300,7 @@ def test_parameter_changes(make_probe):
     assert p.node.get_parameter('window').value == 5
     later = sine_stamps(3000)[1500:]
     p.feed(later, values[1500:])
-    expected = offline(later, values[1500:], EstimatorConfig().replace(window=5),
+    expected = offline(later, values[1500:], PAPER_CONFIG.replace(window=5),
                        origin=stamps[0])
     assert len(expected) >= 2
     assert p.frequencies()[before:] == expected.frequency_hz.tolist()
@@ -458,7 +465,7 @@ def test_reset_service_starts_a_new_segment_counters_kept(make_probe):
     assert response.success and 'new segment' in response.message
     p.feed(stamps[420:], values[420:])
     t = seconds_since(np.asarray(stamps), stamps[0])
-    est = FrequencyEstimator()
+    est = FrequencyEstimator(PAPER_CONFIG)
     first = est.process(t[:420], values[:420])
     est.reset()
     with_reset = first.frequency_hz.tolist() + est.process(t[420:], values[420:]) \

@@ -13,6 +13,7 @@ import rclpy
 import yaml
 
 from vib_estimator.core import EstimatorConfig
+from vib_estimator.core.config import PAPER
 from vib_estimator.io.fields import DEFAULT_COMPONENT, INPUT_TYPES, WRENCH_STAMPED
 from vib_estimator.nodes.estimator_node import EstimatorNode
 
@@ -33,6 +34,12 @@ def test_params_file_holds_the_defaults():
         expected = [] if default is None else list(default) if isinstance(default, tuple) \
             else default
         assert value == expected and type(value) is type(expected), (name, value, expected)
+
+
+def test_paper_params_file_holds_the_paper_configuration():
+    params = yaml.safe_load((ROOT / 'config' / 'paper.yaml').read_text())['/**']['ros__parameters']
+    assert params == PAPER
+    assert EstimatorConfig().replace(**params) == EstimatorConfig.paper()
 
 
 def test_params_file_loads_into_the_node():

@@ -15,6 +15,7 @@ from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Float64, Header
 
+from vib_estimator.core.config import PAPER
 from vib_estimator.sim.arm_model import MASSES_5_5, natural_frequency_hz, schedule_5_5
 from vib_estimator.nodes.estimator_node import EstimatorNode
 from vib_estimator.nodes.runner import StartupError, make_executor, spin_until
@@ -61,7 +62,9 @@ def pipeline_run():
     rclpy.init(context=context, domain_id=int(os.environ['ROS_DOMAIN_ID']))
     executor = make_executor(context)
     listener = Listener(context)
-    estimator = EstimatorNode(context=context)
+    # the demo's pipeline: the paper's configuration on Section 5.5 (vib_estimator.demo)
+    estimator = EstimatorNode(context=context, parameter_overrides=[
+        Parameter(name, value=value) for name, value in PAPER.items()])
     sim = sim_node(context, speed=SPEED, duration=3 * SECONDS_PER_MASS, wait_for_subscribers=1,
                    schedule=schedule_to_array(schedule_5_5(SECONDS_PER_MASS)))
     for node in (listener.node, estimator, sim):
@@ -256,3 +259,31 @@ def test_lockstep_waits_for_the_commander(ros_context, executor):
             if node in executor.get_nodes():
                 executor.remove_node(node)
             node.destroy_node()
+
+
+def test_realism_parameters_reach_the_published_torque(ros_context, executor):
+    """offset, quantum and limit_cycle_voltage (issue 25): coupling_torque is the model's with
+    them, sample for sample, on the quantum's grid."""
+    from geometry_msgs.msg import WrenchStamped
+
+    from vib_estimator.sim.arm_model import ArmParameters, ArmSimulator, Move
+
+    realism = {'offset': -0.15, 'quantum': 0.03, 'limit_cycle_voltage': 0.3}
+    sim = sim_node(ros_context, namespace='real_test', seed=3, speed=20.0, wait_for_subscribers=1,
+                   **realism)
+    probe = Node('probe', context=ros_context)
+    for node in (sim, probe):
+        executor.add_node(node)
+    try:
+        torque = _collect(executor, probe, WrenchStamped, '/real_test/coupling_torque', 2000,
+                          lambda m: m.wrench.torque.z)
+    finally:
+        for node in (sim, probe):
+            executor.remove_node(node)
+            node.destroy_node()
+    model = ArmSimulator(ArmParameters(), seed=3, schedule=(Move(0.0, 1.0, 1.0),), **realism)
+    np.testing.assert_array_equal(torque, [model.step()[1] for _ in range(len(torque))])
+    np.testing.assert_allclose(np.asarray(torque) / 0.03, np.round(np.asarray(torque) / 0.03),
+                               atol=1e-9)
+    with pytest.raises(StartupError, match='limit_cycle_voltage'):
+        sim_node(ros_context, namespace='bad_real', limit_cycle_voltage=20.0)

@@ -21,7 +21,7 @@ def feed(stream, stamps, values):
 
 
 def test_same_floats_as_offline_with_epoch_stamps():
-    stamps, values = sine(2000)
+    stamps, values = sine(4000)     # 8 s: >= 5 windows of 1.25 periods (the default)
     stream = EstimatorStream(EstimatorConfig(), now=0.0)
     online = feed(stream, stamps, values)
     offline = FrequencyEstimator().process((stamps - stamps[0]) * 1e-9, values)

@@ -24,6 +24,7 @@ from typing import Optional, Tuple
 import numpy as np
 
 from ..core import MODELS, EstimateArrays, EstimatorConfig
+from ..core.config import PAPER
 from ..core.modes import create_estimator
 from ..errors import VibEstimatorError, report
 from ..io.fields import INPUT_TYPES
@@ -34,7 +35,7 @@ _CONFIG_OPTIONS = {
     'lowpass_cutoff_hz': float, 'lowpass_damping': float, 'window': int, 'tolerance': float,
     'min_time': float, 'min_periods': float, 'max_window': float, 'min_fit': float,
     'min_amplitude': float, 'max_damping': float, 'max_gap': float, 'target_std_rel': float,
-    'modes': int, 'refine': int,
+    'modes': int, 'refine': int, 'consistency': float,
 }
 
 
@@ -55,21 +56,29 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def add_config_arguments(parser: argparse.ArgumentParser) -> None:
-    """The estimator options (``--model``, ``--band-hz``, one per scalar config field)."""
-    defaults = EstimatorConfig()
-    parser.add_argument('--model', choices=MODELS, default=defaults.model)
+    """The estimator options (``--paper``, ``--model``, ``--band-hz``, one per scalar config
+    field); an option not given keeps the default (or with ``--paper`` the paper's) value."""
+    defaults, paper = EstimatorConfig(), EstimatorConfig.paper()
+    parser.add_argument('--paper', action='store_true',
+                        help='start from the paper\'s configuration (' + ', '.join(
+                            f'{k} {v}' for k, v in PAPER.items()) + ') instead of the defaults')
+    parser.add_argument('--model', choices=MODELS, default=None,
+                        help=f'(default {defaults.model}; --paper: {paper.model})')
     parser.add_argument('--band-hz', nargs=2, type=float, metavar=('LO', 'HI'),
                         help='band-pass prefilter [LO, HI] Hz (default off)')
     for name, kind in _CONFIG_OPTIONS.items():
-        parser.add_argument('--' + name.replace('_', '-'), type=kind,
-                            default=getattr(defaults, name), help=f'(default {getattr(defaults, name)})')
+        value, paper_value = getattr(defaults, name), getattr(paper, name)
+        parser.add_argument('--' + name.replace('_', '-'), type=kind, default=None,
+                            help=f'(default {value}' + (
+                                f'; --paper: {paper_value})' if paper_value != value else ')'))
 
 
 def make_config(args: argparse.Namespace) -> EstimatorConfig:
     """The estimator configuration of the command line (ValueError if out of range)."""
-    return EstimatorConfig().replace(
-        model=args.model, band_hz=tuple(args.band_hz) if args.band_hz else None,
-        **{name: getattr(args, name) for name in _CONFIG_OPTIONS})
+    base = EstimatorConfig.paper() if args.paper else EstimatorConfig()
+    given = {name: getattr(args, name) for name in ('model', *_CONFIG_OPTIONS)
+             if getattr(args, name) is not None}
+    return base.replace(band_hz=tuple(args.band_hz) if args.band_hz else None, **given)
 
 
 def _check_times(t: np.ndarray, previous: float, count: int, name: str) -> None:

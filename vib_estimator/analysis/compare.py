@@ -62,11 +62,12 @@ OUTLIER = 0.05
 #: Table 2 of the paper (algebraic method, Section 5.5): f (Hz) -> (bias Hz, variance Hz^2)
 PAPER_TABLE_2 = {1.64: (7.0e-2, 1.2e-4), 1.33: (3.0e-2, 3.1e-5), 1.15: (1.5e-2, 7.1e-5)}
 ALGEBRAIC = 'Algebraic'
-#: the paper's algebraic estimator (refine = 0; the sinusoid model and the damped model) and this
-#: package's default, its maximum-likelihood refinement over the same segments
-ALGEBRAIC_CONFIGS = {ALGEBRAIC: EstimatorConfig(refine=0),
-                     'Algebraic-damped': EstimatorConfig(model='damped-sinusoid', refine=0),
-                     'Algebraic-ML': EstimatorConfig()}
+#: the paper's algebraic estimator (refine = 0; the sinusoid model and the damped model) and its
+#: maximum-likelihood refinement over the same segments (the paper's configuration,
+#: ``EstimatorConfig.paper``: the comparison of Section 5.4 is the paper's)
+ALGEBRAIC_CONFIGS = {ALGEBRAIC: EstimatorConfig.paper(refine=0),
+                     'Algebraic-damped': EstimatorConfig.paper(model='damped-sinusoid', refine=0),
+                     'Algebraic-ML': EstimatorConfig.paper()}
 TRACKERS = (ZiaraniKonrad, Hou, MojiriBakhshai, SlidingDFT, SlidingMatrixPencil)
 #: the adaptive trackers with amplitude-tuned gains: name -> (tracker, the gain that multiplies
 #: the signal's amplitude squared in its frequency adaptation law)

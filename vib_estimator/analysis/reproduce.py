@@ -46,9 +46,9 @@ class Fig1Result:
 
 def _trajectory(t, y, invariant_filter: bool) -> np.ndarray:
     """Running Eq. 12 estimate in rad/s over one segment that never resets."""
-    config = EstimatorConfig(lowpass_cutoff_hz=FIG1_WC / (2 * math.pi), tolerance=1e-300,
-                             max_window=1e9, min_time=0.0, invariant_filter=invariant_filter,
-                             refine=0)
+    config = EstimatorConfig.paper(lowpass_cutoff_hz=FIG1_WC / (2 * math.pi), tolerance=1e-300,
+                                   max_window=1e9, min_time=0.0,
+                                   invariant_filter=invariant_filter, refine=0)
     est = FrequencyEstimator(config)
     out = np.full(len(t), np.nan)
     for i, (a, b) in enumerate(zip(t, y)):
@@ -80,7 +80,7 @@ class Fig2Result:
 
 def fig2(zetas=FIG2_ZETAS, **overrides) -> Fig2Result:
     """First estimate of the normalised damped sine for each zeta_n (paper's settings + overrides)."""
-    config = EstimatorConfig(window=10, tolerance=1e-3, refine=0).replace(**overrides)
+    config = EstimatorConfig.paper(window=10, tolerance=1e-3, refine=0, **overrides)
     t = np.arange(0.0, 5.0, FIG2_TS)
     conv: List[float] = []
     mae: List[float] = []
@@ -158,7 +158,7 @@ def run(args: argparse.Namespace) -> int:
         columns = [r, fig2(), fig2(model='damped-sinusoid')]
         print('Fig. 2: Eq. 15, phi = 0, M = 10, tolerance 1e-3, Ts = 2 ms (first estimate; '
               'T* in periods)')
-        print(f'{"":7} {"Eq. 16 as printed":>20} {"package defaults":>20} '
+        print(f'{"":7} {"Eq. 16 as printed":>20} {"paper defaults":>20} '
               f'{"damped-sinusoid":>20}')
         print(f'{"zeta_n":>7}' + f' {"T*":>8} {"MAE":>11}' * len(columns))
         for i, z in enumerate(r.zetas):

@@ -18,6 +18,10 @@ MODELS = ('sinusoid', 'biased-sinusoid', 'damped-sinusoid')
 
 INF = math.inf
 
+#: the fields in which the paper's configuration differs from the default: Eq. 1's model (no
+#: offset) over half-period windows, each estimate judged alone (``EstimatorConfig.paper``)
+PAPER = {'model': 'sinusoid', 'min_periods': 0.5, 'consistency': 0.0}
+
 
 def _param(default, doc: str, lo=None, hi=None, open_lo=False, open_hi=False):
     """A configuration field with its description and its range [lo, hi] (bounds open if asked).
@@ -31,10 +35,13 @@ def _param(default, doc: str, lo=None, hi=None, open_lo=False, open_hi=False):
 
 @dataclass(frozen=True)
 class EstimatorConfig:
-    """Parameters of the estimator; defaults are those of Section 5.3 of the paper where it gives
-    them. Each field's description and range: :meth:`describe`."""
+    """Parameters of the estimator. The filter and test settings are those of Section 5.3 of the
+    paper; the model, the window and the consistency gate are chosen for real sensors (an offset,
+    a waveform with harmonics, coarse quantisation: ``docs/real_arm.md``), and :meth:`paper` sets
+    them back to the paper's (:data:`PAPER`). Each field's description and range: :meth:`describe`.
+    """
 
-    model: str = _param('sinusoid', 'sinusoid (Eq. 1, the paper), biased-sinusoid '
+    model: str = _param('biased-sinusoid', 'sinusoid (Eq. 1, the paper), biased-sinusoid '
                         '(y = A sin(wt+phi) + B, the offset eliminated algebraically) or '
                         'damped-sinusoid (natural frequency and damping of a decaying sine)')
     lowpass_cutoff_hz: float = _param(3.0, 'cut-off of the invariant low-pass filter of Eqs. '
@@ -49,7 +56,7 @@ class EstimatorConfig:
                              'seconds after a reset', 0.0, INF, open_hi=True)
     min_samples: int = _param(16, 'samples a segment must hold before the test may fire',
                               1, 10 ** 8)
-    min_periods: float = _param(0.5, 'the test may fire only once the segment spans this '
+    min_periods: float = _param(1.25, 'the test may fire only once the segment spans this '
                                 'many periods of the frequency it estimates (0 = off)', 0.0, 50.0)
     invariant_filter: bool = _param(True, 'false computes n/d unfiltered (Fig. 1, lower trace)')
     one_sided_test: bool = _param(False, 'Eq. 16 exactly as printed, (MA(k) - MA(k-M))/MA(k) < '
@@ -74,6 +81,12 @@ class EstimatorConfig:
     max_damping: float = _param(0.1, 'quality gate of the damped-sinusoid model: an estimate '
                                 'whose |damping ratio| exceeds this is a transient, not published',
                                 0.0, 1.0, open_lo=True)
+    consistency: float = _param(0.03, 'quality gate: an estimate is published only if it lies '
+                                'within this fraction of the estimate of the segment just before '
+                                'it (none after a restart, a timeout or a rejected segment): two '
+                                'consecutive estimates of one mode that differ more cannot both '
+                                'be right (0 = off, the paper; modes >= 1 have their own rule)',
+                                0.0, 1.0)
     max_gap: float = _param(0.5, 'a gap, or a backward jump, between stamps longer than this '
                             '(s) restarts the estimator; a smaller step back is skipped',
                             0.0, INF, open_lo=True, open_hi=True)
@@ -85,6 +98,12 @@ class EstimatorConfig:
                         'optionally band-limited, signal)', 0, 8)
     buffer_samples: int = _param(200_000, 'segment buffer of the quality gate; a longer segment '
                                  'resets', 1, 10 ** 8)
+
+    @classmethod
+    def paper(cls, **changes) -> 'EstimatorConfig':
+        """The paper's configuration (:data:`PAPER`: its sinusoid model over half-period windows,
+        no consistency gate), validated, with ``changes`` applied."""
+        return cls().replace(**{**PAPER, **changes})
 
     @classmethod
     def describe(cls, name: str) -> Tuple[str, Optional[tuple]]:
@@ -164,4 +183,5 @@ class EstimatorConfig:
         p[K.P_MAXDAMP] = self.max_damping
         p[K.P_REFINE] = self.refine
         p[K.P_TARGET] = self.target_std_rel
+        p[K.P_CONSIST] = self.consistency
         return p

@@ -37,7 +37,7 @@ from .config import EstimatorConfig
 COUNTER_NAMES = ('received', 'used', 'skipped_non_finite', 'skipped_duplicate',
                  'skipped_out_of_order', 'time_jump_resets', 'gap_resets', 'rejected_at_rest',
                  'rejected_fit', 'rejected_nyquist', 'max_window_resets', 'estimates',
-                 'rejected_damping')
+                 'rejected_damping', 'rejected_inconsistent')
 
 
 def as_series(t: Sequence[float], y: Sequence[float]) -> Tuple[np.ndarray, np.ndarray]:

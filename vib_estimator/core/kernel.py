@@ -60,13 +60,14 @@ from .uncertainty import MODEL_BIASED, MODEL_DAMPED, MODEL_SINUSOID, TWO_PI
 # ---- parameter array layout (float64) -------------------------------------------------------
 P_MODEL, P_WC, P_ZC, P_M, P_TOL, P_EPS, P_MAXWIN, P_BAND, P_WLO, P_WHI, P_MINAMP, P_MINFIT, \
     P_MAXGAP, P_MINSAMP, P_MINPER, P_FILTER, P_ONESIDED, P_RULE, P_MAXDAMP, P_REFINE, \
-    P_TARGET = range(21)
-N_PARAMS = 21
+    P_TARGET, P_CONSIST = range(22)
+N_PARAMS = 22
 
 # ---- counter array layout (int64) -----------------------------------------------------------
 (C_RECEIVED, C_USED, C_NONFINITE, C_DUPLICATE, C_OUT_OF_ORDER, C_TIME_JUMP, C_GAP, C_REST,
- C_FIT, C_NYQUIST, C_MAX_WINDOW, C_ESTIMATES, C_DAMPING, C_SEG_N, C_HIST_N, C_MA_N) = range(16)
-N_COUNTERS = 16
+ C_FIT, C_NYQUIST, C_MAX_WINDOW, C_ESTIMATES, C_DAMPING, C_INCONSISTENT, C_SEG_N, C_HIST_N,
+ C_MA_N) = range(17)
+N_COUNTERS = 17
 
 # ---- state array layout (float64) -----------------------------------------------------------
 NH = 8              # samples in the interpolation stencil (degree-7 rule)
@@ -100,7 +101,8 @@ S_BANDJ = S_WORK + U.N_WORK  # ... (3 sections x (2 states, previous input) each
 S_JROW = S_BANDJ + 9 * NBJ   # ... the inputs of one step
 S_TAILW = S_JROW + NBJ       # ... the Gramian of the prefilter's free response (9 x 9)
 S_TAILH = S_TAILW + 81       # ... the step it was computed for, and rho(0) = sum g^2
-S_MA = S_TAILH + 2           # moving-average ring (2M+1 values) starts here
+S_FPREV = S_TAILH + 2        # ``consistency``: the estimate of the segment just before (0: none)
+S_MA = S_FPREV + 1           # moving-average ring (2M+1 values) starts here
 N_STATE_FIXED = S_MA
 
 # ---- estimate row layout --------------------------------------------------------------------
@@ -543,18 +545,21 @@ def _converged(m, one_sided, tol, s, c, f):
 
 
 @njit(cache=True, inline='always')
-def _quality_gate(p, c, model, f, damping, h, r2, amp, consistent):
+def _quality_gate(p, c, model, f, damping, h, r2, amp, consistent, spread, confirmed):
     """True if the converged estimate may be published; else count why it is held back.
 
-    At rest (no variance, or amplitude at or below ``min_amplitude``), above Nyquist, a fit R^2
-    below ``min_fit`` (of the refined model; with ``refine`` = 0 of a sinusoid and offset at f)
-    or not ``consistent`` (the refinement moved the segment's own algebraic estimate by more than
-    ``MAX_REFINE_MOVE`` stds and ``MIN_REFINE_MOVE_REL``: both fit one model to the same
+    At rest (no variance, or amplitude, or the segment's half range ``spread``, at or below
+    ``min_amplitude``: a flat, quantised segment is at rest whatever its fit), above Nyquist, a
+    fit R^2 below ``min_fit`` (of the refined model; with ``refine`` = 0 of a sinusoid and offset
+    at f) or not ``consistent`` (the refinement moved the segment's own algebraic estimate by more
+    than ``MAX_REFINE_MOVE`` stds and ``MIN_REFINE_MOVE_REL``: both fit one model to the same
     samples, so on data the model describes they differ by about one std; a forced motion, not a
     free vibration; counted with the fit), or (damped model) |damping ratio| above
-    ``max_damping``: a "lightly damped vibration" with more damping is a transient, not a mode.
+    ``max_damping``: a "lightly damped vibration" with more damping is a transient, not a mode;
+    last, not ``confirmed`` by the estimate of the segment just before (``consistency``,
+    :func:`_confirmed`; counted as inconsistent).
     """
-    if r2 < 0.0 or amp <= p[P_MINAMP]:
+    if r2 < 0.0 or amp <= p[P_MINAMP] or spread <= p[P_MINAMP]:
         c[C_REST] += 1
     elif f * 2.0 * h >= 1.0:
         c[C_NYQUIST] += 1
@@ -562,9 +567,32 @@ def _quality_gate(p, c, model, f, damping, h, r2, amp, consistent):
         c[C_FIT] += 1
     elif model == MODEL_DAMPED and not abs(damping) <= p[P_MAXDAMP]:
         c[C_DAMPING] += 1
+    elif not confirmed:
+        c[C_INCONSISTENT] += 1
     else:
         return True
     return False
+
+
+@njit(cache=True, inline='always')
+def _confirmed(p, s, f):
+    """``consistency`` (0 = off): True if f lies within that fraction of the estimate of the
+    segment just before (``S_FPREV``; none after a restart, a timeout or a rejected segment).
+
+    Two consecutive estimates of one mode that differ by more cannot both be right: a model that
+    misses the signal's offset or waveform fits each half-period lobe with its own frequency
+    (1.43 / 2.59 Hz on a 1.81 Hz limit cycle with an offset of half its amplitude), each with a
+    high R^2, so a segment is judged against its neighbour, not alone.
+    """
+    tol = p[P_CONSIST]
+    return tol <= 0.0 or (s[S_FPREV] > 0.0 and abs(f - s[S_FPREV]) <= tol * s[S_FPREV])
+
+
+@njit(cache=True, inline='always')
+def _chain(s, c, f, published, inconsistent_before):
+    """Keep f as the next segment's predecessor if this one was published or held back only by
+    :func:`_confirmed`; forget it (0) if the gate rejected it for any other reason."""
+    s[S_FPREV] = f if published or c[C_INCONSISTENT] > inconsistent_before else 0.0
 
 
 @njit(cache=True, inline='always')
@@ -592,6 +620,7 @@ def _store_sample(p, s, c, seg, t, tau, y):
         else:
             c[C_MAX_WINDOW] += 1
         reset_segment(s, c, seg, t, y)
+        s[S_FPREV] = 0.0
         return True
     return False
 
@@ -675,7 +704,10 @@ def step(p, s, c, seg, t, y, out, row):
         consistent = not local_start or abs(f - start) <= allowed
     else:
         r2, amp = _fit(seg, n_fit, TWO_PI * f)
-    published = _quality_gate(p, c, model, f, res[U.R_DAMP], h, r2, amp, consistent)
+    inconsistent_before = c[C_INCONSISTENT]
+    published = _quality_gate(p, c, model, f, res[U.R_DAMP], h, r2, amp, consistent,
+                              _spread(seg, n_fit), _confirmed(p, s, f))
+    _chain(s, c, f, published, inconsistent_before)
     if published:
         out[row, O_T] = t
         out[row, O_F] = f

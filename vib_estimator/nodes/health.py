@@ -24,7 +24,7 @@ DIAGNOSTICS_PERIOD = 1.0
 STALE_AFTER = 2.0
 #: core counters that grow when the quality gate holds a converged estimate back, or none forms
 HELD_BACK = ('rejected_at_rest', 'rejected_fit', 'rejected_nyquist', 'rejected_damping',
-             'max_window_resets')
+             'rejected_inconsistent', 'max_window_resets')
 #: the node's own counters: zero header stamps replaced by the receipt time; JointState messages
 #: without the configured joint (skipped); samples received while ``band_hz`` reached above the
 #: Nyquist frequency of the input's sampling rate; samples dropped while the kernels compiled (the

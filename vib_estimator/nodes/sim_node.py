@@ -7,6 +7,10 @@ Publishes the measured coupling torque (Eq. 21, scaled as in Fig. 5) as
 ``std_msgs/Float64`` on ``vibration/ground_truth`` (transient local, so a late subscriber gets the
 current value) at start and whenever it changes.
 
+Realism of a real rig (all off by default, read-only): ``offset`` (a strain-gauge offset),
+``quantum`` (an ADC's step) and ``limit_cycle_voltage`` (a sustained closed-loop oscillation at
+the link's frequency), :class:`vib_estimator.sim.arm_model.ArmSimulator`; ``docs/real_arm.md``.
+
 Commands: ``position_command`` (``std_msgs/Float64``, the motor angle reference in rad) is held
 from the next sample until the next message; the first one takes over from the motion schedule
 for good (the schedule's tip-mass changes still apply).
@@ -43,8 +47,8 @@ from rosgraph_msgs.msg import Clock as ClockMsg
 from std_msgs.msg import Float64
 
 from ..io.fields import IMU, WRENCH_STAMPED, normalise_type
-from ..sim.arm_model import (DEFAULT_NOISE_STD, ArmParameters, ArmSimulator, Move,
-                             natural_frequency_hz)
+from ..sim.arm_model import (DEFAULT_NOISE_STD, DEFAULT_QUANTUM, ArmParameters, ArmSimulator,
+                             Move, natural_frequency_hz)
 from .runner import StartupError, run
 from .parameters import declare, descriptor
 
@@ -124,6 +128,19 @@ PARAMETERS = {
         read_only=True)),
     'noise_std': (DEFAULT_NOISE_STD, descriptor(
         'standard deviation of the strain-gauge noise on the torque, N m', (0.0, 10.0))),
+    'offset': (0.0, descriptor(
+        'constant offset of the measurement (a strain-gauge bridge\'s imbalance), N m of '
+        'coupling torque (the tip acceleration: divided by m L); real rigs have one, the paper\'s '
+        'sinusoid model does not (docs/real_arm.md)', (-10.0, 10.0), read_only=True)),
+    'quantum': (DEFAULT_QUANTUM, descriptor(
+        'quantisation step of the measurement (an ADC\'s resolution), N m of coupling torque '
+        '(0 = none); a real rig\'s can be a tenth of the vibration\'s amplitude',
+        (0.0, 1.0), read_only=True)),
+    'limit_cycle_voltage': (0.0, descriptor(
+        'closed-loop limit cycle: amplitude of a relay on the rate of bending added to the PD '
+        'voltage (the describing function of friction and backlash in a stiff loop), V; the link '
+        'then holds a sustained oscillation at its own frequency, ~1 N m per V (0 = off)',
+        (0.0, 10.0), read_only=True)),
     'seed': (0, descriptor('seed of the noise generator', (0, 2 ** 31 - 1), read_only=True)),
     'frame_id': ('arm_base', descriptor('frame_id of the coupling_torque headers',
                                          read_only=True)),
@@ -197,8 +214,10 @@ class SimNode(Node):
         self.lockstep_timeouts = 0
         self._sim = ArmSimulator(
             ArmParameters(tip_mass_kg=p['tip_mass_kg'], damping_ratio=p['damping_ratio']),
-            rate_hz=self._rate, noise_std=p['noise_std'], seed=p['seed'], schedule=schedule,
-            output='torque' if self._output_type == WRENCH_STAMPED else 'tip_acceleration')
+            rate_hz=self._rate, noise_std=p['noise_std'], quantum=p['quantum'], seed=p['seed'],
+            schedule=schedule,
+            output='torque' if self._output_type == WRENCH_STAMPED else 'tip_acceleration',
+            offset=p['offset'], limit_cycle_voltage=p['limit_cycle_voltage'])
         self._sync_mass_parameter()
 
         msg_type, topic = OUTPUTS[self._output_type]

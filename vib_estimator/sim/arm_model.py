@@ -25,7 +25,18 @@ Model (Trapero, Sira-Ramirez & Feliu, Section 5.1; Fig. 3):
 * measurement (``output``): the coupling torque at the base ``Gamma_coup = n Gamma^_coup`` as
   plotted in Fig. 5, i.e. the bending moment ``c (theta_m - theta_t)`` seen by the strain gauges,
   or the tangential acceleration of the tip ``L theta_t''`` an accelerometer there would read;
-  plus seeded Gaussian noise, quantised.
+  plus a constant ``offset`` (a strain-gauge bridge's imbalance), seeded Gaussian noise, and
+  quantisation to ``quantum`` (an ADC's step);
+* optionally a closed-loop limit cycle (``limit_cycle_voltage`` V): real rigs under a stiff loop
+  hold a sustained oscillation at the link's frequency (friction and backlash in the loop,
+  ``docs/real_arm.md``); modelled by its describing function, a relay of that amplitude on the
+  rate of bending added to the PD voltage::
+
+      u += -V tanh(Gamma_coup' / LIMIT_CYCLE_RATE)
+
+  which moves the base in phase with the tip's velocity and so feeds the link energy at its own
+  frequency until the bar's damping takes as much back: a sustained oscillation whose amplitude
+  grows with V / zeta and whose frequency stays Eq. 23's (the relay adds no stiffness).
 
 With the stiff PD loop of :class:`ArmParameters` the base barely moves while the bar vibrates, so
 the observed frequency is the clamped-base one of Eq. 23 (within 0.02 %, checked by the tests).
@@ -117,6 +128,9 @@ class Move:
 
 DEFAULT_NOISE_STD = 0.004  # N m: 1.3 % of the 0.31 N m vibration of experiment_5_3
 DEFAULT_QUANTUM = 1e-4     # N m: the resolution of the torques quoted in Section 5.3
+#: rate of bending (N m/s) over which the limit cycle's relay switches (tanh): far below the
+#: ~2 N m/s of a 0.1 N m vibration at 1.3 Hz, so the relay is a sign
+LIMIT_CYCLE_RATE = 1e-3
 #: what :class:`ArmSimulator` measures
 OUTPUTS = ('torque', 'tip_acceleration')
 
@@ -132,15 +146,23 @@ class ArmSimulator:
     ``output`` is what :meth:`step` measures: ``'torque'`` (N m) or ``'tip_acceleration'``
     (``L theta_t''``, m/s^2). ``noise_std`` and ``quantum`` are in N m of coupling torque; for the
     acceleration they are divided by ``m L`` (the torque-to-acceleration factor of Eq. 19), so
-    both outputs have the same signal-to-noise ratio.
+    both outputs have the same signal-to-noise ratio; so is ``offset`` (N m, added before the
+    noise). ``limit_cycle_voltage`` (V, 0 = off): the closed-loop limit cycle of the module
+    docstring.
     """
 
     def __init__(self, params: ArmParameters = ArmParameters(), rate_hz: float = 500.0,
                  noise_std: float = DEFAULT_NOISE_STD, quantum: float = DEFAULT_QUANTUM,
                  seed: int = 0, schedule: Sequence[Move] = (Move(0.0, 1.0),),
-                 substeps: int = 8, output: str = 'torque'):
+                 substeps: int = 8, output: str = 'torque', offset: float = 0.0,
+                 limit_cycle_voltage: float = 0.0):
         if not rate_hz > 0 or substeps < 1 or noise_std < 0 or quantum < 0:
             raise ValueError('rate_hz and substeps must be > 0, noise_std and quantum >= 0')
+        if not (math.isfinite(offset) and 0 <= limit_cycle_voltage <= params.max_voltage):
+            raise ValueError(f'offset must be finite and limit_cycle_voltage in [0, '
+                             f'{params.max_voltage:g}] V, got {offset!r}, {limit_cycle_voltage!r}')
+        self.offset = float(offset)
+        self.limit_cycle_voltage = float(limit_cycle_voltage)
         if output not in OUTPUTS:
             raise ValueError(f'output must be one of {", ".join(OUTPUTS)}, got {output!r}')
         self.output = output
@@ -209,9 +231,16 @@ class ArmSimulator:
         """The noise-free output at state ``x`` under voltage ``u``, and its noise scale."""
         p = self.params
         if self.output == 'torque':
-            return p.stiffness * (x[0] - x[2]), 1.0
+            return p.stiffness * (x[0] - x[2]) + self.offset, 1.0
         scale = 1.0 / (p.tip_mass_kg * p.length)
-        return p.length * self._derivatives(x, u)[3], scale
+        return p.length * self._derivatives(x, u)[3] + scale * self.offset, scale
+
+    def _limit_cycle(self, x) -> float:
+        """The limit cycle's relay voltage at state ``x`` (0 when off), module docstring."""
+        if not self.limit_cycle_voltage:
+            return 0.0
+        bending_rate = self.params.stiffness * (x[1] - x[3])
+        return -self.limit_cycle_voltage * math.tanh(bending_rate / LIMIT_CYCLE_RATE)
 
     def _derivatives(self, x, u):
         p = self.params
@@ -232,7 +261,7 @@ class ArmSimulator:
         self._apply_moves(t)
         p = self.params
         x = self._x
-        u = p.kp * (self._command - x[0]) - p.kd * x[1]
+        u = p.kp * (self._command - x[0]) - p.kd * x[1] + self._limit_cycle(x)
         u = min(max(u, -p.max_voltage), p.max_voltage)
         y, scale = self._measure(x, u)
         if self.noise_std:
@@ -273,10 +302,13 @@ class Recording:
 def simulate(duration: float, schedule: Sequence[Move] = (Move(0.0, 1.0),),
              params: ArmParameters = ArmParameters(), rate_hz: float = 500.0,
              noise_std: float = DEFAULT_NOISE_STD, seed: int = 0,
-             quantum: float = DEFAULT_QUANTUM, output: str = 'torque') -> Recording:
+             quantum: float = DEFAULT_QUANTUM, output: str = 'torque', offset: float = 0.0,
+             limit_cycle_voltage: float = 0.0) -> Recording:
     """Simulate ``duration`` s of the arm under ``schedule`` and return the :class:`Recording`
-    (its ``torque`` column holds the ``output``)."""
-    sim = ArmSimulator(params, rate_hz, noise_std, quantum, seed, schedule, output=output)
+    (its ``torque`` column holds the ``output``); ``offset``, ``quantum`` and
+    ``limit_cycle_voltage``: :class:`ArmSimulator`."""
+    sim = ArmSimulator(params, rate_hz, noise_std, quantum, seed, schedule, output=output,
+                       offset=offset, limit_cycle_voltage=limit_cycle_voltage)
     rows = np.array([sim.step() for _ in range(int(round(duration * rate_hz)))]).reshape(-1, 3)
     return Recording(rows[:, 0].copy(), rows[:, 1].copy(), rows[:, 2].copy())
 
