@@ -296,7 +296,7 @@ def test_parameter_changes(make_probe):
     assert p.node._stream.estimator is estimator
     # valid: a new estimator with the new configuration, same time origin
     assert p.node.set_parameters([Parameter('window', value=5)])[0].successful
-    assert p.node._stream.estimator.config.window == 5
+    assert p.node._stream.config.window == 5
     assert p.node.get_parameter('window').value == 5
     later = sine_stamps(3000)[1500:]
     p.feed(later, values[1500:])
@@ -306,10 +306,10 @@ def test_parameter_changes(make_probe):
     assert p.frequencies()[before:] == expected.frequency_hz.tolist()
     assert p.node.counters['received'] == 3000        # counters span the change
     assert p.node.set_parameters([Parameter('band_hz', value=[0.5, 5.0])])[0].successful
-    assert p.node._stream.estimator.config.band_hz == (0.5, 5.0)
+    assert p.node._stream.config.band_hz == (0.5, 5.0)
     assert p.node.set_parameters(
         [Parameter('band_hz', Parameter.Type.DOUBLE_ARRAY, [])])[0].successful
-    assert p.node._stream.estimator.config.band_hz is None
+    assert p.node._stream.config.band_hz is None
 
 
 def test_sigint_shuts_down_cleanly(ros_context):
