@@ -66,7 +66,7 @@ ROSDEP_KEYS = {'numpy': 'python3-numpy', 'numba': 'python3-numba', 'scipy': 'pyt
 #: import name of requirements whose distribution name differs
 IMPORT_NAMES = {'pyyaml': 'yaml'}
 #: requirements for building and proving the package here, not for using it
-DEVELOPMENT_ONLY = {'wheel', 'colcon-core', 'colcon-ros', 'colcon-package-selection'}
+DEVELOPMENT_ONLY = {'wheel', 'colcon-core', 'colcon-ros', 'colcon-package-selection', 'ruff'}
 
 
 def _requirements():
