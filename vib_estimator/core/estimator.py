@@ -148,6 +148,8 @@ class FrequencyEstimator:
         self._c = np.zeros(K.N_COUNTERS, dtype=np.int64)
         self._seg = np.zeros((2, config.buffer_samples))
         self._row = np.zeros((1, K.N_OUT))
+        self._t1 = np.zeros(1)      # the streaming path's sample, fed to the batch kernel
+        self._y1 = np.zeros(1)
         self.restart()
 
     @property
@@ -179,7 +181,10 @@ class FrequencyEstimator:
 
     def update(self, t: float, y: float) -> Optional[Estimate]:
         """Feed one sample (time in s, any origin); return an estimate when one is published."""
-        if K.step(self._p, self._s, self._c, self._seg, float(t), float(y), self._row, 0):
+        # the batch kernel over one sample: one compiled entry point for both paths
+        self._t1[0] = t
+        self._y1[0] = y
+        if K.run(self._p, self._s, self._c, self._seg, self._t1, self._y1, self._row, 0)[0]:
             return Estimate(*(int(v) if i == K.O_SAMPLES else float(v)
                               for i, v in enumerate(self._row[0])))
         return None

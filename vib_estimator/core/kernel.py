@@ -52,9 +52,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from . import uncertainty as U
+from .jit import jit
 from .uncertainty import MODEL_BIASED, MODEL_DAMPED, MODEL_SINUSOID
 
 # ---- parameter array layout (float64) -------------------------------------------------------
@@ -125,7 +125,7 @@ BINOMIAL = ((1.0, 0.0, 0.0, 0.0, 0.0), (1.0, 1.0, 0.0, 0.0, 0.0), (1.0, 2.0, 1.0
             (1.0, 3.0, 3.0, 1.0, 0.0), (1.0, 4.0, 6.0, 4.0, 1.0))
 
 
-@njit(cache=True)
+@jit
 def _discretise(w, z, h, out, off):
     """Exact first-order-hold discretisation of the unit-gain low-pass w^2/(s^2 + 2 z w s + w^2).
 
@@ -166,7 +166,7 @@ def _discretise(w, z, h, out, off):
     out[off + 7] = gb1
 
 
-@njit(cache=True)
+@jit(inline='always')
 def _advance(s, xo, d, u0, u1):
     """Advance the 2-state section stored at s[xo:xo+2] with the discretisation at s[d:d+8]."""
     x0 = s[xo]
@@ -175,7 +175,7 @@ def _advance(s, xo, d, u0, u1):
     s[xo + 1] = s[d + 2] * x0 + s[d + 3] * x1 + s[d + 5] * u0 + s[d + 7] * u1
 
 
-@njit(cache=True)
+@jit
 def _restart(s, c):
     """Forget everything, the prefilter and interpolation history included (start, gap, jump)."""
     s[S_HT:] = 0.0
@@ -186,7 +186,7 @@ def _restart(s, c):
     c[C_MA_N] = 0
 
 
-@njit(cache=True)
+@jit
 def reset_segment(s, c, seg, t0, y0):
     """Start a new estimation segment at time ``t0`` (after an estimate, a timeout or a rejection).
 
@@ -205,7 +205,7 @@ def reset_segment(s, c, seg, t0, y0):
     c[C_MA_N] = 0
 
 
-@njit(cache=True)
+@jit
 def _newton_integrals(s, kmax, yoff, q):
     """I_m = int_0^h u^m p(u) du, m = 0..kmax, for the polynomial p through the q newest samples.
 
@@ -250,7 +250,7 @@ def _newton_integrals(s, kmax, yoff, q):
         hp *= h
 
 
-@njit(cache=True)
+@jit
 def _interval_moments(s, kmax, a, h, npts):
     """Add to M_0..M_kmax the exact integral over the newest interval of s^k p(s).
 
@@ -297,7 +297,7 @@ def _interval_moments(s, kmax, a, h, npts):
         s[S_MOM + k] += acc
 
 
-@njit(cache=True)
+@jit
 def _spread(seg, n):
     """Half the peak-to-peak range of the segment's values (0 for a flat line)."""
     lo = seg[1, 0]
@@ -308,7 +308,7 @@ def _spread(seg, n):
     return 0.5 * (hi - lo)
 
 
-@njit(cache=True)
+@jit
 def _fit(seg, n, omega):
     """Least-squares fit y ~ a sin(w tau) + b cos(w tau) + c over the segment.
 
@@ -352,7 +352,7 @@ def _fit(seg, n, omega):
     return 1.0 - ssres / sstot, math.sqrt(ca * ca + cb * cb)
 
 
-@njit(cache=True)
+@jit
 def _prefilter(p, s, y, xb):
     """Band-pass one sample through the prefilter whose states are at s[xb:xb+9]; returns the
     filtered value (the signal's prefilter, at S_BAND, is never reset by an estimate)."""
@@ -368,7 +368,7 @@ def _prefilter(p, s, y, xb):
     return u - s[x] - (2.0 * BAND_DAMPING[2] / p[P_WLO]) * s[x + 1]
 
 
-@njit(cache=True)
+@jit
 def _first_sample(p, s, c, t, y):
     """Initialise the prefilter at its steady state for a constant input and prime the history."""
     if p[P_BAND] > 0.0:
@@ -382,7 +382,7 @@ def _first_sample(p, s, c, t, y):
     return y
 
 
-@njit(cache=True, inline='always')
+@jit(inline='always')
 def _accept_time(max_gap, s, c, t, y):
     """Time handling: True if the sample is used, False if it is skipped (counted either way).
 
@@ -414,7 +414,7 @@ def _accept_time(max_gap, s, c, t, y):
     return True
 
 
-@njit(cache=True, inline='always')
+@jit(inline='always')
 def _update_discretisations(p, s, h):
     """Exact discretisations of the invariant filter (Eq. 11) and the prefilter for the step h.
 
@@ -429,7 +429,7 @@ def _update_discretisations(p, s, h):
     s[S_CACHE_H] = h
 
 
-@njit(cache=True, inline='always')
+@jit(inline='always')
 def _push_history(s, c, seg, t, y):
     """Shift (t, y) into the interpolation stencil; True once the stencil holds NH samples.
 
@@ -449,7 +449,7 @@ def _push_history(s, c, seg, t, y):
     return True
 
 
-@njit(cache=True, inline='always')
+@jit(inline='always')
 def _numerator_denominator(model, tau, y, m0, m1, m2, m3, m4):
     """Eq. 7 (with Eq. 8's corrected sign) in moments: n and d of omega^2 = n / d at time tau.
 
@@ -467,7 +467,7 @@ def _numerator_denominator(model, tau, y, m0, m1, m2, m3, m4):
     return num, den
 
 
-@njit(cache=True, inline='always')
+@jit(inline='always')
 def _invariant_filter(filtered, s, model, num, den, tau, h):
     """Invariant filtering, Eqs. 9-11: n and d (and q of the damped model) through one low-pass.
 
@@ -495,7 +495,7 @@ def _invariant_filter(filtered, s, model, num, den, tau, h):
         s[S_INT + 2] += h * s[S_DF]
 
 
-@njit(cache=True, inline='always')
+@jit(inline='always')
 def _ratio(model, nf, df, qf, i_n, i_q, i_d):
     """Eq. 12: (omega^2, damping ratio) from the filtered terms; omega^2 <= 0 when undefined.
 
@@ -514,7 +514,7 @@ def _ratio(model, nf, df, qf, i_n, i_q, i_d):
     return w2, damping
 
 
-@njit(cache=True, inline='always')
+@jit(inline='always')
 def _converged(m, one_sided, tol, s, c, f):
     """Eqs. 16-17: the moving average of the last M+1 estimates against the one M samples earlier.
 
@@ -543,7 +543,7 @@ def _converged(m, one_sided, tol, s, c, f):
     return change < tol * ma_now
 
 
-@njit(cache=True, inline='always')
+@jit(inline='always')
 def _quality_gate(p, c, model, f, damping, h, r2, amp, consistent):
     """True if the converged estimate may be published; else count why it is held back.
 
@@ -568,7 +568,7 @@ def _quality_gate(p, c, model, f, damping, h, r2, amp, consistent):
     return False
 
 
-@njit(cache=True, inline='always')
+@jit(inline='always')
 def _store_sample(p, s, c, seg, t, tau, y):
     """Keep (tau, y) in the segment buffer; True if the segment ran out (``max_window`` or buffer).
 
@@ -597,7 +597,7 @@ def _store_sample(p, s, c, seg, t, tau, y):
     return False
 
 
-@njit(cache=True)
+@jit
 def _long_window_spanned(p, s, c, m, one_sided, model, tau, f, damping):
     """Long window (``refine`` and ``min_periods`` >= 1): True once the segment spans
     ``min_periods`` periods of its first converged half-period estimate.
@@ -617,7 +617,7 @@ def _long_window_spanned(p, s, c, m, one_sided, model, tau, f, damping):
     return tau * s[S_FLAST] >= p[P_MINPER]
 
 
-@njit(cache=True)
+@jit(inline='always')
 def step(p, s, c, seg, t, y, out, row):
     """Feed one sample; return 1 and fill ``out[row]`` when an estimate is published, else 0.
 
@@ -692,7 +692,7 @@ def step(p, s, c, seg, t, y, out, row):
     return 1 if published else 0
 
 
-@njit(cache=True)
+@jit
 def _tail_gramian(p, s):
     """W = sum_(k>=1) (C A^k)^T C A^k of the prefilter's free response, and rho(0) = sum g^2.
 
@@ -709,7 +709,8 @@ def _tail_gramian(p, s):
         s[base:base + 9] = 0.0
         s[base + k] = 1.0
         v[k] = _prefilter(p, s, 0.0, base)
-        a[:, k] = s[base:base + 9]
+        for i in range(9):
+            a[i, k] = s[base + i]
     w = s[S_TAILW:S_TAILW + 81].reshape((9, 9))
     w[:, :] = 0.0
     peak = 0.0
@@ -728,14 +729,15 @@ def _tail_gramian(p, s):
             for i in range(9):
                 acc += v[i] * a[i, j]
             nxt[j] = acc
-        v[:] = nxt
+        for i in range(9):
+            v[i] = nxt[i]
     s[base:base + 9] = 0.0
     g0 = _prefilter(p, s, 1.0, base)
     s[S_TAILH] = s[S_CACHE_H]
     s[S_TAILH + 1] = g0 * g0 + _quadratic(w, s, base, base)
 
 
-@njit(cache=True)
+@jit
 def _quadratic(w, s, xi, xj):
     """s[xi:xi+9]^T w s[xj:xj+9]."""
     acc = 0.0
@@ -745,7 +747,7 @@ def _quadratic(w, s, xi, xj):
     return acc
 
 
-@njit(cache=True)
+@jit
 def _band_std(p, s, seg, n, model, res):
     """With ``band_hz``: the std of the fit under the prefilter's coloured noise (sandwich).
 
@@ -776,7 +778,7 @@ def _band_std(p, s, seg, n, model, res):
     U.coloured_std(model, n, gram, s[S_TAILH + 1], res, work)
 
 
-@njit(cache=True)
+@jit(inline='always')
 def _start(model, f, damping):
     """Start of the refinement: (w, sigma) = (w_d, zeta w_n) from the algebraic (w_n, zeta)."""
     wn = TWO_PI * f
@@ -785,7 +787,7 @@ def _start(model, f, damping):
     return wn, 0.0
 
 
-@njit(cache=True)
+@jit
 def _fit_with_std(p, s, seg, n, model, f, damping, iterations, res):
     """``iterations`` Gauss-Newton steps of the model over the segment from the algebraic (f,
     damping) and the std of the result (:func:`core.uncertainty.refine`; with ``band_hz`` the
@@ -799,7 +801,7 @@ def _fit_with_std(p, s, seg, n, model, f, damping, iterations, res):
     return True
 
 
-@njit(cache=True)
+@jit(inline='always')
 def _refine(p, s, seg, n, model, f, damping, res):
     """The estimate to gate and publish: ``res`` = (f, damping, their std), core.uncertainty.
 
@@ -813,7 +815,7 @@ def _refine(p, s, seg, n, model, f, damping, res):
         res[U.R_DAMP] = damping
 
 
-@njit(cache=True)
+@jit(inline='always')
 def _target_reached(p, s, seg, n, model, f, damping):
     """``target_std_rel``: True once the predicted relative std of f is at or below the target.
 
@@ -829,7 +831,7 @@ def _target_reached(p, s, seg, n, model, f, damping):
         res[U.R_FSTD] <= p[P_TARGET] * f
 
 
-@njit(cache=True)
+@jit
 def run(p, s, c, seg, t, y, out, start):
     """Feed ``t[start:]``, ``y[start:]``; write estimates to ``out`` rows.
 
