@@ -787,7 +787,7 @@ def _start(model, f, damping):
     return wn, 0.0
 
 
-@jit
+@jit(inline='always')
 def _fit_with_std(p, s, seg, n, model, f, damping, iterations, res):
     """``iterations`` Gauss-Newton steps of the model over the segment from the algebraic (f,
     damping) and the std of the result (:func:`core.uncertainty.refine`; with ``band_hz`` the

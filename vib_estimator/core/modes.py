@@ -219,7 +219,7 @@ def _scale_len(s):
     return (M_A if s % 2 == 0 else M_B) << (s // 2)
 
 
-@jit
+@jit(inline='always')
 def _poles(b, ic, qs, lams, pa, s, pp, undamped):
     """Analyse scale s (its light pairs refined as undamped if ``undamped``); the poles that count
     (module docstring) as rows of pp: frequency (Hz), amplitude, damping, cycles in the window,
@@ -551,6 +551,21 @@ def _feed(b, ic, sl, pd, qs, lams, pa, t, y, out):
 
 
 @jit
+def _median_step(b):
+    """The median of the first N_STEP intervals (N_STEP odd: the middle one once sorted), by
+    insertion sort (np.median's sort machinery costs more to compile than this runs)."""
+    x = np.empty(N_STEP)
+    for i in range(N_STEP):
+        v = b[B_HBUF + i]
+        j = i
+        while j > 0 and x[j - 1] > v:
+            x[j] = x[j - 1]
+            j -= 1
+        x[j] = v
+    return x[N_STEP // 2]
+
+
+@jit(inline='always')
 def _step(b, ic, sl, pd, qs, lams, pa, t, y, out):
     """One input sample (counted; restarting the levels, or resampled onto the uniform grid by
     linear interpolation); estimates into out."""
@@ -562,7 +577,7 @@ def _step(b, ic, sl, pd, qs, lams, pa, t, y, out):
         ic[I_NDT] = 0
     elif ic[I_NDT] == N_STEP and b[B_DT] == 0.0:
         # the grid: the median of the first intervals as its step, from this sample on
-        b[B_DT] = np.median(b[B_HBUF:B_HBUF + N_STEP])
+        b[B_DT] = _median_step(b)
         _levels_settle(b, ic, y)
         b[B_TG] = t
         _feed(b, ic, sl, pd, qs, lams, pa, t, y, out)
@@ -603,18 +618,9 @@ def _unpack(fs):
 
 
 @jit
-def _update(fs, ic, qs, t, y, out):
-    """One sample (the streaming path); returns the number of estimates in out."""
-    b, sl, pd, lams, pa = _unpack(fs)
-    ic[I_NOUT] = 0
-    _step(b, ic, sl, pd, qs, lams, pa, t, y, out)
-    return ic[I_NOUT]
-
-
-@jit
 def _run(fs, ic, qs, t, y, out, start):
     """Feed t[start:] until out may not hold another sample's estimates; returns the next index
-    to feed (the batch path)."""
+    to feed (the batch path, and the streaming one over one sample: one compiled entry point)."""
     b, sl, pd, lams, pa = _unpack(fs)
     ic[I_NOUT] = 0
     i = start
@@ -655,6 +661,8 @@ class ModeTracker:
         pa[:] = (config.max_gap, config.modes, band[0], band[1], config.max_damping,
                  config.min_fit, self._npc)
         self._out = np.empty((ROOM, N_O))
+        self._t1 = np.zeros(1)      # the streaming path's sample, fed to the batch kernel
+        self._y1 = np.zeros(1)
         _levels_init(self._b)
         self.restart()
 
@@ -665,7 +673,10 @@ class ModeTracker:
     # ---- streaming and batch ---------------------------------------------------------------
     def update(self, t: float, y: float) -> List[Estimate]:
         """Feed one sample; return the estimates published at it (ascending mode)."""
-        n = _update(self._fs, self._ic, self._qs, float(t), float(y), self._out)
+        self._t1[0] = t
+        self._y1[0] = y
+        _run(self._fs, self._ic, self._qs, self._t1, self._y1, self._out, 0)
+        n = self._ic[I_NOUT]
         if n == 0:
             return []
         rows = self._out[:n]

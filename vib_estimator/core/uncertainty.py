@@ -143,7 +143,7 @@ def _accumulate(model, seg, n, tc, th, jtj, jtr, linear=False):
     return rss
 
 
-@jit
+@jit(inline='always')
 def _store_normal_equations(model, jtj, jtr, upper, rhs):
     """J^T J (symmetric, from its upper triangle row by row) and J^T r; the sinusoid's 4th column
     (not a parameter of it) stays zero."""
@@ -203,7 +203,7 @@ def _invert(a, idx, m, out, aug, scale):
     return True
 
 
-@jit
+@jit(inline='always')
 def _solve_linear(model, seg, n, tc, work):
     """Variable projection: the least-squares a, b (and c) at theta's w (and sigma)."""
     th, _, jtr, jtj, cov, _, aug, scale = _workspace(work)
@@ -223,7 +223,7 @@ def _solve_linear(model, seg, n, tc, work):
     return True
 
 
-@jit
+@jit(inline='always')
 def _newton_step(npar, th, cov, jtr, s2):
     """theta += (J^T J)^-1 J^T r; True if the step of the nonlinear parameters (w, and sigma or c)
     is below ``STEP_TOL`` of their std (s^2 (J^T J)^-1 with the current residual variance ``s2``)
@@ -272,7 +272,7 @@ def _gauss_newton(model, seg, n, iterations, work):
     return best_rss
 
 
-@jit
+@jit(inline='always')
 def _first_prefix(seg, n, npar, w0):
     """Length of the continuation's first window: n halved while it spans at least half a period
     (and 2 npar + 2 samples), so the prefixes double up to n exactly."""
@@ -324,7 +324,7 @@ def refine(model, seg, n, w0, sigma0, iterations, res, work):
     return True
 
 
-@jit
+@jit(inline='always')
 def _goodness(seg, n, th, rss, res):
     """R^2 = 1 - RSS / (sum of squares about the mean) of the fitted model, and its amplitude.
 
