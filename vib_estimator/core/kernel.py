@@ -52,6 +52,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba.core import types
+from numba.extending import overload
 
 from . import uncertainty as U
 from .jit import jit
@@ -618,10 +620,12 @@ def _long_window_spanned(p, s, c, m, one_sided, model, tau, f, damping):
 
 
 @jit(inline='always')
-def step(p, s, c, seg, t, y, out, row):
+def step(p, s, c, seg, t, y, out, row, band=None):
     """Feed one sample; return 1 and fill ``out[row]`` when an estimate is published, else 0.
 
     (The row index rather than a view of it: a view per sample costs its reference counting.)
+    ``band``: None unless ``band_hz`` is set (then any other value): the band std's code is
+    compiled only for a configuration that uses it (:func:`_band_std_if`).
     """
     if not _accept_time(p[P_MAXGAP], s, c, t, y):
         return 0
@@ -657,7 +661,8 @@ def step(p, s, c, seg, t, y, out, row):
     n_fit = min(nseg + 1, seg.shape[1])
     local_start = True          # the refinement starts at this segment's own algebraic estimate
     if p[P_TARGET] > 0.0:
-        if tau * f < p[P_MINPER] or not _target_reached(p, s, seg, n_fit, model, f, damping):
+        if tau * f < p[P_MINPER] or not _target_reached(p, s, seg, n_fit, model, f, damping,
+                                                              band):
             return 0
     elif p[P_REFINE] > 0.0 and p[P_MINPER] >= 1.0:
         if not _long_window_spanned(p, s, c, m, one_sided, model, tau, f, damping):
@@ -667,7 +672,7 @@ def step(p, s, c, seg, t, y, out, row):
     elif not _converged(m, one_sided, p[P_TOL], s, c, f) or tau * f < p[P_MINPER]:
         return 0
     res = s[S_RES:S_RES + U.N_RESULT]
-    _refine(p, s, seg, n_fit, model, f, damping, res)
+    _refine(p, s, seg, n_fit, model, f, damping, res, band)
     start, f = f, res[U.R_F]
     consistent = True
     if p[P_REFINE] > 0.0 and math.isfinite(res[U.R_FIT]):
@@ -778,6 +783,20 @@ def _band_std(p, s, seg, n, model, res):
     U.coloured_std(model, n, gram, s[S_TAILH + 1], res, work)
 
 
+def _band_std_if(band, p, s, seg, n, model, res):
+    """:func:`_band_std` unless ``band`` is None: compiled (an overload chosen by the type of
+    ``band``) only for a configuration with ``band_hz``, which passes a value."""
+    if band is not None:
+        _band_std(p, s, seg, n, model, res)
+
+
+@overload(_band_std_if)
+def _band_std_if_typed(band, p, s, seg, n, model, res):
+    if isinstance(band, (types.NoneType, types.Omitted)):
+        return lambda band, p, s, seg, n, model, res: None
+    return lambda band, p, s, seg, n, model, res: _band_std(p, s, seg, n, model, res)
+
+
 @jit(inline='always')
 def _start(model, f, damping):
     """Start of the refinement: (w, sigma) = (w_d, zeta w_n) from the algebraic (w_n, zeta)."""
@@ -788,7 +807,7 @@ def _start(model, f, damping):
 
 
 @jit(inline='always')
-def _fit_with_std(p, s, seg, n, model, f, damping, iterations, res):
+def _fit_with_std(p, s, seg, n, model, f, damping, iterations, res, band):
     """``iterations`` Gauss-Newton steps of the model over the segment from the algebraic (f,
     damping) and the std of the result (:func:`core.uncertainty.refine`; with ``band_hz`` the
     coloured-noise std, :func:`_band_std`) into ``res``; False if no fit is possible."""
@@ -797,12 +816,12 @@ def _fit_with_std(p, s, seg, n, model, f, damping, iterations, res):
     if not U.refine(model, seg, n, w0, sigma0, iterations, res, s[S_WORK:S_WORK + U.N_WORK]):
         return False
     if p[P_BAND] > 0.0:
-        _band_std(p, s, seg, n, model, res)
+        _band_std_if(band, p, s, seg, n, model, res)
     return True
 
 
 @jit(inline='always')
-def _refine(p, s, seg, n, model, f, damping, res):
+def _refine(p, s, seg, n, model, f, damping, res, band):
     """The estimate to gate and publish: ``res`` = (f, damping, their std), core.uncertainty.
 
     ``refine`` = 0 keeps the paper's algebraic (f, damping) and adds their std; otherwise up to
@@ -810,13 +829,14 @@ def _refine(p, s, seg, n, model, f, damping, res):
     then judges the refined frequency).
     """
     iterations = int(p[P_REFINE])
-    if not _fit_with_std(p, s, seg, n, model, f, damping, iterations, res) or iterations == 0:
+    if not _fit_with_std(p, s, seg, n, model, f, damping, iterations, res, band) or \
+            iterations == 0:
         res[U.R_F] = f
         res[U.R_DAMP] = damping
 
 
 @jit(inline='always')
-def _target_reached(p, s, seg, n, model, f, damping):
+def _target_reached(p, s, seg, n, model, f, damping, band):
     """``target_std_rel``: True once the predicted relative std of f is at or below the target.
 
     The std (the Fisher information of the model over the segment at the algebraic estimate, with
@@ -827,13 +847,13 @@ def _target_reached(p, s, seg, n, model, f, damping):
         return False
     s[S_NEXT] = max(n + 1.0, n * (1.0 + 1.0 / 16.0)) if n >= 64 else n + 1.0
     res = s[S_RES:S_RES + U.N_RESULT]
-    return _fit_with_std(p, s, seg, n, model, f, damping, 0, res) and \
+    return _fit_with_std(p, s, seg, n, model, f, damping, 0, res, band) and \
         res[U.R_FSTD] <= p[P_TARGET] * f
 
 
 @jit
-def run(p, s, c, seg, t, y, out, start):
-    """Feed ``t[start:]``, ``y[start:]``; write estimates to ``out`` rows.
+def run(p, s, c, seg, t, y, out, start, band=None):
+    """Feed ``t[start:]``, ``y[start:]``; write estimates to ``out`` rows (``band``: :func:`step`).
 
     Returns (number of estimates written, index of the next sample to feed). Stops early when
     ``out`` is full so the caller can grow it and continue.
@@ -844,7 +864,7 @@ def run(p, s, c, seg, t, y, out, start):
     while i < n:
         if n_out >= out.shape[0]:
             return n_out, i
-        if step(p, s, c, seg, t[i], y[i], out, n_out):
+        if step(p, s, c, seg, t[i], y[i], out, n_out, band):
             n_out += 1
         i += 1
     return n_out, i

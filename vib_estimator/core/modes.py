@@ -536,7 +536,7 @@ def _wake(b, ic, y):
         b[B_E] = 0.0
 
 
-@jit
+@jit(inline='always')
 def _feed(b, ic, sl, pd, qs, lams, pa, t, y, out):
     """One (possibly interpolated) sample through the levels and the analyses it completes."""
     top = _levels_step(b, ic, y)

@@ -381,7 +381,7 @@ def _gauss_newton_step(jac, res):
     return -_normal_solve(jac, res)
 
 
-@jit
+@jit(inline='always')
 def refine_undamped(x, poles):
     """The close pairs of poles (:func:`_close_pairs`) moved onto the unit circle, their angles
     refined by Gauss-Newton on the variable-projection residual of window x
@@ -437,7 +437,7 @@ def init_subspace(q):
         q[:, k] /= math.sqrt(np.sum(q[:, k] ** 2))
 
 
-@jit
+@jit(inline='always')
 def analyse(x, q, lam, roots, ratio, rows, undamped=False):
     """The damped sinusoids of window x (module docstring), updating its scale's subspace q,
     eigenvalues lam and poles roots (rows re and im, NaN: none), their lightly damped pairs
