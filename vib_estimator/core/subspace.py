@@ -75,6 +75,24 @@ def hankel_cov(x, lag, r):
             r[j + 1, i + 1] = v
 
 
+@jit
+def _descending(lam):
+    """The order of lam's values, descending, NaN last, ties in place (what np.argsort(-lam)
+    gives for the fewer than 15 columns here: numba's quicksort is an insertion sort below 15
+    elements; this one costs less to compile than numpy's sort machinery)."""
+    n = lam.shape[0]
+    order = np.empty(n, dtype=np.int64)
+    for i in range(n):
+        v = -lam[i]
+        j = i
+        while j > 0 and (v < -lam[order[j - 1]] or (math.isnan(-lam[order[j - 1]])
+                                                     and not math.isnan(v))):
+            order[j] = order[j - 1]
+            j -= 1
+        order[j] = i
+    return order
+
+
 @jit(fastmath=FAST)
 def orthogonal_iteration(r, n, q, lam):
     """One step Q <- orth(R Q) on q[:n, :P] (modified Gram-Schmidt), columns sorted by their
@@ -109,8 +127,12 @@ def orthogonal_iteration(r, n, q, lam):
         else:
             w[k, :] = 0.0
             w[k, k % n] = 1.0
-    order = np.argsort(-lam)
-    lam[:] = lam[order]
+    order = _descending(lam)
+    ranked = np.empty(npc)
+    for k in range(npc):
+        ranked[k] = lam[order[k]]
+    for k in range(npc):
+        lam[k] = ranked[k]
     for k in range(npc):
         for i in range(n):
             qt[k, i] = w[order[k], i]
@@ -434,7 +456,12 @@ def init_subspace(q):
     for k in range(npc):
         for i in range(n):
             q[i, k] = math.cos(math.pi * (k + 0.5) * (i + 0.5) / n)
-        q[:, k] /= math.sqrt(np.sum(q[:, k] ** 2))
+        acc = 0.0                   # element by element: no array expression to compile
+        for i in range(n):
+            acc += q[i, k] ** 2
+        norm = math.sqrt(acc)
+        for i in range(n):
+            q[i, k] /= norm
 
 
 @jit(inline='always')
