@@ -211,7 +211,7 @@ def _solve_linear(model, seg, n, tc, work):
     if model == MODEL_BIASED:
         th[3] = 0.0
     _accumulate(model, seg, n, tc, th, jtj, jtr, True)
-    idx = (0, 1, 3)
+    idx = (0, 1, 3, 3)      # a, b, c (the first m); four entries: _invert's one signature
     m = 3 if model == MODEL_BIASED else 2
     if not _invert(jtj, idx, m, cov, aug, scale):
         return False
