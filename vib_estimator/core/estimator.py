@@ -150,7 +150,7 @@ class FrequencyEstimator:
         self._row = np.zeros((1, K.N_OUT))
         self._t1 = np.zeros(1)      # the streaming path's sample, fed to the batch kernel
         self._y1 = np.zeros(1)
-        self._band = None if config.band_hz is None else True   # kernel.step's band
+        self._optional = K.optional_features(self._p)
         self.restart()
 
     @property
@@ -186,7 +186,7 @@ class FrequencyEstimator:
         self._t1[0] = t
         self._y1[0] = y
         if K.run(self._p, self._s, self._c, self._seg, self._t1, self._y1, self._row, 0,
-                 self._band)[0]:
+                 self._optional)[0]:
             return Estimate(*(int(v) if i == K.O_SAMPLES else float(v)
                               for i, v in enumerate(self._row[0])))
         return None
@@ -200,7 +200,7 @@ class FrequencyEstimator:
         while True:
             out = np.empty((size, K.N_OUT))
             n, start = K.run(self._p, self._s, self._c, self._seg, t, y, out, start,
-                             self._band)
+                             self._optional)
             chunks.append(out[:n])
             if start >= len(t):
                 break

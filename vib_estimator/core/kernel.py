@@ -620,12 +620,12 @@ def _long_window_spanned(p, s, c, m, one_sided, model, tau, f, damping):
 
 
 @jit(inline='always')
-def step(p, s, c, seg, t, y, out, row, band=None):
+def step(p, s, c, seg, t, y, out, row, optional=None):
     """Feed one sample; return 1 and fill ``out[row]`` when an estimate is published, else 0.
 
     (The row index rather than a view of it: a view per sample costs its reference counting.)
-    ``band``: None unless ``band_hz`` is set (then any other value): the band std's code is
-    compiled only for a configuration that uses it (:func:`_band_std_if`).
+    ``optional``: :func:`optional_features` of ``p`` (None for a configuration without band std,
+    ``target_std_rel`` or long windows: their code is then not compiled, :func:`_band_std_if`).
     """
     if not _accept_time(p[P_MAXGAP], s, c, t, y):
         return 0
@@ -661,18 +661,18 @@ def step(p, s, c, seg, t, y, out, row, band=None):
     n_fit = min(nseg + 1, seg.shape[1])
     local_start = True          # the refinement starts at this segment's own algebraic estimate
     if p[P_TARGET] > 0.0:
-        if tau * f < p[P_MINPER] or not _target_reached(p, s, seg, n_fit, model, f, damping,
-                                                              band):
+        if tau * f < p[P_MINPER] or not _target_reached_if(optional, p, s, seg, n_fit, model,
+                                                                 f, damping):
             return 0
     elif p[P_REFINE] > 0.0 and p[P_MINPER] >= 1.0:
-        if not _long_window_spanned(p, s, c, m, one_sided, model, tau, f, damping):
+        if not _long_window_if(optional, p, s, c, m, one_sided, model, tau, f, damping):
             return 0
         f, damping, local_start = s[S_FLAST], s[S_DLAST], False
     # the segment must span a fraction of the period it estimates
     elif not _converged(m, one_sided, p[P_TOL], s, c, f) or tau * f < p[P_MINPER]:
         return 0
     res = s[S_RES:S_RES + U.N_RESULT]
-    _refine(p, s, seg, n_fit, model, f, damping, res, band)
+    _refine(p, s, seg, n_fit, model, f, damping, res, optional)
     start, f = f, res[U.R_F]
     consistent = True
     if p[P_REFINE] > 0.0 and math.isfinite(res[U.R_FIT]):
@@ -783,18 +783,65 @@ def _band_std(p, s, seg, n, model, res):
     U.coloured_std(model, n, gram, s[S_TAILH + 1], res, work)
 
 
-def _band_std_if(band, p, s, seg, n, model, res):
-    """:func:`_band_std` unless ``band`` is None: compiled (an overload chosen by the type of
-    ``band``) only for a configuration with ``band_hz``, which passes a value."""
-    if band is not None:
-        _band_std(p, s, seg, n, model, res)
+def optional_features(p):
+    """The ``optional`` argument of :func:`step` and :func:`run` for the parameters ``p``: None
+    unless the configuration uses the band std, ``target_std_rel`` or long windows (the
+    conditions under which :func:`step` calls them), else True."""
+    long_window = p[P_REFINE] > 0.0 and p[P_MINPER] >= 1.0
+    return True if p[P_BAND] > 0.0 or p[P_TARGET] > 0.0 or long_window else None
 
 
-@overload(_band_std_if)
-def _band_std_if_typed(band, p, s, seg, n, model, res):
-    if isinstance(band, (types.NoneType, types.Omitted)):
-        return lambda band, p, s, seg, n, model, res: None
-    return lambda band, p, s, seg, n, model, res: _band_std(p, s, seg, n, model, res)
+def _unused(optional):
+    """Whether ``optional`` (a numba type) is None: the optional features are then not compiled."""
+    return isinstance(optional, (types.NoneType, types.Omitted))
+
+
+@jit
+def _missing_optional():
+    """A configuration's optional feature reached with ``optional`` None (a caller's error)."""
+    raise ValueError('kernel: run/step need optional=optional_features(p) for this p')
+
+
+def _band_std_if(optional, p, s, seg, n, model, res):
+    """:func:`_band_std`, compiled (an overload chosen by the type of ``optional``) only for a
+    configuration with optional features (:func:`optional_features`)."""
+
+
+@overload(_band_std_if, inline='always')
+def _band_std_if_typed(optional, p, s, seg, n, model, res):
+    if _unused(optional):
+        return lambda optional, p, s, seg, n, model, res: _missing_optional()
+    return lambda optional, p, s, seg, n, model, res: _band_std(p, s, seg, n, model, res)
+
+
+def _target_reached_if(optional, p, s, seg, n, model, f, damping):
+    """:func:`_target_reached`, compiled only with optional features (:func:`_band_std_if`)."""
+
+
+@overload(_target_reached_if, inline='always')
+def _target_reached_if_typed(optional, p, s, seg, n, model, f, damping):
+    if _unused(optional):
+        def missing(optional, p, s, seg, n, model, f, damping):
+            _missing_optional()
+            return False
+        return missing
+    return lambda optional, p, s, seg, n, model, f, damping: _target_reached(
+        p, s, seg, n, model, f, damping, optional)
+
+
+def _long_window_if(optional, p, s, c, m, one_sided, model, tau, f, damping):
+    """:func:`_long_window_spanned`, compiled only with optional features (:func:`_band_std_if`)."""
+
+
+@overload(_long_window_if, inline='always')
+def _long_window_if_typed(optional, p, s, c, m, one_sided, model, tau, f, damping):
+    if _unused(optional):
+        def missing(optional, p, s, c, m, one_sided, model, tau, f, damping):
+            _missing_optional()
+            return False
+        return missing
+    return lambda optional, p, s, c, m, one_sided, model, tau, f, damping: \
+        _long_window_spanned(p, s, c, m, one_sided, model, tau, f, damping)
 
 
 @jit(inline='always')
@@ -807,7 +854,7 @@ def _start(model, f, damping):
 
 
 @jit(inline='always')
-def _fit_with_std(p, s, seg, n, model, f, damping, iterations, res, band):
+def _fit_with_std(p, s, seg, n, model, f, damping, iterations, res, optional):
     """``iterations`` Gauss-Newton steps of the model over the segment from the algebraic (f,
     damping) and the std of the result (:func:`core.uncertainty.refine`; with ``band_hz`` the
     coloured-noise std, :func:`_band_std`) into ``res``; False if no fit is possible."""
@@ -816,12 +863,12 @@ def _fit_with_std(p, s, seg, n, model, f, damping, iterations, res, band):
     if not U.refine(model, seg, n, w0, sigma0, iterations, res, s[S_WORK:S_WORK + U.N_WORK]):
         return False
     if p[P_BAND] > 0.0:
-        _band_std_if(band, p, s, seg, n, model, res)
+        _band_std_if(optional, p, s, seg, n, model, res)
     return True
 
 
 @jit(inline='always')
-def _refine(p, s, seg, n, model, f, damping, res, band):
+def _refine(p, s, seg, n, model, f, damping, res, optional):
     """The estimate to gate and publish: ``res`` = (f, damping, their std), core.uncertainty.
 
     ``refine`` = 0 keeps the paper's algebraic (f, damping) and adds their std; otherwise up to
@@ -829,14 +876,14 @@ def _refine(p, s, seg, n, model, f, damping, res, band):
     then judges the refined frequency).
     """
     iterations = int(p[P_REFINE])
-    if not _fit_with_std(p, s, seg, n, model, f, damping, iterations, res, band) or \
+    if not _fit_with_std(p, s, seg, n, model, f, damping, iterations, res, optional) or \
             iterations == 0:
         res[U.R_F] = f
         res[U.R_DAMP] = damping
 
 
 @jit(inline='always')
-def _target_reached(p, s, seg, n, model, f, damping, band):
+def _target_reached(p, s, seg, n, model, f, damping, optional):
     """``target_std_rel``: True once the predicted relative std of f is at or below the target.
 
     The std (the Fisher information of the model over the segment at the algebraic estimate, with
@@ -847,13 +894,14 @@ def _target_reached(p, s, seg, n, model, f, damping, band):
         return False
     s[S_NEXT] = max(n + 1.0, n * (1.0 + 1.0 / 16.0)) if n >= 64 else n + 1.0
     res = s[S_RES:S_RES + U.N_RESULT]
-    return _fit_with_std(p, s, seg, n, model, f, damping, 0, res, band) and \
+    return _fit_with_std(p, s, seg, n, model, f, damping, 0, res, optional) and \
         res[U.R_FSTD] <= p[P_TARGET] * f
 
 
 @jit
-def run(p, s, c, seg, t, y, out, start, band=None):
-    """Feed ``t[start:]``, ``y[start:]``; write estimates to ``out`` rows (``band``: :func:`step`).
+def run(p, s, c, seg, t, y, out, start, optional=None):
+    """Feed ``t[start:]``, ``y[start:]``; write estimates to ``out`` rows (``optional``:
+    :func:`step`).
 
     Returns (number of estimates written, index of the next sample to feed). Stops early when
     ``out`` is full so the caller can grow it and continue.
@@ -864,7 +912,7 @@ def run(p, s, c, seg, t, y, out, start, band=None):
     while i < n:
         if n_out >= out.shape[0]:
             return n_out, i
-        if step(p, s, c, seg, t[i], y[i], out, n_out, band):
+        if step(p, s, c, seg, t[i], y[i], out, n_out, optional):
             n_out += 1
         i += 1
     return n_out, i
