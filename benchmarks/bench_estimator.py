@@ -94,8 +94,8 @@ def compare_split(t, y):
         then_create(then_cfg).process(t[:5000], y[:5000])
         now, then = [], []
         for _ in range(3):
-            now.append(best(lambda: create_estimator(now_cfg).process(t[:m], y[:m]), 1))
-            then.append(best(lambda: then_create(then_cfg).process(t[:m], y[:m]), 1))
+            now.append(best(lambda c=now_cfg, k=m: create_estimator(c).process(t[:k], y[:k]), 1))
+            then.append(best(lambda c=then_cfg, k=m: then_create(c).process(t[:k], y[:k]), 1))
         print(f'batch {name:>20} {m / min(now) / 1e6:8.2f} this {m / min(then) / 1e6:8.2f} '
               f'{SPLIT}   this/then {min(then) / min(now):5.2f}')
     m = 200_000
