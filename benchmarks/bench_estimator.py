@@ -12,6 +12,10 @@ Prints (one run, same machine, same signal: 2 M samples of a noisy 1.33 Hz sine 
   refinement; loaded at run time with ``git show`` into a temporary package, "skipped" without git)
   on the same signal, ``refine`` = 0 (it also computes each estimate's std) and the default
   against it, timed alternately (the ratios hold when the machine is loaded; the rates do not).
+- the kernel of ``SPLIT`` (before issues 19 and 24: the compile-time and speed restructuring),
+  loaded the same way, beside this one for each configuration, ``modes`` = 3 and streaming,
+  timed alternately: rates and this/then ratios (the outputs are bit-identical,
+  test/core/test_kernel_reference.py).
 Numba compiles once before timing; each figure is the best of 3 repeats.
 """
 import atexit
@@ -35,25 +39,78 @@ VARIANTS = {'refine=0 (paper)': dict(refine=0), 'min_periods=5': dict(min_period
 
 #: the commit whose kernel (one 169-line step, no refinement) is the speed baseline of issue 14
 PREVIOUS = '627a108'
+#: the kernel before the compile-time and speed work of issues 19 and 24 (the bit-identity reference)
+SPLIT = '7374e6d'
+
+
+def load_core(commit, package, names=None):
+    """vib_estimator/core of ``commit`` as the package ``package`` (a temporary copy), or None
+    without git; ``names``: only these modules (default: all of them)."""
+    root = Path(__file__).resolve().parents[1]
+    folder = Path(tempfile.mkdtemp(prefix=f'{package}_')) / package
+    atexit.register(shutil.rmtree, folder.parent, True)
+    folder.mkdir()
+    (folder / '__init__.py').write_text('')
+    try:
+        if names is None:
+            names = [Path(f).stem for f in subprocess.run(
+                ['git', 'ls-tree', '--name-only', f'{commit}:vib_estimator/core'], cwd=root,
+                capture_output=True, text=True, check=True).stdout.split()
+                if f.endswith('.py') and f != '__init__.py']
+        for name in names:
+            text = subprocess.run(['git', 'show', f'{commit}:vib_estimator/core/{name}.py'],
+                                  cwd=root, capture_output=True, text=True, check=True).stdout
+            (folder / f'{name}.py').write_text(text)
+    except (OSError, subprocess.CalledProcessError):
+        return None
+    sys.path.insert(0, str(folder.parent))
+    return package
 
 
 def load_previous():
     """The previous kernel's FrequencyEstimator and EstimatorConfig, or None without git."""
-    root = Path(__file__).resolve().parents[1]
-    folder = Path(tempfile.mkdtemp(prefix='vib_previous_')) / 'vib_previous'
-    atexit.register(shutil.rmtree, folder.parent, True)
-    folder.mkdir()
-    (folder / '__init__.py').write_text('')
-    for name in ('kernel', 'estimator', 'config'):
-        try:
-            text = subprocess.run(['git', 'show', f'{PREVIOUS}:vib_estimator/core/{name}.py'],
-                                  cwd=root, capture_output=True, text=True, check=True).stdout
-        except (OSError, subprocess.CalledProcessError):
-            return None
-        (folder / f'{name}.py').write_text(text)
-    sys.path.insert(0, str(folder.parent))
+    if load_core(PREVIOUS, 'vib_previous', ('kernel', 'estimator', 'config')) is None:
+        return None
     return (importlib.import_module('vib_previous.estimator').FrequencyEstimator,
             importlib.import_module('vib_previous.config').EstimatorConfig)
+
+
+def compare_split(t, y):
+    """This kernel beside SPLIT's, per configuration (batch), ``modes`` = 3 and streaming,
+    alternating, best of 3."""
+    from vib_estimator.core.modes import create_estimator
+    if load_core(SPLIT, 'vib_split') is None:
+        print(f'kernel of {SPLIT}   skipped (git or the commit is not available)')
+        return
+    then_config = importlib.import_module('vib_split.config').EstimatorConfig
+    then_create = importlib.import_module('vib_split.modes').create_estimator
+    n = len(t)
+    print(f'\nthis kernel beside {SPLIT}\'s (batch M samples/s; streaming us/sample)')
+    rows = [('default', {}), *VARIANTS.items(), ('modes=3', dict(modes=3))]
+    for name, changes in rows:
+        m = n // 4 if 'modes' in changes else n
+        now_cfg, then_cfg = EstimatorConfig(**changes), then_config(**changes)
+        create_estimator(now_cfg).process(t[:5000], y[:5000])
+        then_create(then_cfg).process(t[:5000], y[:5000])
+        now, then = [], []
+        for _ in range(3):
+            now.append(best(lambda c=now_cfg, k=m: create_estimator(c).process(t[:k], y[:k]), 1))
+            then.append(best(lambda c=then_cfg, k=m: then_create(c).process(t[:k], y[:k]), 1))
+        print(f'batch {name:>20} {m / min(now) / 1e6:8.2f} this {m / min(then) / 1e6:8.2f} '
+              f'{SPLIT}   this/then {min(then) / min(now):5.2f}')
+    m = 200_000
+    tl, yl = t[:m].tolist(), y[:m].tolist()
+
+    def stream(update):
+        for a, b in zip(tl, yl):
+            update(a, b)
+
+    now, then = [], []
+    for _ in range(3):
+        now.append(best(lambda: stream(create_estimator(EstimatorConfig()).update), 1))
+        then.append(best(lambda: stream(then_create(then_config()).update), 1))
+    print(f'streaming {"default":>16} {min(now) / m * 1e6:8.3f} this {min(then) / m * 1e6:8.3f} '
+          f'{SPLIT}   this/then {min(then) / min(now):5.2f}')
 
 
 def compare_previous(t, y):
@@ -125,6 +182,7 @@ def main() -> None:
         print(f'batch {name:>20} {n / v / 1e6:8.2f} M samples/s   '
               f'ratio to default {batch / v:6.2f}')
     compare_previous(t, y)
+    compare_split(t, y)
 
 
 if __name__ == '__main__':

@@ -148,6 +148,9 @@ class FrequencyEstimator:
         self._c = np.zeros(K.N_COUNTERS, dtype=np.int64)
         self._seg = np.zeros((2, config.buffer_samples))
         self._row = np.zeros((1, K.N_OUT))
+        self._t1 = np.zeros(1)      # the streaming path's sample, fed to the batch kernel
+        self._y1 = np.zeros(1)
+        self._optional = K.optional_features(self._p)
         self.restart()
 
     @property
@@ -179,7 +182,11 @@ class FrequencyEstimator:
 
     def update(self, t: float, y: float) -> Optional[Estimate]:
         """Feed one sample (time in s, any origin); return an estimate when one is published."""
-        if K.step(self._p, self._s, self._c, self._seg, float(t), float(y), self._row, 0):
+        # the batch kernel over one sample: one compiled entry point for both paths
+        self._t1[0] = t
+        self._y1[0] = y
+        if K.run(self._p, self._s, self._c, self._seg, self._t1, self._y1, self._row, 0,
+                 self._optional)[0]:
             return Estimate(*(int(v) if i == K.O_SAMPLES else float(v)
                               for i, v in enumerate(self._row[0])))
         return None
@@ -192,7 +199,8 @@ class FrequencyEstimator:
         size = max(16, len(t) // 100)
         while True:
             out = np.empty((size, K.N_OUT))
-            n, start = K.run(self._p, self._s, self._c, self._seg, t, y, out, start)
+            n, start = K.run(self._p, self._s, self._c, self._seg, t, y, out, start,
+                             self._optional)
             chunks.append(out[:n])
             if start >= len(t):
                 break

@@ -52,9 +52,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba.core import types
+from numba.extending import overload
 
 from . import uncertainty as U
+from .jit import jit
 from .uncertainty import MODEL_BIASED, MODEL_DAMPED, MODEL_SINUSOID, TWO_PI
 
 # ---- parameter array layout (float64) -------------------------------------------------------
@@ -126,7 +128,7 @@ BINOMIAL = ((1.0, 0.0, 0.0, 0.0, 0.0), (1.0, 1.0, 0.0, 0.0, 0.0), (1.0, 2.0, 1.0
             (1.0, 3.0, 3.0, 1.0, 0.0), (1.0, 4.0, 6.0, 4.0, 1.0))
 
 
-@njit(cache=True)
+@jit
 def _discretise(w, z, h, out, off):
     """Exact first-order-hold discretisation of the unit-gain low-pass w^2/(s^2 + 2 z w s + w^2).
 
@@ -167,7 +169,7 @@ def _discretise(w, z, h, out, off):
     out[off + 7] = gb1
 
 
-@njit(cache=True)
+@jit(inline='always')
 def _advance(s, xo, d, u0, u1):
     """Advance the 2-state section stored at s[xo:xo+2] with the discretisation at s[d:d+8]."""
     x0 = s[xo]
@@ -176,7 +178,7 @@ def _advance(s, xo, d, u0, u1):
     s[xo + 1] = s[d + 2] * x0 + s[d + 3] * x1 + s[d + 5] * u0 + s[d + 7] * u1
 
 
-@njit(cache=True)
+@jit
 def _restart(s, c):
     """Forget everything, the prefilter and interpolation history included (start, gap, jump)."""
     s[S_HT:] = 0.0
@@ -187,7 +189,7 @@ def _restart(s, c):
     c[C_MA_N] = 0
 
 
-@njit(cache=True)
+@jit
 def reset_segment(s, c, seg, t0, y0):
     """Start a new estimation segment at time ``t0`` (after an estimate, a timeout or a rejection).
 
@@ -206,7 +208,7 @@ def reset_segment(s, c, seg, t0, y0):
     c[C_MA_N] = 0
 
 
-@njit(cache=True)
+@jit
 def _newton_integrals(s, kmax, yoff, q):
     """I_m = int_0^h u^m p(u) du, m = 0..kmax, for the polynomial p through the q newest samples.
 
@@ -251,7 +253,7 @@ def _newton_integrals(s, kmax, yoff, q):
         hp *= h
 
 
-@njit(cache=True)
+@jit
 def _interval_moments(s, kmax, a, h, npts):
     """Add to M_0..M_kmax the exact integral over the newest interval of s^k p(s).
 
@@ -298,7 +300,7 @@ def _interval_moments(s, kmax, a, h, npts):
         s[S_MOM + k] += acc
 
 
-@njit(cache=True)
+@jit
 def _spread(seg, n):
     """Half the peak-to-peak range of the segment's values (0 for a flat line)."""
     lo = seg[1, 0]
@@ -309,7 +311,7 @@ def _spread(seg, n):
     return 0.5 * (hi - lo)
 
 
-@njit(cache=True)
+@jit
 def _fit(seg, n, omega):
     """Least-squares fit y ~ a sin(w tau) + b cos(w tau) + c over the segment.
 
@@ -353,7 +355,7 @@ def _fit(seg, n, omega):
     return 1.0 - ssres / sstot, math.sqrt(ca * ca + cb * cb)
 
 
-@njit(cache=True)
+@jit
 def _prefilter(p, s, y, xb):
     """Band-pass one sample through the prefilter whose states are at s[xb:xb+9]; returns the
     filtered value (the signal's prefilter, at S_BAND, is never reset by an estimate)."""
@@ -369,7 +371,7 @@ def _prefilter(p, s, y, xb):
     return u - s[x] - (2.0 * BAND_DAMPING[2] / p[P_WLO]) * s[x + 1]
 
 
-@njit(cache=True)
+@jit
 def _first_sample(p, s, c, t, y):
     """Initialise the prefilter at its steady state for a constant input and prime the history."""
     if p[P_BAND] > 0.0:
@@ -383,7 +385,7 @@ def _first_sample(p, s, c, t, y):
     return y
 
 
-@njit(cache=True, inline='always')
+@jit(inline='always')
 def _accept_time(max_gap, s, c, t, y):
     """Time handling: True if the sample is used, False if it is skipped (counted either way).
 
@@ -415,7 +417,7 @@ def _accept_time(max_gap, s, c, t, y):
     return True
 
 
-@njit(cache=True, inline='always')
+@jit(inline='always')
 def _update_discretisations(p, s, h):
     """Exact discretisations of the invariant filter (Eq. 11) and the prefilter for the step h.
 
@@ -430,7 +432,7 @@ def _update_discretisations(p, s, h):
     s[S_CACHE_H] = h
 
 
-@njit(cache=True, inline='always')
+@jit(inline='always')
 def _push_history(s, c, seg, t, y):
     """Shift (t, y) into the interpolation stencil; True once the stencil holds NH samples.
 
@@ -450,7 +452,7 @@ def _push_history(s, c, seg, t, y):
     return True
 
 
-@njit(cache=True, inline='always')
+@jit(inline='always')
 def _numerator_denominator(model, tau, y, m0, m1, m2, m3, m4):
     """Eq. 7 (with Eq. 8's corrected sign) in moments: n and d of omega^2 = n / d at time tau.
 
@@ -468,7 +470,7 @@ def _numerator_denominator(model, tau, y, m0, m1, m2, m3, m4):
     return num, den
 
 
-@njit(cache=True, inline='always')
+@jit(inline='always')
 def _invariant_filter(filtered, s, model, num, den, tau, h):
     """Invariant filtering, Eqs. 9-11: n and d (and q of the damped model) through one low-pass.
 
@@ -496,7 +498,7 @@ def _invariant_filter(filtered, s, model, num, den, tau, h):
         s[S_INT + 2] += h * s[S_DF]
 
 
-@njit(cache=True, inline='always')
+@jit(inline='always')
 def _ratio(model, nf, df, qf, i_n, i_q, i_d):
     """Eq. 12: (omega^2, damping ratio) from the filtered terms; omega^2 <= 0 when undefined.
 
@@ -515,7 +517,7 @@ def _ratio(model, nf, df, qf, i_n, i_q, i_d):
     return w2, damping
 
 
-@njit(cache=True, inline='always')
+@jit(inline='always')
 def _converged(m, one_sided, tol, s, c, f):
     """Eqs. 16-17: the moving average of the last M+1 estimates against the one M samples earlier.
 
@@ -544,7 +546,7 @@ def _converged(m, one_sided, tol, s, c, f):
     return change < tol * ma_now
 
 
-@njit(cache=True, inline='always')
+@jit(inline='always')
 def _quality_gate(p, c, model, f, damping, h, r2, amp, consistent, spread, confirmed):
     """True if the converged estimate may be published; else count why it is held back.
 
@@ -574,7 +576,7 @@ def _quality_gate(p, c, model, f, damping, h, r2, amp, consistent, spread, confi
     return False
 
 
-@njit(cache=True, inline='always')
+@jit(inline='always')
 def _confirmed(p, s, f):
     """``consistency`` (0 = off): True if f lies within that fraction of the estimate of the
     segment just before (``S_FPREV``; none after a restart, a timeout or a rejected segment).
@@ -588,14 +590,14 @@ def _confirmed(p, s, f):
     return tol <= 0.0 or (s[S_FPREV] > 0.0 and abs(f - s[S_FPREV]) <= tol * s[S_FPREV])
 
 
-@njit(cache=True, inline='always')
+@jit(inline='always')
 def _chain(s, c, f, published, inconsistent_before):
     """Keep f as the next segment's predecessor if this one was published or held back only by
     :func:`_confirmed`; forget it (0) if the gate rejected it for any other reason."""
     s[S_FPREV] = f if published or c[C_INCONSISTENT] > inconsistent_before else 0.0
 
 
-@njit(cache=True, inline='always')
+@jit(inline='always')
 def _store_sample(p, s, c, seg, t, tau, y):
     """Keep (tau, y) in the segment buffer; True if the segment ran out (``max_window`` or buffer).
 
@@ -625,7 +627,7 @@ def _store_sample(p, s, c, seg, t, tau, y):
     return False
 
 
-@njit(cache=True)
+@jit
 def _long_window_spanned(p, s, c, m, one_sided, model, tau, f, damping):
     """Long window (``refine`` and ``min_periods`` >= 1): True once the segment spans
     ``min_periods`` periods of its first converged half-period estimate.
@@ -645,11 +647,13 @@ def _long_window_spanned(p, s, c, m, one_sided, model, tau, f, damping):
     return tau * s[S_FLAST] >= p[P_MINPER]
 
 
-@njit(cache=True)
-def step(p, s, c, seg, t, y, out, row):
+@jit(inline='always')
+def step(p, s, c, seg, t, y, out, row, optional=None):
     """Feed one sample; return 1 and fill ``out[row]`` when an estimate is published, else 0.
 
     (The row index rather than a view of it: a view per sample costs its reference counting.)
+    ``optional``: :func:`optional_features` of ``p`` (None for a configuration without band std,
+    ``target_std_rel`` or long windows: their code is then not compiled, :func:`_band_std_if`).
     """
     if not _accept_time(p[P_MAXGAP], s, c, t, y):
         return 0
@@ -685,17 +689,18 @@ def step(p, s, c, seg, t, y, out, row):
     n_fit = min(nseg + 1, seg.shape[1])
     local_start = True          # the refinement starts at this segment's own algebraic estimate
     if p[P_TARGET] > 0.0:
-        if tau * f < p[P_MINPER] or not _target_reached(p, s, seg, n_fit, model, f, damping):
+        if tau * f < p[P_MINPER] or not _target_reached_if(optional, p, s, seg, n_fit, model,
+                                                                 f, damping):
             return 0
     elif p[P_REFINE] > 0.0 and p[P_MINPER] >= 1.0:
-        if not _long_window_spanned(p, s, c, m, one_sided, model, tau, f, damping):
+        if not _long_window_if(optional, p, s, c, m, one_sided, model, tau, f, damping):
             return 0
         f, damping, local_start = s[S_FLAST], s[S_DLAST], False
     # the segment must span a fraction of the period it estimates
     elif not _converged(m, one_sided, p[P_TOL], s, c, f) or tau * f < p[P_MINPER]:
         return 0
     res = s[S_RES:S_RES + U.N_RESULT]
-    _refine(p, s, seg, n_fit, model, f, damping, res)
+    _refine(p, s, seg, n_fit, model, f, damping, res, optional)
     start, f = f, res[U.R_F]
     consistent = True
     if p[P_REFINE] > 0.0 and math.isfinite(res[U.R_FIT]):
@@ -723,7 +728,7 @@ def step(p, s, c, seg, t, y, out, row):
     return 1 if published else 0
 
 
-@njit(cache=True)
+@jit
 def _tail_gramian(p, s):
     """W = sum_(k>=1) (C A^k)^T C A^k of the prefilter's free response, and rho(0) = sum g^2.
 
@@ -740,7 +745,8 @@ def _tail_gramian(p, s):
         s[base:base + 9] = 0.0
         s[base + k] = 1.0
         v[k] = _prefilter(p, s, 0.0, base)
-        a[:, k] = s[base:base + 9]
+        for i in range(9):
+            a[i, k] = s[base + i]
     w = s[S_TAILW:S_TAILW + 81].reshape((9, 9))
     w[:, :] = 0.0
     peak = 0.0
@@ -759,14 +765,15 @@ def _tail_gramian(p, s):
             for i in range(9):
                 acc += v[i] * a[i, j]
             nxt[j] = acc
-        v[:] = nxt
+        for i in range(9):
+            v[i] = nxt[i]
     s[base:base + 9] = 0.0
     g0 = _prefilter(p, s, 1.0, base)
     s[S_TAILH] = s[S_CACHE_H]
     s[S_TAILH + 1] = g0 * g0 + _quadratic(w, s, base, base)
 
 
-@njit(cache=True)
+@jit
 def _quadratic(w, s, xi, xj):
     """s[xi:xi+9]^T w s[xj:xj+9]."""
     acc = 0.0
@@ -776,7 +783,7 @@ def _quadratic(w, s, xi, xj):
     return acc
 
 
-@njit(cache=True)
+@jit
 def _band_std(p, s, seg, n, model, res):
     """With ``band_hz``: the std of the fit under the prefilter's coloured noise (sandwich).
 
@@ -807,7 +814,68 @@ def _band_std(p, s, seg, n, model, res):
     U.coloured_std(model, n, gram, s[S_TAILH + 1], res, work)
 
 
-@njit(cache=True)
+def optional_features(p):
+    """The ``optional`` argument of :func:`step` and :func:`run` for the parameters ``p``: None
+    unless the configuration uses the band std, ``target_std_rel`` or long windows (the
+    conditions under which :func:`step` calls them), else True."""
+    long_window = p[P_REFINE] > 0.0 and p[P_MINPER] >= 1.0
+    return True if p[P_BAND] > 0.0 or p[P_TARGET] > 0.0 or long_window else None
+
+
+def _unused(optional):
+    """Whether ``optional`` (a numba type) is None: the optional features are then not compiled."""
+    return isinstance(optional, (types.NoneType, types.Omitted))
+
+
+@jit
+def _missing_optional():
+    """A configuration's optional feature reached with ``optional`` None (a caller's error)."""
+    raise ValueError('kernel: run/step need optional=optional_features(p) for this p')
+
+
+def _band_std_if(optional, p, s, seg, n, model, res):
+    """:func:`_band_std`, compiled (an overload chosen by the type of ``optional``) only for a
+    configuration with optional features (:func:`optional_features`)."""
+
+
+@overload(_band_std_if, inline='always')
+def _band_std_if_typed(optional, p, s, seg, n, model, res):
+    if _unused(optional):
+        return lambda optional, p, s, seg, n, model, res: _missing_optional()
+    return lambda optional, p, s, seg, n, model, res: _band_std(p, s, seg, n, model, res)
+
+
+def _target_reached_if(optional, p, s, seg, n, model, f, damping):
+    """:func:`_target_reached`, compiled only with optional features (:func:`_band_std_if`)."""
+
+
+@overload(_target_reached_if, inline='always')
+def _target_reached_if_typed(optional, p, s, seg, n, model, f, damping):
+    if _unused(optional):
+        def missing(optional, p, s, seg, n, model, f, damping):
+            _missing_optional()
+            return False
+        return missing
+    return lambda optional, p, s, seg, n, model, f, damping: _target_reached(
+        p, s, seg, n, model, f, damping, optional)
+
+
+def _long_window_if(optional, p, s, c, m, one_sided, model, tau, f, damping):
+    """:func:`_long_window_spanned`, compiled only with optional features (:func:`_band_std_if`)."""
+
+
+@overload(_long_window_if, inline='always')
+def _long_window_if_typed(optional, p, s, c, m, one_sided, model, tau, f, damping):
+    if _unused(optional):
+        def missing(optional, p, s, c, m, one_sided, model, tau, f, damping):
+            _missing_optional()
+            return False
+        return missing
+    return lambda optional, p, s, c, m, one_sided, model, tau, f, damping: \
+        _long_window_spanned(p, s, c, m, one_sided, model, tau, f, damping)
+
+
+@jit(inline='always')
 def _start(model, f, damping):
     """Start of the refinement: (w, sigma) = (w_d, zeta w_n) from the algebraic (w_n, zeta)."""
     wn = TWO_PI * f
@@ -816,8 +884,8 @@ def _start(model, f, damping):
     return wn, 0.0
 
 
-@njit(cache=True)
-def _fit_with_std(p, s, seg, n, model, f, damping, iterations, res):
+@jit(inline='always')
+def _fit_with_std(p, s, seg, n, model, f, damping, iterations, res, optional):
     """``iterations`` Gauss-Newton steps of the model over the segment from the algebraic (f,
     damping) and the std of the result (:func:`core.uncertainty.refine`; with ``band_hz`` the
     coloured-noise std, :func:`_band_std`) into ``res``; False if no fit is possible."""
@@ -826,12 +894,12 @@ def _fit_with_std(p, s, seg, n, model, f, damping, iterations, res):
     if not U.refine(model, seg, n, w0, sigma0, iterations, res, s[S_WORK:S_WORK + U.N_WORK]):
         return False
     if p[P_BAND] > 0.0:
-        _band_std(p, s, seg, n, model, res)
+        _band_std_if(optional, p, s, seg, n, model, res)
     return True
 
 
-@njit(cache=True)
-def _refine(p, s, seg, n, model, f, damping, res):
+@jit(inline='always')
+def _refine(p, s, seg, n, model, f, damping, res, optional):
     """The estimate to gate and publish: ``res`` = (f, damping, their std), core.uncertainty.
 
     ``refine`` = 0 keeps the paper's algebraic (f, damping) and adds their std; otherwise up to
@@ -839,13 +907,14 @@ def _refine(p, s, seg, n, model, f, damping, res):
     then judges the refined frequency).
     """
     iterations = int(p[P_REFINE])
-    if not _fit_with_std(p, s, seg, n, model, f, damping, iterations, res) or iterations == 0:
+    if not _fit_with_std(p, s, seg, n, model, f, damping, iterations, res, optional) or \
+            iterations == 0:
         res[U.R_F] = f
         res[U.R_DAMP] = damping
 
 
-@njit(cache=True)
-def _target_reached(p, s, seg, n, model, f, damping):
+@jit(inline='always')
+def _target_reached(p, s, seg, n, model, f, damping, optional):
     """``target_std_rel``: True once the predicted relative std of f is at or below the target.
 
     The std (the Fisher information of the model over the segment at the algebraic estimate, with
@@ -856,13 +925,14 @@ def _target_reached(p, s, seg, n, model, f, damping):
         return False
     s[S_NEXT] = max(n + 1.0, n * (1.0 + 1.0 / 16.0)) if n >= 64 else n + 1.0
     res = s[S_RES:S_RES + U.N_RESULT]
-    return _fit_with_std(p, s, seg, n, model, f, damping, 0, res) and \
+    return _fit_with_std(p, s, seg, n, model, f, damping, 0, res, optional) and \
         res[U.R_FSTD] <= p[P_TARGET] * f
 
 
-@njit(cache=True)
-def run(p, s, c, seg, t, y, out, start):
-    """Feed ``t[start:]``, ``y[start:]``; write estimates to ``out`` rows.
+@jit
+def run(p, s, c, seg, t, y, out, start, optional=None):
+    """Feed ``t[start:]``, ``y[start:]``; write estimates to ``out`` rows (``optional``:
+    :func:`step`).
 
     Returns (number of estimates written, index of the next sample to feed). Stops early when
     ``out`` is full so the caller can grow it and continue.
@@ -873,7 +943,7 @@ def run(p, s, c, seg, t, y, out, start):
     while i < n:
         if n_out >= out.shape[0]:
             return n_out, i
-        if step(p, s, c, seg, t[i], y[i], out, n_out):
+        if step(p, s, c, seg, t[i], y[i], out, n_out, optional):
             n_out += 1
         i += 1
     return n_out, i

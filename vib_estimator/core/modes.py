@@ -63,10 +63,9 @@ from dataclasses import dataclass
 from typing import Dict, List, Sequence, Union
 
 import numpy as np
-from numba import njit
-
 from .config import EstimatorConfig
 from .estimator import COUNTER_NAMES, Estimate, EstimateArrays, FrequencyEstimator, as_series
+from .jit import jit
 from .kernel import BAND_DAMPING, _advance, _discretise
 from .subspace import N_R, R_AMP, R_ENERGY, R_NU, R_ZETA, analyse, init_subspace
 
@@ -156,7 +155,7 @@ N_O = 10
 
 
 # ---- decimation ------------------------------------------------------------------------------
-@njit(cache=True)
+@jit
 def _levels_init(b):
     """Discretise each level's anti-alias low-pass (two Butterworth sections)."""
     for k in range(2):
@@ -165,7 +164,7 @@ def _levels_init(b):
                         B_DEC + DEC_N * d + 8 * k)
 
 
-@njit(cache=True)
+@jit
 def _levels_settle(b, ic, y):
     """Every filter at rest on a constant input y; the rings start empty."""
     for d in range(NLEV):
@@ -178,7 +177,7 @@ def _levels_settle(b, ic, y):
     ic[I_WAKE] = 0
 
 
-@njit(cache=True)
+@jit
 def _levels_step(b, ic, y):
     """Input sample y through the levels; returns the highest level that got a sample."""
     n = ic[I_NB]
@@ -203,7 +202,7 @@ def _levels_step(b, ic, y):
     return top
 
 
-@njit(cache=True)
+@jit
 def _window(b, ic, d, m):
     """The last m samples of level d, oldest first."""
     x = np.empty(m)
@@ -214,13 +213,13 @@ def _window(b, ic, d, m):
 
 
 # ---- one analysis ------------------------------------------------------------------------------
-@njit(cache=True)
+@jit
 def _scale_len(s):
     """Window of scale s in input samples."""
     return (M_A if s % 2 == 0 else M_B) << (s // 2)
 
 
-@njit(cache=True)
+@jit(inline='always')
 def _poles(b, ic, qs, lams, pa, s, pp, undamped):
     """Analyse scale s (its light pairs refined as undamped if ``undamped``); the poles that count
     (module docstring) as rows of pp: frequency (Hz), amplitude, damping, cycles in the window,
@@ -252,7 +251,7 @@ def _poles(b, ic, qs, lams, pa, s, pp, undamped):
     return n, r2
 
 
-@njit(cache=True)
+@jit
 def _harmonic(f, amp, cycles, pp, n, sl):
     """Whether f lies within HARMONIC_TOL of 2..9 times a pole of pp[:n] or an active mode
     HARMONIC_RATIO times stronger than amp, or, seen over fewer than ``SUSPECT_CYCLES`` cycles,
@@ -273,7 +272,7 @@ def _harmonic(f, amp, cycles, pp, n, sl):
     return False
 
 
-@njit(cache=True)
+@jit
 def _cap(sl):
     """(lowest active mode's frequency, longest publishing window in its periods): ``C_CAP``, or
     ``C_CAP_CLOSE`` when two active modes lie within ``CLOSE_RATIO``."""
@@ -289,7 +288,7 @@ def _cap(sl):
     return fmin, cap
 
 
-@njit(cache=True)
+@jit
 def _first_tol(undamped, pp, n, i):
     """Consistency a first estimate (pole i of pp[:n]) needs: ``CONSISTENCY_FIRST`` from an
     undamped refinement (:func:`vib_estimator.core.subspace.refine_undamped`) when another pole
@@ -300,14 +299,14 @@ def _first_tol(undamped, pp, n, i):
     return CONSISTENCY
 
 
-@njit(cache=True)
+@jit
 def _mode_cap(sl, k, cap):
     """Mode k's publishing cap: ``C_CAP`` until its first estimate (a close pair's first estimates
     come from the undamped refinement of a shorter window), then cap (:func:`_cap`)."""
     return min(cap, C_CAP) if sl[k, SL_FIRST] == math.inf else cap
 
 
-@njit(cache=True)
+@jit
 def _owner(b, sl, k, t, fmin, cap):
     """(the scale mode k publishes from (module docstring), the next longer one if only its start
     keeps it from publishing: the owner soon), -1 for none; fmin, cap from :func:`_cap`."""
@@ -324,7 +323,7 @@ def _owner(b, sl, k, t, fmin, cap):
     return best, -1
 
 
-@njit(cache=True)
+@jit
 def _remove(ic, sl, k):
     """Mode k is lost: its counters go to the lost modes' sums."""
     sl[k, SL_ACTIVE] = 0.0
@@ -333,7 +332,7 @@ def _remove(ic, sl, k):
         ic[I_RET + j] += int(sl[k, col])
 
 
-@njit(cache=True)
+@jit
 def _publish(b, ic, sl, k, s, t, pp, i, r2, out):
     """One estimate of mode k (pole i of scale s's analysis at t) into the next row of out."""
     f = pp[i, 0]
@@ -361,7 +360,7 @@ def _publish(b, ic, sl, k, s, t, pp, i, r2, out):
     sl[k, SL_EST] += 1
 
 
-@njit(cache=True)
+@jit
 def _admit(ic, sl, pa, f, amp, start, t):
     """A new mode at f if there is room, or in place of the weakest if twice as strong."""
     free = -1
@@ -394,7 +393,7 @@ def _admit(ic, sl, pa, f, amp, start, t):
     return free
 
 
-@njit(cache=True)
+@jit
 def _candidates(b, ic, sl, pd, pa, pp, n, used, t, s, r2, undamped, out):
     """The poles no mode explains (module docstring): candidates, confirmed or expired. A
     confirming pole whose window starts after the candidate's first one and lies within
@@ -441,7 +440,7 @@ def _candidates(b, ic, sl, pd, pa, pp, n, used, t, s, r2, undamped, out):
     ic[I_NPEND] = kept
 
 
-@njit(cache=True)
+@jit
 def _analysis(b, ic, sl, pd, qs, lams, pa, s, t, out):
     """Scale s's analysis at t: match the modes, publish those it owns, find, lose."""
     pp = np.empty((PCOL, 6))
@@ -494,7 +493,7 @@ def _analysis(b, ic, sl, pd, qs, lams, pa, s, t, out):
 
 
 # ---- input, one sample, a run of samples --------------------------------------------------
-@njit(cache=True)
+@jit
 def _input_ok(b, ic, pa, t, y):
     """Count the sample as the estimator does; 1 = it advances the levels, 2 = it restarts them."""
     ic[I_RECEIVED] += 1
@@ -522,7 +521,7 @@ def _input_ok(b, ic, pa, t, y):
     return 1
 
 
-@njit(cache=True)
+@jit
 def _wake(b, ic, y):
     """The energy of the input's blocks of WAKE_BLOCK samples against a reference (the largest
     block's, fading by WAKE_FADE per block, so that the blocks of a slow sine, a fraction of its
@@ -537,7 +536,7 @@ def _wake(b, ic, y):
         b[B_E] = 0.0
 
 
-@njit(cache=True)
+@jit(inline='always')
 def _feed(b, ic, sl, pd, qs, lams, pa, t, y, out):
     """One (possibly interpolated) sample through the levels and the analyses it completes."""
     top = _levels_step(b, ic, y)
@@ -551,7 +550,22 @@ def _feed(b, ic, sl, pd, qs, lams, pa, t, y, out):
                 _analysis(b, ic, sl, pd, qs, lams, pa, 2 * d + half, t, out)
 
 
-@njit(cache=True)
+@jit
+def _median_step(b):
+    """The median of the first N_STEP intervals (N_STEP odd: the middle one once sorted), by
+    insertion sort (np.median's sort machinery costs more to compile than this runs)."""
+    x = np.empty(N_STEP)
+    for i in range(N_STEP):
+        v = b[B_HBUF + i]
+        j = i
+        while j > 0 and x[j - 1] > v:
+            x[j] = x[j - 1]
+            j -= 1
+        x[j] = v
+    return x[N_STEP // 2]
+
+
+@jit(inline='always')
 def _step(b, ic, sl, pd, qs, lams, pa, t, y, out):
     """One input sample (counted; restarting the levels, or resampled onto the uniform grid by
     linear interpolation); estimates into out."""
@@ -563,7 +577,7 @@ def _step(b, ic, sl, pd, qs, lams, pa, t, y, out):
         ic[I_NDT] = 0
     elif ic[I_NDT] == N_STEP and b[B_DT] == 0.0:
         # the grid: the median of the first intervals as its step, from this sample on
-        b[B_DT] = np.median(b[B_HBUF:B_HBUF + N_STEP])
+        b[B_DT] = _median_step(b)
         _levels_settle(b, ic, y)
         b[B_TG] = t
         _feed(b, ic, sl, pd, qs, lams, pa, t, y, out)
@@ -596,26 +610,17 @@ F_PA = F_LAM + NS * 3 * PCOL    # per scale: eigenvalues, poles (re, im) of its 
 N_F = F_PA + 7
 
 
-@njit(cache=True)
+@jit
 def _unpack(fs):
     """The views b, sl, pd, lams, pa of the float state."""
     return (fs[:N_B], fs[F_SL:F_PD].reshape((KMAX, N_SL)), fs[F_PD:F_LAM].reshape((NPEND, 3)),
             fs[F_LAM:F_PA].reshape((NS, 3, PCOL)), fs[F_PA:N_F])
 
 
-@njit(cache=True)
-def _update(fs, ic, qs, t, y, out):
-    """One sample (the streaming path); returns the number of estimates in out."""
-    b, sl, pd, lams, pa = _unpack(fs)
-    ic[I_NOUT] = 0
-    _step(b, ic, sl, pd, qs, lams, pa, t, y, out)
-    return ic[I_NOUT]
-
-
-@njit(cache=True)
+@jit
 def _run(fs, ic, qs, t, y, out, start):
     """Feed t[start:] until out may not hold another sample's estimates; returns the next index
-    to feed (the batch path)."""
+    to feed (the batch path, and the streaming one over one sample: one compiled entry point)."""
     b, sl, pd, lams, pa = _unpack(fs)
     ic[I_NOUT] = 0
     i = start
@@ -656,6 +661,8 @@ class ModeTracker:
         pa[:] = (config.max_gap, config.modes, band[0], band[1], config.max_damping,
                  config.min_fit, self._npc)
         self._out = np.empty((ROOM, N_O))
+        self._t1 = np.zeros(1)      # the streaming path's sample, fed to the batch kernel
+        self._y1 = np.zeros(1)
         _levels_init(self._b)
         self.restart()
 
@@ -666,7 +673,10 @@ class ModeTracker:
     # ---- streaming and batch ---------------------------------------------------------------
     def update(self, t: float, y: float) -> List[Estimate]:
         """Feed one sample; return the estimates published at it (ascending mode)."""
-        n = _update(self._fs, self._ic, self._qs, float(t), float(y), self._out)
+        self._t1[0] = t
+        self._y1[0] = y
+        _run(self._fs, self._ic, self._qs, self._t1, self._y1, self._out, 0)
+        n = self._ic[I_NOUT]
         if n == 0:
             return []
         rows = self._out[:n]

@@ -39,7 +39,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+
+from .jit import jit
 
 R_NU, R_ZETA, R_AMP, R_ENERGY = range(4)
 N_R = 4
@@ -56,7 +57,7 @@ REFINE_STEP = 1e-7    # forward differences of this many radians per sample
 FAST = {'reassoc', 'contract', 'nsz', 'arcp'}
 
 
-@njit(cache=True, fastmath=FAST)
+@jit(fastmath=FAST)
 def hankel_cov(x, lag, r):
     """R = H^T H of the window's Hankel matrix (module docstring) into r[:lag+1, :lag+1]."""
     m = len(x)
@@ -74,7 +75,25 @@ def hankel_cov(x, lag, r):
             r[j + 1, i + 1] = v
 
 
-@njit(cache=True, fastmath=FAST)
+@jit
+def _descending(lam):
+    """The order of lam's values, descending, NaN last, ties in place (what np.argsort(-lam)
+    gives for the fewer than 15 columns here: numba's quicksort is an insertion sort below 15
+    elements; this one costs less to compile than numpy's sort machinery)."""
+    n = lam.shape[0]
+    order = np.empty(n, dtype=np.int64)
+    for i in range(n):
+        v = -lam[i]
+        j = i
+        while j > 0 and (v < -lam[order[j - 1]] or (math.isnan(-lam[order[j - 1]])
+                                                     and not math.isnan(v))):
+            order[j] = order[j - 1]
+            j -= 1
+        order[j] = i
+    return order
+
+
+@jit(fastmath=FAST)
 def orthogonal_iteration(r, n, q, lam):
     """One step Q <- orth(R Q) on q[:n, :P] (modified Gram-Schmidt), columns sorted by their
     eigenvalue estimates lam (descending); returns the new columns as the rows of a contiguous
@@ -108,8 +127,12 @@ def orthogonal_iteration(r, n, q, lam):
         else:
             w[k, :] = 0.0
             w[k, k % n] = 1.0
-    order = np.argsort(-lam)
-    lam[:] = lam[order]
+    order = _descending(lam)
+    ranked = np.empty(npc)
+    for k in range(npc):
+        ranked[k] = lam[order[k]]
+    for k in range(npc):
+        lam[k] = ranked[k]
     for k in range(npc):
         for i in range(n):
             qt[k, i] = w[order[k], i]
@@ -117,7 +140,7 @@ def orthogonal_iteration(r, n, q, lam):
     return qt
 
 
-@njit(cache=True)
+@jit
 def cholesky_solve(a, b):
     """Solve a x = b (b: a matrix of right-hand columns) for a symmetric positive (semi)definite
     a (a tiny ridge keeps it regular)."""
@@ -149,7 +172,7 @@ def cholesky_solve(a, b):
     return x
 
 
-@njit(cache=True, fastmath=FAST)
+@jit(fastmath=FAST)
 def esprit_poly(qt, n, p):
     """Characteristic polynomial (monic, low coefficients first) of the rotation Phi of the signal
     subspace (the first p rows of qt, each a column of Q), Q[:-1] Phi = Q[1:] in least squares
@@ -188,7 +211,7 @@ def esprit_poly(qt, n, p):
     return c[:p]
 
 
-@njit(cache=True)
+@jit
 def poly_roots(a, start):
     """Roots of z^p + a[p-1] z^(p-1) + ... + a[0] (Aberth-Ehrlich iteration), started from
     start[:, k] = (re, im) where finite and distinct from the others (the previous window's
@@ -229,7 +252,7 @@ def poly_roots(a, start):
     return z
 
 
-@njit(cache=True)
+@jit
 def all_apart(z, k, w):
     """Whether w lies apart (1e-9) from z[:k]."""
     for j in range(k):
@@ -238,7 +261,7 @@ def all_apart(z, k, w):
     return True
 
 
-@njit(cache=True, fastmath=FAST)
+@jit(fastmath=FAST)
 def _basis(m, poles):
     """The real least-squares basis of the poles (module docstring), one row per column, and
     each pole's columns (0: dropped, 1: real, 2: a pair; a pole with negative imaginary part is
@@ -266,7 +289,7 @@ def _basis(m, poles):
     return basis, kind
 
 
-@njit(cache=True, fastmath=FAST)
+@jit(fastmath=FAST)
 def _normal_solve(basis, x):
     """Least-squares coefficients c of the basis rows (ncol x m) to x: (B B^T) c = B x."""
     m = len(x)
@@ -287,7 +310,7 @@ def _normal_solve(basis, x):
     return cholesky_solve(gram, bx)[:, 0]
 
 
-@njit(cache=True, fastmath=FAST)
+@jit(fastmath=FAST)
 def _lsq(x, basis):
     """Least-squares coefficients of the basis rows to x and the residual x - basis^T c."""
     c = _normal_solve(basis, x)
@@ -298,7 +321,7 @@ def _lsq(x, basis):
     return c, res
 
 
-@njit(cache=True, fastmath=FAST)
+@jit(fastmath=FAST)
 def fit_poles(x, poles, rows):
     """Least-squares amplitudes of the poles (module docstring); returns (pairs written to rows,
     residual variance, R^2)."""
@@ -333,7 +356,7 @@ def fit_poles(x, poles, rows):
 
 
 # ---- undamped refinement of a short window (the first estimates of a close pair) --------------
-@njit(cache=True)
+@jit
 def _circle_residual(x, poles, idx, theta):
     """Residual of the least-squares fit of x with poles[idx[i]] replaced by e^(j theta[i])
     (undamped); empty when the basis is degenerate."""
@@ -346,7 +369,7 @@ def _circle_residual(x, poles, idx, theta):
     return _lsq(x, basis)[1]
 
 
-@njit(cache=True)
+@jit
 def _close_pairs(poles, m):
     """Indices of the poles refined over m samples (:func:`refine_undamped`): upper pairs damped
     below ``REFINE_ZETA`` with ``REFINE_CYCLES`` in the window and another such within
@@ -374,13 +397,13 @@ def _close_pairs(poles, m):
     return close[:nc]
 
 
-@njit(cache=True, fastmath=FAST)
+@jit(fastmath=FAST)
 def _gauss_newton_step(jac, res):
     """The step d minimising |res + jac^T d| (``jac``: one row per parameter)."""
     return -_normal_solve(jac, res)
 
 
-@njit(cache=True)
+@jit(inline='always')
 def refine_undamped(x, poles):
     """The close pairs of poles (:func:`_close_pairs`) moved onto the unit circle, their angles
     refined by Gauss-Newton on the variable-projection residual of window x
@@ -426,17 +449,22 @@ def refine_undamped(x, poles):
     return z
 
 
-@njit(cache=True)
+@jit
 def init_subspace(q):
     """A start for the orthogonal iteration: orthonormal cosines of spread frequencies."""
     n, npc = q.shape
     for k in range(npc):
         for i in range(n):
             q[i, k] = math.cos(math.pi * (k + 0.5) * (i + 0.5) / n)
-        q[:, k] /= math.sqrt(np.sum(q[:, k] ** 2))
+        acc = 0.0                   # element by element: no array expression to compile
+        for i in range(n):
+            acc += q[i, k] ** 2
+        norm = math.sqrt(acc)
+        for i in range(n):
+            q[i, k] /= norm
 
 
-@njit(cache=True)
+@jit(inline='always')
 def analyse(x, q, lam, roots, ratio, rows, undamped=False):
     """The damped sinusoids of window x (module docstring), updating its scale's subspace q,
     eigenvalues lam and poles roots (rows re and im, NaN: none), their lightly damped pairs

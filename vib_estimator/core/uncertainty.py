@@ -52,7 +52,7 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
+from .jit import jit
 
 #: values of the kernel's model parameter
 MODEL_SINUSOID, MODEL_BIASED, MODEL_DAMPED = 0, 1, 2
@@ -68,7 +68,7 @@ STEP_TOL = 1e-3
 N_WORK = 96
 
 
-@njit(cache=True)
+@jit
 def _workspace(work):
     """Named views of the caller's scratch (``N_WORK`` floats): theta, the best theta, J^T r, J^T J,
     its inverse, the best theta's inverse, Gauss-Jordan's augmented matrix and its scaling."""
@@ -77,7 +77,15 @@ def _workspace(work):
             work[60:92].reshape((4, 8)), work[92:96])
 
 
-@njit(cache=True)
+@jit(inline='always')
+def _copy(dst, src):
+    """dst[:n] = src[:n] element by element (numba's array assignment brings its broadcasting and
+    the formatting of its error message into the compile)."""
+    for i in range(src.shape[0]):
+        dst[i] = src[i]
+
+
+@jit
 def _accumulate(model, seg, n, tc, th, jtj, jtr, linear=False):
     """One pass over the segment at theta: J^T J, J^T r into ``jtj``, ``jtr``; returns the RSS.
 
@@ -135,7 +143,7 @@ def _accumulate(model, seg, n, tc, th, jtj, jtr, linear=False):
     return rss
 
 
-@njit(cache=True)
+@jit(inline='always')
 def _store_normal_equations(model, jtj, jtr, upper, rhs):
     """J^T J (symmetric, from its upper triangle row by row) and J^T r; the sinusoid's 4th column
     (not a parameter of it) stays zero."""
@@ -153,7 +161,7 @@ def _store_normal_equations(model, jtj, jtr, upper, rhs):
             jtr[i] = rhs[i]
 
 
-@njit(cache=True)
+@jit
 def _invert(a, idx, m, out, aug, scale):
     """Inverse of the symmetric block a[idx][:, idx] (m x m) into out[:m, :m]; False if singular.
 
@@ -195,7 +203,7 @@ def _invert(a, idx, m, out, aug, scale):
     return True
 
 
-@njit(cache=True)
+@jit(inline='always')
 def _solve_linear(model, seg, n, tc, work):
     """Variable projection: the least-squares a, b (and c) at theta's w (and sigma)."""
     th, _, jtr, jtj, cov, _, aug, scale = _workspace(work)
@@ -203,7 +211,7 @@ def _solve_linear(model, seg, n, tc, work):
     if model == MODEL_BIASED:
         th[3] = 0.0
     _accumulate(model, seg, n, tc, th, jtj, jtr, True)
-    idx = (0, 1, 3)
+    idx = (0, 1, 3, 3)      # a, b, c (the first m); four entries: _invert's one signature
     m = 3 if model == MODEL_BIASED else 2
     if not _invert(jtj, idx, m, cov, aug, scale):
         return False
@@ -215,7 +223,7 @@ def _solve_linear(model, seg, n, tc, work):
     return True
 
 
-@njit(cache=True)
+@jit(inline='always')
 def _newton_step(npar, th, cov, jtr, s2):
     """theta += (J^T J)^-1 J^T r; True if the step of the nonlinear parameters (w, and sigma or c)
     is below ``STEP_TOL`` of their std (s^2 (J^T J)^-1 with the current residual variance ``s2``)
@@ -232,7 +240,7 @@ def _newton_step(npar, th, cov, jtr, s2):
     return small
 
 
-@njit(cache=True)
+@jit
 def _gauss_newton(model, seg, n, iterations, work):
     """Fit theta (``work``) over seg[:, :n]: variable projection at theta's (w, sigma), then
     Gauss-Newton.
@@ -246,24 +254,25 @@ def _gauss_newton(model, seg, n, iterations, work):
     tc = 0.5 * (seg[0, 0] + seg[0, n - 1])
     if not _solve_linear(model, seg, n, tc, work):
         return math.inf
-    best[:] = th
+    _copy(best, th)
     best_rss = math.inf
     for k in range(iterations + 1):
-        rss = _accumulate(model, seg, n, tc, th, jtj, jtr)
+        rss = _accumulate(model, seg, n, tc, th, jtj, jtr, False)
         if not (rss < best_rss and _invert(jtj, (0, 1, 2, 3), npar, cov, aug, scale)):
             break
         best_rss = rss
-        best[:] = th
-        best_cov[:, :] = cov
+        _copy(best, th)
+        for i in range(4):
+            _copy(best_cov[i], cov[i])
         if k == iterations or _newton_step(npar, th, cov, jtr, rss / (n - npar)):
             break
         if not (th[2] > 0.0 and math.isfinite(th[2])):
             break
-    th[:] = best
+    _copy(th, best)
     return best_rss
 
 
-@njit(cache=True)
+@jit(inline='always')
 def _first_prefix(seg, n, npar, w0):
     """Length of the continuation's first window: n halved while it spans at least half a period
     (and 2 npar + 2 samples), so the prefixes double up to n exactly."""
@@ -276,7 +285,7 @@ def _first_prefix(seg, n, npar, w0):
     return m
 
 
-@njit(cache=True)
+@jit
 def refine(model, seg, n, w0, sigma0, iterations, res, work):
     """Refine the algebraic estimate over the segment ``seg[:, :n]`` (rows: tau, y); fill ``res``.
 
@@ -315,7 +324,7 @@ def refine(model, seg, n, w0, sigma0, iterations, res, work):
     return True
 
 
-@njit(cache=True)
+@jit(inline='always')
 def _goodness(seg, n, th, rss, res):
     """R^2 = 1 - RSS / (sum of squares about the mean) of the fitted model, and its amplitude.
 
@@ -333,7 +342,7 @@ def _goodness(seg, n, th, rss, res):
     res[R_AMP] = math.hypot(th[0], th[1])
 
 
-@njit(cache=True)
+@jit
 def _moments_of_result(model, th, cov, s2, res):
     """Frequency, damping ratio and their std from theta and s^2 (J^T J)^-1 (delta method)."""
     w = th[2]
@@ -358,7 +367,7 @@ def _moments_of_result(model, th, cov, s2, res):
     res[R_FSTD] = math.sqrt(var_w) / TWO_PI if var_w >= 0.0 else math.nan
 
 
-@njit(cache=True)
+@jit
 def jacobian_row(model, th, u, row):
     """The Jacobian's row at centred time u (the columns of :func:`_accumulate`) into row[:4]."""
     a, b, w = th[0], th[1], th[2]
@@ -371,7 +380,7 @@ def jacobian_row(model, th, u, row):
     row[3] = 1.0 if model == MODEL_BIASED else -u * e * (a * sn + b * cs)
 
 
-@njit(cache=True)
+@jit
 def coloured_std(model, n, gram, rho0, res, work):
     """Replace the std in ``res`` by the sandwich under coloured noise (module docstring).
 

@@ -1,0 +1,174 @@
+"""The compiled core's outputs, bit for bit, against stored reference results (seeded signal and
+configuration pairs).
+
+A change that only restructures the kernels (compile time, speed) must leave every float as it was:
+this test compares each case's estimate columns and counters with ``data/kernel_reference.npz``
+exactly (NaN equal to NaN). The reference was written by the kernel of 7374e6d with
+``python test/core/test_kernel_reference.py --write``; a change meant to alter the results (a new
+gate rule, a default) rewrites it with that command and says so in its commit.
+
+Each case stores its whole configuration, so a later change of a default does not move the case.
+
+The mode tracker's subspace fit is compiled with fastmath (core.subspace.FAST): its reductions may
+round differently from one process to another (7374e6d itself gives R^2 values 1 ulp apart when a
+process runs only the modes cases), so its float columns are compared to ``MODES_ULP`` units in
+the last place, its counts and stamps exactly.
+"""
+from __future__ import annotations
+
+import dataclasses
+import json
+import pathlib
+import sys
+
+import numpy as np
+import pytest
+
+from vib_estimator.core import EstimatorConfig
+from vib_estimator.core.modes import create_estimator
+
+DATA = pathlib.Path(__file__).parent / 'data' / 'kernel_reference.npz'
+FS = 500.0
+MODES_ULP = 4
+COLUMNS = ('t', 'frequency_hz', 'convergence_time', 'samples', 'fit', 'amplitude', 'damping',
+           'frequency_std_hz', 'damping_std', 'mode')
+
+
+def _signal(kind: str, seed: int):
+    """Seeded test signals (numpy only, so a change in vib_estimator.sim does not move them)."""
+    rng = np.random.default_rng(seed)
+    n = 15000
+    if kind == 'irregular':
+        # jittered stamps, an offset, a NaN, a duplicate, a step back, a gap (restart)
+        t = np.cumsum(rng.uniform(0.6, 1.4, n)) / FS
+        t[9000:] += 1.0
+        t[400] = t[399]
+        t[700], t[701] = t[701], t[700]
+    else:
+        t = np.arange(n) / FS
+    if kind == 'two-modes':
+        y = (np.exp(-0.05 * t) * np.sin(2 * np.pi * 2.3 * t + 0.3)
+             + 0.6 * np.exp(-0.1 * t) * np.sin(2 * np.pi * 7.9 * t + 1.1))
+    else:
+        # a lightly damped mode re-excited every 6 s
+        tr = t % 6.0
+        y = np.exp(-2 * np.pi * 3.1 * 0.01 * tr) * np.sin(2 * np.pi * 3.1 * tr + 0.4)
+        if kind == 'irregular':
+            y = y + 0.2
+    y = y + 0.02 * rng.standard_normal(n)
+    if kind == 'irregular':
+        y[1234] = np.nan
+    return t, y
+
+
+#: (case name, signal kind, seed, configuration changes)
+CASES = [
+    ('default', 'uniform', 1, {}),
+    ('default-irregular', 'irregular', 2, {}),
+    ('refine0', 'uniform', 3, {'refine': 0}),
+    ('min_periods5', 'uniform', 4, {'min_periods': 5.0}),
+    ('band', 'uniform', 5, {'band_hz': (1.0, 10.0)}),
+    ('band-irregular', 'irregular', 6, {'band_hz': (1.0, 10.0)}),
+    ('target', 'uniform', 7, {'target_std_rel': 0.002}),
+    ('target-band', 'uniform', 8, {'target_std_rel': 0.005, 'band_hz': (1.0, 10.0)}),
+    ('damped', 'uniform', 9, {'model': 'damped-sinusoid'}),
+    ('damped-long', 'uniform', 10, {'model': 'damped-sinusoid', 'min_periods': 4.0}),
+    ('damped-band-refine0', 'irregular', 11,
+     {'model': 'damped-sinusoid', 'band_hz': (1.0, 10.0), 'refine': 0}),
+    ('biased', 'irregular', 12, {'model': 'biased-sinusoid'}),
+    ('biased-target', 'irregular', 13, {'model': 'biased-sinusoid', 'target_std_rel': 0.005}),
+    ('one-sided-trapezoid', 'uniform', 14,
+     {'one_sided_test': True, 'rule_points': 2, 'invariant_filter': False}),
+    ('short-window', 'uniform', 15, {'max_window': 0.3, 'window': 5}),
+    ('modes3', 'two-modes', 16, {'modes': 3}),
+    ('modes3-band', 'two-modes', 17, {'modes': 3, 'band_hz': (1.0, 20.0)}),
+]
+
+
+def _config(changes: dict) -> EstimatorConfig:
+    return EstimatorConfig().replace(**changes)
+
+
+def _columns(est) -> dict:
+    return {name: np.asarray(getattr(est, name), dtype=np.float64) for name in COLUMNS}
+
+
+def _run(name, kind, seed, config: EstimatorConfig):
+    """(estimate columns, counters) of a batch run of the case."""
+    t, y = _signal(kind, seed)
+    est = create_estimator(config)
+    cols = _columns(est.process(t, y))
+    counters = est.counters
+    return cols, np.array([counters[k] for k in sorted(counters)], dtype=np.int64)
+
+
+def _assert_same(name, col, got, want) -> None:
+    """Exactly equal (NaN = NaN); the mode tracker's floats to ``MODES_ULP`` (module docstring)."""
+    got = np.asarray(got, dtype=np.float64)
+    if name.startswith('modes') and col not in ('t', 'samples', 'mode'):
+        np.testing.assert_array_equal(np.isnan(got), np.isnan(want), err_msg=col)
+        ok = ~np.isnan(want)
+        np.testing.assert_array_max_ulp(got[ok], want[ok], maxulp=MODES_ULP)
+    else:
+        np.testing.assert_array_equal(got, want, err_msg=col)
+
+
+def write() -> None:
+    """Write the reference of every case (run on the kernel the reference is meant to pin)."""
+    store = {}
+    for name, kind, seed, changes in CASES:
+        config = _config(changes)
+        cols, counters = _run(name, kind, seed, config)
+        for col, v in cols.items():
+            store[f'{name}/{col}'] = v
+        store[f'{name}/counters'] = counters
+        store[f'{name}/config'] = np.array(json.dumps(dataclasses.asdict(config)))
+        print(f'{name:22s} {len(cols["t"]):4d} estimates')
+    DATA.parent.mkdir(exist_ok=True)
+    np.savez_compressed(DATA, **store)
+
+
+@pytest.fixture(scope='module')
+def reference():
+    if not DATA.exists():
+        pytest.fail(f'{DATA} missing: python {__file__} --write (on the pinned kernel)')
+    with np.load(DATA) as data:
+        return {k: data[k] for k in data.files}
+
+
+def _stored_config(reference, name) -> EstimatorConfig:
+    data = json.loads(str(reference[f'{name}/config']))
+    if data.get('band_hz') is not None:
+        data['band_hz'] = tuple(data['band_hz'])
+    fields = {f.name for f in dataclasses.fields(EstimatorConfig)}
+    return EstimatorConfig(**{k: v for k, v in data.items() if k in fields})
+
+
+@pytest.mark.parametrize('name,kind,seed', [c[:3] for c in CASES], ids=[c[0] for c in CASES])
+def test_batch_results_are_bit_identical_to_the_reference(reference, name, kind, seed):
+    cols, counters = _run(name, kind, seed, _stored_config(reference, name))
+    assert len(cols['t']) > 0
+    for col in COLUMNS:
+        _assert_same(name, col, cols[col], reference[f'{name}/{col}'])
+    np.testing.assert_array_equal(counters, reference[f'{name}/counters'])
+
+
+@pytest.mark.parametrize('name', ['default-irregular', 'band', 'target', 'damped', 'biased',
+                                  'modes3'])
+def test_streaming_results_are_bit_identical_to_the_reference(reference, name):
+    kind, seed = next(c[1:3] for c in CASES if c[0] == name)
+    t, y = _signal(kind, seed)
+    est = create_estimator(_stored_config(reference, name))
+    got = []
+    for a, b in zip(t, y):
+        e = est.update(a, b)
+        got.extend(e if isinstance(e, list) else [] if e is None else [e])
+    assert len(got) == len(reference[f'{name}/t']) > 0
+    for col in COLUMNS:
+        _assert_same(name, col, [float(getattr(e, col)) for e in got], reference[f'{name}/{col}'])
+
+
+if __name__ == '__main__':
+    if sys.argv[1:] != ['--write']:
+        sys.exit(f'usage: python {sys.argv[0]} --write')
+    write()

@@ -1,0 +1,42 @@
+"""The compiled core's decorator: numba's ``njit(cache=True)``, compiled once per argument types.
+
+numba types a constant argument (a literal, or a module constant such as a state offset) as
+``Literal[int](value)`` and compiles a called function once per such literal: today's kernel
+compiled its whole refinement chain twice (for ``iterations`` = ``Literal[int](0)`` and for int64),
+the step twice (its row index), ``_advance`` four times (its offsets). :func:`jit` compiles a
+function called from compiled code for the plain types of its arguments only (a literal converts
+to its type at the call; LLVM still folds the constant once it inlines the callee), so each
+function is compiled once per real signature.
+
+``inline='always'`` (numba's IR inlining: no compiled function of its own, typed in its caller) is
+the right choice for a function called from one place: the caller's code is built and optimised
+once instead of once per level of the call tree (numba links each callee's code into its caller
+and optimises and emits the whole again).
+"""
+from __future__ import annotations
+
+from numba import njit, types
+
+
+def _plain(ty):
+    """The type without its literal value (``Literal[int](4)`` -> int64; tuples element-wise)."""
+    if isinstance(ty, types.BaseTuple) and not isinstance(ty, types.BaseNamedTuple):
+        return types.BaseTuple.from_types([_plain(t) for t in ty])
+    return types.unliteral(ty)
+
+
+def jit(fn=None, **options):
+    """``njit(cache=True, **options)``, compiled from compiled callers for unliteral types."""
+    if fn is None:
+        return lambda f: jit(f, **options)
+    dispatcher = njit(cache=True, **options)(fn)
+    if options.get('inline', 'never') != 'never':
+        return dispatcher
+    template = dispatcher.get_call_template
+
+    def get_call_template(args, kws):
+        return template(tuple(_plain(a) for a in args),
+                        {k: _plain(v) for k, v in kws.items()})
+
+    dispatcher.get_call_template = get_call_template
+    return dispatcher
