@@ -19,6 +19,7 @@ from typing import Optional, Tuple
 import numpy as np
 
 from ..core import MODELS, EstimateArrays, EstimatorConfig
+from ..core.config import EXCITATIONS
 from ..core.modes import create_estimator
 from ..io.csv_reader import CsvError
 from ..io.fields import INPUT_TYPES
@@ -29,7 +30,7 @@ _CONFIG_OPTIONS = {
     'lowpass_cutoff_hz': float, 'lowpass_damping': float, 'window': int, 'tolerance': float,
     'min_time': float, 'min_periods': float, 'max_window': float, 'min_fit': float,
     'min_amplitude': float, 'max_damping': float, 'max_gap': float, 'target_std_rel': float,
-    'modes': int, 'refine': int,
+    'modes': int, 'refine': int, 'ambient_window_s': float,
 }
 
 
@@ -48,9 +49,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def add_config_arguments(parser: argparse.ArgumentParser) -> None:
-    """The estimator options (``--model``, ``--band-hz``, one per scalar config field)."""
+    """The estimator options (``--model``, ``--excitation``, ``--band-hz``, one per scalar config
+    field)."""
     defaults = EstimatorConfig()
     parser.add_argument('--model', choices=MODELS, default=defaults.model)
+    parser.add_argument('--excitation', choices=EXCITATIONS, default=defaults.excitation,
+                        help=EstimatorConfig.describe('excitation')[0])
     parser.add_argument('--band-hz', nargs=2, type=float, metavar=('LO', 'HI'),
                         help='band-pass prefilter [LO, HI] Hz (default off)')
     for name, kind in _CONFIG_OPTIONS.items():
@@ -61,7 +65,7 @@ def add_config_arguments(parser: argparse.ArgumentParser) -> None:
 def make_config(args: argparse.Namespace) -> EstimatorConfig:
     """The estimator configuration of the command line (ValueError if out of range)."""
     return EstimatorConfig().replace(
-        model=args.model, band_hz=tuple(args.band_hz) if args.band_hz else None,
+        model=args.model, excitation=args.excitation, band_hz=tuple(args.band_hz) if args.band_hz else None,
         **{name: getattr(args, name) for name in _CONFIG_OPTIONS})
 
 
@@ -164,7 +168,8 @@ def run(args: argparse.Namespace) -> int:
         print(f'vib-estimator analyze: error: {err}', file=sys.stderr)
         return 2
     estimates = result.estimates
-    _print(estimates, signal.origin_ns, args.format, config.modes)
+    _print(estimates, signal.origin_ns, args.format,
+           config.modes or config.excitation == 'ambient')
     counters = result.estimator.counters
     extra = f', messages_without_component={signal.skipped}' if signal.skipped else ''
     print('analyze: ' + ', '.join(f'{k}={v}' for k, v in counters.items()) + extra,

@@ -80,6 +80,8 @@ MAX_TRACKS = 8
 #: a frequency bin counts in the Fisher information of the modes where their density exceeds this
 #: fraction of the noise's
 ACTIVE = 1e-3
+#: Fisher-scoring steps of the Whittle-likelihood refinement
+WHITTLE_STEPS = 4
 #: highest pole frequency kept, in units of the sampling rate
 NU_MAX = 0.45
 #: the second pass's rate puts the highest mode of the first at or below this fraction of it
@@ -123,6 +125,30 @@ def _sdof_psd(e: np.ndarray, frequency_hz: float, zeta: float, variance: float,
     return 0.5 * total.real
 
 
+def _fejer_sum(q: np.ndarray, n: int) -> np.ndarray:
+    """``sum_{k=0}^{n-1} (1 - k/n) q^k`` in closed form."""
+    qn = q ** n
+    one = 1.0 - q
+    return (1.0 - qn) / one - q * (1.0 - n * qn / q + (n - 1) * qn) / (n * one * one)
+
+
+def _sdof_expected(e: np.ndarray, frequency_hz: float, zeta: float, variance: float,
+                   dt: float, n: int) -> np.ndarray:
+    """The expected periodogram of ``n`` samples of the SDOF of :func:`sdof_psd` at
+    ``e = exp(-i w)``: ``sum_{|k|<n} (1 - |k|/n) c_k e^(-i w k)`` in closed form -- its density
+    smeared by the window's Fejer kernel (debiased Whittle, Sykulski et al. 2019: no leakage
+    bias on a lightly damped mode)."""
+    wn = 2 * math.pi * frequency_hz * dt
+    root = math.sqrt(max(1.0 - zeta * zeta, 1e-12))
+    decay = math.exp(-zeta * wn)
+    z = complex(decay * math.cos(wn * root), decay * math.sin(wn * root))
+    a = variance * complex(1.0, -zeta / root)
+    zc = z.conjugate()
+    total = (a * (_fejer_sum(z * e, n) + _fejer_sum(z / e, n) - 1.0)
+             + a.conjugate() * (_fejer_sum(zc * e, n) + _fejer_sum(zc / e, n) - 1.0))
+    return 0.5 * total.real
+
+
 def peak_ratio(frequency_hz: float, zeta: float, variance: float, noise_var: float,
                dt: float) -> float:
     """A mode's spectral density at its frequency over the white noise's (:func:`sdof_psd`)."""
@@ -143,6 +169,27 @@ def _active_bins(modes, noise_var: float, dt: float, n: int) -> np.ndarray:
     return np.flatnonzero(keep)
 
 
+def _log_density_gradient(e: np.ndarray, modes, noise_var: float, dt: float, density=None):
+    """The model's density ``S`` at ``e = exp(-i w)`` and the gradient of ``ln S`` with respect
+    to (f, zeta, variance of each mode, the noise variance), one row each (``density``: a mode's
+    density function of (e, f, zeta, variance, dt), :func:`_sdof_psd` if none)."""
+    density = density or _sdof_psd
+    parts = [density(e, f, z, v, dt) for f, z, v in modes]
+    total = noise_var + (np.sum(parts, axis=0) if parts else 0.0)
+    grads = []
+    for (f, z, v), part in zip(modes, parts):
+        for i, x in enumerate((f, z)):
+            h = 1e-6 * x
+            hi = [f, z, v]
+            lo = [f, z, v]
+            hi[i] += h
+            lo[i] -= h
+            grads.append((density(e, *hi, dt) - density(e, *lo, dt)) / (2 * h))
+        grads.append(part / v)
+    grads.append(np.ones(len(e)))
+    return total, np.array(grads) / total
+
+
 def whittle_fisher(modes: Sequence[Tuple[float, float, float]], noise_var: float, fs: float,
                    n: int) -> np.ndarray:
     """Fisher information of the Whittle likelihood of ``n`` samples at ``fs`` of a sum of
@@ -154,24 +201,57 @@ def whittle_fisher(modes: Sequence[Tuple[float, float, float]], noise_var: float
     precision) information on the noise level only, and are counted as such."""
     dt = 1.0 / fs
     bins = _active_bins(modes, noise_var, dt, n)
-    e = np.exp(-2j * math.pi * bins / n)
-    parts = [_sdof_psd(e, f, z, v, dt) for f, z, v in modes]
-    total = noise_var + (np.sum(parts, axis=0) if parts else 0.0)
-    grads = []
-    for (f, z, v), part in zip(modes, parts):
-        for i, x in enumerate((f, z)):
-            h = 1e-6 * x
-            hi = [f, z, v]
-            lo = [f, z, v]
-            hi[i] += h
-            lo[i] -= h
-            grads.append((_sdof_psd(e, *hi, dt) - _sdof_psd(e, *lo, dt)) / (2 * h))
-        grads.append(part / v)
-    grads.append(np.ones(len(bins)))
-    d = np.array(grads) / total
+    _, d = _log_density_gradient(np.exp(-2j * math.pi * bins / n), modes, noise_var, dt)
     fisher = d @ d.T
     fisher[-1, -1] += ((n + 1) // 2 - 1 - len(bins)) / noise_var ** 2
     return fisher
+
+
+def whittle_refine(y: np.ndarray, fs: float, modes, noise_var: float):
+    """Maximum-(debiased-)Whittle-likelihood refinement of ``modes`` [(f, zeta, variance)] and
+    the local white-noise level from the window's periodogram (its expectation
+    :func:`_sdof_expected` as the model), over the bins near the modes
+    (:func:`_active_bins`): :data:`WHITTLE_STEPS` Fisher-scoring steps, each halved until the
+    likelihood rises and the parameters stay physical. Returns (modes, noise variance)."""
+    n = len(y)
+    dt = 1.0 / fs
+    bins = _active_bins(modes, noise_var, dt, n)
+    if not len(modes) or not len(bins):
+        return modes, noise_var
+    periodogram = np.abs(np.fft.rfft(y - y.mean())[bins]) ** 2 / n
+    e = np.exp(-2j * math.pi * bins / n)
+    theta = np.array([x for m in modes for x in m] + [noise_var])
+
+    def density(ee, f, z, v, dtt):
+        return _sdof_expected(ee, f, z, v, dtt, n)
+
+    def unpack(th):
+        return [tuple(th[3 * j:3 * j + 3]) for j in range(len(modes))], th[-1]
+
+    def cost(th):
+        m, nv = unpack(th)
+        if nv <= 0 or any(not (0 < z < 1 and v > 0 and f > 0) for f, z, v in m):
+            return math.inf
+        total = nv + np.sum([density(e, *mm, dt) for mm in m], axis=0)
+        return float(np.sum(np.log(total) + periodogram / total))
+
+    best = cost(theta)
+    for _ in range(WHITTLE_STEPS):
+        total, d = _log_density_gradient(e, *unpack(theta), dt, density)
+        try:
+            step = np.linalg.solve(d @ d.T, d @ (periodogram / total - 1.0))
+        except np.linalg.LinAlgError:
+            break
+        for _ in range(6):
+            trial = theta + step
+            value = cost(trial)
+            if value < best:
+                theta, best = trial, value
+                break
+            step *= 0.5
+        else:
+            break
+    return unpack(theta)
 
 
 def whittle_std(modes: Sequence[Tuple[float, float, float]], noise_var: float, fs: float,
@@ -335,6 +415,10 @@ def identify(y: np.ndarray, fs: float, max_damping: float = 0.1,
             modes, noise = _strong(_modes_at(yq, rate, max_damping, band, counts), total, fs,
                                    counts)
     triples = [(f, z, v) for f, z, v, _ in modes]
+    refined, local = whittle_refine(y, fs, triples, noise)
+    if all(abs(a[0] / b[0] - 1) <= MATCH_TOL for a, b in zip(refined, triples)):
+        triples, noise = refined, local
+        modes = np.array([(*m, 1.0) for m in triples]).reshape(-1, 4)
     stds = np.array(whittle_std(triples, noise, fs, len(y))).reshape(-1, 2)
     out = np.column_stack((modes[:, :3], stds)) if len(modes) else np.empty((0, 5))
     weak = ~(out[:, 3] <= MAX_STD_REL * out[:, 0])
