@@ -60,7 +60,7 @@ HOP_S = 1.0
 #: block rows p of the correlation Hankel matrix (lags 1 .. 2p)
 BLOCK_ROWS = 40
 #: model orders of the stabilisation diagram
-ORDERS = tuple(range(4, 31, 2))
+ORDERS = tuple(range(4, 31, 4))
 #: neighbouring poles within this relative frequency join one cluster
 CLUSTER_TOL = 0.004
 #: a cluster spans at most this relative frequency range
@@ -73,15 +73,15 @@ MIN_PEAK_RATIO = 4.0
 MAX_STD_REL = 0.02
 #: a window's mode continues a tracked mode within this relative frequency
 MATCH_TOL = 0.03
+#: while modes are known, one analysis in this many searches the full rate for higher ones
+SEARCH_EVERY = 5
 #: consecutive analyses that must see a new mode before it publishes
 CONFIRM = 3
 #: most modes tracked at once
 MAX_TRACKS = 8
 #: a frequency bin counts in the Fisher information of the modes where their density exceeds this
 #: fraction of the noise's
-ACTIVE = 1e-3
-#: Fisher-scoring steps of the Whittle-likelihood refinement
-WHITTLE_STEPS = 4
+ACTIVE = 1e-2
 #: highest pole frequency kept, in units of the sampling rate
 NU_MAX = 0.45
 #: the second pass's rate puts the highest mode of the first at or below this fraction of it
@@ -125,30 +125,6 @@ def _sdof_psd(e: np.ndarray, frequency_hz: float, zeta: float, variance: float,
     return 0.5 * total.real
 
 
-def _fejer_sum(q: np.ndarray, n: int) -> np.ndarray:
-    """``sum_{k=0}^{n-1} (1 - k/n) q^k`` in closed form."""
-    qn = q ** n
-    one = 1.0 - q
-    return (1.0 - qn) / one - q * (1.0 - n * qn / q + (n - 1) * qn) / (n * one * one)
-
-
-def _sdof_expected(e: np.ndarray, frequency_hz: float, zeta: float, variance: float,
-                   dt: float, n: int) -> np.ndarray:
-    """The expected periodogram of ``n`` samples of the SDOF of :func:`sdof_psd` at
-    ``e = exp(-i w)``: ``sum_{|k|<n} (1 - |k|/n) c_k e^(-i w k)`` in closed form -- its density
-    smeared by the window's Fejer kernel (debiased Whittle, Sykulski et al. 2019: no leakage
-    bias on a lightly damped mode)."""
-    wn = 2 * math.pi * frequency_hz * dt
-    root = math.sqrt(max(1.0 - zeta * zeta, 1e-12))
-    decay = math.exp(-zeta * wn)
-    z = complex(decay * math.cos(wn * root), decay * math.sin(wn * root))
-    a = variance * complex(1.0, -zeta / root)
-    zc = z.conjugate()
-    total = (a * (_fejer_sum(z * e, n) + _fejer_sum(z / e, n) - 1.0)
-             + a.conjugate() * (_fejer_sum(zc * e, n) + _fejer_sum(zc / e, n) - 1.0))
-    return 0.5 * total.real
-
-
 def peak_ratio(frequency_hz: float, zeta: float, variance: float, noise_var: float,
                dt: float) -> float:
     """A mode's spectral density at its frequency over the white noise's (:func:`sdof_psd`)."""
@@ -169,11 +145,10 @@ def _active_bins(modes, noise_var: float, dt: float, n: int) -> np.ndarray:
     return np.flatnonzero(keep)
 
 
-def _log_density_gradient(e: np.ndarray, modes, noise_var: float, dt: float, density=None):
+def _log_density_gradient(e: np.ndarray, modes, noise_var: float, dt: float):
     """The model's density ``S`` at ``e = exp(-i w)`` and the gradient of ``ln S`` with respect
-    to (f, zeta, variance of each mode, the noise variance), one row each (``density``: a mode's
-    density function of (e, f, zeta, variance, dt), :func:`_sdof_psd` if none)."""
-    density = density or _sdof_psd
+    to (f, zeta, variance of each mode, the noise variance), one row each."""
+    density = _sdof_psd
     parts = [density(e, f, z, v, dt) for f, z, v in modes]
     total = noise_var + (np.sum(parts, axis=0) if parts else 0.0)
     grads = []
@@ -205,53 +180,6 @@ def whittle_fisher(modes: Sequence[Tuple[float, float, float]], noise_var: float
     fisher = d @ d.T
     fisher[-1, -1] += ((n + 1) // 2 - 1 - len(bins)) / noise_var ** 2
     return fisher
-
-
-def whittle_refine(y: np.ndarray, fs: float, modes, noise_var: float):
-    """Maximum-(debiased-)Whittle-likelihood refinement of ``modes`` [(f, zeta, variance)] and
-    the local white-noise level from the window's periodogram (its expectation
-    :func:`_sdof_expected` as the model), over the bins near the modes
-    (:func:`_active_bins`): :data:`WHITTLE_STEPS` Fisher-scoring steps, each halved until the
-    likelihood rises and the parameters stay physical. Returns (modes, noise variance)."""
-    n = len(y)
-    dt = 1.0 / fs
-    bins = _active_bins(modes, noise_var, dt, n)
-    if not len(modes) or not len(bins):
-        return modes, noise_var
-    periodogram = np.abs(np.fft.rfft(y - y.mean())[bins]) ** 2 / n
-    e = np.exp(-2j * math.pi * bins / n)
-    theta = np.array([x for m in modes for x in m] + [noise_var])
-
-    def density(ee, f, z, v, dtt):
-        return _sdof_expected(ee, f, z, v, dtt, n)
-
-    def unpack(th):
-        return [tuple(th[3 * j:3 * j + 3]) for j in range(len(modes))], th[-1]
-
-    def cost(th):
-        m, nv = unpack(th)
-        if nv <= 0 or any(not (0 < z < 1 and v > 0 and f > 0) for f, z, v in m):
-            return math.inf
-        total = nv + np.sum([density(e, *mm, dt) for mm in m], axis=0)
-        return float(np.sum(np.log(total) + periodogram / total))
-
-    best = cost(theta)
-    for _ in range(WHITTLE_STEPS):
-        total, d = _log_density_gradient(e, *unpack(theta), dt, density)
-        try:
-            step = np.linalg.solve(d @ d.T, d @ (periodogram / total - 1.0))
-        except np.linalg.LinAlgError:
-            break
-        for _ in range(6):
-            trial = theta + step
-            value = cost(trial)
-            if value < best:
-                theta, best = trial, value
-                break
-            step *= 0.5
-        else:
-            break
-    return unpack(theta)
 
 
 def whittle_std(modes: Sequence[Tuple[float, float, float]], noise_var: float, fs: float,
@@ -399,15 +327,19 @@ def _strong(modes: np.ndarray, total: float, fs: float, counts: Dict[str, int]):
 
 def identify(y: np.ndarray, fs: float, max_damping: float = 0.1,
              band: Tuple[float, float] = (0.0, math.inf), counts: Dict[str, int] = None,
-             top_hz: float = 0.0):
+             top_hz: float = 0.0, search: bool = True):
     """Modes of one window ``y`` sampled at ``fs``: (rows of frequency, damping, variance,
     frequency std, damping std, ascending; the white noise variance left over; the window's
     variance). A first pass at ``fs`` finds the highest mode (or ``top_hz``, the highest mode
-    known, if higher); when it lies low enough, the modes come from a second pass at the rate
+    known, if higher; with ``search`` false and ``top_hz`` given, no first pass); when it lies
+    low enough, the modes come from a second pass at the rate
     :func:`decimate` gives, over whose lags (``BLOCK_ROWS`` samples) close modes are resolved."""
     counts = dict.fromkeys(COUNTER_NAMES, 0) if counts is None else counts
     total = float(np.var(y))
-    modes, noise = _strong(_modes_at(y, fs, max_damping, band, counts), total, fs, counts)
+    if search or top_hz <= 0:
+        modes, noise = _strong(_modes_at(y, fs, max_damping, band, counts), total, fs, counts)
+    else:
+        modes, noise = np.empty((0, 4)), total
     top = max(float(np.max(modes[:, 0])) if len(modes) else 0.0, top_hz)
     if top > 0:
         yq, rate = decimate(y, fs, top)
@@ -415,10 +347,6 @@ def identify(y: np.ndarray, fs: float, max_damping: float = 0.1,
             modes, noise = _strong(_modes_at(yq, rate, max_damping, band, counts), total, fs,
                                    counts)
     triples = [(f, z, v) for f, z, v, _ in modes]
-    refined, local = whittle_refine(y, fs, triples, noise)
-    if all(abs(a[0] / b[0] - 1) <= MATCH_TOL for a, b in zip(refined, triples)):
-        triples, noise = refined, local
-        modes = np.array([(*m, 1.0) for m in triples]).reshape(-1, 4)
     stds = np.array(whittle_std(triples, noise, fs, len(y))).reshape(-1, 2)
     out = np.column_stack((modes[:, :3], stds)) if len(modes) else np.empty((0, 5))
     weak = ~(out[:, 3] <= MAX_STD_REL * out[:, 0])
@@ -573,8 +501,9 @@ class AmbientEstimator:
         fs = (n - 1) / span
         self._c['analyses'] += 1
         known = max((tr.frequency for tr in self._tracks if tr.published), default=0.0)
+        search = self._c['analyses'] % SEARCH_EVERY == 1
         modes, _noise, total = identify(ys, fs, self._config.max_damping, self._band, self._c,
-                                        known)
+                                        known, search)
         return self._track(modes, total, float(t_end), span, n)
 
     def _track(self, modes: np.ndarray, total: float, t: float, span: float,
