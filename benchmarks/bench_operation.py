@@ -2,6 +2,7 @@
 vs the Whittle bound at the window used.
 
     .venv/bin/python benchmarks/bench_operation.py [--seeds 3] [--window 30] [--no-peer]
+        [--real-data ../shared/real-data] [--real-only]
 
 Synthetic records (``vib_estimator.sim.ambient``: white-noise-driven modes, 500 Hz, 180 s, the
 estimates of the whole record, i.e. from the first full window on) and the real Heritage Court
@@ -49,8 +50,8 @@ CASES = {
         [(3.0, 0.02, 1.0), (11.0, 0.01, 0.5), (23.0, 0.005, 0.2)], 25.0),
     'close pair 8 / 8.8 Hz, zeta 1 %, 26 dB': ([(8.0, 0.01, 1.0), (8.8, 0.01, 0.8)], 26.0),
 }
-HCT = Path(__file__).resolve().parents[1] / '..' / 'shared' / 'real-data' / \
-    'heritage_court_tower' / 'hct_setup1.csv'
+REAL_DATA = Path(__file__).resolve().parents[2] / 'shared' / 'real-data'
+HCT_FILE = Path('heritage_court_tower') / 'hct_setup1.csv'
 HCT_MODES = (1.23, 1.29, 1.45, 3.85, 4.26, 5.35)
 PEER_WINDOW_S = 20.0
 PEER_ORDER = 20
@@ -152,11 +153,12 @@ def synthetic(seeds, window, peer):
         sys.stdout.flush()
 
 
-def real_hct(peer):
-    if not HCT.exists():
-        print(f'\n(Heritage Court Tower record not found at {HCT}: skipped)')
+def real_hct(peer, real_data):
+    hct = Path(real_data) / HCT_FILE
+    if not hct.exists():
+        print(f'\n(Heritage Court Tower record not found at {hct}: skipped)')
         return
-    data = np.loadtxt(HCT, delimiter=',', skiprows=1)
+    data = np.loadtxt(hct, delimiter=',', skiprows=1)
     t, y = data[:, 0], data[:, 2]          # ch2
     config = EstimatorConfig(excitation='ambient', ambient_window_s=120.0, band_hz=(0.5, 6.0))
     e, elapsed = ours(t, y, config)
@@ -190,9 +192,13 @@ def main():
     parser.add_argument('--seeds', type=int, default=3)
     parser.add_argument('--window', type=float, default=30.0)
     parser.add_argument('--no-peer', action='store_true')
+    parser.add_argument('--real-data', default=str(REAL_DATA),
+                        help='the shared real-data folder (default ../shared/real-data)')
+    parser.add_argument('--real-only', action='store_true', help='only the real record')
     args = parser.parse_args()
-    synthetic(args.seeds, args.window, not args.no_peer)
-    real_hct(not args.no_peer)
+    if not args.real_only:
+        synthetic(args.seeds, args.window, not args.no_peer)
+    real_hct(not args.no_peer, args.real_data)
 
 
 if __name__ == '__main__':
