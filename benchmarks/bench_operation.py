@@ -21,13 +21,12 @@ from __future__ import annotations
 
 import argparse
 import logging
-import os
 import math
+import os
 import sys
 import time
-from pathlib import Path
-
 import warnings
+from pathlib import Path
 
 import numpy as np
 
@@ -61,9 +60,9 @@ PEER_HC = {'xi_max': 0.2, 'mpc_lim': None, 'mpd_lim': None, 'CoV_max': None}
 
 def peer_ssi(t, y, fs, freqs):
     """pyOMA2 SSI-cov on consecutive 20 s windows: {true frequency: [(f, zeta)]}."""
-    from scipy.signal import decimate
     from pyoma2.algorithms import SSI
     from pyoma2.setup import SingleSetup
+    from scipy.signal import decimate
 
     q = max(1, int(fs // (4 * max(freqs))))
     out = {f: [] for f in freqs}
@@ -78,7 +77,7 @@ def peer_ssi(t, y, fs, freqs):
         setup.run_by_name('cov')
         try:
             setup.mpe('cov', sel_freq=list(freqs), order_in=PEER_ORDER)
-        except Exception:        # noqa: BLE001 -- pyOMA2 raises plain errors when a mode is absent
+        except Exception:        # noqa: BLE001, S112 -- pyOMA2 raises plain errors (mode absent)
             continue
         res = algo.result
         for f, fn, xi in zip(freqs, np.ravel(res.Fn), np.ravel(res.Xi)):
@@ -171,7 +170,8 @@ def real_hct(peer, real_data):
           f'cost {t[-1] / elapsed:.0f}x real time')
     for k in sorted(set(e.mode)):
         m = e.mode == k
-        print(f'  mode {k}: {np.count_nonzero(m)} estimates, median {np.median(e.frequency_hz[m]):.3f} Hz, '
+        print(f'  mode {k}: {np.count_nonzero(m)} estimates, '
+              f'median {np.median(e.frequency_hz[m]):.3f} Hz, '
               f'damping {100 * np.median(e.damping[m]):.2f} %, '
               f'median std {np.median(e.frequency_std_hz[m]):.4f} Hz')
     if peer:

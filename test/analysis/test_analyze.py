@@ -4,9 +4,9 @@ import json
 import numpy as np
 import pytest
 
-from vib_estimator.io.bags import WrenchSeries, write_wrench_series
 from vib_estimator.cli import main
 from vib_estimator.core import EstimatorConfig, estimate
+from vib_estimator.io.bags import WrenchSeries, write_wrench_series
 from vib_estimator.io.fields import seconds_since
 
 
@@ -108,7 +108,7 @@ def test_unknown_topic_lists_the_available_ones(tmp_path, capsys, samples):
 def test_every_input_type_of_a_bag_and_the_topic_choice(tmp_path, capsys, samples):
     """An Imu topic (component checked against its type), a Float64 topic (log time), and the
     default topic refused when there are several."""
-    from vib_estimator.io.bags import BagWriter, TYPESTORE
+    from vib_estimator.io.bags import TYPESTORE, BagWriter
 
     t, y = samples
     stamps = 1_700_000_000_000_000_000 + np.round(t * 1e9).astype(np.int64)

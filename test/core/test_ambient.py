@@ -5,7 +5,12 @@ import numpy as np
 import pytest
 
 from vib_estimator.core import EstimatorConfig, FrequencyEstimator
-from vib_estimator.core.ambient import AmbientEstimator, sdof_psd, whittle_fisher, whittle_std
+from vib_estimator.core.ambient import (
+    AmbientEstimator,
+    sdof_psd,
+    whittle_fisher,
+    whittle_std,
+)
 from vib_estimator.core.modes import create_estimator
 from vib_estimator.sim.ambient import ambient_record
 from vib_estimator.sim.signals import fig1_signal

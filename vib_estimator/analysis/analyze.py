@@ -65,7 +65,8 @@ def add_config_arguments(parser: argparse.ArgumentParser) -> None:
 def make_config(args: argparse.Namespace) -> EstimatorConfig:
     """The estimator configuration of the command line (ValueError if out of range)."""
     return EstimatorConfig().replace(
-        model=args.model, excitation=args.excitation, band_hz=tuple(args.band_hz) if args.band_hz else None,
+        model=args.model, excitation=args.excitation,
+        band_hz=tuple(args.band_hz) if args.band_hz else None,
         **{name: getattr(args, name) for name in _CONFIG_OPTIONS})
 
 

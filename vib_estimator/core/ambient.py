@@ -16,7 +16,8 @@ Method, per analysis (every :data:`HOP_S` of input once ``ambient_window_s`` of 
    SVD ``H = U S V^T``; at each model order n = :data:`ORDERS` the observability matrix
    ``O = U_n S_n^1/2``, the state matrix ``A = O_up^+ O_down`` and the output/next-state
    covariance ``G`` (first column of ``S_n^1/2 V_n^T``). Each eigenvalue ``lambda`` of ``A`` gives a
-   pole ``s = ln(lambda) fs``: frequency ``|s| / 2 pi``, damping ratio ``-Re s / |s|``, and, from the
+   pole ``s = ln(lambda) fs``: frequency ``|s| / 2 pi``, damping ratio ``-Re s / |s|``, and, from
+   the
    modal decomposition ``R_k = sum_m c_m g_m lambda_m^(k-1)``, the mode's share of the variance.
 2. **Physical or spurious** (automated OMA): poles with a damping ratio outside
    (0, ``max_damping``], or above 0.45 fs (or outside ``band_hz`` when set), are dropped
@@ -47,7 +48,7 @@ counted; a gap or a backward jump longer than ``max_gap`` starts a new window (`
 from __future__ import annotations
 
 import math
-from typing import Dict, List, Sequence, Tuple
+from collections.abc import Sequence
 
 import numpy as np
 from scipy.signal import butter, sosfiltfilt
@@ -96,7 +97,8 @@ DECIMATE_SOS = butter(8, 0.45, output='sos')
 
 COUNTER_NAMES = ('received', 'used', 'skipped_non_finite', 'skipped_duplicate',
                  'skipped_out_of_order', 'time_jump_resets', 'gap_resets', 'analyses',
-                 'rejected_damping', 'rejected_unstable', 'rejected_weak', 'rejected_uncertain', 'modes_found',
+                 'rejected_damping', 'rejected_unstable', 'rejected_weak', 'rejected_uncertain',
+                 'modes_found',
                  'modes_lost', 'estimates')
 
 
@@ -117,7 +119,8 @@ def _sdof_psd(e: np.ndarray, frequency_hz: float, zeta: float, variance: float,
     """:func:`sdof_psd` at ``e = exp(-i w)``."""
     wn = 2 * math.pi * frequency_hz * dt
     root = math.sqrt(max(1.0 - zeta * zeta, 1e-12))
-    z = complex(math.exp(-zeta * wn) * math.cos(wn * root), math.exp(-zeta * wn) * math.sin(wn * root))
+    decay = math.exp(-zeta * wn)
+    z = complex(decay * math.cos(wn * root), decay * math.sin(wn * root))
     a = variance * complex(1.0, -zeta / root)
     zc = z.conjugate()
     total = (a * (1.0 / (1.0 - z * e) + 1.0 / (1.0 - z / e) - 1.0)
@@ -165,7 +168,7 @@ def _log_density_gradient(e: np.ndarray, modes, noise_var: float, dt: float):
     return total, np.array(grads) / total
 
 
-def whittle_fisher(modes: Sequence[Tuple[float, float, float]], noise_var: float, fs: float,
+def whittle_fisher(modes: Sequence[tuple[float, float, float]], noise_var: float, fs: float,
                    n: int) -> np.ndarray:
     """Fisher information of the Whittle likelihood of ``n`` samples at ``fs`` of a sum of
     noise-driven SDOFs ``modes`` = [(frequency Hz, damping ratio, variance)] plus white noise of
@@ -182,8 +185,8 @@ def whittle_fisher(modes: Sequence[Tuple[float, float, float]], noise_var: float
     return fisher
 
 
-def whittle_std(modes: Sequence[Tuple[float, float, float]], noise_var: float, fs: float,
-                n: int) -> List[Tuple[float, float]]:
+def whittle_std(modes: Sequence[tuple[float, float, float]], noise_var: float, fs: float,
+                n: int) -> list[tuple[float, float]]:
     """The Whittle (asymptotic Cramer-Rao) bound of each mode's frequency (Hz) and damping ratio,
     as standard deviations, over ``n`` samples (see :func:`whittle_fisher`); NaN if singular."""
     if not modes:
@@ -205,14 +208,14 @@ def correlations(y: np.ndarray, lags: int) -> np.ndarray:
     mean-removed ``y`` (by FFT)."""
     n = len(y)
     y = y - y.mean()
-    size = 1 << int(math.ceil(math.log2(n + lags + 1)))
+    size = 1 << math.ceil(math.log2(n + lags + 1))
     spec = np.fft.rfft(y, size)
     r = np.fft.irfft(spec * np.conj(spec), size)[:lags + 1]
     return r / np.arange(n, n - lags - 1, -1)
 
 
 def ssi_poles(r: np.ndarray, fs: float, rows: int = BLOCK_ROWS,
-              orders: Sequence[int] = ORDERS) -> List[np.ndarray]:
+              orders: Sequence[int] = ORDERS) -> list[np.ndarray]:
     """SSI-cov poles of correlations ``r`` at each model order: one array per order with a row
     (frequency Hz, damping ratio, variance of the mode) per complex pair (upper half plane)."""
     hankel = r[1 + np.add.outer(np.arange(rows), np.arange(rows))]
@@ -248,8 +251,8 @@ def ssi_poles(r: np.ndarray, fs: float, rows: int = BLOCK_ROWS,
     return out
 
 
-def cluster_modes(poles: List[np.ndarray], fs: float, max_damping: float,
-                  band: Tuple[float, float], counts: Dict[str, int]) -> np.ndarray:
+def cluster_modes(poles: list[np.ndarray], fs: float, max_damping: float,
+                  band: tuple[float, float], counts: dict[str, int]) -> np.ndarray:
     """The physical modes of a stabilisation diagram ``poles`` (:func:`ssi_poles`): rows
     (frequency, damping, variance, support), ascending; counts the rejected poles/clusters."""
     rows = []
@@ -278,7 +281,7 @@ def cluster_modes(poles: List[np.ndarray], fs: float, max_damping: float,
     return np.array(modes).reshape(-1, 4)
 
 
-def decimate(y: np.ndarray, fs: float, top_hz: float) -> Tuple[np.ndarray, float]:
+def decimate(y: np.ndarray, fs: float, top_hz: float) -> tuple[np.ndarray, float]:
     """``y`` at the lowest rate fs / 2^k that keeps ``top_hz`` at or below :data:`TOP_NU` of it
     and :data:`MIN_SAMPLES` samples in the window (each halving behind the zero-phase anti-alias
     filter :data:`DECIMATE_SOS`): ``(samples, rate)``."""
@@ -288,8 +291,8 @@ def decimate(y: np.ndarray, fs: float, top_hz: float) -> Tuple[np.ndarray, float
     return y, fs
 
 
-def _modes_at(y: np.ndarray, fs: float, max_damping: float, band: Tuple[float, float],
-              counts: Dict[str, int]) -> np.ndarray:
+def _modes_at(y: np.ndarray, fs: float, max_damping: float, band: tuple[float, float],
+              counts: dict[str, int]) -> np.ndarray:
     """The clustered modes (:func:`cluster_modes`) of ``y`` at ``fs``, poles up to
     :data:`NU_MAX` fs in ``band``; clusters closer than :data:`MERGE_TOL` are one mode (the one
     with the larger support)."""
@@ -305,7 +308,7 @@ def _modes_at(y: np.ndarray, fs: float, max_damping: float, band: Tuple[float, f
     return np.array(keep).reshape(-1, 4)
 
 
-def _strong(modes: np.ndarray, total: float, fs: float, counts: Dict[str, int]):
+def _strong(modes: np.ndarray, total: float, fs: float, counts: dict[str, int]):
     """The ``modes`` whose peak stands :data:`MIN_PEAK_RATIO` above the density of everything
     else at its frequency (the white noise -- the variance ``total`` less the modes' -- and the
     other modes' skirts), and that noise variance."""
@@ -326,7 +329,7 @@ def _strong(modes: np.ndarray, total: float, fs: float, counts: Dict[str, int]):
 
 
 def identify(y: np.ndarray, fs: float, max_damping: float = 0.1,
-             band: Tuple[float, float] = (0.0, math.inf), counts: Dict[str, int] = None,
+             band: tuple[float, float] = (0.0, math.inf), counts: dict[str, int] | None = None,
              top_hz: float = 0.0, search: bool = True):
     """Modes of one window ``y`` sampled at ``fs``: (rows of frequency, damping, variance,
     frequency std, damping std, ascending; the white noise variance left over; the window's
@@ -358,7 +361,7 @@ def identify(y: np.ndarray, fs: float, max_damping: float = 0.1,
 class _Track:
     """A mode followed across windows."""
 
-    __slots__ = ('frequency', 'seen', 'last_t', 'published', 'amplitude')
+    __slots__ = ('amplitude', 'frequency', 'last_t', 'published', 'seen')
 
     def __init__(self, frequency: float, t: float):
         self.frequency, self.seen, self.last_t, self.published = frequency, 1, t, False
@@ -376,7 +379,7 @@ class AmbientEstimator:
         self._c = dict.fromkeys(COUNTER_NAMES, 0)
         self._t = np.empty(1 << 14)
         self._y = np.empty(1 << 14)
-        self._tracks: List[_Track] = []
+        self._tracks: list[_Track] = []
         self.restart()
 
     @property
@@ -384,7 +387,7 @@ class AmbientEstimator:
         return self._config
 
     @property
-    def counters(self) -> Dict[str, int]:
+    def counters(self) -> dict[str, int]:
         return dict(self._c)
 
     def restart(self) -> None:
@@ -409,7 +412,7 @@ class AmbientEstimator:
         if self._n + m > len(self._t):
             keep = self._n - self._start
             if keep + m > len(self._t) // 2:      # grow
-                size = 1 << int(math.ceil(math.log2(2 * (keep + m))))
+                size = 1 << math.ceil(math.log2(2 * (keep + m)))
                 self._t = np.concatenate((self._t[self._start:self._n], np.empty(size - keep)))
                 self._y = np.concatenate((self._y[self._start:self._n], np.empty(size - keep)))
             else:                                  # compact
@@ -444,7 +447,7 @@ class AmbientEstimator:
         c['used'] += 1
         return True
 
-    def update(self, t: float, y: float) -> List[Estimate]:
+    def update(self, t: float, y: float) -> list[Estimate]:
         """Feed one sample; the estimates of an analysis it completes (ascending mode)."""
         t, y = float(t), float(y)
         if not self._accept(t, y):
@@ -457,7 +460,7 @@ class AmbientEstimator:
     def process(self, t: Sequence[float], y: Sequence[float]) -> EstimateArrays:
         """Feed arrays of samples (continuing the stream); the estimates as columns, by time."""
         t, y = as_series(t, y)
-        out: List[Estimate] = []
+        out: list[Estimate] = []
         i, n = 0, len(t)
         while i < n:
             # the longest clean run from i: finite, increasing, no gap (else one sample at a time)
@@ -465,7 +468,8 @@ class AmbientEstimator:
             if math.isfinite(t[i]) and math.isfinite(y[i]) and t[i] > self._last \
                     and (t[i] - self._last <= self._config.max_gap or not self._n):
                 d = np.diff(t[i:min(n, i + 65536)])
-                bad = ~((d > 0) & (d <= self._config.max_gap)) | ~np.isfinite(y[i + 1:i + 1 + len(d)])
+                bad = (~((d > 0) & (d <= self._config.max_gap))
+                       | ~np.isfinite(y[i + 1:i + 1 + len(d)]))
                 j = i + 1 + (int(np.argmax(bad)) if bad.any() else len(d))
             if j == i:
                 out.extend(self.update(t[i], y[i]))
@@ -485,7 +489,7 @@ class AmbientEstimator:
         return _columns(out)
 
     # ---- analysis -----------------------------------------------------------------------------
-    def _analyse(self) -> List[Estimate]:
+    def _analyse(self) -> list[Estimate]:
         t_end = self._t[self._n - 1]
         self._next += HOP_S
         if self._next <= t_end:
@@ -507,12 +511,12 @@ class AmbientEstimator:
         return self._track(modes, total, float(t_end), span, n)
 
     def _track(self, modes: np.ndarray, total: float, t: float, span: float,
-               n: int) -> List[Estimate]:
+               n: int) -> list[Estimate]:
         """Match the window's modes to the tracked ones, publish the confirmed ones."""
         tracks = self._tracks
         pairs = sorted((abs(m[0] / tr.frequency - 1), i, j) for i, m in enumerate(modes)
                        for j, tr in enumerate(tracks))
-        match: Dict[int, int] = {}
+        match: dict[int, int] = {}
         used = set()
         pairs.sort(key=lambda p: (not tracks[p[2]].published, p[0]))   # published ones first
         for dist, i, j in pairs:
@@ -556,7 +560,7 @@ class AmbientEstimator:
         return out
 
 
-def _columns(estimates: List[Estimate]) -> EstimateArrays:
+def _columns(estimates: list[Estimate]) -> EstimateArrays:
     """Estimates as the columns of :class:`EstimateArrays`."""
     names = list(EstimateArrays.__dataclass_fields__)
     ints = ('samples', 'mode')

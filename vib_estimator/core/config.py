@@ -89,7 +89,8 @@ class EstimatorConfig:
     excitation: str = _param('free', 'free (free decays: the algebraic estimator, or the mode '
                              'tracker with modes >= 1) or ambient (driven by unmeasured broadband '
                              'forces: covariance-driven subspace identification over a sliding '
-                             'window of ambient_window_s, every mode numbered as the mode tracker\'s, '
+                             'window of ambient_window_s, every mode numbered as the mode '
+                             'tracker\'s, '
                              'at most modes of them if modes >= 1)')
     ambient_window_s: float = _param(30.0, 'excitation ambient: the sliding window, s (the '
                                      'frequency std falls as its square root; docs/operation.md)',

@@ -9,7 +9,7 @@ measurement noise at a signal-to-noise ratio (total modal variance over noise va
 from __future__ import annotations
 
 import math
-from typing import Sequence, Tuple
+from collections.abc import Sequence
 
 import numpy as np
 from scipy.linalg import expm, solve_discrete_lyapunov
@@ -44,13 +44,13 @@ def sdof_response(n: int, fs: float, frequency_hz: float, zeta: float, variance:
     return scale * x[:, 0]
 
 
-def ambient_record(duration_s: float, fs: float, modes: Sequence[Tuple[float, float, float]],
-                   snr_db: float, seed: int = 0) -> Tuple[np.ndarray, np.ndarray, float]:
+def ambient_record(duration_s: float, fs: float, modes: Sequence[tuple[float, float, float]],
+                   snr_db: float, seed: int = 0) -> tuple[np.ndarray, np.ndarray, float]:
     """``(t, y, noise variance)``: ``duration_s`` at ``fs`` of the white-noise-driven ``modes``
     [(frequency Hz, damping ratio, variance)] plus white noise at ``snr_db`` (total modal
     variance over noise variance)."""
     rng = np.random.default_rng(seed)
-    n = int(round(duration_s * fs))
+    n = round(duration_s * fs)
     y = np.zeros(n)
     for f, z, v in modes:
         y += sdof_response(n, fs, f, z, v, rng)
