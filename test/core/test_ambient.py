@@ -153,3 +153,15 @@ def test_config_validation():
         EstimatorConfig(excitation='driven').validate()
     with pytest.raises(ValueError, match='ambient_window_s'):
         EstimatorConfig(excitation='ambient', ambient_window_s=0.5).validate()
+
+
+@pytest.mark.parametrize('excitation, level', [('ambient', 0.02), ('random', 0.3)])
+def test_driven_arm(excitation, level):
+    from vib_estimator.sim.arm_model import simulate_driven
+
+    rec = simulate_driven(45.0, excitation, level, seed=2)
+    est = AmbientEstimator(AMBIENT).process(rec.t, rec.torque)
+    f0 = rec.f_true[0]
+    assert len(est) >= 15
+    err = np.abs(est.frequency_hz / f0 - 1)
+    assert np.median(err) < 0.01 and np.mean(err <= 0.02) >= 0.9

@@ -333,16 +333,24 @@ def identify(y: np.ndarray, fs: float, max_damping: float = 0.1,
              top_hz: float = 0.0, search: bool = True):
     """Modes of one window ``y`` sampled at ``fs``: (rows of frequency, damping, variance,
     frequency std, damping std, ascending; the white noise variance left over; the window's
-    variance). A first pass at ``fs`` finds the highest mode (or ``top_hz``, the highest mode
+    variance). A first pass at ``fs`` (or, if it finds none, at the first of the rates halved in
+    turn that does) finds the highest mode (or ``top_hz``, the highest mode
     known, if higher; with ``search`` false and ``top_hz`` given, no first pass); when it lies
     low enough, the modes come from a second pass at the rate
     :func:`decimate` gives, over whose lags (``BLOCK_ROWS`` samples) close modes are resolved."""
     counts = dict.fromkeys(COUNTER_NAMES, 0) if counts is None else counts
     total = float(np.var(y))
+    modes, noise = np.empty((0, 4)), total
     if search or top_hz <= 0:
-        modes, noise = _strong(_modes_at(y, fs, max_damping, band, counts), total, fs, counts)
-    else:
-        modes, noise = np.empty((0, 4)), total
+        # the search: from the full rate down by halvings until a level finds a mode (a low
+        # mode spans too few periods of the full rate's lags to be stable there)
+        yk, rate = y, fs
+        while True:
+            modes, noise = _strong(_modes_at(yk, rate, max_damping, band, counts), total, fs,
+                                   counts)
+            if len(modes) or len(yk) // 2 < MIN_SAMPLES:
+                break
+            yk, rate = sosfiltfilt(DECIMATE_SOS, yk)[::2], 0.5 * rate
     top = max(float(np.max(modes[:, 0])) if len(modes) else 0.0, top_hz)
     if top > 0:
         yq, rate = decimate(y, fs, top)
