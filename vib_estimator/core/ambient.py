@@ -28,7 +28,9 @@ Method, per analysis (every :data:`HOP_S` of input once ``ambient_window_s`` of 
 3. **Standard deviations** from the window's own statistics: the inverse Fisher information of the
    Whittle likelihood (:func:`whittle_std`) of the identified model -- every mode a noise-driven
    SDOF with the estimated frequency, damping and variance, plus white measurement noise of the
-   variance left over (``R_0`` minus the modes') -- over the window's samples. SSI-cov attains this
+   variance left over (``R_0`` minus the modes') -- over the window's samples, scaled up by the
+   factor the mode's own estimates from non-overlapping earlier windows show it to be too small
+   (variance across windows: :meth:`_Track.calibration`). SSI-cov attains this
    bound within the measured factor of ``benchmarks/bench_operation.py``; a mode whose relative
    frequency std exceeds :data:`MAX_STD_REL` is too weak to tell (``rejected_uncertain``).
 4. **Identity over time** (stability across windows): each mode is matched to the nearest tracked
@@ -76,6 +78,8 @@ MAX_STD_REL = 0.02
 MATCH_TOL = 0.03
 #: while modes are known, one analysis in this many searches the full rate for higher ones
 SEARCH_EVERY = 5
+#: a mode's estimates over this many windows calibrate its stds (:meth:`_Track.calibration`)
+HISTORY_WINDOWS = 4
 #: consecutive analyses that must see a new mode before it publishes
 CONFIRM = 3
 #: most modes tracked at once
@@ -369,11 +373,28 @@ def identify(y: np.ndarray, fs: float, max_damping: float = 0.1,
 class _Track:
     """A mode followed across windows."""
 
-    __slots__ = ('amplitude', 'frequency', 'last_t', 'published', 'seen')
+    __slots__ = ('amplitude', 'frequency', 'history', 'last_t', 'published', 'seen')
 
     def __init__(self, frequency: float, t: float):
         self.frequency, self.seen, self.last_t, self.published = frequency, 1, t, False
         self.amplitude = 0.0
+        self.history: list[tuple[float, float, float, float, float]] = []
+
+    def calibration(self, t: float, f: float, f_std: float, z: float, z_std: float,
+                    window: float) -> float:
+        """The factor (>= 1) by which the Whittle stds are too small, from this mode's own
+        estimates: the RMS of ``(f - f_j) / sqrt(std^2 + std_j^2)`` (and of the damping's) over
+        its estimates ``f_j`` of windows that do not overlap this one (at least ``window`` s
+        earlier, within :data:`HISTORY_WINDOWS` windows); 1 until there are such. Records
+        ``(t, f, f_std, z, z_std)`` for the next ones."""
+        hist = [h for h in self.history if h[0] >= t - HISTORY_WINDOWS * window]
+        self.history = hist + [(t, f, f_std, z, z_std)]
+        old = np.array([h for h in hist if h[0] <= t - window]).reshape(-1, 5)
+        if not len(old):
+            return 1.0
+        d = np.concatenate(((f - old[:, 1]) / np.hypot(f_std, old[:, 2]),
+                            (z - old[:, 3]) / np.hypot(z_std, old[:, 4])))
+        return max(1.0, math.sqrt(float(np.mean(d * d))))
 
 
 class AmbientEstimator:
@@ -562,6 +583,8 @@ class AmbientEstimator:
         for k, tr in enumerate(numbered, 1):
             if tr in ready:
                 f, z, v, fstd, zstd = seen[id(tr)]
+                scale = tr.calibration(t, f, fstd, z, zstd, self._window)
+                fstd, zstd = fstd * scale, zstd * scale
                 out.append(Estimate(t, float(f), span, n, explained, math.sqrt(v), float(z),
                                     float(fstd), float(zstd), k))
         self._c['estimates'] += len(out)
