@@ -165,3 +165,12 @@ def test_driven_arm(excitation, level):
     assert len(est) >= 15
     err = np.abs(est.frequency_hz / f0 - 1)
     assert np.median(err) < 0.01 and np.mean(err <= 0.02) >= 0.9
+
+
+def test_mode_counters_count_each_modes_estimates():
+    t, y, _ = ambient_record(40.0, FS, [(5.0, 0.01, 1.0), (17.0, 0.005, 0.3)], 25.0, 8)
+    est = AmbientEstimator(AMBIENT)
+    e = est.process(t, y)
+    counts = est.mode_counters()
+    assert sorted(counts) == sorted(set(e.mode)) == [1, 2]
+    assert sum(c['estimates'] for c in counts.values()) == len(e) == est.counters['estimates']

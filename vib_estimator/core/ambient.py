@@ -373,11 +373,12 @@ def identify(y: np.ndarray, fs: float, max_damping: float = 0.1,
 class _Track:
     """A mode followed across windows."""
 
-    __slots__ = ('amplitude', 'frequency', 'history', 'last_t', 'published', 'seen')
+    __slots__ = ('amplitude', 'estimates', 'frequency', 'history', 'last_t', 'published', 'seen')
 
     def __init__(self, frequency: float, t: float):
         self.frequency, self.seen, self.last_t, self.published = frequency, 1, t, False
         self.amplitude = 0.0
+        self.estimates = 0
         self.history: list[tuple[float, float, float, float, float]] = []
 
     def calibration(self, t: float, f: float, f_std: float, z: float, z_std: float,
@@ -418,6 +419,12 @@ class AmbientEstimator:
     @property
     def counters(self) -> dict[str, int]:
         return dict(self._c)
+
+    def mode_counters(self) -> dict[int, dict[str, int]]:
+        """Each current mode's estimates (as the mode tracker's ``mode_counters``)."""
+        published = sorted((tr for tr in self._tracks if tr.published),
+                           key=lambda tr: tr.frequency)
+        return {k: {'estimates': tr.estimates} for k, tr in enumerate(published, 1)}
 
     def restart(self) -> None:
         """Forget the signal and the tracked modes; counters are kept."""
@@ -585,6 +592,7 @@ class AmbientEstimator:
                 f, z, v, fstd, zstd = seen[id(tr)]
                 scale = tr.calibration(t, f, fstd, z, zstd, self._window)
                 fstd, zstd = fstd * scale, zstd * scale
+                tr.estimates += 1
                 out.append(Estimate(t, float(f), span, n, explained, math.sqrt(v), float(z),
                                     float(fstd), float(zstd), k))
         self._c['estimates'] += len(out)
