@@ -174,3 +174,11 @@ def test_mode_counters_count_each_modes_estimates():
     counts = est.mode_counters()
     assert sorted(counts) == sorted(set(e.mode)) == [1, 2]
     assert sum(c['estimates'] for c in counts.values()) == len(e) == est.counters['estimates']
+
+
+def test_modes_limits_to_the_strongest():
+    t, y, _ = ambient_record(40.0, FS, [(5.0, 0.01, 1.0), (17.0, 0.005, 0.05)], 25.0, 9)
+    both = AmbientEstimator(AMBIENT).process(t, y)
+    one = AmbientEstimator(AMBIENT.replace(modes=1)).process(t, y)
+    assert set(both.mode) == {1, 2}
+    assert set(one.mode) == {1} and np.all(np.abs(one.frequency_hz / 5.0 - 1) < 0.02)
