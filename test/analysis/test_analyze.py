@@ -4,9 +4,9 @@ import json
 import numpy as np
 import pytest
 
-from vib_estimator.io.bags import WrenchSeries, write_wrench_series
 from vib_estimator.cli import main
 from vib_estimator.core import EstimatorConfig, estimate
+from vib_estimator.io.bags import WrenchSeries, write_wrench_series
 from vib_estimator.io.fields import seconds_since
 
 
@@ -108,7 +108,7 @@ def test_unknown_topic_lists_the_available_ones(tmp_path, capsys, samples):
 def test_every_input_type_of_a_bag_and_the_topic_choice(tmp_path, capsys, samples):
     """An Imu topic (component checked against its type), a Float64 topic (log time), and the
     default topic refused when there are several."""
-    from vib_estimator.io.bags import BagWriter, TYPESTORE
+    from vib_estimator.io.bags import TYPESTORE, BagWriter
 
     t, y = samples
     stamps = 1_700_000_000_000_000_000 + np.round(t * 1e9).astype(np.int64)
@@ -146,3 +146,22 @@ def test_band_above_nyquist_is_an_error(tmp_path, capsys, samples):
     err = capsys.readouterr().err
     assert 'above the Nyquist frequency 250 Hz' in err and len(err.strip().splitlines()) == 1
     assert main(['analyze', str(path), '--band-hz', '1', '200']) == 0
+
+
+def test_excitation_ambient_equals_the_core_and_bad_window_is_refused(tmp_path, capsys):
+    from vib_estimator.core.modes import create_estimator
+    from vib_estimator.sim.ambient import ambient_record
+
+    t, y, _ = ambient_record(30.0, 500.0, [(5.0, 0.01, 1.0)], 26.0, 0)
+    path = tmp_path / 'ambient.csv'
+    np.savetxt(path, np.column_stack((t, y)), delimiter=',', header='t,y', comments='')
+    assert main(['analyze', str(path), '--excitation', 'ambient', '--ambient-window-s', '20']) == 0
+    rows = jsonl(capsys.readouterr().out)
+    config = EstimatorConfig(excitation='ambient', ambient_window_s=20.0)
+    ref = create_estimator(config).process(*np.loadtxt(path, delimiter=',', skiprows=1).T)
+    assert len(rows) == len(ref) > 0
+    assert [r['frequency_hz'] for r in rows] == list(ref.frequency_hz)
+    assert [r['mode'] for r in rows] == list(ref.mode)
+    assert main(['analyze', str(path), '--excitation', 'ambient', '--ambient-window-s', '1']) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[-1].startswith('vib-estimator analyze: error: ambient_window_s')

@@ -287,3 +287,44 @@ def test_realism_parameters_reach_the_published_torque(ros_context, executor):
                                atol=1e-9)
     with pytest.raises(StartupError, match='limit_cycle_voltage'):
         sim_node(ros_context, namespace='bad_real', limit_cycle_voltage=20.0)
+
+
+def test_driven_arm_tracked_in_operation():
+    """sim_node excitation ambient (the arm never at rest) -> estimator_node excitation ambient:
+    the bar's mode on vibration/frequency (mode 1), every second once a window is in."""
+    context = rclpy.Context()
+    rclpy.init(context=context, domain_id=int(os.environ['ROS_DOMAIN_ID']))
+    executor = make_executor(context)
+    listener = Listener(context)
+    estimator = EstimatorNode(context=context, parameter_overrides=[
+        Parameter('excitation', value='ambient'), Parameter('ambient_window_s', value=15.0)])
+    sim = sim_node(context, speed=20.0, duration=40.0, wait_for_subscribers=1,
+                   excitation='ambient', seed=3)
+    nodes = (listener.node, estimator, sim)
+    for node in nodes:
+        executor.add_node(node)
+    try:
+        assert spin_until(executor, lambda: all(s.get_publisher_count() >= 1
+                                                for s in listener.subs), 10.0)
+        assert spin_until(executor, lambda: sim.finished, 60.0)
+        spin_until(executor, lambda: False, 0.3)
+        t, f = listener.estimates()
+        f0 = natural_frequency_hz(0.04555)
+        assert len(f) >= 15
+        assert np.median(np.abs(f / f0 - 1)) < 0.01
+        assert np.all(np.diff(t) > 0.5)              # one per analysis, every second
+    finally:
+        executor.shutdown()
+        for node in nodes:
+            node.destroy_node()
+        context.try_shutdown()
+
+
+def test_sim_node_refuses_an_unknown_excitation():
+    context = rclpy.Context()
+    rclpy.init(context=context, domain_id=int(os.environ['ROS_DOMAIN_ID']))
+    try:
+        with pytest.raises(StartupError, match='excitation'):
+            sim_node(context, excitation='shaker')
+    finally:
+        context.try_shutdown()

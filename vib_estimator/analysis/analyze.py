@@ -24,7 +24,7 @@ from typing import Optional, Tuple
 import numpy as np
 
 from ..core import MODELS, EstimateArrays, EstimatorConfig
-from ..core.config import PAPER
+from ..core.config import EXCITATIONS, PAPER
 from ..core.modes import create_estimator
 from ..errors import VibEstimatorError, report
 from ..io.fields import INPUT_TYPES
@@ -35,7 +35,7 @@ _CONFIG_OPTIONS = {
     'lowpass_cutoff_hz': float, 'lowpass_damping': float, 'window': int, 'tolerance': float,
     'min_time': float, 'min_periods': float, 'max_window': float, 'min_fit': float,
     'min_amplitude': float, 'max_damping': float, 'max_gap': float, 'target_std_rel': float,
-    'modes': int, 'refine': int, 'consistency': float,
+    'modes': int, 'refine': int, 'consistency': float, 'ambient_window_s': float,
 }
 
 
@@ -64,6 +64,9 @@ def add_config_arguments(parser: argparse.ArgumentParser) -> None:
                             f'{k} {v}' for k, v in PAPER.items()) + ') instead of the defaults')
     parser.add_argument('--model', choices=MODELS, default=None,
                         help=f'(default {defaults.model}; --paper: {paper.model})')
+    parser.add_argument('--excitation', choices=EXCITATIONS, default=None,
+                        help=EstimatorConfig.describe('excitation')[0]
+                        + f' (default {defaults.excitation})')
     parser.add_argument('--band-hz', nargs=2, type=float, metavar=('LO', 'HI'),
                         help='band-pass prefilter [LO, HI] Hz (default off)')
     for name, kind in _CONFIG_OPTIONS.items():
@@ -76,7 +79,7 @@ def add_config_arguments(parser: argparse.ArgumentParser) -> None:
 def make_config(args: argparse.Namespace) -> EstimatorConfig:
     """The estimator configuration of the command line (ValueError if out of range)."""
     base = EstimatorConfig.paper() if args.paper else EstimatorConfig()
-    given = {name: getattr(args, name) for name in ('model', *_CONFIG_OPTIONS)
+    given = {name: getattr(args, name) for name in ('model', 'excitation', *_CONFIG_OPTIONS)
              if getattr(args, name) is not None}
     return base.replace(band_hz=tuple(args.band_hz) if args.band_hz else None, **given)
 
@@ -187,7 +190,8 @@ def run(args: argparse.Namespace) -> int:
         return report(err, 'vib-estimator analyze')
     damage_warning(signal, 'vib-estimator analyze')
     estimates = result.estimates
-    _print(estimates, signal.origin_ns, args.format, config.modes)
+    _print(estimates, signal.origin_ns, args.format,
+           config.modes or config.excitation == 'ambient')
     counters = result.estimator.counters
     extra = f', messages_without_component={signal.skipped}' if signal.skipped else ''
     extra += f', corrupt_records={signal.corrupt}' if signal.topic else ''

@@ -179,6 +179,7 @@ def _stat_rows(recording: Path, signal, result, modes: int) -> List[Dict]:
     est = result.estimates
     start = (signal.origin_ns * 1e-9 if signal.origin_ns is not None else result.first_t)
     rows = []
+    modes = modes or int(est.mode.max(initial=0))     # excitation ambient numbers its modes
     for mode in (range(1, modes + 1) if modes else [0]):
         take = est.mode == mode
         counters = (result.estimator.mode_counters().get(mode, {}) if modes

@@ -15,6 +15,9 @@ import numpy as np
 from . import kernel as K
 
 MODELS = ('sinusoid', 'biased-sinusoid', 'damped-sinusoid')
+#: what drives the structure: ``free`` (it rings freely after a pluck: the paper's estimators) or
+#: ``ambient`` (unmeasured broadband forces: output-only identification, :mod:`.ambient`)
+EXCITATIONS = ('free', 'ambient')
 
 INF = math.inf
 
@@ -96,6 +99,15 @@ class EstimatorConfig:
     modes: int = _param(0, 'modes to find and track by a multi-scale subspace fit, each '
                         'numbered by ascending frequency (0 = one estimator on the whole, '
                         'optionally band-limited, signal)', 0, 8)
+    excitation: str = _param('free', 'free (free decays: the algebraic estimator, or the mode '
+                             'tracker with modes >= 1) or ambient (driven by unmeasured broadband '
+                             'forces: covariance-driven subspace identification over a sliding '
+                             'window of ambient_window_s, every mode numbered as the mode '
+                             'tracker\'s, '
+                             'at most modes of them if modes >= 1)')
+    ambient_window_s: float = _param(30.0, 'excitation ambient: the sliding window, s (the '
+                                     'frequency std falls as its square root; docs/operation.md)',
+                                     2.0, 3600.0)
     buffer_samples: int = _param(200_000, 'segment buffer of the quality gate; a longer segment '
                                  'resets', 1, 10 ** 8)
 
@@ -131,6 +143,9 @@ class EstimatorConfig:
                         (open_hi and value == hi):
                     raise ValueError(f'{f.name} must be in {"(" if open_lo else "["}{lo}, '
                                      f'{hi}{")" if open_hi else "]"}, got {value!r}')
+        if self.excitation not in EXCITATIONS:
+            raise ValueError(f'excitation must be one of {", ".join(EXCITATIONS)}, '
+                             f'got {self.excitation!r}')
         if self.model not in MODELS:
             raise ValueError(f'model must be one of {", ".join(MODELS)}, got {self.model!r}')
         window = self.max_window or K.AUTO_WINDOW_S

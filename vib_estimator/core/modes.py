@@ -63,6 +63,7 @@ from dataclasses import dataclass
 from typing import Dict, List, Sequence, Union
 
 import numpy as np
+from .ambient import AmbientEstimator
 from .config import EstimatorConfig
 from .estimator import COUNTER_NAMES, Estimate, EstimateArrays, FrequencyEstimator, as_series
 from .jit import jit
@@ -760,6 +761,10 @@ class ModeTracker:
         self._lams[:, 1:] = math.nan
 
 
-def create_estimator(config: EstimatorConfig) -> Union[FrequencyEstimator, ModeTracker]:
-    """The estimator of a configuration: one estimator (``modes`` = 0) or a mode tracker."""
+def create_estimator(config: EstimatorConfig) -> Union[FrequencyEstimator, ModeTracker,
+                                                       AmbientEstimator]:
+    """The estimator of a configuration: with ``excitation`` = ambient the output-only
+    identifier (:mod:`.ambient`); else one estimator (``modes`` = 0) or a mode tracker."""
+    if config.excitation == 'ambient':
+        return AmbientEstimator(config)
     return FrequencyEstimator(config) if config.modes == 0 else ModeTracker(config)

@@ -47,8 +47,8 @@ from rosgraph_msgs.msg import Clock as ClockMsg
 from std_msgs.msg import Float64
 
 from ..io.fields import IMU, WRENCH_STAMPED, normalise_type
-from ..sim.arm_model import (DEFAULT_NOISE_STD, DEFAULT_QUANTUM, ArmParameters, ArmSimulator,
-                             Move, natural_frequency_hz)
+from ..sim.arm_model import (DEFAULT_NOISE_STD, DEFAULT_QUANTUM, EXCITATIONS, ArmParameters,
+                             ArmSimulator, DrivenArmSimulator, Move, natural_frequency_hz)
 from .runner import StartupError, run
 from .parameters import declare, descriptor
 
@@ -168,7 +168,17 @@ PARAMETERS = {
         'message of the measurement: geometry_msgs/msg/WrenchStamped (coupling torque, torque.z, '
         'on coupling_torque) or sensor_msgs/msg/Imu (tip acceleration, linear_acceleration.z, on '
         'tip_imu)', read_only=True)),
+    'excitation': ('moves', descriptor(
+        'what drives the arm: moves (the schedule\'s ramps), random (a band-limited random motor '
+        'command of excitation_level rad std, 2 Hz) or ambient (a white disturbance torque at '
+        'the tip of excitation_level N m std): the arm never at rest (docs/operation.md)',
+        read_only=True)),
+    'excitation_level': (0.0, descriptor(
+        'excitation random: rad; ambient: N m (0 = the default: 0.3 rad, 0.02 N m)',
+        (0.0, 100.0), read_only=True)),
 }
+#: ``excitation_level`` 0 means these
+DEFAULT_EXCITATION_LEVEL = {'random': 0.3, 'ambient': 0.02}
 
 
 class SimNode(Node):
@@ -212,12 +222,18 @@ class SimNode(Node):
         self._answered = True             # a command arrived since the last /clock (lockstep)
         self._clock_at = 0.0              # monotonic time of the last batch's /clock
         self.lockstep_timeouts = 0
-        self._sim = ArmSimulator(
+        if p['excitation'] not in EXCITATIONS:
+            raise StartupError(f'excitation must be one of {", ".join(EXCITATIONS)}, '
+                               f'got {p["excitation"]!r}')
+        driven = {} if p['excitation'] == 'moves' else {
+            'excitation': p['excitation'],
+            'level': p['excitation_level'] or DEFAULT_EXCITATION_LEVEL[p['excitation']]}
+        self._sim = (DrivenArmSimulator if driven else ArmSimulator)(
             ArmParameters(tip_mass_kg=p['tip_mass_kg'], damping_ratio=p['damping_ratio']),
             rate_hz=self._rate, noise_std=p['noise_std'], quantum=p['quantum'], seed=p['seed'],
             schedule=schedule,
             output='torque' if self._output_type == WRENCH_STAMPED else 'tip_acceleration',
-            offset=p['offset'], limit_cycle_voltage=p['limit_cycle_voltage'])
+            offset=p['offset'], limit_cycle_voltage=p['limit_cycle_voltage'], **driven)
         self._sync_mass_parameter()
 
         msg_type, topic = OUTPUTS[self._output_type]

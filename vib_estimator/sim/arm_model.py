@@ -342,3 +342,65 @@ def experiment_5_3(seed: int = 0) -> Recording:
 def experiment_5_5(seed: int = 0) -> Recording:
     """Section 5.5 / Fig. 7: 30 -> 45.55 -> 61.17 g, 6 s each, of increasing vibration amplitude."""
     return simulate(18.0, schedule_5_5(), seed=seed)
+
+
+#: how a :class:`DrivenArmSimulator` drives the arm: scheduled ramps only (``moves``), a
+#: band-limited random motor command (``random``) or a broadband disturbance torque at the tip
+#: (``ambient``)
+EXCITATIONS = ('moves', 'random', 'ambient')
+
+
+class DrivenArmSimulator(ArmSimulator):
+    """The arm in operation, never at rest (issue 20): an :class:`ArmSimulator` whose motor
+    command is, with ``excitation = 'random'``, a random walk of the angle low-pass filtered at
+    ``bandwidth_hz`` (first order, ``level`` rad of standard deviation), or whose tip receives,
+    with ``'ambient'``, a white disturbance torque of standard deviation ``level`` N m, held over
+    each sample (``moves``: the schedule's ramps only, as the base class). Seeded (``seed + 1``,
+    independent of the measurement noise's stream)."""
+
+    def __init__(self, params: ArmParameters = ArmParameters(), rate_hz: float = 500.0,
+                 noise_std: float = DEFAULT_NOISE_STD, quantum: float = DEFAULT_QUANTUM,
+                 seed: int = 0, schedule: Sequence[Move] = (Move(0.0, 0.0),),
+                 substeps: int = 8, output: str = 'torque', offset: float = 0.0,
+                 limit_cycle_voltage: float = 0.0, *, excitation: str = 'ambient',
+                 level: float = 0.02, bandwidth_hz: float = 2.0):
+        super().__init__(params, rate_hz, noise_std, quantum, seed, schedule, substeps, output,
+                         offset, limit_cycle_voltage)
+        if excitation not in EXCITATIONS:
+            raise ValueError(f'excitation must be one of {", ".join(EXCITATIONS)}, '
+                             f'got {excitation!r}')
+        if not (level >= 0 and bandwidth_hz > 0):
+            raise ValueError('level must be >= 0 and bandwidth_hz > 0')
+        self.excitation = excitation
+        self.level = float(level)
+        self._drive = np.random.default_rng(seed + 1)
+        self._pole = math.exp(-2 * math.pi * bandwidth_hz / self.rate_hz)
+        self._disturbance = 0.0
+        self._random_angle = 0.0
+
+    def _derivatives(self, x, u):
+        wm, am, wt, at = super()._derivatives(x, u)
+        return wm, am, wt, at + self._disturbance / self._tip_inertia
+
+    def step(self) -> Tuple[float, float, float]:
+        if self.excitation == 'ambient':
+            self._disturbance = self.level * self._drive.standard_normal()
+        elif self.excitation == 'random':
+            # first-order low-pass of white noise, scaled to a standard deviation of ``level``
+            a = self._pole
+            self._random_angle = a * self._random_angle + math.sqrt(1 - a * a) * self.level * \
+                self._drive.standard_normal()
+            self.set_command(self._random_angle)
+        return super().step()
+
+
+def simulate_driven(duration: float, excitation: str = 'ambient', level: float = 0.02,
+                    params: ArmParameters = ArmParameters(), rate_hz: float = 500.0,
+                    noise_std: float = DEFAULT_NOISE_STD, seed: int = 0,
+                    output: str = 'torque') -> Recording:
+    """``duration`` s of the arm driven by ``excitation`` (:class:`DrivenArmSimulator`)."""
+    sim = DrivenArmSimulator(params, rate_hz, noise_std, DEFAULT_QUANTUM, seed,
+                             (Move(0.0, 0.0),), output=output, excitation=excitation,
+                             level=level)
+    rows = np.array([sim.step() for _ in range(int(round(duration * rate_hz)))]).reshape(-1, 3)
+    return Recording(rows[:, 0].copy(), rows[:, 1].copy(), rows[:, 2].copy())

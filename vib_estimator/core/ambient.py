@@ -1,0 +1,608 @@
+"""Output-only (operational, ambient) identification of the modes of a driven structure.
+
+``excitation = ambient``: the structure is driven by broadband, unmeasured forces (wind, traffic, a
+robot that never rests), so there is no free decay to fit. Its modes are identified from the
+correlation structure of the response over a sliding window, as operational modal analysis does.
+
+Interface (that of :class:`~vib_estimator.core.FrequencyEstimator` and the mode tracker, which the
+node stream and ``analyze`` use): :class:`AmbientEstimator` ``.update(t, y) -> List[Estimate]``,
+``.process(t, y) -> EstimateArrays``, ``.counters``, ``.reset()``, ``.restart()``, ``.config``.
+
+Method, per analysis (every :data:`HOP_S` of input once ``ambient_window_s`` of samples are in):
+
+1. **Covariance-driven stochastic subspace identification** (SSI-cov; Peeters & De Roeck 1999) of
+   the last ``ambient_window_s`` seconds: the output correlations ``R_k`` (k = 0 .. 2 p, by FFT,
+   unbiased), their block Hankel matrix ``H = [R_{i+j+1}]`` (p = :data:`BLOCK_ROWS` rows), its
+   SVD ``H = U S V^T``; at each model order n = :data:`ORDERS` the observability matrix
+   ``O = U_n S_n^1/2``, the state matrix ``A = O_up^+ O_down`` and the output/next-state
+   covariance ``G`` (first column of ``S_n^1/2 V_n^T``). Each eigenvalue ``lambda`` of ``A`` gives a
+   pole ``s = ln(lambda) fs``: frequency ``|s| / 2 pi``, damping ratio ``-Re s / |s|``, and, from
+   the
+   modal decomposition ``R_k = sum_m c_m g_m lambda_m^(k-1)``, the mode's share of the variance.
+2. **Physical or spurious** (automated OMA): poles with a damping ratio outside
+   (0, ``max_damping``], or above 0.45 fs (or outside ``band_hz`` when set), are dropped
+   (``rejected_damping``); the others are clustered in frequency (neighbours within
+   :data:`CLUSTER_TOL`, a cluster no wider than :data:`CLUSTER_SPAN`); a cluster is a mode when it
+   holds a pole at :data:`MIN_SUPPORT` of the orders (stable across model orders; else
+   ``rejected_unstable``). Its frequency, damping and variance are the medians over its poles.
+3. **Standard deviations** from the window's own statistics: the inverse Fisher information of the
+   Whittle likelihood (:func:`whittle_std`) of the identified model -- every mode a noise-driven
+   SDOF with the estimated frequency, damping and variance, plus white measurement noise of the
+   variance left over (``R_0`` minus the modes') -- over the window's samples, scaled up by the
+   factor the mode's own estimates from non-overlapping earlier windows show it to be too small
+   (variance across windows: :meth:`_Track.calibration`). SSI-cov attains this
+   bound within the measured factor of ``benchmarks/bench_operation.py``; a mode whose relative
+   frequency std exceeds :data:`MAX_STD_REL` is too weak to tell (``rejected_uncertain``).
+4. **Identity over time** (stability across windows): each mode is matched to the nearest tracked
+   mode within :data:`MATCH_TOL`; a new one publishes once seen by :data:`CONFIRM` consecutive
+   analyses (``modes_found``); one unseen for a window is lost (``modes_lost``). With ``modes`` >= 1
+   at most that many (the strongest) publish. Published modes are numbered by ascending frequency,
+   1 = the lowest, as the mode tracker's ``mode`` key.
+
+Each estimate: ``t`` = the window's last stamp, ``convergence_time`` = the window's span (the
+window used), ``samples`` = its samples, ``amplitude`` = RMS of the modal response, ``fit`` = share
+of the window's variance the modes explain.
+
+Bad samples never raise: non-finite values, duplicate and out-of-order stamps are skipped and
+counted; a gap or a backward jump longer than ``max_gap`` starts a new window (``gap_resets``,
+``time_jump_resets``); the tracked modes are kept.
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+from scipy.signal import butter, sosfiltfilt
+
+from .config import EstimatorConfig
+from .estimator import Estimate, EstimateArrays, as_series
+
+#: seconds of input between two analyses (the estimates' update period)
+HOP_S = 1.0
+#: block rows p of the correlation Hankel matrix (lags 1 .. 2p)
+BLOCK_ROWS = 40
+#: model orders of the stabilisation diagram
+ORDERS = tuple(range(4, 31, 4))
+#: neighbouring poles within this relative frequency join one cluster
+CLUSTER_TOL = 0.004
+#: a cluster spans at most this relative frequency range
+CLUSTER_SPAN = 0.02
+#: fraction of the model orders at which a cluster must hold a pole to be a mode
+MIN_SUPPORT = 0.5
+#: a mode's spectral peak must stand this far above the noise's density (else ``rejected_weak``)
+MIN_PEAK_RATIO = 4.0
+#: a mode whose predicted relative frequency std exceeds this is not published
+MAX_STD_REL = 0.02
+#: a window's mode continues a tracked mode within this relative frequency
+MATCH_TOL = 0.03
+#: while modes are known, one analysis in this many searches the full rate for higher ones
+SEARCH_EVERY = 5
+#: a mode's estimates over this many windows calibrate its stds (:meth:`_Track.calibration`)
+HISTORY_WINDOWS = 4
+#: consecutive analyses that must see a new mode before it publishes
+CONFIRM = 3
+#: most modes tracked at once
+MAX_TRACKS = 8
+#: a frequency bin counts in the Fisher information of the modes where their density exceeds this
+#: fraction of the noise's
+ACTIVE = 1e-2
+#: highest pole frequency kept, in units of the sampling rate
+NU_MAX = 0.45
+#: the second pass's rate puts the highest mode of the first at or below this fraction of it
+TOP_NU = 0.4
+#: the decimated window holds at least this many samples
+MIN_SAMPLES = 20 * BLOCK_ROWS
+#: two clusters closer than this (relative) are one mode
+MERGE_TOL = 0.02
+#: anti-alias filter of each halving of the rate: 8th order Butterworth at 0.45 of the Nyquist
+#: frequency (run forwards and backwards: no phase, gain 0.96 at the owned band's top edge)
+DECIMATE_SOS = butter(8, 0.45, output='sos')
+
+COUNTER_NAMES = ('received', 'used', 'skipped_non_finite', 'skipped_duplicate',
+                 'skipped_out_of_order', 'time_jump_resets', 'gap_resets', 'analyses',
+                 'rejected_damping', 'rejected_unstable', 'rejected_weak', 'rejected_uncertain',
+                 'modes_found',
+                 'modes_lost', 'estimates')
+
+
+# ---- the bound and the standard deviations ------------------------------------------------------
+def sdof_psd(w: np.ndarray, frequency_hz: float, zeta: float, variance: float,
+             dt: float) -> np.ndarray:
+    """Spectral density at ``w`` (rad/sample; normalised so that its mean over a period is the
+    variance) of a white-noise-driven SDOF's response sampled every ``dt``: the DTFT of its
+    autocovariance ``c_k = variance e^(-zeta wn |k| dt) (cos wd k dt + zeta / sqrt(1 - zeta^2)
+    sin wd |k| dt)``, summed in closed form (``c_k = Re(a z^|k|)``, ``z = e^((-zeta wn + i wd)
+    dt)``)."""
+    return _sdof_psd(np.exp(-1j * np.asarray(w, dtype=np.float64)), frequency_hz, zeta,
+                     variance, dt)
+
+
+def _sdof_psd(e: np.ndarray, frequency_hz: float, zeta: float, variance: float,
+              dt: float) -> np.ndarray:
+    """:func:`sdof_psd` at ``e = exp(-i w)``."""
+    wn = 2 * math.pi * frequency_hz * dt
+    root = math.sqrt(max(1.0 - zeta * zeta, 1e-12))
+    decay = math.exp(-zeta * wn)
+    z = complex(decay * math.cos(wn * root), decay * math.sin(wn * root))
+    a = variance * complex(1.0, -zeta / root)
+    zc = z.conjugate()
+    total = (a * (1.0 / (1.0 - z * e) + 1.0 / (1.0 - z / e) - 1.0)
+             + a.conjugate() * (1.0 / (1.0 - zc * e) + 1.0 / (1.0 - zc / e) - 1.0))
+    return 0.5 * total.real
+
+
+def peak_ratio(frequency_hz: float, zeta: float, variance: float, noise_var: float,
+               dt: float) -> float:
+    """A mode's spectral density at its frequency over the white noise's (:func:`sdof_psd`)."""
+    w = 2 * math.pi * frequency_hz * dt
+    return float(sdof_psd(np.array([w]), frequency_hz, zeta, variance, dt)[0]) / noise_var
+
+
+def _active_bins(modes, noise_var: float, dt: float, n: int) -> np.ndarray:
+    """The Fourier bins 0 < k < n/2 near enough a mode for its density to exceed :data:`ACTIVE`
+    of the noise's (a Lorentzian of the mode's peak and half-width bounds the distance)."""
+    keep = np.zeros((n + 1) // 2, dtype=bool)
+    for f, z, v in modes:
+        centre = f * dt * n
+        peak = peak_ratio(f, z, v, noise_var, dt)
+        half = z * f * dt * n * math.sqrt(max(peak / ACTIVE, 1.0)) + 2.0
+        keep[max(1, int(centre - half)):max(1, min(len(keep), int(centre + half) + 2))] = True
+    keep[0] = False
+    return np.flatnonzero(keep)
+
+
+def _log_density_gradient(e: np.ndarray, modes, noise_var: float, dt: float):
+    """The model's density ``S`` at ``e = exp(-i w)`` and the gradient of ``ln S`` with respect
+    to (f, zeta, variance of each mode, the noise variance), one row each."""
+    density = _sdof_psd
+    parts = [density(e, f, z, v, dt) for f, z, v in modes]
+    total = noise_var + (np.sum(parts, axis=0) if parts else 0.0)
+    grads = []
+    for (f, z, v), part in zip(modes, parts):
+        for i, x in enumerate((f, z)):
+            h = 1e-6 * x
+            hi = [f, z, v]
+            lo = [f, z, v]
+            hi[i] += h
+            lo[i] -= h
+            grads.append((density(e, *hi, dt) - density(e, *lo, dt)) / (2 * h))
+        grads.append(part / v)
+    grads.append(np.ones(len(e)))
+    return total, np.array(grads) / total
+
+
+def whittle_fisher(modes: Sequence[tuple[float, float, float]], noise_var: float, fs: float,
+                   n: int) -> np.ndarray:
+    """Fisher information of the Whittle likelihood of ``n`` samples at ``fs`` of a sum of
+    noise-driven SDOFs ``modes`` = [(frequency Hz, damping ratio, variance)] plus white noise of
+    variance ``noise_var``: ``F_ij = sum_k d_i ln S(w_k) d_j ln S(w_k)`` over the Fourier
+    frequencies 0 < w_k < pi (parameters: f, zeta, variance of each mode, then the noise's).
+
+    Bins where the modes' density is below :data:`ACTIVE` of the noise's carry (to that
+    precision) information on the noise level only, and are counted as such."""
+    dt = 1.0 / fs
+    bins = _active_bins(modes, noise_var, dt, n)
+    _, d = _log_density_gradient(np.exp(-2j * math.pi * bins / n), modes, noise_var, dt)
+    fisher = d @ d.T
+    fisher[-1, -1] += ((n + 1) // 2 - 1 - len(bins)) / noise_var ** 2
+    return fisher
+
+
+def whittle_std(modes: Sequence[tuple[float, float, float]], noise_var: float, fs: float,
+                n: int) -> list[tuple[float, float]]:
+    """The Whittle (asymptotic Cramer-Rao) bound of each mode's frequency (Hz) and damping ratio,
+    as standard deviations, over ``n`` samples (see :func:`whittle_fisher`); NaN if singular."""
+    if not modes:
+        return []
+    fisher = whittle_fisher(modes, noise_var, fs, n)
+    try:
+        cov = np.linalg.inv(fisher)
+    except np.linalg.LinAlgError:
+        return [(math.nan, math.nan)] * len(modes)
+    var = np.diag(cov)
+    return [(math.sqrt(var[3 * j]) if var[3 * j] > 0 else math.nan,
+             math.sqrt(var[3 * j + 1]) if var[3 * j + 1] > 0 else math.nan)
+            for j in range(len(modes))]
+
+
+# ---- one window ---------------------------------------------------------------------------------
+def correlations(y: np.ndarray, lags: int) -> np.ndarray:
+    """Unbiased output correlations ``R_k = sum_t y_t+k y_t / (N - k)``, k = 0 .. ``lags``, of the
+    mean-removed ``y`` (by FFT)."""
+    n = len(y)
+    y = y - y.mean()
+    size = 1 << math.ceil(math.log2(n + lags + 1))
+    spec = np.fft.rfft(y, size)
+    r = np.fft.irfft(spec * np.conj(spec), size)[:lags + 1]
+    return r / np.arange(n, n - lags - 1, -1)
+
+
+def ssi_poles(r: np.ndarray, fs: float, rows: int = BLOCK_ROWS,
+              orders: Sequence[int] = ORDERS) -> list[np.ndarray]:
+    """SSI-cov poles of correlations ``r`` at each model order: one array per order with a row
+    (frequency Hz, damping ratio, variance of the mode) per complex pair (upper half plane)."""
+    hankel = r[1 + np.add.outer(np.arange(rows), np.arange(rows))]
+    u, s, vt = np.linalg.svd(hankel)
+    out = []
+    for order in orders:
+        root = np.sqrt(s[:order])
+        obs = u[:, :order] * root
+        ctrl = root[:, None] * vt[:order]
+        up = obs[:-1]
+        try:
+            a = np.linalg.solve(up.T @ up, up.T @ obs[1:])
+            lam, vec = np.linalg.eig(a)
+        except np.linalg.LinAlgError:
+            out.append(np.empty((0, 3)))
+            continue
+        keep = lam.imag > 1e-12
+        if not np.any(keep):
+            out.append(np.empty((0, 3)))
+            continue
+        c_modal = obs[0] @ vec
+        try:
+            g_modal = np.linalg.solve(vec, ctrl[:, 0])
+        except np.linalg.LinAlgError:
+            out.append(np.empty((0, 3)))
+            continue
+        lam_k, amp = lam[keep], (c_modal * g_modal)[keep]
+        pole = np.log(lam_k) * fs
+        freq = np.abs(pole) / (2 * math.pi)
+        zeta = -pole.real / np.abs(pole)
+        variance = 2.0 * (amp / lam_k).real     # the pair's share of R_0
+        out.append(np.column_stack((freq, zeta, variance)))
+    return out
+
+
+def cluster_modes(poles: list[np.ndarray], fs: float, max_damping: float,
+                  band: tuple[float, float], counts: dict[str, int]) -> np.ndarray:
+    """The physical modes of a stabilisation diagram ``poles`` (:func:`ssi_poles`): rows
+    (frequency, damping, variance, support), ascending; counts the rejected poles/clusters."""
+    rows = []
+    for k, p in enumerate(poles):
+        ok = ((p[:, 1] > 0) & (p[:, 1] <= max_damping) & (p[:, 0] < NU_MAX * fs)
+              & (p[:, 0] >= band[0]) & (p[:, 0] <= band[1]))
+        counts['rejected_damping'] += int(np.count_nonzero(~ok))
+        rows.append(np.column_stack((p[ok], np.full(np.count_nonzero(ok), k))))
+    allp = np.concatenate(rows) if rows else np.empty((0, 4))
+    allp = allp[np.argsort(allp[:, 0])]
+    modes = []
+    start = 0
+    n_orders = len(poles)
+    for i in range(1, len(allp) + 1):
+        if i < len(allp) and allp[i, 0] <= allp[i - 1, 0] * (1 + CLUSTER_TOL) \
+                and allp[i, 0] <= allp[start, 0] * (1 + CLUSTER_SPAN):
+            continue
+        group = allp[start:i]
+        start = i
+        support = len(np.unique(group[:, 3])) / n_orders
+        if support < MIN_SUPPORT:
+            counts['rejected_unstable'] += 1
+            continue
+        modes.append((np.median(group[:, 0]), np.median(group[:, 1]),
+                      max(np.median(group[:, 2]), 0.0), support))
+    return np.array(modes).reshape(-1, 4)
+
+
+def decimate(y: np.ndarray, fs: float, top_hz: float) -> tuple[np.ndarray, float]:
+    """``y`` at the lowest rate fs / 2^k that keeps ``top_hz`` at or below :data:`TOP_NU` of it
+    and :data:`MIN_SAMPLES` samples in the window (each halving behind the zero-phase anti-alias
+    filter :data:`DECIMATE_SOS`): ``(samples, rate)``."""
+    while top_hz <= 0.5 * TOP_NU * fs and len(y) // 2 >= MIN_SAMPLES:
+        y = sosfiltfilt(DECIMATE_SOS, y)[::2]
+        fs *= 0.5
+    return y, fs
+
+
+def _modes_at(y: np.ndarray, fs: float, max_damping: float, band: tuple[float, float],
+              counts: dict[str, int]) -> np.ndarray:
+    """The clustered modes (:func:`cluster_modes`) of ``y`` at ``fs``, poles up to
+    :data:`NU_MAX` fs in ``band``; clusters closer than :data:`MERGE_TOL` are one mode (the one
+    with the larger support)."""
+    modes = cluster_modes(ssi_poles(correlations(y, 2 * BLOCK_ROWS), fs), fs, max_damping,
+                          (band[0], min(band[1], NU_MAX * fs)), counts)
+    keep = []
+    for row in modes:
+        if keep and row[0] <= keep[-1][0] * (1 + MERGE_TOL):
+            if row[3] > keep[-1][3]:
+                keep[-1] = row
+            continue
+        keep.append(row)
+    return np.array(keep).reshape(-1, 4)
+
+
+def _strong(modes: np.ndarray, total: float, fs: float, counts: dict[str, int]):
+    """The ``modes`` whose peak stands :data:`MIN_PEAK_RATIO` above the density of everything
+    else at its frequency (the white noise -- the variance ``total`` less the modes' -- and the
+    other modes' skirts), and that noise variance."""
+    dt = 1.0 / fs
+    while True:
+        noise = max(total - float(np.sum(modes[:, 2])), 1e-3 * total)
+        w = 2 * math.pi * modes[:, 0] * dt
+        e = np.exp(-1j * w)
+        dens = np.array([_sdof_psd(e, f, z, max(v, 1e-300), dt) for f, z, v, _ in modes])
+        own = np.diag(dens) if len(modes) else np.empty(0)
+        ratio = own / (noise + dens.sum(axis=0) - own) if len(modes) else own
+        weak = ratio < MIN_PEAK_RATIO
+        if not np.any(weak):
+            return modes, noise
+        worst = int(np.argmin(ratio))      # drop the weakest, then judge the others again
+        counts['rejected_weak'] += 1
+        modes = np.delete(modes, worst, axis=0)
+
+
+def identify(y: np.ndarray, fs: float, max_damping: float = 0.1,
+             band: tuple[float, float] = (0.0, math.inf), counts: dict[str, int] | None = None,
+             top_hz: float = 0.0, search: bool = True):
+    """Modes of one window ``y`` sampled at ``fs``: (rows of frequency, damping, variance,
+    frequency std, damping std, ascending; the white noise variance left over; the window's
+    variance). A first pass at ``fs`` (or, if it finds none, at the first of the rates halved in
+    turn that does) finds the highest mode (or ``top_hz``, the highest mode
+    known, if higher; with ``search`` false and ``top_hz`` given, no first pass); when it lies
+    low enough, the modes come from a second pass at the rate
+    :func:`decimate` gives, over whose lags (``BLOCK_ROWS`` samples) close modes are resolved."""
+    counts = dict.fromkeys(COUNTER_NAMES, 0) if counts is None else counts
+    total = float(np.var(y))
+    modes, noise = np.empty((0, 4)), total
+    if search or top_hz <= 0:
+        # the search: from the full rate down by halvings until a level finds a mode (a low
+        # mode spans too few periods of the full rate's lags to be stable there)
+        yk, rate = y, fs
+        while True:
+            modes, noise = _strong(_modes_at(yk, rate, max_damping, band, counts), total, fs,
+                                   counts)
+            if len(modes) or len(yk) // 2 < MIN_SAMPLES:
+                break
+            yk, rate = sosfiltfilt(DECIMATE_SOS, yk)[::2], 0.5 * rate
+    top = max(float(np.max(modes[:, 0])) if len(modes) else 0.0, top_hz)
+    if top > 0:
+        yq, rate = decimate(y, fs, top)
+        if rate < fs:
+            modes, noise = _strong(_modes_at(yq, rate, max_damping, band, counts), total, fs,
+                                   counts)
+    triples = [(f, z, v) for f, z, v, _ in modes]
+    stds = np.array(whittle_std(triples, noise, fs, len(y))).reshape(-1, 2)
+    out = np.column_stack((modes[:, :3], stds)) if len(modes) else np.empty((0, 5))
+    weak = ~(out[:, 3] <= MAX_STD_REL * out[:, 0])
+    counts['rejected_uncertain'] += int(np.count_nonzero(weak))
+    return out[~weak], noise, total
+
+
+# ---- streaming ----------------------------------------------------------------------------------
+class _Track:
+    """A mode followed across windows."""
+
+    __slots__ = ('amplitude', 'estimates', 'frequency', 'history', 'last_t', 'published', 'seen')
+
+    def __init__(self, frequency: float, t: float):
+        self.frequency, self.seen, self.last_t, self.published = frequency, 1, t, False
+        self.amplitude = 0.0
+        self.estimates = 0
+        self.history: list[tuple[float, float, float, float, float]] = []
+
+    def calibration(self, t: float, f: float, f_std: float, z: float, z_std: float,
+                    window: float) -> float:
+        """The factor (>= 1) by which the Whittle stds are too small, from this mode's own
+        estimates: the RMS of ``(f - f_j) / sqrt(std^2 + std_j^2)`` (and of the damping's) over
+        its estimates ``f_j`` of windows that do not overlap this one (at least ``window`` s
+        earlier, within :data:`HISTORY_WINDOWS` windows); 1 until there are such. Records
+        ``(t, f, f_std, z, z_std)`` for the next ones."""
+        hist = [h for h in self.history if h[0] >= t - HISTORY_WINDOWS * window]
+        self.history = hist + [(t, f, f_std, z, z_std)]
+        old = np.array([h for h in hist if h[0] <= t - window]).reshape(-1, 5)
+        if not len(old):
+            return 1.0
+        d = np.concatenate(((f - old[:, 1]) / np.hypot(f_std, old[:, 2]),
+                            (z - old[:, 3]) / np.hypot(z_std, old[:, 4])))
+        return max(1.0, math.sqrt(float(np.mean(d * d))))
+
+
+class AmbientEstimator:
+    """Sliding-window output-only mode identification; see the module docstring."""
+
+    def __init__(self, config: EstimatorConfig):
+        config.validate()
+        self._config = config
+        self._window = config.ambient_window_s
+        self._band = config.band_hz or (0.0, math.inf)
+        self._c = dict.fromkeys(COUNTER_NAMES, 0)
+        self._t = np.empty(1 << 14)
+        self._y = np.empty(1 << 14)
+        self._tracks: list[_Track] = []
+        self.restart()
+
+    @property
+    def config(self) -> EstimatorConfig:
+        return self._config
+
+    @property
+    def counters(self) -> dict[str, int]:
+        return dict(self._c)
+
+    def mode_counters(self) -> dict[int, dict[str, int]]:
+        """Each current mode's estimates (as the mode tracker's ``mode_counters``)."""
+        published = sorted((tr for tr in self._tracks if tr.published),
+                           key=lambda tr: tr.frequency)
+        return {k: {'estimates': tr.estimates} for k, tr in enumerate(published, 1)}
+
+    def restart(self) -> None:
+        """Forget the signal and the tracked modes; counters are kept."""
+        self._tracks = []
+        self._last = -math.inf
+        self._clear()
+
+    def reset(self) -> None:
+        """Start a new window at the next sample (the tracked modes are kept): the next estimates
+        come from samples after this call."""
+        self._clear()
+
+    def _clear(self) -> None:
+        self._n = 0          # samples in the buffer
+        self._start = 0      # first sample of the current window
+        self._next = math.inf
+
+    # ---- input --------------------------------------------------------------------------------
+    def _append(self, t: np.ndarray, y: np.ndarray) -> None:
+        m = len(t)
+        if self._n + m > len(self._t):
+            keep = self._n - self._start
+            if keep + m > len(self._t) // 2:      # grow
+                size = 1 << math.ceil(math.log2(2 * (keep + m)))
+                self._t = np.concatenate((self._t[self._start:self._n], np.empty(size - keep)))
+                self._y = np.concatenate((self._y[self._start:self._n], np.empty(size - keep)))
+            else:                                  # compact
+                self._t[:keep] = self._t[self._start:self._n]
+                self._y[:keep] = self._y[self._start:self._n]
+            self._n, self._start = keep, 0
+        self._t[self._n:self._n + m] = t
+        self._y[self._n:self._n + m] = y
+        if self._n == 0:
+            self._next = float(t[0]) + self._window
+        self._n += m
+
+    def _accept(self, t: float, y: float) -> bool:
+        """Count one sample; False if skipped. A gap or a long jump back clears the window."""
+        c = self._c
+        c['received'] += 1
+        if not (math.isfinite(t) and math.isfinite(y)):
+            c['skipped_non_finite'] += 1
+            return False
+        last = self._last
+        if t <= last:
+            if last - t > self._config.max_gap:
+                c['time_jump_resets'] += 1
+                self._clear()
+            else:
+                c['skipped_duplicate' if t == last else 'skipped_out_of_order'] += 1
+                return False
+        elif t - last > self._config.max_gap and self._n:
+            c['gap_resets'] += 1
+            self._clear()
+        self._last = t
+        c['used'] += 1
+        return True
+
+    def update(self, t: float, y: float) -> list[Estimate]:
+        """Feed one sample; the estimates of an analysis it completes (ascending mode)."""
+        t, y = float(t), float(y)
+        if not self._accept(t, y):
+            return []
+        self._append(np.array((t,)), np.array((y,)))
+        if t >= self._next:
+            return self._analyse()
+        return []
+
+    def process(self, t: Sequence[float], y: Sequence[float]) -> EstimateArrays:
+        """Feed arrays of samples (continuing the stream); the estimates as columns, by time."""
+        t, y = as_series(t, y)
+        out: list[Estimate] = []
+        i, n = 0, len(t)
+        while i < n:
+            # the longest clean run from i: finite, increasing, no gap (else one sample at a time)
+            j = i
+            if math.isfinite(t[i]) and math.isfinite(y[i]) and t[i] > self._last \
+                    and (t[i] - self._last <= self._config.max_gap or not self._n):
+                d = np.diff(t[i:min(n, i + 65536)])
+                bad = (~((d > 0) & (d <= self._config.max_gap))
+                       | ~np.isfinite(y[i + 1:i + 1 + len(d)]))
+                j = i + 1 + (int(np.argmax(bad)) if bad.any() else len(d))
+            if j == i:
+                out.extend(self.update(t[i], y[i]))
+                i += 1
+                continue
+            while i < j:
+                if not self._n:
+                    self._next = float(t[i]) + self._window
+                k = min(j, int(np.searchsorted(t[i:j], self._next, 'left')) + i + 1)
+                self._c['received'] += k - i
+                self._c['used'] += k - i
+                self._append(t[i:k], y[i:k])
+                self._last = float(t[k - 1])
+                i = k
+                if self._last >= self._next:
+                    out.extend(self._analyse())
+        return _columns(out)
+
+    # ---- analysis -----------------------------------------------------------------------------
+    def _analyse(self) -> list[Estimate]:
+        t_end = self._t[self._n - 1]
+        self._next += HOP_S
+        if self._next <= t_end:
+            self._next = t_end + HOP_S
+        first = self._start + int(np.searchsorted(self._t[self._start:self._n],
+                                                  t_end - self._window, 'left'))
+        self._start = first
+        ts, ys = self._t[first:self._n], self._y[first:self._n]
+        n = len(ts)
+        if n < 4 * BLOCK_ROWS + 2:
+            return []
+        span = float(ts[-1] - ts[0])
+        fs = (n - 1) / span
+        self._c['analyses'] += 1
+        known = max((tr.frequency for tr in self._tracks if tr.published), default=0.0)
+        search = self._c['analyses'] % SEARCH_EVERY == 1
+        modes, _noise, total = identify(ys, fs, self._config.max_damping, self._band, self._c,
+                                        known, search)
+        return self._track(modes, total, float(t_end), span, n)
+
+    def _track(self, modes: np.ndarray, total: float, t: float, span: float,
+               n: int) -> list[Estimate]:
+        """Match the window's modes to the tracked ones, publish the confirmed ones."""
+        tracks = self._tracks
+        pairs = sorted((abs(m[0] / tr.frequency - 1), i, j) for i, m in enumerate(modes)
+                       for j, tr in enumerate(tracks))
+        match: dict[int, int] = {}
+        used = set()
+        pairs.sort(key=lambda p: (not tracks[p[2]].published, p[0]))   # published ones first
+        for dist, i, j in pairs:
+            if dist <= MATCH_TOL and i not in match and j not in used:
+                match[i] = j
+                used.add(j)
+        seen = {}
+        for i, m in enumerate(modes):
+            if i in match:
+                tr = tracks[match[i]]
+                tr.seen += 1
+            elif len(tracks) < MAX_TRACKS:
+                tr = _Track(m[0], t)
+                tracks.append(tr)
+            else:
+                continue
+            tr.frequency, tr.last_t, tr.amplitude = m[0], t, math.sqrt(m[2])
+            seen[id(tr)] = m
+        for tr in list(tracks):
+            if id(tr) not in seen:
+                tr.seen = 0
+                if not tr.published or t - tr.last_t > self._window:
+                    tracks.remove(tr)
+                    self._c['modes_lost'] += tr.published
+        ready = [tr for tr in tracks if id(tr) in seen and tr.seen >= CONFIRM]
+        if self._config.modes:
+            ready = sorted(ready, key=lambda tr: -tr.amplitude)[:self._config.modes]
+        for tr in ready:
+            if not tr.published:
+                tr.published = True
+                self._c['modes_found'] += 1
+        numbered = sorted((tr for tr in tracks if tr.published), key=lambda tr: tr.frequency)
+        explained = min(1.0, float(np.sum(modes[:, 2])) / total) if total > 0 else 0.0
+        out = []
+        for k, tr in enumerate(numbered, 1):
+            if tr in ready:
+                f, z, v, fstd, zstd = seen[id(tr)]
+                scale = tr.calibration(t, f, fstd, z, zstd, self._window)
+                fstd, zstd = fstd * scale, zstd * scale
+                tr.estimates += 1
+                out.append(Estimate(t, float(f), span, n, explained, math.sqrt(v), float(z),
+                                    float(fstd), float(zstd), k))
+        self._c['estimates'] += len(out)
+        return out
+
+
+def _columns(estimates: list[Estimate]) -> EstimateArrays:
+    """Estimates as the columns of :class:`EstimateArrays`."""
+    names = list(EstimateArrays.__dataclass_fields__)
+    ints = ('samples', 'mode')
+    return EstimateArrays(**{
+        name: np.array([getattr(e, name) for e in estimates],
+                       dtype=np.int64 if name in ints else np.float64) for name in names})
