@@ -132,7 +132,9 @@ def test_every_input_type_of_a_bag_and_the_topic_choice(tmp_path, capsys, sample
         assert main(['analyze', str(tmp_path / 'bag')] + args) == 0
         assert [r['frequency_hz'] for r in jsonl(capsys.readouterr().out)] == expected
     assert main(['analyze', str(tmp_path / 'bag')]) == 2
-    assert 'choose one with --topic: /imu (sensor_msgs/msg/Imu), /raw' in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert f'choose one with --topic, e.g. `vib-estimator analyze {tmp_path / "bag"} --topic /imu`: ' \
+        '/imu (sensor_msgs/msg/Imu), /raw' in err
     assert main(['analyze', str(tmp_path / 'bag'), '--topic', '/imu', '--component',
                  'torque.z']) == 2
     assert 'linear_acceleration.x' in capsys.readouterr().err
