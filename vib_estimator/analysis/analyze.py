@@ -29,6 +29,7 @@ _CONFIG_OPTIONS = {
     'lowpass_cutoff_hz': float, 'lowpass_damping': float, 'window': int, 'tolerance': float,
     'min_time': float, 'min_periods': float, 'max_window': float, 'min_fit': float,
     'min_amplitude': float, 'max_damping': float, 'max_gap': float, 'target_std_rel': float,
+    'gap_intervals': float, 'outlier_ratio': float,
     'modes': int, 'refine': int,
 }
 
