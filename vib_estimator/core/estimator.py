@@ -173,6 +173,11 @@ class FrequencyEstimator:
         return {name: int(self._c[i]) for i, name in enumerate(COUNTER_NAMES)}
 
     @property
+    def segment_samples(self) -> int:
+        """Samples of the open segment: taken since the last reset, not (yet) in an estimate."""
+        return int(self._c[K.C_SEG_N])
+
+    @property
     def omega_squared(self) -> float:
         """Eq. 12's current value n_f / d_f (rad^2/s^2) of the running segment; NaN if undefined.
 

@@ -40,7 +40,8 @@ from std_srvs.srv import Trigger
 from ..core.config import EstimatorConfig
 from ..io.fields import check_component, check_input_type, component_getter, has_header, stamp_ns
 from . import health as H
-from .parameters import config_of, config_value, declare_config, declare_input
+from .parameters import (config_of, config_value, declare_config, declare_input,
+                         warn_unused_params_files)
 from .runner import StartupError, run
 from .stream import EstimatorStream
 
@@ -114,6 +115,8 @@ class EstimatorNode(Node):
         super().__init__('estimator_node', **kwargs)
         self._input_type, topic = declare_input(self)
         declare_config(self)
+        #: warnings about params files that set nothing for this node (also logged)
+        self.params_file_warnings = warn_unused_params_files(self, kwargs.get('cli_args'))
         try:
             self._component = check_component(self.get_parameter('component').value,
                                               self._input_type)
