@@ -51,6 +51,21 @@ MAX_STEP = 2.0
 SETTLE_S = 0.3
 
 
+#: the ROS domain ids DDS can map to ports (ROS 2 documentation: 0-232)
+MAX_DOMAIN_ID = 232
+
+
+def domain_id(text: str) -> int:
+    """``--domain-id``: an integer in [0, :data:`MAX_DOMAIN_ID`] (argparse: error and exit 2)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'not an integer: {text!r}') from None
+    if not 0 <= value <= MAX_DOMAIN_ID:
+        raise argparse.ArgumentTypeError(f'must be in [0, {MAX_DOMAIN_ID}], got {value}')
+    return value
+
+
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--speed', type=float, default=10.0,
                         help='simulated seconds per wall-clock second (default 10)')
@@ -58,7 +73,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help='simulated seconds spent on each tip mass (default 8)')
     parser.add_argument('--out', default=None,
                         help='figure path (default out/demo.png, with --shaping out/shaping.png)')
-    parser.add_argument('--domain-id', type=int, default=None,
+    parser.add_argument('--domain-id', type=domain_id, default=None,
                         help='ROS domain of the demo (default: 120 + pid %% 100)')
     parser.add_argument('--shaping', action='store_true',
                         help='input shaping: per mass a move unshaped, then the same move shaped '

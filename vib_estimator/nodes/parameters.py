@@ -35,11 +35,16 @@ def descriptor(description: str, bounds: Optional[Sequence] = None, read_only: b
 
 def declare(node: Node, name: str, default, desc: ParameterDescriptor):
     """Declare a parameter and return its value; a refused override (out of range, wrong type,
-    e.g. ``rate:=10`` for a double) raises :class:`StartupError` with rclpy's reason."""
+    e.g. ``rate:=10`` for a double, or ``[]`` for an array with a default) raises
+    :class:`StartupError` with rclpy's reason."""
     try:
-        return node.declare_parameter(name, default, desc).value
+        value = node.declare_parameter(name, default, desc).value
     except ParameterException as err:
         raise StartupError(str(err)) from None
+    if value is None and not isinstance(default, Parameter.Type):
+        # an override of [] has no type: rclpy leaves the parameter unset, and reading it raises
+        raise StartupError(f'parameter {name} must not be empty (got []); default: {default!r}')
+    return value
 
 
 def config_value(value):
