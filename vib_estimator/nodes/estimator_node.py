@@ -190,18 +190,23 @@ class EstimatorNode(Node):
         self._clock = self.get_clock()
         self._outputs = Outputs(self)
         self._outputs.set_modes(self._stream.config.modes)
-        qos = QoSProfile(depth=INPUT_DEPTH, reliability=qos_profile_sensor_data.reliability,
-                         durability=qos_profile_sensor_data.durability)
-        self._subscription = self.create_subscription(
-            message_class(self._input_type), topic,
-            self._on_stamped if has_header(self._input_type) else self._on_unstamped, qos)
-        self.add_on_set_parameters_callback(self._check_parameters)
-        self.add_post_set_parameters_callback(self._apply_parameters)
+        # before the subscription: a node whose input is matched answers its services
         self._trigger_services = Services(self)
-        self._diagnostics_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
-        # on the steady clock: diagnostics go on (and can say STALE) when sim time stops
-        self.create_timer(DIAGNOSTICS_PERIOD, self._publish_diagnostics,
-                          clock=Clock(clock_type=ClockType.STEADY_TIME))
+        try:
+            qos = QoSProfile(depth=INPUT_DEPTH, reliability=qos_profile_sensor_data.reliability,
+                             durability=qos_profile_sensor_data.durability)
+            self._subscription = self.create_subscription(
+                message_class(self._input_type), topic,
+                self._on_stamped if has_header(self._input_type) else self._on_unstamped, qos)
+            self.add_on_set_parameters_callback(self._check_parameters)
+            self.add_post_set_parameters_callback(self._apply_parameters)
+            self._diagnostics_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
+            # on the steady clock: diagnostics go on (and can say STALE) when sim time stops
+            self.create_timer(DIAGNOSTICS_PERIOD, self._publish_diagnostics,
+                              clock=Clock(clock_type=ClockType.STEADY_TIME))
+        except BaseException:      # e.g. Ctrl-C while starting: no thread left running
+            self._trigger_services.destroy()
+            raise
         self.get_logger().info(f'estimating on {self._subscription.topic_name} '
                                f'({self._input_type} [{self._component}]) with '
                                f'{self._stream.config}')
