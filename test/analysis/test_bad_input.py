@@ -95,3 +95,23 @@ def test_no_estimate_says_why():
     why = [line for line in err.splitlines() if line.startswith('analyze: no estimate: ')]
     assert len(why) == 1 and 'never fired' in why[0] and 'damped-sinusoid' in why[0]
     assert 'open_segment_samples=4993' in err
+
+
+def test_gaps_are_counted_in_analyze_and_survey_rows(tmp_path):
+    """Issue 22 case 1 in the command line: the gaps and the samples lost are in analyze's
+    summary and in each survey row."""
+    t = np.arange(0, 20, 0.002)
+    keep = np.ones(len(t), bool)
+    for start in (1000, 3000, 6000):
+        keep[start:start + 100] = False                  # three 200 ms gaps (< max_gap)
+    path = tmp_path / 'gappy.csv'
+    path.write_text('t,y\n' + ''.join(f'{a!r},{b!r}\n' for a, b in
+                                      zip(t[keep].tolist(), np.sin(2 * np.pi * 2 * t[keep]).tolist())))
+    code, _, err = analyze(path.read_bytes())
+    assert code == 0 and 'gaps=3' in err and 'samples_lost=300' in err
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(io.StringIO()):
+        assert cli.main(['survey', str(path), '--format', 'csv']) == 0
+    header, row = out.getvalue().splitlines()[:2]
+    values = dict(zip(header.split(','), row.split(',')))
+    assert values['gaps'] == '3' and values['samples_lost'] == '300'
