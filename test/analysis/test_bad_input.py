@@ -105,8 +105,9 @@ def test_gaps_are_counted_in_analyze_and_survey_rows(tmp_path):
     for start in (1000, 3000, 6000):
         keep[start:start + 100] = False                  # three 200 ms gaps (< max_gap)
     path = tmp_path / 'gappy.csv'
-    path.write_text('t,y\n' + ''.join(f'{a!r},{b!r}\n' for a, b in
-                                      zip(t[keep].tolist(), np.sin(2 * np.pi * 2 * t[keep]).tolist())))
+    y = np.sin(2 * np.pi * 2 * t[keep])
+    path.write_text('t,y\n' + ''.join(f'{a!r},{b!r}\n' for a, b in zip(t[keep].tolist(),
+                                                                       y.tolist())))
     code, _, err = analyze(path.read_bytes())
     assert code == 0 and 'gaps=3' in err and 'samples_lost=300' in err
     out = io.StringIO()

@@ -83,8 +83,8 @@ class EstimatorConfig:
                                   'samples_lost (0 = off, else >= 2)', 0.0, 1e6)
     outlier_ratio: float = _param(1000.0, 'a sample farther from the signal\'s running centre '
                                   'than this many times its running peak deviation is skipped '
-                                  f'(skipped_outlier); {K.OUTLIER_RUN} in a row are a real change of '
-                                  'level, taken (the estimator restarts) (0 = off, else >= 2)',
+                                  f'(skipped_outlier); {K.OUTLIER_RUN} in a row are a real change '
+                                  'of level, taken (the estimator restarts) (0 = off, else >= 2)',
                                   0.0, 1e12)
     target_std_rel: float = _param(0.0, 'publish as soon as the predicted relative standard '
                                    'deviation of the frequency is at or below this, whatever the '

@@ -88,8 +88,9 @@ def run(factory: Callable[[], Node], args: Optional[Sequence[str]] = None,
     ``done(node)``, when given, is polled between callbacks; spinning stops when it returns True
     (the bag replayer uses it to exit 0 at the end of a bag). Returns the process exit code: 2 for
     a :class:`StartupError` or a ROS argument rcl refuses (a malformed ``-p``/``-r``, a missing
-    ``--params-file``, an invalid name given to a node: one ``error:`` line), else the node's ``exit_code`` read after it was destroyed (so an error
-    while closing, e.g. a bag that cannot be finished at SIGINT, still fails the process).
+    ``--params-file``, an invalid name given to a node: one ``error:`` line), else the node's
+    ``exit_code`` read after it was destroyed (so an error while closing, e.g. a bag that cannot
+    be finished at SIGINT, still fails the process).
     """
     error = init_or_error(args)
     if error is not None:

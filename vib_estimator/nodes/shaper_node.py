@@ -37,7 +37,7 @@ from rosgraph_msgs.msg import Clock as ClockMsg
 from std_msgs.msg import Float64
 
 from ..control.shaping import MAX_DAMPING, SHAPERS, Shaper, StreamingShaper, design, none
-from .parameters import declare, descriptor
+from .parameters import declare, descriptor, warn_unused_params_files
 from .runner import StartupError, run
 
 #: period of /diagnostics, s
@@ -75,6 +75,7 @@ class ShaperNode(Node):
         super().__init__('shaper_node', **kwargs)
         p = {name: declare(self, name, default, desc)
              for name, (default, desc) in PARAMETERS.items()}
+        warn_unused_params_files(self, kwargs.get('cli_args'))
         self._rate = p['rate_hz']
         self._check_parameters([Parameter(name, value=value) for name, value in p.items()],
                                startup=True)

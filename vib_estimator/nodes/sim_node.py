@@ -46,7 +46,7 @@ from ..io.fields import IMU, WRENCH_STAMPED, normalise_type
 from ..sim.arm_model import (DEFAULT_NOISE_STD, ArmParameters, ArmSimulator, Move,
                              natural_frequency_hz)
 from .runner import StartupError, run
-from .parameters import declare, descriptor
+from .parameters import declare, descriptor, warn_unused_params_files
 
 # wall-clock rate of the publishing timer: a command takes effect at the start of the next batch,
 # so a tick of 1 ms keeps that within 10 samples (20 ms simulated) at 10x (input shaping needs it)
@@ -164,6 +164,7 @@ class SimNode(Node):
         super().__init__('sim_node', **kwargs)
         for name, (default, desc) in PARAMETERS.items():
             declare(self, name, default, desc)
+        warn_unused_params_files(self, kwargs.get('cli_args'))
         p = {name: self.get_parameter(name).value for name in PARAMETERS}
         try:
             schedule = schedule_from_array(p['schedule'])
