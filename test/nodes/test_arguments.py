@@ -18,11 +18,24 @@ ROOT = Path(__file__).resolve().parents[2]
 BAG = ROOT / 'bags' / 'fig1'
 
 
+#: a node that starts although it should not is stopped after this long (the test then fails)
+WATCHDOG_S = 20.0
+
+
 def _exit_code(main, args):
+    """``main(args)``'s exit code; a node still running after WATCHDOG_S is shut down."""
+    import threading
+
+    import rclpy
+
+    watchdog = threading.Timer(WATCHDOG_S, rclpy.try_shutdown)
+    watchdog.start()
     try:
         return main(args)
     except SystemExit as stop:
         return stop.code
+    finally:
+        watchdog.cancel()
 
 
 def _assert_one_error_line(capfd, code, *words):

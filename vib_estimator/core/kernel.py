@@ -411,9 +411,9 @@ def _outlier(p, s, c, y):
     if abs(y) > MAX_ABS_VALUE:
         c[C_OUTLIER] += 1
         return True
-    ratio = p[P_OUTLIER]
-    dev = abs(y - s[S_YC])
-    if ratio > 0.0 and c[C_SCALE_N] >= SCALE_WARMUP and dev > ratio * s[S_YR]:
+    yc = s[S_YC]
+    dev = abs(y - yc)
+    if dev > p[P_OUTLIER] * s[S_YR] and p[P_OUTLIER] > 0.0 and c[C_SCALE_N] >= SCALE_WARMUP:
         c[C_OUTLIER_RUN] += 1
         if c[C_OUTLIER_RUN] < OUTLIER_RUN:
             c[C_OUTLIER] += 1
@@ -421,14 +421,18 @@ def _outlier(p, s, c, y):
         s[S_YC] = y
         s[S_YR] = dev
         c[C_SCALE_N] = 1
+        c[C_OUTLIER_RUN] = 0
         _restart(s, c)
-    else:
+        return False
+    if c[C_SCALE_N] < SCALE_WARMUP:
         if c[C_SCALE_N] == 0:
-            s[S_YC] = y
-        s[S_YC] += SCALE_WEIGHT * (y - s[S_YC])
-        s[S_YR] = max(dev, (1.0 - SCALE_WEIGHT) * s[S_YR])
+            yc = y
         c[C_SCALE_N] += 1
-    c[C_OUTLIER_RUN] = 0
+    s[S_YC] = yc + SCALE_WEIGHT * (y - yc)
+    decayed = (1.0 - SCALE_WEIGHT) * s[S_YR]
+    s[S_YR] = dev if dev > decayed else decayed
+    if c[C_OUTLIER_RUN] != 0:
+        c[C_OUTLIER_RUN] = 0
     return False
 
 
