@@ -638,9 +638,8 @@ def test_names_are_relative_so_namespaces_apply(ros_context, executor):
     def graph():
         topics = {n for n, _ in probe.get_publisher_names_and_types_by_node(
             'estimator_node', '/arm1')}
-        # ~/reset and ~/self_test are served by the node's hidden helper (their own threads)
-        services = {n for node_name in ('estimator_node', '_estimator_node_services')
-                    for n, _ in probe.get_service_names_and_types_by_node(node_name, '/arm1')}
+        services = {n for n, _ in probe.get_service_names_and_types_by_node(
+            'estimator_node', '/arm1')}
         return topics, services
     try:
         for n in (node, probe):
@@ -656,8 +655,8 @@ def test_names_are_relative_so_namespaces_apply(ros_context, executor):
 
 def test_simultaneous_service_calls_are_all_answered_while_estimating(make_probe):
     """Issue 22 case 7: 50 resets and 50 self-tests sent together while streaming were 21 answered.
-    Now every call is answered, a self-test asked for while one runs is "busy", and the samples
-    streamed meanwhile are all taken and estimated on."""
+    Now every call is answered (in turn) and the samples streamed meanwhile are all taken and
+    estimated on."""
     from rclpy.qos import QoSProfile, ReliabilityPolicy
 
     p = make_probe()
@@ -677,9 +676,7 @@ def test_simultaneous_service_calls_are_all_answered_while_estimating(make_probe
         f'{sum(f.done() for _, f in futures)} of {len(futures)} answered'
     answers = [(name, f.result()) for name, f in futures]
     assert all(r.success for name, r in answers if name == 'reset')
-    tests = [r for name, r in answers if name == 'self_test']
-    assert all(r.success and r.message.startswith('passed') or
-               not r.success and r.message.startswith('busy') for r in tests)
-    assert any(r.success for r in tests)
+    assert all(r.success and r.message.startswith('passed')
+               for name, r in answers if name == 'self_test')
     assert p.node.counters['received'] == 5000
     assert len(p.frequencies()) > 5 and all(abs(f / 1.33 - 1) < 0.01 for f in p.frequencies())

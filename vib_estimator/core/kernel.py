@@ -411,7 +411,7 @@ def _outlier(p, s, c, y):
     if abs(y) > MAX_ABS_VALUE:
         c[C_OUTLIER] += 1
         return True
-    yc = s[S_YC]
+    yc = s[S_YC] if c[C_SCALE_N] > 0 else y
     dev = abs(y - yc)
     if dev > p[P_OUTLIER] * s[S_YR] and p[P_OUTLIER] > 0.0 and c[C_SCALE_N] >= SCALE_WARMUP:
         c[C_OUTLIER_RUN] += 1
@@ -425,8 +425,6 @@ def _outlier(p, s, c, y):
         _restart(s, c)
         return False
     if c[C_SCALE_N] < SCALE_WARMUP:
-        if c[C_SCALE_N] == 0:
-            yc = y
         c[C_SCALE_N] += 1
     s[S_YC] = yc + SCALE_WEIGHT * (y - yc)
     decayed = (1.0 - SCALE_WEIGHT) * s[S_YR]

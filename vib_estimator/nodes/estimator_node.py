@@ -14,8 +14,8 @@ and the diagnostics bookkeeping, all without rclpy) and publishes what comes bac
   converging sample); with ``modes`` >= 1 these carry mode 1, and each mode k has
   ``vibration/mode<k>/frequency`` and ``vibration/mode<k>/reset``.
 * Services ``~/reset`` (a new segment now) and ``~/self_test`` (:mod:`.self_test`), std_srvs/Trigger,
-  answered off the data path (:class:`Services`): every call is answered, the node keeps
-  estimating meanwhile, and a self-test asked for while one runs gets ``success: false``, "busy".
+  with a request history of :data:`SERVICE_DEPTH`: a burst of calls is queued and every call
+  answered, in turn (a self-test takes ~8 ms at the defaults; the input history covers 2 s).
 * ``/diagnostics`` at 1 Hz (steady clock): one status named after the node (:mod:`.health`).
 
 Time base: the header stamps (``t`` = stamp - first stamp, as the offline ``vib-estimator
@@ -28,14 +28,11 @@ from __future__ import annotations
 
 import importlib
 import sys
-import threading
 import time
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from rcl_interfaces.msg import SetParametersResult
-from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.clock import Clock, ClockType
-from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
 from rclpy.time import Time
@@ -57,8 +54,6 @@ INPUT_DEPTH = 1000
 #: request history of the services: a burst of calls queues instead of being dropped (rclpy's
 #: default, 10, answered 21 of 100 simultaneous calls)
 SERVICE_DEPTH = 1000
-#: threads answering the services: one may run a self-test while the others answer
-SERVICE_THREADS = 3
 #: period of /diagnostics, s
 DIAGNOSTICS_PERIOD = 1.0
 #: the ROS parameters that configure the core, one per EstimatorConfig field
@@ -118,58 +113,6 @@ class Outputs:
             reset.publish(header)
 
 
-class Services:
-    """``~/reset`` and ``~/self_test`` of ``node``, answered by their own threads.
-
-    The node's executor (the package's EventsExecutor) runs one callback at a time and cannot
-    defer a response, so a self-test there would stall the data path and queue every other call
-    behind it. The services live on a hidden helper node (``_<name>_services``, same context and
-    namespace) under the node's own names (``<node>/reset``, ``<node>/self_test``), spun by a
-    :class:`MultiThreadedExecutor` in a daemon thread: a self-test asked for while another runs
-    is answered at once, ``success: false``, "busy". The kernel calls hold the GIL, so a reset
-    never interleaves with a sample.
-    """
-
-    def __init__(self, node: 'EstimatorNode'):
-        self._node = node
-        self._busy = threading.Lock()
-        base = node.get_fully_qualified_name()
-        self._helper = Node(f'_{node.get_name()}_services', namespace=node.get_namespace(),
-                            context=node.context, start_parameter_services=False)
-        qos = QoSProfile(depth=SERVICE_DEPTH, reliability=ReliabilityPolicy.RELIABLE)
-        group = ReentrantCallbackGroup()
-        for name, callback in (('reset', node.on_reset), ('self_test', self._self_test)):
-            self._helper.create_service(Trigger, f'{base}/{name}', callback, qos_profile=qos,
-                                        callback_group=group)
-        self._executor = MultiThreadedExecutor(num_threads=SERVICE_THREADS,
-                                               context=node.context)
-        self._executor.add_node(self._helper)
-        self._thread = threading.Thread(target=self._spin, name=f'{base} services', daemon=True)
-        self._thread.start()
-
-    def _spin(self) -> None:
-        try:
-            self._executor.spin()
-        except ExternalShutdownException:
-            pass
-
-    def _self_test(self, request, response):
-        if not self._busy.acquire(blocking=False):
-            response.success = False
-            response.message = 'busy: a self test is running; call again when it has answered'
-            return response
-        try:
-            return self._node.on_self_test(request, response)
-        finally:
-            self._busy.release()
-
-    def destroy(self) -> None:
-        """Stop the threads and destroy the helper node."""
-        self._executor.shutdown()
-        self._thread.join(timeout=5.0)
-        self._helper.destroy_node()
-
-
 class EstimatorNode(Node):
     """Publishes the natural frequency of the vibration in one field of a sensor stream."""
 
@@ -190,23 +133,22 @@ class EstimatorNode(Node):
         self._clock = self.get_clock()
         self._outputs = Outputs(self)
         self._outputs.set_modes(self._stream.config.modes)
-        # before the subscription: a node whose input is matched answers its services
-        self._trigger_services = Services(self)
-        try:
-            qos = QoSProfile(depth=INPUT_DEPTH, reliability=qos_profile_sensor_data.reliability,
-                             durability=qos_profile_sensor_data.durability)
-            self._subscription = self.create_subscription(
-                message_class(self._input_type), topic,
-                self._on_stamped if has_header(self._input_type) else self._on_unstamped, qos)
-            self.add_on_set_parameters_callback(self._check_parameters)
-            self.add_post_set_parameters_callback(self._apply_parameters)
-            self._diagnostics_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
-            # on the steady clock: diagnostics go on (and can say STALE) when sim time stops
-            self.create_timer(DIAGNOSTICS_PERIOD, self._publish_diagnostics,
-                              clock=Clock(clock_type=ClockType.STEADY_TIME))
-        except BaseException:      # e.g. Ctrl-C while starting: no thread left running
-            self._trigger_services.destroy()
-            raise
+        # before the subscription: a node whose input is matched answers its services; a deep
+        # request history, so that a burst of calls queues instead of being dropped
+        service_qos = QoSProfile(depth=SERVICE_DEPTH, reliability=ReliabilityPolicy.RELIABLE)
+        self.create_service(Trigger, '~/reset', self._on_reset, qos_profile=service_qos)
+        self.create_service(Trigger, '~/self_test', self._on_self_test, qos_profile=service_qos)
+        qos = QoSProfile(depth=INPUT_DEPTH, reliability=qos_profile_sensor_data.reliability,
+                         durability=qos_profile_sensor_data.durability)
+        self._subscription = self.create_subscription(
+            message_class(self._input_type), topic,
+            self._on_stamped if has_header(self._input_type) else self._on_unstamped, qos)
+        self.add_on_set_parameters_callback(self._check_parameters)
+        self.add_post_set_parameters_callback(self._apply_parameters)
+        self._diagnostics_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
+        # on the steady clock: diagnostics go on (and can say STALE) when sim time stops
+        self.create_timer(DIAGNOSTICS_PERIOD, self._publish_diagnostics,
+                          clock=Clock(clock_type=ClockType.STEADY_TIME))
         self.get_logger().info(f'estimating on {self._subscription.topic_name} '
                                f'({self._input_type} [{self._component}]) with '
                                f'{self._stream.config}')
@@ -282,12 +224,7 @@ class EstimatorNode(Node):
                                    'diagnostics)')
 
     # ---- services --------------------------------------------------------------------------
-    def destroy_node(self):
-        if getattr(self, '_trigger_services', None) is not None:
-            self._trigger_services.destroy()
-        return super().destroy_node()
-
-    def on_reset(self, request, response):
+    def _on_reset(self, request, response):
         """``~/reset``: start a new segment at the last sample; counters kept."""
         self._stream.reset()
         response.success = True
@@ -295,7 +232,7 @@ class EstimatorNode(Node):
         self.get_logger().info('reset requested: new segment started')
         return response
 
-    def on_self_test(self, request, response):
+    def _on_self_test(self, request, response):
         """``~/self_test``: three tones through a fresh estimator of the live configuration."""
         response.success, response.message = self._stream.self_test()
         text = 'self test ' + response.message.replace('\n', '; ')
