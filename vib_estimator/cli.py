@@ -31,8 +31,15 @@ COMMANDS = {
 }
 
 
+class Parser(argparse.ArgumentParser):
+    """argparse with a bad argument reported as one ``error:`` line (no usage block), exit 2."""
+
+    def error(self, message: str):
+        self.exit(2, f'{self.prog}: error: {message} (see {self.prog} --help)\n')
+
+
 def main(argv: Optional[Sequence[str]] = None) -> int:
-    parser = argparse.ArgumentParser(prog='vib-estimator', description=__doc__.splitlines()[0])
+    parser = Parser(prog='vib-estimator', description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest='command', required=True, metavar='COMMAND')
     chosen = (argv if argv is not None else sys.argv[1:])[:1]
     modules = {}

@@ -66,6 +66,21 @@ MAX_STEP = 2.0
 SETTLE_S = 0.3
 
 
+#: the ROS domain ids DDS can map to ports (ROS 2 documentation: 0-232)
+MAX_DOMAIN_ID = 232
+
+
+def domain_id(text: str) -> int:
+    """``--domain-id``: an integer in [0, :data:`MAX_DOMAIN_ID`] (argparse: error and exit 2)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'not an integer: {text!r}') from None
+    if not 0 <= value <= MAX_DOMAIN_ID:
+        raise argparse.ArgumentTypeError(f'must be in [0, {MAX_DOMAIN_ID}], got {value}')
+    return value
+
+
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--speed', type=float, default=10.0,
                         help='simulated seconds per wall-clock second (default 10)')
@@ -73,7 +88,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help='simulated seconds spent on each tip mass (default 8)')
     parser.add_argument('--out', default=None,
                         help='figure path (default out/demo.png, with --shaping out/shaping.png)')
-    parser.add_argument('--domain-id', type=int, default=None,
+    parser.add_argument('--domain-id', type=domain_id, default=None,
                         help='ROS domain of the demo, 0-232 (default: ROS_DOMAIN_ID when set, '
                              'else one of 1-101 from the process id)')
     parser.add_argument('--real-arm', action='store_true',
@@ -314,13 +329,11 @@ class Session:
 
 
 def demo_domain(asked: Optional[int], env: Optional[str]) -> int:
-    """The demo's ROS domain: ``--domain-id`` if given (0-232: ValueError otherwise), else
+    """The demo's ROS domain: ``--domain-id`` if given (checked by :func:`domain_id`), else
     ``ROS_DOMAIN_ID`` when set to one, else one of :data:`DOMAINS` from the process id."""
     if asked is not None:
-        if not 0 <= asked <= 232:
-            raise ValueError(f'--domain-id must be in 0-232, got {asked}')
         return asked
-    if env and env.strip().isdigit() and 0 <= int(env) <= 232:
+    if env and env.strip().isdigit() and 0 <= int(env) <= MAX_DOMAIN_ID:
         return int(env)
     return DOMAINS[os.getpid() % len(DOMAINS)]
 
@@ -346,11 +359,6 @@ def run(args: argparse.Namespace) -> int:
         return 2
     truth = [(i * args.seconds_per_mass, (i + 1) * args.seconds_per_mass, natural_frequency_hz(m))
              for i, m in enumerate(MASSES_5_5)]
-    try:
-        demo_domain(args.domain_id, None)
-    except ValueError as err:
-        print(f'error: {err}', file=sys.stderr)
-        return 2
     wall_start = time.monotonic()
     session = Session(args, truth)
     try:

@@ -658,3 +658,32 @@ def test_names_are_relative_so_namespaces_apply(ros_context, executor):
         for n in (node, probe):
             executor.remove_node(n)
             n.destroy_node()
+
+
+def test_simultaneous_service_calls_are_all_answered_while_estimating(make_probe):
+    """Issue 22 case 7: 50 resets and 50 self-tests sent together while streaming were 21 answered.
+    Now every call is answered (in turn) and the samples streamed meanwhile are all taken and
+    estimated on."""
+    from rclpy.qos import QoSProfile, ReliabilityPolicy
+
+    p = make_probe()
+    qos = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
+    clients = {name: p.probe.create_client(Trigger, f'/estimator_node/{name}', qos_profile=qos)
+               for name in ('reset', 'self_test')}
+    for client in clients.values():
+        assert spin_until(p.executor, client.service_is_ready, 60.0)
+    assert p.call('self_test').success           # compiled before the burst
+    stamps = sine_stamps(5000)
+    values = np.sin(2 * np.pi * 1.33 * np.arange(5000) / FS)
+    p.feed(stamps[:1000], values[:1000])
+    futures = [(name, clients[name].call_async(Trigger.Request()))
+               for _ in range(50) for name in ('reset', 'self_test')]
+    p.feed(stamps[1000:], values[1000:])
+    assert spin_until(p.executor, lambda: all(f.done() for _, f in futures), 60.0), \
+        f'{sum(f.done() for _, f in futures)} of {len(futures)} answered'
+    answers = [(name, f.result()) for name, f in futures]
+    assert all(r.success for name, r in answers if name == 'reset')
+    assert all(r.success and r.message.startswith('passed')
+               for name, r in answers if name == 'self_test')
+    assert p.node.counters['received'] == 5000
+    assert len(p.frequencies()) > 5 and all(abs(f / 1.33 - 1) < 0.01 for f in p.frequencies())

@@ -151,3 +151,22 @@ def test_an_estimate_of_any_mode_clears_held_back():
     h.record(estimate(8.0, mode=2), 1.5, held)
     s = h.status(2.0, h.totals(core(received=200, used=200, rejected_fit=2)), 0.4, modes=2)
     assert s.level == H.OK and s.message == 'waiting for a first estimate'   # of mode 1
+
+
+def test_gaps_and_outliers_warn_and_are_logged_once_per_episode():
+    """Issue 22 case 1/2 in the diagnostics: gaps and skipped outliers since the last status make
+    it WARN, saying how many samples were lost; the warning is logged when the episode starts."""
+    h = H.Health(now=0.0)
+    h.record(estimate(), 0.5, h.totals(core()))
+    s = h.status(1.0, h.totals(core(received=500, used=500)), 1.0)
+    assert s.level == H.OK and s.log is None
+    s = h.status(2.0, h.totals(core(received=900, used=899, gaps=2, samples_lost=100,
+                                    skipped_outlier=1)), 2.0)
+    assert s.level == H.WARN and '2 gaps (100 samples lost' in s.message
+    assert '1 outliers skipped' in s.message and s.log is not None
+    s = h.status(3.0, h.totals(core(received=1300, used=1298, gaps=3, samples_lost=150,
+                                    skipped_outlier=2)), 3.0)
+    assert s.level == H.WARN and '1 gaps (50 samples lost' in s.message and s.log is None
+    s = h.status(4.0, h.totals(core(received=1800, used=1798, gaps=3, samples_lost=150,
+                                    skipped_outlier=2)), 4.0)
+    assert s.level == H.OK and s.values['gaps'] == 3 and s.values['samples_lost'] == 150

@@ -23,7 +23,7 @@ LAUNCH = ROOT / 'launch' / 'estimator.launch.py'
 
 
 def test_params_file_holds_the_defaults():
-    params = yaml.safe_load(PARAMS.read_text())['estimator_node']['ros__parameters']
+    params = yaml.safe_load(PARAMS.read_text())['/**']['ros__parameters']
     assert params.pop('input_type') == WRENCH_STAMPED
     assert params.pop('input_topic') == 'coupling_torque'
     assert params.pop('component') == DEFAULT_COMPONENT[WRENCH_STAMPED]
@@ -127,3 +127,42 @@ def test_readme_parameter_table_states_the_defaults():
             assert shown == default, name
         else:
             assert float(shown) == default, (name, shown, default)
+
+
+def _node_with(context, *ros_args):
+    rclpy.init(context=context, domain_id=int(os.environ['ROS_DOMAIN_ID']),
+               args=['--ros-args', *ros_args])
+    return EstimatorNode(context=context, cli_args=['--ros-args', *ros_args])
+
+
+def test_params_file_applies_under_any_namespace_and_name(tmp_path):
+    """Issue 22 case 3: keyed ``estimator_node:`` the file was ignored under a namespace."""
+    changed = tmp_path / 'changed.yaml'
+    changed.write_text(PARAMS.read_text().replace('min_fit: 0.9', 'min_fit: 0.75'))
+    for remap in ('__ns:=/robot1', '__node:=x'):
+        context = rclpy.Context()
+        try:
+            node = _node_with(context, '-r', remap, '--params-file', str(changed))
+            assert node._stream.config.min_fit == 0.75, remap
+            assert node.params_file_warnings == []
+            node.destroy_node()
+        finally:
+            context.try_shutdown()
+
+
+def test_a_params_file_that_sets_nothing_for_the_node_is_warned_about(tmp_path):
+    wrong = tmp_path / 'wrong.yaml'
+    wrong.write_text('estimator_node:\n  ros__parameters:\n    min_fit: 0.75\n')
+    unknown = tmp_path / 'unknown.yaml'
+    unknown.write_text('/**:\n  ros__parameters:\n    min_fitt: 0.75\n')
+    context = rclpy.Context()
+    try:
+        node = _node_with(context, '-r', '__ns:=/robot1', '--params-file', str(wrong),
+                          '--params-file', str(unknown))
+        assert node._stream.config.min_fit == 0.9
+        first, second = node.params_file_warnings
+        assert 'wrong.yaml sets nothing for /robot1/estimator_node' in first
+        assert '"/**:"' in first and 'min_fitt' in second
+        node.destroy_node()
+    finally:
+        context.try_shutdown()

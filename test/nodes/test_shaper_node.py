@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 from builtin_interfaces.msg import Time
-from diagnostic_msgs.msg import DiagnosticArray
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
@@ -192,3 +192,26 @@ def test_live_demo_short_run(tmp_path):
     bad = subprocess.run([str(exe), 'demo', '--shaping', '--seconds-per-mass', '3'],
                          capture_output=True, text=True, timeout=60)
     assert bad.returncode == 2 and bad.stderr.startswith('error:')
+
+
+def test_only_garbage_estimates_turn_the_diagnostics_to_warn(ros_context, executor):
+    """Issue 22 case 8: fed only garbage estimates the node kept a safe command, but its status
+    stayed OK and nothing was logged. Now WARN, saying what was ignored, until a usable one."""
+    node = shaper_node(ros_context, use_sim_time=True, shaper='zvd', rate_hz=RATE)
+    rig = Rig(ros_context, executor, node)
+    try:
+        rig.publish('reference', 1.0)
+        for value in (math.nan, 0.0, -2.0, 1e9):
+            rig.publish('vibration/frequency', value)
+        rig.publish('vibration/damping_ratio', 1.5)
+        rig.wait(lambda: node.counters['estimates_ignored'] == 5)
+        rig.tick(2)
+        assert node._shaper.shaper.name == 'none' and rig.commands[-1][1] == 1.0   # safe
+        status = node.status()
+        assert status.level == DiagnosticStatus.WARN
+        assert '5 estimates ignored' in status.message and 'damping ratio 1.5' in status.message
+        rig.publish('vibration/frequency', 1.25)
+        rig.wait(lambda: node.counters['frequency_estimates'] == 1)
+        assert node.status().level == DiagnosticStatus.OK
+    finally:
+        rig.close()

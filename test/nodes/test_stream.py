@@ -3,6 +3,7 @@ replacement, counters, status (the reset service: test_estimator_node.py)."""
 from __future__ import annotations
 
 import numpy as np
+from hypothesis import given, settings, strategies as st
 
 from vib_estimator.core import EstimatorConfig, FrequencyEstimator
 from vib_estimator.nodes import health as H
@@ -54,3 +55,35 @@ def test_status_knows_the_sampling_rate_and_the_last_estimate():
     assert status.values['band_above_nyquist'] == 1001
     ok, message = stream.self_test()
     assert not ok and 'at 500 Hz sampling' in message
+
+
+@settings(max_examples=40, deadline=None)
+@given(samples=st.lists(st.tuples(
+    st.one_of(st.integers(0, 2 ** 63 - 1), st.integers(-10 ** 9, 10 ** 9)),
+    st.one_of(st.floats(allow_nan=True, allow_infinity=True),
+              st.sampled_from([1e308, -1e308, 5e-324, 0.0]), st.floats(-2.0, 2.0))),
+    max_size=200))
+def test_fuzz_the_message_path_publishes_only_finite_numbers(samples):
+    """Issue 22: random stamps (ns, any order) and values mixed into a clean 500 Hz sine through
+    the node's message path: no exception, every estimate's numbers finite (damping and stds
+    finite or NaN = not computed), every sample counted exactly once, a valid status."""
+    import math
+
+    from vib_estimator.nodes.health import format_value
+
+    s = EstimatorStream(EstimatorConfig(), 0.0)
+    n = 3000
+    clean = [(10 ** 18 + i * 2_000_000, math.sin(2 * math.pi * 3 * i / 500)) for i in range(n)]
+    for i, sample in enumerate(samples):
+        clean.insert((i * 131) % n, (10 ** 18 + sample[0], sample[1]))
+    estimates = [e for stamp, value in clean for e in s.feed(stamp, value)]
+    c = s.counters
+    assert c['received'] == len(clean) == sum(
+        c[k] for k in ('used', 'skipped_non_finite', 'skipped_duplicate', 'skipped_out_of_order',
+                       'skipped_outlier'))
+    for e in estimates:
+        assert all(math.isfinite(v) for v in (e.t, e.frequency_hz, e.fit, e.amplitude,
+                                               e.convergence_time))
+        assert not any(math.isinf(v) for v in (e.damping, e.frequency_std_hz, e.damping_std))
+    status = s.status(1.0)
+    assert all(isinstance(format_value(v), str) for v in status.values.values())

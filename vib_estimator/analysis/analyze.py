@@ -16,9 +16,9 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Optional, Tuple
 
 import numpy as np
@@ -29,12 +29,14 @@ from ..core.modes import create_estimator
 from ..errors import VibEstimatorError, report
 from ..io.fields import INPUT_TYPES
 from ..io.streaming import Signal, open_signal
+from .outputs import check_output
 
 #: CLI option -> EstimatorConfig field for the estimator's scalar parameters
 _CONFIG_OPTIONS = {
     'lowpass_cutoff_hz': float, 'lowpass_damping': float, 'window': int, 'tolerance': float,
     'min_time': float, 'min_periods': float, 'max_window': float, 'min_fit': float,
     'min_amplitude': float, 'max_damping': float, 'max_gap': float, 'target_std_rel': float,
+    'gap_intervals': float, 'outlier_ratio': float,
     'modes': int, 'refine': int, 'consistency': float, 'ambient_window_s': float,
 }
 
@@ -145,6 +147,30 @@ def estimate_signal(signal: Signal, config: EstimatorConfig, keep_samples: bool 
     return Run(estimator, EstimateArrays.concatenate(parts), first_t, previous, samples)
 
 
+def json_row(row: dict) -> dict:
+    """``row`` with every non-finite float as None, so strict JSON can hold it (null)."""
+    return {k: None if isinstance(v, float) and not math.isfinite(v) else v
+            for k, v in row.items()}
+
+
+def explain_no_estimate(counters, open_samples: Optional[int], config: EstimatorConfig) -> str:
+    """Why a run gave no estimate, from its counters, and what to try."""
+    held = {k: v for k, v in counters.items() if v and k.startswith('rejected_')}
+    if held:
+        return ('every converged estimate was held back by the quality gate (' +
+                ', '.join(f'{k}={v}' for k, v in held.items()) + '): check --min-fit, '
+                '--max-damping, --min-amplitude, or the model (--model)')
+    if counters.get('used', 0) == 0:
+        return 'no sample was usable (see the skipped_* counters)'
+    text = 'the convergence test (Eqs. 16-17) never fired'
+    if open_samples:
+        text += f' (the last segment ran {open_samples} samples without converging'
+        text += ', ' + ('max_window automatic: 10 s' if not config.max_window else
+                        f'max_window {config.max_window:g} s') + ')'
+    return (text + f': the signal may not follow --model {config.model} (a decay: try '
+            '--model damped-sinusoid), or try a larger --tolerance or a longer recording')
+
+
 def _print(estimates, origin, fmt, modes: int = 0) -> None:
     rows = []
     for e in estimates.to_list():
@@ -154,8 +180,8 @@ def _print(estimates, origin, fmt, modes: int = 0) -> None:
         rows.append(row)
     out = sys.stdout
     if fmt == 'jsonl':
-        for row in rows:     # strict JSON: NaN (e.g. no damping estimate) becomes null
-            out.write(json.dumps({k: None if v != v else v for k, v in row.items()}) + '\n')
+        for row in rows:     # strict JSON: NaN or inf (unknown, e.g. no damping) becomes null
+            out.write(json.dumps(json_row(row), allow_nan=False) + '\n')
     elif fmt == 'csv':
         keys = list(rows[0]) if rows else ['t', 'frequency_hz', 'convergence_time_s']
         out.write(','.join(keys) + '\n')
@@ -183,6 +209,7 @@ def damage_warning(signal: Signal, prog: str) -> None:
 def run(args: argparse.Namespace) -> int:
     try:
         config = make_config(args)
+        check_output(args.plot, '--plot')
         signal = open_signal(args.input, args.topic, args.component, args.column,
                              strict=getattr(args, 'strict', False))
         result = estimate_signal(signal, config, bool(args.plot))
@@ -195,12 +222,17 @@ def run(args: argparse.Namespace) -> int:
     counters = result.estimator.counters
     extra = f', messages_without_component={signal.skipped}' if signal.skipped else ''
     extra += f', corrupt_records={signal.corrupt}' if signal.topic else ''
+    open_samples = getattr(result.estimator, 'segment_samples', None)
+    if open_samples is not None:
+        extra += f', open_segment_samples={open_samples}'
     print('analyze: ' + ', '.join(f'{k}={v}' for k, v in counters.items()) + extra,
           file=sys.stderr)
+    if len(estimates) == 0:
+        print('analyze: no estimate: ' + explain_no_estimate(counters, open_samples, config),
+              file=sys.stderr)
     if args.plot:
         from .plotting import plot_estimates
 
-        Path(args.plot).parent.mkdir(parents=True, exist_ok=True)
         plot_estimates(args.plot, *result.samples, estimates.t, estimates.frequency_hz,
                        estimates.convergence_time, title=f'{args.input}: {signal.label}',
                        ylabel=signal.label, mode=estimates.mode if config.modes else None)

@@ -44,6 +44,7 @@ import functools
 import inspect
 import math
 import os
+import sys
 import time
 from dataclasses import dataclass
 from typing import Callable, Dict, List, Optional, Sequence, Tuple
@@ -54,6 +55,7 @@ from ..sim import arm_model
 from .baselines import (Hou, MojiriBakhshai, SlidingDFT, SlidingMatrixPencil, ZiaraniKonrad,
                         hold_last)
 from .bounds import window_crlb_std
+from .outputs import check_output
 from ..core import EstimatorConfig, FrequencyEstimator
 from ..sim.signals import fig1_signal
 
@@ -420,8 +422,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     seeds = args.seeds if args.seeds is not None else (10 if args.quick else 100)
-    if seeds < 1:
-        raise SystemExit('--seeds must be >= 1')
+    try:
+        if seeds < 1:
+            raise ValueError(f'--seeds must be >= 1, got {seeds}')
+        check_output(args.out, '--out', directory=True)
+    except ValueError as err:
+        print(f'vib-estimator compare: error: {err}', file=sys.stderr)
+        return 2
     start = time.perf_counter()
     keep: Dict[str, Tuple[Record, Dict[str, Run]]] = {}
     rows = compare(seeds, keep=keep)

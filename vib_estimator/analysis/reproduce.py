@@ -13,14 +13,15 @@ from __future__ import annotations
 
 import argparse
 import math
+import sys
 from dataclasses import dataclass
-from pathlib import Path
 from typing import List
 
 import numpy as np
 
 from ..core import EstimatorConfig, FrequencyEstimator
 from ..sim.signals import fig1_signal, normalised_damped_sine
+from .outputs import check_output
 
 FIG1_WC = 15.0                     # rad/s
 #: s; the paper gives neither the solver step nor the noise's hold time. At 0.1 ms the noise is
@@ -139,7 +140,11 @@ def _plot_fig2(r: Fig2Result, path: str) -> None:
 
 def run(args: argparse.Namespace) -> int:
     path = args.out or f'out/{args.figure}.png'
-    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    try:
+        check_output(path, '--out')
+    except ValueError as err:
+        print(f'vib-estimator reproduce: error: {err}', file=sys.stderr)
+        return 2
     if args.figure == 'fig1':
         r = fig1()
         print('Fig. 1: y = sin(10t + 1) + U[-0.01, 0.01], wc = 15 rad/s, zeta = 0.707, '

@@ -49,6 +49,7 @@ from ..errors import VibEstimatorError, report
 from ..io.fields import DEFAULT_COMPONENT, check_component
 from ..io.streaming import bag_topics, is_csv, open_signal, supported_topics
 from .analyze import add_config_arguments, estimate_signal, make_config
+from .outputs import check_output
 
 _STATS = ('start_utc', 'duration_s', 'samples', 'estimates', 'frequency_hz', 'frequency_lo_hz',
           'frequency_hi_hz', 'damping', 'amplitude')
@@ -501,6 +502,8 @@ def report_entries(rows: List[Dict], ignored: Sequence[Path], out) -> None:
 def _options(args: argparse.Namespace) -> Options:
     if args.out and Path(args.out).suffix not in _OUT_SUFFIXES:
         raise ValueError(f'--out must end in {", ".join(_OUT_SUFFIXES)}, got {args.out}')
+    check_output(args.out, '--out')
+    check_output(args.plot, '--plot')
     if args.jobs < 1:
         raise ValueError(f'--jobs must be >= 1, got {args.jobs}')
     if not args.alarm_rel >= 0:

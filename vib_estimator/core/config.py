@@ -93,6 +93,15 @@ class EstimatorConfig:
     max_gap: float = _param(0.5, 'a gap, or a backward jump, between stamps longer than this '
                             '(s) restarts the estimator; a smaller step back is skipped',
                             0.0, INF, open_lo=True, open_hi=True)
+    gap_intervals: float = _param(10.0, 'a step between stamps longer than this many running '
+                                  'sample intervals (yet within max_gap) is a gap: the estimator '
+                                  'restarts, never fitting across it; counted in gaps and '
+                                  'samples_lost (0 = off, else >= 2)', 0.0, 1e6)
+    outlier_ratio: float = _param(1000.0, 'a sample farther from the signal\'s running centre '
+                                  'than this many times its running peak deviation is skipped '
+                                  f'(skipped_outlier); {K.OUTLIER_RUN} in a row are a real change '
+                                  'of level, taken (the estimator restarts) (0 = off, else >= 2)',
+                                  0.0, 1e12)
     target_std_rel: float = _param(0.0, 'publish as soon as the predicted relative standard '
                                    'deviation of the frequency is at or below this, whatever the '
                                    'period fraction (0 = off)', 0.0, 1.0)
@@ -146,6 +155,10 @@ class EstimatorConfig:
         if self.excitation not in EXCITATIONS:
             raise ValueError(f'excitation must be one of {", ".join(EXCITATIONS)}, '
                              f'got {self.excitation!r}')
+        for name in ('gap_intervals', 'outlier_ratio'):
+            if 0 < getattr(self, name) < 2:
+                raise ValueError(f'{name} must be 0 (off) or at least 2, '
+                                 f'got {getattr(self, name)!r}')
         if self.model not in MODELS:
             raise ValueError(f'model must be one of {", ".join(MODELS)}, got {self.model!r}')
         window = self.max_window or K.AUTO_WINDOW_S
@@ -199,4 +212,6 @@ class EstimatorConfig:
         p[K.P_REFINE] = self.refine
         p[K.P_TARGET] = self.target_std_rel
         p[K.P_CONSIST] = self.consistency
+        p[K.P_GAPN] = self.gap_intervals
+        p[K.P_OUTLIER] = self.outlier_ratio
         return p

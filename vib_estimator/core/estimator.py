@@ -37,7 +37,8 @@ from .config import EstimatorConfig
 COUNTER_NAMES = ('received', 'used', 'skipped_non_finite', 'skipped_duplicate',
                  'skipped_out_of_order', 'time_jump_resets', 'gap_resets', 'rejected_at_rest',
                  'rejected_fit', 'rejected_nyquist', 'max_window_resets', 'estimates',
-                 'rejected_damping', 'rejected_inconsistent')
+                 'rejected_damping', 'rejected_inconsistent', 'gaps', 'samples_lost',
+                 'skipped_outlier')
 
 
 def as_series(t: Sequence[float], y: Sequence[float]) -> Tuple[np.ndarray, np.ndarray]:
@@ -135,8 +136,11 @@ class EstimateArrays:
 class FrequencyEstimator:
     """Streaming algebraic frequency estimator; see the module docstring.
 
-    Bad samples never raise: a non-finite value, a duplicate or an out-of-order stamp is skipped
-    and counted; a gap or a backward jump longer than ``max_gap`` restarts the estimator (counted).
+    Bad samples never raise: a non-finite value, a duplicate or an out-of-order stamp, or an
+    outlier (``outlier_ratio``) is skipped and counted; a gap or a backward jump longer than
+    ``max_gap``, or a gap of more than ``gap_intervals`` running sample intervals, restarts the
+    estimator (counted, with the samples lost). An estimate with a non-finite frequency, fit or
+    amplitude, or an infinite std, is never published (counted as ``rejected_fit``).
     ``counters`` tells how many samples went where and why estimates were held back.
     """
 
@@ -158,8 +162,9 @@ class FrequencyEstimator:
         return self._config
 
     def restart(self) -> None:
-        """Forget the signal entirely (prefilter and history too); counters are kept."""
-        K._restart(self._s, self._c)
+        """Forget the signal entirely (prefilter, history, running interval and scale too);
+        counters are kept."""
+        K.forget_stream(self._s, self._c)
 
     def reset(self) -> None:
         """Start a new estimation segment at the last sample, as after a convergence."""
@@ -170,6 +175,11 @@ class FrequencyEstimator:
     @property
     def counters(self) -> Dict[str, int]:
         return {name: int(self._c[i]) for i, name in enumerate(COUNTER_NAMES)}
+
+    @property
+    def segment_samples(self) -> int:
+        """Samples of the open segment: taken since the last reset, not (yet) in an estimate."""
+        return int(self._c[K.C_SEG_N])
 
     @property
     def omega_squared(self) -> float:

@@ -62,20 +62,23 @@ from .uncertainty import MODEL_BIASED, MODEL_DAMPED, MODEL_SINUSOID, TWO_PI
 # ---- parameter array layout (float64) -------------------------------------------------------
 P_MODEL, P_WC, P_ZC, P_M, P_TOL, P_EPS, P_MAXWIN, P_BAND, P_WLO, P_WHI, P_MINAMP, P_MINFIT, \
     P_MAXGAP, P_MINSAMP, P_MINPER, P_FILTER, P_ONESIDED, P_RULE, P_MAXDAMP, P_REFINE, \
-    P_TARGET, P_CONSIST = range(22)
-N_PARAMS = 22
+    P_TARGET, P_CONSIST, P_GAPN, P_OUTLIER = range(24)
+N_PARAMS = 24
 
 # ---- counter array layout (int64) -----------------------------------------------------------
 (C_RECEIVED, C_USED, C_NONFINITE, C_DUPLICATE, C_OUT_OF_ORDER, C_TIME_JUMP, C_GAP, C_REST,
- C_FIT, C_NYQUIST, C_MAX_WINDOW, C_ESTIMATES, C_DAMPING, C_INCONSISTENT, C_SEG_N, C_HIST_N,
- C_MA_N) = range(17)
-N_COUNTERS = 17
+ C_FIT, C_NYQUIST, C_MAX_WINDOW, C_ESTIMATES, C_DAMPING, C_INCONSISTENT, C_GAPS, C_LOST,
+ C_OUTLIER, C_SEG_N, C_HIST_N, C_MA_N, C_OUTLIER_RUN, C_SCALE_N) = range(22)
+N_COUNTERS = 22
 
 # ---- state array layout (float64) -----------------------------------------------------------
 NH = 8              # samples in the interpolation stencil (degree-7 rule)
 S_T0 = 0            # time origin of the current segment
 S_TLAST = 1         # time of the last accepted sample
-S_HT = 2            # NH last sample times (oldest first)
+S_HRUN = 2          # running sample interval (kept across restarts: it describes the stream)
+S_YC = 3            # running centre of the raw signal (outlier test), kept across restarts
+S_YR = 4            # running (decaying) peak of |y - centre|, kept across restarts
+S_HT = 5            # NH last sample times (oldest first)
 S_HY = S_HT + NH    # NH last (prefiltered) sample values
 S_MOM = S_HY + NH   # moments M0..M4
 S_NF = S_MOM + 5    # low-pass state of n: x5, x6 (Eq. 11)
@@ -117,6 +120,17 @@ AUTO_WINDOW_PERIODS = 2.0
 #: of its stds, and never less than this fraction of f (a clean or coarsely sampled signal:
 #: std ~ 0, the algebraic estimate's discretisation error up to ~1e-3)
 MAX_REFINE_MOVE, MIN_REFINE_MOVE_REL = 8.0, 0.02
+#: running sample interval: weight of the newest interval in its exponential average
+HRUN_WEIGHT = 1.0 / 16.0
+#: outlier test: the signal's centre and decaying peak deviation follow it with this weight per
+#: sample; the test starts once this many samples set them; this many consecutive outliers are a
+#: real change of level (accepted: the estimator and the scale restart)
+SCALE_WEIGHT = 1.0 / 1024.0
+SCALE_WARMUP = 64
+OUTLIER_RUN = 4
+#: a sample value beyond this magnitude is always an outlier (keeps every product of the moments,
+#: t^4 y, and every square of the fit finite)
+MAX_ABS_VALUE = 1e100
 #: band std: most steps of the prefilter's free response summed in its Gramian
 MAX_BAND_TAIL = 1 << 22
 
@@ -386,31 +400,99 @@ def _first_sample(p, s, c, t, y):
 
 
 @jit(inline='always')
-def _accept_time(max_gap, s, c, t, y):
+def _outlier(p, s, c, y):
+    """True if the value ``y`` is an outlier, to skip (counted ``skipped_outlier``).
+
+    The signal's running centre ``S_YC`` (exponential average, weight :data:`SCALE_WEIGHT`) and
+    scale ``S_YR`` (the peak of |y - centre|, decaying by the same weight per sample) describe the
+    stream, so they survive restarts. A value more than ``outlier_ratio`` scales from the centre,
+    or beyond :data:`MAX_ABS_VALUE`, is an outlier once :data:`SCALE_WARMUP` samples set the
+    scale; :data:`OUTLIER_RUN` outliers in a row are a real change of level: that one is taken,
+    the scale restarts from it and the estimator restarts.
+    """
+    if abs(y) > MAX_ABS_VALUE:
+        c[C_OUTLIER] += 1
+        return True
+    yc = s[S_YC] if c[C_SCALE_N] > 0 else y
+    dev = abs(y - yc)
+    if dev > p[P_OUTLIER] * s[S_YR] and p[P_OUTLIER] > 0.0 and c[C_SCALE_N] >= SCALE_WARMUP:
+        c[C_OUTLIER_RUN] += 1
+        if c[C_OUTLIER_RUN] < OUTLIER_RUN:
+            c[C_OUTLIER] += 1
+            return True
+        s[S_YC] = y
+        s[S_YR] = dev
+        c[C_SCALE_N] = 1
+        c[C_OUTLIER_RUN] = 0
+        _restart(s, c)
+        return False
+    if c[C_SCALE_N] < SCALE_WARMUP:
+        c[C_SCALE_N] += 1
+    s[S_YC] = yc + SCALE_WEIGHT * (y - yc)
+    decayed = (1.0 - SCALE_WEIGHT) * s[S_YR]
+    s[S_YR] = dev if dev > decayed else decayed
+    if c[C_OUTLIER_RUN] != 0:
+        c[C_OUTLIER_RUN] = 0
+    return False
+
+
+@jit(inline='always')
+def _gap(p, s, c, h):
+    """True if the step ``h`` (within ``max_gap``) is a gap: longer than ``gap_intervals`` running
+    sample intervals. Counts it (``gaps``) and the samples it lost (``samples_lost``, at the
+    running interval); the caller restarts the estimator, so no fit spans it. The running interval
+    ``S_HRUN`` (exponential average of the steps, weight :data:`HRUN_WEIGHT`) is learnt again from
+    the next step, so a lasting change of rate costs one restart.
+    """
+    hrun = s[S_HRUN]
+    if hrun <= 0.0:
+        s[S_HRUN] = h
+        return False
+    if p[P_GAPN] > 0.0 and h > p[P_GAPN] * hrun:
+        c[C_GAPS] += 1
+        c[C_LOST] += max(0, int(round(h / hrun)) - 1)
+        s[S_HRUN] = 0.0
+        return True
+    s[S_HRUN] = hrun + HRUN_WEIGHT * (h - hrun)
+    return False
+
+
+@jit(inline='always')
+def _accept_time(p, s, c, t, y):
     """Time handling: True if the sample is used, False if it is skipped (counted either way).
 
-    A non-finite sample, a duplicate stamp or a small step back is skipped; a gap, or a backward
-    jump, longer than ``max_gap`` restarts the estimator (counted), which then takes the sample as
-    its first.
+    A non-finite sample, a duplicate stamp, a small step back or an outlier (:func:`_outlier`) is
+    skipped; a gap, or a backward jump, longer than ``max_gap`` restarts the estimator (counted),
+    which then takes the sample as its first; so does a shorter gap (:func:`_gap`).
     """
     c[C_RECEIVED] += 1
     if not (math.isfinite(t) and math.isfinite(y)):
         c[C_NONFINITE] += 1
         return False
+    max_gap = p[P_MAXGAP]
     if c[C_HIST_N] > 0:
         h = t - s[S_TLAST]
         if h == 0.0:
             c[C_DUPLICATE] += 1
             return False
+        if h < 0.0 and -h <= max_gap:
+            c[C_OUT_OF_ORDER] += 1
+            return False
+    if _outlier(p, s, c, y):
+        return False
+    if c[C_HIST_N] > 0:
+        h = t - s[S_TLAST]
         if h < 0.0:
-            if -h > max_gap:
-                c[C_TIME_JUMP] += 1
-                _restart(s, c)
-            else:
-                c[C_OUT_OF_ORDER] += 1
-                return False
+            c[C_TIME_JUMP] += 1
+            _restart(s, c)
+            s[S_HRUN] = 0.0
         elif h > max_gap:
             c[C_GAP] += 1
+            if s[S_HRUN] > 0.0:
+                c[C_LOST] += max(0, int(round(min(h / s[S_HRUN], 1e15))) - 1)
+            s[S_HRUN] = 0.0
+            _restart(s, c)
+        elif _gap(p, s, c, h):
             _restart(s, c)
     c[C_USED] += 1
     s[S_TLAST] = t
@@ -598,6 +680,32 @@ def _chain(s, c, f, published, inconsistent_before):
 
 
 @jit(inline='always')
+def _finite_estimate(c, f, r2, amp, res):
+    """True if the estimate's numbers may be published: frequency, fit and amplitude finite,
+    the stds and damping finite or NaN (not computed, not applicable), never infinite. Else
+    the estimate is held back, counted with the fit (``rejected_fit``): a NaN R^2 compares
+    false against ``min_fit`` and would pass the quality gate.
+    """
+    if math.isfinite(f) and math.isfinite(r2) and math.isfinite(amp) and \
+            not math.isinf(res[U.R_FSTD]) and not math.isinf(res[U.R_DSTD]) and \
+            not math.isinf(res[U.R_DAMP]):
+        return True
+    c[C_FIT] += 1
+    return False
+
+
+@jit
+def forget_stream(s, c):
+    """:func:`_restart`, and forget the stream's running interval and scale too."""
+    _restart(s, c)
+    s[S_HRUN] = 0.0
+    s[S_YC] = 0.0
+    s[S_YR] = 0.0
+    c[C_SCALE_N] = 0
+    c[C_OUTLIER_RUN] = 0
+
+
+@jit(inline='always')
 def _store_sample(p, s, c, seg, t, tau, y):
     """Keep (tau, y) in the segment buffer; True if the segment ran out (``max_window`` or buffer).
 
@@ -655,7 +763,7 @@ def step(p, s, c, seg, t, y, out, row, optional=None):
     ``optional``: :func:`optional_features` of ``p`` (None for a configuration without band std,
     ``target_std_rel`` or long windows: their code is then not compiled, :func:`_band_std_if`).
     """
-    if not _accept_time(p[P_MAXGAP], s, c, t, y):
+    if not _accept_time(p, s, c, t, y):
         return 0
     if c[C_HIST_N] == 0:
         _first_sample(p, s, c, t, y)
@@ -710,8 +818,9 @@ def step(p, s, c, seg, t, y, out, row, optional=None):
     else:
         r2, amp = _fit(seg, n_fit, TWO_PI * f)
     inconsistent_before = c[C_INCONSISTENT]
-    published = _quality_gate(p, c, model, f, res[U.R_DAMP], h, r2, amp, consistent,
-                              _spread(seg, n_fit), _confirmed(p, s, f))
+    published = _finite_estimate(c, f, r2, amp, res) and \
+        _quality_gate(p, c, model, f, res[U.R_DAMP], h, r2, amp, consistent,
+                      _spread(seg, n_fit), _confirmed(p, s, f))
     _chain(s, c, f, published, inconsistent_before)
     if published:
         out[row, O_T] = t

@@ -87,6 +87,11 @@ DEPTH = 1000  # history depth of the publishers
 ACK_TIMEOUT = 2.0  # s to wait at the end for reliable subscribers to acknowledge everything
 LOOP_GAP_ONE_MESSAGE = 1.0  # s of bag time between passes of a one-message bag
 LOOP_LOG_PERIOD = 10.0  # s, the "looping" line at most this often
+#: ranges of the time parameters: start_offset (s; 1e9 s = 31 years, far inside int64 ns), the
+#: /clock rate (Hz; above 1 kHz a timer cannot keep up) and delay / wait_timeout (s; a day)
+MAX_SECONDS = 1e9
+MAX_CLOCK_HZ = 1000.0
+MAX_WAIT_S = 86400.0
 
 
 def offered_policies(info: TopicInfo):
@@ -159,20 +164,23 @@ class BagReplayer(Node):
                                f'{self.rate}' + (', paused' if settings['start_paused'] else ''))
 
     def _declare_parameters(self) -> dict:
-        def param(name, default, description, read_only=True):
-            return declare(self, name, default, descriptor(description, read_only=read_only))
+        def param(name, default, description, read_only=True, bounds=None):
+            return declare(self, name, default, descriptor(description, bounds, read_only))
 
         settings = {
             'bag': param('bag', '', 'bag directory, or .mcap / .db3 file, to play'),
             'loop': param('loop', False, 'start over at the end of the bag'),
-            'start_offset': param('start_offset', 0.0, 'seconds of the bag to skip from its start'),
+            'start_offset': param('start_offset', 0.0, 'seconds of the bag to skip from its start',
+                                  bounds=(0.0, MAX_SECONDS)),
             'topics': param('topics', Parameter.Type.STRING_ARRAY,
                             'topics to play (default: all)') or [],
             'remap': param('remap', Parameter.Type.STRING_ARRAY, 'old:=new topic renames') or [],
-            'clock_hz': param('clock_hz', 0.0, 'publish /clock at this rate when > 0'),
-            'delay': param('delay', 0.0, 'seconds to wait before playing'),
+            'clock_hz': param('clock_hz', 0.0, 'publish /clock at this rate when > 0',
+                              bounds=(0.0, MAX_CLOCK_HZ)),
+            'delay': param('delay', 0.0, 'seconds to wait before playing',
+                           bounds=(0.0, MAX_WAIT_S)),
             'wait_timeout': param('wait_timeout', 5.0, 'seconds to wait at most for subscribers '
-                                  'before playing; 0 = do not wait'),
+                                  'before playing; 0 = do not wait', bounds=(0.0, MAX_WAIT_S)),
             'start_paused': param('start_paused', False, 'start paused'),
             'strict': param('strict', False, 'refuse a bag with a damaged record (checked before '
                             'playing) instead of skipping it'),

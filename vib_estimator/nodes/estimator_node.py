@@ -13,7 +13,9 @@ and the diagnostics bookkeeping, all without rclpy) and publishes what comes bac
   (std_msgs/Float64), then ``vibration/reset`` (std_msgs/Header: stamp and frame_id of the
   converging sample); with ``modes`` >= 1 these carry mode 1, and each mode k has
   ``vibration/mode<k>/frequency`` and ``vibration/mode<k>/reset``.
-* Services ``~/reset`` (a new segment now) and ``~/self_test`` (:mod:`.self_test`), std_srvs/Trigger.
+* Services ``~/reset`` (a new segment now) and ``~/self_test`` (:mod:`.self_test`), std_srvs/Trigger,
+  with a request history of :data:`SERVICE_DEPTH`: a burst of calls is queued and every call
+  answered, in turn (a self-test takes ~8 ms at the defaults; the input history covers 2 s).
 * ``/diagnostics`` at 1 Hz (steady clock): one status named after the node (:mod:`.health`).
 
 Time base: the header stamps (``t`` = stamp - first stamp, as the offline ``vib-estimator
@@ -33,7 +35,7 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
-from rclpy.qos import QoSProfile, qos_profile_sensor_data
+from rclpy.qos import QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
 from rclpy.time import Time
 from std_msgs.msg import Float64, Header
 from std_srvs.srv import Trigger
@@ -41,7 +43,8 @@ from std_srvs.srv import Trigger
 from ..core.config import EstimatorConfig
 from ..io.fields import check_component, check_input_type, component_getter, has_header, stamp_ns
 from . import health as H
-from .parameters import config_of, config_value, declare_config, declare_input
+from .parameters import (config_of, config_value, declare_config, declare_input,
+                         warn_unused_params_files)
 from .runner import StartupError, run
 from .stream import WARMUP_BUFFER, WARMUP_MESSAGE, EstimatorStream
 
@@ -52,6 +55,9 @@ INPUT_DEPTH = 1000
 #: how often the end of a warm-up is looked for, and after how long it is announced, s
 WARMUP_POLL = 0.05
 WARMUP_NOTICE = 1.0
+#: request history of the services: a burst of calls queues instead of being dropped (rclpy's
+#: default, 10, answered 21 of 100 simultaneous calls)
+SERVICE_DEPTH = 1000
 #: the ROS parameters that configure the core, one per EstimatorConfig field
 CORE_NAMES = frozenset(EstimatorConfig.names())
 #: the Float64 outputs of each estimate, in publication order: (topic under vibration/, field)
@@ -116,6 +122,8 @@ class EstimatorNode(Node):
         super().__init__('estimator_node', **kwargs)
         self._input_type, topic = declare_input(self)
         declare_config(self)
+        #: warnings about params files that set nothing for this node (also logged)
+        self.params_file_warnings = warn_unused_params_files(self, kwargs.get('cli_args'))
         try:
             self._component = check_component(self.get_parameter('component').value,
                                               self._input_type)
@@ -128,6 +136,11 @@ class EstimatorNode(Node):
         self._clock = self.get_clock()
         self._outputs = Outputs(self)
         self._outputs.set_modes(self._stream.config.modes)
+        # before the subscription: a node whose input is matched answers its services; a deep
+        # request history, so that a burst of calls queues instead of being dropped
+        service_qos = QoSProfile(depth=SERVICE_DEPTH, reliability=ReliabilityPolicy.RELIABLE)
+        self.create_service(Trigger, '~/reset', self._on_reset, qos_profile=service_qos)
+        self.create_service(Trigger, '~/self_test', self._on_self_test, qos_profile=service_qos)
         qos = QoSProfile(depth=INPUT_DEPTH, reliability=qos_profile_sensor_data.reliability,
                          durability=qos_profile_sensor_data.durability)
         self._subscription = self.create_subscription(
@@ -135,8 +148,6 @@ class EstimatorNode(Node):
             self._on_stamped if has_header(self._input_type) else self._on_unstamped, qos)
         self.add_on_set_parameters_callback(self._check_parameters)
         self.add_post_set_parameters_callback(self._apply_parameters)
-        self.create_service(Trigger, '~/reset', self._on_reset)
-        self.create_service(Trigger, '~/self_test', self._on_self_test)
         self._diagnostics_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
         # on the steady clock: diagnostics go on (and can say STALE) when sim time stops
         steady = Clock(clock_type=ClockType.STEADY_TIME)

@@ -25,6 +25,9 @@ STALE_AFTER = 2.0
 #: core counters that grow when the quality gate holds a converged estimate back, or none forms
 HELD_BACK = ('rejected_at_rest', 'rejected_fit', 'rejected_nyquist', 'rejected_damping',
              'rejected_inconsistent', 'max_window_resets')
+#: core counters of bad input: their growth since the previous status makes it WARN (and is logged
+#: once per episode)
+BAD_INPUT = ('gaps', 'samples_lost', 'skipped_outlier')
 #: the node's own counters: zero header stamps replaced by the receipt time; JointState messages
 #: without the configured joint (skipped); samples received while ``band_hz`` reached above the
 #: Nyquist frequency of the input's sampling rate; samples dropped while the kernels compiled (the
@@ -53,6 +56,7 @@ class _Tick:
     joint_missing: int = 0
     used: int = 0
     last_t: Optional[float] = None
+    bad: Optional[Dict[str, int]] = None     # the BAD_INPUT counters
 
 
 @dataclass
@@ -86,6 +90,7 @@ class Health:
         self._tick = _Tick(now)
         self._input_at: Optional[float] = None
         self._band_warned: Optional[tuple] = None
+        self._bad_warned = False
 
     # ---- counters ----------------------------------------------------------------------------
     def count(self, name: str, n: int = 1) -> int:
@@ -153,6 +158,10 @@ class Health:
             problems.append(f'{missing} messages without the joint')
         if nyquist:
             problems.append(nyquist)
+        bad, bad_log = self._check_bad_input(totals)
+        if bad:
+            problems.append(bad)
+        log = '; '.join(text for text in (log, bad_log) if text) or None
         if self._input_at is None or now - self._input_at > self.stale_after:
             level, message = STALE, 'no input'
         elif problems:
@@ -162,11 +171,27 @@ class Health:
         else:
             level, message = OK, 'estimating'
         self._tick = _Tick(now, messages, totals['skipped_joint_missing'], totals.get('used', 0),
-                           last_t)
+                           last_t, {name: totals.get(name, 0) for name in BAD_INPUT})
         values = {**self._estimate_values(now), 'input_rate_hz': input_rate,
                   'sample_rate_hz': self.sample_rate_hz, **self._mode_values(now, modes),
                   **totals, **self.node_counters}
         return Status(level, message, values, log)
+
+    def _check_bad_input(self, totals: Mapping[str, int]):
+        """(problem text or None, warning to log or None): gaps and outliers since the previous
+        status; the warning is logged when such an episode starts."""
+        before = self._tick.bad or dict.fromkeys(BAD_INPUT, 0)
+        grown = {name: totals.get(name, 0) - before[name] for name in BAD_INPUT}
+        if not any(grown.values()):
+            self._bad_warned = False
+            return None, None
+        text = (f'input since the last status: {grown["gaps"]} gaps ({grown["samples_lost"]} '
+                f'samples lost; each restarts the estimate), {grown["skipped_outlier"]} outliers '
+                'skipped')
+        hint = ': check the sensor and its stamps (a lasting change of rate costs one gap)'
+        log = None if self._bad_warned else text + hint
+        self._bad_warned = True
+        return text, log
 
     def _update_sample_rate(self, used: int, last_t: Optional[float]) -> None:
         """The input's sampling rate from its stamps: samples used over the time they span since

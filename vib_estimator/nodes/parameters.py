@@ -4,7 +4,8 @@ the estimator's parameters (one per :class:`EstimatorConfig` field) declared and
 """
 from __future__ import annotations
 
-from typing import Optional, Sequence
+import sys
+from typing import Iterable, List, Optional, Sequence, Tuple
 
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
 from rclpy.exceptions import ParameterException
@@ -34,11 +35,16 @@ def descriptor(description: str, bounds: Optional[Sequence] = None, read_only: b
 
 def declare(node: Node, name: str, default, desc: ParameterDescriptor):
     """Declare a parameter and return its value; a refused override (out of range, wrong type,
-    e.g. ``rate:=10`` for a double) raises :class:`StartupError` with rclpy's reason."""
+    e.g. ``rate:=10`` for a double, or ``[]`` for an array with a default) raises
+    :class:`StartupError` with rclpy's reason."""
     try:
-        return node.declare_parameter(name, default, desc).value
+        value = node.declare_parameter(name, default, desc).value
     except ParameterException as err:
         raise StartupError(str(err)) from None
+    if value is None and not isinstance(default, Parameter.Type):
+        # an override of [] has no type: rclpy leaves the parameter unset, and reading it raises
+        raise StartupError(f'parameter {name} must not be empty (got []); default: {default!r}')
+    return value
 
 
 def config_value(value):
@@ -87,3 +93,82 @@ def declare_input(node: Node, default_topic: str = DEFAULT_INPUT_TOPIC):
     declare(node, 'component', DEFAULT_COMPONENT[input_type], descriptor(
         f'field of the input to estimate on: {describe_components(input_type)}'))
     return input_type, topic
+
+
+def params_files(args: Optional[Sequence[str]]) -> List[str]:
+    """The ``--params-file`` paths of a command line's ``--ros-args`` sections."""
+    files, ros, tokens = [], False, list(args or ())
+    for i, token in enumerate(tokens):
+        if token == '--ros-args':
+            ros = True
+        elif token == '--':
+            ros = False
+        elif ros and token == '--params-file' and i + 1 < len(tokens):
+            files.append(tokens[i + 1])
+    return files
+
+
+def _key_matches(pattern: str, name: str) -> bool:
+    """rcl's match of a params file's node key (``*`` one token, ``**`` any number of tokens)
+    against a fully qualified node name."""
+    pat = [p for p in pattern.split('/') if p]
+    parts = [p for p in name.split('/') if p]
+
+    def match(i: int, j: int) -> bool:
+        if i == len(pat):
+            return j == len(parts)
+        if pat[i] == '**':
+            return any(match(i + 1, k) for k in range(j, len(parts) + 1))
+        return j < len(parts) and pat[i] in ('*', parts[j]) and match(i + 1, j + 1)
+
+    return match(0, 0)
+
+
+def _node_sections(data, prefix: str = '') -> Iterable[Tuple[str, dict]]:
+    """(node key, ros__parameters) of a params file's mapping, nested namespaces joined."""
+    if not isinstance(data, dict):
+        return
+    for key, value in data.items():
+        if not isinstance(value, dict):
+            continue
+        path = f'{prefix}/{str(key).strip("/")}'
+        if isinstance(value.get('ros__parameters'), dict):
+            yield path, value['ros__parameters']
+        yield from _node_sections({k: v for k, v in value.items() if k != 'ros__parameters'},
+                                  path)
+
+
+def params_file_warnings(files: Sequence[str], node_name: str,
+                         declared: Iterable[str]) -> List[str]:
+    """A warning per params file that sets nothing this node (fully qualified ``node_name``,
+    parameters ``declared``) has: no key matches the node, or only unknown names do."""
+    import yaml
+
+    warnings, declared = [], set(declared)
+    for path in files:
+        try:
+            with open(path) as f:
+                sections = list(_node_sections(yaml.safe_load(f)))
+        except (OSError, yaml.YAMLError):
+            continue            # rcl has already refused such a file
+        keys = [key for key, _ in sections]
+        names = {n for key, params in sections if _key_matches(key, node_name) for n in params}
+        if not names:
+            warnings.append(f'params file {path} sets nothing for {node_name} (its node keys: '
+                            f'{", ".join(keys) or "none"}); key it "/**:" to apply it under any '
+                            'name and namespace')
+        elif not names & declared:
+            warnings.append(f'params file {path} sets only parameters {node_name} does not '
+                            f'have: {", ".join(sorted(names))}')
+    return warnings
+
+
+def warn_unused_params_files(node: Node, cli_args: Optional[Sequence[str]] = None) -> List[str]:
+    """Log (WARN) :func:`params_file_warnings` for the process's command line and the node's
+    ``cli_args``; return them."""
+    files = params_files(sys.argv) + params_files(cli_args)
+    names = node.list_parameters([], 0).names
+    warnings = params_file_warnings(files, node.get_fully_qualified_name(), names)
+    for text in warnings:
+        node.get_logger().warn(text)
+    return warnings

@@ -8,11 +8,16 @@ workload (see the README's figures).
 """
 from __future__ import annotations
 
+import os
+import re
 import sys
+import tempfile
 import time
 from typing import Callable, Optional, Sequence
 
 import rclpy
+from rclpy._rclpy_pybind11 import RCLError
+from rclpy.exceptions import NameValidationException
 from rclpy.executors import ExternalShutdownException
 from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
@@ -23,6 +28,39 @@ class StartupError(Exception):
 
     :func:`run` prints the message as one line on stderr and exits with code 2, never a traceback.
     """
+
+
+#: rcl's error text cites its C sources (", at /project/src/rcl/arguments.c:356"); cut from there
+_RCL_LOCATION = re.compile(r',? at /\S+:\d+')
+
+
+def argument_error(err: Exception) -> str:
+    """One line for an error rcl or rclpy raised about the command line (``-p``, ``-r``,
+    ``--params-file``, a remapped or configured name): its message without source locations."""
+    text = ' '.join(_RCL_LOCATION.sub('', str(err)).split())
+    return text.removeprefix('failed to initialize rcl: ')
+
+
+def init_or_error(args: Optional[Sequence[str]]) -> Optional[str]:
+    """``rclpy.init(args=args)``; on a command line rcl refuses, the one-line reason (rcl's own log
+    line about it, written to stderr during the call, is dropped; anything else is passed on)."""
+    sys.stderr.flush()
+    saved = os.dup(2)
+    with tempfile.TemporaryFile() as captured:
+        os.dup2(captured.fileno(), 2)
+        try:
+            rclpy.init(args=args)
+            error = None
+        except RCLError as err:
+            error = argument_error(err)
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+        if error is None:
+            captured.seek(0)
+            sys.stderr.buffer.write(captured.read())
+            sys.stderr.flush()
+    return error
 
 
 def make_executor(context=None):
@@ -49,10 +87,15 @@ def run(factory: Callable[[], Node], args: Optional[Sequence[str]] = None,
 
     ``done(node)``, when given, is polled between callbacks; spinning stops when it returns True
     (the bag replayer uses it to exit 0 at the end of a bag). Returns the process exit code: 2 for
-    a :class:`StartupError`, else the node's ``exit_code`` read after it was destroyed (so an error
-    while closing, e.g. a bag that cannot be finished at SIGINT, still fails the process).
+    a :class:`StartupError` or a ROS argument rcl refuses (a malformed ``-p``/``-r``, a missing
+    ``--params-file``, an invalid name given to a node: one ``error:`` line), else the node's
+    ``exit_code`` read after it was destroyed (so an error while closing, e.g. a bag that cannot
+    be finished at SIGINT, still fails the process).
     """
-    rclpy.init(args=args)
+    error = init_or_error(args)
+    if error is not None:
+        print(f'error: {error}', file=sys.stderr)
+        return 2
     node = None
     code = 0
     try:
@@ -63,6 +106,9 @@ def run(factory: Callable[[], Node], args: Optional[Sequence[str]] = None,
             executor.spin_once(timeout_sec=0.1)
     except StartupError as err:
         print(f'error: {err}', file=sys.stderr)
+        code = 2
+    except (NameValidationException, RCLError) as err:     # e.g. -p input_topic:=1bad
+        print(f'error: {argument_error(err)}', file=sys.stderr)
         code = 2
     except (KeyboardInterrupt, ExternalShutdownException):
         pass

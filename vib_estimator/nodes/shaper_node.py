@@ -38,7 +38,7 @@ from std_msgs.msg import Float64
 
 from ..control.shaping import MAX_DAMPING, SHAPERS, Shaper, StreamingShaper, design, none
 from .health import DIAGNOSTICS_PERIOD
-from .parameters import declare, descriptor
+from .parameters import declare, descriptor, warn_unused_params_files
 from .runner import StartupError, run
 
 #: the status goes WARN when a new design has waited this long for the reference to rest, s
@@ -74,6 +74,7 @@ class ShaperNode(Node):
         super().__init__('shaper_node', **kwargs)
         p = {name: declare(self, name, default, desc)
              for name, (default, desc) in PARAMETERS.items()}
+        warn_unused_params_files(self, kwargs.get('cli_args'))
         self._rate = p['rate_hz']
         self._check_parameters([Parameter(name, value=value) for name, value in p.items()],
                                startup=True)
@@ -87,6 +88,9 @@ class ShaperNode(Node):
         self._t0_ns: Optional[int] = None    # clock at the first reference
         self._k = 0                          # samples computed since t0
         self._pending_since: Optional[float] = None
+        #: estimates ignored since the last one taken, and what the last ignored one was
+        self._ignored_run = 0
+        self._ignored_last = ''
         self._command = Float64()
         self._command_pub = self.create_publisher(Float64, 'position_command', 10)
         self._diagnostics_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
@@ -172,18 +176,28 @@ class ShaperNode(Node):
 
     def _on_frequency(self, msg: Float64) -> None:
         self._take_estimate(msg.data, MIN_FREQUENCY_HZ, self._rate / 4, 'frequency_estimates',
-                            self._frequencies)
+                            self._frequencies, 'frequency', 'Hz')
 
     def _on_damping(self, msg: Float64) -> None:
         if not math.isnan(msg.data):       # NaN: a model without damping
-            self._take_estimate(msg.data, 0.0, MAX_DAMPING, 'damping_estimates', self._dampings)
+            self._take_estimate(msg.data, 0.0, MAX_DAMPING, 'damping_estimates', self._dampings,
+                                'damping ratio', '')
 
     def _take_estimate(self, value: float, lo: float, hi: float, counter: str,
-                       store: deque) -> None:
-        """Keep an estimate within [lo, hi] and redesign; count one outside (or NaN) ignored."""
+                       store: deque, what: str, unit: str) -> None:
+        """Keep an estimate within [lo, hi] and redesign; count one outside (or NaN) ignored,
+        with a throttled warning (the diagnostics go WARN until an estimate is taken again)."""
         if not lo <= value <= hi:
             self.counters['estimates_ignored'] += 1
+            self._ignored_run += 1
+            self._ignored_last = (f'{what} {value:g}{" " + unit if unit else ""} outside '
+                                  f'[{lo:g}, {hi:g}]')
+            self.get_logger().warning(
+                f'ignored {self._ignored_last} ({self._ignored_run} since the last usable '
+                f'estimate); keeping {self._shaper.shaper.describe()}: check what publishes '
+                f'{self.resolve_topic_name("vibration/frequency")}', throttle_duration_sec=5.0)
             return
+        self._ignored_run = 0
         self.counters[counter] += 1
         store.append(value)
         self._redesign()
@@ -218,13 +232,18 @@ class ShaperNode(Node):
 
     # ---- diagnostics -----------------------------------------------------------------------
     def status(self) -> DiagnosticStatus:
-        """OK while shaping (or passing through before the first estimate); WARN when a new
-        design has waited more than PENDING_WARN_AFTER s for the reference to rest."""
+        """OK while shaping (or passing through before the first estimate); WARN while the
+        estimates received since the last usable one were all ignored (NaN, out of range), or
+        when a new design has waited more than PENDING_WARN_AFTER s for the reference to rest."""
         s = self._shaper.shaper
         f, zeta, source = self.design_mode()
         pending = self._shaper.pending
         waited = time.monotonic() - self._pending_since if pending is not None else 0.0
-        if waited > PENDING_WARN_AFTER:
+        if self._ignored_run:
+            level, message = DiagnosticStatus.WARN, (
+                f'{self._ignored_run} estimates ignored since the last usable one (last: '
+                f'{self._ignored_last}); in use: {s.describe()}')
+        elif waited > PENDING_WARN_AFTER:
             level, message = DiagnosticStatus.WARN, (
                 f'{pending.name} waits {waited:.0f} s for the reference to rest; in use: '
                 f'{s.describe()}')

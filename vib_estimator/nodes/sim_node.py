@@ -50,7 +50,7 @@ from ..io.fields import IMU, WRENCH_STAMPED, normalise_type
 from ..sim.arm_model import (DEFAULT_NOISE_STD, DEFAULT_QUANTUM, EXCITATIONS, ArmParameters,
                              ArmSimulator, DrivenArmSimulator, Move, natural_frequency_hz)
 from .runner import StartupError, run
-from .parameters import declare, descriptor
+from .parameters import declare, descriptor, warn_unused_params_files
 
 # wall-clock rate of the publishing timer: a command takes effect at the start of the next batch,
 # so a tick of 1 ms keeps that within 10 samples (20 ms simulated) at 10x (input shaping needs it)
@@ -65,6 +65,8 @@ SIM_TIME_ORIGIN_NS = 1_000_000_000  # stamp of the first sample in simulated tim
 # the command answering the previous batch's /clock
 LOCKSTEP_BATCH_SECONDS = 0.02
 LOCKSTEP_TIMEOUT = 1.0
+#: physical range of the tip mass, kg (Table 1's bar: 45.55 g; 10 kg gives f0 = 0.09 Hz)
+TIP_MASS_RANGE_KG = (0.001, 10.0)
 SCHEDULE_FIELDS = 4        # start, final_angle, slope, tip_mass_kg (0 = unchanged)
 #: output_type -> (message class, topic)
 OUTPUTS = {WRENCH_STAMPED: (WrenchStamped, 'coupling_torque'), IMU: (Imu, 'tip_imu')}
@@ -114,7 +116,7 @@ PARAMETERS = {
     # name: (default, descriptor)
     'tip_mass_kg': (ArmParameters.tip_mass_kg, descriptor(
         'tip mass m of Eqs. 19/23, kg; changing it while running changes the frequency abruptly '
-        '(Section 5.5)', (0.001, 10.0))),
+        '(Section 5.5)', TIP_MASS_RANGE_KG)),
     'rate_hz': (500.0, descriptor('sample rate of coupling_torque, Hz (Section 5.2: 2 ms)',
                                    (10.0, 10000.0), read_only=True)),
     'speed': (1.0, descriptor('simulated seconds per wall-clock second; other than 1 the node '
@@ -189,6 +191,7 @@ class SimNode(Node):
         super().__init__('sim_node', **kwargs)
         for name, (default, desc) in PARAMETERS.items():
             declare(self, name, default, desc)
+        warn_unused_params_files(self, kwargs.get('cli_args'))
         p = {name: self.get_parameter(name).value for name in PARAMETERS}
         try:
             schedule = schedule_from_array(p['schedule'])
@@ -320,6 +323,11 @@ class SimNode(Node):
         """
         for param in params:
             if param.name == 'tip_mass_kg':
+                lo, hi = TIP_MASS_RANGE_KG
+                if not lo <= param.value <= hi:     # the schedule's masses have no descriptor
+                    return SetParametersResult(
+                        successful=False, reason=f'tip_mass_kg {param.value} is outside the '
+                        f'physical range [{lo}, {hi}] kg of the arm (45.55 g in Section 5.3)')
                 f0 = natural_frequency_hz(param.value)   # Table 1's bar
                 if f0 * MIN_SAMPLES_PER_PERIOD > self._rate:
                     return SetParametersResult(

@@ -1,0 +1,35 @@
+"""Output paths of the command line, checked before any work starts (issue 22): a path that
+cannot be written fails at once with one ``error:`` line, not after the whole analysis."""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Optional
+
+
+def check_output(path: Optional[str], option: str, directory: bool = False) -> None:
+    """ValueError naming ``option`` unless ``path`` (a file, or a ``directory``) can be written.
+
+    The missing parent folders are created (as the writers would); a file is probed by opening it
+    for appending, and removed again if the probe created it.
+    """
+    if not path:
+        return
+    target = Path(path)
+    folder = target if directory else target.parent
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        if directory:
+            probe = folder / f'.vib_estimator_probe_{os.getpid()}'
+            probe.open('ab').close()
+            probe.unlink()
+        elif target.is_dir():
+            raise IsADirectoryError(21, 'is a directory')
+        else:
+            existed = target.exists()
+            target.open('ab').close()
+            if not existed:
+                target.unlink()
+    except OSError as err:
+        raise ValueError(f'{option} {path}: cannot write there ({err.strerror or err})') \
+            from None
