@@ -87,3 +87,20 @@ def test_fuzz_the_message_path_publishes_only_finite_numbers(samples):
         assert not any(math.isinf(v) for v in (e.damping, e.frequency_std_hz, e.damping_std))
     status = s.status(1.0)
     assert all(isinstance(format_value(v), str) for v in status.values.values())
+
+
+def test_a_burst_of_self_tests_runs_the_tones_once(monkeypatch):
+    """The node shares one executor thread with the data path: a burst of ~/self_test calls costs
+    one run of the tones (seeded: a function of configuration and rate), a change of either a new
+    one."""
+    from vib_estimator.nodes import stream as stream_module
+
+    runs = []
+    real = stream_module.self_test
+    monkeypatch.setattr(stream_module, 'self_test',
+                        lambda config, rate: runs.append((config, rate)) or real(config, rate))
+    s = stream_module.EstimatorStream(EstimatorConfig(), 0.0)
+    answers = [s.self_test() for _ in range(50)]
+    assert len(runs) == 1 and answers[0][0] and len(set(answers)) == 1
+    s.configure(EstimatorConfig(window=5))
+    assert s.self_test()[0] and len(runs) == 2

@@ -1,7 +1,14 @@
 """The one ``main`` every node of this package uses.
 
-It holds the Jazzy idiom (``init`` / spin / ``KeyboardInterrupt`` or ``ExternalShutdownException`` /
-``destroy_node`` / ``try_shutdown``) once, so that the node modules only build their node. The
+It holds the Jazzy idiom (``init`` / spin / shutdown / ``destroy_node`` / ``try_shutdown``) once, so
+that the node modules only build their node.
+
+Ctrl-C and SIGTERM only *ask* the spin loop to stop (:class:`StopRequest`, a flag checked between
+``spin_once`` calls): rclpy's own handler raises ``KeyboardInterrupt`` or shuts the context down
+wherever the signal lands, inside a timer or subscription callback included, where it became a
+FATAL "Exception in callback" line, a ``RuntimeError`` from the executor (exit 1) or rosout errors
+from a logger whose context had gone. Here the callback in progress finishes, the node is
+destroyed, and the process exits 0. The
 executor is :class:`rclpy.experimental.EventsExecutor`: measured by ``benchmarks/bench_node.py`` it
 sustains several times the message rate of the default ``SingleThreadedExecutor`` on this package's
 workload (see the README's figures).
@@ -10,6 +17,7 @@ from __future__ import annotations
 
 import os
 import re
+import signal
 import sys
 import tempfile
 import time
@@ -21,6 +29,7 @@ from rclpy.exceptions import NameValidationException
 from rclpy.executors import ExternalShutdownException
 from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
+from rclpy.signals import SignalHandlerOptions
 
 
 class StartupError(Exception):
@@ -49,7 +58,7 @@ def init_or_error(args: Optional[Sequence[str]]) -> Optional[str]:
     with tempfile.TemporaryFile() as captured:
         os.dup2(captured.fileno(), 2)
         try:
-            rclpy.init(args=args)
+            rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
             error = None
         except RCLError as err:
             error = argument_error(err)
@@ -61,6 +70,21 @@ def init_or_error(args: Optional[Sequence[str]]) -> Optional[str]:
             sys.stderr.buffer.write(captured.read())
             sys.stderr.flush()
     return error
+
+
+class StopRequest:
+    """SIGINT / SIGTERM set :attr:`requested` (between bytecodes, wherever the main thread is)
+    instead of raising there; :func:`run`'s loop stops at the next turn."""
+
+    SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+    def __init__(self):
+        self.requested = False
+        for signum in self.SIGNALS:
+            signal.signal(signum, self._request)
+
+    def _request(self, signum, frame) -> None:
+        self.requested = True
 
 
 def make_executor(context=None):
@@ -98,11 +122,12 @@ def run(factory: Callable[[], Node], args: Optional[Sequence[str]] = None,
         return 2
     node = None
     code = 0
+    stop = StopRequest()
     try:
         node = factory()
         executor = make_executor()
         executor.add_node(node)
-        while rclpy.ok() and not (done is not None and done(node)):
+        while rclpy.ok() and not stop.requested and not (done is not None and done(node)):
             executor.spin_once(timeout_sec=0.1)
     except StartupError as err:
         print(f'error: {err}', file=sys.stderr)

@@ -16,6 +16,7 @@ up to :data:`WARMUP_BUFFER` (the oldest beyond it are dropped and counted in ``d
 """
 from __future__ import annotations
 
+import math
 import threading
 import time
 from collections import deque
@@ -34,6 +35,9 @@ _NONE: Tuple[Estimate, ...] = ()
 _IDLE_COUNTERS = dict.fromkeys(COUNTER_NAMES, 0)
 #: samples held while the kernels compile: a minute at 1 kHz (a cold compile takes seconds)
 WARMUP_BUFFER = 60_000
+#: significant digits of the measured sampling rate the self-test's tones are made for (a rate
+#: that wanders in its last digits gives the same tones, and the kept result)
+SELF_TEST_DIGITS = 3
 #: the diagnostics message while the kernels compile
 WARMUP_MESSAGE = 'compiling estimator kernels (first start)'
 
@@ -81,6 +85,7 @@ class EstimatorStream:
         self._background = background
         self._build: Optional[_Build] = None
         self._held: deque = deque()
+        self._self_test: Tuple[Any, Tuple[bool, str]] = (None, (False, ''))
         #: seconds the last warm-up took (None before one ended)
         self.warmup_seconds: Optional[float] = None
         self.configure(config)
@@ -193,8 +198,18 @@ class EstimatorStream:
         return True, 'new segment started'
 
     def self_test(self) -> Tuple[bool, str]:
-        """:func:`~.self_test.self_test` of the live configuration at the input's sampling rate;
-        (False, busy) during a warm-up."""
+        """:func:`~.self_test.self_test` of the live configuration at the input's sampling rate
+        (to :data:`SELF_TEST_DIGITS` significant digits); (False, busy) during a warm-up.
+
+        The tones are seeded, so the result is a function of (configuration, rate): it is kept,
+        and a burst of calls costs one run, not one each -- the data path, which shares the node's
+        single executor thread, is held up once."""
         if not self.ready:
             return False, f'busy: {WARMUP_MESSAGE}'
-        return self_test(self.config, self.health.sample_rate_hz)
+        rate = self.health.sample_rate_hz
+        if math.isfinite(rate) and rate > 0:
+            rate = float(f'{rate:.{SELF_TEST_DIGITS}g}')
+        key = (self.config, rate if math.isfinite(rate) else None)
+        if self._self_test[0] != key:
+            self._self_test = (key, self_test(self.config, rate))
+        return self._self_test[1]
