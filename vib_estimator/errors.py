@@ -62,6 +62,12 @@ class CdrLayoutError(VibEstimatorError):
     """A batch the vectorised decoder cannot take (not little-endian CDR, or too short)."""
 
 
+class StartupError(VibEstimatorError):
+    """A node's configuration it cannot start with (a parameter, a missing bag, a name rcl
+    refuses): :func:`vib_estimator.nodes.runner.run` prints it as one ``error:`` line on stderr
+    and exits with code 2, never a traceback."""
+
+
 class DamageCount:
     """Mixin of a reader that skips damaged records: :meth:`count_damage` adds them to ``corrupt``
     and keeps the first description in ``damage`` -- or, with ``strict``, raises

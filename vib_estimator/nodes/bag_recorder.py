@@ -52,10 +52,10 @@ from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPo
 from rosbags.interfaces import (Qos, QosDurability, QosHistory, QosLiveliness, QosReliability,
                                 QosTime)
 
-from ..errors import BagError
+from ..errors import BagError, StartupError
 from ..io.bags import STORAGES, BagWriter
 from .parameters import declare, descriptor
-from .runner import StartupError, run
+from .runner import run
 
 DISCOVERY_PERIOD = 0.05  # s between looks at the graph for publishers of topics not yet recorded
 

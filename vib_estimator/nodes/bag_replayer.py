@@ -75,12 +75,12 @@ from rosbags.interfaces import QosDurability, QosReliability
 from rosgraph_msgs.msg import Clock
 from std_srvs.srv import Trigger
 
-from ..errors import BagError, EmptyPlayback
+from ..errors import BagError, EmptyPlayback, StartupError
 from ..io.bags import BagReader, TopicInfo
 from .bag_recorder import adapted_qos, message_class
 from .parameters import declare, descriptor
 from .playback import Playback, StartGate
-from .runner import StartupError, run
+from .runner import run
 
 TICK = 0.001  # s, period of the scheduling timer
 DEPTH = 1000  # history depth of the publishers

@@ -40,12 +40,13 @@ from rclpy.time import Time
 from std_msgs.msg import Float64, Header
 from std_srvs.srv import Trigger
 
+from ..errors import StartupError
 from ..core.config import EstimatorConfig
 from ..io.fields import check_component, check_input_type, component_getter, has_header, stamp_ns
 from . import health as H
 from .parameters import (config_of, config_value, declare_config, declare_input,
                          warn_unused_params_files)
-from .runner import StartupError, run
+from .runner import run
 from .stream import WARMUP_BUFFER, WARMUP_MESSAGE, EstimatorStream
 
 #: input history: sensor-data QoS (best effort) but 1000 deep instead of 5, so that a scheduling

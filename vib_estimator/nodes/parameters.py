@@ -12,10 +12,11 @@ from rclpy.exceptions import ParameterException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
+from ..errors import StartupError
 from ..core.config import EstimatorConfig
 from ..io.fields import (DEFAULT_COMPONENT, DEFAULT_INPUT_TOPIC, INPUT_TYPES, WRENCH_STAMPED,
                          check_input_type, describe_components)
-from .runner import StartupError
+
 
 
 def descriptor(description: str, bounds: Optional[Sequence] = None, read_only: bool = False,

@@ -31,12 +31,9 @@ from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
+from ..errors import StartupError
 
-class StartupError(Exception):
-    """Raised by a node's constructor for a configuration it cannot start with.
 
-    :func:`run` prints the message as one line on stderr and exits with code 2, never a traceback.
-    """
 
 
 #: rcl's error text cites its C sources (", at /project/src/rcl/arguments.c:356"); cut from there

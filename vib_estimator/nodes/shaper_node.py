@@ -36,10 +36,11 @@ from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock as ClockMsg
 from std_msgs.msg import Float64
 
+from ..errors import StartupError
 from ..control.shaping import MAX_DAMPING, SHAPERS, Shaper, StreamingShaper, design, none
 from .health import DIAGNOSTICS_PERIOD
 from .parameters import declare, descriptor, warn_unused_params_files
-from .runner import StartupError, run
+from .runner import run
 
 #: the status goes WARN when a new design has waited this long for the reference to rest, s
 PENDING_WARN_AFTER = 10.0

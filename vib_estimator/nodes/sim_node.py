@@ -46,10 +46,11 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock as ClockMsg
 from std_msgs.msg import Float64
 
+from ..errors import StartupError
 from ..io.fields import IMU, WRENCH_STAMPED, normalise_type
 from ..sim.arm_model import (DEFAULT_NOISE_STD, DEFAULT_QUANTUM, EXCITATIONS, ArmParameters,
                              ArmSimulator, DrivenArmSimulator, Move, natural_frequency_hz)
-from .runner import StartupError, run
+from .runner import run
 from .parameters import declare, descriptor, warn_unused_params_files
 
 # wall-clock rate of the publishing timer: a command takes effect at the start of the next batch,
