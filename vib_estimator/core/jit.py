@@ -3,7 +3,7 @@
 numba types a constant argument (a literal, or a module constant such as a state offset) as
 ``Literal[int](value)`` and compiles a called function once per such literal: today's kernel
 compiled its whole refinement chain twice (for ``iterations`` = ``Literal[int](0)`` and for int64),
-the step twice (its row index), ``_advance`` four times (its offsets). :func:`jit` compiles a
+the step twice (its row index), ``advance`` four times (its offsets). :func:`jit` compiles a
 function called from compiled code for the plain types of its arguments only (a literal converts
 to its type at the call; LLVM still folds the constant once it inlines the callee), so each
 function is compiled once per real signature.

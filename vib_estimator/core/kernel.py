@@ -62,14 +62,12 @@ from .uncertainty import MODEL_BIASED, MODEL_DAMPED, MODEL_SINUSOID, TWO_PI
 # ---- parameter array layout (float64) -------------------------------------------------------
 P_MODEL, P_WC, P_ZC, P_M, P_TOL, P_EPS, P_MAXWIN, P_BAND, P_WLO, P_WHI, P_MINAMP, P_MINFIT, \
     P_MAXGAP, P_MINSAMP, P_MINPER, P_FILTER, P_ONESIDED, P_RULE, P_MAXDAMP, P_REFINE, \
-    P_TARGET, P_CONSIST, P_GAPN, P_OUTLIER = range(24)
-N_PARAMS = 24
+    P_TARGET, P_CONSIST, P_GAPN, P_OUTLIER, N_PARAMS = range(25)   # N_*: the slots' number
 
 # ---- counter array layout (int64) -----------------------------------------------------------
 (C_RECEIVED, C_USED, C_NONFINITE, C_DUPLICATE, C_OUT_OF_ORDER, C_TIME_JUMP, C_GAP, C_REST,
  C_FIT, C_NYQUIST, C_MAX_WINDOW, C_ESTIMATES, C_DAMPING, C_INCONSISTENT, C_GAPS, C_LOST,
- C_OUTLIER, C_SEG_N, C_HIST_N, C_MA_N, C_OUTLIER_RUN, C_SCALE_N) = range(22)
-N_COUNTERS = 22
+ C_OUTLIER, C_SEG_N, C_HIST_N, C_MA_N, C_OUTLIER_RUN, C_SCALE_N, N_COUNTERS) = range(23)
 
 # ---- state array layout (float64) -----------------------------------------------------------
 NH = 8              # samples in the interpolation stencil (degree-7 rule)
@@ -111,8 +109,7 @@ S_MA = S_FPREV + 1           # moving-average ring (2M+1 values) starts here
 N_STATE_FIXED = S_MA
 
 # ---- estimate row layout --------------------------------------------------------------------
-O_T, O_F, O_CONV, O_SAMPLES, O_FIT, O_AMP, O_DAMP, O_FSTD, O_DSTD = range(9)
-N_OUT = 9
+O_T, O_F, O_CONV, O_SAMPLES, O_FIT, O_AMP, O_DAMP, O_FSTD, O_DSTD, N_OUT = range(10)
 #: automatic max_window: this long at least (s), and min_periods + this many periods
 AUTO_WINDOW_S = 10.0
 AUTO_WINDOW_PERIODS = 2.0
@@ -143,7 +140,7 @@ BINOMIAL = ((1.0, 0.0, 0.0, 0.0, 0.0), (1.0, 1.0, 0.0, 0.0, 0.0), (1.0, 2.0, 1.0
 
 
 @jit
-def _discretise(w, z, h, out, off):
+def discretise(w, z, h, out, off):
     """Exact first-order-hold discretisation of the unit-gain low-pass w^2/(s^2 + 2 z w s + w^2).
 
     Writes Phi (row-major), G0, G1 so that x(h) = Phi x(0) + G0 u(0) + G1 u(h).
@@ -184,7 +181,7 @@ def _discretise(w, z, h, out, off):
 
 
 @jit(inline='always')
-def _advance(s, xo, d, u0, u1):
+def advance(s, xo, d, u0, u1):
     """Advance the 2-state section stored at s[xo:xo+2] with the discretisation at s[d:d+8]."""
     x0 = s[xo]
     x1 = s[xo + 1]
@@ -376,7 +373,7 @@ def _prefilter(p, s, y, xb):
     u = y
     for k in range(3):
         x = xb + 3 * k
-        _advance(s, x, S_DISC + 8 * (k + 1), s[x + 2], u)
+        advance(s, x, S_DISC + 8 * (k + 1), s[x + 2], u)
         s[x + 2] = u
         if k < 2:
             u = s[x]
@@ -506,10 +503,10 @@ def _update_discretisations(p, s, h):
     Called only when the step changes by more than rounding (a uniform stream's stamps differ in
     the last bits), see :func:`step`.
     """
-    _discretise(p[P_WC], p[P_ZC], h, s, S_DISC)
+    discretise(p[P_WC], p[P_ZC], h, s, S_DISC)
     if p[P_BAND] > 0.0:
         for k in range(3):
-            _discretise(p[P_WHI] if k < 2 else p[P_WLO], BAND_DAMPING[k], h, s,
+            discretise(p[P_WHI] if k < 2 else p[P_WLO], BAND_DAMPING[k], h, s,
                         S_DISC + 8 * (k + 1))
     s[S_CACHE_H] = h
 
@@ -561,8 +558,8 @@ def _invariant_filter(filtered, s, model, num, den, tau, h):
     n_f, q_f, d_f (its second equation).
     """
     if filtered:
-        _advance(s, S_NF, S_DISC, s[S_NPREV], num)
-        _advance(s, S_DF, S_DISC, s[S_DPREV], den)
+        advance(s, S_NF, S_DISC, s[S_NPREV], num)
+        advance(s, S_DF, S_DISC, s[S_DPREV], den)
     else:
         s[S_NF] = num
         s[S_DF] = den
@@ -571,7 +568,7 @@ def _invariant_filter(filtered, s, model, num, den, tau, h):
     if model == MODEL_DAMPED:
         q = 3.0 * s[S_MOM + 2] - 2.0 * tau * s[S_MOM + 1]
         if filtered:
-            _advance(s, S_QF, S_DISC, s[S_QPREV], q)
+            advance(s, S_QF, S_DISC, s[S_QPREV], q)
         else:
             s[S_QF] = q
         s[S_QPREV] = q

@@ -67,7 +67,7 @@ from .ambient import AmbientEstimator
 from .config import EstimatorConfig
 from .estimator import COUNTER_NAMES, Estimate, EstimateArrays, FrequencyEstimator, as_series
 from .jit import jit
-from .kernel import BAND_DAMPING, _advance, _discretise
+from .kernel import BAND_DAMPING, advance, discretise
 from .subspace import N_R, R_AMP, R_ENERGY, R_NU, R_ZETA, analyse, init_subspace
 
 KMAX = 8                 # most modes a tracker follows (the range of ``modes``)
@@ -125,8 +125,7 @@ N_B = B_E + 2
 # ---- int array ic ------------------------------------------------------------------------------
 (I_N, I_NDT, I_NB, I_RECEIVED, I_USED, I_NONFINITE, I_DUPLICATE, I_OUT_OF_ORDER, I_TIME_JUMP,
  I_GAP, I_FOUND, I_LOST, I_REJ_HARM, I_REJ_NOISE, I_REJ_UNRES, I_REJ_EDGE, I_NPEND,
- I_UID, I_NOUT) = range(19)
-I_LEV = 19                        # NLEV samples since the (re)start, per level
+ I_UID, I_NOUT, I_LEV) = range(20)   # I_LEV on: NLEV samples since the (re)start, per level
 I_RET = I_LEV + NLEV              # the lost modes' counters (MODE_COUNTERS, in order)
 I_BUSY = I_RET + 4                # NS flags: a mode publishes from the scale (or soon will)
 I_WAKE = I_BUSY + NS             # input samples of fast analyses left (a change in the signal)
@@ -141,8 +140,7 @@ FINDER_COUNTERS = {'modes_found': I_FOUND, 'modes_lost': I_LOST, 'rejected_harmo
                    'rejected_band_edge': I_REJ_EDGE}
 # ---- modes sl[k] -------------------------------------------------------------------------------
 (SL_ACTIVE, SL_UID, SL_F, SL_AMP, SL_SEEN, SL_START, SL_FIRST, SL_LAST_F, SL_LAST_T, SL_PREV,
- SL_EST, SL_INCONS, SL_HARM, SL_FIT) = range(14)
-N_SL = 14
+ SL_EST, SL_INCONS, SL_HARM, SL_FIT, N_SL) = range(15)      # N_*: the slots' number
 #: per-mode counters: name -> column of sl (and, for the lost modes' sums, of ic after I_RET)
 MODE_COUNTERS = {'estimates': SL_EST, 'rejected_inconsistent': SL_INCONS,
                  'rejected_harmonic': SL_HARM, 'rejected_fit': SL_FIT}
@@ -151,8 +149,7 @@ PD_F, PD_START, PD_SEEN = range(3)
 # ---- parameters pa -----------------------------------------------------------------------------
 PA_MAXGAP, PA_K, PA_BLO, PA_BHI, PA_MAXDAMP, PA_MINFIT, PA_P = range(7)
 # ---- output rows: the estimate's fields (EstimateArrays order), then the mode -------------------
-(O_T, O_F, O_CONV, O_SAMPLES, O_FIT, O_AMP, O_DAMP, O_FSTD, O_DSTD, O_MODE) = range(10)
-N_O = 10
+(O_T, O_F, O_CONV, O_SAMPLES, O_FIT, O_AMP, O_DAMP, O_FSTD, O_DSTD, O_MODE, N_O) = range(11)
 
 
 # ---- decimation ------------------------------------------------------------------------------
@@ -161,7 +158,7 @@ def _levels_init(b):
     """Discretise each level's anti-alias low-pass (two Butterworth sections)."""
     for k in range(2):
         for d in range(NLEV):
-            _discretise(2.0 * math.pi * DEC_CUTOFF, BAND_DAMPING[k], 1.0, b,
+            discretise(2.0 * math.pi * DEC_CUTOFF, BAND_DAMPING[k], 1.0, b,
                         B_DEC + DEC_N * d + 8 * k)
 
 
@@ -190,9 +187,9 @@ def _levels_step(b, ic, y):
             if n % (1 << (d - 1)) != 0:
                 break
             o = B_DEC + DEC_N * d
-            _advance(b, o + 16, o, b[o + 20], u)
+            advance(b, o + 16, o, b[o + 20], u)
             b[o + 20] = u
-            _advance(b, o + 18, o + 8, b[o + 21], b[o + 16])
+            advance(b, o + 18, o + 8, b[o + 21], b[o + 16])
             b[o + 21] = b[o + 16]
             if n % (1 << d) != 0:
                 break

@@ -42,8 +42,7 @@ import numpy as np
 
 from .jit import jit
 
-R_NU, R_ZETA, R_AMP, R_ENERGY = range(4)
-N_R = 4
+R_NU, R_ZETA, R_AMP, R_ENERGY, N_R = range(5)        # N_R: the slots' number
 DECAY_MAX = 12.0      # poles decaying (or growing) more than e^12 over the window are dropped
 REAL_TOL = 1e-7       # |Im z| below this: a real pole
 ROOT_ITER = 40

@@ -58,8 +58,7 @@ from .jit import jit
 MODEL_SINUSOID, MODEL_BIASED, MODEL_DAMPED = 0, 1, 2
 #: refine() result layout: frequency (Hz), damping ratio, their standard deviations, the fitted
 #: model's R^2 (about the segment's mean) and amplitude (at the segment's centre), and its RSS
-R_F, R_DAMP, R_FSTD, R_DSTD, R_FIT, R_AMP, R_RSS = range(7)
-N_RESULT = 7
+R_F, R_DAMP, R_FSTD, R_DSTD, R_FIT, R_AMP, R_RSS, N_RESULT = range(8)   # N_RESULT: slots
 TWO_PI = 2.0 * math.pi
 _RESYNC = 256
 #: Gauss-Newton stops once the step of the nonlinear parameters is below this fraction of their std
