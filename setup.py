@@ -1,4 +1,5 @@
 """ament_python package definition for vib_estimator."""
+
 import os
 from glob import glob
 
@@ -17,13 +18,14 @@ setup(
         ('share/' + PACKAGE, ['package.xml']),
         ('share/' + PACKAGE + '/config', glob('config/*.yaml')),
         ('share/' + PACKAGE + '/launch', glob('launch/*.py')),
-    ] + [('share/' + PACKAGE + '/' + d, glob(d + '/*.*')) for d in BAG_DIRS],
+    ]
+    + [('share/' + PACKAGE + '/' + d, glob(d + '/*.*')) for d in BAG_DIRS],
     install_requires=['setuptools'],
     zip_safe=True,
     maintainer='vib_estimator developers',
     maintainer_email='vib-estimator@example.com',
     description='Fast on-line algebraic frequency estimator of lightly damped vibrations '
-                '(Trapero, Sira-Ramirez, Feliu), with flexible-arm simulator and bag tools.',
+    '(Trapero, Sira-Ramirez, Feliu), with flexible-arm simulator and bag tools.',
     license='Apache-2.0',
     tests_require=['pytest'],
     entry_points={

@@ -5,6 +5,7 @@
 prints the worst relative error of any published estimate, for fs/f >= 100 and 20 <= fs/f < 100
 (targets: 1e-5 and 1e-3), and the median convergence time in periods.
 """
+
 import numpy as np
 
 from vib_estimator.core import EstimatorConfig, estimate

@@ -9,6 +9,7 @@ defaults.
    (a value beyond 1e100 is skipped even with the tests off):
    estimates, worst error, non-finite numbers published, outliers counted.
 """
+
 import numpy as np
 
 from vib_estimator.core import EstimatorConfig, FrequencyEstimator
@@ -22,22 +23,27 @@ def gappy(seed, offset):
     t = np.arange(0, 60, 1 / FS)
     keep = np.ones(len(t), bool)
     for start in rng.choice(len(t) - 300, 40, replace=False):
-        keep[start:start + int(rng.uniform(0.04, 0.4) * FS)] = False
+        keep[start : start + int(rng.uniform(0.04, 0.4) * FS)] = False
     return t[keep], np.sin(2 * np.pi * F0 * t[keep]) + offset, int((~keep).sum())
 
 
 def row(label, est, e, truth):
     err = np.abs(e.frequency_hz / truth - 1)
     c = est.counters
-    bad = sum(int(np.sum(~np.isfinite(getattr(e, k)))) for k in ('fit', 'amplitude',
-                                                                   'frequency_std_hz'))
-    print(f'  {label:<34} {len(e):5d} {int(np.sum(err > 0.05)):5d} {np.max(err, initial=0):9.2e} '
-          f'{bad:5d} {c["gaps"]:5d} {c["samples_lost"]:6d} {c["skipped_outlier"]:5d}')
+    bad = sum(
+        int(np.sum(~np.isfinite(getattr(e, k)))) for k in ('fit', 'amplitude', 'frequency_std_hz')
+    )
+    print(
+        f'  {label:<34} {len(e):5d} {int(np.sum(err > 0.05)):5d} {np.max(err, initial=0):9.2e} '
+        f'{bad:5d} {c["gaps"]:5d} {c["samples_lost"]:6d} {c["skipped_outlier"]:5d}'
+    )
 
 
 def main() -> None:
-    head = (f'  {"case":<34} {"est":>5} {">5%":>5} {"worst":>9} {"inf":>5} {"gaps":>5} '
-            f'{"lost":>6} {"outl":>5}')
+    head = (
+        f'  {"case":<34} {"est":>5} {">5%":>5} {"worst":>9} {"inf":>5} {"gaps":>5} '
+        f'{"lost":>6} {"outl":>5}'
+    )
     print('1. 40 gaps of 40-400 ms in a 2 Hz sine at 500 Hz (lost samples per seed in brackets)')
     print(head)
     for model, offset in (('sinusoid', 0.0), ('biased-sinusoid', 0.3)):

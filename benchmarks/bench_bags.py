@@ -8,6 +8,7 @@ and with ``check=False``), and, as the reference, rosbags' MCAP reader iterating
 
     python benchmarks/bench_bags.py [--messages N]
 """
+
 from __future__ import annotations
 
 import argparse
@@ -37,7 +38,7 @@ def main() -> None:
     n = parser.parse_args().messages
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / 'bag'
-        stamps = 1_700_000_000 * 10 ** 9 + np.arange(n, dtype=np.int64) * 2_000_000
+        stamps = 1_700_000_000 * 10**9 + np.arange(n, dtype=np.int64) * 2_000_000
         write_wrench_series(path, WrenchSeries(stamps, np.sin(np.arange(n) * 0.01), 'f', '/w'))
 
         def streaming():
@@ -51,10 +52,12 @@ def main() -> None:
             with Reader(path) as reader:
                 assert sum(1 for _ in reader.messages()) == n
 
-        rows = [('rosbags Reader.messages (reference)', best(rosbags)),
-                ('open_signal (streaming, checked)', best(streaming)),
-                ('BagReader.messages(check=False)', best(lambda: bag_reader(False))),
-                ('BagReader.messages (checked + CDR decode)', best(bag_reader))]
+        rows = [
+            ('rosbags Reader.messages (reference)', best(rosbags)),
+            ('open_signal (streaming, checked)', best(streaming)),
+            ('BagReader.messages(check=False)', best(lambda: bag_reader(False))),
+            ('BagReader.messages (checked + CDR decode)', best(bag_reader)),
+        ]
     print(f'{n} WrenchStamped messages, best of 3:')
     for name, seconds in rows:
         print(f'  {name:<44} {seconds * 1e3:8.0f} ms  {seconds / n * 1e6:6.2f} us/message')

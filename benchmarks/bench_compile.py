@@ -12,6 +12,7 @@ self time = inclusive minus the functions compiled inside it, split into front e
     python benchmarks/bench_compile.py --ref HEAD~1 --warm
     python benchmarks/bench_compile.py --profile "{'modes': 3}"
 """
+
 from __future__ import annotations
 
 import argparse
@@ -26,7 +27,7 @@ import tempfile
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 CONFIGS = {'default': {}, 'modes: 3': {'modes': 3}, 'band_hz': {'band_hz': (1.0, 10.0)}}
 
-PROBE = r'''
+PROBE = r"""
 import json, sys, time
 c0, w0 = time.process_time(), time.perf_counter()
 import numpy as np
@@ -42,19 +43,26 @@ est.process(t[1:], y[1:])
 c3, w3 = time.process_time(), time.perf_counter()
 print(json.dumps({'import': [c1 - c0, w1 - w0], 'update': [c2 - c1, w2 - w1],
                   'process': [c3 - c2, w3 - w2], 'total': [c3 - c0, w3 - w0]}))
-'''
+"""
 
 
 def probe(src: pathlib.Path, config: dict, cache: str) -> dict:
     env = dict(os.environ, NUMBA_CACHE_DIR=cache, PYTHONPATH=str(src))
-    out = subprocess.run([sys.executable, '-c', PROBE, json.dumps(config)], env=env, cwd=src,
-                         capture_output=True, text=True, check=True)
+    out = subprocess.run(
+        [sys.executable, '-c', PROBE, json.dumps(config)],
+        env=env,
+        cwd=src,
+        capture_output=True,
+        text=True,
+        check=True,
+    )
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
 def extract(ref: str, into: pathlib.Path) -> pathlib.Path:
-    archive = subprocess.run(['git', 'archive', ref, 'vib_estimator'], cwd=ROOT,
-                             capture_output=True, check=True).stdout
+    archive = subprocess.run(
+        ['git', 'archive', ref, 'vib_estimator'], cwd=ROOT, capture_output=True, check=True
+    ).stdout
     subprocess.run(['tar', '-x', '-C', str(into)], input=archive, check=True)
     return into
 
@@ -115,10 +123,18 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument('--ref', default='7374e6d', help='previous commit to compare with')
     ap.add_argument('--warm', action='store_true', help='also a second run on the filled cache')
-    ap.add_argument('--config', action='append', choices=sorted(CONFIGS),
-                    help='configurations to measure (default: all)')
-    ap.add_argument('--profile', metavar='CONFIG', help='per-function compile time of a '
-                    'configuration given as a Python dict, e.g. "{\'modes\': 3}"')
+    ap.add_argument(
+        '--config',
+        action='append',
+        choices=sorted(CONFIGS),
+        help='configurations to measure (default: all)',
+    )
+    ap.add_argument(
+        '--profile',
+        metavar='CONFIG',
+        help='per-function compile time of a '
+        'configuration given as a Python dict, e.g. "{\'modes\': 3}"',
+    )
     args = ap.parse_args()
     if args.profile is not None:
         os.environ.setdefault('NUMBA_CACHE_DIR', tempfile.mkdtemp())
@@ -127,19 +143,23 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         previous = extract(args.ref, pathlib.Path(tmp))
         print(f'cold start (empty NUMBA_CACHE_DIR), CPU s / wall s; previous = {args.ref}')
-        print(f'{"configuration":14s} {"kernel":8s} {"update":>13s} {"process":>13s} '
-              f'{"total":>13s}' + (f' {"warm total":>13s}' if args.warm else ''))
+        print(
+            f'{"configuration":14s} {"kernel":8s} {"update":>13s} {"process":>13s} '
+            f'{"total":>13s}' + (f' {"warm total":>13s}' if args.warm else '')
+        )
         for label in args.config or CONFIGS:
             for kernel, src in (('previous', previous), ('this', ROOT)):
                 with tempfile.TemporaryDirectory() as cache:
                     r = probe(src, CONFIGS[label], cache)
                     warm = probe(src, CONFIGS[label], cache)['total'] if args.warm else None
-                cells = [f'{r[k][0]:5.1f} / {r[k][1]:5.1f}' for k in ('update', 'process',
-                                                                        'total')]
+                cells = [
+                    f'{r[k][0]:5.1f} / {r[k][1]:5.1f}' for k in ('update', 'process', 'total')
+                ]
                 if warm:
                     cells.append(f'{warm[0]:5.2f} / {warm[1]:5.2f}')
-                print(f'{label:14s} {kernel:8s} ' + ' '.join(f'{c:>13s}' for c in cells),
-                      flush=True)
+                print(
+                    f'{label:14s} {kernel:8s} ' + ' '.join(f'{c:>13s}' for c in cells), flush=True
+                )
 
 
 if __name__ == '__main__':

@@ -18,6 +18,7 @@ Prints (one run, same machine, same signal: 2 M samples of a noisy 1.33 Hz sine 
   test/core/test_kernel_reference.py).
 Numba compiles once before timing; each figure is the best of 3 repeats.
 """
+
 import atexit
 import importlib
 import shutil
@@ -31,10 +32,13 @@ import numpy as np
 
 from vib_estimator.core import EstimatorConfig, FrequencyEstimator
 
-VARIANTS = {'refine=0 (paper)': dict(refine=0), 'min_periods=5': dict(min_periods=5.0),
-            'min_periods=20': dict(min_periods=20.0), 'target_std_rel=1e-4': dict(
-                target_std_rel=1e-4, min_periods=0.0), 'band_hz=[f/2, 2f]': dict(
-                band_hz=(0.665, 2.66))}
+VARIANTS = {
+    'refine=0 (paper)': dict(refine=0),
+    'min_periods=5': dict(min_periods=5.0),
+    'min_periods=20': dict(min_periods=20.0),
+    'target_std_rel=1e-4': dict(target_std_rel=1e-4, min_periods=0.0),
+    'band_hz=[f/2, 2f]': dict(band_hz=(0.665, 2.66)),
+}
 
 
 #: the commit whose kernel (one 169-line step, no refinement) is the speed baseline of issue 14
@@ -53,13 +57,25 @@ def load_core(commit, package, names=None):
     (folder / '__init__.py').write_text('')
     try:
         if names is None:
-            names = [Path(f).stem for f in subprocess.run(
-                ['git', 'ls-tree', '--name-only', f'{commit}:vib_estimator/core'], cwd=root,
-                capture_output=True, text=True, check=True).stdout.split()
-                if f.endswith('.py') and f != '__init__.py']
+            names = [
+                Path(f).stem
+                for f in subprocess.run(
+                    ['git', 'ls-tree', '--name-only', f'{commit}:vib_estimator/core'],
+                    cwd=root,
+                    capture_output=True,
+                    text=True,
+                    check=True,
+                ).stdout.split()
+                if f.endswith('.py') and f != '__init__.py'
+            ]
         for name in names:
-            text = subprocess.run(['git', 'show', f'{commit}:vib_estimator/core/{name}.py'],
-                                  cwd=root, capture_output=True, text=True, check=True).stdout
+            text = subprocess.run(
+                ['git', 'show', f'{commit}:vib_estimator/core/{name}.py'],
+                cwd=root,
+                capture_output=True,
+                text=True,
+                check=True,
+            ).stdout
             (folder / f'{name}.py').write_text(text)
     except (OSError, subprocess.CalledProcessError):
         return None
@@ -71,21 +87,24 @@ def load_previous():
     """The previous kernel's FrequencyEstimator and EstimatorConfig, or None without git."""
     if load_core(PREVIOUS, 'vib_previous', ('kernel', 'estimator', 'config')) is None:
         return None
-    return (importlib.import_module('vib_previous.estimator').FrequencyEstimator,
-            importlib.import_module('vib_previous.config').EstimatorConfig)
+    return (
+        importlib.import_module('vib_previous.estimator').FrequencyEstimator,
+        importlib.import_module('vib_previous.config').EstimatorConfig,
+    )
 
 
 def compare_split(t, y):
     """This kernel beside SPLIT's, per configuration (batch), ``modes`` = 3 and streaming,
     alternating, best of 3."""
     from vib_estimator.core.modes import create_estimator
+
     if load_core(SPLIT, 'vib_split') is None:
         print(f'kernel of {SPLIT}   skipped (git or the commit is not available)')
         return
     then_config = importlib.import_module('vib_split.config').EstimatorConfig
     then_create = importlib.import_module('vib_split.modes').create_estimator
     n = len(t)
-    print(f'\nthis kernel beside {SPLIT}\'s (batch M samples/s; streaming us/sample)')
+    print(f"\nthis kernel beside {SPLIT}'s (batch M samples/s; streaming us/sample)")
     rows = [('default', {}), *VARIANTS.items(), ('modes=3', dict(modes=3))]
     for name, changes in rows:
         m = n // 4 if 'modes' in changes else n
@@ -96,8 +115,10 @@ def compare_split(t, y):
         for _ in range(3):
             now.append(best(lambda c=now_cfg, k=m: create_estimator(c).process(t[:k], y[:k]), 1))
             then.append(best(lambda c=then_cfg, k=m: then_create(c).process(t[:k], y[:k]), 1))
-        print(f'batch {name:>20} {m / min(now) / 1e6:8.2f} this {m / min(then) / 1e6:8.2f} '
-              f'{SPLIT}   this/then {min(then) / min(now):5.2f}')
+        print(
+            f'batch {name:>20} {m / min(now) / 1e6:8.2f} this {m / min(then) / 1e6:8.2f} '
+            f'{SPLIT}   this/then {min(then) / min(now):5.2f}'
+        )
     m = 200_000
     tl, yl = t[:m].tolist(), y[:m].tolist()
 
@@ -109,8 +130,10 @@ def compare_split(t, y):
     for _ in range(3):
         now.append(best(lambda: stream(create_estimator(EstimatorConfig()).update), 1))
         then.append(best(lambda: stream(then_create(then_config()).update), 1))
-    print(f'streaming {"default":>16} {min(now) / m * 1e6:8.3f} this {min(then) / m * 1e6:8.3f} '
-          f'{SPLIT}   this/then {min(then) / min(now):5.2f}')
+    print(
+        f'streaming {"default":>16} {min(now) / m * 1e6:8.3f} this {min(then) / m * 1e6:8.3f} '
+        f'{SPLIT}   this/then {min(then) / min(now):5.2f}'
+    )
 
 
 def compare_previous(t, y):
@@ -129,10 +152,14 @@ def compare_previous(t, y):
         default.append(best(lambda: FrequencyEstimator().process(t, y), 1))
         old.append(best(lambda: old_estimator(old_config()).process(t, y), 1))
     n = len(t)
-    print(f'previous kernel ({PREVIOUS}) {n / min(old) / 1e6:8.2f} M samples/s   refine=0 today '
-          f'{n / min(now) / 1e6:8.2f} M samples/s   today/previous {min(old) / min(now):5.2f}')
-    print(f'{"":27}{"":22}   default today  {n / min(default) / 1e6:8.2f} M samples/s   '
-          f'today/previous {min(old) / min(default):5.2f}')
+    print(
+        f'previous kernel ({PREVIOUS}) {n / min(old) / 1e6:8.2f} M samples/s   refine=0 today '
+        f'{n / min(now) / 1e6:8.2f} M samples/s   today/previous {min(old) / min(now):5.2f}'
+    )
+    print(
+        f'{"":27}{"":22}   default today  {n / min(default) / 1e6:8.2f} M samples/s   '
+        f'today/previous {min(old) / min(default):5.2f}'
+    )
 
 
 def best(fn, repeats=3):
@@ -149,12 +176,14 @@ def main() -> None:
     n = 2_000_000
     t = np.arange(n) * 0.002
     y = np.sin(2 * np.pi * 1.33 * t) + 0.01 * rng.standard_normal(n)
-    FrequencyEstimator().process(t[:5000], y[:5000])                 # compile
+    FrequencyEstimator().process(t[:5000], y[:5000])  # compile
 
     batch = best(lambda: FrequencyEstimator().process(t, y))
     base = best(lambda: np.cumsum(y))
-    print(f'batch     {n / batch / 1e6:8.2f} M samples/s   numpy.cumsum {n / base / 1e6:8.1f} '
-          f'M samples/s   ratio {base / batch:6.3f}   (goal >= 5 M samples/s)')
+    print(
+        f'batch     {n / batch / 1e6:8.2f} M samples/s   numpy.cumsum {n / base / 1e6:8.1f} '
+        f'M samples/s   ratio {base / batch:6.3f}   (goal >= 5 M samples/s)'
+    )
 
     m = 200_000
     tl, yl = t[:m].tolist(), y[:m].tolist()
@@ -173,14 +202,17 @@ def main() -> None:
 
     s = best(stream) / m * 1e6
     f = best(floor) / m * 1e6
-    print(f'streaming {s:8.3f} us/sample        empty Python call {f:8.3f} us/sample   '
-          f'ratio {s / f:6.1f}   (goal <= 3 us/sample)')
+    print(
+        f'streaming {s:8.3f} us/sample        empty Python call {f:8.3f} us/sample   '
+        f'ratio {s / f:6.1f}   (goal <= 3 us/sample)'
+    )
     for name, changes in VARIANTS.items():
         cfg = EstimatorConfig(**changes)
         FrequencyEstimator(cfg).process(t[:5000], y[:5000])
         v = best(lambda: FrequencyEstimator(cfg).process(t, y))
-        print(f'batch {name:>20} {n / v / 1e6:8.2f} M samples/s   '
-              f'ratio to default {batch / v:6.2f}')
+        print(
+            f'batch {name:>20} {n / v / 1e6:8.2f} M samples/s   ratio to default {batch / v:6.2f}'
+        )
     compare_previous(t, y)
     compare_split(t, y)
 

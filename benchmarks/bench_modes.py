@@ -23,20 +23,20 @@ magnitude) on the same signals, and prints the issue's goals side by side:
 
 Usage: ``.venv/bin/python benchmarks/bench_modes.py [--seeds N] [--real-data DIR]``.
 """
+
 import argparse
 import math
 import sys
 from pathlib import Path
 
 import numpy as np
+from bench_estimator import best  # benchmarks/ is the script's folder
+from real_data import REFERENCE as REAL_F1
 
 from vib_estimator.core import EstimatorConfig, FrequencyEstimator
 from vib_estimator.core.modes import ModeTracker
 from vib_estimator.io.csv_reader import read_csv_series
 from vib_estimator.sim.arm_model import Move, simulate
-
-from bench_estimator import best            # benchmarks/ is the script's folder
-from real_data import REFERENCE as REAL_F1
 
 CONFIG = EstimatorConfig(modes=3, model='damped-sinusoid')
 FS = 1000.0
@@ -45,10 +45,18 @@ T_EXCITE = 1.0
 CASES = {
     '1 mode 12 Hz': ((12.0,), (1.0,), (0.003,), None),
     '2 modes 10/13 Hz (30 %), 1:0.5': ((10.0, 13.0), (1.0, 0.5), (0.003, 0.003), None),
-    '3 modes 8/21/55 Hz, 1:0.3:0.05': ((8.0, 21.0, 55.0), (1.0, 0.3, 0.05), (0.003, 0.002, 0.002),
-                                       None),
-    '3 modes 20/26/97 Hz, fs/f=10': ((20.0, 26.0, 97.0), (1.0, 0.5, 0.3),
-                                      (0.002, 0.002, 0.001), None),
+    '3 modes 8/21/55 Hz, 1:0.3:0.05': (
+        (8.0, 21.0, 55.0),
+        (1.0, 0.3, 0.05),
+        (0.003, 0.002, 0.002),
+        None,
+    ),
+    '3 modes 20/26/97 Hz, fs/f=10': (
+        (20.0, 26.0, 97.0),
+        (1.0, 0.5, 0.3),
+        (0.002, 0.002, 0.001),
+        None,
+    ),
     '1 mode 12 Hz clipped at 60 %': ((12.0,), (1.0,), (0.002,), 0.6),
 }
 #: the authors' second modes (points_data, SOURCE.md); the first: real_data.REFERENCE
@@ -84,13 +92,17 @@ class FftPeaks:
         """(stamps, frequencies) of every peak of every window."""
         out_t, out_f = [], []
         for end in range(self.n, len(y) + 1, self.n // 4):
-            seg = y[end - self.n:end]
+            seg = y[end - self.n : end]
             mag = np.abs(np.fft.rfft((seg - seg.mean()) * self.win)) + 1e-30
             floor = 10 * np.median(mag)
-            k = np.flatnonzero((mag[1:-1] > mag[:-2]) & (mag[1:-1] >= mag[2:])
-                               & (mag[1:-1] > floor)) + 1
-            for i in k[np.argsort(mag[k])[::-1][:self.peaks]]:
-                a, b, c = np.log(mag[i - 1:i + 2])
+            k = (
+                np.flatnonzero(
+                    (mag[1:-1] > mag[:-2]) & (mag[1:-1] >= mag[2:]) & (mag[1:-1] > floor)
+                )
+                + 1
+            )
+            for i in k[np.argsort(mag[k])[::-1][: self.peaks]]:
+                a, b, c = np.log(mag[i - 1 : i + 2])
                 delta = 0.5 * (a - c) / (a - 2 * b + c) if a - 2 * b + c < 0 else 0.0
                 out_t.append(t[end - 1])
                 out_f.append((i + delta) * self.fs / self.n)
@@ -111,17 +123,22 @@ def score(est_t, est_f, freqs):
         e = err[nearest == k]
         ok = (nearest == k) & (err < 0.02)
         first = (est_t[ok][0] - T_EXCITE) * freqs.min() if np.any(ok) else math.inf
-        rows.append((np.median(e) if len(e) else math.nan, np.mean(e < 0.02) if len(e) else 0.0,
-                     first))
+        rows.append(
+            (np.median(e) if len(e) else math.nan, np.mean(e < 0.02) if len(e) else 0.0, first)
+        )
     return rows, float(np.mean(err > 0.03)), len(est_f)
 
 
 def synthetic(seeds):
     print('1. synthetic decays (%d seeds; medians over seeds; fft = 1 s FFT peaks)' % seeds)
-    print(f'{"case":34} {"mode":>6} {"med |err| %":>17} {"within 2 %":>15} '
-          f'{"first (periods f1)":>19} {">3 % from all":>15} {"published":>13}')
-    print(f'{"":34} {"":>6} {"tracker":>8} {"fft":>8} {"tracker":>7} {"fft":>7} '
-          f'{"tracker":>9} {"fft":>9} {"tracker":>7} {"fft":>7} {"tracker":>7} {"fft":>5}')
+    print(
+        f'{"case":34} {"mode":>6} {"med |err| %":>17} {"within 2 %":>15} '
+        f'{"first (periods f1)":>19} {">3 % from all":>15} {"published":>13}'
+    )
+    print(
+        f'{"":34} {"":>6} {"tracker":>8} {"fft":>8} {"tracker":>7} {"fft":>7} '
+        f'{"tracker":>9} {"fft":>9} {"tracker":>7} {"fft":>7} {"tracker":>7} {"fft":>5}'
+    )
     for name, (freqs, amps, zetas, clip) in CASES.items():
         res = {'tracker': [], 'fft': []}
         for seed in range(seeds):
@@ -136,10 +153,13 @@ def synthetic(seeds):
                     cols.append(np.median([r[0][k][i] for r in res[m]]) * scale)
             spur = [np.median([r[1] for r in res[m]]) * 100 for m in ('tracker', 'fft')]
             count = [np.median([r[2] for r in res[m]]) for m in ('tracker', 'fft')]
-            tail = (f'{spur[0]:7.2f} {spur[1]:7.2f} {count[0]:7.0f} {count[1]:5.0f}' if k == 0
-                    else '')
-            print(f'{name if k == 0 else "":34} {f:6.1f} {cols[0]:8.3f} {cols[1]:8.3f} '
-                  f'{cols[2]:7.1f} {cols[3]:7.1f} {cols[4]:9.2f} {cols[5]:9.2f} {tail}')
+            tail = (
+                f'{spur[0]:7.2f} {spur[1]:7.2f} {count[0]:7.0f} {count[1]:5.0f}' if k == 0 else ''
+            )
+            print(
+                f'{name if k == 0 else "":34} {f:6.1f} {cols[0]:8.3f} {cols[1]:8.3f} '
+                f'{cols[2]:7.1f} {cols[3]:7.1f} {cols[4]:9.2f} {cols[5]:9.2f} {tail}'
+            )
 
 
 def mass_change():
@@ -147,13 +167,17 @@ def mass_change():
     sched = (Move(0.0, 1.0, 1.0, 0.030), Move(12.0, 0.0, 1.0, 0.06117))
     rec = simulate(24.0, sched)
     f_new = rec.f_true[-1]
-    for name, (et, ef) in (('tracker', _tracker(rec.t, rec.torque, mode1=True)),
-                           ('fft', FftPeaks(500.0, peaks=1).process(rec.t, rec.torque))):
+    for name, (et, ef) in (
+        ('tracker', _tracker(rec.t, rec.torque, mode1=True)),
+        ('fft', FftPeaks(500.0, peaks=1).process(rec.t, rec.torque)),
+    ):
         after = (et > 12.0) & (np.abs(ef / f_new - 1) < 0.01)
         before = (et < 12.0) & (et > 2.0)
         lag = (et[after][0] - 12.0) * f_new if np.any(after) else math.inf
-        print(f'  {name:8} before: median {np.median(ef[before]):.4f} Hz (true {rec.f_true[0]:.4f})'
-              f'; first within 1 % of {f_new:.4f} Hz after the change: {lag:.2f} new periods')
+        print(
+            f'  {name:8} before: median {np.median(ef[before]):.4f} Hz (true {rec.f_true[0]:.4f})'
+            f'; first within 1 % of {f_new:.4f} Hz after the change: {lag:.2f} new periods'
+        )
 
 
 def _tracker(t, y, mode1=False):
@@ -163,33 +187,44 @@ def _tracker(t, y, mode1=False):
 
 
 def real(folder):
-    print('\n3. real recordings, no band_hz (mode 1: median error vs the file\'s reference; '
-          'mode 2: n, time span, median vs the authors\' value)')
+    print(
+        "\n3. real recordings, no band_hz (mode 1: median error vs the file's reference; "
+        "mode 2: n, time span, median vs the authors' value)"
+    )
     if not folder.is_dir():
         print(f'  no real data at {folder}')
         return
     for length, f1 in REAL_F1.items():
         csv = read_csv_series(folder / f'{length}cm_uniform_1000Hz.csv')
         raw = np.load(next(folder.glob(f'raw_{length}cm_*.npy')))
-        for label, t, y, fs in ((f'{length} cm 1 kHz', csv.t, csv.y, 1000.0),
-                                (f'{length} cm raw', raw[0] - raw[0, 0], raw[1], 3900.0)):
+        for label, t, y, fs in (
+            (f'{length} cm 1 kHz', csv.t, csv.y, 1000.0),
+            (f'{length} cm raw', raw[0] - raw[0, 0], raw[1], 3900.0),
+        ):
             e = ModeTracker(CONFIG).process(t, y)
             m1 = e.frequency_hz[e.mode == 1]
             m2 = e.mode >= 2
             near2 = m2 & (np.abs(e.frequency_hz / REAL_F2[length] - 1) < 0.1)
             ft, ff = FftPeaks(fs, peaks=1).process(t, y)
-            span = (f'{e.t[near2][0]:.2f}-{e.t[near2][-1]:.2f} s, median '
-                    f'{100 * (np.median(e.frequency_hz[near2]) / REAL_F2[length] - 1):+.1f} %'
-                    if np.any(near2) else '-')
-            print(f'  {label:12} mode 1 n={len(m1):4d} median '
-                  f'{100 * (np.median(m1) / f1 - 1):+.3f} % (fft 1 peak: n={len(ff):3d} '
-                  f'{100 * (np.median(ff) / f1 - 1):+.3f} %); modes >= 2: n={int(np.sum(m2)):3d}, '
-                  f'near mode 2: {int(np.sum(near2)):3d} ({span})')
+            span = (
+                f'{e.t[near2][0]:.2f}-{e.t[near2][-1]:.2f} s, median '
+                f'{100 * (np.median(e.frequency_hz[near2]) / REAL_F2[length] - 1):+.1f} %'
+                if np.any(near2)
+                else '-'
+            )
+            print(
+                f'  {label:12} mode 1 n={len(m1):4d} median '
+                f'{100 * (np.median(m1) / f1 - 1):+.3f} % (fft 1 peak: n={len(ff):3d} '
+                f'{100 * (np.median(ff) / f1 - 1):+.3f} %); modes >= 2: n={int(np.sum(m2)):3d}, '
+                f'near mode 2: {int(np.sum(near2)):3d} ({span})'
+            )
 
 
 def cost():
-    print('\n4. cost (3 modes 8/21/55 Hz signal, 20 s at 1 kHz; the machine may be loaded: '
-          'compare with the single estimator of the same run)')
+    print(
+        '\n4. cost (3 modes 8/21/55 Hz signal, 20 s at 1 kHz; the machine may be loaded: '
+        'compare with the single estimator of the same run)'
+    )
     freqs, amps, zetas, clip = CASES['3 modes 8/21/55 Hz, 1:0.3:0.05']
     t, y = decay(freqs, amps, zetas, clip, 0, duration=21.0)
     ModeTracker(CONFIG).process(t[:3000], y[:3000])
@@ -204,22 +239,30 @@ def cost():
             est = make()
             for a, b in zip(tl, yl):
                 est.update(a, b)
+
         return best(run) / len(tl) * 1e6
 
     ts = stream(lambda: ModeTracker(CONFIG))
     ss = stream(lambda: FrequencyEstimator(single))
-    print(f'  batch      modes 3 {len(t) / tb / 1e6:6.2f} M samples/s   one estimator '
-          f'{len(t) / sb / 1e6:6.2f}   ratio {sb / tb:5.2f}   fft tracker {len(t) / fb / 1e6:6.2f}'
-          f'   (goal >= 1 M samples/s)')
-    print(f'  streaming  modes 3 {ts:6.2f} us/sample    one estimator {ss:6.2f}   ratio '
-          f'{ts / ss:5.2f}   (goal <= 10 us/sample)')
+    print(
+        f'  batch      modes 3 {len(t) / tb / 1e6:6.2f} M samples/s   one estimator '
+        f'{len(t) / sb / 1e6:6.2f}   ratio {sb / tb:5.2f}   fft tracker {len(t) / fb / 1e6:6.2f}'
+        f'   (goal >= 1 M samples/s)'
+    )
+    print(
+        f'  streaming  modes 3 {ts:6.2f} us/sample    one estimator {ss:6.2f}   ratio '
+        f'{ts / ss:5.2f}   (goal <= 10 us/sample)'
+    )
 
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--seeds', type=int, default=5)
-    parser.add_argument('--real-data', type=Path, default=Path(__file__).resolve().parents[2]
-                        / 'shared' / 'real-data')
+    parser.add_argument(
+        '--real-data',
+        type=Path,
+        default=Path(__file__).resolve().parents[2] / 'shared' / 'real-data',
+    )
     args = parser.parse_args()
     synthetic(args.seeds)
     mass_change()

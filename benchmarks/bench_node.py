@@ -26,6 +26,7 @@ Latency: callback entry of the converging sample to the return of the reset publ
 callback entry to the receipt of ``vibration/reset`` by a subscriber in the same process and
 executor, with the input at 1 kHz (stamps of a notional 100 Hz stream, for ~26 estimates/s).
 """
+
 from __future__ import annotations
 
 import argparse
@@ -42,14 +43,17 @@ os.environ.setdefault('ROS_DOMAIN_ID', str(100 + os.getpid() % 100))
 os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
 
 # the node's own input history, used for the empty subscriber too (imported after the env is set)
+from vib_estimator.io.fields import (  # noqa: E402
+    INPUT_TYPES,
+    check_input_type,  # noqa: E402
+)
+from vib_estimator.io.fields import WRENCH_STAMPED as WRENCH
 from vib_estimator.nodes.estimator_node import INPUT_DEPTH as DEPTH  # noqa: E402
-from vib_estimator.io.fields import INPUT_TYPES, WRENCH_STAMPED as WRENCH  # noqa: E402
-from vib_estimator.io.fields import check_input_type  # noqa: E402
 
 RATES = [1000, 2000, 3000, 4500, 6500, 9000, 11000, 13000, 15000, 17500, 20000, 25000, 35000]
 TRIAL_S = 1.0
-REPEATS = 2     # a rate passes when this many trials in a row lose nothing
-JOINTS = ['joint0', 'joint1', 'joint2']   # JointState: the default component is effort[joint1]
+REPEATS = 2  # a rate passes when this many trials in a row lose nothing
+JOINTS = ['joint0', 'joint1', 'joint2']  # JointState: the default component is effort[joint1]
 
 
 # ---- publisher process --------------------------------------------------------------------
@@ -58,17 +62,24 @@ def publisher(topic: str, input_type: str) -> None:
     import rclpy
     from rclpy.qos import QoSProfile, ReliabilityPolicy
 
-    from vib_estimator.io.fields import (DEFAULT_COMPONENT, JOINT_STATE, component_setter,
-                                         has_header)
+    from vib_estimator.io.fields import (
+        DEFAULT_COMPONENT,
+        JOINT_STATE,
+        component_setter,
+        has_header,
+    )
     from vib_estimator.nodes.estimator_node import message_class
 
     rclpy.init()
     node = rclpy.create_node('bench_publisher')
-    pub = node.create_publisher(message_class(input_type), topic,
-                                QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE))
+    pub = node.create_publisher(
+        message_class(input_type),
+        topic,
+        QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE),
+    )
     while pub.get_subscription_count() < 1:
         time.sleep(0.01)
-    time.sleep(0.5)   # let discovery settle in both directions
+    time.sleep(0.5)  # let discovery settle in both directions
     print('ready', flush=True)
     msg = message_class(input_type)()
     stamped = has_header(input_type)
@@ -89,7 +100,8 @@ def publisher(topic: str, input_type: str) -> None:
             k += 1
             if stamped:
                 msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(
-                    1_000_000_000_000_000_000 + round(k * 1e9 / fs), 10 ** 9)
+                    1_000_000_000_000_000_000 + round(k * 1e9 / fs), 10**9
+                )
             set_value(msg, math.sin(2 * math.pi * 1.33 * k / fs))
             pub.publish(msg)
         print(int(count), time.perf_counter() - start, flush=True)
@@ -112,15 +124,20 @@ def make_subscriber(kind, context, topic, depth, input_type):
 
         def callback(msg):
             count[0] += 1
-        node.create_subscription(en.message_class(input_type), topic, callback, QoSProfile(
-            depth=depth, reliability=qos_profile_sensor_data.reliability))
+
+        node.create_subscription(
+            en.message_class(input_type),
+            topic,
+            callback,
+            QoSProfile(depth=depth, reliability=qos_profile_sensor_data.reliability),
+        )
         return node, lambda: count[0]
 
     class TimedNode(en.EstimatorNode):
         """The estimator node, with its callback timed when it publishes an estimate."""
 
         latencies = []
-        entries = {}    # stamp ns of converging samples -> perf_counter at callback entry
+        entries = {}  # stamp ns of converging samples -> perf_counter at callback entry
 
         def _on_stamped(self, msg):
             entry = time.perf_counter()
@@ -128,11 +145,16 @@ def make_subscriber(kind, context, topic, depth, input_type):
             super()._on_stamped(msg)
             if self._stream.health.last_estimate is not before:
                 self.latencies.append(time.perf_counter() - entry)
-                self.entries[msg.header.stamp.sec * 10 ** 9 + msg.header.stamp.nanosec] = entry
+                self.entries[msg.header.stamp.sec * 10**9 + msg.header.stamp.nanosec] = entry
 
     en.INPUT_DEPTH = depth
-    node = TimedNode(context=context, parameter_overrides=[
-        Parameter('input_topic', value=topic), Parameter('input_type', value=input_type)])
+    node = TimedNode(
+        context=context,
+        parameter_overrides=[
+            Parameter('input_topic', value=topic),
+            Parameter('input_type', value=input_type),
+        ],
+    )
     return node, lambda: node.counters['received'] + node.counters['skipped_joint_missing']
 
 
@@ -150,20 +172,25 @@ class Rig:
         rclpy.init(context=self.context)
         self.node, self.received = make_subscriber(kind, self.context, topic, depth, input_type)
         self.nodes = [self.node] + [make(self.context) for make in extra_nodes]
-        self.executor = (EventsExecutor if executor_name == 'events'
-                         else SingleThreadedExecutor)(context=self.context)
+        self.executor = (EventsExecutor if executor_name == 'events' else SingleThreadedExecutor)(
+            context=self.context
+        )
         for node in self.nodes:
             self.executor.add_node(node)
         self.running = True
         self.thread = threading.Thread(target=self._spin, daemon=True)
         self.thread.start()
-        self.pub = subprocess.Popen([sys.executable, __file__, '--publisher', topic, input_type],
-                                    text=True, stdin=subprocess.PIPE, stdout=subprocess.PIPE)
+        self.pub = subprocess.Popen(
+            [sys.executable, __file__, '--publisher', topic, input_type],
+            text=True,
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+        )
         assert self.pub.stdout.readline().strip() == 'ready'
         # the subscriber must have matched the publisher too (best effort drops until then)
         while self.node.count_publishers(topic) < 1:
             time.sleep(0.01)
-        self.trial(1000, 200)   # warm-up (first calls, caches), not counted
+        self.trial(1000, 200)  # warm-up (first calls, caches), not counted
 
     def _spin(self):
         while self.running:
@@ -176,7 +203,7 @@ class Rig:
         self.pub.stdin.flush()
         sent, elapsed = self.pub.stdout.readline().split()
         last, quiet_since = -1, time.monotonic()
-        while time.monotonic() - quiet_since < 0.3:     # until nothing more arrives
+        while time.monotonic() - quiet_since < 0.3:  # until nothing more arrives
             time.sleep(0.02)
             if self.received() != last:
                 last, quiet_since = self.received(), time.monotonic()
@@ -201,8 +228,10 @@ def ramp(rigs, log, rates=RATES):
         for rig in list(alive):
             for _ in range(REPEATS):
                 sent, got, achieved = rig.trial(rate, int(rate * TRIAL_S))
-                log(f'  {rig.label}: target {rate:6d}/s, sent {sent:6d} at {achieved:6.0f}/s, '
-                    f'received {got:6d} ({100 * (sent - got) / sent:.2f} % lost)')
+                log(
+                    f'  {rig.label}: target {rate:6d}/s, sent {sent:6d} at {achieved:6.0f}/s, '
+                    f'received {got:6d} ({100 * (sent - got) / sent:.2f} % lost)'
+                )
                 if got < sent:
                     alive.remove(rig)
                     break
@@ -224,9 +253,16 @@ def end_to_end(topic):
 
     def listener(context):
         import rclpy
+
         node = rclpy.create_node('reset_listener', context=context)
-        node.create_subscription(Header, 'vibration/reset', lambda m: received.setdefault(
-            m.stamp.sec * 10 ** 9 + m.stamp.nanosec, time.perf_counter()), 100)
+        node.create_subscription(
+            Header,
+            'vibration/reset',
+            lambda m: received.setdefault(
+                m.stamp.sec * 10**9 + m.stamp.nanosec, time.perf_counter()
+            ),
+            100,
+        )
         return node
 
     rig = Rig('node', 'events', DEPTH, topic, extra_nodes=[listener])
@@ -258,36 +294,52 @@ def per_type(input_types, log):
     results = {}
     for input_type in input_types:
         short = input_type.split('/')[-1].lower()
-        rigs = [Rig(kind, 'events', DEPTH, f'bench_{kind}_{short}', input_type=input_type)
-                for kind in ('empty', 'node')]
+        rigs = [
+            Rig(kind, 'events', DEPTH, f'bench_{kind}_{short}', input_type=input_type)
+            for kind in ('empty', 'node')
+        ]
         best = ramp(rigs, log)
-        results[input_type] = (best[rigs[1]], best[rigs[0]], cpu_per_message(rigs[1]),
-                               cpu_per_message(rigs[0]))
+        results[input_type] = (
+            best[rigs[1]],
+            best[rigs[0]],
+            cpu_per_message(rigs[1]),
+            cpu_per_message(rigs[0]),
+        )
         for rig in rigs:
             rig.close()
     log('')
-    log(f'highest input rate with zero loss per input type (msgs/s; EventsExecutor, best effort, '
-        f'history {DEPTH}; goal ratio >= 0.9):')
-    log(f'  {"input type":34s} {"estimator_node":>15s} {"empty callback":>15s} {"ratio":>6s}'
-        f'   CPU us/msg: {"node":>6s} {"empty":>6s} {"ratio":>6s}')
+    log(
+        f'highest input rate with zero loss per input type (msgs/s; EventsExecutor, best effort, '
+        f'history {DEPTH}; goal ratio >= 0.9):'
+    )
+    log(
+        f'  {"input type":34s} {"estimator_node":>15s} {"empty callback":>15s} {"ratio":>6s}'
+        f'   CPU us/msg: {"node":>6s} {"empty":>6s} {"ratio":>6s}'
+    )
     for input_type, (n, e, cpu_n, cpu_e) in results.items():
-        log(f'  {input_type:34s} {n:15d} {e:15d} {n / e if e else math.nan:6.2f}'
-            f'               {1e6 * cpu_n:6.1f} {1e6 * cpu_e:6.1f} {cpu_e / cpu_n:6.2f}')
-    log('  (CPU us/msg: process CPU time per message received at 1000/s, median of 3 trials; '
-        'its ratio empty/node is the rate ratio a saturated core would give)')
+        log(
+            f'  {input_type:34s} {n:15d} {e:15d} {n / e if e else math.nan:6.2f}'
+            f'               {1e6 * cpu_n:6.1f} {1e6 * cpu_e:6.1f} {cpu_e / cpu_n:6.2f}'
+        )
+    log(
+        '  (CPU us/msg: process CPU time per message received at 1000/s, median of 3 trials; '
+        'its ratio empty/node is the rate ratio a saturated core would give)'
+    )
 
 
 def executors(log):
     """The executor comparison on WrenchStamped, history 5, and the latencies."""
     results = {}
     for executor_name in ('single', 'events'):
-        rigs = {kind: Rig(kind, executor_name, DEPTH, f'bench_{kind}_{executor_name}')
-                for kind in ('empty', 'node')}
+        rigs = {
+            kind: Rig(kind, executor_name, DEPTH, f'bench_{kind}_{executor_name}')
+            for kind in ('empty', 'node')
+        }
         best = ramp(list(rigs.values()), log)
         for kind, rig in rigs.items():
             results[kind, executor_name] = best[rig]
             rig.close()
-    latencies = list(rigs['node'].node.latencies)      # the EventsExecutor trials
+    latencies = list(rigs['node'].node.latencies)  # the EventsExecutor trials
     shallow = Rig('node', 'events', 5, 'bench_node_depth5')
     rate5 = ramp([shallow], log, rates=[500, 1000, 2000])[shallow]
     shallow.close()
@@ -298,8 +350,10 @@ def executors(log):
     for executor_name, label in (('single', 'SingleThreaded'), ('events', 'EventsExecutor')):
         n, e = results['node', executor_name], results['empty', executor_name]
         log(f'  {label:16s} {n:15d} {e:15d} {n / e if e else math.nan:6.2f}')
-    log(f'  estimator_node, EventsExecutor, history 5 (sensor-data default): {rate5}'
-        ' (0: lost samples at 500/s)')
+    log(
+        f'  estimator_node, EventsExecutor, history 5 (sensor-data default): {rate5}'
+        ' (0: lost samples at 500/s)'
+    )
     log('latency, converging sample -> estimate published:')
     log(f'  inside the callback (EventsExecutor trials):  {percentiles(latencies)}')
     if e2e:
@@ -308,20 +362,31 @@ def executors(log):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument('--input-type', action='append', metavar='TYPE',
-                        help=f'an input type ({", ".join(INPUT_TYPES)}) or all; repeatable')
+    parser.add_argument(
+        '--input-type',
+        action='append',
+        metavar='TYPE',
+        help=f'an input type ({", ".join(INPUT_TYPES)}) or all; repeatable',
+    )
     args = parser.parse_args(argv)
     try:
-        types = None if not args.input_type else list(INPUT_TYPES) if 'all' in args.input_type \
+        types = (
+            None
+            if not args.input_type
+            else list(INPUT_TYPES)
+            if 'all' in args.input_type
             else list(dict.fromkeys(check_input_type(t) for t in args.input_type))
+        )
     except ValueError as err:
         parser.exit(2, f'error: {err}\n')
 
     def log(text):
         print(text, flush=True)
 
-    log(f'estimator_node benchmark, {os.cpu_count()} cores, ROS_DOMAIN_ID '
-        f'{os.environ["ROS_DOMAIN_ID"]}; trials of {TRIAL_S:.0f} s x {REPEATS}')
+    log(
+        f'estimator_node benchmark, {os.cpu_count()} cores, ROS_DOMAIN_ID '
+        f'{os.environ["ROS_DOMAIN_ID"]}; trials of {TRIAL_S:.0f} s x {REPEATS}'
+    )
     if types:
         per_type(types, log)
     else:

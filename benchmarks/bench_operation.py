@@ -17,6 +17,7 @@ block rows 40, orders to 30, the pole nearest the true frequency at order 20:
 ``mpe(order_in=PEER_ORDER)`` -- told the frequencies, a generous peer) median error, share within
 2 %, damping median ratio; and the cost as multiples of real time.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -35,9 +36,9 @@ from vib_estimator.core.ambient import whittle_std
 from vib_estimator.core.modes import create_estimator
 from vib_estimator.sim.ambient import ambient_record
 
-warnings.filterwarnings('ignore', category=RuntimeWarning)    # pyOMA2's np.cov on one channel
-os.environ.setdefault('TQDM_DISABLE', '1')     # pyOMA2's progress bars
-logging.disable(logging.WARNING)       # pyOMA2's INFO/WARNING chatter
+warnings.filterwarnings('ignore', category=RuntimeWarning)  # pyOMA2's np.cov on one channel
+os.environ.setdefault('TQDM_DISABLE', '1')  # pyOMA2's progress bars
+logging.disable(logging.WARNING)  # pyOMA2's INFO/WARNING chatter
 FS = 500.0
 DURATION = 180.0
 #: name -> (modes [(f Hz, zeta, variance)], SNR dB)
@@ -46,7 +47,9 @@ CASES = {
     '1 mode 5 Hz, zeta 0.2 %, 30 dB': ([(5.0, 0.002, 1.0)], 30.0),
     '5 + 17 Hz, zeta 1 / 0.5 %, 20 dB': ([(5.0, 0.01, 1.0), (17.0, 0.005, 0.3)], 20.0),
     '3 + 11 + 23 Hz, zeta 2 / 1 / 0.5 %, 25 dB': (
-        [(3.0, 0.02, 1.0), (11.0, 0.01, 0.5), (23.0, 0.005, 0.2)], 25.0),
+        [(3.0, 0.02, 1.0), (11.0, 0.01, 0.5), (23.0, 0.005, 0.2)],
+        25.0,
+    ),
     'close pair 8 / 8.8 Hz, zeta 1 %, 26 dB': ([(8.0, 0.01, 1.0), (8.8, 0.01, 0.8)], 26.0),
 }
 REAL_DATA = Path(__file__).resolve().parents[2] / 'shared' / 'real-data'
@@ -68,7 +71,7 @@ def peer_ssi(t, y, fs, freqs):
     out = {f: [] for f in freqs}
     n = int(PEER_WINDOW_S * fs)
     for start in range(0, len(y) - n + 1, n):
-        seg = y[start:start + n]
+        seg = y[start : start + n]
         if q > 1:
             seg = decimate(seg, q, ftype='fir', zero_phase=True)
         setup = SingleSetup(seg[:, None], fs / q)
@@ -77,7 +80,7 @@ def peer_ssi(t, y, fs, freqs):
         setup.run_by_name('cov')
         try:
             setup.mpe('cov', sel_freq=list(freqs), order_in=PEER_ORDER)
-        except Exception:        # noqa: BLE001, S112 -- pyOMA2 raises plain errors (mode absent)
+        except Exception:  # noqa: BLE001, S112 -- pyOMA2 raises plain errors (mode absent)
             continue
         res = algo.result
         for f, fn, xi in zip(freqs, np.ravel(res.Fn), np.ravel(res.Xi)):
@@ -103,9 +106,11 @@ def synthetic(seeds, window, peer):
     config = EstimatorConfig(excitation='ambient', ambient_window_s=window)
     n_window = int(window * FS) + 1
     print(f'## Synthetic records: {FS:g} Hz, {DURATION:g} s, {seeds} seeds, window {window:g} s')
-    print('| record | mode | Whittle bound | RMS err (x bound) | median err | within 2 % | > 5 % '
-          '| damping med / true | RMS err/std | SSI-cov (pyOMA2) median / within 2 % / damping '
-          '| spurious | cost (x real time) |')
+    print(
+        '| record | mode | Whittle bound | RMS err (x bound) | median err | within 2 % | > 5 % '
+        '| damping med / true | RMS err/std | SSI-cov (pyOMA2) median / within 2 % / damping '
+        '| spurious | cost (x real time) |'
+    )
     print('|---|---|---|---|---|---|---|---|---|---|---|---|')
     for name, (modes, snr) in CASES.items():
         truth = [m[0] for m in modes]
@@ -138,17 +143,25 @@ def synthetic(seeds, window, peer):
         for k, (f, z, _) in enumerate(modes):
             a = np.abs(np.array(err[k]))
             bound = bounds[k][0] / f
-            rms = math.sqrt(np.mean(a ** 2)) if len(a) else math.nan
+            rms = math.sqrt(np.mean(a**2)) if len(a) else math.nan
             pe = np.array(peer_err[k])
-            peer_txt = (f'{100 * np.median(pe):.2f} % / {100 * np.mean(pe <= 0.02):.0f} % / '
-                        f'{np.median(peer_z[k]) / z:.2f}') if len(pe) else 'n/a'
-            print(f'| {name if k == 0 else ""} | {f:g} Hz | {100 * bound:.2f} % | '
-                  f'{100 * rms:.2f} % ({rms / bound:.2f}) | {100 * np.median(a):.2f} % | '
-                  f'{100 * np.mean(a <= 0.02):.1f} % | {int(np.count_nonzero(a > 0.05))} | '
-                  f'{np.median(zs[k]) / z:.2f} | {math.sqrt(np.mean(np.square(cal[k]))):.2f} | '
-                  f'{peer_txt} | '
-                  f'{(f"{100 * spurious / max(total, 1):.1f} % of {total}") if k == 0 else ""} | '
-                  f'{(f"{seeds * DURATION / cost:.0f}") if k == 0 else ""} |')
+            peer_txt = (
+                (
+                    f'{100 * np.median(pe):.2f} % / {100 * np.mean(pe <= 0.02):.0f} % / '
+                    f'{np.median(peer_z[k]) / z:.2f}'
+                )
+                if len(pe)
+                else 'n/a'
+            )
+            print(
+                f'| {name if k == 0 else ""} | {f:g} Hz | {100 * bound:.2f} % | '
+                f'{100 * rms:.2f} % ({rms / bound:.2f}) | {100 * np.median(a):.2f} % | '
+                f'{100 * np.mean(a <= 0.02):.1f} % | {int(np.count_nonzero(a > 0.05))} | '
+                f'{np.median(zs[k]) / z:.2f} | {math.sqrt(np.mean(np.square(cal[k]))):.2f} | '
+                f'{peer_txt} | '
+                f'{(f"{100 * spurious / max(total, 1):.1f} % of {total}") if k == 0 else ""} | '
+                f'{(f"{seeds * DURATION / cost:.0f}") if k == 0 else ""} |'
+            )
         sys.stdout.flush()
 
 
@@ -157,10 +170,14 @@ def arm(seeds, window):
     from vib_estimator.sim.arm_model import simulate_driven
 
     config = EstimatorConfig(excitation='ambient', ambient_window_s=window)
-    print(f'\n## Simulated arm under continuous motion (coupling torque, 500 Hz, {DURATION:g} s, '
-          f'{seeds} seeds, window {window:g} s)')
-    print('| excitation | true f | median err | RMS err | within 2 % | > 5 % | spurious | '
-          'damping med / true | RMS err/std | estimates |')
+    print(
+        f'\n## Simulated arm under continuous motion (coupling torque, 500 Hz, {DURATION:g} s, '
+        f'{seeds} seeds, window {window:g} s)'
+    )
+    print(
+        '| excitation | true f | median err | RMS err | within 2 % | > 5 % | spurious | '
+        'damping med / true | RMS err/std | estimates |'
+    )
     print('|---|---|---|---|---|---|---|---|---|---|')
     for excitation, level in (('random', 0.3), ('ambient', 0.02)):
         rel, zs, cal, n_spur, n = [], [], [], 0, 0
@@ -176,10 +193,12 @@ def arm(seeds, window):
             zs.extend(e.damping[m])
             cal.extend((e.frequency_hz[m] - f0) / e.frequency_std_hz[m])
         a = np.abs(np.array(rel))
-        print(f'| {excitation} (level {level:g}) | {f0:.4f} Hz | {100 * np.median(a):.2f} % | '
-              f'{100 * math.sqrt(np.mean(a ** 2)):.2f} % | {100 * np.mean(a <= 0.02):.1f} % | '
-              f'{int(np.count_nonzero(a > 0.05))} | {100 * n_spur / max(n, 1):.1f} % | '
-              f'{np.median(zs) / 0.004:.2f} | {math.sqrt(np.mean(np.square(cal))):.2f} | {n} |')
+        print(
+            f'| {excitation} (level {level:g}) | {f0:.4f} Hz | {100 * np.median(a):.2f} % | '
+            f'{100 * math.sqrt(np.mean(a**2)):.2f} % | {100 * np.mean(a <= 0.02):.1f} % | '
+            f'{int(np.count_nonzero(a > 0.05))} | {100 * n_spur / max(n, 1):.1f} % | '
+            f'{np.median(zs) / 0.004:.2f} | {math.sqrt(np.mean(np.square(cal))):.2f} | {n} |'
+        )
         sys.stdout.flush()
 
 
@@ -189,33 +208,45 @@ def real_hct(peer, real_data):
         print(f'\n(Heritage Court Tower record not found at {hct}: skipped)')
         return
     data = np.loadtxt(hct, delimiter=',', skiprows=1)
-    t, y = data[:, 0], data[:, 2]          # ch2
+    t, y = data[:, 0], data[:, 2]  # ch2
     config = EstimatorConfig(excitation='ambient', ambient_window_s=120.0, band_hz=(0.5, 6.0))
     e, elapsed = ours(t, y, config)
     idx, dist = assign(e.frequency_hz, HCT_MODES)
-    found = sorted({HCT_MODES[i] for i in set(idx[dist <= 0.02])
-                    if np.count_nonzero((idx == i) & (dist <= 0.02)) >= 10})
+    found = sorted(
+        {
+            HCT_MODES[i]
+            for i in set(idx[dist <= 0.02])
+            if np.count_nonzero((idx == i) & (dist <= 0.02)) >= 10
+        }
+    )
     print('\n## Heritage Court Tower, ch2 (40 Hz, 327.7 s), window 120 s, band 0.5-6 Hz')
-    print(f'estimates {len(e)}; published modes found (>= 10 estimates within 2 %): {found}; '
-          f'estimates > 2 % from every published mode: {100 * np.mean(dist > 0.02):.1f} %; '
-          f'cost {t[-1] / elapsed:.0f}x real time')
+    print(
+        f'estimates {len(e)}; published modes found (>= 10 estimates within 2 %): {found}; '
+        f'estimates > 2 % from every published mode: {100 * np.mean(dist > 0.02):.1f} %; '
+        f'cost {t[-1] / elapsed:.0f}x real time'
+    )
     for k in sorted(set(e.mode)):
         m = e.mode == k
-        print(f'  mode {k}: {np.count_nonzero(m)} estimates, '
-              f'median {np.median(e.frequency_hz[m]):.3f} Hz, '
-              f'damping {100 * np.median(e.damping[m]):.2f} %, '
-              f'median std {np.median(e.frequency_std_hz[m]):.4f} Hz')
+        print(
+            f'  mode {k}: {np.count_nonzero(m)} estimates, '
+            f'median {np.median(e.frequency_hz[m]):.3f} Hz, '
+            f'damping {100 * np.median(e.damping[m]):.2f} %, '
+            f'median std {np.median(e.frequency_std_hz[m]):.4f} Hz'
+        )
     if peer:
         from pyoma2.algorithms import SSI
         from pyoma2.setup import SingleSetup
+
         setup = SingleSetup(y[:, None], 40.0)
         algo = SSI(name='cov', method='cov', br=60, ordmax=40, calc_unc=False, hc=PEER_HC)
         setup.add_algorithms(algo)
         setup.run_by_name('cov')
         setup.mpe('cov', sel_freq=list(HCT_MODES), order_in=PEER_ORDER)
         fn = np.ravel(algo.result.Fn)
-        print('  SSI-cov (pyOMA2, whole record, told the published frequencies): '
-              + ', '.join(f'{f:.3f}' for f in fn))
+        print(
+            '  SSI-cov (pyOMA2, whole record, told the published frequencies): '
+            + ', '.join(f'{f:.3f}' for f in fn)
+        )
 
 
 def main():
@@ -223,8 +254,11 @@ def main():
     parser.add_argument('--seeds', type=int, default=3)
     parser.add_argument('--window', type=float, default=30.0)
     parser.add_argument('--no-peer', action='store_true')
-    parser.add_argument('--real-data', default=str(REAL_DATA),
-                        help='the shared real-data folder (default ../shared/real-data)')
+    parser.add_argument(
+        '--real-data',
+        default=str(REAL_DATA),
+        help='the shared real-data folder (default ../shared/real-data)',
+    )
     parser.add_argument('--real-only', action='store_true', help='only the real record')
     parser.add_argument('--arm-only', action='store_true', help='only the simulated arm')
     args = parser.parse_args()

@@ -21,6 +21,7 @@ against 1 / (f_hi - f_lo) = 0.5 s (``calib``, here, shows where). Its records st
 dropped; its bound is the sinusoid's on the unfiltered white noise.
 Usage: ``python benchmarks/bench_precision.py [--quick]`` (--quick: 0.5, 2 and 20 periods, 40 dB).
 """
+
 import math
 import sys
 import time
@@ -33,10 +34,12 @@ from vib_estimator.core import EstimatorConfig, FrequencyEstimator
 
 F0, AMP, TS = 1.33, 0.1, 0.002
 #: label: (model, zeta, offset, band_hz)
-CASES = {'sinusoid': ('sinusoid', 0.0, 0.0, None),
-         'biased-sinusoid': ('biased-sinusoid', 0.0, 0.3, None),
-         'damped-sinusoid': ('damped-sinusoid', 0.01, 0.0, None),
-         'sinusoid+band': ('sinusoid', 0.0, 0.0, (F0 / 2, 2 * F0))}
+CASES = {
+    'sinusoid': ('sinusoid', 0.0, 0.0, None),
+    'biased-sinusoid': ('biased-sinusoid', 0.0, 0.3, None),
+    'damped-sinusoid': ('damped-sinusoid', 0.01, 0.0, None),
+    'sinusoid+band': ('sinusoid', 0.0, 0.0, (F0 / 2, 2 * F0)),
+}
 #: the band prefilter's start-up: windows beginning earlier are not scored (s)
 SETTLE = 3.0
 
@@ -68,7 +71,7 @@ def cell(model, zeta, offset, band, snr_db, periods):
             n = int(e.samples[k])
             if t[i1 - n + 1] < lead:
                 continue
-            tw = t[i1 - n + 1:i1 + 1]
+            tw = t[i1 - n + 1 : i1 + 1]
             # the mode's amplitude and phase at t = 0 of the record: the bound on the window
             b, _ = model_crb(model, tw, AMP, F0, phase, sd, zeta)
             err.append(e.frequency_hz[k] - F0)
@@ -76,11 +79,11 @@ def cell(model, zeta, offset, band, snr_db, periods):
             norm.append((e.frequency_hz[k] - F0) / b)
             z.append((e.frequency_hz[k] - F0) / e.frequency_std_hz[k])
             per.append(e.convergence_time[k] * F0)
-            mp.append(matrix_pencil(y[i1 - n + 1:i1 + 1], TS, 3 if offset else 2)[0] - F0)
+            mp.append(matrix_pencil(y[i1 - n + 1 : i1 + 1], TS, 3 if offset else 2)[0] - F0)
             mpn.append(mp[-1] / b)
     if not err:
         return None
-    rms = lambda v: math.sqrt(np.nanmean(np.square(v)))   # noqa: E731
+    rms = lambda v: math.sqrt(np.nanmean(np.square(v)))  # noqa: E731
     return len(err), rms(err), rms(bound), rms(norm), rms(z), np.median(per), rms(mpn)
 
 
@@ -88,9 +91,11 @@ def main() -> None:
     quick = '--quick' in sys.argv
     windows = (0.5, 2, 20) if quick else (0.25, 0.5, 1, 2, 5, 20)
     snrs = (40,) if quick else (20, 40, 60)
-    print(f'{"model":>16} {"periods":>7} {"SNR":>4} {"n":>5} {"std Hz":>9} {"bound Hz":>9} '
-          f'{"ratio":>6} {"calib":>6} {"+-":>5} {"conv":>6} {"pencil":>7}'
-          '   (ratio, pencil: RMS error/bound; +-: sampling error of an RMS over n)')
+    print(
+        f'{"model":>16} {"periods":>7} {"SNR":>4} {"n":>5} {"std Hz":>9} {"bound Hz":>9} '
+        f'{"ratio":>6} {"calib":>6} {"+-":>5} {"conv":>6} {"pencil":>7}'
+        '   (ratio, pencil: RMS error/bound; +-: sampling error of an RMS over n)'
+    )
     start = time.perf_counter()
     for label, (model, zeta, offset, band) in CASES.items():
         for periods in windows:
@@ -100,9 +105,12 @@ def main() -> None:
                     print(f'{label:>16} {periods:7} {snr:4}   no estimate')
                     continue
                 n, std, bound, ratio, calib, conv, mp = r
-                print(f'{label:>16} {periods:7} {snr:4} {n:5} {std:9.2e} {bound:9.2e} '
-                      f'{ratio:6.2f} {calib:6.2f} {1 / math.sqrt(2 * n):5.2f} {conv:6.2f} '
-                      f'{mp:7.2f}', flush=True)
+                print(
+                    f'{label:>16} {periods:7} {snr:4} {n:5} {std:9.2e} {bound:9.2e} '
+                    f'{ratio:6.2f} {calib:6.2f} {1 / math.sqrt(2 * n):5.2f} {conv:6.2f} '
+                    f'{mp:7.2f}',
+                    flush=True,
+                )
     print(f'({time.perf_counter() - start:.0f} s)')
 
 

@@ -20,6 +20,7 @@ same run, on the same machine state.
 * ``shaper_node``: spawn to its first ``/diagnostics``.
 * ``analyze``: the whole ``vib-estimator analyze`` of a 20 s CSV (500 Hz).
 """
+
 from __future__ import annotations
 
 import argparse
@@ -82,11 +83,13 @@ class Probe:
         self.executor = make_executor(self.context)
         self.executor.add_node(self.node)
         self.msg_type = WrenchStamped
-        self.pub = self.node.create_publisher(WrenchStamped, 'coupling_torque',
-                                              qos_profile_sensor_data)
+        self.pub = self.node.create_publisher(
+            WrenchStamped, 'coupling_torque', qos_profile_sensor_data
+        )
         self.node.create_subscription(Float64, 'vibration/frequency', self._on_frequency, 10)
         self.node.create_subscription(DiagnosticArray, '/diagnostics', self._on_diagnostics, 10)
         from std_srvs.srv import Trigger
+
         self.self_test = self.node.create_client(Trigger, '/estimator_node/self_test')
         self.trigger = Trigger.Request
         self.reset()
@@ -120,8 +123,11 @@ class Probe:
                 state['ready'] = time.monotonic()
             state['future'] = None
             state['next'] = time.monotonic() + 0.1
-        elif future is None and time.monotonic() >= state.get('next', 0.0) \
-                and self.self_test.service_is_ready():
+        elif (
+            future is None
+            and time.monotonic() >= state.get('next', 0.0)
+            and self.self_test.service_is_ready()
+        ):
             state['future'] = self.self_test.call_async(self.trigger())
 
     def estimator(self, cmd, env):
@@ -129,15 +135,15 @@ class Probe:
         of one estimator_node start."""
         self.reset()
         start = time.monotonic()
-        proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL,
-                                stderr=subprocess.DEVNULL)
+        proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         sent = 0
         msg = self.msg_type()
         state = {}
         matched = None
         try:
-            while (self.first_estimate is None or 'ready' not in state) \
-                    and time.monotonic() - start < TIMEOUT_S:
+            while (
+                self.first_estimate is None or 'ready' not in state
+            ) and time.monotonic() - start < TIMEOUT_S:
                 if proc.poll() is not None:
                     break
                 if 'ready' not in state:
@@ -150,14 +156,14 @@ class Probe:
                     due = int((time.monotonic() - first) * RATE_HZ)
                     while sent < due:
                         ns = 1_000_000_000 + int(sent * 1e9 / RATE_HZ)
-                        msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(ns, 10 ** 9)
+                        msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(ns, 10**9)
                         msg.wrench.torque.z = math.sin(2 * math.pi * TONE_HZ * sent / RATE_HZ)
                         self.pub.publish(msg)
                         sent += 1
                 self.spin(0.002)
             ready = state['ready'] - start if 'ready' in state else math.nan
             latency = self.first_estimate - first if self.first_estimate else math.nan
-            self.spin(1.5)             # a diagnostics period after the first estimate
+            self.spin(1.5)  # a diagnostics period after the first estimate
             live = min(self.first_diag.values(), default=math.nan) - start
             values = next(iter(self.last_values.values()), {})
             counted = int(values.get('received', 0)) + int(values.get('dropped_warmup', 0))
@@ -170,11 +176,13 @@ class Probe:
         """(spawn to first /diagnostics s, exit code) of a node."""
         self.reset()
         start = time.monotonic()
-        proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL,
-                                stderr=subprocess.DEVNULL)
+        proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         try:
-            while not self.first_diag and time.monotonic() - start < TIMEOUT_S \
-                    and proc.poll() is None:
+            while (
+                not self.first_diag
+                and time.monotonic() - start < TIMEOUT_S
+                and proc.poll() is None
+            ):
                 self.spin(0.005)
             live = min(self.first_diag.values(), default=math.nan) - start
         finally:
@@ -202,8 +210,13 @@ def stop(proc) -> int:
 def analyze_seconds(tree: Path, env: dict, csv: Path) -> float:
     code = 'import sys; from vib_estimator.cli import main; sys.exit(main())'
     start = time.monotonic()
-    done = subprocess.run([sys.executable, '-c', code, 'analyze', str(csv)], env=env,
-                          stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    done = subprocess.run(
+        [sys.executable, '-c', code, 'analyze', str(csv)],
+        env=env,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     if done.returncode:
         return math.nan
     return time.monotonic() - start
@@ -221,8 +234,12 @@ def checkout(ref: str, where: Path) -> Path:
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--ref', default='7374e6d', help='reference commit (default 7374e6d)')
-    parser.add_argument('--only', choices=['estimator_node', 'shaper_node', 'analyze'],
-                        action='append', help='run only these cases (repeatable)')
+    parser.add_argument(
+        '--only',
+        choices=['estimator_node', 'shaper_node', 'analyze'],
+        action='append',
+        help='run only these cases (repeatable)',
+    )
     args = parser.parse_args(argv)
     only = set(args.only or ['estimator_node', 'shaper_node', 'analyze'])
     with tempfile.TemporaryDirectory() as tmp:
@@ -230,8 +247,14 @@ def main(argv=None) -> int:
         trees = {'today': ROOT, args.ref: checkout(args.ref, tmp)}
         csv = tmp / 'tone.csv'
         t = np.arange(int(20 * RATE_HZ)) / RATE_HZ
-        np.savetxt(csv, np.column_stack([t, np.sin(2 * np.pi * TONE_HZ * t)]), delimiter=',',
-                   header='t,y', comments='', fmt='%.9g')
+        np.savetxt(
+            csv,
+            np.column_stack([t, np.sin(2 * np.pi * TONE_HZ * t)]),
+            delimiter=',',
+            header='t,y',
+            comments='',
+            fmt='%.9g',
+        )
         probe = Probe()
         rows = []
         try:
@@ -243,11 +266,15 @@ def main(argv=None) -> int:
                     cmd = node_command(tree, 'vib_estimator.nodes.estimator_node', params)
                     for kind in ('cold', 'warm'):
                         live, ready, latency, lost, code = probe.estimator(
-                            cmd, environment(tree, cache))
+                            cmd, environment(tree, cache)
+                        )
                         rows.append((case, label, kind, live, ready, lost, code, latency))
-                        print(f'{case:28s} {label:8s} {kind}: live {live:6.2f} s, ready '
-                              f'{ready:6.2f} s, first estimate {latency:6.2f} s after the '
-                              f'first sample, lost {lost}, exit {code}', flush=True)
+                        print(
+                            f'{case:28s} {label:8s} {kind}: live {live:6.2f} s, ready '
+                            f'{ready:6.2f} s, first estimate {latency:6.2f} s after the '
+                            f'first sample, lost {lost}, exit {code}',
+                            flush=True,
+                        )
             if 'shaper_node' in only:
                 for label, tree in trees.items():
                     cache = tempfile.mkdtemp(dir=tmp)
@@ -255,23 +282,31 @@ def main(argv=None) -> int:
                     for kind in ('cold', 'warm'):
                         live, code = probe.first_diagnostics(cmd, environment(tree, cache))
                         rows.append(('shaper_node', label, kind, live, live, 0, code, math.nan))
-                        print(f'{"shaper_node":28s} {label:8s} {kind}: live {live:6.2f} s, '
-                              f'exit {code}', flush=True)
+                        print(
+                            f'{"shaper_node":28s} {label:8s} {kind}: live {live:6.2f} s, '
+                            f'exit {code}',
+                            flush=True,
+                        )
             if 'analyze' in only:
                 for label, tree in trees.items():
                     cache = tempfile.mkdtemp(dir=tmp)
                     for kind in ('cold', 'warm'):
                         seconds = analyze_seconds(tree, environment(tree, cache), csv)
-                        rows.append(('analyze (20 s CSV)', label, kind, math.nan, seconds, 0, 0,
-                                     math.nan))
-                        print(f'{"analyze (20 s CSV)":28s} {label:8s} {kind}: {seconds:6.2f} s',
-                              flush=True)
+                        rows.append(
+                            ('analyze (20 s CSV)', label, kind, math.nan, seconds, 0, 0, math.nan)
+                        )
+                        print(
+                            f'{"analyze (20 s CSV)":28s} {label:8s} {kind}: {seconds:6.2f} s',
+                            flush=True,
+                        )
         finally:
             probe.close()
-    print(f'\n| case | cold ready, today | cold, {args.ref} | warm ready, today | warm, '
-          f'{args.ref} | live (first /diagnostics), cold today / {args.ref} | first estimate after '
-          f'the first sample, cold today / {args.ref} | samples lost, cold today / {args.ref} | '
-          'exit on SIGINT |')
+    print(
+        f'\n| case | cold ready, today | cold, {args.ref} | warm ready, today | warm, '
+        f'{args.ref} | live (first /diagnostics), cold today / {args.ref} | first estimate after '
+        f'the first sample, cold today / {args.ref} | samples lost, cold today / {args.ref} | '
+        'exit on SIGINT |'
+    )
     print('|---|---|---|---|---|---|---|---|---|')
     cases = list(dict.fromkeys(r[0] for r in rows))
     for case in cases:
@@ -279,9 +314,11 @@ def main(argv=None) -> int:
         today_c, ref_c = get.get(('today', 'cold')), get.get((args.ref, 'cold'))
         today_w, ref_w = get.get(('today', 'warm')), get.get((args.ref, 'warm'))
         codes = sorted({r[6] for r in get.values()})
-        print(f'| {case} | {today_c[4]:.1f} s | {ref_c[4]:.1f} s | {today_w[4]:.2f} s | '
-              f'{ref_w[4]:.2f} s | {today_c[3]:.1f} / {ref_c[3]:.1f} s | '
-              f'{today_c[7]:.1f} / {ref_c[7]:.1f} s | {today_c[5]} / {ref_c[5]} | {codes} |')
+        print(
+            f'| {case} | {today_c[4]:.1f} s | {ref_c[4]:.1f} s | {today_w[4]:.2f} s | '
+            f'{ref_w[4]:.2f} s | {today_c[3]:.1f} / {ref_c[3]:.1f} s | '
+            f'{today_c[7]:.1f} / {ref_c[7]:.1f} s | {today_c[5]} / {ref_c[5]} | {codes} |'
+        )
     print(GOALS)
     return 0
 

@@ -19,6 +19,7 @@ Prints:
 Reader throughputs are per CPU second of the process (``time.process_time``, all threads); the
 survey times are wall-clock. Each time is the best of 2 runs (the surveys: of the 3 rounds). The generated files go to ``--work`` (default a temporary folder).
 """
+
 from __future__ import annotations
 
 import argparse
@@ -33,11 +34,16 @@ import numpy as np
 from vib_estimator.analysis import survey as S
 from vib_estimator.core import EstimatorConfig
 from vib_estimator.io import streaming
-from vib_estimator.io.bags import (TYPESTORE, WRENCH_STAMPED, BagWriter, read_wrench_series,
-                                   wrench_message)
+from vib_estimator.io.bags import (
+    TYPESTORE,
+    WRENCH_STAMPED,
+    BagWriter,
+    read_wrench_series,
+    wrench_message,
+)
 from vib_estimator.io.csv_reader import csv_layout, iter_csv_rows
 
-EPOCH = 1_700_000_000 * 10 ** 9
+EPOCH = 1_700_000_000 * 10**9
 
 
 def best(fn, repeats=2, clock=time.perf_counter):
@@ -63,6 +69,7 @@ def signal(n, f=1.33, seed=0):
 def write_csv(path: Path, n: int, seed=0) -> None:
     import pyarrow as pa
     import pyarrow.csv as pacsv
+
     t, y = signal(n, seed=seed)
     pacsv.write_csv(pa.table({'t': t, 'y': y}), path)
 
@@ -71,14 +78,15 @@ def write_bag(path: Path, n: int) -> None:
     """A WrenchStamped bag: one message serialised by rosbags, the stamps patched in its bytes."""
     t, y = signal(n)
     stamps = EPOCH + np.round(t * 1e9).astype(np.int64)
-    template = bytearray(TYPESTORE.serialize_cdr(wrench_message(0, 'arm_base', 'torque.z', 0.0),
-                                                 WRENCH_STAMPED))
-    offset = len(template) - 8          # torque.z is the last double
+    template = bytearray(
+        TYPESTORE.serialize_cdr(wrench_message(0, 'arm_base', 'torque.z', 0.0), WRENCH_STAMPED)
+    )
+    offset = len(template) - 8  # torque.z is the last double
     with BagWriter(path) as bag:
         conn = bag.add_topic('/coupling_torque', WRENCH_STAMPED)
         for stamp, value in zip(stamps.tolist(), y.tolist()):
-            template[4:8] = (stamp // 10 ** 9).to_bytes(4, 'little')
-            template[8:12] = (stamp % 10 ** 9).to_bytes(4, 'little')
+            template[4:8] = (stamp // 10**9).to_bytes(4, 'little')
+            template[8:12] = (stamp % 10**9).to_bytes(4, 'little')
             template[offset:] = np.float64(value).tobytes()
             bag.write(conn, stamp, bytes(template))
 
@@ -90,11 +98,14 @@ def drain(signal_) -> int:
 def peak_rss_mb(code: str) -> float:
     """Peak resident memory of a fresh interpreter running ``code``: its ``VmHWM`` (unlike
     ``ru_maxrss``, not inherited from the forking parent)."""
-    script = (code + '\nfrom pathlib import Path\n'
-              'print(next(int(line.split()[1]) for line in Path("/proc/self/status").open() '
-              'if line.startswith("VmHWM")) / 1024)')
-    out = subprocess.run([sys.executable, '-c', script], check=True, capture_output=True,
-                         text=True).stdout
+    script = (
+        code + '\nfrom pathlib import Path\n'
+        'print(next(int(line.split()[1]) for line in Path("/proc/self/status").open() '
+        'if line.startswith("VmHWM")) / 1024)'
+    )
+    out = subprocess.run(
+        [sys.executable, '-c', script], check=True, capture_output=True, text=True
+    ).stdout
     return float(out.split()[-1])
 
 
@@ -112,9 +123,11 @@ def bench_csv(work: Path, rows: int) -> Path:
     n = rows // 10
     loadtxt = cpu(lambda: np.loadtxt(small, delimiter=',', skiprows=1), 1)
     exact = cpu(lambda: sum(1 for _ in iter_csv_rows(csv_layout(small))), 1)
-    print(f'csv   streaming {rows / fast / 1e6:6.2f} M rows/s   numpy.loadtxt {n / loadtxt / 1e6:6.2f}'
-          f'   row-by-row reader {n / exact / 1e6:6.2f}   ratio {loadtxt / n * rows / fast:5.1f}x / '
-          f'{exact / n * rows / fast:5.1f}x   (goal >= 5 M rows/s)')
+    print(
+        f'csv   streaming {rows / fast / 1e6:6.2f} M rows/s   numpy.loadtxt {n / loadtxt / 1e6:6.2f}'
+        f'   row-by-row reader {n / exact / 1e6:6.2f}   ratio {loadtxt / n * rows / fast:5.1f}x / '
+        f'{exact / n * rows / fast:5.1f}x   (goal >= 5 M rows/s)'
+    )
     return big
 
 
@@ -127,26 +140,33 @@ def bench_bag(work: Path, messages: int) -> Path:
         with Reader(small) as reader:
             for _, _, data in reader.messages():
                 TYPESTORE.deserialize_cdr(data, WRENCH_STAMPED)
+
     gen = cpu(generic, 1)
     ref = cpu(lambda: read_wrench_series(small), 1)
-    print(f'mcap  streaming {messages / fast / 1e6:6.2f} M msg/s    rosbags deserialize_cdr '
-          f'{n / gen / 1e6:6.2f}   read_wrench_series {n / ref / 1e6:6.2f}   ratio '
-          f'{gen / n * messages / fast:5.1f}x / {ref / n * messages / fast:5.1f}x   '
-          f'(goal >= 1 M msg/s per core)')
+    print(
+        f'mcap  streaming {messages / fast / 1e6:6.2f} M msg/s    rosbags deserialize_cdr '
+        f'{n / gen / 1e6:6.2f}   read_wrench_series {n / ref / 1e6:6.2f}   ratio '
+        f'{gen / n * messages / fast:5.1f}x / {ref / n * messages / fast:5.1f}x   '
+        f'(goal >= 1 M msg/s per core)'
+    )
     return big
 
 
 def bench_rss(csv_path: Path, bag_path: Path) -> None:
     tiny = csv_path.with_name('tiny.csv')
     tiny.write_text('t,y\n0,1\n0.002,2\n0.004,1\n')
-    run = ('from vib_estimator.analysis.analyze import estimate_signal\n'
-           'from vib_estimator.io.streaming import open_signal\n'
-           'from vib_estimator.core import EstimatorConfig\n'
-           'estimate_signal(open_signal({!r}), EstimatorConfig())')
+    run = (
+        'from vib_estimator.analysis.analyze import estimate_signal\n'
+        'from vib_estimator.io.streaming import open_signal\n'
+        'from vib_estimator.core import EstimatorConfig\n'
+        'estimate_signal(open_signal({!r}), EstimatorConfig())'
+    )
     peaks = [peak_rss_mb(run.format(str(path))) for path in (csv_path, bag_path, tiny)]
-    print(f'rss   streaming through the estimator: the CSV {peaks[0]:5.0f} MB, the bag '
-          f'{peaks[1]:5.0f} MB   a 3-row CSV (imports, compiled estimator) {peaks[2]:5.0f} MB   '
-          f'(goal <= 300 MB)')
+    print(
+        f'rss   streaming through the estimator: the CSV {peaks[0]:5.0f} MB, the bag '
+        f'{peaks[1]:5.0f} MB   a 3-row CSV (imports, compiled estimator) {peaks[2]:5.0f} MB   '
+        f'(goal <= 300 MB)'
+    )
 
 
 def bench_survey(work: Path) -> None:
@@ -156,23 +176,34 @@ def bench_survey(work: Path) -> None:
         write_csv(folder / f'rec_{i}.csv', 1_000_000, seed=i)
     recordings = S.find_recordings([str(folder)])
     options = S.Options(EstimatorConfig())
-    S.survey(recordings[:1], options)                                    # compile, warm caches
+    S.survey(recordings[:1], options)  # compile, warm caches
     from distributed import LocalCluster
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                      dashboard_address=None) as cluster:
+
+    with LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+    ) as cluster:
+
         def on_dask():
             return S.survey(recordings, options, scheduler=cluster.scheduler_address)
-        on_dask()                                                        # warm every worker
+
+        on_dask()  # warm every worker
         # the three alternated, so that all see the same machine (other work comes and goes)
-        rounds = [(with_cpu(lambda: S.survey(recordings, options, jobs=1), 1),
-                   with_cpu(lambda: S.survey(recordings, options, jobs=2), 1), best(on_dask, 1))
-                  for _ in range(3)]
+        rounds = [
+            (
+                with_cpu(lambda: S.survey(recordings, options, jobs=1), 1),
+                with_cpu(lambda: S.survey(recordings, options, jobs=2), 1),
+                best(on_dask, 1),
+            )
+            for _ in range(3)
+        ]
     (one, cpu_one), (two, cpu_two) = (min(r[i] for r in rounds) for i in (0, 1))
     dask = min(r[2] for r in rounds)
-    print(f'survey 8 recordings  --jobs 1 {one:6.2f} s ({cpu_one:5.2f} CPU s)   --jobs 2 '
-          f'{two:6.2f} s ({cpu_two:5.2f} CPU s, workers included)   speed-up {one / two:5.2f}x '
-          f'(goal >= 1.7)   Dask 2 workers {dask:6.2f} s   vs --jobs 2 {dask / two - 1:+6.1%} '
-          f'(goal within 15 %)')
+    print(
+        f'survey 8 recordings  --jobs 1 {one:6.2f} s ({cpu_one:5.2f} CPU s)   --jobs 2 '
+        f'{two:6.2f} s ({cpu_two:5.2f} CPU s, workers included)   speed-up {one / two:5.2f}x '
+        f'(goal >= 1.7)   Dask 2 workers {dask:6.2f} s   vs --jobs 2 {dask / two - 1:+6.1%} '
+        f'(goal within 15 %)'
+    )
 
 
 def with_cpu(fn, repeats=2):
@@ -183,6 +214,7 @@ def with_cpu(fn, repeats=2):
     def cpu_now():
         kids = resource.getrusage(resource.RUSAGE_CHILDREN)
         return time.process_time() + kids.ru_utime + kids.ru_stime
+
     runs = []
     for _ in range(repeats):
         wall, used = time.perf_counter(), cpu_now()

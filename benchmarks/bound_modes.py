@@ -8,6 +8,7 @@ dampings known (second block: the undamped refinement's situation); printed: the
 each frequency in %, median / 90th percentile over 400 random phase pairs.
 Usage: ``python benchmarks/bound_modes.py``
 """
+
 import math
 
 import numpy as np
@@ -25,29 +26,39 @@ def bound_percent(periods, phases, free_damping):
     for f, a, ph in zip(FREQS, AMPS, phases):
         w = 2 * math.pi * f
         env = np.exp(-ZETA * w * t)
-        s, c = np.sin(w * math.sqrt(1 - ZETA ** 2) * t + ph), np.cos(
-            w * math.sqrt(1 - ZETA ** 2) * t + ph)
-        cols += [env * s, a * env * c, a * t * env * c]          # d/dA, d/dphase, d/dw
+        s, c = (
+            np.sin(w * math.sqrt(1 - ZETA**2) * t + ph),
+            np.cos(w * math.sqrt(1 - ZETA**2) * t + ph),
+        )
+        cols += [env * s, a * env * c, a * t * env * c]  # d/dA, d/dphase, d/dw
         if free_damping:
-            cols.append(-a * t * env * s)                        # d/dsigma
+            cols.append(-a * t * env * s)  # d/dsigma
     jac = np.column_stack(cols)
-    cov = np.linalg.inv(jac.T @ jac) * SIGMA ** 2
+    cov = np.linalg.inv(jac.T @ jac) * SIGMA**2
     k = 4 if free_damping else 3
-    return [100 * math.sqrt(cov[i * k + 2, i * k + 2]) / (2 * math.pi * f)
-            for i, f in enumerate(FREQS)]
+    return [
+        100 * math.sqrt(cov[i * k + 2, i * k + 2]) / (2 * math.pi * f) for i, f in enumerate(FREQS)
+    ]
 
 
 def main() -> None:
     phases = np.random.default_rng(0).uniform(0, 2 * math.pi, (400, 2))
     for free in (True, False):
-        print('dampings ' + ('unknown' if free else 'known') +
-              f': 1-sigma bound in %, median / p90 over {len(phases)} phase pairs')
+        print(
+            'dampings '
+            + ('unknown' if free else 'known')
+            + f': 1-sigma bound in %, median / p90 over {len(phases)} phase pairs'
+        )
         print(f'{"periods":>8} {"10 Hz":>15} {"13 Hz":>15}')
         for periods in WINDOWS:
             b = np.array([bound_percent(periods, p, free) for p in phases])
-            print(f'{periods:8.1f} ' + ' '.join(
-                f'{np.median(b[:, i]):7.2f} / {np.percentile(b[:, i], 90):5.2f}'
-                for i in range(2)))
+            print(
+                f'{periods:8.1f} '
+                + ' '.join(
+                    f'{np.median(b[:, i]):7.2f} / {np.percentile(b[:, i], 90):5.2f}'
+                    for i in range(2)
+                )
+            )
 
 
 if __name__ == '__main__':

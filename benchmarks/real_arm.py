@@ -15,6 +15,7 @@ argument; see its SOURCE.md) and prints two tables (``docs/real_arm.md`` quotes 
 
 Usage: ``python benchmarks/real_arm.py [REAL_DATA_DIR]``.
 """
+
 import sys
 from pathlib import Path
 
@@ -72,8 +73,10 @@ def mean_over(crossings, freqs, a, b):
 
 def goals_table(t, y):
     crossings, freqs = local_frequency(t, y)
-    print(f'{"configuration":32} {"n>4.5s":>6} {"in 2 %":>7} {">5 %":>5} {"first":>7} '
-          f'{"max wait":>9} {"ringing n":>9} {"worst":>7}')
+    print(
+        f'{"configuration":32} {"n>4.5s":>6} {"in 2 %":>7} {">5 %":>5} {"first":>7} '
+        f'{"max wait":>9} {"ringing n":>9} {"worst":>7}'
+    )
     for name, cfg in configs().items():
         e = create_estimator(cfg).process(t, y)
         late = e.t >= RINGING_S[1]
@@ -81,11 +84,18 @@ def goals_table(t, y):
         first = f'{e.t[late][0]:6.2f}s' if late.any() else '      -'
         wait = f'{np.max(np.diff(e.t[late])):8.2f}s' if late.sum() > 1 else '        -'
         ring = (e.t >= RINGING_S[0]) & ~late
-        worst = max((abs(f / mean_over(crossings, freqs, ti - c, ti) - 1) for ti, f, c in
-                     zip(e.t[ring], e.frequency_hz[ring], e.convergence_time[ring])), default=0)
+        worst = max(
+            (
+                abs(f / mean_over(crossings, freqs, ti - c, ti) - 1)
+                for ti, f, c in zip(e.t[ring], e.frequency_hz[ring], e.convergence_time[ring])
+            ),
+            default=0,
+        )
         within = f'{100 * np.mean(err <= 0.02):6.0f}%' if late.any() else '      -'
-        print(f'{name:32} {late.sum():6d} {within} {np.sum(err > 0.05):5d} {first} {wait} '
-              f'{ring.sum():9d} {100 * worst:6.1f}%')
+        print(
+            f'{name:32} {late.sum():6d} {within} {np.sum(err > 0.05):5d} {first} {wait} '
+            f'{ring.sum():9d} {100 * worst:6.1f}%'
+        )
 
 
 def design(w, t):
@@ -102,18 +112,32 @@ def causes_table(t, y):
     def residual(p):
         a = design(p[0], tt)
         return yy - a @ np.linalg.lstsq(a, yy, rcond=None)[0]
+
     w = least_squares(residual, [2 * np.pi * LIMIT_CYCLE_HZ]).x[0]
     coef = np.linalg.lstsq(design(w, tt), yy, rcond=None)[0]
     f = w / (2 * np.pi)
     amps = [np.hypot(coef[2 * k - 1], coef[2 * k]) * 1e3 for k in range(1, HARMONICS + 1)]
-    print(f'\nfit of 5-10 s: f {f:.4f} Hz, offset {coef[0] * 1e3:.2f} mm, harmonics '
-          + ', '.join(f'{a:.2f}' for a in amps) + ' mm')
+    print(
+        f'\nfit of 5-10 s: f {f:.4f} Hz, offset {coef[0] * 1e3:.2f} mm, harmonics '
+        + ', '.join(f'{a:.2f}' for a in amps)
+        + ' mm'
+    )
     ts = np.arange(0.0, 10.0, 1e-3)
-    cases = {'sine': (0, 0, 0), 'sine + offset': (1, 0, 0), 'sine + harmonics': (0, 1, 0),
-             'sine + 1 mm quantisation': (0, 0, 1), 'sine + offset + quantisation': (1, 0, 1),
-             'all three (as recorded)': (1, 1, 1)}
-    chosen = {k: v for k, v in configs().items() if k.startswith('biased') or k == 'paper (the '
-              'old defaults)' or k == 'paper, biased-sinusoid'}
+    cases = {
+        'sine': (0, 0, 0),
+        'sine + offset': (1, 0, 0),
+        'sine + harmonics': (0, 1, 0),
+        'sine + 1 mm quantisation': (0, 0, 1),
+        'sine + offset + quantisation': (1, 0, 1),
+        'all three (as recorded)': (1, 1, 1),
+    }
+    chosen = {
+        k: v
+        for k, v in configs().items()
+        if k.startswith('biased')
+        or k == 'paper (the old defaults)'
+        or k == 'paper, biased-sinusoid'
+    }
     print(f'{"synthetic limit cycle":30}' + ''.join(f' {k[:22]:>22}' for k in chosen))
     for name, (offset, harmonics, quantised) in cases.items():
         c = coef.copy()
@@ -125,14 +149,20 @@ def causes_table(t, y):
         cells = []
         for cfg in chosen.values():
             rel = create_estimator(cfg).process(ts, ys).frequency_hz / f - 1
-            cells.append(f'{len(rel):3d} {100 * np.median(rel):+6.2f}% {100 * np.max(np.abs(rel)):5.2f}%'
-                         if len(rel) else '  0')
+            cells.append(
+                f'{len(rel):3d} {100 * np.median(rel):+6.2f}% {100 * np.max(np.abs(rel)):5.2f}%'
+                if len(rel)
+                else '  0'
+            )
         print(f'{name:30}' + ''.join(f' {c:>22}' for c in cells))
 
 
 def main() -> int:
-    root = Path(sys.argv[1] if len(sys.argv) > 1 else
-                Path(__file__).resolve().parents[2] / 'shared' / 'real-data')
+    root = Path(
+        sys.argv[1]
+        if len(sys.argv) > 1
+        else Path(__file__).resolve().parents[2] / 'shared' / 'real-data'
+    )
     path = root / 'flexible_link_arm' / 'flex8.csv'
     if not path.is_file():
         print(f'no recording at {path}; pass the real-data folder as argument')

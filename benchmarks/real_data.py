@@ -11,13 +11,14 @@ compare with the log-decrement values of SOURCE.md), all four the paper's config
 (``EstimatorConfig.paper``) but for the change named, and last the package's defaults
 (biased-sinusoid over 1.25 periods with the consistency gate, ``docs/real_arm.md``).
 """
+
 import sys
 from pathlib import Path
 
 import numpy as np
 
-from vib_estimator.io.csv_reader import read_csv_series
 from vib_estimator.core import EstimatorConfig, estimate
+from vib_estimator.io.csv_reader import read_csv_series
 
 #: reference first-mode frequencies (Hz): this file's own FFT, per SOURCE.md
 REFERENCE = {30: 16.360, 40: 9.392, 50: 6.054, 60: 4.268}
@@ -28,8 +29,9 @@ def configs(f_ref):
         'paper (sinusoid)': EstimatorConfig.paper(),
         'biased-sinusoid': EstimatorConfig.paper(model='biased-sinusoid'),
         'sinusoid + band [f/2, 2f]': EstimatorConfig.paper(band_hz=(f_ref / 2, 2 * f_ref)),
-        'damped + band [f/2, 2f]': EstimatorConfig.paper(model='damped-sinusoid',
-                                                         band_hz=(f_ref / 2, 2 * f_ref)),
+        'damped + band [f/2, 2f]': EstimatorConfig.paper(
+            model='damped-sinusoid', band_hz=(f_ref / 2, 2 * f_ref)
+        ),
         'package defaults': EstimatorConfig(),
     }
 
@@ -42,20 +44,27 @@ def report(label, t, y, f_ref):
             continue
         err = e.frequency_hz / f_ref - 1
         zeta = f'{np.median(e.damping):11.4f}' if cfg.model == 'damped-sinusoid' else ''
-        print(f'{label:18} {name:28} {len(e):5d} {100 * np.median(err):+8.2f} % '
-              f'{100 * np.percentile(np.abs(err), 90):8.2f} % '
-              f'{np.median(e.convergence_time) * f_ref:14.2f} {zeta}')
+        print(
+            f'{label:18} {name:28} {len(e):5d} {100 * np.median(err):+8.2f} % '
+            f'{100 * np.percentile(np.abs(err), 90):8.2f} % '
+            f'{np.median(e.convergence_time) * f_ref:14.2f} {zeta}'
+        )
 
 
 def main() -> int:
-    root = Path(sys.argv[1] if len(sys.argv) > 1 else
-                Path(__file__).resolve().parents[2] / 'shared' / 'real-data')
+    root = Path(
+        sys.argv[1]
+        if len(sys.argv) > 1
+        else Path(__file__).resolve().parents[2] / 'shared' / 'real-data'
+    )
     folder = root / 'aluminium_cantilever_adxl357'
     if not folder.is_dir():
         print(f'no real data at {folder}; pass the real-data folder as argument')
         return 1
-    print(f'{"recording":18} {"configuration":28} {"n":>5} {"median err":>10} '
-          f'{"p90 |err|":>10} {"conv (periods)":>14} {"median zeta":>11}')
+    print(
+        f'{"recording":18} {"configuration":28} {"n":>5} {"median err":>10} '
+        f'{"p90 |err|":>10} {"conv (periods)":>14} {"median zeta":>11}'
+    )
     for length, f_ref in REFERENCE.items():
         s = read_csv_series(folder / f'{length}cm_uniform_1000Hz.csv')
         report(f'{length} cm, 1 kHz CSV', s.t, s.y, f_ref)

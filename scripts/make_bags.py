@@ -15,6 +15,7 @@ frequency in Hz, every :data:`TRUTH_EVERY` samples). Header stamps and log times
 sample times from :data:`EPOCH_NS` (an epoch, not 0, because ROS treats a zero ``/clock`` as "no
 time yet"). The bag directories of these names in ``--out`` are replaced.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -24,8 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
-from vib_estimator.sim import arm_model
 from vib_estimator.io.bags import TYPESTORE, WRENCH_STAMPED, BagWriter, wrench_message
+from vib_estimator.sim import arm_model
 from vib_estimator.sim.signals import fig1_signal
 
 EPOCH_NS = 1_700_000_000 * 1_000_000_000  # 2023-11-14 22:13:20 UTC, time of the first sample
@@ -47,8 +48,9 @@ def write_bag(path: Path, t: np.ndarray, signal: np.ndarray, f_true: np.ndarray)
     with BagWriter(path) as bag:
         wrench = bag.add_topic(TOPIC, WRENCH_STAMPED)
         truth = bag.add_topic(TRUTH_TOPIC, 'std_msgs/msg/Float64')
-        for k, (stamp, value, f) in enumerate(zip(stamps.tolist(), signal.tolist(),
-                                                  f_true.tolist())):
+        for k, (stamp, value, f) in enumerate(
+            zip(stamps.tolist(), signal.tolist(), f_true.tolist())
+        ):
             bag.write_message(wrench, stamp, wrench_message(stamp, FRAME, COMPONENT, value))
             if k % TRUTH_EVERY == 0:
                 bag.write_message(truth, stamp, float64(data=f))
@@ -64,8 +66,11 @@ def main(argv=None) -> int:
     recordings = {
         'arm_5_3': arm_model.experiment_5_3(args.seed),
         'arm_5_5': arm_model.experiment_5_5(args.seed),
-        'fig1': arm_model.Recording(t, fig1_signal(t, args.seed, omega=FIG1_OMEGA),
-                                    np.full(len(t), FIG1_OMEGA / (2 * math.pi))),
+        'fig1': arm_model.Recording(
+            t,
+            fig1_signal(t, args.seed, omega=FIG1_OMEGA),
+            np.full(len(t), FIG1_OMEGA / (2 * math.pi)),
+        ),
     }
     args.out.mkdir(parents=True, exist_ok=True)
     for name, rec in recordings.items():

@@ -11,6 +11,7 @@ the simulated sample times from midnight UTC of day d. Each day draws (seeded) i
 lower (Eq. 23: f ~ sqrt(c)). The topic is ``/coupling_torque`` (``WrenchStamped``, ``torque.z``),
 the only one, so ``survey`` reads it without ``--topic``. The output directory is replaced.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -23,7 +24,7 @@ import numpy as np
 from vib_estimator.io.bags import WrenchSeries, write_wrench_series
 from vib_estimator.sim import arm_model
 
-EPOCH_NS = 1_767_225_600 * 1_000_000_000   # 2026-01-01 00:00:00 UTC, day 0
+EPOCH_NS = 1_767_225_600 * 1_000_000_000  # 2026-01-01 00:00:00 UTC, day 0
 DAY_NS = 86_400 * 1_000_000_000
 DURATION_S = 20.0
 STIFFNESS_DROP = 0.01
@@ -36,8 +37,13 @@ def day_recording(day: int, drop_day: int, rng: np.random.Generator) -> arm_mode
     noise = arm_model.DEFAULT_NOISE_STD * rng.uniform(0.5, 2.0)
     stiffness = nominal.stiffness * (1 - STIFFNESS_DROP if day >= drop_day else 1.0)
     params = replace(nominal, stiffness=stiffness, tip_mass_kg=mass)
-    return arm_model.simulate(DURATION_S, (arm_model.Move(0.0, 1.0, 1.0, mass),), params,
-                              noise_std=noise, seed=int(rng.integers(2 ** 31)))
+    return arm_model.simulate(
+        DURATION_S,
+        (arm_model.Move(0.0, 1.0, 1.0, mass),),
+        params,
+        noise_std=noise,
+        seed=int(rng.integers(2**31)),
+    )
 
 
 def main(argv=None) -> int:
@@ -53,8 +59,10 @@ def main(argv=None) -> int:
     for day in range(args.days):
         rec = day_recording(day, args.drop_day, rng)
         stamps = EPOCH_NS + day * DAY_NS + np.round(rec.t * 1e9).astype(np.int64)
-        write_wrench_series(args.out / f'day_{day:02d}',
-                            WrenchSeries(stamps, rec.torque, 'arm_base', '/coupling_torque'))
+        write_wrench_series(
+            args.out / f'day_{day:02d}',
+            WrenchSeries(stamps, rec.torque, 'arm_base', '/coupling_torque'),
+        )
         print(f'{args.out / f"day_{day:02d}"}: f0 = {rec.f_true[-1]:.5f} Hz')
     return 0
 

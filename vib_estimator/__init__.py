@@ -15,10 +15,18 @@ The core's public API is importable from the top: ``from vib_estimator import Fr
 (loaded on first use, so ``vib-estimator --help`` and the nodes start without compiling anything
 they do not need).
 """
+
 from importlib import import_module
 
-_CORE = ('MODELS', 'COUNTER_NAMES', 'EstimatorConfig', 'Estimate', 'EstimateArrays',
-         'FrequencyEstimator', 'estimate')
+_CORE = (
+    'MODELS',
+    'COUNTER_NAMES',
+    'EstimatorConfig',
+    'Estimate',
+    'EstimateArrays',
+    'FrequencyEstimator',
+    'estimate',
+)
 __all__ = list(_CORE)
 
 

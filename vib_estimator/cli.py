@@ -5,6 +5,7 @@ this module only dispatches, importing the chosen one lazily so ``--help`` stays
 command refuses (:mod:`vib_estimator.errors`) ends as one ``error:`` line and the exit code
 :func:`vib_estimator.errors.exit_code` gives it (2), here if the command does not report it itself.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -16,18 +17,31 @@ from typing import Optional, Sequence
 from .errors import VibEstimatorError, report
 
 COMMANDS = {
-    'analyze': ('vib_estimator.analysis.analyze', 'estimate frequencies in a recorded signal (CSV, MCAP, '
-                'rosbag2)'),
-    'survey': ('vib_estimator.analysis.survey', 'many recordings: one summary row each, trend plot, '
-               'frequency-drift alarm; local or Dask-distributed'),
+    'analyze': (
+        'vib_estimator.analysis.analyze',
+        'estimate frequencies in a recorded signal (CSV, MCAP, rosbag2)',
+    ),
+    'survey': (
+        'vib_estimator.analysis.survey',
+        'many recordings: one summary row each, trend plot, '
+        'frequency-drift alarm; local or Dask-distributed',
+    ),
     'reproduce': ('vib_estimator.analysis.reproduce', "reproduce the paper's Figs. 1 and 2"),
-    'compare': ('vib_estimator.analysis.compare', 'algebraic vs adaptive/FFT estimators (Table 2, Figs. 6-7, '
-                'Cramer-Rao bound)'),
+    'compare': (
+        'vib_estimator.analysis.compare',
+        'algebraic vs adaptive/FFT estimators (Table 2, Figs. 6-7, Cramer-Rao bound)',
+    ),
     'demo': ('vib_estimator.demo', 'live demo: simulator + estimator node, three tip masses'),
-    'warmup': ('vib_estimator.analysis.warm', 'compile the estimator kernels now (make setup runs it; '
-               'a first start then takes a second, not half a minute)'),
-    'reindex': ('vib_estimator.io.reindex', 'rebuild the metadata.yaml of a rosbag2 directory from its '
-                'storage files (repairs a cut last MCAP file)'),
+    'warmup': (
+        'vib_estimator.analysis.warm',
+        'compile the estimator kernels now (make setup runs it; '
+        'a first start then takes a second, not half a minute)',
+    ),
+    'reindex': (
+        'vib_estimator.io.reindex',
+        'rebuild the metadata.yaml of a rosbag2 directory from its '
+        'storage files (repairs a cut last MCAP file)',
+    ),
 }
 
 

@@ -18,6 +18,7 @@ Hierarchy::
 
 ``ValueError`` (a bad option value, e.g. an unknown component) also maps to exit code 2.
 """
+
 from __future__ import annotations
 
 import contextlib
@@ -120,7 +121,11 @@ def as_bag_error(path: Path, doing: str):
     except Exception as err:  # noqa: BLE001 -- see docstring
         path = Path(path)
         detail = str(err).strip().rstrip('.') or type(err).__name__
-        repair = (f'; `vib-estimator reindex {path}` rebuilds it from what is complete'
-                  if path.is_dir() else '')
-        raise BagError(f'cannot {doing} {path}: {detail} (corrupt or truncated bag?{repair})'
-                       ) from None
+        repair = (
+            f'; `vib-estimator reindex {path}` rebuilds it from what is complete'
+            if path.is_dir()
+            else ''
+        )
+        raise BagError(
+            f'cannot {doing} {path}: {detail} (corrupt or truncated bag?{repair})'
+        ) from None

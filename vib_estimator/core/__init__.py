@@ -3,8 +3,16 @@
 Public API: :class:`EstimatorConfig`, :class:`FrequencyEstimator`, :class:`Estimate`,
 :class:`EstimateArrays`, :func:`estimate`, ``MODELS``, ``COUNTER_NAMES``.
 """
+
 from .config import MODELS, EstimatorConfig
 from .estimator import COUNTER_NAMES, Estimate, EstimateArrays, FrequencyEstimator, estimate
 
-__all__ = ['MODELS', 'COUNTER_NAMES', 'EstimatorConfig', 'Estimate', 'EstimateArrays',
-           'FrequencyEstimator', 'estimate']
+__all__ = [
+    'MODELS',
+    'COUNTER_NAMES',
+    'EstimatorConfig',
+    'Estimate',
+    'EstimateArrays',
+    'FrequencyEstimator',
+    'estimate',
+]

@@ -47,6 +47,7 @@ Bad samples never raise: non-finite values, duplicate and out-of-order stamps ar
 counted; a gap or a backward jump longer than ``max_gap`` starts a new window (``gap_resets``,
 ``time_jump_resets``); the tracked modes are kept.
 """
+
 from __future__ import annotations
 
 import math
@@ -99,27 +100,42 @@ MERGE_TOL = 0.02
 #: frequency (run forwards and backwards: no phase, gain 0.96 at the owned band's top edge)
 DECIMATE_SOS = butter(8, 0.45, output='sos')
 
-COUNTER_NAMES = ('received', 'used', 'skipped_non_finite', 'skipped_duplicate',
-                 'skipped_out_of_order', 'time_jump_resets', 'gap_resets', 'analyses',
-                 'rejected_damping', 'rejected_unstable', 'rejected_weak', 'rejected_uncertain',
-                 'modes_found',
-                 'modes_lost', 'estimates')
+COUNTER_NAMES = (
+    'received',
+    'used',
+    'skipped_non_finite',
+    'skipped_duplicate',
+    'skipped_out_of_order',
+    'time_jump_resets',
+    'gap_resets',
+    'analyses',
+    'rejected_damping',
+    'rejected_unstable',
+    'rejected_weak',
+    'rejected_uncertain',
+    'modes_found',
+    'modes_lost',
+    'estimates',
+)
 
 
 # ---- the bound and the standard deviations ------------------------------------------------------
-def sdof_psd(w: np.ndarray, frequency_hz: float, zeta: float, variance: float,
-             dt: float) -> np.ndarray:
+def sdof_psd(
+    w: np.ndarray, frequency_hz: float, zeta: float, variance: float, dt: float
+) -> np.ndarray:
     """Spectral density at ``w`` (rad/sample; normalised so that its mean over a period is the
     variance) of a white-noise-driven SDOF's response sampled every ``dt``: the DTFT of its
     autocovariance ``c_k = variance e^(-zeta wn |k| dt) (cos wd k dt + zeta / sqrt(1 - zeta^2)
     sin wd |k| dt)``, summed in closed form (``c_k = Re(a z^|k|)``, ``z = e^((-zeta wn + i wd)
     dt)``)."""
-    return _sdof_psd(np.exp(-1j * np.asarray(w, dtype=np.float64)), frequency_hz, zeta,
-                     variance, dt)
+    return _sdof_psd(
+        np.exp(-1j * np.asarray(w, dtype=np.float64)), frequency_hz, zeta, variance, dt
+    )
 
 
-def _sdof_psd(e: np.ndarray, frequency_hz: float, zeta: float, variance: float,
-              dt: float) -> np.ndarray:
+def _sdof_psd(
+    e: np.ndarray, frequency_hz: float, zeta: float, variance: float, dt: float
+) -> np.ndarray:
     """:func:`sdof_psd` at ``e = exp(-i w)``."""
     wn = 2 * math.pi * frequency_hz * dt
     root = math.sqrt(max(1.0 - zeta * zeta, 1e-12))
@@ -127,13 +143,15 @@ def _sdof_psd(e: np.ndarray, frequency_hz: float, zeta: float, variance: float,
     z = complex(decay * math.cos(wn * root), decay * math.sin(wn * root))
     a = variance * complex(1.0, -zeta / root)
     zc = z.conjugate()
-    total = (a * (1.0 / (1.0 - z * e) + 1.0 / (1.0 - z / e) - 1.0)
-             + a.conjugate() * (1.0 / (1.0 - zc * e) + 1.0 / (1.0 - zc / e) - 1.0))
+    total = a * (1.0 / (1.0 - z * e) + 1.0 / (1.0 - z / e) - 1.0) + a.conjugate() * (
+        1.0 / (1.0 - zc * e) + 1.0 / (1.0 - zc / e) - 1.0
+    )
     return 0.5 * total.real
 
 
-def peak_ratio(frequency_hz: float, zeta: float, variance: float, noise_var: float,
-               dt: float) -> float:
+def peak_ratio(
+    frequency_hz: float, zeta: float, variance: float, noise_var: float, dt: float
+) -> float:
     """A mode's spectral density at its frequency over the white noise's (:func:`sdof_psd`)."""
     w = 2 * math.pi * frequency_hz * dt
     return float(sdof_psd(np.array([w]), frequency_hz, zeta, variance, dt)[0]) / noise_var
@@ -147,7 +165,7 @@ def _active_bins(modes, noise_var: float, dt: float, n: int) -> np.ndarray:
         centre = f * dt * n
         peak = peak_ratio(f, z, v, noise_var, dt)
         half = z * f * dt * n * math.sqrt(max(peak / ACTIVE, 1.0)) + 2.0
-        keep[max(1, int(centre - half)):max(1, min(len(keep), int(centre + half) + 2))] = True
+        keep[max(1, int(centre - half)) : max(1, min(len(keep), int(centre + half) + 2))] = True
     keep[0] = False
     return np.flatnonzero(keep)
 
@@ -172,8 +190,9 @@ def _log_density_gradient(e: np.ndarray, modes, noise_var: float, dt: float):
     return total, np.array(grads) / total
 
 
-def whittle_fisher(modes: Sequence[tuple[float, float, float]], noise_var: float, fs: float,
-                   n: int) -> np.ndarray:
+def whittle_fisher(
+    modes: Sequence[tuple[float, float, float]], noise_var: float, fs: float, n: int
+) -> np.ndarray:
     """Fisher information of the Whittle likelihood of ``n`` samples at ``fs`` of a sum of
     noise-driven SDOFs ``modes`` = [(frequency Hz, damping ratio, variance)] plus white noise of
     variance ``noise_var``: ``F_ij = sum_k d_i ln S(w_k) d_j ln S(w_k)`` over the Fourier
@@ -185,12 +204,13 @@ def whittle_fisher(modes: Sequence[tuple[float, float, float]], noise_var: float
     bins = _active_bins(modes, noise_var, dt, n)
     _, d = _log_density_gradient(np.exp(-2j * math.pi * bins / n), modes, noise_var, dt)
     fisher = d @ d.T
-    fisher[-1, -1] += ((n + 1) // 2 - 1 - len(bins)) / noise_var ** 2
+    fisher[-1, -1] += ((n + 1) // 2 - 1 - len(bins)) / noise_var**2
     return fisher
 
 
-def whittle_std(modes: Sequence[tuple[float, float, float]], noise_var: float, fs: float,
-                n: int) -> list[tuple[float, float]]:
+def whittle_std(
+    modes: Sequence[tuple[float, float, float]], noise_var: float, fs: float, n: int
+) -> list[tuple[float, float]]:
     """The Whittle (asymptotic Cramer-Rao) bound of each mode's frequency (Hz) and damping ratio,
     as standard deviations, over ``n`` samples (see :func:`whittle_fisher`); NaN if singular."""
     if not modes:
@@ -201,9 +221,13 @@ def whittle_std(modes: Sequence[tuple[float, float, float]], noise_var: float, f
     except np.linalg.LinAlgError:
         return [(math.nan, math.nan)] * len(modes)
     var = np.diag(cov)
-    return [(math.sqrt(var[3 * j]) if var[3 * j] > 0 else math.nan,
-             math.sqrt(var[3 * j + 1]) if var[3 * j + 1] > 0 else math.nan)
-            for j in range(len(modes))]
+    return [
+        (
+            math.sqrt(var[3 * j]) if var[3 * j] > 0 else math.nan,
+            math.sqrt(var[3 * j + 1]) if var[3 * j + 1] > 0 else math.nan,
+        )
+        for j in range(len(modes))
+    ]
 
 
 # ---- one window ---------------------------------------------------------------------------------
@@ -214,12 +238,13 @@ def correlations(y: np.ndarray, lags: int) -> np.ndarray:
     y = y - y.mean()
     size = 1 << math.ceil(math.log2(n + lags + 1))
     spec = np.fft.rfft(y, size)
-    r = np.fft.irfft(spec * np.conj(spec), size)[:lags + 1]
+    r = np.fft.irfft(spec * np.conj(spec), size)[: lags + 1]
     return r / np.arange(n, n - lags - 1, -1)
 
 
-def ssi_poles(r: np.ndarray, fs: float, rows: int = BLOCK_ROWS,
-              orders: Sequence[int] = ORDERS) -> list[np.ndarray]:
+def ssi_poles(
+    r: np.ndarray, fs: float, rows: int = BLOCK_ROWS, orders: Sequence[int] = ORDERS
+) -> list[np.ndarray]:
     """SSI-cov poles of correlations ``r`` at each model order: one array per order with a row
     (frequency Hz, damping ratio, variance of the mode) per complex pair (upper half plane)."""
     hankel = r[1 + np.add.outer(np.arange(rows), np.arange(rows))]
@@ -250,19 +275,29 @@ def ssi_poles(r: np.ndarray, fs: float, rows: int = BLOCK_ROWS,
         pole = np.log(lam_k) * fs
         freq = np.abs(pole) / (2 * math.pi)
         zeta = -pole.real / np.abs(pole)
-        variance = 2.0 * (amp / lam_k).real     # the pair's share of R_0
+        variance = 2.0 * (amp / lam_k).real  # the pair's share of R_0
         out.append(np.column_stack((freq, zeta, variance)))
     return out
 
 
-def cluster_modes(poles: list[np.ndarray], fs: float, max_damping: float,
-                  band: tuple[float, float], counts: dict[str, int]) -> np.ndarray:
+def cluster_modes(
+    poles: list[np.ndarray],
+    fs: float,
+    max_damping: float,
+    band: tuple[float, float],
+    counts: dict[str, int],
+) -> np.ndarray:
     """The physical modes of a stabilisation diagram ``poles`` (:func:`ssi_poles`): rows
     (frequency, damping, variance, support), ascending; counts the rejected poles/clusters."""
     rows = []
     for k, p in enumerate(poles):
-        ok = ((p[:, 1] > 0) & (p[:, 1] <= max_damping) & (p[:, 0] < NU_MAX * fs)
-              & (p[:, 0] >= band[0]) & (p[:, 0] <= band[1]))
+        ok = (
+            (p[:, 1] > 0)
+            & (p[:, 1] <= max_damping)
+            & (p[:, 0] < NU_MAX * fs)
+            & (p[:, 0] >= band[0])
+            & (p[:, 0] <= band[1])
+        )
         counts['rejected_damping'] += int(np.count_nonzero(~ok))
         rows.append(np.column_stack((p[ok], np.full(np.count_nonzero(ok), k))))
     allp = np.concatenate(rows) if rows else np.empty((0, 4))
@@ -271,8 +306,11 @@ def cluster_modes(poles: list[np.ndarray], fs: float, max_damping: float,
     start = 0
     n_orders = len(poles)
     for i in range(1, len(allp) + 1):
-        if i < len(allp) and allp[i, 0] <= allp[i - 1, 0] * (1 + CLUSTER_TOL) \
-                and allp[i, 0] <= allp[start, 0] * (1 + CLUSTER_SPAN):
+        if (
+            i < len(allp)
+            and allp[i, 0] <= allp[i - 1, 0] * (1 + CLUSTER_TOL)
+            and allp[i, 0] <= allp[start, 0] * (1 + CLUSTER_SPAN)
+        ):
             continue
         group = allp[start:i]
         start = i
@@ -280,8 +318,14 @@ def cluster_modes(poles: list[np.ndarray], fs: float, max_damping: float,
         if support < MIN_SUPPORT:
             counts['rejected_unstable'] += 1
             continue
-        modes.append((np.median(group[:, 0]), np.median(group[:, 1]),
-                      max(np.median(group[:, 2]), 0.0), support))
+        modes.append(
+            (
+                np.median(group[:, 0]),
+                np.median(group[:, 1]),
+                max(np.median(group[:, 2]), 0.0),
+                support,
+            )
+        )
     return np.array(modes).reshape(-1, 4)
 
 
@@ -295,13 +339,19 @@ def decimate(y: np.ndarray, fs: float, top_hz: float) -> tuple[np.ndarray, float
     return y, fs
 
 
-def _modes_at(y: np.ndarray, fs: float, max_damping: float, band: tuple[float, float],
-              counts: dict[str, int]) -> np.ndarray:
+def _modes_at(
+    y: np.ndarray, fs: float, max_damping: float, band: tuple[float, float], counts: dict[str, int]
+) -> np.ndarray:
     """The clustered modes (:func:`cluster_modes`) of ``y`` at ``fs``, poles up to
     :data:`NU_MAX` fs in ``band``; clusters closer than :data:`MERGE_TOL` are one mode (the one
     with the larger support)."""
-    modes = cluster_modes(ssi_poles(correlations(y, 2 * BLOCK_ROWS), fs), fs, max_damping,
-                          (band[0], min(band[1], NU_MAX * fs)), counts)
+    modes = cluster_modes(
+        ssi_poles(correlations(y, 2 * BLOCK_ROWS), fs),
+        fs,
+        max_damping,
+        (band[0], min(band[1], NU_MAX * fs)),
+        counts,
+    )
     keep = []
     for row in modes:
         if keep and row[0] <= keep[-1][0] * (1 + MERGE_TOL):
@@ -327,14 +377,20 @@ def _strong(modes: np.ndarray, total: float, fs: float, counts: dict[str, int]):
         weak = ratio < MIN_PEAK_RATIO
         if not np.any(weak):
             return modes, noise
-        worst = int(np.argmin(ratio))      # drop the weakest, then judge the others again
+        worst = int(np.argmin(ratio))  # drop the weakest, then judge the others again
         counts['rejected_weak'] += 1
         modes = np.delete(modes, worst, axis=0)
 
 
-def identify(y: np.ndarray, fs: float, max_damping: float = 0.1,
-             band: tuple[float, float] = (0.0, math.inf), counts: dict[str, int] | None = None,
-             top_hz: float = 0.0, search: bool = True):
+def identify(
+    y: np.ndarray,
+    fs: float,
+    max_damping: float = 0.1,
+    band: tuple[float, float] = (0.0, math.inf),
+    counts: dict[str, int] | None = None,
+    top_hz: float = 0.0,
+    search: bool = True,
+):
     """Modes of one window ``y`` sampled at ``fs``: (rows of frequency, damping, variance,
     frequency std, damping std, ascending; the white noise variance left over; the window's
     variance). A first pass at ``fs`` (or, if it finds none, at the first of the rates halved in
@@ -350,8 +406,9 @@ def identify(y: np.ndarray, fs: float, max_damping: float = 0.1,
         # mode spans too few periods of the full rate's lags to be stable there)
         yk, rate = y, fs
         while True:
-            modes, noise = _strong(_modes_at(yk, rate, max_damping, band, counts), total, fs,
-                                   counts)
+            modes, noise = _strong(
+                _modes_at(yk, rate, max_damping, band, counts), total, fs, counts
+            )
             if len(modes) or len(yk) // 2 < MIN_SAMPLES:
                 break
             yk, rate = sosfiltfilt(DECIMATE_SOS, yk)[::2], 0.5 * rate
@@ -359,8 +416,9 @@ def identify(y: np.ndarray, fs: float, max_damping: float = 0.1,
     if top > 0:
         yq, rate = decimate(y, fs, top)
         if rate < fs:
-            modes, noise = _strong(_modes_at(yq, rate, max_damping, band, counts), total, fs,
-                                   counts)
+            modes, noise = _strong(
+                _modes_at(yq, rate, max_damping, band, counts), total, fs, counts
+            )
     triples = [(f, z, v) for f, z, v, _ in modes]
     stds = np.array(whittle_std(triples, noise, fs, len(y))).reshape(-1, 2)
     out = np.column_stack((modes[:, :3], stds)) if len(modes) else np.empty((0, 5))
@@ -381,8 +439,9 @@ class _Track:
         self.estimates = 0
         self.history: list[tuple[float, float, float, float, float]] = []
 
-    def calibration(self, t: float, f: float, f_std: float, z: float, z_std: float,
-                    window: float) -> float:
+    def calibration(
+        self, t: float, f: float, f_std: float, z: float, z_std: float, window: float
+    ) -> float:
         """The factor (>= 1) by which the Whittle stds are too small, from this mode's own
         estimates: the RMS of ``(f - f_j) / sqrt(std^2 + std_j^2)`` (and of the damping's) over
         its estimates ``f_j`` of windows that do not overlap this one (at least ``window`` s
@@ -393,8 +452,12 @@ class _Track:
         old = np.array([h for h in hist if h[0] <= t - window]).reshape(-1, 5)
         if not len(old):
             return 1.0
-        d = np.concatenate(((f - old[:, 1]) / np.hypot(f_std, old[:, 2]),
-                            (z - old[:, 3]) / np.hypot(z_std, old[:, 4])))
+        d = np.concatenate(
+            (
+                (f - old[:, 1]) / np.hypot(f_std, old[:, 2]),
+                (z - old[:, 3]) / np.hypot(z_std, old[:, 4]),
+            )
+        )
         return max(1.0, math.sqrt(float(np.mean(d * d))))
 
 
@@ -422,8 +485,9 @@ class AmbientEstimator:
 
     def mode_counters(self) -> dict[int, dict[str, int]]:
         """Each current mode's estimates (as the mode tracker's ``mode_counters``)."""
-        published = sorted((tr for tr in self._tracks if tr.published),
-                           key=lambda tr: tr.frequency)
+        published = sorted(
+            (tr for tr in self._tracks if tr.published), key=lambda tr: tr.frequency
+        )
         return {k: {'estimates': tr.estimates} for k, tr in enumerate(published, 1)}
 
     def restart(self) -> None:
@@ -438,8 +502,8 @@ class AmbientEstimator:
         self._clear()
 
     def _clear(self) -> None:
-        self._n = 0          # samples in the buffer
-        self._start = 0      # first sample of the current window
+        self._n = 0  # samples in the buffer
+        self._start = 0  # first sample of the current window
         self._next = math.inf
 
     # ---- input --------------------------------------------------------------------------------
@@ -447,16 +511,16 @@ class AmbientEstimator:
         m = len(t)
         if self._n + m > len(self._t):
             keep = self._n - self._start
-            if keep + m > len(self._t) // 2:      # grow
+            if keep + m > len(self._t) // 2:  # grow
                 size = 1 << math.ceil(math.log2(2 * (keep + m)))
-                self._t = np.concatenate((self._t[self._start:self._n], np.empty(size - keep)))
-                self._y = np.concatenate((self._y[self._start:self._n], np.empty(size - keep)))
-            else:                                  # compact
-                self._t[:keep] = self._t[self._start:self._n]
-                self._y[:keep] = self._y[self._start:self._n]
+                self._t = np.concatenate((self._t[self._start : self._n], np.empty(size - keep)))
+                self._y = np.concatenate((self._y[self._start : self._n], np.empty(size - keep)))
+            else:  # compact
+                self._t[:keep] = self._t[self._start : self._n]
+                self._y[:keep] = self._y[self._start : self._n]
             self._n, self._start = keep, 0
-        self._t[self._n:self._n + m] = t
-        self._y[self._n:self._n + m] = y
+        self._t[self._n : self._n + m] = t
+        self._y[self._n : self._n + m] = y
         if self._n == 0:
             self._next = float(t[0]) + self._window
         self._n += m
@@ -501,11 +565,16 @@ class AmbientEstimator:
         while i < n:
             # the longest clean run from i: finite, increasing, no gap (else one sample at a time)
             j = i
-            if math.isfinite(t[i]) and math.isfinite(y[i]) and t[i] > self._last \
-                    and (t[i] - self._last <= self._config.max_gap or not self._n):
-                d = np.diff(t[i:min(n, i + 65536)])
-                bad = (~((d > 0) & (d <= self._config.max_gap))
-                       | ~np.isfinite(y[i + 1:i + 1 + len(d)]))
+            if (
+                math.isfinite(t[i])
+                and math.isfinite(y[i])
+                and t[i] > self._last
+                and (t[i] - self._last <= self._config.max_gap or not self._n)
+            ):
+                d = np.diff(t[i : min(n, i + 65536)])
+                bad = ~((d > 0) & (d <= self._config.max_gap)) | ~np.isfinite(
+                    y[i + 1 : i + 1 + len(d)]
+                )
                 j = i + 1 + (int(np.argmax(bad)) if bad.any() else len(d))
             if j == i:
                 out.extend(self.update(t[i], y[i]))
@@ -530,10 +599,11 @@ class AmbientEstimator:
         self._next += HOP_S
         if self._next <= t_end:
             self._next = t_end + HOP_S
-        first = self._start + int(np.searchsorted(self._t[self._start:self._n],
-                                                  t_end - self._window, 'left'))
+        first = self._start + int(
+            np.searchsorted(self._t[self._start : self._n], t_end - self._window, 'left')
+        )
         self._start = first
-        ts, ys = self._t[first:self._n], self._y[first:self._n]
+        ts, ys = self._t[first : self._n], self._y[first : self._n]
         n = len(ts)
         if n < 4 * BLOCK_ROWS + 2:
             return []
@@ -542,19 +612,24 @@ class AmbientEstimator:
         self._c['analyses'] += 1
         known = max((tr.frequency for tr in self._tracks if tr.published), default=0.0)
         search = self._c['analyses'] % SEARCH_EVERY == 1
-        modes, _noise, total = identify(ys, fs, self._config.max_damping, self._band, self._c,
-                                        known, search)
+        modes, _noise, total = identify(
+            ys, fs, self._config.max_damping, self._band, self._c, known, search
+        )
         return self._track(modes, total, float(t_end), span, n)
 
-    def _track(self, modes: np.ndarray, total: float, t: float, span: float,
-               n: int) -> list[Estimate]:
+    def _track(
+        self, modes: np.ndarray, total: float, t: float, span: float, n: int
+    ) -> list[Estimate]:
         """Match the window's modes to the tracked ones, publish the confirmed ones."""
         tracks = self._tracks
-        pairs = sorted((abs(m[0] / tr.frequency - 1), i, j) for i, m in enumerate(modes)
-                       for j, tr in enumerate(tracks))
+        pairs = sorted(
+            (abs(m[0] / tr.frequency - 1), i, j)
+            for i, m in enumerate(modes)
+            for j, tr in enumerate(tracks)
+        )
         match: dict[int, int] = {}
         used = set()
-        pairs.sort(key=lambda p: (not tracks[p[2]].published, p[0]))   # published ones first
+        pairs.sort(key=lambda p: (not tracks[p[2]].published, p[0]))  # published ones first
         for dist, i, j in pairs:
             if dist <= MATCH_TOL and i not in match and j not in used:
                 match[i] = j
@@ -579,7 +654,7 @@ class AmbientEstimator:
                     self._c['modes_lost'] += tr.published
         ready = [tr for tr in tracks if id(tr) in seen and tr.seen >= CONFIRM]
         if self._config.modes:
-            ready = sorted(ready, key=lambda tr: -tr.amplitude)[:self._config.modes]
+            ready = sorted(ready, key=lambda tr: -tr.amplitude)[: self._config.modes]
         for tr in ready:
             if not tr.published:
                 tr.published = True
@@ -593,8 +668,20 @@ class AmbientEstimator:
                 scale = tr.calibration(t, f, fstd, z, zstd, self._window)
                 fstd, zstd = fstd * scale, zstd * scale
                 tr.estimates += 1
-                out.append(Estimate(t, float(f), span, n, explained, math.sqrt(v), float(z),
-                                    float(fstd), float(zstd), k))
+                out.append(
+                    Estimate(
+                        t,
+                        float(f),
+                        span,
+                        n,
+                        explained,
+                        math.sqrt(v),
+                        float(z),
+                        float(fstd),
+                        float(zstd),
+                        k,
+                    )
+                )
         self._c['estimates'] += len(out)
         return out
 
@@ -603,6 +690,12 @@ def _columns(estimates: list[Estimate]) -> EstimateArrays:
     """Estimates as the columns of :class:`EstimateArrays`."""
     names = list(EstimateArrays.__dataclass_fields__)
     ints = ('samples', 'mode')
-    return EstimateArrays(**{
-        name: np.array([getattr(e, name) for e in estimates],
-                       dtype=np.int64 if name in ints else np.float64) for name in names})
+    return EstimateArrays(
+        **{
+            name: np.array(
+                [getattr(e, name) for e in estimates],
+                dtype=np.int64 if name in ints else np.float64,
+            )
+            for name in names
+        }
+    )

@@ -4,6 +4,7 @@ One source for :meth:`EstimatorConfig.validate`, the nodes' ``ParameterDescripto
 line and the documentation (:meth:`EstimatorConfig.describe`); :meth:`EstimatorConfig.as_params`
 lays the values out as the compiled kernel's parameter array (:mod:`vib_estimator.core.kernel`).
 """
+
 from __future__ import annotations
 
 import math
@@ -32,8 +33,10 @@ def _param(default, doc: str, lo=None, hi=None, open_lo=False, open_hi=False):
     One source for :meth:`EstimatorConfig.validate`, the node's ``ParameterDescriptor`` and the
     documentation (:meth:`EstimatorConfig.describe`).
     """
-    return field(default=default, metadata={'doc': doc, 'range': None if lo is None else
-                                            (lo, hi, open_lo, open_hi)})
+    return field(
+        default=default,
+        metadata={'doc': doc, 'range': None if lo is None else (lo, hi, open_lo, open_hi)},
+    )
 
 
 @dataclass(frozen=True)
@@ -44,81 +47,183 @@ class EstimatorConfig:
     them back to the paper's (:data:`PAPER`). Each field's description and range: :meth:`describe`.
     """
 
-    model: str = _param('biased-sinusoid', 'sinusoid (Eq. 1, the paper), biased-sinusoid '
-                        '(y = A sin(wt+phi) + B, the offset eliminated algebraically) or '
-                        'damped-sinusoid (natural frequency and damping of a decaying sine)')
-    lowpass_cutoff_hz: float = _param(3.0, 'cut-off of the invariant low-pass filter of Eqs. '
-                                      '9-11, Hz (3 Hz = 6 pi rad/s, Section 5.3)',
-                                      0.0, INF, open_lo=True, open_hi=True)
-    lowpass_damping: float = _param(0.707, 'damping ratio of the invariant low-pass filter',
-                                    0.0, INF, open_lo=True, open_hi=True)
+    model: str = _param(
+        'biased-sinusoid',
+        'sinusoid (Eq. 1, the paper), biased-sinusoid '
+        '(y = A sin(wt+phi) + B, the offset eliminated algebraically) or '
+        'damped-sinusoid (natural frequency and damping of a decaying sine)',
+    )
+    lowpass_cutoff_hz: float = _param(
+        3.0,
+        'cut-off of the invariant low-pass filter of Eqs. '
+        '9-11, Hz (3 Hz = 6 pi rad/s, Section 5.3)',
+        0.0,
+        INF,
+        open_lo=True,
+        open_hi=True,
+    )
+    lowpass_damping: float = _param(
+        0.707,
+        'damping ratio of the invariant low-pass filter',
+        0.0,
+        INF,
+        open_lo=True,
+        open_hi=True,
+    )
     window: int = _param(3, 'M of the moving-average convergence test (Eqs. 16-17)', 1, 10_000)
-    tolerance: float = _param(1e-3, 'relative tolerance of the convergence test (Eq. 16)',
-                              0.0, 1.0, open_lo=True, open_hi=True)
-    min_time: float = _param(0.01, 'eps of Eq. 12: no estimate is formed during the first eps '
-                             'seconds after a reset', 0.0, INF, open_hi=True)
-    min_samples: int = _param(16, 'samples a segment must hold before the test may fire',
-                              1, 10 ** 8)
-    min_periods: float = _param(1.25, 'the test may fire only once the segment spans this '
-                                'many periods of the frequency it estimates (0 = off)', 0.0, 50.0)
+    tolerance: float = _param(
+        1e-3,
+        'relative tolerance of the convergence test (Eq. 16)',
+        0.0,
+        1.0,
+        open_lo=True,
+        open_hi=True,
+    )
+    min_time: float = _param(
+        0.01,
+        'eps of Eq. 12: no estimate is formed during the first eps seconds after a reset',
+        0.0,
+        INF,
+        open_hi=True,
+    )
+    min_samples: int = _param(16, 'samples a segment must hold before the test may fire', 1, 10**8)
+    min_periods: float = _param(
+        1.25,
+        'the test may fire only once the segment spans this '
+        'many periods of the frequency it estimates (0 = off)',
+        0.0,
+        50.0,
+    )
     invariant_filter: bool = _param(True, 'false computes n/d unfiltered (Fig. 1, lower trace)')
-    one_sided_test: bool = _param(False, 'Eq. 16 exactly as printed, (MA(k) - MA(k-M))/MA(k) < '
-                                  'tolerance, which accepts any falling estimate')
-    rule_points: int = _param(K.NH, 'samples of the interpolating polynomial the moments are '
-                              'integrated over (2 = trapezoid, for comparison)', 2, K.NH)
-    max_window: float = _param(0.0, 'seconds without convergence after which the estimator '
-                               'resets without publishing (0 = automatic: 10 s, or min_periods '
-                               '+ 2 periods of the running estimate if longer)', 0.0, INF,
-                               open_hi=True)
-    refine: int = _param(4, 'Gauss-Newton (maximum-likelihood) steps of the model over the '
-                         'segment, started from the algebraic estimate (0 = the paper\'s '
-                         'algebraic estimate as it is)', 0, 50)
+    one_sided_test: bool = _param(
+        False,
+        'Eq. 16 exactly as printed, (MA(k) - MA(k-M))/MA(k) < '
+        'tolerance, which accepts any falling estimate',
+    )
+    rule_points: int = _param(
+        K.NH,
+        'samples of the interpolating polynomial the moments are '
+        'integrated over (2 = trapezoid, for comparison)',
+        2,
+        K.NH,
+    )
+    max_window: float = _param(
+        0.0,
+        'seconds without convergence after which the estimator '
+        'resets without publishing (0 = automatic: 10 s, or min_periods '
+        '+ 2 periods of the running estimate if longer)',
+        0.0,
+        INF,
+        open_hi=True,
+    )
+    refine: int = _param(
+        4,
+        'Gauss-Newton (maximum-likelihood) steps of the model over the '
+        "segment, started from the algebraic estimate (0 = the paper's "
+        'algebraic estimate as it is)',
+        0,
+        50,
+    )
     band_hz: Optional[Tuple[float, float]] = _param(
-        None, 'band-pass prefilter [f_lo, f_hi] Hz on the signal (4th-order Butterworth '
-        'low-pass at f_hi, 2nd-order high-pass at f_lo), never reset; none = off')
-    min_amplitude: float = _param(0.0, 'quality gate: a segment whose half range is at or '
-                                  'below this is at rest (signal units)', 0.0, INF, open_hi=True)
-    min_fit: float = _param(0.9, 'quality gate: R^2 the refined model (with refine = 0: a '
-                            'sinusoid at the estimated frequency) must reach over the segment for '
-                            'the estimate to be published', 0.0, 1.0)
-    max_damping: float = _param(0.1, 'quality gate of the damped-sinusoid model: an estimate '
-                                'whose |damping ratio| exceeds this is a transient, not published',
-                                0.0, 1.0, open_lo=True)
-    consistency: float = _param(0.03, 'quality gate: an estimate is published only if it lies '
-                                'within this fraction of the estimate of the segment just before '
-                                'it (none after a restart, a timeout or a rejected segment): two '
-                                'consecutive estimates of one mode that differ more cannot both '
-                                'be right (0 = off, the paper; modes >= 1 have their own rule)',
-                                0.0, 1.0)
-    max_gap: float = _param(0.5, 'a gap, or a backward jump, between stamps longer than this '
-                            '(s) restarts the estimator; a smaller step back is skipped',
-                            0.0, INF, open_lo=True, open_hi=True)
-    gap_intervals: float = _param(10.0, 'a step between stamps longer than this many running '
-                                  'sample intervals (yet within max_gap) is a gap: the estimator '
-                                  'restarts, never fitting across it; counted in gaps and '
-                                  'samples_lost (0 = off, else >= 2)', 0.0, 1e6)
-    outlier_ratio: float = _param(1000.0, 'a sample farther from the signal\'s running centre '
-                                  'than this many times its running peak deviation is skipped '
-                                  f'(skipped_outlier); {K.OUTLIER_RUN} in a row are a real change '
-                                  'of level, taken (the estimator restarts) (0 = off, else >= 2)',
-                                  0.0, 1e12)
-    target_std_rel: float = _param(0.0, 'publish as soon as the predicted relative standard '
-                                   'deviation of the frequency is at or below this, whatever the '
-                                   'period fraction (0 = off)', 0.0, 1.0)
-    modes: int = _param(0, 'modes to find and track by a multi-scale subspace fit, each '
-                        'numbered by ascending frequency (0 = one estimator on the whole, '
-                        'optionally band-limited, signal)', 0, 8)
-    excitation: str = _param('free', 'free (free decays: the algebraic estimator, or the mode '
-                             'tracker with modes >= 1) or ambient (driven by unmeasured broadband '
-                             'forces: covariance-driven subspace identification over a sliding '
-                             'window of ambient_window_s, every mode numbered as the mode '
-                             'tracker\'s, '
-                             'at most modes of them if modes >= 1)')
-    ambient_window_s: float = _param(30.0, 'excitation ambient: the sliding window, s (the '
-                                     'frequency std falls as its square root; docs/operation.md)',
-                                     2.0, 3600.0)
-    buffer_samples: int = _param(200_000, 'segment buffer of the quality gate; a longer segment '
-                                 'resets', 1, 10 ** 8)
+        None,
+        'band-pass prefilter [f_lo, f_hi] Hz on the signal (4th-order Butterworth '
+        'low-pass at f_hi, 2nd-order high-pass at f_lo), never reset; none = off',
+    )
+    min_amplitude: float = _param(
+        0.0,
+        'quality gate: a segment whose half range is at or below this is at rest (signal units)',
+        0.0,
+        INF,
+        open_hi=True,
+    )
+    min_fit: float = _param(
+        0.9,
+        'quality gate: R^2 the refined model (with refine = 0: a '
+        'sinusoid at the estimated frequency) must reach over the segment for '
+        'the estimate to be published',
+        0.0,
+        1.0,
+    )
+    max_damping: float = _param(
+        0.1,
+        'quality gate of the damped-sinusoid model: an estimate '
+        'whose |damping ratio| exceeds this is a transient, not published',
+        0.0,
+        1.0,
+        open_lo=True,
+    )
+    consistency: float = _param(
+        0.03,
+        'quality gate: an estimate is published only if it lies '
+        'within this fraction of the estimate of the segment just before '
+        'it (none after a restart, a timeout or a rejected segment): two '
+        'consecutive estimates of one mode that differ more cannot both '
+        'be right (0 = off, the paper; modes >= 1 have their own rule)',
+        0.0,
+        1.0,
+    )
+    max_gap: float = _param(
+        0.5,
+        'a gap, or a backward jump, between stamps longer than this '
+        '(s) restarts the estimator; a smaller step back is skipped',
+        0.0,
+        INF,
+        open_lo=True,
+        open_hi=True,
+    )
+    gap_intervals: float = _param(
+        10.0,
+        'a step between stamps longer than this many running '
+        'sample intervals (yet within max_gap) is a gap: the estimator '
+        'restarts, never fitting across it; counted in gaps and '
+        'samples_lost (0 = off, else >= 2)',
+        0.0,
+        1e6,
+    )
+    outlier_ratio: float = _param(
+        1000.0,
+        "a sample farther from the signal's running centre "
+        'than this many times its running peak deviation is skipped '
+        f'(skipped_outlier); {K.OUTLIER_RUN} in a row are a real change '
+        'of level, taken (the estimator restarts) (0 = off, else >= 2)',
+        0.0,
+        1e12,
+    )
+    target_std_rel: float = _param(
+        0.0,
+        'publish as soon as the predicted relative standard '
+        'deviation of the frequency is at or below this, whatever the '
+        'period fraction (0 = off)',
+        0.0,
+        1.0,
+    )
+    modes: int = _param(
+        0,
+        'modes to find and track by a multi-scale subspace fit, each '
+        'numbered by ascending frequency (0 = one estimator on the whole, '
+        'optionally band-limited, signal)',
+        0,
+        8,
+    )
+    excitation: str = _param(
+        'free',
+        'free (free decays: the algebraic estimator, or the mode '
+        'tracker with modes >= 1) or ambient (driven by unmeasured broadband '
+        'forces: covariance-driven subspace identification over a sliding '
+        'window of ambient_window_s, every mode numbered as the mode '
+        "tracker's, "
+        'at most modes of them if modes >= 1)',
+    )
+    ambient_window_s: float = _param(
+        30.0,
+        'excitation ambient: the sliding window, s (the '
+        'frequency std falls as its square root; docs/operation.md)',
+        2.0,
+        3600.0,
+    )
+    buffer_samples: int = _param(
+        200_000, 'segment buffer of the quality gate; a longer segment resets', 1, 10**8
+    )
 
     @classmethod
     def paper(cls, **changes) -> 'EstimatorConfig':
@@ -139,38 +244,54 @@ class EstimatorConfig:
             kind = type(f.default) if f.default is not None else None
             if kind is bool and not isinstance(value, bool):
                 raise ValueError(f'{f.name} must be true or false, got {value!r}')
-            if kind is int and (isinstance(value, bool)
-                                or not isinstance(value, (int, np.integer))):
+            if kind is int and (
+                isinstance(value, bool) or not isinstance(value, (int, np.integer))
+            ):
                 raise ValueError(f'{f.name} must be an integer, got {value!r}')
-            if kind is float and (isinstance(value, bool) or not isinstance(value, (int, float))
-                                  or math.isnan(value)):
+            if kind is float and (
+                isinstance(value, bool) or not isinstance(value, (int, float)) or math.isnan(value)
+            ):
                 raise ValueError(f'{f.name} must be a number, got {value!r}')
             bounds = f.metadata['range']
             if bounds is not None:
                 lo, hi, open_lo, open_hi = bounds
-                if value < lo or value > hi or (open_lo and value == lo) or \
-                        (open_hi and value == hi):
-                    raise ValueError(f'{f.name} must be in {"(" if open_lo else "["}{lo}, '
-                                     f'{hi}{")" if open_hi else "]"}, got {value!r}')
+                if (
+                    value < lo
+                    or value > hi
+                    or (open_lo and value == lo)
+                    or (open_hi and value == hi)
+                ):
+                    raise ValueError(
+                        f'{f.name} must be in {"(" if open_lo else "["}{lo}, '
+                        f'{hi}{")" if open_hi else "]"}, got {value!r}'
+                    )
         if self.excitation not in EXCITATIONS:
-            raise ValueError(f'excitation must be one of {", ".join(EXCITATIONS)}, '
-                             f'got {self.excitation!r}')
+            raise ValueError(
+                f'excitation must be one of {", ".join(EXCITATIONS)}, got {self.excitation!r}'
+            )
         for name in ('gap_intervals', 'outlier_ratio'):
             if 0 < getattr(self, name) < 2:
-                raise ValueError(f'{name} must be 0 (off) or at least 2, '
-                                 f'got {getattr(self, name)!r}')
+                raise ValueError(
+                    f'{name} must be 0 (off) or at least 2, got {getattr(self, name)!r}'
+                )
         if self.model not in MODELS:
             raise ValueError(f'model must be one of {", ".join(MODELS)}, got {self.model!r}')
         window = self.max_window or K.AUTO_WINDOW_S
         if self.min_time >= window:
-            raise ValueError(f'min_time ({self.min_time}) must be below max_window '
-                             f'({window}{" when automatic" if not self.max_window else ""})')
+            raise ValueError(
+                f'min_time ({self.min_time}) must be below max_window '
+                f'({window}{" when automatic" if not self.max_window else ""})'
+            )
         if self.band_hz is not None:
             band = tuple(self.band_hz)
-            if len(band) != 2 or not all(isinstance(b, (int, float)) and math.isfinite(b)
-                                         for b in band) or not 0 < band[0] < band[1]:
-                raise ValueError(f'band_hz must be [f_lo, f_hi] with 0 < f_lo < f_hi, '
-                                 f'got {self.band_hz!r}')
+            if (
+                len(band) != 2
+                or not all(isinstance(b, (int, float)) and math.isfinite(b) for b in band)
+                or not 0 < band[0] < band[1]
+            ):
+                raise ValueError(
+                    f'band_hz must be [f_lo, f_hi] with 0 < f_lo < f_hi, got {self.band_hz!r}'
+                )
 
     def replace(self, **changes) -> 'EstimatorConfig':
         """A validated copy with ``changes`` applied."""

@@ -22,6 +22,7 @@ early, poorly determined ratios out of the convergence test; ``min_time`` (eps o
 floor in seconds for noisy signals, where the first milliseconds of ``n_f / d_f`` are dominated by
 noise (d ~ t^4).
 """
+
 from __future__ import annotations
 
 import math
@@ -34,11 +35,25 @@ from . import kernel as K
 from .config import EstimatorConfig
 
 #: counter names, in the order of :mod:`vib_estimator.core.kernel`'s counter array
-COUNTER_NAMES = ('received', 'used', 'skipped_non_finite', 'skipped_duplicate',
-                 'skipped_out_of_order', 'time_jump_resets', 'gap_resets', 'rejected_at_rest',
-                 'rejected_fit', 'rejected_nyquist', 'max_window_resets', 'estimates',
-                 'rejected_damping', 'rejected_inconsistent', 'gaps', 'samples_lost',
-                 'skipped_outlier')
+COUNTER_NAMES = (
+    'received',
+    'used',
+    'skipped_non_finite',
+    'skipped_duplicate',
+    'skipped_out_of_order',
+    'time_jump_resets',
+    'gap_resets',
+    'rejected_at_rest',
+    'rejected_fit',
+    'rejected_nyquist',
+    'max_window_resets',
+    'estimates',
+    'rejected_damping',
+    'rejected_inconsistent',
+    'gaps',
+    'samples_lost',
+    'skipped_outlier',
+)
 
 
 def as_series(t: Sequence[float], y: Sequence[float]) -> Tuple[np.ndarray, np.ndarray]:
@@ -84,11 +99,19 @@ class Estimate:
         return 2 * math.pi * self.frequency_hz
 
     def as_dict(self) -> Dict[str, float]:
-        return {'t': self.t, 'frequency_hz': self.frequency_hz, 'omega_rad_s': self.omega,
-                'convergence_time_s': self.convergence_time, 'samples': self.samples,
-                'fit': self.fit, 'amplitude': self.amplitude, 'damping': self.damping,
-                'frequency_std_hz': self.frequency_std_hz, 'damping_std': self.damping_std,
-                'mode': self.mode}
+        return {
+            't': self.t,
+            'frequency_hz': self.frequency_hz,
+            'omega_rad_s': self.omega,
+            'convergence_time_s': self.convergence_time,
+            'samples': self.samples,
+            'fit': self.fit,
+            'amplitude': self.amplitude,
+            'damping': self.damping,
+            'frequency_std_hz': self.frequency_std_hz,
+            'damping_std': self.damping_std,
+            'mode': self.mode,
+        }
 
 
 @dataclass
@@ -109,8 +132,13 @@ class EstimateArrays:
     @classmethod
     def from_rows(cls, rows: np.ndarray, mode: int = 0) -> 'EstimateArrays':
         """Columns of the kernel's estimate rows, all of one ``mode``."""
-        return cls(*(rows[:, i].astype(np.int64) if i == K.O_SAMPLES else rows[:, i].copy()
-                     for i in range(K.N_OUT)), np.full(len(rows), mode, dtype=np.int64))
+        return cls(
+            *(
+                rows[:, i].astype(np.int64) if i == K.O_SAMPLES else rows[:, i].copy()
+                for i in range(K.N_OUT)
+            ),
+            np.full(len(rows), mode, dtype=np.int64),
+        )
 
     @classmethod
     def concatenate(cls, parts: Sequence['EstimateArrays']) -> 'EstimateArrays':
@@ -127,10 +155,21 @@ class EstimateArrays:
 
     def to_list(self) -> List[Estimate]:
         ints = {K.O_SAMPLES, K.N_OUT}
-        return [Estimate(*(int(v) if i in ints else float(v) for i, v in enumerate(row)))
-                for row in zip(self.t, self.frequency_hz, self.convergence_time, self.samples,
-                               self.fit, self.amplitude, self.damping, self.frequency_std_hz,
-                               self.damping_std, self.mode)]
+        return [
+            Estimate(*(int(v) if i in ints else float(v) for i, v in enumerate(row)))
+            for row in zip(
+                self.t,
+                self.frequency_hz,
+                self.convergence_time,
+                self.samples,
+                self.fit,
+                self.amplitude,
+                self.damping,
+                self.frequency_std_hz,
+                self.damping_std,
+                self.mode,
+            )
+        ]
 
 
 class FrequencyEstimator:
@@ -152,7 +191,7 @@ class FrequencyEstimator:
         self._c = np.zeros(K.N_COUNTERS, dtype=np.int64)
         self._seg = np.zeros((2, config.buffer_samples))
         self._row = np.zeros((1, K.N_OUT))
-        self._t1 = np.zeros(1)      # the streaming path's sample, fed to the batch kernel
+        self._t1 = np.zeros(1)  # the streaming path's sample, fed to the batch kernel
         self._y1 = np.zeros(1)
         self._optional = K.optional_features(self._p)
         self.restart()
@@ -169,8 +208,9 @@ class FrequencyEstimator:
     def reset(self) -> None:
         """Start a new estimation segment at the last sample, as after a convergence."""
         if self._c[K.C_HIST_N] >= K.NH:
-            K.reset_segment(self._s, self._c, self._seg, self._s[K.S_TLAST],
-                            self._s[K.S_HY + K.NH - 1])
+            K.reset_segment(
+                self._s, self._c, self._seg, self._s[K.S_TLAST], self._s[K.S_HY + K.NH - 1]
+            )
 
     @property
     def counters(self) -> Dict[str, int]:
@@ -195,10 +235,12 @@ class FrequencyEstimator:
         # the batch kernel over one sample: one compiled entry point for both paths
         self._t1[0] = t
         self._y1[0] = y
-        if K.run(self._p, self._s, self._c, self._seg, self._t1, self._y1, self._row, 0,
-                 self._optional)[0]:
-            return Estimate(*(int(v) if i == K.O_SAMPLES else float(v)
-                              for i, v in enumerate(self._row[0])))
+        if K.run(
+            self._p, self._s, self._c, self._seg, self._t1, self._y1, self._row, 0, self._optional
+        )[0]:
+            return Estimate(
+                *(int(v) if i == K.O_SAMPLES else float(v) for i, v in enumerate(self._row[0]))
+            )
         return None
 
     def process(self, t: Sequence[float], y: Sequence[float]) -> EstimateArrays:
@@ -209,8 +251,9 @@ class FrequencyEstimator:
         size = max(16, len(t) // 100)
         while True:
             out = np.empty((size, K.N_OUT))
-            n, start = K.run(self._p, self._s, self._c, self._seg, t, y, out, start,
-                             self._optional)
+            n, start = K.run(
+                self._p, self._s, self._c, self._seg, t, y, out, start, self._optional
+            )
             chunks.append(out[:n])
             if start >= len(t):
                 break
@@ -219,7 +262,8 @@ class FrequencyEstimator:
         return EstimateArrays.from_rows(rows)
 
 
-def estimate(t: Sequence[float], y: Sequence[float],
-             config: EstimatorConfig = EstimatorConfig()) -> EstimateArrays:
+def estimate(
+    t: Sequence[float], y: Sequence[float], config: EstimatorConfig = EstimatorConfig()
+) -> EstimateArrays:
     """Batch convenience: run a fresh estimator over a whole record."""
     return FrequencyEstimator(config).process(t, y)

@@ -13,6 +13,7 @@ the right choice for a function called from one place: the caller's code is buil
 once instead of once per level of the call tree (numba links each callee's code into its caller
 and optimises and emits the whole again).
 """
+
 from __future__ import annotations
 
 from numba import njit, types
@@ -35,8 +36,7 @@ def jit(fn=None, **options):
     template = dispatcher.get_call_template
 
     def get_call_template(args, kws):
-        return template(tuple(_plain(a) for a in args),
-                        {k: _plain(v) for k, v in kws.items()})
+        return template(tuple(_plain(a) for a in args), {k: _plain(v) for k, v in kws.items()})
 
     dispatcher.get_call_template = get_call_template
     return dispatcher

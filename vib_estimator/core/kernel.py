@@ -47,6 +47,7 @@ Mathematics (equation numbers are those of Trapero, Sira-Ramirez & Feliu):
   higher modes) followed by a 2nd-order Butterworth high-pass at ``f_lo`` (offset and drift), all
   with the same exact discretisation; it is never reset by an estimate.
 """
+
 from __future__ import annotations
 
 import math
@@ -60,52 +61,98 @@ from .jit import jit
 from .uncertainty import MODEL_BIASED, MODEL_DAMPED, MODEL_SINUSOID, TWO_PI
 
 # ---- parameter array layout (float64) -------------------------------------------------------
-P_MODEL, P_WC, P_ZC, P_M, P_TOL, P_EPS, P_MAXWIN, P_BAND, P_WLO, P_WHI, P_MINAMP, P_MINFIT, \
-    P_MAXGAP, P_MINSAMP, P_MINPER, P_FILTER, P_ONESIDED, P_RULE, P_MAXDAMP, P_REFINE, \
-    P_TARGET, P_CONSIST, P_GAPN, P_OUTLIER, N_PARAMS = range(25)   # N_*: the slots' number
+(
+    P_MODEL,
+    P_WC,
+    P_ZC,
+    P_M,
+    P_TOL,
+    P_EPS,
+    P_MAXWIN,
+    P_BAND,
+    P_WLO,
+    P_WHI,
+    P_MINAMP,
+    P_MINFIT,
+    P_MAXGAP,
+    P_MINSAMP,
+    P_MINPER,
+    P_FILTER,
+    P_ONESIDED,
+    P_RULE,
+    P_MAXDAMP,
+    P_REFINE,
+    P_TARGET,
+    P_CONSIST,
+    P_GAPN,
+    P_OUTLIER,
+    N_PARAMS,
+) = range(25)  # N_*: the slots' number
 
 # ---- counter array layout (int64) -----------------------------------------------------------
-(C_RECEIVED, C_USED, C_NONFINITE, C_DUPLICATE, C_OUT_OF_ORDER, C_TIME_JUMP, C_GAP, C_REST,
- C_FIT, C_NYQUIST, C_MAX_WINDOW, C_ESTIMATES, C_DAMPING, C_INCONSISTENT, C_GAPS, C_LOST,
- C_OUTLIER, C_SEG_N, C_HIST_N, C_MA_N, C_OUTLIER_RUN, C_SCALE_N, N_COUNTERS) = range(23)
+(
+    C_RECEIVED,
+    C_USED,
+    C_NONFINITE,
+    C_DUPLICATE,
+    C_OUT_OF_ORDER,
+    C_TIME_JUMP,
+    C_GAP,
+    C_REST,
+    C_FIT,
+    C_NYQUIST,
+    C_MAX_WINDOW,
+    C_ESTIMATES,
+    C_DAMPING,
+    C_INCONSISTENT,
+    C_GAPS,
+    C_LOST,
+    C_OUTLIER,
+    C_SEG_N,
+    C_HIST_N,
+    C_MA_N,
+    C_OUTLIER_RUN,
+    C_SCALE_N,
+    N_COUNTERS,
+) = range(23)
 
 # ---- state array layout (float64) -----------------------------------------------------------
-NH = 8              # samples in the interpolation stencil (degree-7 rule)
-S_T0 = 0            # time origin of the current segment
-S_TLAST = 1         # time of the last accepted sample
-S_HRUN = 2          # running sample interval (kept across restarts: it describes the stream)
-S_YC = 3            # running centre of the raw signal (outlier test), kept across restarts
-S_YR = 4            # running (decaying) peak of |y - centre|, kept across restarts
-S_HT = 5            # NH last sample times (oldest first)
-S_HY = S_HT + NH    # NH last (prefiltered) sample values
-S_MOM = S_HY + NH   # moments M0..M4
-S_NF = S_MOM + 5    # low-pass state of n: x5, x6 (Eq. 11)
-S_DF = S_NF + 2     # low-pass state of d: x7, x8
+NH = 8  # samples in the interpolation stencil (degree-7 rule)
+S_T0 = 0  # time origin of the current segment
+S_TLAST = 1  # time of the last accepted sample
+S_HRUN = 2  # running sample interval (kept across restarts: it describes the stream)
+S_YC = 3  # running centre of the raw signal (outlier test), kept across restarts
+S_YR = 4  # running (decaying) peak of |y - centre|, kept across restarts
+S_HT = 5  # NH last sample times (oldest first)
+S_HY = S_HT + NH  # NH last (prefiltered) sample values
+S_MOM = S_HY + NH  # moments M0..M4
+S_NF = S_MOM + 5  # low-pass state of n: x5, x6 (Eq. 11)
+S_DF = S_NF + 2  # low-pass state of d: x7, x8
 S_NPREV = S_DF + 2  # n, d at the previous sample (first-order hold)
 S_DPREV = S_NPREV + 1
 S_QF = S_DPREV + 1  # damped model: low-pass state of q (2) and q at the previous sample
 S_QPREV = S_QF + 2
 S_INT = S_QPREV + 1  # damped model: running integrals of n_f, q_f, d_f (the second equation)
-S_BAND = S_INT + 3       # band-pass: 3 sections x (2 states, previous input)
-S_CACHE_H = S_BAND + 9   # step for which the discretisations below were computed
-S_DISC = S_CACHE_H + 1   # 4 sections x 8 numbers (Phi 2x2, G0 2, G1 2): Eq. 11, then band
-S_SCR = S_DISC + 32     # scratch for the interval rule: nodes, differences, coefficients
-S_IM = S_SCR + 3 * NH    # the rule's integrals I_0..I_4 of the newest interval
-S_W = S_IM + 5           # cached weights of the rule on a uniform stencil (5 x NH)
-S_WH = S_W + 5 * NH      # step of the cached weights (-1: none)
-S_UNIT = S_WH + 1        # scratch unit vector
-S_FLAST = S_UNIT + NH    # long windows: the segment's first converged half-period estimate
-S_DLAST = S_FLAST + 1    # ... and its damping ratio (damped model), where the fit starts
-S_NEXT = S_DLAST + 1     # segment length at which target_std_rel is checked next
-S_RES = S_NEXT + 1       # result of the refinement (core.uncertainty's layout)
+S_BAND = S_INT + 3  # band-pass: 3 sections x (2 states, previous input)
+S_CACHE_H = S_BAND + 9  # step for which the discretisations below were computed
+S_DISC = S_CACHE_H + 1  # 4 sections x 8 numbers (Phi 2x2, G0 2, G1 2): Eq. 11, then band
+S_SCR = S_DISC + 32  # scratch for the interval rule: nodes, differences, coefficients
+S_IM = S_SCR + 3 * NH  # the rule's integrals I_0..I_4 of the newest interval
+S_W = S_IM + 5  # cached weights of the rule on a uniform stencil (5 x NH)
+S_WH = S_W + 5 * NH  # step of the cached weights (-1: none)
+S_UNIT = S_WH + 1  # scratch unit vector
+S_FLAST = S_UNIT + NH  # long windows: the segment's first converged half-period estimate
+S_DLAST = S_FLAST + 1  # ... and its damping ratio (damped model), where the fit starts
+S_NEXT = S_DLAST + 1  # segment length at which target_std_rel is checked next
+S_RES = S_NEXT + 1  # result of the refinement (core.uncertainty's layout)
 S_WORK = S_RES + U.N_RESULT  # the refinement's scratch
-NBJ = 4                      # band std: prefilter states of the Jacobian's 4 columns
+NBJ = 4  # band std: prefilter states of the Jacobian's 4 columns
 S_BANDJ = S_WORK + U.N_WORK  # ... (3 sections x (2 states, previous input) each)
-S_JROW = S_BANDJ + 9 * NBJ   # ... the inputs of one step
-S_TAILW = S_JROW + NBJ       # ... the Gramian of the prefilter's free response (9 x 9)
-S_TAILH = S_TAILW + 81       # ... the step it was computed for, and rho(0) = sum g^2
-S_FPREV = S_TAILH + 2        # ``consistency``: the estimate of the segment just before (0: none)
-S_MA = S_FPREV + 1           # moving-average ring (2M+1 values) starts here
+S_JROW = S_BANDJ + 9 * NBJ  # ... the inputs of one step
+S_TAILW = S_JROW + NBJ  # ... the Gramian of the prefilter's free response (9 x 9)
+S_TAILH = S_TAILW + 81  # ... the step it was computed for, and rho(0) = sum g^2
+S_FPREV = S_TAILH + 2  # ``consistency``: the estimate of the segment just before (0: none)
+S_MA = S_FPREV + 1  # moving-average ring (2M+1 values) starts here
 N_STATE_FIXED = S_MA
 
 # ---- estimate row layout --------------------------------------------------------------------
@@ -135,8 +182,13 @@ MAX_BAND_TAIL = 1 << 22
 #: Butterworth high-pass at f_lo
 BAND_DAMPING = (math.cos(math.pi / 8), math.cos(3 * math.pi / 8), math.sqrt(0.5))
 #: C(k, j) for the moments M_0..M_4 (a table: no division per sample)
-BINOMIAL = ((1.0, 0.0, 0.0, 0.0, 0.0), (1.0, 1.0, 0.0, 0.0, 0.0), (1.0, 2.0, 1.0, 0.0, 0.0),
-            (1.0, 3.0, 3.0, 1.0, 0.0), (1.0, 4.0, 6.0, 4.0, 1.0))
+BINOMIAL = (
+    (1.0, 0.0, 0.0, 0.0, 0.0),
+    (1.0, 1.0, 0.0, 0.0, 0.0),
+    (1.0, 2.0, 1.0, 0.0, 0.0),
+    (1.0, 3.0, 3.0, 1.0, 0.0),
+    (1.0, 4.0, 6.0, 4.0, 1.0),
+)
 
 
 @jit
@@ -210,8 +262,8 @@ def reset_segment(s, c, seg, t0, y0):
     s[S_T0] = t0
     seg[0, 0] = 0.0
     seg[1, 0] = y0
-    s[S_MOM:S_MOM + 5] = 0.0
-    s[S_NF:S_INT + 3] = 0.0
+    s[S_MOM : S_MOM + 5] = 0.0
+    s[S_NF : S_INT + 3] = 0.0
     s[S_FLAST] = 0.0
     s[S_DLAST] = 0.0
     s[S_NEXT] = 0.0
@@ -351,16 +403,22 @@ def _fit(seg, n, omega):
     if sstot <= 0.0:
         return -1.0, 0.0
     # Cramer's rule on the 3x3 normal equations
-    det = (s11 * (s22 * s33 - s23 * s23) - s12 * (s12 * s33 - s23 * s13)
-           + s13 * (s12 * s23 - s22 * s13))
+    det = (
+        s11 * (s22 * s33 - s23 * s23)
+        - s12 * (s12 * s33 - s23 * s13)
+        + s13 * (s12 * s23 - s22 * s13)
+    )
     if abs(det) <= 1e-12 * s33 * s33 * s33:
         return 0.0, 0.0
-    ca = (r1 * (s22 * s33 - s23 * s23) - s12 * (r2 * s33 - s23 * r3)
-          + s13 * (r2 * s23 - s22 * r3)) / det
-    cb = (s11 * (r2 * s33 - r3 * s23) - r1 * (s12 * s33 - s23 * s13)
-          + s13 * (s12 * r3 - r2 * s13)) / det
-    cc = (s11 * (s22 * r3 - s23 * r2) - s12 * (s12 * r3 - r2 * s13)
-          + r1 * (s12 * s23 - s22 * s13)) / det
+    ca = (
+        r1 * (s22 * s33 - s23 * s23) - s12 * (r2 * s33 - s23 * r3) + s13 * (r2 * s23 - s22 * r3)
+    ) / det
+    cb = (
+        s11 * (r2 * s33 - r3 * s23) - r1 * (s12 * s33 - s23 * s13) + s13 * (s12 * r3 - r2 * s13)
+    ) / det
+    cc = (
+        s11 * (s22 * r3 - s23 * r2) - s12 * (s12 * r3 - r2 * s13) + r1 * (s12 * s23 - s22 * s13)
+    ) / det
     # least squares: residual sum of squares = y'y - beta' X'y (y centred, so y'y = sstot)
     ssres = sstot - (ca * r1 + cb * r2 + cc * r3)
     return 1.0 - ssres / sstot, math.sqrt(ca * ca + cb * cb)
@@ -506,8 +564,9 @@ def _update_discretisations(p, s, h):
     discretise(p[P_WC], p[P_ZC], h, s, S_DISC)
     if p[P_BAND] > 0.0:
         for k in range(3):
-            discretise(p[P_WHI] if k < 2 else p[P_WLO], BAND_DAMPING[k], h, s,
-                        S_DISC + 8 * (k + 1))
+            discretise(
+                p[P_WHI] if k < 2 else p[P_WLO], BAND_DAMPING[k], h, s, S_DISC + 8 * (k + 1)
+            )
     s[S_CACHE_H] = h
 
 
@@ -605,7 +664,7 @@ def _converged(m, one_sided, tol, s, c, f):
     """
     size = 2 * m + 1
     k = c[C_MA_N]
-    newest = k % size            # ring positions by wrapping, not by a modulo per term
+    newest = k % size  # ring positions by wrapping, not by a modulo per term
     s[S_MA + newest] = f
     c[C_MA_N] = k + 1
     if k + 1 < size:
@@ -683,9 +742,14 @@ def _finite_estimate(c, f, r2, amp, res):
     the estimate is held back, counted with the fit (``rejected_fit``): a NaN R^2 compares
     false against ``min_fit`` and would pass the quality gate.
     """
-    if math.isfinite(f) and math.isfinite(r2) and math.isfinite(amp) and \
-            not math.isinf(res[U.R_FSTD]) and not math.isinf(res[U.R_DSTD]) and \
-            not math.isinf(res[U.R_DAMP]):
+    if (
+        math.isfinite(f)
+        and math.isfinite(r2)
+        and math.isfinite(amp)
+        and not math.isinf(res[U.R_FSTD])
+        and not math.isinf(res[U.R_DSTD])
+        and not math.isinf(res[U.R_DAMP])
+    ):
         return True
     c[C_FIT] += 1
     return False
@@ -746,8 +810,9 @@ def _long_window_spanned(p, s, c, m, one_sided, model, tau, f, damping):
     if s[S_FLAST] == 0.0:
         if _converged(m, one_sided, p[P_TOL], s, c, f) and tau * f >= 0.5:
             s[S_FLAST] = f
-            s[S_DLAST] = min(max(damping, -p[P_MAXDAMP]), p[P_MAXDAMP]) \
-                if model == MODEL_DAMPED else 0.0
+            s[S_DLAST] = (
+                min(max(damping, -p[P_MAXDAMP]), p[P_MAXDAMP]) if model == MODEL_DAMPED else 0.0
+            )
         return False
     return tau * s[S_FLAST] >= p[P_MINPER]
 
@@ -765,7 +830,7 @@ def step(p, s, c, seg, t, y, out, row, optional=None):
     if c[C_HIST_N] == 0:
         _first_sample(p, s, c, t, y)
         return 0
-    h = t - s[S_HT + NH - 1]      # the newest sample of the stencil is the previous one
+    h = t - s[S_HT + NH - 1]  # the newest sample of the stencil is the previous one
     if abs(h - s[S_CACHE_H]) > 1e-9 * h:
         _update_discretisations(p, s, h)
     if p[P_BAND] > 0.0:
@@ -774,10 +839,12 @@ def step(p, s, c, seg, t, y, out, row, optional=None):
         return 0
     tau = t - s[S_T0]
     model = int(p[P_MODEL])
-    _interval_moments(s, 4 if model == MODEL_BIASED else 3, s[S_HT + NH - 2] - s[S_T0], h,
-                      int(p[P_RULE]))
-    num, den = _numerator_denominator(model, tau, y, s[S_MOM], s[S_MOM + 1], s[S_MOM + 2],
-                                      s[S_MOM + 3], s[S_MOM + 4])
+    _interval_moments(
+        s, 4 if model == MODEL_BIASED else 3, s[S_HT + NH - 2] - s[S_T0], h, int(p[P_RULE])
+    )
+    num, den = _numerator_denominator(
+        model, tau, y, s[S_MOM], s[S_MOM + 1], s[S_MOM + 2], s[S_MOM + 3], s[S_MOM + 4]
+    )
     _invariant_filter(p[P_FILTER] > 0.0, s, model, num, den, tau, h)
     nseg = c[C_SEG_N]
     if _store_sample(p, s, c, seg, t, tau, y):
@@ -792,10 +859,11 @@ def step(p, s, c, seg, t, y, out, row, optional=None):
     m = int(p[P_M])
     one_sided = p[P_ONESIDED] != 0.0
     n_fit = min(nseg + 1, seg.shape[1])
-    local_start = True          # the refinement starts at this segment's own algebraic estimate
+    local_start = True  # the refinement starts at this segment's own algebraic estimate
     if p[P_TARGET] > 0.0:
-        if tau * f < p[P_MINPER] or not _target_reached_if(optional, p, s, seg, n_fit, model,
-                                                                 f, damping):
+        if tau * f < p[P_MINPER] or not _target_reached_if(
+            optional, p, s, seg, n_fit, model, f, damping
+        ):
             return 0
     elif p[P_REFINE] > 0.0 and p[P_MINPER] >= 1.0:
         if not _long_window_if(optional, p, s, c, m, one_sided, model, tau, f, damping):
@@ -804,20 +872,30 @@ def step(p, s, c, seg, t, y, out, row, optional=None):
     # the segment must span a fraction of the period it estimates
     elif not _converged(m, one_sided, p[P_TOL], s, c, f) or tau * f < p[P_MINPER]:
         return 0
-    res = s[S_RES:S_RES + U.N_RESULT]
+    res = s[S_RES : S_RES + U.N_RESULT]
     _refine(p, s, seg, n_fit, model, f, damping, res, optional)
     start, f = f, res[U.R_F]
     consistent = True
     if p[P_REFINE] > 0.0 and math.isfinite(res[U.R_FIT]):
-        r2, amp = res[U.R_FIT], res[U.R_AMP]     # the refined model's own residual
+        r2, amp = res[U.R_FIT], res[U.R_AMP]  # the refined model's own residual
         allowed = max(MAX_REFINE_MOVE * res[U.R_FSTD], MIN_REFINE_MOVE_REL * f)
         consistent = not local_start or abs(f - start) <= allowed
     else:
         r2, amp = _fit(seg, n_fit, TWO_PI * f)
     inconsistent_before = c[C_INCONSISTENT]
-    published = _finite_estimate(c, f, r2, amp, res) and \
-        _quality_gate(p, c, model, f, res[U.R_DAMP], h, r2, amp, consistent,
-                      _spread(seg, n_fit), _confirmed(p, s, f))
+    published = _finite_estimate(c, f, r2, amp, res) and _quality_gate(
+        p,
+        c,
+        model,
+        f,
+        res[U.R_DAMP],
+        h,
+        r2,
+        amp,
+        consistent,
+        _spread(seg, n_fit),
+        _confirmed(p, s, f),
+    )
     _chain(s, c, f, published, inconsistent_before)
     if published:
         out[row, O_T] = t
@@ -848,12 +926,12 @@ def _tail_gramian(p, s):
     a = np.empty((9, 9))
     v = np.empty(9)
     for k in range(9):
-        s[base:base + 9] = 0.0
+        s[base : base + 9] = 0.0
         s[base + k] = 1.0
         v[k] = _prefilter(p, s, 0.0, base)
         for i in range(9):
             a[i, k] = s[base + i]
-    w = s[S_TAILW:S_TAILW + 81].reshape((9, 9))
+    w = s[S_TAILW : S_TAILW + 81].reshape((9, 9))
     w[:, :] = 0.0
     peak = 0.0
     nxt = np.empty(9)
@@ -873,7 +951,7 @@ def _tail_gramian(p, s):
             nxt[j] = acc
         for i in range(9):
             v[i] = nxt[i]
-    s[base:base + 9] = 0.0
+    s[base : base + 9] = 0.0
     g0 = _prefilter(p, s, 1.0, base)
     s[S_TAILH] = s[S_CACHE_H]
     s[S_TAILH + 1] = g0 * g0 + _quadratic(w, s, base, base)
@@ -900,20 +978,20 @@ def _band_std(p, s, seg, n, model, res):
     latest step); :func:`core.uncertainty.coloured_std`.
     """
     _tail_gramian(p, s)
-    work = s[S_WORK:S_WORK + U.N_WORK]
-    th, _, _, gram, _, _, _, _ = U._workspace(work)      # J^T J's scratch, free after the fit
+    work = s[S_WORK : S_WORK + U.N_WORK]
+    th, _, _, gram, _, _, _, _ = U._workspace(work)  # J^T J's scratch, free after the fit
     npar = 3 if model == MODEL_SINUSOID else 4
-    s[S_BANDJ:S_JROW + NBJ] = 0.0
+    s[S_BANDJ : S_JROW + NBJ] = 0.0
     gram[:, :] = 0.0
     tc = 0.5 * (seg[0, 0] + seg[0, n - 1])
     for r in range(n):
-        U.jacobian_row(model, th, seg[0, n - 1 - r] - tc, s[S_JROW:S_JROW + 4])
+        U.jacobian_row(model, th, seg[0, n - 1 - r] - tc, s[S_JROW : S_JROW + 4])
         for col in range(npar):
             s[S_JROW + col] = _prefilter(p, s, s[S_JROW + col], S_BANDJ + 9 * col)
         for i in range(npar):
             for j in range(npar):
                 gram[i, j] += s[S_JROW + i] * s[S_JROW + j]
-    w = s[S_TAILW:S_TAILW + 81].reshape((9, 9))
+    w = s[S_TAILW : S_TAILW + 81].reshape((9, 9))
     for i in range(npar):
         for j in range(npar):
             gram[i, j] += _quadratic(w, s, S_BANDJ + 9 * i, S_BANDJ + 9 * j)
@@ -958,12 +1036,15 @@ def _target_reached_if(optional, p, s, seg, n, model, f, damping):
 @overload(_target_reached_if, inline='always')
 def _target_reached_if_typed(optional, p, s, seg, n, model, f, damping):
     if _unused(optional):
+
         def missing(optional, p, s, seg, n, model, f, damping):
             _missing_optional()
             return False
+
         return missing
     return lambda optional, p, s, seg, n, model, f, damping: _target_reached(
-        p, s, seg, n, model, f, damping, optional)
+        p, s, seg, n, model, f, damping, optional
+    )
 
 
 def _long_window_if(optional, p, s, c, m, one_sided, model, tau, f, damping):
@@ -973,12 +1054,15 @@ def _long_window_if(optional, p, s, c, m, one_sided, model, tau, f, damping):
 @overload(_long_window_if, inline='always')
 def _long_window_if_typed(optional, p, s, c, m, one_sided, model, tau, f, damping):
     if _unused(optional):
+
         def missing(optional, p, s, c, m, one_sided, model, tau, f, damping):
             _missing_optional()
             return False
+
         return missing
-    return lambda optional, p, s, c, m, one_sided, model, tau, f, damping: \
-        _long_window_spanned(p, s, c, m, one_sided, model, tau, f, damping)
+    return lambda optional, p, s, c, m, one_sided, model, tau, f, damping: _long_window_spanned(
+        p, s, c, m, one_sided, model, tau, f, damping
+    )
 
 
 @jit(inline='always')
@@ -997,7 +1081,7 @@ def _fit_with_std(p, s, seg, n, model, f, damping, iterations, res, optional):
     coloured-noise std, :func:`_band_std`) into ``res``; False if no fit is possible."""
     w0, sigma0 = _start(model, f, damping)
     res[:] = math.nan
-    if not U.refine(model, seg, n, w0, sigma0, iterations, res, s[S_WORK:S_WORK + U.N_WORK]):
+    if not U.refine(model, seg, n, w0, sigma0, iterations, res, s[S_WORK : S_WORK + U.N_WORK]):
         return False
     if p[P_BAND] > 0.0:
         _band_std_if(optional, p, s, seg, n, model, res)
@@ -1013,8 +1097,10 @@ def _refine(p, s, seg, n, model, f, damping, res, optional):
     then judges the refined frequency).
     """
     iterations = int(p[P_REFINE])
-    if not _fit_with_std(p, s, seg, n, model, f, damping, iterations, res, optional) or \
-            iterations == 0:
+    if (
+        not _fit_with_std(p, s, seg, n, model, f, damping, iterations, res, optional)
+        or iterations == 0
+    ):
         res[U.R_F] = f
         res[U.R_DAMP] = damping
 
@@ -1030,9 +1116,11 @@ def _target_reached(p, s, seg, n, model, f, damping, optional):
     if n < s[S_NEXT]:
         return False
     s[S_NEXT] = max(n + 1.0, n * (1.0 + 1.0 / 16.0)) if n >= 64 else n + 1.0
-    res = s[S_RES:S_RES + U.N_RESULT]
-    return _fit_with_std(p, s, seg, n, model, f, damping, 0, res, optional) and \
-        res[U.R_FSTD] <= p[P_TARGET] * f
+    res = s[S_RES : S_RES + U.N_RESULT]
+    return (
+        _fit_with_std(p, s, seg, n, model, f, damping, 0, res, optional)
+        and res[U.R_FSTD] <= p[P_TARGET] * f
+    )
 
 
 @jit

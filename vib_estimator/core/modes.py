@@ -56,6 +56,7 @@ How the modes are found and estimated (everything compiled, one call per sample)
 
 Streaming and batch run the same compiled step, so they give the same floats.
 """
+
 from __future__ import annotations
 
 import math
@@ -63,6 +64,7 @@ from dataclasses import dataclass
 from typing import Dict, List, Sequence, Union
 
 import numpy as np
+
 from .ambient import AmbientEstimator
 from .config import EstimatorConfig
 from .estimator import COUNTER_NAMES, Estimate, EstimateArrays, FrequencyEstimator, as_series
@@ -70,80 +72,129 @@ from .jit import jit
 from .kernel import BAND_DAMPING, advance, discretise
 from .subspace import N_R, R_AMP, R_ENERGY, R_NU, R_ZETA, analyse, init_subspace
 
-KMAX = 8                 # most modes a tracker follows (the range of ``modes``)
-NLEV = 8                 # decimation levels: rates fs .. fs / 128
-NS = 2 * NLEV            # scales
-M_A, M_B = 48, 68        # window lengths of the even and odd scales (level samples)
-NQ = M_B // 3 + 1        # rows of a scale's subspace
-PCOL = 14                # most subspace columns
-HOP = 12                 # level samples between two analyses of a scale a mode publishes from,
-HOP_IDLE = 96            # ... of the others at levels >= 1,
-HOP_TOP = 384            # ... of the others at level 0 (above 0.1 fs only level 0 counts a pole)
-DEC_CUTOFF = 0.12        # anti-alias low-pass before each decimation by 2, cycles per sample
-EIG_RATIO = 6.0          # signal eigenvalues: this factor above the noise's
-NU_HI = 0.2              # highest pole counted at a scale, cycles per level sample
-C_TRACK = 0.7            # cycles in the window for a pole to count ...
-C_DETECT = 1.0           # ... for it to become a candidate
-C_CAP = 2.0              # publishing windows hold at most this many periods of the lowest mode,
-C_CAP_CLOSE = 2.8        # ... this many when two modes lie within CLOSE_RATIO (to resolve them)
+KMAX = 8  # most modes a tracker follows (the range of ``modes``)
+NLEV = 8  # decimation levels: rates fs .. fs / 128
+NS = 2 * NLEV  # scales
+M_A, M_B = 48, 68  # window lengths of the even and odd scales (level samples)
+NQ = M_B // 3 + 1  # rows of a scale's subspace
+PCOL = 14  # most subspace columns
+HOP = 12  # level samples between two analyses of a scale a mode publishes from,
+HOP_IDLE = 96  # ... of the others at levels >= 1,
+HOP_TOP = 384  # ... of the others at level 0 (above 0.1 fs only level 0 counts a pole)
+DEC_CUTOFF = 0.12  # anti-alias low-pass before each decimation by 2, cycles per sample
+EIG_RATIO = 6.0  # signal eigenvalues: this factor above the noise's
+NU_HI = 0.2  # highest pole counted at a scale, cycles per level sample
+C_TRACK = 0.7  # cycles in the window for a pole to count ...
+C_DETECT = 1.0  # ... for it to become a candidate
+C_CAP = 2.0  # publishing windows hold at most this many periods of the lowest mode,
+C_CAP_CLOSE = 2.8  # ... this many when two modes lie within CLOSE_RATIO (to resolve them)
 CLOSE_RATIO = 1.5
-SIG_TRACK = 100.0        # energy / residual variance of a counted pole (20 dB) ...
-SIG_DETECT = 300.0       # ... and of a candidate (25 dB)
-MIN_DAMPING = -0.02      # poles growing faster than this are not modes
-MATCH_TOL = 0.06         # a pole within this of a mode is the mode's
-DUPLICATE_TOL = 0.12     # a candidate this close to a mode is not a mode of its own
-PENDING_TOL = 0.02       # a candidate seen again within this is confirmed
-HARMONIC_TOL = 0.015     # relative distance to n f of a stronger pole or mode (n = 2..9)
+SIG_TRACK = 100.0  # energy / residual variance of a counted pole (20 dB) ...
+SIG_DETECT = 300.0  # ... and of a candidate (25 dB)
+MIN_DAMPING = -0.02  # poles growing faster than this are not modes
+MATCH_TOL = 0.06  # a pole within this of a mode is the mode's
+DUPLICATE_TOL = 0.12  # a candidate this close to a mode is not a mode of its own
+PENDING_TOL = 0.02  # a candidate seen again within this is confirmed
+HARMONIC_TOL = 0.015  # relative distance to n f of a stronger pole or mode (n = 2..9)
 MAX_HARMONIC = 9
-HARMONIC_RATIO = 2.0     # a harmonic's parent is at least this much stronger (amplitude)
-SUSPECT_TOL = 0.08       # a pole this near n f of a pole SUSPECT_RATIO times stronger ...
+HARMONIC_RATIO = 2.0  # a harmonic's parent is at least this much stronger (amplitude)
+SUSPECT_TOL = 0.08  # a pole this near n f of a pole SUSPECT_RATIO times stronger ...
 SUSPECT_RATIO = 3.0
-SUSPECT_CYCLES = 5.0     # ... is a harmonic unless seen over this many cycles
-CONSISTENCY = 0.01       # a published pole lies this close to the mode's previous pole,
+SUSPECT_CYCLES = 5.0  # ... is a harmonic unless seen over this many cycles
+CONSISTENCY = 0.01  # a published pole lies this close to the mode's previous pole,
 CONSISTENCY_FIRST = 0.03  # ... a close pair's first one (undamped refinement) this close
-LOSE_PERIODS = 3.0       # a mode unseen for this many of its periods is lost
-N_STEP = 15              # intervals whose median is the grid step
-MAX_FILL = 64            # grid steps interpolated between two samples at most (else a restart)
-NPEND = 16               # candidates kept
-WAKE_BLOCK = 32          # an input block WAKE_RATIO times more energetic than the largest of the
-WAKE_RATIO = 8.0         # previous ones (fading by WAKE_FADE per block) ...
+LOSE_PERIODS = 3.0  # a mode unseen for this many of its periods is lost
+N_STEP = 15  # intervals whose median is the grid step
+MAX_FILL = 64  # grid steps interpolated between two samples at most (else a restart)
+NPEND = 16  # candidates kept
+WAKE_BLOCK = 32  # an input block WAKE_RATIO times more energetic than the largest of the
+WAKE_RATIO = 8.0  # previous ones (fading by WAKE_FADE per block) ...
 WAKE_FADE = 0.97
-WAKE_N = M_B << 3        # ... makes every scale fast for this many samples
-BLOCK = 1 << 15          # samples per block of the batch path
+WAKE_N = M_B << 3  # ... makes every scale fast for this many samples
+BLOCK = 1 << 15  # samples per block of the batch path
 
 # ---- float array b: decimators, level rings, time base -------------------------------------
-DEC_N = 22               # per level: two sections' Phi G0 G1 (16), states (2 + 2), inputs (2)
+DEC_N = 22  # per level: two sections' Phi G0 G1 (16), states (2 + 2), inputs (2)
 B_DEC = 0
 B_RING = B_DEC + DEC_N * NLEV
-B_DT = B_RING + M_B * NLEV       # step of the uniform grid, s
+B_DT = B_RING + M_B * NLEV  # step of the uniform grid, s
 B_TLAST = B_DT + 1
-B_Y = B_TLAST + 1                # last accepted input
-B_TG = B_Y + 1                   # time of the last grid sample
-B_HBUF = B_TG + 1                # the first N_STEP intervals (their median is the grid step)
-B_E = B_HBUF + 16                # energy of the current WAKE_BLOCK samples, the reference
+B_Y = B_TLAST + 1  # last accepted input
+B_TG = B_Y + 1  # time of the last grid sample
+B_HBUF = B_TG + 1  # the first N_STEP intervals (their median is the grid step)
+B_E = B_HBUF + 16  # energy of the current WAKE_BLOCK samples, the reference
 N_B = B_E + 2
 # ---- int array ic ------------------------------------------------------------------------------
-(I_N, I_NDT, I_NB, I_RECEIVED, I_USED, I_NONFINITE, I_DUPLICATE, I_OUT_OF_ORDER, I_TIME_JUMP,
- I_GAP, I_FOUND, I_LOST, I_REJ_HARM, I_REJ_NOISE, I_REJ_UNRES, I_REJ_EDGE, I_NPEND,
- I_UID, I_NOUT, I_LEV) = range(20)   # I_LEV on: NLEV samples since the (re)start, per level
-I_RET = I_LEV + NLEV              # the lost modes' counters (MODE_COUNTERS, in order)
-I_BUSY = I_RET + 4                # NS flags: a mode publishes from the scale (or soon will)
-I_WAKE = I_BUSY + NS             # input samples of fast analyses left (a change in the signal)
+(
+    I_N,
+    I_NDT,
+    I_NB,
+    I_RECEIVED,
+    I_USED,
+    I_NONFINITE,
+    I_DUPLICATE,
+    I_OUT_OF_ORDER,
+    I_TIME_JUMP,
+    I_GAP,
+    I_FOUND,
+    I_LOST,
+    I_REJ_HARM,
+    I_REJ_NOISE,
+    I_REJ_UNRES,
+    I_REJ_EDGE,
+    I_NPEND,
+    I_UID,
+    I_NOUT,
+    I_LEV,
+) = range(20)  # I_LEV on: NLEV samples since the (re)start, per level
+I_RET = I_LEV + NLEV  # the lost modes' counters (MODE_COUNTERS, in order)
+I_BUSY = I_RET + 4  # NS flags: a mode publishes from the scale (or soon will)
+I_WAKE = I_BUSY + NS  # input samples of fast analyses left (a change in the signal)
 N_I = I_WAKE + 1
 #: input counters, named as the estimator's
-STAGE_COUNTERS = {'received': I_RECEIVED, 'used': I_USED, 'skipped_non_finite': I_NONFINITE,
-                  'skipped_duplicate': I_DUPLICATE, 'skipped_out_of_order': I_OUT_OF_ORDER,
-                  'time_jump_resets': I_TIME_JUMP, 'gap_resets': I_GAP}
+STAGE_COUNTERS = {
+    'received': I_RECEIVED,
+    'used': I_USED,
+    'skipped_non_finite': I_NONFINITE,
+    'skipped_duplicate': I_DUPLICATE,
+    'skipped_out_of_order': I_OUT_OF_ORDER,
+    'time_jump_resets': I_TIME_JUMP,
+    'gap_resets': I_GAP,
+}
 #: the finder's counters (the candidates' rules)
-FINDER_COUNTERS = {'modes_found': I_FOUND, 'modes_lost': I_LOST, 'rejected_harmonic': I_REJ_HARM,
-                   'rejected_noise': I_REJ_NOISE, 'rejected_unresolved': I_REJ_UNRES,
-                   'rejected_band_edge': I_REJ_EDGE}
+FINDER_COUNTERS = {
+    'modes_found': I_FOUND,
+    'modes_lost': I_LOST,
+    'rejected_harmonic': I_REJ_HARM,
+    'rejected_noise': I_REJ_NOISE,
+    'rejected_unresolved': I_REJ_UNRES,
+    'rejected_band_edge': I_REJ_EDGE,
+}
 # ---- modes sl[k] -------------------------------------------------------------------------------
-(SL_ACTIVE, SL_UID, SL_F, SL_AMP, SL_SEEN, SL_START, SL_FIRST, SL_LAST_F, SL_LAST_T, SL_PREV,
- SL_EST, SL_INCONS, SL_HARM, SL_FIT, N_SL) = range(15)      # N_*: the slots' number
+(
+    SL_ACTIVE,
+    SL_UID,
+    SL_F,
+    SL_AMP,
+    SL_SEEN,
+    SL_START,
+    SL_FIRST,
+    SL_LAST_F,
+    SL_LAST_T,
+    SL_PREV,
+    SL_EST,
+    SL_INCONS,
+    SL_HARM,
+    SL_FIT,
+    N_SL,
+) = range(15)  # N_*: the slots' number
 #: per-mode counters: name -> column of sl (and, for the lost modes' sums, of ic after I_RET)
-MODE_COUNTERS = {'estimates': SL_EST, 'rejected_inconsistent': SL_INCONS,
-                 'rejected_harmonic': SL_HARM, 'rejected_fit': SL_FIT}
+MODE_COUNTERS = {
+    'estimates': SL_EST,
+    'rejected_inconsistent': SL_INCONS,
+    'rejected_harmonic': SL_HARM,
+    'rejected_fit': SL_FIT,
+}
 # ---- candidates pd[i]: frequency (Hz), start of the first window, last seen ---------------------
 PD_F, PD_START, PD_SEEN = range(3)
 # ---- parameters pa -----------------------------------------------------------------------------
@@ -158,8 +209,9 @@ def _levels_init(b):
     """Discretise each level's anti-alias low-pass (two Butterworth sections)."""
     for k in range(2):
         for d in range(NLEV):
-            discretise(2.0 * math.pi * DEC_CUTOFF, BAND_DAMPING[k], 1.0, b,
-                        B_DEC + DEC_N * d + 8 * k)
+            discretise(
+                2.0 * math.pi * DEC_CUTOFF, BAND_DAMPING[k], 1.0, b, B_DEC + DEC_N * d + 8 * k
+            )
 
 
 @jit
@@ -167,11 +219,11 @@ def _levels_settle(b, ic, y):
     """Every filter at rest on a constant input y; the rings start empty."""
     for d in range(NLEV):
         o = B_DEC + DEC_N * d
-        b[o + 16:o + 22] = y
+        b[o + 16 : o + 22] = y
         b[o + 17] = 0.0
         b[o + 19] = 0.0
         ic[I_LEV + d] = 0
-    b[B_E:B_E + 2] = 0.0
+    b[B_E : B_E + 2] = 0.0
     ic[I_WAKE] = 0
 
 
@@ -226,8 +278,15 @@ def _poles(b, ic, qs, lams, pa, s, pp, undamped):
     m = M_A if s % 2 == 0 else M_B
     npc = int(pa[PA_P])
     rows = np.empty((PCOL, N_R))
-    k, var, r2 = analyse(_window(b, ic, d, m), qs[s, :m // 3 + 1, :npc], lams[s, 0, :npc],
-                         lams[s, 1:], EIG_RATIO, rows, undamped)
+    k, var, r2 = analyse(
+        _window(b, ic, d, m),
+        qs[s, : m // 3 + 1, :npc],
+        lams[s, 0, :npc],
+        lams[s, 1:],
+        EIG_RATIO,
+        rows,
+        undamped,
+    )
     h = b[B_DT] * (1 << d)
     n = 0
     for i in range(k):
@@ -235,8 +294,15 @@ def _poles(b, ic, qs, lams, pa, s, pp, undamped):
         z = rows[i, R_ZETA]
         sig = rows[i, R_ENERGY] / max(var, 1e-300)
         f = nu / h
-        if nu * m < C_TRACK or nu > NU_HI or z > pa[PA_MAXDAMP] or z < MIN_DAMPING or \
-                sig < SIG_TRACK or f < pa[PA_BLO] or f > pa[PA_BHI]:
+        if (
+            nu * m < C_TRACK
+            or nu > NU_HI
+            or z > pa[PA_MAXDAMP]
+            or z < MIN_DAMPING
+            or sig < SIG_TRACK
+            or f < pa[PA_BLO]
+            or f > pa[PA_BHI]
+        ):
             continue
         pp[n, 0] = f
         pp[n, 1] = rows[i, R_AMP]
@@ -244,7 +310,7 @@ def _poles(b, ic, qs, lams, pa, s, pp, undamped):
         pp[n, 3] = nu * m
         pp[n, 4] = sig
         # the Cramer-Rao bound of a sinusoid's frequency over m samples of residual variance var
-        pp[n, 5] = math.sqrt(24.0 * var / (rows[i, R_AMP] ** 2 * m ** 3)) / (2.0 * math.pi * h)
+        pp[n, 5] = math.sqrt(24.0 * var / (rows[i, R_AMP] ** 2 * m**3)) / (2.0 * math.pi * h)
         n += 1
     return n, r2
 
@@ -265,7 +331,8 @@ def _harmonic(f, amp, cycles, pp, n, sl):
         if 2 <= r <= MAX_HARMONIC:
             off = abs(f / (r * g) - 1.0)
             if (a >= HARMONIC_RATIO * amp and off < HARMONIC_TOL) or (
-                    a >= SUSPECT_RATIO * amp and off < SUSPECT_TOL and cycles < SUSPECT_CYCLES):
+                a >= SUSPECT_RATIO * amp and off < SUSPECT_TOL and cycles < SUSPECT_CYCLES
+            ):
                 return True
     return False
 
@@ -280,8 +347,10 @@ def _cap(sl):
         if sl[j, SL_ACTIVE] != 0.0:
             fmin = min(fmin, sl[j, SL_F])
             for i in range(j):
-                if sl[i, SL_ACTIVE] != 0.0 and max(sl[i, SL_F] / sl[j, SL_F],
-                                                   sl[j, SL_F] / sl[i, SL_F]) < CLOSE_RATIO:
+                if (
+                    sl[i, SL_ACTIVE] != 0.0
+                    and max(sl[i, SL_F] / sl[j, SL_F], sl[j, SL_F] / sl[i, SL_F]) < CLOSE_RATIO
+                ):
                     cap = C_CAP_CLOSE
     return fmin, cap
 
@@ -336,8 +405,7 @@ def _publish(b, ic, sl, k, s, t, pp, i, r2, out):
     f = pp[i, 0]
     mode = 1
     for j in range(KMAX):
-        if j != k and sl[j, SL_ACTIVE] != 0.0 and sl[j, SL_FIRST] < math.inf and \
-                sl[j, SL_F] < f:
+        if j != k and sl[j, SL_ACTIVE] != 0.0 and sl[j, SL_FIRST] < math.inf and sl[j, SL_F] < f:
             mode += 1
     w = _scale_len(s)
     row = out[ic[I_NOUT]]
@@ -416,10 +484,14 @@ def _candidates(b, ic, sl, pd, pa, pp, n, used, t, s, r2, undamped, out):
         if j < ic[I_NPEND]:
             if pd[j, PD_SEEN] < t:
                 k = _admit(ic, sl, pa, f, pp[i, 1], pd[j, PD_START], t)
-                if k >= 0 and start >= pd[j, PD_START] and r2 >= pa[PA_MINFIT] and \
-                        abs(f / pd[j, PD_F] - 1.0) < _first_tol(undamped, pp, n, i):
+                if (
+                    k >= 0
+                    and start >= pd[j, PD_START]
+                    and r2 >= pa[PA_MINFIT]
+                    and abs(f / pd[j, PD_F] - 1.0) < _first_tol(undamped, pp, n, i)
+                ):
                     _publish(b, ic, sl, k, s, t, pp, i, r2, out)
-                pd[j, PD_SEEN] = -math.inf           # taken: dropped below, not as noise
+                pd[j, PD_SEEN] = -math.inf  # taken: dropped below, not as noise
             continue
         if j < NPEND:
             pd[j, PD_F] = f
@@ -445,8 +517,11 @@ def _analysis(b, ic, sl, pd, qs, lams, pa, s, t, out):
     fmin, cap = _cap(sl)
     undamped = ic[I_WAKE] > 0
     for k in range(KMAX):
-        undamped = undamped or (sl[k, SL_ACTIVE] != 0.0 and sl[k, SL_FIRST] == math.inf and
-                                _owner(b, sl, k, t, fmin, C_CAP)[0] == s)
+        undamped = undamped or (
+            sl[k, SL_ACTIVE] != 0.0
+            and sl[k, SL_FIRST] == math.inf
+            and _owner(b, sl, k, t, fmin, C_CAP)[0] == s
+        )
     n, r2 = _poles(b, ic, qs, lams, pa, s, pp, undamped)
     used = np.zeros(n, dtype=np.int64)
     for k in range(KMAX):
@@ -454,9 +529,14 @@ def _analysis(b, ic, sl, pd, qs, lams, pa, s, t, out):
             continue
         best = -1
         for i in range(n):
-            if not used[i] and abs(pp[i, 0] / sl[k, SL_F] - 1.0) < MATCH_TOL and (
-                    best < 0 or abs(pp[i, 0] / sl[k, SL_F] - 1.0)
-                    < abs(pp[best, 0] / sl[k, SL_F] - 1.0)):
+            if (
+                not used[i]
+                and abs(pp[i, 0] / sl[k, SL_F] - 1.0) < MATCH_TOL
+                and (
+                    best < 0
+                    or abs(pp[i, 0] / sl[k, SL_F] - 1.0) < abs(pp[best, 0] / sl[k, SL_F] - 1.0)
+                )
+            ):
                 best = i
         if best < 0:
             continue
@@ -473,13 +553,14 @@ def _analysis(b, ic, sl, pd, qs, lams, pa, s, t, out):
             sl[k, SL_FIT] += 1
         elif _harmonic(f, pp[best, 1], pp[best, 3], pp, n, sl):
             sl[k, SL_HARM] += 1
-        elif not abs(f / prev - 1.0) < (CONSISTENCY if sl[k, SL_FIRST] < math.inf
-                                        else _first_tol(undamped, pp, n, best)):
+        elif not abs(f / prev - 1.0) < (
+            CONSISTENCY if sl[k, SL_FIRST] < math.inf else _first_tol(undamped, pp, n, best)
+        ):
             sl[k, SL_INCONS] += 1
         else:
             _publish(b, ic, sl, k, s, t, pp, best, r2, out)
     _candidates(b, ic, sl, pd, pa, pp, n, used, t, s, r2, undamped, out)
-    ic[I_BUSY:I_BUSY + NS] = 0
+    ic[I_BUSY : I_BUSY + NS] = 0
     fmin, cap = _cap(sl)
     for k in range(KMAX):
         if sl[k, SL_ACTIVE] != 0.0 and (t - sl[k, SL_SEEN]) * sl[k, SL_F] > LOSE_PERIODS:
@@ -588,8 +669,9 @@ def _step(b, ic, sl, pd, qs, lams, pa, t, y, out):
         while b[B_TG] + h <= t + 1e-9 * h:
             tg = b[B_TG] + h
             b[B_TG] = tg
-            _feed(b, ic, sl, pd, qs, lams, pa, tg, b[B_Y] + (y - b[B_Y]) * (tg - t0) / (t - t0),
-                  out)
+            _feed(
+                b, ic, sl, pd, qs, lams, pa, tg, b[B_Y] + (y - b[B_Y]) * (tg - t0) / (t - t0), out
+            )
     b[B_TLAST] = t
     b[B_Y] = y
     ic[I_N] += 1
@@ -604,15 +686,20 @@ ROOM = KMAX * (NS + 2 * MAX_FILL)
 F_SL = N_B
 F_PD = F_SL + KMAX * N_SL
 F_LAM = F_PD + NPEND * 3
-F_PA = F_LAM + NS * 3 * PCOL    # per scale: eigenvalues, poles (re, im) of its last analysis
+F_PA = F_LAM + NS * 3 * PCOL  # per scale: eigenvalues, poles (re, im) of its last analysis
 N_F = F_PA + 7
 
 
 @jit
 def _unpack(fs):
     """The views b, sl, pd, lams, pa of the float state."""
-    return (fs[:N_B], fs[F_SL:F_PD].reshape((KMAX, N_SL)), fs[F_PD:F_LAM].reshape((NPEND, 3)),
-            fs[F_LAM:F_PA].reshape((NS, 3, PCOL)), fs[F_PA:N_F])
+    return (
+        fs[:N_B],
+        fs[F_SL:F_PD].reshape((KMAX, N_SL)),
+        fs[F_PD:F_LAM].reshape((NPEND, 3)),
+        fs[F_LAM:F_PA].reshape((NS, 3, PCOL)),
+        fs[F_PA:N_F],
+    )
 
 
 @jit
@@ -633,9 +720,9 @@ class ModeStatus:
     """What the tracker knows of one mode now."""
 
     mode: int
-    frequency_hz: float       # last published frequency (NaN before the first)
-    last_t: float             # stamp of that estimate (NaN before the first)
-    band_hz: tuple            # the frequencies whose poles are this mode's
+    frequency_hz: float  # last published frequency (NaN before the first)
+    last_t: float  # stamp of that estimate (NaN before the first)
+    band_hz: tuple  # the frequencies whose poles are this mode's
 
 
 class ModeTracker:
@@ -648,18 +735,28 @@ class ModeTracker:
         self._config = config
         self._fs = np.zeros(N_F)
         self._b, self._sl, self._pd, self._lams, pa = (
-            self._fs[:N_B], self._fs[F_SL:F_PD].reshape((KMAX, N_SL)),
-            self._fs[F_PD:F_LAM].reshape((NPEND, 3)), self._fs[F_LAM:F_PA].reshape((NS, 3, PCOL)),
-            self._fs[F_PA:N_F])
+            self._fs[:N_B],
+            self._fs[F_SL:F_PD].reshape((KMAX, N_SL)),
+            self._fs[F_PD:F_LAM].reshape((NPEND, 3)),
+            self._fs[F_LAM:F_PA].reshape((NS, 3, PCOL)),
+            self._fs[F_PA:N_F],
+        )
         self._ic = np.zeros(N_I, dtype=np.int64)
         self._qs = np.zeros((NS, NQ, PCOL))
         band = config.band_hz or (0.0, math.inf)
         # subspace columns: a pair per mode, an offset, a noise column (at least 6, at most PCOL)
         self._npc = min(max(2 * config.modes + 2, 6), M_A // 3 + 1 - 3)
-        pa[:] = (config.max_gap, config.modes, band[0], band[1], config.max_damping,
-                 config.min_fit, self._npc)
+        pa[:] = (
+            config.max_gap,
+            config.modes,
+            band[0],
+            band[1],
+            config.max_damping,
+            config.min_fit,
+            self._npc,
+        )
         self._out = np.empty((ROOM, N_O))
-        self._t1 = np.zeros(1)      # the streaming path's sample, fed to the batch kernel
+        self._t1 = np.zeros(1)  # the streaming path's sample, fed to the batch kernel
         self._y1 = np.zeros(1)
         _levels_init(self._b)
         self.restart()
@@ -678,9 +775,12 @@ class ModeTracker:
         if n == 0:
             return []
         rows = self._out[:n]
-        return [Estimate(*row[:O_SAMPLES], int(row[O_SAMPLES]), *row[O_FIT:O_MODE],
-                         mode=int(row[O_MODE]))
-                for row in rows[np.lexsort((rows[:, O_MODE], rows[:, O_T]))]]
+        return [
+            Estimate(
+                *row[:O_SAMPLES], int(row[O_SAMPLES]), *row[O_FIT:O_MODE], mode=int(row[O_MODE])
+            )
+            for row in rows[np.lexsort((rows[:, O_MODE], rows[:, O_T]))]
+        ]
 
     def process(self, t: Sequence[float], y: Sequence[float]) -> EstimateArrays:
         """Feed arrays of samples (continuing the stream); the estimates as columns, by time."""
@@ -690,19 +790,23 @@ class ModeTracker:
         i = 0
         while i < len(t):
             i = _run(self._fs, self._ic, self._qs, t, y, out, i)
-            parts.append(out[:self._ic[I_NOUT]].copy())
+            parts.append(out[: self._ic[I_NOUT]].copy())
         rows = np.concatenate(parts) if parts else np.empty((0, N_O))
         rows = rows[np.lexsort((rows[:, O_MODE], rows[:, O_T]))]
-        cols = [rows[:, j].astype(np.int64) if j in (O_SAMPLES, O_MODE) else rows[:, j].copy()
-                for j in range(N_O)]
+        cols = [
+            rows[:, j].astype(np.int64) if j in (O_SAMPLES, O_MODE) else rows[:, j].copy()
+            for j in range(N_O)
+        ]
         return EstimateArrays(*cols)
 
     # ---- what it knows -----------------------------------------------------------------------
     def _active(self) -> List[int]:
         """The slots of the modes that have published, by ascending frequency."""
         sl = self._sl
-        return sorted((k for k in range(KMAX) if sl[k, SL_ACTIVE] and sl[k, SL_FIRST] < math.inf),
-                      key=lambda k: sl[k, SL_F])
+        return sorted(
+            (k for k in range(KMAX) if sl[k, SL_ACTIVE] and sl[k, SL_FIRST] < math.inf),
+            key=lambda k: sl[k, SL_F],
+        )
 
     @property
     def counters(self) -> Dict[str, int]:
@@ -718,17 +822,24 @@ class ModeTracker:
 
     def mode_counters(self) -> Dict[int, Dict[str, int]]:
         """Each current mode's counters (its publishing rule)."""
-        return {mode: {name: int(self._sl[k, col]) for name, col in MODE_COUNTERS.items()}
-                for mode, k in enumerate(self._active(), 1)}
+        return {
+            mode: {name: int(self._sl[k, col]) for name, col in MODE_COUNTERS.items()}
+            for mode, k in enumerate(self._active(), 1)
+        }
 
     def status(self) -> List[ModeStatus]:
         """The tracked modes that have published, ascending."""
         out = []
         for mode, k in enumerate(self._active(), 1):
             f = float(self._sl[k, SL_F])
-            out.append(ModeStatus(mode, float(self._sl[k, SL_LAST_F]),
-                                  float(self._sl[k, SL_LAST_T]),
-                                  (f / (1 + MATCH_TOL), f * (1 + MATCH_TOL))))
+            out.append(
+                ModeStatus(
+                    mode,
+                    float(self._sl[k, SL_LAST_F]),
+                    float(self._sl[k, SL_LAST_T]),
+                    (f / (1 + MATCH_TOL), f * (1 + MATCH_TOL)),
+                )
+            )
         return out
 
     def reset(self) -> None:
@@ -742,8 +853,10 @@ class ModeTracker:
             if self._sl[k, SL_ACTIVE]:
                 _remove(self._ic, self._sl, k)
                 self._ic[I_LOST] -= 1
-        keep = {i: self._ic[i] for i in (*STAGE_COUNTERS.values(), *FINDER_COUNTERS.values(),
-                                         *range(I_RET, N_I))}
+        keep = {
+            i: self._ic[i]
+            for i in (*STAGE_COUNTERS.values(), *FINDER_COUNTERS.values(), *range(I_RET, N_I))
+        }
         self._ic[:] = 0
         for i, v in keep.items():
             self._ic[i] = v
@@ -753,13 +866,14 @@ class ModeTracker:
         _levels_settle(self._b, self._ic, 0.0)
         for s in range(NS):
             m = M_A if s % 2 == 0 else M_B
-            init_subspace(self._qs[s, :m // 3 + 1, :self._npc])
+            init_subspace(self._qs[s, : m // 3 + 1, : self._npc])
         self._lams[:, 0] = 0.0
         self._lams[:, 1:] = math.nan
 
 
-def create_estimator(config: EstimatorConfig) -> Union[FrequencyEstimator, ModeTracker,
-                                                       AmbientEstimator]:
+def create_estimator(
+    config: EstimatorConfig,
+) -> Union[FrequencyEstimator, ModeTracker, AmbientEstimator]:
     """The estimator of a configuration: with ``excitation`` = ambient the output-only
     identifier (:mod:`.ambient`); else one estimator (``modes`` = 0) or a mode tracker."""
     if config.excitation == 'ambient':

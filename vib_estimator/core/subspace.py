@@ -34,6 +34,7 @@ these sizes a call costs more than the arithmetic):
 :func:`analyse` chains them and writes one row per pair (``R_NU``, ``R_ZETA``, ``R_AMP``,
 ``R_ENERGY``).
 """
+
 from __future__ import annotations
 
 import math
@@ -42,16 +43,16 @@ import numpy as np
 
 from .jit import jit
 
-R_NU, R_ZETA, R_AMP, R_ENERGY, N_R = range(5)        # N_R: the slots' number
-DECAY_MAX = 12.0      # poles decaying (or growing) more than e^12 over the window are dropped
-REAL_TOL = 1e-7       # |Im z| below this: a real pole
+R_NU, R_ZETA, R_AMP, R_ENERGY, N_R = range(5)  # N_R: the slots' number
+DECAY_MAX = 12.0  # poles decaying (or growing) more than e^12 over the window are dropped
+REAL_TOL = 1e-7  # |Im z| below this: a real pole
 ROOT_ITER = 40
-ROOT_TOL = 1e-10      # Aberth steps below this: converged
-REFINE_ZETA = 0.1     # pairs damped less than this, with another within REFINE_RATIO in
-REFINE_RATIO = 1.5    # frequency (a close pair), are refined as undamped ...
+ROOT_TOL = 1e-10  # Aberth steps below this: converged
+REFINE_ZETA = 0.1  # pairs damped less than this, with another within REFINE_RATIO in
+REFINE_RATIO = 1.5  # frequency (a close pair), are refined as undamped ...
 REFINE_CYCLES = (1.0, 3.0)  # ... when they hold this many cycles in the window,
-REFINE_ITER = 4       # ... by at most this many Gauss-Newton steps,
-REFINE_STEP = 1e-7    # forward differences of this many radians per sample
+REFINE_ITER = 4  # ... by at most this many Gauss-Newton steps,
+REFINE_STEP = 1e-7  # forward differences of this many radians per sample
 #: reassociated sums (vectorised loops); no assumption about NaN or infinities
 FAST = {'reassoc', 'contract', 'nsz', 'arcp'}
 
@@ -84,8 +85,9 @@ def _descending(lam):
     for i in range(n):
         v = -lam[i]
         j = i
-        while j > 0 and (v < -lam[order[j - 1]] or (math.isnan(-lam[order[j - 1]])
-                                                     and not math.isnan(v))):
+        while j > 0 and (
+            v < -lam[order[j - 1]] or (math.isnan(-lam[order[j - 1]]) and not math.isnan(v))
+        ):
             order[j] = order[j - 1]
             j -= 1
         order[j] = i
@@ -107,7 +109,7 @@ def orthogonal_iteration(r, n, q, lam):
         for j in range(n):
             a = qt[k, j]
             for i in range(n):
-                w[k, i] += r[j, i] * a          # R is symmetric: row j of R is its column j
+                w[k, i] += r[j, i] * a  # R is symmetric: row j of R is its column j
     for k in range(npc):
         for j in range(k):
             d = 0.0
@@ -380,8 +382,10 @@ def _close_pairs(poles, m):
         if z.imag > REAL_TOL and abs(z) > 0.0:
             lz = np.log(z)
             cycles = lz.imag * m / (2.0 * math.pi)
-            if abs(lz.real) < REFINE_ZETA * abs(lz) and \
-                    REFINE_CYCLES[0] <= cycles <= REFINE_CYCLES[1]:
+            if (
+                abs(lz.real) < REFINE_ZETA * abs(lz)
+                and REFINE_CYCLES[0] <= cycles <= REFINE_CYCLES[1]
+            ):
                 light[k] = i
                 k += 1
     close = np.empty(k, dtype=np.int64)
@@ -455,7 +459,7 @@ def init_subspace(q):
     for k in range(npc):
         for i in range(n):
             q[i, k] = math.cos(math.pi * (k + 0.5) * (i + 0.5) / n)
-        acc = 0.0                   # element by element: no array expression to compile
+        acc = 0.0  # element by element: no array expression to compile
         for i in range(n):
             acc += q[i, k] ** 2
         norm = math.sqrt(acc)

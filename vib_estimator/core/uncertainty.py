@@ -48,6 +48,7 @@ variable projection sums only the linear columns, and the scratch arrays are the
 kernel's state, allocated once): a default estimate over half a period costs one projection and
 about two Gauss-Newton passes over its samples.
 """
+
 from __future__ import annotations
 
 import math
@@ -58,7 +59,7 @@ from .jit import jit
 MODEL_SINUSOID, MODEL_BIASED, MODEL_DAMPED = 0, 1, 2
 #: refine() result layout: frequency (Hz), damping ratio, their standard deviations, the fitted
 #: model's R^2 (about the segment's mean) and amplitude (at the segment's centre), and its RSS
-R_F, R_DAMP, R_FSTD, R_DSTD, R_FIT, R_AMP, R_RSS, N_RESULT = range(8)   # N_RESULT: slots
+R_F, R_DAMP, R_FSTD, R_DSTD, R_FIT, R_AMP, R_RSS, N_RESULT = range(8)  # N_RESULT: slots
 TWO_PI = 2.0 * math.pi
 _RESYNC = 256
 #: Gauss-Newton stops once the step of the nonlinear parameters is below this fraction of their std
@@ -71,9 +72,16 @@ N_WORK = 96
 def _workspace(work):
     """Named views of the caller's scratch (``N_WORK`` floats): theta, the best theta, J^T r, J^T J,
     its inverse, the best theta's inverse, Gauss-Jordan's augmented matrix and its scaling."""
-    return (work[0:4], work[4:8], work[8:12], work[12:28].reshape((4, 4)),
-            work[28:44].reshape((4, 4)), work[44:60].reshape((4, 4)),
-            work[60:92].reshape((4, 8)), work[92:96])
+    return (
+        work[0:4],
+        work[4:8],
+        work[8:12],
+        work[12:28].reshape((4, 4)),
+        work[28:44].reshape((4, 4)),
+        work[44:60].reshape((4, 4)),
+        work[60:92].reshape((4, 8)),
+        work[92:96],
+    )
 
 
 @jit(inline='always')
@@ -137,8 +145,9 @@ def _accumulate(model, seg, n, tc, th, jtj, jtr, linear=False):
                 a33 += j3 * j3
                 if not linear:
                     a23 += j2 * j3
-    _store_normal_equations(model, jtj, jtr, (a00, a01, a02, a03, a11, a12, a13, a22, a23, a33),
-                            (r0, r1, r2, r3))
+    _store_normal_equations(
+        model, jtj, jtr, (a00, a01, a02, a03, a11, a12, a13, a22, a23, a33), (r0, r1, r2, r3)
+    )
     return rss
 
 
@@ -210,7 +219,7 @@ def _solve_linear(model, seg, n, tc, work):
     if model == MODEL_BIASED:
         th[3] = 0.0
     _accumulate(model, seg, n, tc, th, jtj, jtr, True)
-    idx = (0, 1, 3, 3)      # a, b, c (the first m); four entries: _invert's one signature
+    idx = (0, 1, 3, 3)  # a, b, c (the first m); four entries: _invert's one signature
     m = 3 if model == MODEL_BIASED else 2
     if not _invert(jtj, idx, m, cov, aug, scale):
         return False
@@ -232,8 +241,7 @@ def _newton_step(npar, th, cov, jtr, s2):
         delta = 0.0
         for j in range(npar):
             delta += cov[i, j] * jtr[j]
-        if i >= 2 and abs(delta) > max(STEP_TOL * math.sqrt(s2 * cov[i, i]),
-                                       1e-13 * abs(th[i])):
+        if i >= 2 and abs(delta) > max(STEP_TOL * math.sqrt(s2 * cov[i, i]), 1e-13 * abs(th[i])):
             small = False
         th[i] += delta
     return small
@@ -350,11 +358,13 @@ def _moments_of_result(model, th, cov, s2, res):
         wn = math.sqrt(w * w + sig * sig)
         # gradients of w_n and zeta = sigma / w_n with respect to (w_d, sigma)
         gw = (w / wn, sig / wn)
-        gz = (-sig * w / wn ** 3, w * w / wn ** 3)
-        var_w = s2 * (gw[0] * gw[0] * cov[2, 2] + 2 * gw[0] * gw[1] * cov[2, 3]
-                      + gw[1] * gw[1] * cov[3, 3])
-        var_z = s2 * (gz[0] * gz[0] * cov[2, 2] + 2 * gz[0] * gz[1] * cov[2, 3]
-                      + gz[1] * gz[1] * cov[3, 3])
+        gz = (-sig * w / wn**3, w * w / wn**3)
+        var_w = s2 * (
+            gw[0] * gw[0] * cov[2, 2] + 2 * gw[0] * gw[1] * cov[2, 3] + gw[1] * gw[1] * cov[3, 3]
+        )
+        var_z = s2 * (
+            gz[0] * gz[0] * cov[2, 2] + 2 * gz[0] * gz[1] * cov[2, 3] + gz[1] * gz[1] * cov[3, 3]
+        )
         res[R_F] = wn / TWO_PI
         res[R_DAMP] = sig / wn
         res[R_DSTD] = math.sqrt(var_z) if var_z >= 0.0 else math.nan

@@ -12,6 +12,7 @@ signal, so that the compile happens before the first real sample. ``make setup``
 numba writes each cache file under a temporary name and renames it, so a process killed during a
 compile leaves the cache as it was: the next start compiles again, nothing reads a torn file.
 """
+
 from __future__ import annotations
 
 import time
@@ -47,8 +48,13 @@ _warmed = set()
 def compile_key(config: EstimatorConfig) -> Hashable:
     """What decides which kernels a configuration compiles. Two configurations with one key run the
     same compiled code (a conservative key: a finer split only costs a call of :func:`warm`)."""
-    return (config.modes > 0, config.model, config.band_hz is not None,
-            config.target_std_rel > 0, config.refine > 0)
+    return (
+        config.modes > 0,
+        config.model,
+        config.band_hz is not None,
+        config.target_std_rel > 0,
+        config.refine > 0,
+    )
 
 
 def is_warm(config: EstimatorConfig) -> bool:
@@ -75,8 +81,10 @@ def warm(config: EstimatorConfig) -> float:
     return time.perf_counter() - start
 
 
-def warm_all(configurations: Optional[Dict[str, EstimatorConfig]] = None,
-             report: Callable[[str], None] = print) -> Sequence[Tuple[str, float]]:
+def warm_all(
+    configurations: Optional[Dict[str, EstimatorConfig]] = None,
+    report: Callable[[str], None] = print,
+) -> Sequence[Tuple[str, float]]:
     """:func:`warm` each configuration (default :data:`CONFIGURATIONS`), reporting each as it ends;
     return (name, seconds) pairs."""
     times = []

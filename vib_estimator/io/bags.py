@@ -29,6 +29,7 @@ enums) would fail in a reader older than that change. The MCAP file follows the 
 profile: ``ros2msg`` schemas with the full message definitions, ``cdr`` channels whose
 ``offered_qos_profiles`` user data is that same YAML string, and the ``rosbag2`` metadata record.
 """
+
 from __future__ import annotations
 
 import contextlib
@@ -44,9 +45,18 @@ from typing import Dict, Iterator, List, Optional, Sequence, Tuple
 
 import numpy as np
 import yaml
-from rosbags.interfaces import (Connection, ConnectionExtRosbag2, MessageDefinition,
-                                MessageDefinitionFormat, Qos, QosDurability, QosHistory,
-                                QosLiveliness, QosReliability, QosTime)
+from rosbags.interfaces import (
+    Connection,
+    ConnectionExtRosbag2,
+    MessageDefinition,
+    MessageDefinitionFormat,
+    Qos,
+    QosDurability,
+    QosHistory,
+    QosLiveliness,
+    QosReliability,
+    QosTime,
+)
 from rosbags.rosbag2 import CompressionMode, Reader
 from rosbags.rosbag2.metadata import dump_qos_v8
 from rosbags.rosbag2.storage_mcap import DECOMPRESSORS, McapReader, McapWriter
@@ -55,8 +65,14 @@ from rosbags.typesys import Stores, get_typestore
 
 from ..errors import BagError, DamageCount, McapFormatError, as_bag_error
 from . import cdr, mcap
-from .fields import (WRENCH_STAMPED, XYZ, check_component, component_getter, normalise_type,
-                     stamp_ns)
+from .fields import (
+    WRENCH_STAMPED,
+    XYZ,
+    check_component,
+    component_getter,
+    normalise_type,
+    stamp_ns,
+)
 
 #: message types of the ROS 2 Jazzy distribution (serialisation, message definitions, hashes)
 TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
@@ -73,8 +89,17 @@ _INFINITE = QosTime(9223372036, 854775807)  # RMW_DURATION_INFINITE, as rosbag2 
 
 #: offered QoS recorded for topics written without one: what ``ros2 bag record`` stores for a
 #: reliable, volatile publisher (history and depth are not visible on the graph, hence UNKNOWN / 0)
-RELIABLE_VOLATILE = Qos(QosHistory.UNKNOWN, 0, QosReliability.RELIABLE, QosDurability.VOLATILE,
-                        _INFINITE, _INFINITE, QosLiveliness.AUTOMATIC, _INFINITE, False)
+RELIABLE_VOLATILE = Qos(
+    QosHistory.UNKNOWN,
+    0,
+    QosReliability.RELIABLE,
+    QosDurability.VOLATILE,
+    _INFINITE,
+    _INFINITE,
+    QosLiveliness.AUTOMATIC,
+    _INFINITE,
+    False,
+)
 
 
 @dataclass(frozen=True)
@@ -190,8 +215,9 @@ class BagReader(DamageCount):
     def topic(self, name: str) -> TopicInfo:
         """The :class:`TopicInfo` of ``name``, or :class:`BagError` listing the bag's topics."""
         if name not in self.topics:
-            raise BagError(f'bag {self.path} has no topic {name!r}; its topics are '
-                           f'{self.describe_topics()}')
+            raise BagError(
+                f'bag {self.path} has no topic {name!r}; its topics are {self.describe_topics()}'
+            )
         return self.topics[name]
 
     def _stream(self, storage, names: set, start_ns: Optional[int]):
@@ -206,16 +232,23 @@ class BagReader(DamageCount):
         conns = [c for c in storage.connections if c.topic in names]
         return ((c.topic, t, d) for c, t, d in storage.messages(conns, start_ns, None))
 
-    def messages(self, topics: Optional[Sequence[str]] = None, start_ns: Optional[int] = None,
-                 check: bool = True) -> Iterator[BagMessage]:
+    def messages(
+        self,
+        topics: Optional[Sequence[str]] = None,
+        start_ns: Optional[int] = None,
+        check: bool = True,
+    ) -> Iterator[BagMessage]:
         """The messages of ``topics`` (default: all), from log time ``start_ns`` on, in log-time
         order across all storage files (ties: in file order). ``check``: decode each payload as
         its type (a Jazzy type) and skip those that do not decode, as damaged records."""
         names = set(self.topics) if topics is None else {self.topic(t).topic for t in topics}
         found, before, undecodable = 0, self.corrupt, 0
         with as_bag_error(self.path, 'read messages of bag'):
-            streams = [self._stream(s, names, start_ns) for s in self._storages
-                       if any(c.topic in names for c in s.connections)]
+            streams = [
+                self._stream(s, names, start_ns)
+                for s in self._storages
+                if any(c.topic in names for c in s.connections)
+            ]
             for topic, log_time, data in heapq.merge(*streams, key=itemgetter(1)):
                 found += 1
                 if self._decompress is not None:
@@ -223,15 +256,18 @@ class BagReader(DamageCount):
                 msgtype = self.topics[topic].msgtype
                 if check and not _decodes(data, msgtype):
                     undecodable += 1
-                    self.count_damage(1, f'a {topic} message logged at {log_time} ns does not '
-                                      f'decode as {msgtype}')
+                    self.count_damage(
+                        1,
+                        f'a {topic} message logged at {log_time} ns does not decode as {msgtype}',
+                    )
                     continue
                 yield BagMessage(topic, msgtype, log_time, bytes(data))
         if start_ns is None:  # the whole bag: what its statistics count but no read found
             skipped_unread = self.corrupt - before - undecodable  # damaged chunks, entries
             missing = sum(self.topics[t].count for t in names) - found - skipped_unread
-            self.count_damage(max(missing, 0), f'{missing} messages counted by the bag were not '
-                              f'found in it')
+            self.count_damage(
+                max(missing, 0), f'{missing} messages counted by the bag were not found in it'
+            )
 
     def close(self) -> None:
         self._stack.close()
@@ -263,8 +299,9 @@ def only_topic(path: Path, candidates: List[str], what: str, listing: str, how: 
     if not candidates:
         raise BagError(f'bag {path} has no {what} topic; its topics are {listing}')
     if len(candidates) > 1:
-        raise BagError(f'bag {path} has several {what} topics, choose one{how}: '
-                       f'{", ".join(candidates)}')
+        raise BagError(
+            f'bag {path} has several {what} topics, choose one{how}: {", ".join(candidates)}'
+        )
     return candidates[0].split(' ')[0]
 
 
@@ -275,23 +312,30 @@ def check_bag_path(path: Path) -> None:
         raise BagError(f'bag {path} does not exist')
     if path.is_dir() and not (path / 'metadata.yaml').exists():
         if storage_files(path):
-            raise BagError(f'bag {path} has no metadata.yaml: run `vib-estimator reindex {path}` '
-                           f'to rebuild it from its storage files')
-        raise BagError(f'{path} is not a rosbag2 bag: it has no metadata.yaml and no .mcap or '
-                       f'.db3 file')
+            raise BagError(
+                f'bag {path} has no metadata.yaml: run `vib-estimator reindex {path}` '
+                f'to rebuild it from its storage files'
+            )
+        raise BagError(
+            f'{path} is not a rosbag2 bag: it has no metadata.yaml and no .mcap or .db3 file'
+        )
     if path.is_file() and path.suffix not in _STORAGE_READERS:
-        raise BagError(f'{path} is not a bag: expected a .mcap or .db3 file or a rosbag2 '
-                       f'directory')
+        raise BagError(
+            f'{path} is not a bag: expected a .mcap or .db3 file or a rosbag2 directory'
+        )
 
 
 def storage_files(directory: Path) -> List[Path]:
     """The ``.mcap`` / ``.db3`` files of a bag directory, in split order (``name_0``, ``name_1``,
     ..., ``name_10``: by the number after the last ``_``, then by name)."""
+
     def order(path: Path):
         stem, _, index = path.stem.rpartition('_')
         return (stem, int(index)) if index.isdigit() else (path.stem, -1)
-    return sorted((p for p in directory.iterdir() if p.is_file() and p.suffix in _STORAGE_READERS),
-                  key=order)
+
+    return sorted(
+        (p for p in directory.iterdir() if p.is_file() and p.suffix in _STORAGE_READERS), key=order
+    )
 
 
 def _merge_topics(storages) -> Dict[str, TopicInfo]:
@@ -302,14 +346,22 @@ def _merge_topics(storages) -> Dict[str, TopicInfo]:
         for conn in storage.connections:
             counts[conn.topic] = counts.get(conn.topic, 0) + conn.msgcount
             first.setdefault(conn.topic, conn)
-    return {topic: TopicInfo(topic, normalise_type(conn.msgtype), counts[topic],
-                             tuple(conn.ext.offered_qos_profiles
-                                   if isinstance(conn.ext, ConnectionExtRosbag2) else ()))
-            for topic, conn in first.items()}
+    return {
+        topic: TopicInfo(
+            topic,
+            normalise_type(conn.msgtype),
+            counts[topic],
+            tuple(
+                conn.ext.offered_qos_profiles if isinstance(conn.ext, ConnectionExtRosbag2) else ()
+            ),
+        )
+        for topic, conn in first.items()
+    }
 
 
-def read_wrench_series(path, topic: Optional[str] = None,
-                       component: str = 'torque.z') -> WrenchSeries:
+def read_wrench_series(
+    path, topic: Optional[str] = None, component: str = 'torque.z'
+) -> WrenchSeries:
     """Header stamps and ``component`` of a WrenchStamped topic of a bag, in recorded order.
 
     ``topic=None`` takes the bag's only WrenchStamped topic. Raises :class:`BagError` for a bag that
@@ -319,13 +371,17 @@ def read_wrench_series(path, topic: Optional[str] = None,
     value_of = component_getter(component)
     with BagReader(path) as bag:
         if topic is None:
-            topic = only_topic(bag.path, [t.topic for t in bag.topics.values()
-                                          if t.msgtype == WRENCH_STAMPED], WRENCH_STAMPED,
-                               bag.describe_topics())
+            topic = only_topic(
+                bag.path,
+                [t.topic for t in bag.topics.values() if t.msgtype == WRENCH_STAMPED],
+                WRENCH_STAMPED,
+                bag.describe_topics(),
+            )
         info = bag.topic(topic)
         if info.msgtype != WRENCH_STAMPED:
-            raise BagError(f'topic {topic} of bag {bag.path} has type {info.msgtype}, '
-                           f'not {WRENCH_STAMPED}')
+            raise BagError(
+                f'topic {topic} of bag {bag.path} has type {info.msgtype}, not {WRENCH_STAMPED}'
+            )
         stamps: List[int] = []
         values: List[float] = []
         frame_id = ''
@@ -334,15 +390,19 @@ def read_wrench_series(path, topic: Optional[str] = None,
                 try:
                     msg = TYPESTORE.deserialize_cdr(message.data, WRENCH_STAMPED)
                 except Exception:  # noqa: BLE001 -- as in BagReader.messages
-                    bag.count_damage(1, f'a {topic} message logged at {message.log_time_ns} ns '
-                                     f'does not decode as {WRENCH_STAMPED}')
+                    bag.count_damage(
+                        1,
+                        f'a {topic} message logged at {message.log_time_ns} ns '
+                        f'does not decode as {WRENCH_STAMPED}',
+                    )
                     continue
                 if not stamps:
                     frame_id = msg.header.frame_id
                 stamps.append(stamp_ns(msg.header))
                 values.append(value_of(msg))
-    return WrenchSeries(np.array(stamps, dtype=np.int64), np.array(values, dtype=np.float64),
-                        frame_id, topic)
+    return WrenchSeries(
+        np.array(stamps, dtype=np.int64), np.array(values, dtype=np.float64), frame_id, topic
+    )
 
 
 def wrench_message(stamp: int, frame_id: str, component: str, value: float):
@@ -352,15 +412,21 @@ def wrench_message(stamp: int, frame_id: str, component: str, value: float):
     part, axis = check_component(component).split('.')
     vec[part][XYZ.index(axis)] = float(value)
     header = types['std_msgs/msg/Header'](
-        stamp=types['builtin_interfaces/msg/Time'](sec=stamp // 1_000_000_000,
-                                                   nanosec=stamp % 1_000_000_000),
-        frame_id=frame_id)
+        stamp=types['builtin_interfaces/msg/Time'](
+            sec=stamp // 1_000_000_000, nanosec=stamp % 1_000_000_000
+        ),
+        frame_id=frame_id,
+    )
     vector = types['geometry_msgs/msg/Vector3']
-    return types[WRENCH_STAMPED](header=header, wrench=types['geometry_msgs/msg/Wrench'](
-        force=vector(*vec['force']), torque=vector(*vec['torque'])))
+    return types[WRENCH_STAMPED](
+        header=header,
+        wrench=types['geometry_msgs/msg/Wrench'](
+            force=vector(*vec['force']), torque=vector(*vec['torque'])
+        ),
+    )
 
 
-_NO_MESSAGE = 2 ** 63 - 1  # start time of a file without messages, as rosbags keeps it
+_NO_MESSAGE = 2**63 - 1  # start time of a file without messages, as rosbags keeps it
 
 
 @dataclass
@@ -378,13 +444,17 @@ class FileStats:
         self.count += n
 
     def as_dict(self) -> dict:
-        return {'path': self.name, 'starting_time': {'nanoseconds_since_epoch': self.start_ns},
-                'duration': {'nanoseconds': max(0, self.end_ns - self.start_ns)},
-                'message_count': self.count}
+        return {
+            'path': self.name,
+            'starting_time': {'nanoseconds_since_epoch': self.start_ns},
+            'duration': {'nanoseconds': max(0, self.end_ns - self.start_ns)},
+            'message_count': self.count,
+        }
 
 
-def bag_metadata(storage: str, files: Sequence[FileStats],
-                 topics: Sequence[Tuple[Connection, int]]) -> dict:
+def bag_metadata(
+    storage: str, files: Sequence[FileStats], topics: Sequence[Tuple[Connection, int]]
+) -> dict:
     """The ``rosbag2_bagfile_information`` of a bag (version :data:`METADATA_VERSION`), from its
     files and its ``(connection, message count)`` topics; what :class:`BagWriter` and
     ``vib-estimator reindex`` write."""
@@ -402,11 +472,18 @@ def bag_metadata(storage: str, files: Sequence[FileStats],
         'starting_time': info['starting_time'],
         'message_count': whole.count,
         'topics_with_message_count': [
-            {'topic_metadata': {'name': c.topic, 'type': c.msgtype,
-                                'serialization_format': c.ext.serialization_format,
-                                'offered_qos_profiles': dump_qos_v8(c.ext.offered_qos_profiles),
-                                'type_description_hash': c.digest},
-             'message_count': count} for c, count in topics],
+            {
+                'topic_metadata': {
+                    'name': c.topic,
+                    'type': c.msgtype,
+                    'serialization_format': c.ext.serialization_format,
+                    'offered_qos_profiles': dump_qos_v8(c.ext.offered_qos_profiles),
+                    'type_description_hash': c.digest,
+                },
+                'message_count': count,
+            }
+            for c, count in topics
+        ],
         'compression_format': '',
         'compression_mode': '',
         'files': [f.as_dict() for f in files],
@@ -478,9 +555,16 @@ class _Sqlite3File(Sqlite3Writer):
 def connection_for(topic: str, msgtype: str, offered_qos: Sequence[Qos], cid: int) -> Connection:
     """A rosbags connection of a Jazzy type, with its message definition and RIHS01 hash."""
     msgdef, _ = TYPESTORE.generate_msgdef(msgtype, ros_version=2)
-    return Connection(cid, topic, msgtype, MessageDefinition(MessageDefinitionFormat.MSG, msgdef),
-                      TYPESTORE.hash_rihs01(msgtype), 0,
-                      ConnectionExtRosbag2('cdr', list(offered_qos)), None)
+    return Connection(
+        cid,
+        topic,
+        msgtype,
+        MessageDefinition(MessageDefinitionFormat.MSG, msgdef),
+        TYPESTORE.hash_rihs01(msgtype),
+        0,
+        ConnectionExtRosbag2('cdr', list(offered_qos)),
+        None,
+    )
 
 
 class BagWriter:
@@ -500,8 +584,9 @@ class BagWriter:
     large, I/O error) is raised as :class:`BagError`; what was flushed before stays readable.
     """
 
-    def __init__(self, path, storage: str = 'mcap', max_bag_size: int = 0,
-                 max_bag_duration_ns: int = 0) -> None:
+    def __init__(
+        self, path, storage: str = 'mcap', max_bag_size: int = 0, max_bag_duration_ns: int = 0
+    ) -> None:
         self.path = Path(path)
         if storage not in STORAGES:
             raise ValueError(f'storage must be one of {", ".join(STORAGES)}, got {storage!r}')
@@ -523,15 +608,18 @@ class BagWriter:
             yield
         except (OSError, sqlite3.Error) as err:
             self._failed = True
-            raise BagError(f'cannot write bag {self.path}: {err}; what was written before is '
-                           f'kept (`vib-estimator reindex {self.path}` makes it readable)') from None
+            raise BagError(
+                f'cannot write bag {self.path}: {err}; what was written before is '
+                f'kept (`vib-estimator reindex {self.path}` makes it readable)'
+            ) from None
 
     def open(self) -> 'BagWriter':
         try:
             self.path.mkdir(parents=True)
         except OSError as err:
-            raise BagError(f'cannot create bag directory {self.path}: '
-                           f'{err.strerror or err}') from None
+            raise BagError(
+                f'cannot create bag directory {self.path}: {err.strerror or err}'
+            ) from None
         with self._writing():
             self._open_file()
         return self
@@ -560,18 +648,21 @@ class BagWriter:
         self._file.add_connection(connection, dump_qos_v8(connection.ext.offered_qos_profiles))
 
     def _metadata(self) -> dict:
-        return bag_metadata(self.storage, self.files,
-                            [(c, self._counts[c.id]) for c in self._connections])
+        return bag_metadata(
+            self.storage, self.files, [(c, self._counts[c.id]) for c in self._connections]
+        )
 
     def _write_metadata(self) -> None:
         write_metadata(self.path, self._metadata())
 
-    def add_topic(self, topic: str, msgtype: str,
-                  offered_qos: Sequence[Qos] = (RELIABLE_VOLATILE,)) -> Connection:
+    def add_topic(
+        self, topic: str, msgtype: str, offered_qos: Sequence[Qos] = (RELIABLE_VOLATILE,)
+    ) -> Connection:
         """Register ``topic`` of ``msgtype`` (a Jazzy type); return the handle to write it with."""
         if msgtype not in TYPESTORE.types:
-            raise BagError(f'cannot record {topic}: message type {msgtype} is not a ROS 2 Jazzy '
-                           f'type')
+            raise BagError(
+                f'cannot record {topic}: message type {msgtype} is not a ROS 2 Jazzy type'
+            )
         connection = connection_for(topic, msgtype, offered_qos, len(self._connections) + 1)
         with self._writing():
             self._register(connection)
@@ -656,10 +747,13 @@ class BagWriter:
             self.abort()
 
 
-def write_wrench_series(path, series: WrenchSeries, component: str = 'torque.z',
-                        storage: str = 'mcap') -> None:
+def write_wrench_series(
+    path, series: WrenchSeries, component: str = 'torque.z', storage: str = 'mcap'
+) -> None:
     """Write ``series`` as a one-topic bag, log time = header stamp (a clean recording)."""
     with BagWriter(path, storage) as bag:
         conn = bag.add_topic(series.topic, WRENCH_STAMPED)
         for stamp, value in zip(series.stamps_ns.tolist(), series.values.tolist()):
-            bag.write_message(conn, stamp, wrench_message(stamp, series.frame_id, component, value))
+            bag.write_message(
+                conn, stamp, wrench_message(stamp, series.frame_id, component, value)
+            )

@@ -16,6 +16,7 @@ vectorised expression over the array of payload offsets. A batch whose payloads 
 little-endian CDR, or are too short for the layout, is refused (:class:`CdrLayoutError`) and the
 caller decodes it with the general ``rosbags`` deserialiser instead.
 """
+
 from __future__ import annotations
 
 from typing import Dict, Optional, Tuple
@@ -23,8 +24,15 @@ from typing import Dict, Optional, Tuple
 import numpy as np
 
 from ..errors import CdrLayoutError
-from .fields import (ACCEL_STAMPED, FLOAT64, IMU, VECTOR3_STAMPED, WRENCH_STAMPED, XYZ,
-                     check_component)
+from .fields import (
+    ACCEL_STAMPED,
+    FLOAT64,
+    IMU,
+    VECTOR3_STAMPED,
+    WRENCH_STAMPED,
+    XYZ,
+    check_component,
+)
 
 
 def _indices(prefix: str, start: int, names=XYZ) -> Dict[str, int]:
@@ -72,8 +80,9 @@ def gather(buf: np.ndarray, offsets: np.ndarray, dtype: str) -> np.ndarray:
     return buf[offsets[:, None] + np.arange(size)].view(dtype).ravel()
 
 
-def decode_fixed(buf: np.ndarray, offsets: np.ndarray, lengths: np.ndarray, msgtype: str,
-                 component: str) -> Tuple[Optional[np.ndarray], np.ndarray]:
+def decode_fixed(
+    buf: np.ndarray, offsets: np.ndarray, lengths: np.ndarray, msgtype: str, component: str
+) -> Tuple[Optional[np.ndarray], np.ndarray]:
     """Header stamps (int64 ns; None for ``Float64``) and ``component`` of many CDR payloads.
 
     ``buf`` is a uint8 array holding the payloads; payload i is ``buf[offsets[i]:offsets[i] +
@@ -96,8 +105,9 @@ def decode_fixed(buf: np.ndarray, offsets: np.ndarray, lengths: np.ndarray, msgt
         if np.any(12 + name_len > lengths - 4):
             raise CdrLayoutError('frame_id longer than the message')
         first = body + ((12 + name_len + 7) & ~7)
-        stamps = (gather(buf, body, '<i4').astype(np.int64) * 1_000_000_000
-                  + gather(buf, body + 4, '<u4').astype(np.int64))
+        stamps = gather(buf, body, '<i4').astype(np.int64) * 1_000_000_000 + gather(
+            buf, body + 4, '<u4'
+        ).astype(np.int64)
     if np.any(first + 8 * N_DOUBLES[msgtype] > offsets + lengths):
         raise CdrLayoutError('message shorter than its type')
     values = gather(buf, first + 8 * DOUBLE_INDEX[msgtype][component], '<f8')

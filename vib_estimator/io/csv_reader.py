@@ -11,6 +11,7 @@ comment lines between the data, cells with spaces, ragged rows, a cell that is n
 read by the exact rules instead, so the result and the error messages are those of the rules).
 :func:`read_csv_series` collects the blocks; :mod:`.streaming` streams them.
 """
+
 from __future__ import annotations
 
 import csv
@@ -125,14 +126,17 @@ def iter_csv_rows(layout: CsvLayout) -> Iterator[Tuple[float, float]]:
                     yield _number(row[0]), _number(row[layout.index])
                 except (ValueError, IndexError):
                     line = count + 2 if layout.has_header else count + 1
-                    raise CsvError(f'{layout.path}: data row {line} is not numbers in columns 0 '
-                                   f'and {layout.index}: {",".join(row)!r}') from None
+                    raise CsvError(
+                        f'{layout.path}: data row {line} is not numbers in columns 0 '
+                        f'and {layout.index}: {",".join(row)!r}'
+                    ) from None
     except (OSError, UnicodeDecodeError, csv.Error) as err:
         raise CsvError(f'cannot read {layout.path} as CSV: {err}') from None
 
 
-def csv_blocks(layout: CsvLayout, block_rows: int = EXACT_BLOCK_ROWS
-               ) -> Iterator[Tuple[np.ndarray, np.ndarray]]:
+def csv_blocks(
+    layout: CsvLayout, block_rows: int = EXACT_BLOCK_ROWS
+) -> Iterator[Tuple[np.ndarray, np.ndarray]]:
     """``(t, y)`` blocks of the file by pyarrow; on a file it refuses, the rest by the exact rules
     (``block_rows`` rows per block); all of it by the exact rules where pyarrow is not installed
     (rosdep alone does not bring it)."""
@@ -153,13 +157,20 @@ def csv_blocks(layout: CsvLayout, block_rows: int = EXACT_BLOCK_ROWS
         with pa.OSFile(str(layout.path)) as handle:
             handle.seek(layout.data_offset)
             reader = pacsv.open_csv(
-                handle, memory_pool=pa.system_memory_pool(),
-                read_options=pacsv.ReadOptions(column_names=names, use_threads=False,
-                                               block_size=CSV_BLOCK_BYTES),
+                handle,
+                memory_pool=pa.system_memory_pool(),
+                read_options=pacsv.ReadOptions(
+                    column_names=names, use_threads=False, block_size=CSV_BLOCK_BYTES
+                ),
                 parse_options=pacsv.ParseOptions(newlines_in_values=False),
                 convert_options=pacsv.ConvertOptions(
-                    column_types={n: pa.float64() for n in wanted}, include_columns=wanted,
-                    null_values=[''], strings_can_be_null=False, quoted_strings_can_be_null=True))
+                    column_types={n: pa.float64() for n in wanted},
+                    include_columns=wanted,
+                    null_values=[''],
+                    strings_can_be_null=False,
+                    quoted_strings_can_be_null=True,
+                ),
+            )
             for batch in reader:
                 t, y = (batch.column(i).to_numpy(zero_copy_only=False) for i in range(2))
                 done += len(t)
@@ -168,8 +179,9 @@ def csv_blocks(layout: CsvLayout, block_rows: int = EXACT_BLOCK_ROWS
         yield from _exact_blocks(layout, done, block_rows)
 
 
-def _exact_blocks(layout: CsvLayout, skip: int, block_rows: int
-                  ) -> Iterator[Tuple[np.ndarray, np.ndarray]]:
+def _exact_blocks(
+    layout: CsvLayout, skip: int, block_rows: int
+) -> Iterator[Tuple[np.ndarray, np.ndarray]]:
     """The exact rules, block by block, after the first ``skip`` data rows."""
     t: List[float] = []
     y: List[float] = []

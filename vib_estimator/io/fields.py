@@ -14,6 +14,7 @@ Supported types (full names, as in ``input_type``) and their components:
   (the joint is looked up by name in every message; a message without it gives ``None``)
 * ``std_msgs/msg/Float64``             -- ``data`` (no header: the receiver's clock is the time base)
 """
+
 from __future__ import annotations
 
 import re
@@ -43,9 +44,14 @@ _FIXED: Dict[str, Tuple[str, ...]] = {
 #: every supported input type, default first
 INPUT_TYPES: Tuple[str, ...] = tuple(_FIXED)
 #: default component of each type
-DEFAULT_COMPONENT = {WRENCH_STAMPED: 'torque.z', IMU: 'linear_acceleration.z',
-                     ACCEL_STAMPED: 'accel.linear.z', VECTOR3_STAMPED: 'vector.z',
-                     JOINT_STATE: 'effort[joint1]', FLOAT64: 'data'}
+DEFAULT_COMPONENT = {
+    WRENCH_STAMPED: 'torque.z',
+    IMU: 'linear_acceleration.z',
+    ACCEL_STAMPED: 'accel.linear.z',
+    VECTOR3_STAMPED: 'vector.z',
+    JOINT_STATE: 'effort[joint1]',
+    FLOAT64: 'data',
+}
 #: the components of a WrenchStamped (the default input type)
 COMPONENTS = _FIXED[WRENCH_STAMPED]
 _JOINT = re.compile(r'^(effort|position|velocity)\[(.+)\]$')
@@ -83,13 +89,15 @@ def check_component(component: str, input_type: str = WRENCH_STAMPED) -> str:
     full = check_input_type(input_type)
     ok = _JOINT.match(component) is not None if full == JOINT_STATE else component in _FIXED[full]
     if not ok:
-        raise ValueError(f'component of {full} must be one of {describe_components(full)}, '
-                         f'got {component!r}')
+        raise ValueError(
+            f'component of {full} must be one of {describe_components(full)}, got {component!r}'
+        )
     return component
 
 
-def component_getter(component: str, input_type: str = WRENCH_STAMPED
-                     ) -> Callable[[object], Optional[float]]:
+def component_getter(
+    component: str, input_type: str = WRENCH_STAMPED
+) -> Callable[[object], Optional[float]]:
     """A function returning ``component`` of a message of ``input_type``.
 
     Fixed fields are one ``operator.attrgetter`` (one C call per message). For ``JointState`` the
@@ -111,11 +119,13 @@ def component_getter(component: str, input_type: str = WRENCH_STAMPED
             return float(values_of(msg)[i])
         except (ValueError, IndexError):
             return None
+
     return joint_value
 
 
-def component_setter(component: str, input_type: str = WRENCH_STAMPED
-                     ) -> Callable[[object, float], None]:
+def component_setter(
+    component: str, input_type: str = WRENCH_STAMPED
+) -> Callable[[object, float], None]:
     """The inverse of :func:`component_getter`: a function ``set(msg, value)`` writing ``value``
     into ``component`` of a message of ``input_type`` (for publishers: the simulator, tests,
     benchmarks). For ``JointState`` the joint is appended to ``name`` when the message lacks it
@@ -128,6 +138,7 @@ def component_setter(component: str, input_type: str = WRENCH_STAMPED
 
         def set_field(msg, value: float) -> None:
             setattr(parent(msg), last, float(value))
+
         return set_field
     field, joint = _JOINT.match(component).groups()
 
@@ -140,6 +151,7 @@ def component_setter(component: str, input_type: str = WRENCH_STAMPED
         values += [0.0] * (len(names) - len(values))
         values[names.index(joint)] = float(value)
         setattr(msg, field, values)
+
     return set_joint
 
 

@@ -22,6 +22,7 @@ So a damaged file never yields more messages than the intact one. Anything else 
 layout (no summary, a summary that does not parse) is :class:`McapFormatError`: the caller reads
 the file another way (``rosbags``) or reports it.
 """
+
 from __future__ import annotations
 
 import heapq
@@ -65,7 +66,7 @@ class Fields:
         if n < 0 or self.pos + n > self.end:
             raise McapCut()
         self.pos += n
-        return self.data[self.pos - n:self.pos]
+        return self.data[self.pos - n : self.pos]
 
     def uint(self, size: int) -> int:
         return int.from_bytes(self.take(size), 'little')
@@ -83,7 +84,7 @@ class Fields:
         return self.pos - length, length
 
     def rest(self) -> bytes:
-        return self.data[self.pos:self.end]
+        return self.data[self.pos : self.end]
 
 
 def records(data: bytes, pos: int, end: int) -> Iterator[Tuple[int, Fields]]:
@@ -145,10 +146,11 @@ def chunk_records(body: Fields) -> Tuple[Optional[bytes], str]:
     body.take(16)  # message start and end time
     size, crc, kind = body.uint(8), body.uint(4), body.string()
     start, length = body.sized(8)
-    return decompress(kind, body.data[start:start + length], size, crc), kind
+    return decompress(kind, body.data[start : start + length], size, crc), kind
 
 
 # ------------------------------------------------------------------------------- the summary
+
 
 @dataclass(frozen=True)
 class ChunkRead:
@@ -195,9 +197,9 @@ def _summary_bytes(handle, path: Path) -> bytes:
         raise McapFormatError(f'{path}: too short for an indexed MCAP file')
     handle.seek(size - len(MAGIC) - FOOTER_BYTES)
     tail = handle.read(len(MAGIC) + FOOTER_BYTES)
-    if tail[-len(MAGIC):] != MAGIC or tail[0] != OP_FOOTER:
+    if tail[-len(MAGIC) :] != MAGIC or tail[0] != OP_FOOTER:
         raise McapFormatError(f'{path}: no MCAP footer')
-    summary_start = int.from_bytes(tail[RECORD_HEAD:RECORD_HEAD + 8], 'little')
+    summary_start = int.from_bytes(tail[RECORD_HEAD : RECORD_HEAD + 8], 'little')
     summary_end = size - len(MAGIC) - FOOTER_BYTES
     if not len(MAGIC) <= summary_start <= summary_end:
         raise McapFormatError(f'{path}: no summary section')
@@ -262,6 +264,7 @@ def read_plan(files: Sequence[Path], topic: str) -> List[ChunkRead]:
 
 # ------------------------------------------------------------------------------- one chunk
 
+
 @dataclass
 class ChunkMessages:
     """The messages of a chunk for the channels asked for, in log-time order: the chunk's records
@@ -279,9 +282,13 @@ class ChunkMessages:
     def payloads(self) -> Iterator[Tuple[int, int, bytes]]:
         """``(channel, log time, payload bytes)`` of each message."""
         raw = self.records.tobytes()
-        for ch, t, off, size in zip(self.channels.tolist(), self.log_times.tolist(),
-                                    self.offsets.tolist(), self.lengths.tolist()):
-            yield ch, t, raw[off:off + size]
+        for ch, t, off, size in zip(
+            self.channels.tolist(),
+            self.log_times.tolist(),
+            self.offsets.tolist(),
+            self.lengths.tolist(),
+        ):
+            yield ch, t, raw[off : off + size]
 
 
 def _empty(skipped: int, damage: str) -> ChunkMessages:
@@ -304,8 +311,9 @@ def _index_entries(handle, chunk: ChunkRead) -> Tuple[np.ndarray, np.ndarray, in
         except McapCut:
             damaged += 1
             continue
-        part = np.frombuffer(record, dtype=INDEX_ENTRY, count=size // INDEX_ENTRY.itemsize,
-                             offset=start)
+        part = np.frombuffer(
+            record, dtype=INDEX_ENTRY, count=size // INDEX_ENTRY.itemsize, offset=start
+        )
         entries.append(part)
         channels.append(np.full(len(part), channel, np.int64))
     if not entries:
@@ -313,12 +321,13 @@ def _index_entries(handle, chunk: ChunkRead) -> Tuple[np.ndarray, np.ndarray, in
     return np.concatenate(entries), np.concatenate(channels), damaged
 
 
-def _valid_entries(records: np.ndarray, index: np.ndarray, channels: np.ndarray
-                   ) -> Tuple[np.ndarray, np.ndarray]:
+def _valid_entries(
+    records: np.ndarray, index: np.ndarray, channels: np.ndarray
+) -> Tuple[np.ndarray, np.ndarray]:
     """Which index entries point at a whole message record of their channel and log time, and
     the length of each such record (one gather of the records' heads)."""
     size = len(records)
-    head = RECORD_HEAD + MESSAGE_HEAD - 8          # up to the end of the log time
+    head = RECORD_HEAD + MESSAGE_HEAD - 8  # up to the end of the log time
     ok = index['o'] <= np.uint64(max(size - RECORD_HEAD - MESSAGE_HEAD, 0))
     if size < RECORD_HEAD + MESSAGE_HEAD:
         return ok & False, np.zeros(len(index), np.int64)
@@ -329,8 +338,8 @@ def _valid_entries(records: np.ndarray, index: np.ndarray, channels: np.ndarray
     ok &= (length >= MESSAGE_HEAD) & (length <= np.uint64(size))
     length = np.where(ok, length, 0).astype(np.int64)
     ok &= at + RECORD_HEAD + length <= size
-    ok &= window[:, RECORD_HEAD:RECORD_HEAD + 2].copy().view('<u2').ravel() == channels
-    ok &= window[:, head - 8:head].copy().view('<u8').ravel() == index['t']
+    ok &= window[:, RECORD_HEAD : RECORD_HEAD + 2].copy().view('<u2').ravel() == channels
+    ok &= window[:, head - 8 : head].copy().view('<u8').ravel() == index['t']
     return ok, length
 
 
@@ -348,42 +357,60 @@ def read_chunk(handle, chunk: ChunkRead) -> ChunkMessages:
     except (McapCut, McapFormatError):
         records = None
     if records is None:
-        return _empty(len(index) + damaged, f'chunk at byte {chunk.start} of {chunk.path.name} '
-                      f'is damaged (checksum, size or compression)')
+        return _empty(
+            len(index) + damaged,
+            f'chunk at byte {chunk.start} of {chunk.path.name} '
+            f'is damaged (checksum, size or compression)',
+        )
     buf = np.frombuffer(records, np.uint8)
     ok, record_lengths = _valid_entries(buf, index, channels)
     keep = np.flatnonzero(ok)
     at = index['o'][keep].astype(np.int64)
-    if len(at) > 1 and not np.all(at[1:] > at[:-1]):   # not in record order: drop repeats
+    if len(at) > 1 and not np.all(at[1:] > at[:-1]):  # not in record order: drop repeats
         keep = keep[np.unique(at, return_index=True)[1]]
     keep = keep[np.argsort(index['t'][keep], kind='stable')]
     rec = index['o'][keep].astype(np.int64)
     skipped = len(index) - len(keep) + damaged
-    return ChunkMessages(buf, rec + RECORD_HEAD + MESSAGE_HEAD,
-                         record_lengths[keep] - MESSAGE_HEAD,
-                         index['t'][keep].astype(np.int64), channels[keep], skipped,
-                         f'{skipped} message index entries of the chunk at byte {chunk.start} of '
-                         f'{chunk.path.name} do not point at a message' if skipped else '')
+    return ChunkMessages(
+        buf,
+        rec + RECORD_HEAD + MESSAGE_HEAD,
+        record_lengths[keep] - MESSAGE_HEAD,
+        index['t'][keep].astype(np.int64),
+        channels[keep],
+        skipped,
+        f'{skipped} message index entries of the chunk at byte {chunk.start} of '
+        f'{chunk.path.name} do not point at a message'
+        if skipped
+        else '',
+    )
 
 
 # ------------------------------------------------------------------------------- many chunks
 
-def iter_messages(path: Path, topics: Collection[str], start_ns: Optional[int] = None,
-                  on_skip=None) -> Iterator[Tuple[str, int, bytes]]:
+
+def iter_messages(
+    path: Path, topics: Collection[str], start_ns: Optional[int] = None, on_skip=None
+) -> Iterator[Tuple[str, int, bytes]]:
     """``(topic, log time, payload)`` of every message of ``topics`` in one indexed MCAP file, in
     log-time order (ties: in file order), from ``start_ns`` on; chunks are read lazily, only as
     many at once as overlap in time. ``on_skip(count, damage)`` is called for each chunk with
     damaged records. McapFormatError (before any message) if the file is not indexed."""
     summary = read_summary(path)
     names = summary.topics
-    chunks = sorted((c for c in summary.chunk_reads(summary.channels_of(set(topics)))
-                     if start_ns is None or c.last_ns >= start_ns),
-                    key=lambda c: (c.first_ns, c.start))
+    chunks = sorted(
+        (
+            c
+            for c in summary.chunk_reads(summary.channels_of(set(topics)))
+            if start_ns is None or c.last_ns >= start_ns
+        ),
+        key=lambda c: (c.first_ns, c.start),
+    )
     return _merged(path, chunks, names, start_ns, on_skip)
 
 
-def _chunk_messages(handle, chunk: ChunkRead, names: Dict[int, str], start_ns, on_skip
-                    ) -> Iterator[Tuple[int, str, bytes]]:
+def _chunk_messages(
+    handle, chunk: ChunkRead, names: Dict[int, str], start_ns, on_skip
+) -> Iterator[Tuple[int, str, bytes]]:
     """``(log time, topic, payload)`` of one chunk's messages from ``start_ns`` on."""
     messages = read_chunk(handle, chunk)
     if messages.skipped and on_skip is not None:
@@ -397,16 +424,18 @@ def _merged(path: Path, chunks: List[ChunkRead], names: Dict[int, str], start_ns
     with Path(path).open('rb') as handle:
         if all(b.first_ns > a.last_ns for a, b in zip(chunks, chunks[1:])):
             for chunk in chunks:  # one after the other: no merge needed
-                for log_time, topic, payload in _chunk_messages(handle, chunk, names, start_ns,
-                                                                on_skip):
+                for log_time, topic, payload in _chunk_messages(
+                    handle, chunk, names, start_ns, on_skip
+                ):
                     yield topic, log_time, payload
             return
         heap: List[Tuple[int, int, str, bytes]] = []
         order, i = 0, 0
         while i < len(chunks) or heap:
             while i < len(chunks) and (not heap or chunks[i].first_ns <= heap[0][0]):
-                for log_time, topic, payload in _chunk_messages(handle, chunks[i], names,
-                                                                start_ns, on_skip):
+                for log_time, topic, payload in _chunk_messages(
+                    handle, chunks[i], names, start_ns, on_skip
+                ):
                     heapq.heappush(heap, (log_time, order, topic, payload))
                     order += 1
                 i += 1

@@ -13,6 +13,7 @@ A file cut short (the recorder was killed, the disk filled up) is repaired first
 * sqlite3: the database is opened read-write once, so that SQLite rolls back an interrupted
   transaction from its journal (what was committed stays).
 """
+
 from __future__ import annotations
 
 import argparse
@@ -21,22 +22,48 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Dict, List, Optional, Tuple
 
-from rosbags.interfaces import (Connection, ConnectionExtRosbag2, MessageDefinition,
-                                MessageDefinitionFormat)
+from rosbags.interfaces import (
+    Connection,
+    ConnectionExtRosbag2,
+    MessageDefinition,
+    MessageDefinitionFormat,
+)
 from rosbags.rosbag2.metadata import parse_qos
 
 from ..errors import BagError, McapCut, McapFormatError, as_bag_error, report
-from .bags import (METADATA_VERSION, TYPESTORE, FileStats, bag_metadata, mcap_file, storage_files,
-                   storage_reader, write_metadata)
-from .mcap import (MAGIC, OP_CHANNEL, OP_CHUNK, OP_DATA_END, OP_MESSAGE, OP_SCHEMA, Fields,
-                   decompress, read_channel, read_message, read_schema, records)
+from .bags import (
+    METADATA_VERSION,
+    TYPESTORE,
+    FileStats,
+    bag_metadata,
+    mcap_file,
+    storage_files,
+    storage_reader,
+    write_metadata,
+)
+from .mcap import (
+    MAGIC,
+    OP_CHANNEL,
+    OP_CHUNK,
+    OP_DATA_END,
+    OP_MESSAGE,
+    OP_SCHEMA,
+    Fields,
+    decompress,
+    read_channel,
+    read_message,
+    read_schema,
+    records,
+)
 
 
 @dataclass
 class McapContent:
     """What the complete records of an MCAP file hold."""
 
-    schemas: Dict[int, Tuple[str, str, bytes]] = field(default_factory=dict)  # name, encoding, data
+    schemas: Dict[int, Tuple[str, str, bytes]] = field(
+        default_factory=dict
+    )  # name, encoding, data
     channels: Dict[int, Tuple[str, int, str]] = field(default_factory=dict)  # topic, schema, QoS
     messages: List[Tuple[int, int, bytes]] = field(default_factory=list)  # channel, log time, data
     #: byte at which the first incomplete record starts (the file's size when none is)
@@ -123,8 +150,16 @@ def _connections(content: McapContent) -> Dict[int, Connection]:
             continue  # its schema was in a damaged chunk: its messages cannot be kept
         name, encoding, definition = content.schemas[sid]
         fmt = MessageDefinitionFormat.IDL if encoding == 'ros2idl' else MessageDefinitionFormat.MSG
-        result[cid] = Connection(cid, topic, name, MessageDefinition(fmt, definition.decode()), '',
-                                 0, ConnectionExtRosbag2('cdr', parse_qos(qos)), None)
+        result[cid] = Connection(
+            cid,
+            topic,
+            name,
+            MessageDefinition(fmt, definition.decode()),
+            '',
+            0,
+            ConnectionExtRosbag2('cdr', parse_qos(qos)),
+            None,
+        )
     return result
 
 
@@ -137,10 +172,15 @@ def repair_mcap(path: Path) -> Optional[str]:
         pass
     data = path.read_bytes()
     if not data.startswith(MAGIC):
-        what = 'is empty (0 bytes)' if not data else (f'does not start with the MCAP magic '
-                                                      f'({len(data)} bytes)')
-        raise BagError(f'cannot reindex {path}: it {what}; it is not an MCAP file, so nothing '
-                       f'can be recovered (left unchanged)')
+        what = (
+            'is empty (0 bytes)'
+            if not data
+            else (f'does not start with the MCAP magic ({len(data)} bytes)')
+        )
+        raise BagError(
+            f'cannot reindex {path}: it {what}; it is not an MCAP file, so nothing '
+            f'can be recovered (left unchanged)'
+        )
     content = scan_mcap(data)
     connections = _connections(content)
     writer = mcap_file(path.with_name(path.name + '.tmp'))
@@ -161,8 +201,10 @@ def repair_mcap(path: Path) -> Optional[str]:
     if content.data_end:
         cut = f'summary section cut or damaged (file of {len(data)} bytes)'
     elif content.complete_bytes < len(data):
-        cut = (f'cut at byte {content.complete_bytes} of {len(data)} (the rest is an incomplete '
-               f'record, dropped)')
+        cut = (
+            f'cut at byte {content.complete_bytes} of {len(data)} (the rest is an incomplete '
+            f'record, dropped)'
+        )
     else:
         cut = 'not closed (no index)'
     if content.damaged_chunks:
@@ -170,7 +212,6 @@ def repair_mcap(path: Path) -> Optional[str]:
     if lost:
         cut += f'; {lost} messages of channels without a schema dropped'
     return f'{path}: {cut}; kept {len(content.messages) - lost} complete messages, index rebuilt'
-
 
 
 def recover_sqlite3(path: Path) -> None:
@@ -194,9 +235,11 @@ class ReindexResult:
 
     def summary(self) -> str:
         total = sum(f.count for f in self.files)
-        lines = [f'reindexed {self.path}: {len(self.files)} {self.storage} file(s), {total} '
-                 f'messages, topics: ' + (', '.join(f'{c.topic} ({c.msgtype}) {n}'
-                                                    for c, n in self.topics) or 'none')]
+        lines = [
+            f'reindexed {self.path}: {len(self.files)} {self.storage} file(s), {total} '
+            f'messages, topics: '
+            + (', '.join(f'{c.topic} ({c.msgtype}) {n}' for c, n in self.topics) or 'none')
+        ]
         return '\n'.join(lines + [f'  {cut}' for cut in self.cuts])
 
 
@@ -220,8 +263,9 @@ def _merge(connections: List[Connection]) -> List[Tuple[Connection, int]]:
     for conn in connections:
         key = (conn.topic, conn.msgtype)
         if key not in merged:
-            digest = conn.digest or (TYPESTORE.hash_rihs01(conn.msgtype)
-                                     if conn.msgtype in TYPESTORE.types else '')
+            digest = conn.digest or (
+                TYPESTORE.hash_rihs01(conn.msgtype) if conn.msgtype in TYPESTORE.types else ''
+            )
             merged[key] = [conn._replace(digest=digest), 0]
         merged[key][1] += conn.msgcount
     return [(conn, count) for conn, count in merged.values()]

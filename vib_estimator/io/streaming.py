@@ -26,6 +26,7 @@ first one raises :class:`~vib_estimator.errors.CorruptRecordError` instead.
 Memory is bounded by the block size (``BLOCK_SAMPLES`` samples, one chunk of the file), never by
 the length of the recording.
 """
+
 from __future__ import annotations
 
 import heapq
@@ -40,8 +41,17 @@ from ..errors import BagError, CdrLayoutError, DamageCount, McapFormatError, as_
 from . import cdr, mcap
 from .bags import TYPESTORE, check_bag_path, only_topic
 from .csv_reader import csv_blocks, csv_layout
-from .fields import (DEFAULT_COMPONENT, DEFAULT_INPUT_TOPIC, FLOAT64, INPUT_TYPES,
-                     check_component, component_getter, normalise_type, seconds_since, stamp_ns)
+from .fields import (
+    DEFAULT_COMPONENT,
+    DEFAULT_INPUT_TOPIC,
+    FLOAT64,
+    INPUT_TYPES,
+    check_component,
+    component_getter,
+    normalise_type,
+    seconds_since,
+    stamp_ns,
+)
 
 #: samples per block handed to the estimator (bags: chunks are grouped up to this size)
 BLOCK_SAMPLES = 1 << 18
@@ -88,8 +98,13 @@ def is_csv(path) -> bool:
     return Path(path).suffix.lower() in ('.csv', '.txt')
 
 
-def open_signal(path, topic: Optional[str] = None, component: Optional[str] = None,
-                column: Optional[str] = None, strict: bool = False) -> Signal:
+def open_signal(
+    path,
+    topic: Optional[str] = None,
+    component: Optional[str] = None,
+    column: Optional[str] = None,
+    strict: bool = False,
+) -> Signal:
     """Open a CSV file or a bag for streaming; raises CsvError, BagError or ValueError (bad
     component) before any sample is read."""
     path = Path(path)
@@ -104,6 +119,7 @@ def csv_signal(path: Path, column: Optional[str]) -> Signal:
 
 
 # ----------------------------------------------------------------------------------------- bags
+
 
 def open_rosbags(path: Path):
     """An open ``rosbags`` reader of ``path``; BagError (with the reindex hint) if it is none."""
@@ -134,20 +150,28 @@ def choose_topic(path: Path, topics: Dict[str, str], topic: Optional[str]) -> st
     if topic is None:
         candidates = supported_topics(topics)
         if len(candidates) > 1 and '/' + DEFAULT_INPUT_TOPIC in candidates:
-            return '/' + DEFAULT_INPUT_TOPIC       # what estimator_node subscribes to by default
-        return only_topic(path, [f'{n} ({k})' for n, k in candidates.items()], 'input-type',
-                          listing, f' with --topic, e.g. `vib-estimator analyze {path} --topic '
-                          f'{next(iter(candidates), "")}`')
+            return '/' + DEFAULT_INPUT_TOPIC  # what estimator_node subscribes to by default
+        return only_topic(
+            path,
+            [f'{n} ({k})' for n, k in candidates.items()],
+            'input-type',
+            listing,
+            f' with --topic, e.g. `vib-estimator analyze {path} --topic '
+            f'{next(iter(candidates), "")}`',
+        )
     if topic not in topics:
         raise BagError(f'bag {path} has no topic {topic!r}; its topics are {listing}')
     if topics[topic] not in INPUT_TYPES:
-        raise BagError(f'topic {topic} of bag {path} has type {topics[topic]}, not one of '
-                       f'{", ".join(INPUT_TYPES)}')
+        raise BagError(
+            f'topic {topic} of bag {path} has type {topics[topic]}, not one of '
+            f'{", ".join(INPUT_TYPES)}'
+        )
     return topic
 
 
-def bag_signal(path: Path, topic: Optional[str], component: Optional[str],
-               strict: bool = False) -> Signal:
+def bag_signal(
+    path: Path, topic: Optional[str], component: Optional[str], strict: bool = False
+) -> Signal:
     """A topic of a bag; ``component`` defaults to the type's ``DEFAULT_COMPONENT``."""
     reader = open_rosbags(path)
     try:
@@ -181,8 +205,9 @@ def _bag_blocks(signal: Signal, files: List[Path]) -> Iterator[Block]:
                 plan = mcap.read_plan(files, signal.topic)
             except McapFormatError:
                 plan = None
-        batches = (_mcap_batches(plan, signal) if plan is not None
-                   else _rosbags_batches(files, signal))
+        batches = (
+            _mcap_batches(plan, signal) if plan is not None else _rosbags_batches(files, signal)
+        )
         yield from _group(_decode(batches, signal))
 
 
@@ -194,8 +219,10 @@ def _counted(signal: Signal, blocks: Iterator[Block], expected: int) -> Iterator
         read += len(block[0])
         yield block
     missing = expected - read - signal.skipped - signal.corrupt
-    signal.count_damage(max(missing, 0), f'{missing} messages of {signal.topic} counted by the '
-                        f'bag were not found in it')
+    signal.count_damage(
+        max(missing, 0),
+        f'{missing} messages of {signal.topic} counted by the bag were not found in it',
+    )
 
 
 def _group(blocks: Iterable[Block]) -> Iterator[Block]:
@@ -218,8 +245,9 @@ def _decode(batches, signal: Signal) -> Iterator[Block]:
     for buf, offsets, lengths, log_times in batches:
         if cdr.is_fixed_layout(signal.msgtype):
             try:
-                stamps, values = cdr.decode_fixed(buf, offsets, lengths, signal.msgtype,
-                                                  signal.component)
+                stamps, values = cdr.decode_fixed(
+                    buf, offsets, lengths, signal.msgtype, signal.component
+                )
                 yield (log_times if stamps is None else stamps), values
                 continue
             except CdrLayoutError:
@@ -236,12 +264,15 @@ def _decode_general(buf, offsets, lengths, log_times, signal: Signal, getter) ->
     raw = buf.tobytes() if isinstance(buf, np.ndarray) else buf
     for off, size, log_time in zip(offsets.tolist(), lengths.tolist(), log_times.tolist()):
         try:
-            msg = TYPESTORE.deserialize_cdr(raw[off:off + size], signal.msgtype)
+            msg = TYPESTORE.deserialize_cdr(raw[off : off + size], signal.msgtype)
             value = getter(msg)
             stamp = log_time if signal.msgtype == FLOAT64 else stamp_ns(msg.header)
         except Exception as err:  # noqa: BLE001 -- rosbags raises what its parsing step does
-            signal.count_damage(1, f'a {signal.topic} message logged at {log_time} ns does not '
-                                f'decode as {signal.msgtype} ({type(err).__name__})')
+            signal.count_damage(
+                1,
+                f'a {signal.topic} message logged at {log_time} ns does not '
+                f'decode as {signal.msgtype} ({type(err).__name__})',
+            )
             continue
         if value is None:
             signal.skipped += 1
@@ -290,8 +321,9 @@ def _mcap_batches(plan: List[mcap.ChunkRead], signal: Signal):
     handles: Dict[Path, object] = {}
     try:
         for chunk in plan:
-            handle = handles.get(chunk.path) or handles.setdefault(chunk.path,
-                                                                   chunk.path.open('rb'))
+            handle = handles.get(chunk.path) or handles.setdefault(
+                chunk.path, chunk.path.open('rb')
+            )
             messages = mcap.read_chunk(handle, chunk)
             signal.count_damage(messages.skipped, messages.damage)
             if len(messages.offsets):

@@ -36,6 +36,7 @@ Parameters (all read-only):
     max_bag_duration (double, 0): split after this many seconds of log time per file; 0 = never.
     max_bag_size (int, 0): split when a file reaches this many bytes; 0 = never.
 """
+
 from __future__ import annotations
 
 import importlib
@@ -49,8 +50,14 @@ from rclpy.duration import Duration
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
-from rosbags.interfaces import (Qos, QosDurability, QosHistory, QosLiveliness, QosReliability,
-                                QosTime)
+from rosbags.interfaces import (
+    Qos,
+    QosDurability,
+    QosHistory,
+    QosLiveliness,
+    QosReliability,
+    QosTime,
+)
 
 from ..errors import BagError, StartupError
 from ..io.bags import STORAGES, BagWriter
@@ -71,8 +78,11 @@ def message_class(msgtype: str):
         raise ImportError(f'message type {msgtype} is not installed') from None
 
 
-def adapted_qos(offered: Iterable[Tuple[ReliabilityPolicy, DurabilityPolicy]],
-                history: HistoryPolicy, depth: int = 0) -> QoSProfile:
+def adapted_qos(
+    offered: Iterable[Tuple[ReliabilityPolicy, DurabilityPolicy]],
+    history: HistoryPolicy,
+    depth: int = 0,
+) -> QoSProfile:
     """A QoS profile that matches every offered (reliability, durability) pair.
 
     rosbag2's adaptive rule: reliable only if every publisher offers reliable (a reliable reader
@@ -83,9 +93,11 @@ def adapted_qos(offered: Iterable[Tuple[ReliabilityPolicy, DurabilityPolicy]],
     reliable = all(r == ReliabilityPolicy.RELIABLE for r, _ in offered)
     latched = bool(offered) and all(d == DurabilityPolicy.TRANSIENT_LOCAL for _, d in offered)
     return QoSProfile(
-        history=history, depth=depth,
+        history=history,
+        depth=depth,
         reliability=ReliabilityPolicy.RELIABLE if reliable else ReliabilityPolicy.BEST_EFFORT,
-        durability=DurabilityPolicy.TRANSIENT_LOCAL if latched else DurabilityPolicy.VOLATILE)
+        durability=DurabilityPolicy.TRANSIENT_LOCAL if latched else DurabilityPolicy.VOLATILE,
+    )
 
 
 def _bag_time(duration: Duration) -> QosTime:
@@ -94,15 +106,21 @@ def _bag_time(duration: Duration) -> QosTime:
 
 def bag_qos(profile: QoSProfile) -> Qos:
     """An offered rclpy QoS profile as rosbag2 records it in the bag's metadata."""
+
     def enum(cls, policy):
         return cls(int(policy)) if int(policy) in {e.value for e in cls} else cls.UNKNOWN
 
-    return Qos(enum(QosHistory, profile.history), profile.depth,
-               enum(QosReliability, profile.reliability), enum(QosDurability, profile.durability),
-               _bag_time(profile.deadline), _bag_time(profile.lifespan),
-               enum(QosLiveliness, profile.liveliness),
-               _bag_time(profile.liveliness_lease_duration),
-               profile.avoid_ros_namespace_conventions)
+    return Qos(
+        enum(QosHistory, profile.history),
+        profile.depth,
+        enum(QosReliability, profile.reliability),
+        enum(QosDurability, profile.durability),
+        _bag_time(profile.deadline),
+        _bag_time(profile.lifespan),
+        enum(QosLiveliness, profile.liveliness),
+        _bag_time(profile.liveliness_lease_duration),
+        profile.avoid_ros_namespace_conventions,
+    )
 
 
 class BagRecorder(Node):
@@ -117,8 +135,12 @@ class BagRecorder(Node):
             raise StartupError(f'invalid topic name in {settings["topics"]}: {err}') from None
         output = settings['output']
         try:
-            self._bag = BagWriter(output, settings['storage'], settings['max_bag_size'],
-                                  int(round(settings['max_bag_duration'] * 1e9))).open()
+            self._bag = BagWriter(
+                output,
+                settings['storage'],
+                settings['max_bag_size'],
+                int(round(settings['max_bag_duration'] * 1e9)),
+            ).open()
         except BagError as err:
             raise StartupError(str(err)) from None
         except OSError as err:
@@ -132,12 +154,14 @@ class BagRecorder(Node):
         self.finished = False
         self.exit_code = 0
         self._discovery = self.create_timer(DISCOVERY_PERIOD, self._discover)
-        self.create_timer(settings['flush_period'], self._flush,
-                          clock=Clock(clock_type=ClockType.STEADY_TIME))
+        self.create_timer(
+            settings['flush_period'], self._flush, clock=Clock(clock_type=ClockType.STEADY_TIME)
+        )
         if settings['duration'] > 0:
             self.create_timer(settings['duration'], self._stop)
-        self.get_logger().info(f'recording {", ".join(sorted(self._pending))} into {output} '
-                               f'({settings["storage"]})')
+        self.get_logger().info(
+            f'recording {", ".join(sorted(self._pending))} into {output} ({settings["storage"]})'
+        )
 
     def _declare_parameters(self) -> dict:
         def param(name, default, description):
@@ -148,30 +172,55 @@ class BagRecorder(Node):
             'output': param('output', '', 'bag directory to create (must not exist)'),
             'storage': param('storage', 'mcap', f'storage plugin: {" or ".join(STORAGES)}'),
             'duration': param('duration', 0.0, 'stop after this many seconds; 0 = until SIGINT'),
-            'flush_period': param('flush_period', 1.0, 'seconds between flushes of the recorded '
-                                  'messages to the storage file (crash safety)'),
-            'max_bag_duration': param('max_bag_duration', 0.0, 'split the bag into files of at '
-                                      'most this many seconds; 0 = no split'),
-            'max_bag_size': param('max_bag_size', 0, 'split the bag into files of at most about '
-                                  'this many bytes; 0 = no split'),
+            'flush_period': param(
+                'flush_period',
+                1.0,
+                'seconds between flushes of the recorded '
+                'messages to the storage file (crash safety)',
+            ),
+            'max_bag_duration': param(
+                'max_bag_duration',
+                0.0,
+                'split the bag into files of at most this many seconds; 0 = no split',
+            ),
+            'max_bag_size': param(
+                'max_bag_size',
+                0,
+                'split the bag into files of at most about this many bytes; 0 = no split',
+            ),
         }
-        self.max_messages = param('max_messages', 0,
-                                  'stop after this many messages in all; 0 = no limit')
+        self.max_messages = param(
+            'max_messages', 0, 'stop after this many messages in all; 0 = no limit'
+        )
         if not settings['topics']:
-            raise StartupError('parameter topics is empty: give the topics to record, e.g. '
-                               '-p topics:="[/coupling_torque]"')
+            raise StartupError(
+                'parameter topics is empty: give the topics to record, e.g. '
+                '-p topics:="[/coupling_torque]"'
+            )
         if not settings['output']:
             raise StartupError('parameter output is empty: give the bag directory to create')
         if settings['storage'] not in STORAGES:
-            raise StartupError(f'parameter storage must be one of {", ".join(STORAGES)}, '
-                               f'got {settings["storage"]!r}')
-        if min(settings['duration'], self.max_messages, settings['max_bag_duration'],
-               settings['max_bag_size']) < 0:
-            raise StartupError('parameters duration, max_messages, max_bag_duration and '
-                               'max_bag_size must be >= 0')
+            raise StartupError(
+                f'parameter storage must be one of {", ".join(STORAGES)}, '
+                f'got {settings["storage"]!r}'
+            )
+        if (
+            min(
+                settings['duration'],
+                self.max_messages,
+                settings['max_bag_duration'],
+                settings['max_bag_size'],
+            )
+            < 0
+        ):
+            raise StartupError(
+                'parameters duration, max_messages, max_bag_duration and max_bag_size must be >= 0'
+            )
         if not (math.isfinite(settings['flush_period']) and settings['flush_period'] > 0):
-            raise StartupError(f'parameter flush_period must be a finite number > 0, '
-                               f'got {settings["flush_period"]}')
+            raise StartupError(
+                f'parameter flush_period must be a finite number > 0, '
+                f'got {settings["flush_period"]}'
+            )
         return settings
 
     def _discover(self) -> None:
@@ -182,27 +231,36 @@ class BagRecorder(Node):
                 continue
             types = sorted({info.topic_type for info in infos})
             if len(types) > 1:
-                self.get_logger().warn(f'{topic} is published with several types {types}; '
-                                       f'waiting for one', throttle_duration_sec=5.0)
+                self.get_logger().warn(
+                    f'{topic} is published with several types {types}; waiting for one',
+                    throttle_duration_sec=5.0,
+                )
                 continue
             self._pending.discard(topic)
             try:
                 cls = message_class(types[0])
-                connection = self._bag.add_topic(topic, types[0],
-                                                 [bag_qos(i.qos_profile) for i in infos])
+                connection = self._bag.add_topic(
+                    topic, types[0], [bag_qos(i.qos_profile) for i in infos]
+                )
             except (ImportError, BagError) as err:
                 self.get_logger().error(f'not recording {topic}: {err}')
                 continue
-            qos = adapted_qos(((i.qos_profile.reliability, i.qos_profile.durability)
-                               for i in infos), HistoryPolicy.KEEP_ALL)
-            self.create_subscription(cls, topic, partial(self._on_message, connection), qos,
-                                     raw=True)
+            qos = adapted_qos(
+                ((i.qos_profile.reliability, i.qos_profile.durability) for i in infos),
+                HistoryPolicy.KEEP_ALL,
+            )
+            self.create_subscription(
+                cls, topic, partial(self._on_message, connection), qos, raw=True
+            )
             self.counts[topic] = 0
-            self.get_logger().info(f'recording {topic} ({types[0]}, '
-                                   f'{qos.reliability.name.lower()})')
+            self.get_logger().info(
+                f'recording {topic} ({types[0]}, {qos.reliability.name.lower()})'
+            )
         if self._pending:
-            self.get_logger().info(f'waiting for publishers on {", ".join(sorted(self._pending))}',
-                                   throttle_duration_sec=5.0)
+            self.get_logger().info(
+                f'waiting for publishers on {", ".join(sorted(self._pending))}',
+                throttle_duration_sec=5.0,
+            )
         else:
             self._discovery.cancel()
 
@@ -241,9 +299,13 @@ class BagRecorder(Node):
             self._bag.close()
         except BagError as err:
             self._fail(err)
-        self.get_logger().info(f'recorded {self.message_count} messages: '
-                               + (', '.join(f'{t} {n}' for t, n in sorted(self.counts.items()))
-                                  or 'no topic had a publisher'))
+        self.get_logger().info(
+            f'recorded {self.message_count} messages: '
+            + (
+                ', '.join(f'{t} {n}' for t, n in sorted(self.counts.items()))
+                or 'no topic had a publisher'
+            )
+        )
         super().destroy_node()
 
 

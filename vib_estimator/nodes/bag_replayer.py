@@ -59,6 +59,7 @@ Exits 0 at the end of the bag (unless looping); a bag that cannot be played (mis
 truncated, empty, no ``metadata.yaml``, unknown topic, no topic of an installed type) gives one
 line on stderr and exit code 2.
 """
+
 from __future__ import annotations
 
 import math
@@ -96,10 +97,17 @@ MAX_WAIT_S = 86400.0
 
 def offered_policies(info: TopicInfo):
     """(reliability, durability) rclpy policies of each QoS profile recorded for a bag topic."""
-    return [(ReliabilityPolicy.BEST_EFFORT if q.reliability == QosReliability.BEST_EFFORT
-             else ReliabilityPolicy.RELIABLE,
-             DurabilityPolicy.TRANSIENT_LOCAL if q.durability == QosDurability.TRANSIENT_LOCAL
-             else DurabilityPolicy.VOLATILE) for q in info.offered_qos]
+    return [
+        (
+            ReliabilityPolicy.BEST_EFFORT
+            if q.reliability == QosReliability.BEST_EFFORT
+            else ReliabilityPolicy.RELIABLE,
+            DurabilityPolicy.TRANSIENT_LOCAL
+            if q.durability == QosDurability.TRANSIENT_LOCAL
+            else DurabilityPolicy.VOLATILE,
+        )
+        for q in info.offered_qos
+    ]
 
 
 def parse_remaps(remap: List[str], bag: BagReader) -> Dict[str, str]:
@@ -147,12 +155,18 @@ class BagReplayer(Node):
             if settings['strict']:
                 self._check_records(first_ns)
             self._playback = Playback(
-                lambda: self._bag.messages(list(self._outputs), start_ns=first_ns), first_ns,
-                self.rate, settings['loop'], settings['start_paused'], self._loop_gap_ns())
+                lambda: self._bag.messages(list(self._outputs), start_ns=first_ns),
+                first_ns,
+                self.rate,
+                settings['loop'],
+                settings['start_paused'],
+                self._loop_gap_ns(),
+            )
         except EmptyPlayback:
             self._bag.close()
-            raise StartupError(f'bag {self._bag.path} has no message to play after '
-                               f'start_offset') from None
+            raise StartupError(
+                f'bag {self._bag.path} has no message to play after start_offset'
+            ) from None
         except (BagError, StartupError) as err:
             self._bag.close()
             raise StartupError(str(err)) from None
@@ -160,8 +174,10 @@ class BagReplayer(Node):
         self._warned_damage = False
         self._gate = StartGate(time.monotonic_ns(), settings['delay'], settings['wait_timeout'])
         self._create_timers_and_services(settings['clock_hz'])
-        self.get_logger().info(f'playing {settings["bag"]}: {", ".join(names)} at rate '
-                               f'{self.rate}' + (', paused' if settings['start_paused'] else ''))
+        self.get_logger().info(
+            f'playing {settings["bag"]}: {", ".join(names)} at rate '
+            f'{self.rate}' + (', paused' if settings['start_paused'] else '')
+        )
 
     def _declare_parameters(self) -> dict:
         def param(name, default, description, read_only=True, bounds=None):
@@ -170,44 +186,61 @@ class BagReplayer(Node):
         settings = {
             'bag': param('bag', '', 'bag directory, or .mcap / .db3 file, to play'),
             'loop': param('loop', False, 'start over at the end of the bag'),
-            'start_offset': param('start_offset', 0.0, 'seconds of the bag to skip from its start',
-                                  bounds=(0.0, MAX_SECONDS)),
-            'topics': param('topics', Parameter.Type.STRING_ARRAY,
-                            'topics to play (default: all)') or [],
+            'start_offset': param(
+                'start_offset',
+                0.0,
+                'seconds of the bag to skip from its start',
+                bounds=(0.0, MAX_SECONDS),
+            ),
+            'topics': param('topics', Parameter.Type.STRING_ARRAY, 'topics to play (default: all)')
+            or [],
             'remap': param('remap', Parameter.Type.STRING_ARRAY, 'old:=new topic renames') or [],
-            'clock_hz': param('clock_hz', 0.0, 'publish /clock at this rate when > 0',
-                              bounds=(0.0, MAX_CLOCK_HZ)),
-            'delay': param('delay', 0.0, 'seconds to wait before playing',
-                           bounds=(0.0, MAX_WAIT_S)),
-            'wait_timeout': param('wait_timeout', 5.0, 'seconds to wait at most for subscribers '
-                                  'before playing; 0 = do not wait', bounds=(0.0, MAX_WAIT_S)),
+            'clock_hz': param(
+                'clock_hz', 0.0, 'publish /clock at this rate when > 0', bounds=(0.0, MAX_CLOCK_HZ)
+            ),
+            'delay': param(
+                'delay', 0.0, 'seconds to wait before playing', bounds=(0.0, MAX_WAIT_S)
+            ),
+            'wait_timeout': param(
+                'wait_timeout',
+                5.0,
+                'seconds to wait at most for subscribers before playing; 0 = do not wait',
+                bounds=(0.0, MAX_WAIT_S),
+            ),
             'start_paused': param('start_paused', False, 'start paused'),
-            'strict': param('strict', False, 'refuse a bag with a damaged record (checked before '
-                            'playing) instead of skipping it'),
+            'strict': param(
+                'strict',
+                False,
+                'refuse a bag with a damaged record (checked before '
+                'playing) instead of skipping it',
+            ),
         }
         self.rate = param('rate', 1.0, 'playback speed factor (> 0)', read_only=False)
         if not settings['bag']:
             raise StartupError('parameter bag is required: the bag directory or .mcap/.db3 file')
         for name in ('start_offset', 'clock_hz', 'delay', 'wait_timeout'):
             if not (math.isfinite(settings[name]) and settings[name] >= 0):
-                raise StartupError(f'parameter {name} must be a finite number >= 0, '
-                                   f'got {settings[name]}')
+                raise StartupError(
+                    f'parameter {name} must be a finite number >= 0, got {settings[name]}'
+                )
         if not self._rate_ok(self.rate):
             raise StartupError(f'parameter rate must be a finite number > 0, got {self.rate}')
         return settings
 
     def _create_publishers(self, settings: dict) -> List[str]:
         """One publisher per played topic of an installed type; the names, for the log."""
-        topics = ([self._bag.topic(t).topic for t in settings['topics']]
-                  or list(self._bag.topics))
+        topics = [self._bag.topic(t).topic for t in settings['topics']] or list(self._bag.topics)
         remaps = parse_remaps(settings['remap'], self._bag)
         classes, skipped = playable(self._bag, topics)
         if not classes:
-            raise StartupError(f'nothing to play in bag {self._bag.path}: the message types of '
-                               f'its topics are not installed: {", ".join(skipped)}')
+            raise StartupError(
+                f'nothing to play in bag {self._bag.path}: the message types of '
+                f'its topics are not installed: {", ".join(skipped)}'
+            )
         if skipped:
-            self.get_logger().warn(f'skipping topics whose message type is not installed: '
-                                   f'{", ".join(skipped)}')
+            self.get_logger().warn(
+                f'skipping topics whose message type is not installed: {", ".join(skipped)}'
+            )
         self._outputs = {}
         for topic, cls in classes.items():
             info = self._bag.topics[topic]
@@ -231,9 +264,11 @@ class BagReplayer(Node):
         """The one WARN at the first damaged record skipped."""
         if self._bag.corrupt and not self._warned_damage:
             self._warned_damage = True
-            self.get_logger().warn(f'skipping damaged records of {self._bag.path} (first: '
-                                   f'{self._bag.damage}); they are counted, and strict:=true '
-                                   f'refuses such a bag')
+            self.get_logger().warn(
+                f'skipping damaged records of {self._bag.path} (first: '
+                f'{self._bag.damage}); they are counted, and strict:=true '
+                f'refuses such a bag'
+            )
 
     def _create_timers_and_services(self, clock_hz: float) -> None:
         self.add_on_set_parameters_callback(self._validate_parameters)
@@ -241,7 +276,8 @@ class BagReplayer(Node):
         self._timer = self.create_timer(TICK, self._tick)
         if clock_hz > 0:
             self._clock_pub = self.create_publisher(
-                Clock, '/clock', QoSProfile(depth=1, reliability=ReliabilityPolicy.BEST_EFFORT))
+                Clock, '/clock', QoSProfile(depth=1, reliability=ReliabilityPolicy.BEST_EFFORT)
+            )
             self._clock_timer = self.create_timer(1.0 / clock_hz, self._publish_clock)
         self.create_service(Trigger, '~/pause', self._on_pause)
         self.create_service(Trigger, '~/resume', self._on_resume)
@@ -254,8 +290,9 @@ class BagReplayer(Node):
     def _validate_parameters(self, params) -> SetParametersResult:
         for param in params:
             if param.name == 'rate' and not self._rate_ok(param.value):
-                return SetParametersResult(successful=False,
-                                           reason='rate must be a finite number > 0')
+                return SetParametersResult(
+                    successful=False, reason='rate must be a finite number > 0'
+                )
         return SetParametersResult(successful=True)
 
     def _apply_parameters(self, params) -> None:
@@ -283,11 +320,14 @@ class BagReplayer(Node):
         if not self._gate.is_open(now_ns, not missing, len(missing) < played):
             return False
         if self._gate.timed_out:
-            self.get_logger().warn(f'no subscriber on {", ".join(missing)} after wait_timeout; '
-                                   f'playing anyway')
+            self.get_logger().warn(
+                f'no subscriber on {", ".join(missing)} after wait_timeout; playing anyway'
+            )
         elif self._gate.partial:
-            self.get_logger().info(f'playing: no subscriber on {", ".join(missing)} (yet); the '
-                                   'topics with one do not wait for them')
+            self.get_logger().info(
+                f'playing: no subscriber on {", ".join(missing)} (yet); the '
+                'topics with one do not wait for them'
+            )
         self._playback.start(now_ns)
         return True
 
@@ -311,24 +351,26 @@ class BagReplayer(Node):
             return
         self._report_damage()
         if self._playback.loops != loops:
-            self.get_logger().info(f'end of bag, looping (pass {self._playback.loops + 1})',
-                                   throttle_duration_sec=LOOP_LOG_PERIOD)
+            self.get_logger().info(
+                f'end of bag, looping (pass {self._playback.loops + 1})',
+                throttle_duration_sec=LOOP_LOG_PERIOD,
+            )
         if self._playback.finished:
             self._finish()
 
     def _finish(self) -> None:
         for publisher in self._outputs.values():
             publisher.wait_for_all_acked(Duration(seconds=ACK_TIMEOUT))
-        skipped = (f', {self._bag.corrupt} damaged records skipped' if self._bag.corrupt
-                   else '')
+        skipped = f', {self._bag.corrupt} damaged records skipped' if self._bag.corrupt else ''
         self.get_logger().info(f'end of bag: {self.published} messages published{skipped}')
         self.finished = True
         self._timer.cancel()
 
     def _publish_clock(self) -> None:
         ns = self.bag_time_ns()
-        self._clock_pub.publish(Clock(clock=Time(sec=ns // 1_000_000_000,
-                                                 nanosec=ns % 1_000_000_000)))
+        self._clock_pub.publish(
+            Clock(clock=Time(sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000))
+        )
 
     # -- services ---------------------------------------------------------------------------------
 

@@ -24,6 +24,7 @@ stamped with the receipt time on the node clock (``use_sim_time`` applies). Non-
 duplicate and out-of-order stamps, gaps and backward jumps are the core's business (skipped or
 restarted, and counted); a JointState without the configured joint is skipped and counted here.
 """
+
 from __future__ import annotations
 
 import importlib
@@ -40,12 +41,17 @@ from rclpy.time import Time
 from std_msgs.msg import Float64, Header
 from std_srvs.srv import Trigger
 
-from ..errors import StartupError
 from ..core.config import EstimatorConfig
+from ..errors import StartupError
 from ..io.fields import check_component, check_input_type, component_getter, has_header, stamp_ns
 from . import health as H
-from .parameters import (config_of, config_value, declare_config, declare_input,
-                         warn_unused_params_files)
+from .parameters import (
+    config_of,
+    config_value,
+    declare_config,
+    declare_input,
+    warn_unused_params_files,
+)
 from .runner import run
 from .stream import WARMUP_BUFFER, WARMUP_MESSAGE, EstimatorStream
 
@@ -62,11 +68,19 @@ SERVICE_DEPTH = 1000
 #: the ROS parameters that configure the core, one per EstimatorConfig field
 CORE_NAMES = frozenset(EstimatorConfig.names())
 #: the Float64 outputs of each estimate, in publication order: (topic under vibration/, field)
-FLOAT_OUTPUTS = (('frequency', 'frequency_hz'), ('damping_ratio', 'damping'),
-                 ('frequency_std', 'frequency_std_hz'), ('amplitude', 'amplitude'))
+FLOAT_OUTPUTS = (
+    ('frequency', 'frequency_hz'),
+    ('damping_ratio', 'damping'),
+    ('frequency_std', 'frequency_std_hz'),
+    ('amplitude', 'amplitude'),
+)
 #: health levels as DiagnosticStatus levels
-LEVELS = {H.OK: DiagnosticStatus.OK, H.WARN: DiagnosticStatus.WARN,
-          H.ERROR: DiagnosticStatus.ERROR, H.STALE: DiagnosticStatus.STALE}
+LEVELS = {
+    H.OK: DiagnosticStatus.OK,
+    H.WARN: DiagnosticStatus.WARN,
+    H.ERROR: DiagnosticStatus.ERROR,
+    H.STALE: DiagnosticStatus.STALE,
+}
 
 
 def message_class(input_type: str):
@@ -81,10 +95,12 @@ class Outputs:
     def __init__(self, node: Node):
         self._node = node
         self._msg = Float64()
-        self._floats = [(node.create_publisher(Float64, f'vibration/{topic}', 10), field)
-                        for topic, field in FLOAT_OUTPUTS]
+        self._floats = [
+            (node.create_publisher(Float64, f'vibration/{topic}', 10), field)
+            for topic, field in FLOAT_OUTPUTS
+        ]
         self._reset = node.create_publisher(Header, 'vibration/reset', 10)
-        self._modes = {}    # mode -> (frequency publisher, reset publisher)
+        self._modes = {}  # mode -> (frequency publisher, reset publisher)
 
     def set_modes(self, modes: int) -> None:
         """Publishers for modes 1..``modes``; those of higher modes are destroyed."""
@@ -98,7 +114,8 @@ class Outputs:
         if k not in self._modes:
             self._modes[k] = (
                 self._node.create_publisher(Float64, f'vibration/mode{k}/frequency', 10),
-                self._node.create_publisher(Header, f'vibration/mode{k}/reset', 10))
+                self._node.create_publisher(Header, f'vibration/mode{k}/reset', 10),
+            )
         return self._modes[k]
 
     def publish(self, estimate, header: Header) -> None:
@@ -126,13 +143,14 @@ class EstimatorNode(Node):
         #: warnings about params files that set nothing for this node (also logged)
         self.params_file_warnings = warn_unused_params_files(self, kwargs.get('cli_args'))
         try:
-            self._component = check_component(self.get_parameter('component').value,
-                                              self._input_type)
+            self._component = check_component(
+                self.get_parameter('component').value, self._input_type
+            )
             self._value = component_getter(self._component, self._input_type)
             self._stream = EstimatorStream(config_of(self), time.monotonic(), background=True)
         except ValueError as err:
             raise StartupError(str(err)) from None
-        self._feed = self._stream.feed     # bound once (data path)
+        self._feed = self._stream.feed  # bound once (data path)
         self._ready = self._stream.ready
         self._clock = self.get_clock()
         self._outputs = Outputs(self)
@@ -142,11 +160,17 @@ class EstimatorNode(Node):
         service_qos = QoSProfile(depth=SERVICE_DEPTH, reliability=ReliabilityPolicy.RELIABLE)
         self.create_service(Trigger, '~/reset', self._on_reset, qos_profile=service_qos)
         self.create_service(Trigger, '~/self_test', self._on_self_test, qos_profile=service_qos)
-        qos = QoSProfile(depth=INPUT_DEPTH, reliability=qos_profile_sensor_data.reliability,
-                         durability=qos_profile_sensor_data.durability)
+        qos = QoSProfile(
+            depth=INPUT_DEPTH,
+            reliability=qos_profile_sensor_data.reliability,
+            durability=qos_profile_sensor_data.durability,
+        )
         self._subscription = self.create_subscription(
-            message_class(self._input_type), topic,
-            self._on_stamped if has_header(self._input_type) else self._on_unstamped, qos)
+            message_class(self._input_type),
+            topic,
+            self._on_stamped if has_header(self._input_type) else self._on_unstamped,
+            qos,
+        )
         self.add_on_set_parameters_callback(self._check_parameters)
         self.add_post_set_parameters_callback(self._apply_parameters)
         self._diagnostics_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
@@ -156,9 +180,11 @@ class EstimatorNode(Node):
         # while the kernels compile (a first start: see .stream), look for the end of the warm-up
         self._warmup_timer = self.create_timer(WARMUP_POLL, self._poll_warmup, clock=steady)
         self._warmup_logged = False
-        self.get_logger().info(f'estimating on {self._subscription.topic_name} '
-                               f'({self._input_type} [{self._component}]) with '
-                               f'{self._stream.config}')
+        self.get_logger().info(
+            f'estimating on {self._subscription.topic_name} '
+            f'({self._input_type} [{self._component}]) with '
+            f'{self._stream.config}'
+        )
 
     # ---- parameters ------------------------------------------------------------------------
     def _check_parameters(self, parameters) -> SetParametersResult:
@@ -186,8 +212,10 @@ class EstimatorNode(Node):
         if not self._ready:
             self._warmup_logged = False
             self._warmup_timer.reset()
-        self.get_logger().info(f'parameters {", ".join(sorted(names))} changed: estimator '
-                               f'restarted on [{self._component}] with {self._stream.config}')
+        self.get_logger().info(
+            f'parameters {", ".join(sorted(names))} changed: estimator '
+            f'restarted on [{self._component}] with {self._stream.config}'
+        )
 
     # ---- data path -------------------------------------------------------------------------
     def _on_stamped(self, msg) -> None:
@@ -232,48 +260,63 @@ class EstimatorNode(Node):
             self.get_logger().warn(
                 f'{self._subscription.topic_name}: more than {WARMUP_BUFFER} samples arrived '
                 'while the estimator kernels compiled: the oldest are dropped (counted as '
-                'dropped_warmup; `vib-estimator warmup` compiles them ahead of a start)')
+                'dropped_warmup; `vib-estimator warmup` compiles them ahead of a start)'
+            )
 
     def _poll_warmup(self) -> None:
         """At the end of a warm-up: install the estimator, estimate on the held samples (in order)
         and say how long it took."""
         try:
             drained = self._stream.poll()
-        except Exception as err:     # a compile that failed: say so, never a silent node
+        except Exception as err:  # a compile that failed: say so, never a silent node
             self._warmup_timer.cancel()
             self.get_logger().error(f'the estimator kernels failed to compile: {err}')
             raise StartupError(f'the estimator kernels failed to compile: {err}') from None
         if drained is None:
-            if not self._warmup_logged and \
-                    self._stream.warmup_elapsed(time.monotonic()) > WARMUP_NOTICE:
+            if (
+                not self._warmup_logged
+                and self._stream.warmup_elapsed(time.monotonic()) > WARMUP_NOTICE
+            ):
                 self._warmup_logged = True
-                self.get_logger().info(f'{WARMUP_MESSAGE}: samples are held until they are '
-                                       'ready (`vib-estimator warmup` compiles them ahead)')
+                self.get_logger().info(
+                    f'{WARMUP_MESSAGE}: samples are held until they are '
+                    'ready (`vib-estimator warmup` compiles them ahead)'
+                )
             return
         self._warmup_timer.cancel()
         held = self._stream.held_samples
         for header, estimates in drained:
-            self._publish(estimates, header if header is not None else
-                          Header(stamp=Time(nanoseconds=self._stream.origin).to_msg()))
+            self._publish(
+                estimates,
+                header
+                if header is not None
+                else Header(stamp=Time(nanoseconds=self._stream.origin).to_msg()),
+            )
         self._ready = True
-        self.get_logger().info(f'estimator kernels ready after {self._stream.warmup_seconds:.1f} s'
-                               f' ({held} samples held meanwhile, '
-                               f'{self._stream.health.node_counters["dropped_warmup"]} dropped)')
+        self.get_logger().info(
+            f'estimator kernels ready after {self._stream.warmup_seconds:.1f} s'
+            f' ({held} samples held meanwhile, '
+            f'{self._stream.health.node_counters["dropped_warmup"]} dropped)'
+        )
 
     def _replace_zero_stamp(self, header: Header) -> None:
         """Stamp a message that came without one with its receipt time (node clock)."""
         header.stamp = self._clock.now().to_msg()
-        if self._stream.health.count('zero_stamps_replaced') == 1:   # warn once (rclpy's once=True
+        if self._stream.health.count('zero_stamps_replaced') == 1:  # warn once (rclpy's once=True
             # costs ~0.15 ms a call)
-            self.get_logger().warn(f'{self._subscription.topic_name}: zero header stamps are '
-                                   'replaced by the receipt time (counted in the diagnostics)')
+            self.get_logger().warn(
+                f'{self._subscription.topic_name}: zero header stamps are '
+                'replaced by the receipt time (counted in the diagnostics)'
+            )
 
     def _skip_joint_missing(self) -> None:
         """Count (and the first time, log) a JointState message without the configured joint."""
         if self._stream.health.count('skipped_joint_missing') == 1:
-            self.get_logger().warn(f'{self._subscription.topic_name}: messages without the '
-                                   f'joint of [{self._component}] are skipped (counted in the '
-                                   'diagnostics)')
+            self.get_logger().warn(
+                f'{self._subscription.topic_name}: messages without the '
+                f'joint of [{self._component}] are skipped (counted in the '
+                'diagnostics)'
+            )
 
     # ---- services --------------------------------------------------------------------------
     def _on_reset(self, request, response):
@@ -286,7 +329,7 @@ class EstimatorNode(Node):
         """``~/self_test``: three tones through a fresh estimator of the live configuration."""
         response.success, response.message = self._stream.self_test()
         text = 'self test ' + response.message.replace('\n', '; ')
-        if response.success:   # one call site per severity (rclpy refuses a change)
+        if response.success:  # one call site per severity (rclpy refuses a change)
             self.get_logger().info(text)
         else:
             self.get_logger().warn(text)
@@ -305,18 +348,29 @@ class EstimatorNode(Node):
         status = self._stream.status(time.monotonic())
         if status.log:
             self.get_logger().warn(status.log)
-        array = DiagnosticArray(status=[DiagnosticStatus(
-            level=LEVELS[status.level], name=self.get_fully_qualified_name(),
-            message=status.message, hardware_id=self._subscription.topic_name,
-            values=[KeyValue(key=key, value=H.format_value(value))
-                    for key, value in status.values.items()])])
+        array = DiagnosticArray(
+            status=[
+                DiagnosticStatus(
+                    level=LEVELS[status.level],
+                    name=self.get_fully_qualified_name(),
+                    message=status.message,
+                    hardware_id=self._subscription.topic_name,
+                    values=[
+                        KeyValue(key=key, value=H.format_value(value))
+                        for key, value in status.values.items()
+                    ],
+                )
+            ]
+        )
         array.header.stamp = self._clock.now().to_msg()
         self._diagnostics_pub.publish(array)
         estimate = self._stream.health.last_estimate
         if estimate is not None:
-            self.get_logger().info(f'{status.message}: last {estimate.frequency_hz:.4f} Hz '
-                                   f'after {estimate.convergence_time:.3f} s',
-                                   throttle_duration_sec=10.0)
+            self.get_logger().info(
+                f'{status.message}: last {estimate.frequency_hz:.4f} Hz '
+                f'after {estimate.convergence_time:.3f} s',
+                throttle_duration_sec=10.0,
+            )
 
 
 def main(args=None):

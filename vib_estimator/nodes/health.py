@@ -10,6 +10,7 @@ period, and converts the returned :class:`Status` to a ``diagnostic_msgs/Diagnos
 Times ``now`` are seconds of a monotonic clock (the node passes ``time.monotonic()``); ``last_t``
 is the time base of the estimator (seconds since the first stamp).
 """
+
 from __future__ import annotations
 
 import math
@@ -23,8 +24,14 @@ DIAGNOSTICS_PERIOD = 1.0
 #: the status goes STALE when no input arrived for this long, s
 STALE_AFTER = 2.0
 #: core counters that grow when the quality gate holds a converged estimate back, or none forms
-HELD_BACK = ('rejected_at_rest', 'rejected_fit', 'rejected_nyquist', 'rejected_damping',
-             'rejected_inconsistent', 'max_window_resets')
+HELD_BACK = (
+    'rejected_at_rest',
+    'rejected_fit',
+    'rejected_nyquist',
+    'rejected_damping',
+    'rejected_inconsistent',
+    'max_window_resets',
+)
 #: core counters of bad input: their growth since the previous status makes it WARN (and is logged
 #: once per episode)
 BAD_INPUT = ('gaps', 'samples_lost', 'skipped_outlier')
@@ -32,8 +39,12 @@ BAD_INPUT = ('gaps', 'samples_lost', 'skipped_outlier')
 #: without the configured joint (skipped); samples received while ``band_hz`` reached above the
 #: Nyquist frequency of the input's sampling rate; samples dropped while the kernels compiled (the
 #: oldest beyond the warm-up buffer of :mod:`.stream`)
-NODE_COUNTERS = ('zero_stamps_replaced', 'skipped_joint_missing', 'band_above_nyquist',
-                 'dropped_warmup')
+NODE_COUNTERS = (
+    'zero_stamps_replaced',
+    'skipped_joint_missing',
+    'band_above_nyquist',
+    'dropped_warmup',
+)
 
 
 @dataclass(frozen=True)
@@ -52,11 +63,11 @@ class _Tick:
     """The state at the previous :meth:`Health.status` call."""
 
     at: float
-    messages: int = 0       # received by the core + skipped by the node
+    messages: int = 0  # received by the core + skipped by the node
     joint_missing: int = 0
     used: int = 0
     last_t: Optional[float] = None
-    bad: Optional[Dict[str, int]] = None     # the BAD_INPUT counters
+    bad: Optional[Dict[str, int]] = None  # the BAD_INPUT counters
 
 
 @dataclass
@@ -83,8 +94,8 @@ class Health:
         self.node_counters: Dict[str, int] = dict.fromkeys(NODE_COUNTERS, 0)
         #: sampling rate of the input from its stamps (NaN until known), Hz
         self.sample_rate_hz = math.nan
-        self._base: Dict[str, int] = {}          # core counters of the replaced estimators
-        self._last: Optional[_Last] = None       # what vibration/frequency carried last
+        self._base: Dict[str, int] = {}  # core counters of the replaced estimators
+        self._last: Optional[_Last] = None  # what vibration/frequency carried last
         self._modes: Dict[int, _Last] = {}
         self._held_at: Dict[str, int] = dict.fromkeys(HELD_BACK, 0)
         self._tick = _Tick(now)
@@ -133,8 +144,14 @@ class Health:
         self._modes = {k: v for k, v in self._modes.items() if k <= modes}
 
     # ---- status ------------------------------------------------------------------------------
-    def status(self, now: float, totals: Mapping[str, int], last_t: Optional[float],
-               band_hz: Optional[Sequence[float]] = None, modes: int = 0) -> Status:
+    def status(
+        self,
+        now: float,
+        totals: Mapping[str, int],
+        last_t: Optional[float],
+        band_hz: Optional[Sequence[float]] = None,
+        modes: int = 0,
+    ) -> Status:
         """The status at ``now``; updates the rates and the ``band_above_nyquist`` counter.
 
         STALE without input for :attr:`stale_after` s; WARN when a :data:`HELD_BACK` counter grew
@@ -152,8 +169,10 @@ class Health:
         held = {name: totals.get(name, 0) - self._held_at[name] for name in HELD_BACK}
         problems = []
         if any(held.values()):
-            problems.append('held back since the last estimate: ' + ', '.join(
-                f'{name} {n}' for name, n in held.items() if n))
+            problems.append(
+                'held back since the last estimate: '
+                + ', '.join(f'{name} {n}' for name, n in held.items() if n)
+            )
         if missing:
             problems.append(f'{missing} messages without the joint')
         if nyquist:
@@ -170,11 +189,22 @@ class Health:
             level, message = OK, 'waiting for a first estimate'
         else:
             level, message = OK, 'estimating'
-        self._tick = _Tick(now, messages, totals['skipped_joint_missing'], totals.get('used', 0),
-                           last_t, {name: totals.get(name, 0) for name in BAD_INPUT})
-        values = {**self._estimate_values(now), 'input_rate_hz': input_rate,
-                  'sample_rate_hz': self.sample_rate_hz, **self._mode_values(now, modes),
-                  **totals, **self.node_counters}
+        self._tick = _Tick(
+            now,
+            messages,
+            totals['skipped_joint_missing'],
+            totals.get('used', 0),
+            last_t,
+            {name: totals.get(name, 0) for name in BAD_INPUT},
+        )
+        values = {
+            **self._estimate_values(now),
+            'input_rate_hz': input_rate,
+            'sample_rate_hz': self.sample_rate_hz,
+            **self._mode_values(now, modes),
+            **totals,
+            **self.node_counters,
+        }
         return Status(level, message, values, log)
 
     def _check_bad_input(self, totals: Mapping[str, int]):
@@ -185,9 +215,11 @@ class Health:
         if not any(grown.values()):
             self._bad_warned = False
             return None, None
-        text = (f'input since the last status: {grown["gaps"]} gaps ({grown["samples_lost"]} '
-                f'samples lost; each restarts the estimate), {grown["skipped_outlier"]} outliers '
-                'skipped')
+        text = (
+            f'input since the last status: {grown["gaps"]} gaps ({grown["samples_lost"]} '
+            f'samples lost; each restarts the estimate), {grown["skipped_outlier"]} outliers '
+            'skipped'
+        )
         hint = ': check the sensor and its stamps (a lasting change of rate costs one gap)'
         log = None if self._bad_warned else text + hint
         self._bad_warned = True
@@ -217,9 +249,11 @@ class Health:
             self._band_warned = None
             return None, None
         self.count('band_above_nyquist', received)
-        text = (f'band_hz upper edge {band_hz[1]:g} Hz is at or above the Nyquist frequency '
-                f'{nyquist:.6g} Hz of the input (sampled at {self.sample_rate_hz:.6g} Hz): '
-                'no estimate can form')
+        text = (
+            f'band_hz upper edge {band_hz[1]:g} Hz is at or above the Nyquist frequency '
+            f'{nyquist:.6g} Hz of the input (sampled at {self.sample_rate_hz:.6g} Hz): '
+            'no estimate can form'
+        )
         key = tuple(band_hz)
         log = None if self._band_warned == key else text
         self._band_warned = key

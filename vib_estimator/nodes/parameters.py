@@ -2,6 +2,7 @@
 a value the node cannot start with becomes a :class:`~vib_estimator.nodes.runner.StartupError`, and
 the estimator's parameters (one per :class:`EstimatorConfig` field) declared and read back.
 """
+
 from __future__ import annotations
 
 import sys
@@ -12,15 +13,21 @@ from rclpy.exceptions import ParameterException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from ..errors import StartupError
 from ..core.config import EstimatorConfig
-from ..io.fields import (DEFAULT_COMPONENT, DEFAULT_INPUT_TOPIC, INPUT_TYPES, WRENCH_STAMPED,
-                         check_input_type, describe_components)
+from ..errors import StartupError
+from ..io.fields import (
+    DEFAULT_COMPONENT,
+    DEFAULT_INPUT_TOPIC,
+    INPUT_TYPES,
+    WRENCH_STAMPED,
+    check_input_type,
+    describe_components,
+)
 
 
-
-def descriptor(description: str, bounds: Optional[Sequence] = None, read_only: bool = False,
-               **extra) -> ParameterDescriptor:
+def descriptor(
+    description: str, bounds: Optional[Sequence] = None, read_only: bool = False, **extra
+) -> ParameterDescriptor:
     """A ParameterDescriptor; ``bounds`` = (lo, hi, ...) adds an integer range when both bounds
     are ints, else a floating-point range (closed: open bounds are the validator's business)."""
     d = ParameterDescriptor(description=description, read_only=read_only, **extra)
@@ -29,8 +36,7 @@ def descriptor(description: str, bounds: Optional[Sequence] = None, read_only: b
         if isinstance(lo, int) and isinstance(hi, int):
             d.integer_range = [IntegerRange(from_value=lo, to_value=hi, step=1)]
         else:
-            d.floating_point_range = [FloatingPointRange(from_value=float(lo),
-                                                         to_value=float(hi))]
+            d.floating_point_range = [FloatingPointRange(from_value=float(lo), to_value=float(hi))]
     return d
 
 
@@ -50,8 +56,9 @@ def declare(node: Node, name: str, default, desc: ParameterDescriptor):
 
 def config_value(value):
     """A ROS parameter value as EstimatorConfig takes it: an empty array (or none) is None."""
-    if value is None or (not isinstance(value, str) and hasattr(value, '__len__')
-                         and len(value) == 0):
+    if value is None or (
+        not isinstance(value, str) and hasattr(value, '__len__') and len(value) == 0
+    ):
         return None
     return value
 
@@ -66,8 +73,9 @@ def declare_config(node: Node) -> None:
         if default is None:
             # an optional array, off by default: rclpy cannot infer a type from [], so declare
             # the type and store an empty array unless an override set a value
-            declare(node, name, Parameter.Type.DOUBLE_ARRAY,
-                    descriptor(description + ' ([] = off)'))
+            declare(
+                node, name, Parameter.Type.DOUBLE_ARRAY, descriptor(description + ' ([] = off)')
+            )
             if node.get_parameter_or(name).type_ == Parameter.Type.NOT_SET:
                 node.set_parameters([Parameter(name, Parameter.Type.DOUBLE_ARRAY, [])])
         else:
@@ -76,23 +84,36 @@ def declare_config(node: Node) -> None:
 
 def config_of(node: Node) -> EstimatorConfig:
     """The EstimatorConfig of the node's current parameter values (ValueError if invalid)."""
-    return EstimatorConfig().replace(**{name: config_value(node.get_parameter(name).value)
-                                        for name in EstimatorConfig.names()})
+    return EstimatorConfig().replace(
+        **{name: config_value(node.get_parameter(name).value) for name in EstimatorConfig.names()}
+    )
 
 
 def declare_input(node: Node, default_topic: str = DEFAULT_INPUT_TOPIC):
     """Declare ``input_type`` and ``input_topic`` (read-only) and ``component`` (its default
     that of the type); return (the type's full name, the topic)."""
-    input_type = declare(node, 'input_type', WRENCH_STAMPED, descriptor(
-        f'input message type, one of {", ".join(INPUT_TYPES)}', read_only=True))
+    input_type = declare(
+        node,
+        'input_type',
+        WRENCH_STAMPED,
+        descriptor(f'input message type, one of {", ".join(INPUT_TYPES)}', read_only=True),
+    )
     try:
         input_type = check_input_type(input_type)
     except ValueError as err:
         raise StartupError(str(err)) from None
-    topic = declare(node, 'input_topic', default_topic, descriptor(
-        'input topic, of type input_type', read_only=True))
-    declare(node, 'component', DEFAULT_COMPONENT[input_type], descriptor(
-        f'field of the input to estimate on: {describe_components(input_type)}'))
+    topic = declare(
+        node,
+        'input_topic',
+        default_topic,
+        descriptor('input topic, of type input_type', read_only=True),
+    )
+    declare(
+        node,
+        'component',
+        DEFAULT_COMPONENT[input_type],
+        descriptor(f'field of the input to estimate on: {describe_components(input_type)}'),
+    )
     return input_type, topic
 
 
@@ -135,12 +156,12 @@ def _node_sections(data, prefix: str = '') -> Iterable[Tuple[str, dict]]:
         path = f'{prefix}/{str(key).strip("/")}'
         if isinstance(value.get('ros__parameters'), dict):
             yield path, value['ros__parameters']
-        yield from _node_sections({k: v for k, v in value.items() if k != 'ros__parameters'},
-                                  path)
+        yield from _node_sections({k: v for k, v in value.items() if k != 'ros__parameters'}, path)
 
 
-def params_file_warnings(files: Sequence[str], node_name: str,
-                         declared: Iterable[str]) -> List[str]:
+def params_file_warnings(
+    files: Sequence[str], node_name: str, declared: Iterable[str]
+) -> List[str]:
     """A warning per params file that sets nothing this node (fully qualified ``node_name``,
     parameters ``declared``) has: no key matches the node, or only unknown names do."""
     import yaml
@@ -151,16 +172,20 @@ def params_file_warnings(files: Sequence[str], node_name: str,
             with open(path) as f:
                 sections = list(_node_sections(yaml.safe_load(f)))
         except (OSError, yaml.YAMLError):
-            continue            # rcl has already refused such a file
+            continue  # rcl has already refused such a file
         keys = [key for key, _ in sections]
         names = {n for key, params in sections if _key_matches(key, node_name) for n in params}
         if not names:
-            warnings.append(f'params file {path} sets nothing for {node_name} (its node keys: '
-                            f'{", ".join(keys) or "none"}); key it "/**:" to apply it under any '
-                            'name and namespace')
+            warnings.append(
+                f'params file {path} sets nothing for {node_name} (its node keys: '
+                f'{", ".join(keys) or "none"}); key it "/**:" to apply it under any '
+                'name and namespace'
+            )
         elif not names & declared:
-            warnings.append(f'params file {path} sets only parameters {node_name} does not '
-                            f'have: {", ".join(sorted(names))}')
+            warnings.append(
+                f'params file {path} sets only parameters {node_name} does not '
+                f'have: {", ".join(sorted(names))}'
+            )
     return warnings
 
 

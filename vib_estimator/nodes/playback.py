@@ -13,6 +13,7 @@ publishes them, and publishes :meth:`Playback.bag_time_ns` on ``/clock``.
 every played topic has a subscriber -- or ``wait_timeout`` has passed since the replayer started
 (``wait_timeout = 0``: do not wait). All times are integer nanoseconds of the caller's steady clock.
 """
+
 from __future__ import annotations
 
 from typing import Callable, Iterator, Optional, Protocol
@@ -56,8 +57,9 @@ class StartGate:
             return False
         if subscribers_matched:
             return True
-        if self._first_match_ns is not None and \
-                now_ns >= self._first_match_ns + int(SETTLE_S * 1e9):
+        if self._first_match_ns is not None and now_ns >= self._first_match_ns + int(
+            SETTLE_S * 1e9
+        ):
             self.partial = True
             return True
         if now_ns >= self.deadline_ns:
@@ -83,9 +85,15 @@ class Playback:
     Raises :class:`EmptyPlayback` when ``open_messages()`` yields nothing.
     """
 
-    def __init__(self, open_messages: Callable[[], Iterator[Message]], first_ns: int,
-                 rate: float = 1.0, loop: bool = False, paused: bool = False,
-                 loop_gap_ns: int = 0) -> None:
+    def __init__(
+        self,
+        open_messages: Callable[[], Iterator[Message]],
+        first_ns: int,
+        rate: float = 1.0,
+        loop: bool = False,
+        paused: bool = False,
+        loop_gap_ns: int = 0,
+    ) -> None:
         self._open = open_messages
         self.loop_gap_ns = max(0, int(loop_gap_ns))
         self.first_ns = first_ns

@@ -13,6 +13,7 @@ executor is :class:`rclpy.experimental.EventsExecutor`: measured by ``benchmarks
 sustains several times the message rate of the default ``SingleThreadedExecutor`` on this package's
 workload (see the README's figures).
 """
+
 from __future__ import annotations
 
 import os
@@ -32,9 +33,6 @@ from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
 from ..errors import StartupError
-
-
-
 
 #: rcl's error text cites its C sources (", at /project/src/rcl/arguments.c:356"); cut from there
 _RCL_LOCATION = re.compile(r',? at /\S+:\d+')
@@ -102,8 +100,11 @@ def spin_until(executor, predicate: Callable[[], bool], timeout: float) -> bool:
     return predicate()
 
 
-def run(factory: Callable[[], Node], args: Optional[Sequence[str]] = None,
-        done: Optional[Callable[[Node], bool]] = None) -> int:
+def run(
+    factory: Callable[[], Node],
+    args: Optional[Sequence[str]] = None,
+    done: Optional[Callable[[Node], bool]] = None,
+) -> int:
     """Initialise rclpy, build the node with ``factory`` and spin it until shutdown.
 
     ``done(node)``, when given, is polled between callbacks; spinning stops when it returns True
@@ -129,7 +130,7 @@ def run(factory: Callable[[], Node], args: Optional[Sequence[str]] = None,
     except StartupError as err:
         print(f'error: {err}', file=sys.stderr)
         code = 2
-    except (NameValidationException, RCLError) as err:     # e.g. -p input_topic:=1bad
+    except (NameValidationException, RCLError) as err:  # e.g. -p input_topic:=1bad
         print(f'error: {argument_error(err)}', file=sys.stderr)
         code = 2
     except (KeyboardInterrupt, ExternalShutdownException):

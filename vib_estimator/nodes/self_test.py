@@ -7,6 +7,7 @@ error of each tone's estimates. The tones sit across the configured ``band_hz`` 
 node answers its ``~/self_test`` service with it, off the data path: the live estimator is not
 touched. (ArduPilot's GyroFFT has the same kind of check.)
 """
+
 from __future__ import annotations
 
 import math
@@ -37,8 +38,8 @@ class ToneResult:
 
     frequency_hz: float
     estimates: int
-    median_hz: float          # NaN without estimates
-    note: str = ''            # why no estimate could be expected (e.g. above Nyquist)
+    median_hz: float  # NaN without estimates
+    note: str = ''  # why no estimate could be expected (e.g. above Nyquist)
 
     @property
     def error(self) -> float:
@@ -54,8 +55,10 @@ class ToneResult:
             return f'{self.frequency_hz:.4g} Hz: {self.note}'
         if not self.estimates:
             return f'{self.frequency_hz:.4g} Hz: no estimate'
-        return (f'{self.frequency_hz:.4g} Hz: median {self.median_hz:.6g} Hz of '
-                f'{self.estimates} estimates, error {100 * self.error:+.4f} %')
+        return (
+            f'{self.frequency_hz:.4g} Hz: median {self.median_hz:.6g} Hz of '
+            f'{self.estimates} estimates, error {100 * self.error:+.4f} %'
+        )
 
 
 def default_band(sample_rate_hz: float) -> Tuple[float, float]:
@@ -64,19 +67,23 @@ def default_band(sample_rate_hz: float) -> Tuple[float, float]:
     return sample_rate_hz / 250, sample_rate_hz / 25
 
 
-def tone_frequencies(band_hz: Optional[Tuple[float, float]],
-                     sample_rate_hz: float) -> List[float]:
+def tone_frequencies(band_hz: Optional[Tuple[float, float]], sample_rate_hz: float) -> List[float]:
     """Three tones at 1/4, 1/2 and 3/4 of the band on a logarithmic scale."""
     lo, hi = band_hz if band_hz is not None else default_band(sample_rate_hz)
     return [lo * (hi / lo) ** q for q in (0.25, 0.5, 0.75)]
 
 
-def run_tone(config: EstimatorConfig, frequency_hz: float, sample_rate_hz: float,
-             seed: int = SEED) -> ToneResult:
+def run_tone(
+    config: EstimatorConfig, frequency_hz: float, sample_rate_hz: float, seed: int = SEED
+) -> ToneResult:
     """One tone through a fresh estimator of ``config``."""
     if frequency_hz >= sample_rate_hz / 2:
-        return ToneResult(frequency_hz, 0, math.nan,
-                          f'above the Nyquist frequency {sample_rate_hz / 2:.6g} Hz of the input')
+        return ToneResult(
+            frequency_hz,
+            0,
+            math.nan,
+            f'above the Nyquist frequency {sample_rate_hz / 2:.6g} Hz of the input',
+        )
     periods = max(PERIODS, 4 * (config.min_periods + 1))
     n = min(MAX_SAMPLES, int(math.ceil(periods * sample_rate_hz / frequency_hz)))
     rng = np.random.default_rng(seed)
@@ -89,18 +96,22 @@ def run_tone(config: EstimatorConfig, frequency_hz: float, sample_rate_hz: float
     return ToneResult(frequency_hz, len(estimates), median)
 
 
-def self_test(config: EstimatorConfig, sample_rate_hz: Optional[float] = None
-              ) -> Tuple[bool, str]:
+def self_test(config: EstimatorConfig, sample_rate_hz: Optional[float] = None) -> Tuple[bool, str]:
     """(all tones passed, one line per tone) for ``config`` at the input's sampling rate
     (:data:`DEFAULT_RATE_HZ` when not known)."""
-    rate = sample_rate_hz if sample_rate_hz and math.isfinite(sample_rate_hz) \
-        else DEFAULT_RATE_HZ
-    results = [run_tone(config, f, rate, SEED + i)
-               for i, f in enumerate(tone_frequencies(config.band_hz, rate))]
+    rate = sample_rate_hz if sample_rate_hz and math.isfinite(sample_rate_hz) else DEFAULT_RATE_HZ
+    results = [
+        run_tone(config, f, rate, SEED + i)
+        for i, f in enumerate(tone_frequencies(config.band_hz, rate))
+    ]
     ok = all(r.passed for r in results)
-    head = (f'{"passed" if ok else "FAILED"}: 3 tones at {rate:.6g} Hz sampling, SNR '
-            f'{SNR_DB:g} dB, tolerance {100 * TOLERANCE:g} % of the median')
+    head = (
+        f'{"passed" if ok else "FAILED"}: 3 tones at {rate:.6g} Hz sampling, SNR '
+        f'{SNR_DB:g} dB, tolerance {100 * TOLERANCE:g} % of the median'
+    )
     if config.band_hz is not None and config.band_hz[1] >= rate / 2:
-        head += (f' (band_hz upper edge {config.band_hz[1]:g} Hz is at or above the Nyquist frequency '
-                 f'{rate / 2:.6g} Hz)')
+        head += (
+            f' (band_hz upper edge {config.band_hz[1]:g} Hz is at or above the Nyquist frequency '
+            f'{rate / 2:.6g} Hz)'
+        )
     return ok, '\n'.join([head] + [r.describe() for r in results])

@@ -19,6 +19,7 @@
   until the first damping estimate the design uses the parameter ``damping_ratio``.
 * ``/diagnostics`` at 1 Hz (steady clock): the shaper in use, its design and impulses, counters.
 """
+
 from __future__ import annotations
 
 import math
@@ -36,8 +37,8 @@ from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock as ClockMsg
 from std_msgs.msg import Float64
 
-from ..errors import StartupError
 from ..control.shaping import MAX_DAMPING, SHAPERS, Shaper, StreamingShaper, design, none
+from ..errors import StartupError
 from .health import DIAGNOSTICS_PERIOD
 from .parameters import declare, descriptor, warn_unused_params_files
 from .runner import run
@@ -51,20 +52,39 @@ MAX_CATCH_UP_S = 1.0
 
 PARAMETERS = {
     # name: (default, descriptor)
-    'shaper': ('zvd', descriptor(
-        f'input shaper, one of {", ".join(SHAPERS)}; a change applies once the reference rests')),
-    'rate_hz': (500.0, descriptor('rate of position_command, Hz', (1.0, 10000.0),
-                                  read_only=True)),
-    'damping_ratio': (0.0, descriptor(
-        'damping ratio the shaper is designed for until a vibration/damping_ratio estimate arrives',
-        (0.0, MAX_DAMPING))),
-    'initial_frequency_hz': (0.0, descriptor(
-        'design frequency before the first estimate, Hz; 0 = pass the reference through until then',
-        (0.0, 1000.0))),
-    'median_of': (1, descriptor(
-        'design for the median of the last median_of estimates (1 = the latest)', (1, 50))),
-    'rest_tolerance': (1e-6, descriptor(
-        'the reference is at rest while it stays within this of one value, rad', (0.0, 1.0))),
+    'shaper': (
+        'zvd',
+        descriptor(
+            f'input shaper, one of {", ".join(SHAPERS)}; a change applies once the reference rests'
+        ),
+    ),
+    'rate_hz': (500.0, descriptor('rate of position_command, Hz', (1.0, 10000.0), read_only=True)),
+    'damping_ratio': (
+        0.0,
+        descriptor(
+            'damping ratio the shaper is designed for until a vibration/damping_ratio estimate arrives',
+            (0.0, MAX_DAMPING),
+        ),
+    ),
+    'initial_frequency_hz': (
+        0.0,
+        descriptor(
+            'design frequency before the first estimate, Hz; 0 = pass the reference through until then',
+            (0.0, 1000.0),
+        ),
+    ),
+    'median_of': (
+        1,
+        descriptor(
+            'design for the median of the last median_of estimates (1 = the latest)', (1, 50)
+        ),
+    ),
+    'rest_tolerance': (
+        1e-6,
+        descriptor(
+            'the reference is at rest while it stays within this of one value, rad', (0.0, 1.0)
+        ),
+    ),
 }
 
 
@@ -73,21 +93,33 @@ class ShaperNode(Node):
 
     def __init__(self, **kwargs):
         super().__init__('shaper_node', **kwargs)
-        p = {name: declare(self, name, default, desc)
-             for name, (default, desc) in PARAMETERS.items()}
+        p = {
+            name: declare(self, name, default, desc)
+            for name, (default, desc) in PARAMETERS.items()
+        }
         warn_unused_params_files(self, kwargs.get('cli_args'))
         self._rate = p['rate_hz']
-        self._check_parameters([Parameter(name, value=value) for name, value in p.items()],
-                               startup=True)
+        self._check_parameters(
+            [Parameter(name, value=value) for name, value in p.items()], startup=True
+        )
         self._frequencies: deque = deque(maxlen=p['median_of'])
         self._dampings: deque = deque(maxlen=p['median_of'])
         self._shaper = StreamingShaper(none(), self._rate, p['rest_tolerance'])
         self.counters = dict.fromkeys(
-            ('references', 'references_skipped', 'frequency_estimates', 'damping_estimates',
-             'estimates_ignored', 'design_failures', 'commands_published'), 0)
+            (
+                'references',
+                'references_skipped',
+                'frequency_estimates',
+                'damping_estimates',
+                'estimates_ignored',
+                'design_failures',
+                'commands_published',
+            ),
+            0,
+        )
         self._reference: Optional[float] = None
-        self._t0_ns: Optional[int] = None    # clock at the first reference
-        self._k = 0                          # samples computed since t0
+        self._t0_ns: Optional[int] = None  # clock at the first reference
+        self._k = 0  # samples computed since t0
         self._pending_since: Optional[float] = None
         #: estimates ignored since the last one taken, and what the last ignored one was
         self._ignored_run = 0
@@ -105,17 +137,24 @@ class ShaperNode(Node):
             # tick on every /clock, at its time: a lockstep simulator gets one answer per step
             self.create_subscription(ClockMsg, '/clock', self._on_clock, 10)
         else:
-            self.create_timer(1.0 / self._rate,
-                              lambda: self._tick(self.get_clock().now().nanoseconds))
-        self.create_timer(DIAGNOSTICS_PERIOD, self._publish_diagnostics,
-                          clock=Clock(clock_type=ClockType.STEADY_TIME))
-        self.get_logger().info(f'shaping {self.resolve_topic_name("reference")} into '
-                               f'{self._command_pub.topic_name} at {self._rate:g} Hz with '
-                               f'{p["shaper"]}')
+            self.create_timer(
+                1.0 / self._rate, lambda: self._tick(self.get_clock().now().nanoseconds)
+            )
+        self.create_timer(
+            DIAGNOSTICS_PERIOD,
+            self._publish_diagnostics,
+            clock=Clock(clock_type=ClockType.STEADY_TIME),
+        )
+        self.get_logger().info(
+            f'shaping {self.resolve_topic_name("reference")} into '
+            f'{self._command_pub.topic_name} at {self._rate:g} Hz with '
+            f'{p["shaper"]}'
+        )
 
     # ---- parameters ------------------------------------------------------------------------
-    def _check_parameters(self, params: List[Parameter], startup: bool = False
-                          ) -> SetParametersResult:
+    def _check_parameters(
+        self, params: List[Parameter], startup: bool = False
+    ) -> SetParametersResult:
         """Refuse an unknown shaper name (ranges and read-only are the descriptors' business);
         at start-up a refusal raises StartupError."""
         for param in params:
@@ -156,8 +195,10 @@ class ShaperNode(Node):
             shaper = none() if f is None or name == 'none' else design(name, f, zeta)
         except ValueError as err:
             self.counters['design_failures'] += 1
-            self.get_logger().warning(f'{name} for {f} Hz, zeta {zeta}: {err}; keeping '
-                                      f'{self._shaper.shaper.name}', throttle_duration_sec=5.0)
+            self.get_logger().warning(
+                f'{name} for {f} Hz, zeta {zeta}: {err}; keeping {self._shaper.shaper.name}',
+                throttle_duration_sec=5.0,
+            )
             return
         if not _same(shaper, self._shaper.pending or self._shaper.shaper):
             self._shaper.request(shaper)
@@ -167,8 +208,9 @@ class ShaperNode(Node):
     def _on_reference(self, msg: Float64) -> None:
         if not math.isfinite(msg.data):
             self.counters['references_skipped'] += 1
-            self.get_logger().warning(f'non-finite reference {msg.data} skipped',
-                                      throttle_duration_sec=5.0)
+            self.get_logger().warning(
+                f'non-finite reference {msg.data} skipped', throttle_duration_sec=5.0
+            )
             return
         self.counters['references'] += 1
         self._reference = msg.data
@@ -176,27 +218,45 @@ class ShaperNode(Node):
             self._t0_ns = self.get_clock().now().nanoseconds
 
     def _on_frequency(self, msg: Float64) -> None:
-        self._take_estimate(msg.data, MIN_FREQUENCY_HZ, self._rate / 4, 'frequency_estimates',
-                            self._frequencies, 'frequency', 'Hz')
+        self._take_estimate(
+            msg.data,
+            MIN_FREQUENCY_HZ,
+            self._rate / 4,
+            'frequency_estimates',
+            self._frequencies,
+            'frequency',
+            'Hz',
+        )
 
     def _on_damping(self, msg: Float64) -> None:
-        if not math.isnan(msg.data):       # NaN: a model without damping
-            self._take_estimate(msg.data, 0.0, MAX_DAMPING, 'damping_estimates', self._dampings,
-                                'damping ratio', '')
+        if not math.isnan(msg.data):  # NaN: a model without damping
+            self._take_estimate(
+                msg.data,
+                0.0,
+                MAX_DAMPING,
+                'damping_estimates',
+                self._dampings,
+                'damping ratio',
+                '',
+            )
 
-    def _take_estimate(self, value: float, lo: float, hi: float, counter: str,
-                       store: deque, what: str, unit: str) -> None:
+    def _take_estimate(
+        self, value: float, lo: float, hi: float, counter: str, store: deque, what: str, unit: str
+    ) -> None:
         """Keep an estimate within [lo, hi] and redesign; count one outside (or NaN) ignored,
         with a throttled warning (the diagnostics go WARN until an estimate is taken again)."""
         if not lo <= value <= hi:
             self.counters['estimates_ignored'] += 1
             self._ignored_run += 1
-            self._ignored_last = (f'{what} {value:g}{" " + unit if unit else ""} outside '
-                                  f'[{lo:g}, {hi:g}]')
+            self._ignored_last = (
+                f'{what} {value:g}{" " + unit if unit else ""} outside [{lo:g}, {hi:g}]'
+            )
             self.get_logger().warning(
                 f'ignored {self._ignored_last} ({self._ignored_run} since the last usable '
                 f'estimate); keeping {self._shaper.shaper.describe()}: check what publishes '
-                f'{self.resolve_topic_name("vibration/frequency")}', throttle_duration_sec=5.0)
+                f'{self.resolve_topic_name("vibration/frequency")}',
+                throttle_duration_sec=5.0,
+            )
             return
         self._ignored_run = 0
         self.counters[counter] += 1
@@ -214,7 +274,7 @@ class ShaperNode(Node):
             return
         due = math.floor((now - self._t0_ns) * 1e-9 * self._rate)
         if due < self._k - 1 or due - self._k > MAX_CATCH_UP_S * self._rate:
-            self._k = due               # the clock jumped (restarted sim, long stall): skip
+            self._k = due  # the clock jumped (restarted sim, long stall): skip
         for _ in range(due - self._k + 1):
             before = self._shaper.shaper
             self._command.data = self._shaper.update(self._reference)
@@ -229,7 +289,8 @@ class ShaperNode(Node):
         self._pending_since = None
         log = self.get_logger()
         (log.info if self._shaper.shaper.name != before.name else log.debug)(
-            f'reference at rest: shaper now {self._shaper.shaper.describe()}')
+            f'reference at rest: shaper now {self._shaper.shaper.describe()}'
+        )
 
     # ---- diagnostics -----------------------------------------------------------------------
     def status(self) -> DiagnosticStatus:
@@ -241,32 +302,47 @@ class ShaperNode(Node):
         pending = self._shaper.pending
         waited = time.monotonic() - self._pending_since if pending is not None else 0.0
         if self._ignored_run:
-            level, message = DiagnosticStatus.WARN, (
-                f'{self._ignored_run} estimates ignored since the last usable one (last: '
-                f'{self._ignored_last}); in use: {s.describe()}')
+            level, message = (
+                DiagnosticStatus.WARN,
+                (
+                    f'{self._ignored_run} estimates ignored since the last usable one (last: '
+                    f'{self._ignored_last}); in use: {s.describe()}'
+                ),
+            )
         elif waited > PENDING_WARN_AFTER:
-            level, message = DiagnosticStatus.WARN, (
-                f'{pending.name} waits {waited:.0f} s for the reference to rest; in use: '
-                f'{s.describe()}')
+            level, message = (
+                DiagnosticStatus.WARN,
+                (
+                    f'{pending.name} waits {waited:.0f} s for the reference to rest; in use: '
+                    f'{s.describe()}'
+                ),
+            )
         elif s.name == 'none' and f is None:
             level, message = DiagnosticStatus.OK, 'passing through: no frequency estimate yet'
         else:
             level, message = DiagnosticStatus.OK, s.describe()
         values = {
-            'shaper': s.name, 'design_frequency_hz': _format(s.frequency_hz),
-            'design_damping_ratio': _format(s.damping), 'delay_s': _format(s.duration),
+            'shaper': s.name,
+            'design_frequency_hz': _format(s.frequency_hz),
+            'design_damping_ratio': _format(s.damping),
+            'delay_s': _format(s.duration),
             'impulse_times_s': ' '.join(_format(t) for t in s.times),
             'impulse_amplitudes': ' '.join(_format(a) for a in s.amplitudes),
             'pending_shaper': pending.describe() if pending is not None else '',
             'estimate_frequency_hz': _format(f if f is not None else math.nan),
-            'estimate_damping_ratio': _format(zeta), 'damping_source': source,
+            'estimate_damping_ratio': _format(zeta),
+            'damping_source': source,
             'reference_at_rest': str(self._shaper.at_rest).lower(),
             'retunes': str(self._shaper.retunes),
             **{name: str(n) for name, n in self.counters.items()},
         }
-        return DiagnosticStatus(level=level, name=self.get_fully_qualified_name(),
-                                message=message, hardware_id=self._command_pub.topic_name,
-                                values=[KeyValue(key=k, value=v) for k, v in values.items()])
+        return DiagnosticStatus(
+            level=level,
+            name=self.get_fully_qualified_name(),
+            message=message,
+            hardware_id=self._command_pub.topic_name,
+            values=[KeyValue(key=k, value=v) for k, v in values.items()],
+        )
 
     def _publish_diagnostics(self) -> None:
         array = DiagnosticArray(status=[self.status()])
@@ -275,8 +351,12 @@ class ShaperNode(Node):
 
 
 def _same(a: Shaper, b: Shaper) -> bool:
-    return (a.name == b.name and len(a.times) == len(b.times)
-            and all(a.times == b.times) and all(a.amplitudes == b.amplitudes))
+    return (
+        a.name == b.name
+        and len(a.times) == len(b.times)
+        and all(a.times == b.times)
+        and all(a.amplitudes == b.amplitudes)
+    )
 
 
 def _format(value: float) -> str:

@@ -29,6 +29,7 @@ use both); ``wait_for_command`` until the first command. ``lockstep`` (simulated
 batch wait for a command answering the previous ``/clock``, so a closed loop through other nodes
 behaves the same at any speed and load.
 """
+
 from __future__ import annotations
 
 import math
@@ -38,20 +39,28 @@ from typing import List, Sequence
 
 from geometry_msgs.msg import WrenchStamped
 from rcl_interfaces.msg import ParameterType, SetParametersResult
-from sensor_msgs.msg import Imu
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock as ClockMsg
+from sensor_msgs.msg import Imu
 from std_msgs.msg import Float64
 
 from ..errors import StartupError
 from ..io.fields import IMU, WRENCH_STAMPED, normalise_type
-from ..sim.arm_model import (DEFAULT_NOISE_STD, DEFAULT_QUANTUM, EXCITATIONS, ArmParameters,
-                             ArmSimulator, DrivenArmSimulator, Move, natural_frequency_hz)
-from .runner import run
+from ..sim.arm_model import (
+    DEFAULT_NOISE_STD,
+    DEFAULT_QUANTUM,
+    EXCITATIONS,
+    ArmParameters,
+    ArmSimulator,
+    DrivenArmSimulator,
+    Move,
+    natural_frequency_hz,
+)
 from .parameters import declare, descriptor, warn_unused_params_files
+from .runner import run
 
 # wall-clock rate of the publishing timer: a command takes effect at the start of the next batch,
 # so a tick of 1 ms keeps that within 10 samples (20 ms simulated) at 10x (input shaping needs it)
@@ -68,20 +77,25 @@ LOCKSTEP_BATCH_SECONDS = 0.02
 LOCKSTEP_TIMEOUT = 1.0
 #: physical range of the tip mass, kg (Table 1's bar: 45.55 g; 10 kg gives f0 = 0.09 Hz)
 TIP_MASS_RANGE_KG = (0.001, 10.0)
-SCHEDULE_FIELDS = 4        # start, final_angle, slope, tip_mass_kg (0 = unchanged)
+SCHEDULE_FIELDS = 4  # start, final_angle, slope, tip_mass_kg (0 = unchanged)
 #: output_type -> (message class, topic)
 OUTPUTS = {WRENCH_STAMPED: (WrenchStamped, 'coupling_torque'), IMU: (Imu, 'tip_imu')}
 
-GROUND_TRUTH_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
-                              durability=DurabilityPolicy.TRANSIENT_LOCAL)
+GROUND_TRUTH_QOS = QoSProfile(
+    depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
+)
 
 
 def schedule_to_array(schedule: Sequence[Move]) -> List[float]:
     """The ``schedule`` parameter for a sequence of moves (see :func:`schedule_from_array`)."""
     out: List[float] = []
     for mv in schedule:
-        out += [float(mv.start), float(mv.final_angle), float(mv.slope),
-                float(mv.tip_mass_kg or 0.0)]
+        out += [
+            float(mv.start),
+            float(mv.final_angle),
+            float(mv.slope),
+            float(mv.tip_mass_kg or 0.0),
+        ]
     return out
 
 
@@ -93,92 +107,186 @@ def schedule_from_array(values: Sequence[float]) -> List[Move]:
     """
     values = [float(v) for v in values]
     if len(values) % SCHEDULE_FIELDS:
-        raise ValueError(f'schedule must hold groups of {SCHEDULE_FIELDS} numbers [start, '
-                         f'final_angle, slope, tip_mass_kg], got {len(values)} numbers')
+        raise ValueError(
+            f'schedule must hold groups of {SCHEDULE_FIELDS} numbers [start, '
+            f'final_angle, slope, tip_mass_kg], got {len(values)} numbers'
+        )
     if not all(math.isfinite(v) for v in values):
         raise ValueError('schedule must hold finite numbers')
     moves = []
     for i in range(0, len(values), SCHEDULE_FIELDS):
-        start, angle, slope, mass = values[i:i + SCHEDULE_FIELDS]
+        start, angle, slope, mass = values[i : i + SCHEDULE_FIELDS]
         if start < 0 or (moves and start < moves[-1].start):
-            raise ValueError(f'schedule move {i // SCHEDULE_FIELDS}: start {start} must be >= 0 '
-                             'and not before the previous move')
+            raise ValueError(
+                f'schedule move {i // SCHEDULE_FIELDS}: start {start} must be >= 0 '
+                'and not before the previous move'
+            )
         if slope <= 0:
-            raise ValueError(f'schedule move {i // SCHEDULE_FIELDS}: slope must be > 0, '
-                             f'got {slope}')
+            raise ValueError(
+                f'schedule move {i // SCHEDULE_FIELDS}: slope must be > 0, got {slope}'
+            )
         if mass < 0:
-            raise ValueError(f'schedule move {i // SCHEDULE_FIELDS}: tip_mass_kg must be 0 '
-                             f'(unchanged) or > 0, got {mass}')
+            raise ValueError(
+                f'schedule move {i // SCHEDULE_FIELDS}: tip_mass_kg must be 0 '
+                f'(unchanged) or > 0, got {mass}'
+            )
         moves.append(Move(start, angle, slope, mass if mass > 0 else None))
     return moves
 
 
 PARAMETERS = {
     # name: (default, descriptor)
-    'tip_mass_kg': (ArmParameters.tip_mass_kg, descriptor(
-        'tip mass m of Eqs. 19/23, kg; changing it while running changes the frequency abruptly '
-        '(Section 5.5)', TIP_MASS_RANGE_KG)),
-    'rate_hz': (500.0, descriptor('sample rate of coupling_torque, Hz (Section 5.2: 2 ms)',
-                                   (10.0, 10000.0), read_only=True)),
-    'speed': (1.0, descriptor('simulated seconds per wall-clock second; other than 1 the node '
-                               'publishes /clock and stamps in simulated time from 1 s',
-                               (0.01, 1000.0), read_only=True)),
-    'publish_clock': (False, descriptor(
-        'stamp in simulated time from 1 s and publish it on /clock even at speed 1 (always so at '
-        'any other speed)', read_only=True)),
-    'damping_ratio': (ArmParameters.damping_ratio, descriptor(
-        'damping ratio zeta of the bar mode (Eq. 24; 0.004 in Section 5.3)', (0.0, 0.5),
-        read_only=True)),
-    'noise_std': (DEFAULT_NOISE_STD, descriptor(
-        'standard deviation of the strain-gauge noise on the torque, N m', (0.0, 10.0))),
-    'offset': (0.0, descriptor(
-        'constant offset of the measurement (a strain-gauge bridge\'s imbalance), N m of '
-        'coupling torque (the tip acceleration: divided by m L); real rigs have one, the paper\'s '
-        'sinusoid model does not (docs/real_arm.md)', (-10.0, 10.0), read_only=True)),
-    'quantum': (DEFAULT_QUANTUM, descriptor(
-        'quantisation step of the measurement (an ADC\'s resolution), N m of coupling torque '
-        '(0 = none); a real rig\'s can be a tenth of the vibration\'s amplitude',
-        (0.0, 1.0), read_only=True)),
-    'limit_cycle_voltage': (0.0, descriptor(
-        'closed-loop limit cycle: amplitude of a relay on the rate of bending added to the PD '
-        'voltage (the describing function of friction and backlash in a stiff loop), V; the link '
-        'then holds a sustained oscillation at its own frequency, ~1 N m per V (0 = off)',
-        (0.0, 10.0), read_only=True)),
-    'seed': (0, descriptor('seed of the noise generator', (0, 2 ** 31 - 1), read_only=True)),
-    'frame_id': ('arm_base', descriptor('frame_id of the coupling_torque headers',
-                                         read_only=True)),
-    'schedule': ([0.0, 1.0, 1.0, 0.0], descriptor(
-        'motor command as flat groups [start s, final_angle rad, slope rad/s, tip_mass_kg '
-        '(0 = unchanged)]: from start, ramp towards final_angle at slope and set the tip mass; '
-        'default: the Section 5.3 ramp of slope 1 to 1 rad', read_only=True,
-        type=ParameterType.PARAMETER_DOUBLE_ARRAY)),
-    'wait_for_subscribers': (0, descriptor(
-        'the simulation starts when the output topic has this many subscribers (0 = at once), '
-        'so that a sped-up run loses no sample to discovery', (0, 1000), read_only=True)),
-    'duration': (0.0, descriptor('simulated seconds after which the node exits 0 '
-                                  '(0 = run forever)', (0.0, 1e9), read_only=True)),
-    'wait_for_command': (False, descriptor(
-        'the simulation starts when the first position_command has arrived (in simulated time '
-        'the start of the clock is published meanwhile, so a use_sim_time commander can run)',
-        read_only=True)),
-    'lockstep': (False, descriptor(
-        'in simulated time, once commands flow, each batch of samples (at most '
-        f'{LOCKSTEP_BATCH_SECONDS * 1e3:g} ms) waits for a position_command received after the '
-        'previous /clock (at most 1 s): a commander answering every /clock (shaper_node with '
-        'use_sim_time) then acts at the simulated times it computed for, however loaded the '
-        'machine; the run goes as fast as that round trip allows, at most speed', read_only=True)),
-    'output_type': (WRENCH_STAMPED, descriptor(
-        'message of the measurement: geometry_msgs/msg/WrenchStamped (coupling torque, torque.z, '
-        'on coupling_torque) or sensor_msgs/msg/Imu (tip acceleration, linear_acceleration.z, on '
-        'tip_imu)', read_only=True)),
-    'excitation': ('moves', descriptor(
-        'what drives the arm: moves (the schedule\'s ramps), random (a band-limited random motor '
-        'command of excitation_level rad std, 2 Hz) or ambient (a white disturbance torque at '
-        'the tip of excitation_level N m std): the arm never at rest (docs/operation.md)',
-        read_only=True)),
-    'excitation_level': (0.0, descriptor(
-        'excitation random: rad; ambient: N m (0 = the default: 0.3 rad, 0.02 N m)',
-        (0.0, 100.0), read_only=True)),
+    'tip_mass_kg': (
+        ArmParameters.tip_mass_kg,
+        descriptor(
+            'tip mass m of Eqs. 19/23, kg; changing it while running changes the frequency abruptly '
+            '(Section 5.5)',
+            TIP_MASS_RANGE_KG,
+        ),
+    ),
+    'rate_hz': (
+        500.0,
+        descriptor(
+            'sample rate of coupling_torque, Hz (Section 5.2: 2 ms)',
+            (10.0, 10000.0),
+            read_only=True,
+        ),
+    ),
+    'speed': (
+        1.0,
+        descriptor(
+            'simulated seconds per wall-clock second; other than 1 the node '
+            'publishes /clock and stamps in simulated time from 1 s',
+            (0.01, 1000.0),
+            read_only=True,
+        ),
+    ),
+    'publish_clock': (
+        False,
+        descriptor(
+            'stamp in simulated time from 1 s and publish it on /clock even at speed 1 (always so at '
+            'any other speed)',
+            read_only=True,
+        ),
+    ),
+    'damping_ratio': (
+        ArmParameters.damping_ratio,
+        descriptor(
+            'damping ratio zeta of the bar mode (Eq. 24; 0.004 in Section 5.3)',
+            (0.0, 0.5),
+            read_only=True,
+        ),
+    ),
+    'noise_std': (
+        DEFAULT_NOISE_STD,
+        descriptor('standard deviation of the strain-gauge noise on the torque, N m', (0.0, 10.0)),
+    ),
+    'offset': (
+        0.0,
+        descriptor(
+            "constant offset of the measurement (a strain-gauge bridge's imbalance), N m of "
+            "coupling torque (the tip acceleration: divided by m L); real rigs have one, the paper's "
+            'sinusoid model does not (docs/real_arm.md)',
+            (-10.0, 10.0),
+            read_only=True,
+        ),
+    ),
+    'quantum': (
+        DEFAULT_QUANTUM,
+        descriptor(
+            "quantisation step of the measurement (an ADC's resolution), N m of coupling torque "
+            "(0 = none); a real rig's can be a tenth of the vibration's amplitude",
+            (0.0, 1.0),
+            read_only=True,
+        ),
+    ),
+    'limit_cycle_voltage': (
+        0.0,
+        descriptor(
+            'closed-loop limit cycle: amplitude of a relay on the rate of bending added to the PD '
+            'voltage (the describing function of friction and backlash in a stiff loop), V; the link '
+            'then holds a sustained oscillation at its own frequency, ~1 N m per V (0 = off)',
+            (0.0, 10.0),
+            read_only=True,
+        ),
+    ),
+    'seed': (0, descriptor('seed of the noise generator', (0, 2**31 - 1), read_only=True)),
+    'frame_id': (
+        'arm_base',
+        descriptor('frame_id of the coupling_torque headers', read_only=True),
+    ),
+    'schedule': (
+        [0.0, 1.0, 1.0, 0.0],
+        descriptor(
+            'motor command as flat groups [start s, final_angle rad, slope rad/s, tip_mass_kg '
+            '(0 = unchanged)]: from start, ramp towards final_angle at slope and set the tip mass; '
+            'default: the Section 5.3 ramp of slope 1 to 1 rad',
+            read_only=True,
+            type=ParameterType.PARAMETER_DOUBLE_ARRAY,
+        ),
+    ),
+    'wait_for_subscribers': (
+        0,
+        descriptor(
+            'the simulation starts when the output topic has this many subscribers (0 = at once), '
+            'so that a sped-up run loses no sample to discovery',
+            (0, 1000),
+            read_only=True,
+        ),
+    ),
+    'duration': (
+        0.0,
+        descriptor(
+            'simulated seconds after which the node exits 0 (0 = run forever)',
+            (0.0, 1e9),
+            read_only=True,
+        ),
+    ),
+    'wait_for_command': (
+        False,
+        descriptor(
+            'the simulation starts when the first position_command has arrived (in simulated time '
+            'the start of the clock is published meanwhile, so a use_sim_time commander can run)',
+            read_only=True,
+        ),
+    ),
+    'lockstep': (
+        False,
+        descriptor(
+            'in simulated time, once commands flow, each batch of samples (at most '
+            f'{LOCKSTEP_BATCH_SECONDS * 1e3:g} ms) waits for a position_command received after the '
+            'previous /clock (at most 1 s): a commander answering every /clock (shaper_node with '
+            'use_sim_time) then acts at the simulated times it computed for, however loaded the '
+            'machine; the run goes as fast as that round trip allows, at most speed',
+            read_only=True,
+        ),
+    ),
+    'output_type': (
+        WRENCH_STAMPED,
+        descriptor(
+            'message of the measurement: geometry_msgs/msg/WrenchStamped (coupling torque, torque.z, '
+            'on coupling_torque) or sensor_msgs/msg/Imu (tip acceleration, linear_acceleration.z, on '
+            'tip_imu)',
+            read_only=True,
+        ),
+    ),
+    'excitation': (
+        'moves',
+        descriptor(
+            "what drives the arm: moves (the schedule's ramps), random (a band-limited random motor "
+            'command of excitation_level rad std, 2 Hz) or ambient (a white disturbance torque at '
+            'the tip of excitation_level N m std): the arm never at rest (docs/operation.md)',
+            read_only=True,
+        ),
+    ),
+    'excitation_level': (
+        0.0,
+        descriptor(
+            'excitation random: rad; ambient: N m (0 = the default: 0.3 rad, 0.02 N m)',
+            (0.0, 100.0),
+            read_only=True,
+        ),
+    ),
 }
 #: ``excitation_level`` 0 means these
 DEFAULT_EXCITATION_LEVEL = {'random': 0.3, 'ambient': 0.02}
@@ -202,8 +310,9 @@ class SimNode(Node):
             raise StartupError('frame_id must not be empty')
         self._output_type = normalise_type(p['output_type'])
         if self._output_type not in OUTPUTS:
-            raise StartupError(f'output_type must be one of {", ".join(OUTPUTS)}, '
-                               f'got {p["output_type"]!r}')
+            raise StartupError(
+                f'output_type must be one of {", ".join(OUTPUTS)}, got {p["output_type"]!r}'
+            )
         self._rate = p['rate_hz']
         masses = [p['tip_mass_kg']] + [mv.tip_mass_kg for mv in schedule if mv.tip_mass_kg]
         check = self._validate([Parameter('tip_mass_kg', value=m) for m in masses])
@@ -221,31 +330,44 @@ class SimNode(Node):
         self._wait_for_command = p['wait_for_command']
         self._lockstep = p['lockstep']
         if self._lockstep and not self._sim_time:
-            raise StartupError('lockstep needs simulated time: speed other than 1 or '
-                               'publish_clock')
-        self._answered = True             # a command arrived since the last /clock (lockstep)
-        self._clock_at = 0.0              # monotonic time of the last batch's /clock
+            raise StartupError(
+                'lockstep needs simulated time: speed other than 1 or publish_clock'
+            )
+        self._answered = True  # a command arrived since the last /clock (lockstep)
+        self._clock_at = 0.0  # monotonic time of the last batch's /clock
         self.lockstep_timeouts = 0
         if p['excitation'] not in EXCITATIONS:
-            raise StartupError(f'excitation must be one of {", ".join(EXCITATIONS)}, '
-                               f'got {p["excitation"]!r}')
-        driven = {} if p['excitation'] == 'moves' else {
-            'excitation': p['excitation'],
-            'level': p['excitation_level'] or DEFAULT_EXCITATION_LEVEL[p['excitation']]}
+            raise StartupError(
+                f'excitation must be one of {", ".join(EXCITATIONS)}, got {p["excitation"]!r}'
+            )
+        driven = (
+            {}
+            if p['excitation'] == 'moves'
+            else {
+                'excitation': p['excitation'],
+                'level': p['excitation_level'] or DEFAULT_EXCITATION_LEVEL[p['excitation']],
+            }
+        )
         self._sim = (DrivenArmSimulator if driven else ArmSimulator)(
             ArmParameters(tip_mass_kg=p['tip_mass_kg'], damping_ratio=p['damping_ratio']),
-            rate_hz=self._rate, noise_std=p['noise_std'], quantum=p['quantum'], seed=p['seed'],
+            rate_hz=self._rate,
+            noise_std=p['noise_std'],
+            quantum=p['quantum'],
+            seed=p['seed'],
             schedule=schedule,
             output='torque' if self._output_type == WRENCH_STAMPED else 'tip_acceleration',
-            offset=p['offset'], limit_cycle_voltage=p['limit_cycle_voltage'], **driven)
+            offset=p['offset'],
+            limit_cycle_voltage=p['limit_cycle_voltage'],
+            **driven,
+        )
         self._sync_mass_parameter()
 
         msg_type, topic = OUTPUTS[self._output_type]
         self._output_pub = self.create_publisher(msg_type, topic, 100)
-        self._truth_pub = self.create_publisher(Float64, 'vibration/ground_truth',
-                                                GROUND_TRUTH_QOS)
-        self._clock_pub = (self.create_publisher(ClockMsg, '/clock', 10)
-                           if self._sim_time else None)
+        self._truth_pub = self.create_publisher(
+            Float64, 'vibration/ground_truth', GROUND_TRUTH_QOS
+        )
+        self._clock_pub = self.create_publisher(ClockMsg, '/clock', 10) if self._sim_time else None
         self._msg = msg_type()
         self._msg.header.frame_id = p['frame_id']
         self._set_value = self._message_setter()
@@ -254,19 +376,25 @@ class SimNode(Node):
         self.create_subscription(Float64, 'position_command', self._on_command, 10)
         self._clock_msg = ClockMsg()
         self._f_true = None
-        self._origin_ns = (SIM_TIME_ORIGIN_NS if self._sim_time
-                           else self.get_clock().now().nanoseconds)
-        self._wall_start = None   # set by the first tick
+        self._origin_ns = (
+            SIM_TIME_ORIGIN_NS if self._sim_time else self.get_clock().now().nanoseconds
+        )
+        self._wall_start = None  # set by the first tick
         self._publish_truth(self._sim.f_true)
-        self._timer = self.create_timer(1.0 / TICK_HZ, self._tick,
-                                        clock=Clock(clock_type=ClockType.STEADY_TIME))
-        mode = (f'simulated time at {self._speed:g}x, /clock published' if self._sim_time
-                else 'real time')
+        self._timer = self.create_timer(
+            1.0 / TICK_HZ, self._tick, clock=Clock(clock_type=ClockType.STEADY_TIME)
+        )
+        mode = (
+            f'simulated time at {self._speed:g}x, /clock published'
+            if self._sim_time
+            else 'real time'
+        )
         self.get_logger().info(
             f'flexible arm: m = {self._sim.params.tip_mass_kg * 1e3:.2f} g, '
             f'f0 = {self._sim.f_true:.3f} Hz '
             f'(Eq. 23), {self._rate:g} Hz, {mode}, {len(schedule)} move(s), publishing '
-            f'{self._output_pub.topic_name} [{self._output_type}]')
+            f'{self._output_pub.topic_name} [{self._output_type}]'
+        )
 
     def _message_setter(self):
         """A function writing one measurement into the output message."""
@@ -275,14 +403,16 @@ class SimNode(Node):
 
             def set_torque(value: float) -> None:
                 torque.z = value
+
             return set_torque
         msg = self._msg
-        msg.orientation_covariance[0] = -1.0          # sensor_msgs/Imu: not provided
+        msg.orientation_covariance[0] = -1.0  # sensor_msgs/Imu: not provided
         msg.angular_velocity_covariance[0] = -1.0
-        accel = msg.linear_acceleration               # covariance left 0: unknown
+        accel = msg.linear_acceleration  # covariance left 0: unknown
 
         def set_acceleration(value: float) -> None:
             accel.z = value
+
         return set_acceleration
 
     def _on_command(self, msg: Float64) -> None:
@@ -292,17 +422,19 @@ class SimNode(Node):
             self._sim.set_command(msg.data)
         except ValueError as err:
             self.commands_skipped += 1
-            self.get_logger().warning(f'position_command skipped: {err}',
-                                      throttle_duration_sec=5.0)
+            self.get_logger().warning(
+                f'position_command skipped: {err}', throttle_duration_sec=5.0
+            )
             return
         if not self.commands_received:
-            self.get_logger().info(f'position_command {msg.data:g} rad: commands take over from '
-                                   'the schedule')
+            self.get_logger().info(
+                f'position_command {msg.data:g} rad: commands take over from the schedule'
+            )
         self.commands_received += 1
         was_waiting = not self._answered
         self._answered = True
         if self._lockstep and was_waiting:
-            self._tick()               # the answer came: the next batch now, not at the next tick
+            self._tick()  # the answer came: the next batch now, not at the next tick
 
     def _lockstep_wait(self) -> bool:
         """In lockstep, whether the next batch must still wait for the commander's answer."""
@@ -311,8 +443,10 @@ class SimNode(Node):
         if time.monotonic() - self._clock_at < LOCKSTEP_TIMEOUT:
             return True
         self.lockstep_timeouts += 1
-        self.get_logger().warning(f'lockstep: no position_command for {LOCKSTEP_TIMEOUT:g} s, '
-                                  'going on', throttle_duration_sec=5.0)
+        self.get_logger().warning(
+            f'lockstep: no position_command for {LOCKSTEP_TIMEOUT:g} s, going on',
+            throttle_duration_sec=5.0,
+        )
         return False
 
     # ---- parameters ------------------------------------------------------------------------
@@ -325,17 +459,20 @@ class SimNode(Node):
         for param in params:
             if param.name == 'tip_mass_kg':
                 lo, hi = TIP_MASS_RANGE_KG
-                if not lo <= param.value <= hi:     # the schedule's masses have no descriptor
+                if not lo <= param.value <= hi:  # the schedule's masses have no descriptor
                     return SetParametersResult(
-                        successful=False, reason=f'tip_mass_kg {param.value} is outside the '
-                        f'physical range [{lo}, {hi}] kg of the arm (45.55 g in Section 5.3)')
-                f0 = natural_frequency_hz(param.value)   # Table 1's bar
+                        successful=False,
+                        reason=f'tip_mass_kg {param.value} is outside the '
+                        f'physical range [{lo}, {hi}] kg of the arm (45.55 g in Section 5.3)',
+                    )
+                f0 = natural_frequency_hz(param.value)  # Table 1's bar
                 if f0 * MIN_SAMPLES_PER_PERIOD > self._rate:
                     return SetParametersResult(
                         successful=False,
                         reason=f'tip_mass_kg {param.value} gives f0 = {f0:.2f} Hz (Eq. 23), fewer '
-                               f'than {MIN_SAMPLES_PER_PERIOD} samples per period at '
-                               f'{self._rate:g} Hz')
+                        f'than {MIN_SAMPLES_PER_PERIOD} samples per period at '
+                        f'{self._rate:g} Hz',
+                    )
         return SetParametersResult(successful=True)
 
     def _apply(self, params: List[Parameter]) -> None:
@@ -343,8 +480,9 @@ class SimNode(Node):
         for param in params:
             if param.name == 'tip_mass_kg' and param.value != self._sim.params.tip_mass_kg:
                 self._sim.set_tip_mass(param.value)
-                self.get_logger().info(f'tip mass set to {param.value * 1e3:.2f} g: f0 = '
-                                       f'{self._sim.f_true:.3f} Hz')
+                self.get_logger().info(
+                    f'tip mass set to {param.value * 1e3:.2f} g: f0 = {self._sim.f_true:.3f} Hz'
+                )
             elif param.name == 'noise_std':
                 self._sim.noise_std = float(param.value)
 
@@ -369,8 +507,9 @@ class SimNode(Node):
         if self.finished:
             return
         if self._wall_start is None:
-            if (self._output_pub.get_subscription_count() < self._wait_for_subscribers
-                    or (self._wait_for_command and not self.commands_received)):
+            if self._output_pub.get_subscription_count() < self._wait_for_subscribers or (
+                self._wait_for_command and not self.commands_received
+            ):
                 self._publish_clock(self._origin_ns)
                 return
             self._wall_start = time.monotonic()
@@ -386,7 +525,9 @@ class SimNode(Node):
         if due > limit:
             self.get_logger().warning(
                 f'{due / self._rate:.2f} s of simulated time behind: the machine cannot keep up '
-                f'with speed {self._speed:g}', throttle_duration_sec=5.0)
+                f'with speed {self._speed:g}',
+                throttle_duration_sec=5.0,
+            )
             due = limit
         stamp = self._msg.header.stamp
         t = None

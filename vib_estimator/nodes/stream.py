@@ -14,6 +14,7 @@ start after an install). Meanwhile :attr:`EstimatorStream.ready` is False, the n
 up to :data:`WARMUP_BUFFER` (the oldest beyond it are dropped and counted in ``dropped_warmup``);
 :meth:`EstimatorStream.poll` installs the estimator once it is built and feeds it the held samples.
 """
+
 from __future__ import annotations
 
 import math
@@ -51,15 +52,16 @@ class _Build:
         self.seconds = 0.0
         self.estimator = None
         self.error: Optional[BaseException] = None
-        self._thread = threading.Thread(target=self._run, name='vib_estimator warm-up',
-                                        daemon=True)
+        self._thread = threading.Thread(
+            target=self._run, name='vib_estimator warm-up', daemon=True
+        )
         self._thread.start()
 
     def _run(self) -> None:
         try:
             warm(self.config)
             self.estimator = create_estimator(self.config)
-        except Exception as err:       # reported by the node, never lost in a thread
+        except Exception as err:  # reported by the node, never lost in a thread
             self.error = err
         self.seconds = time.monotonic() - self.started
 
@@ -78,8 +80,8 @@ class EstimatorStream:
     def __init__(self, config: EstimatorConfig, now: float, background: bool = False):
         config.validate()
         self.health = Health(now)
-        self.origin = None     # first stamp, ns: t = 0
-        self.last_t = None     # time of the last sample, s
+        self.origin = None  # first stamp, ns: t = 0
+        self.last_t = None  # time of the last sample, s
         self.estimator = None
         self._config = config
         self._background = background
@@ -115,7 +117,7 @@ class EstimatorStream:
 
     def _install(self, estimator) -> None:
         self.estimator = estimator
-        self._update = estimator.update     # bound once: the data path's one call
+        self._update = estimator.update  # bound once: the data path's one call
         self._build = None
 
     def feed(self, stamp_ns: int, value: float) -> Sequence[Estimate]:
@@ -125,7 +127,7 @@ class EstimatorStream:
             self.origin = stamp_ns
         self.last_t = t = seconds_since(stamp_ns, self.origin)
         result = self._update(t, value)
-        if not result:     # None, or an empty list (modes >= 1)
+        if not result:  # None, or an empty list (modes >= 1)
             return _NONE
         return result if isinstance(result, list) else (result,)
 
@@ -184,8 +186,11 @@ class EstimatorStream:
     def status(self, now: float) -> Status:
         """The diagnostics status at ``now`` (monotonic s)."""
         if not self.ready:
-            values: Dict[str, object] = {'warmup_s': self.warmup_elapsed(now),
-                                         'held_samples': self.held_samples, **self.counters}
+            values: Dict[str, object] = {
+                'warmup_s': self.warmup_elapsed(now),
+                'held_samples': self.held_samples,
+                **self.counters,
+            }
             return Status(WARN, WARMUP_MESSAGE, values)
         config = self.config
         return self.health.status(now, self.counters, self.last_t, config.band_hz, config.modes)

@@ -6,6 +6,7 @@ exactly (the discrete model of the sampled process: ``x_k+1 = Ad x_k + e_k`` wit
 from its stationary distribution; the record is the sum of the modes' displacements plus white
 measurement noise at a signal-to-noise ratio (total modal variance over noise variance).
 """
+
 from __future__ import annotations
 
 import math
@@ -16,8 +17,9 @@ from scipy.linalg import expm, solve_discrete_lyapunov
 from scipy.signal import lfilter
 
 
-def sdof_response(n: int, fs: float, frequency_hz: float, zeta: float, variance: float,
-                  rng: np.random.Generator) -> np.ndarray:
+def sdof_response(
+    n: int, fs: float, frequency_hz: float, zeta: float, variance: float, rng: np.random.Generator
+) -> np.ndarray:
     """``n`` samples at ``fs`` of a white-noise-driven SDOF's displacement of stationary
     ``variance`` (see the module doc)."""
     w = 2 * math.pi * frequency_hz
@@ -34,7 +36,7 @@ def sdof_response(n: int, fs: float, frequency_hz: float, zeta: float, variance:
     # not couple; run the 2-state recursion as a vector IIR on the modal (complex) coordinate
     lam, vec = np.linalg.eig(ad)
     inv = np.linalg.inv(vec)
-    q = e @ inv.T                       # modal noise, complex
+    q = e @ inv.T  # modal noise, complex
     z = np.empty((n, 2), dtype=complex)
     z0 = inv @ x0
     for i in range(2):
@@ -44,8 +46,13 @@ def sdof_response(n: int, fs: float, frequency_hz: float, zeta: float, variance:
     return scale * x[:, 0]
 
 
-def ambient_record(duration_s: float, fs: float, modes: Sequence[tuple[float, float, float]],
-                   snr_db: float, seed: int = 0) -> tuple[np.ndarray, np.ndarray, float]:
+def ambient_record(
+    duration_s: float,
+    fs: float,
+    modes: Sequence[tuple[float, float, float]],
+    snr_db: float,
+    seed: int = 0,
+) -> tuple[np.ndarray, np.ndarray, float]:
     """``(t, y, noise variance)``: ``duration_s`` at ``fs`` of the white-noise-driven ``modes``
     [(frequency Hz, damping ratio, variance)] plus white noise at ``snr_db`` (total modal
     variance over noise variance)."""

@@ -41,6 +41,7 @@ Model (Trapero, Sira-Ramirez & Feliu, Section 5.1; Fig. 3):
 With the stiff PD loop of :class:`ArmParameters` the base barely moves while the bar vibrates, so
 the observed frequency is the clamped-base one of Eq. 23 (within 0.02 %, checked by the tests).
 """
+
 from __future__ import annotations
 
 import math
@@ -50,16 +51,20 @@ from typing import Optional, Sequence, Tuple
 import numpy as np
 
 
-def natural_frequency_hz(tip_mass_kg: float, stiffness: float = 1.56, length: float = 0.7) -> float:
+def natural_frequency_hz(
+    tip_mass_kg: float, stiffness: float = 1.56, length: float = 0.7
+) -> float:
     """Eq. 23: ``f0 = sqrt(c / (m L^2)) / (2 pi)`` of the bar clamped at its base, Hz.
 
     Table 1's bar (c = 1.56 N m/rad, L = 0.7 m) gives 1.64, 1.33 and 1.15 Hz for the 30, 45.55 and
     61.17 g tip masses of Section 5.5.
     """
     if not (tip_mass_kg > 0 and stiffness > 0 and length > 0):
-        raise ValueError(f'tip mass, stiffness and length must be > 0, got '
-                         f'{tip_mass_kg!r}, {stiffness!r}, {length!r}')
-    return math.sqrt(stiffness / (tip_mass_kg * length ** 2)) / (2 * math.pi)
+        raise ValueError(
+            f'tip mass, stiffness and length must be > 0, got '
+            f'{tip_mass_kg!r}, {stiffness!r}, {length!r}'
+        )
+    return math.sqrt(stiffness / (tip_mass_kg * length**2)) / (2 * math.pi)
 
 
 @dataclass(frozen=True)
@@ -127,7 +132,7 @@ class Move:
 
 
 DEFAULT_NOISE_STD = 0.004  # N m: 1.3 % of the 0.31 N m vibration of experiment_5_3
-DEFAULT_QUANTUM = 1e-4     # N m: the resolution of the torques quoted in Section 5.3
+DEFAULT_QUANTUM = 1e-4  # N m: the resolution of the torques quoted in Section 5.3
 #: rate of bending (N m/s) over which the limit cycle's relay switches (tanh): far below the
 #: ~2 N m/s of a 0.1 N m vibration at 1.3 Hz, so the relay is a sign
 LIMIT_CYCLE_RATE = 1e-3
@@ -151,22 +156,32 @@ class ArmSimulator:
     docstring.
     """
 
-    def __init__(self, params: ArmParameters = ArmParameters(), rate_hz: float = 500.0,
-                 noise_std: float = DEFAULT_NOISE_STD, quantum: float = DEFAULT_QUANTUM,
-                 seed: int = 0, schedule: Sequence[Move] = (Move(0.0, 1.0),),
-                 substeps: int = 8, output: str = 'torque', offset: float = 0.0,
-                 limit_cycle_voltage: float = 0.0):
+    def __init__(
+        self,
+        params: ArmParameters = ArmParameters(),
+        rate_hz: float = 500.0,
+        noise_std: float = DEFAULT_NOISE_STD,
+        quantum: float = DEFAULT_QUANTUM,
+        seed: int = 0,
+        schedule: Sequence[Move] = (Move(0.0, 1.0),),
+        substeps: int = 8,
+        output: str = 'torque',
+        offset: float = 0.0,
+        limit_cycle_voltage: float = 0.0,
+    ):
         if not rate_hz > 0 or substeps < 1 or noise_std < 0 or quantum < 0:
             raise ValueError('rate_hz and substeps must be > 0, noise_std and quantum >= 0')
         if not (math.isfinite(offset) and 0 <= limit_cycle_voltage <= params.max_voltage):
-            raise ValueError(f'offset must be finite and limit_cycle_voltage in [0, '
-                             f'{params.max_voltage:g}] V, got {offset!r}, {limit_cycle_voltage!r}')
+            raise ValueError(
+                f'offset must be finite and limit_cycle_voltage in [0, '
+                f'{params.max_voltage:g}] V, got {offset!r}, {limit_cycle_voltage!r}'
+            )
         self.offset = float(offset)
         self.limit_cycle_voltage = float(limit_cycle_voltage)
         if output not in OUTPUTS:
             raise ValueError(f'output must be one of {", ".join(OUTPUTS)}, got {output!r}')
         self.output = output
-        self.commanded = False            # set_command took over from the schedule
+        self.commanded = False  # set_command took over from the schedule
         self.params = params
         self.rate_hz = float(rate_hz)
         self.noise_std = float(noise_std)
@@ -176,13 +191,13 @@ class ArmSimulator:
         self._next_move = 0
         self._substeps = int(substeps)
         self._h = 1.0 / (self.rate_hz * self._substeps)
-        self._k = 0                       # samples produced so far
-        self._x = [0.0, 0.0, 0.0, 0.0]    # theta_m, theta_m', theta_t, theta_t'
+        self._k = 0  # samples produced so far
+        self._x = [0.0, 0.0, 0.0, 0.0]  # theta_m, theta_m', theta_t, theta_t'
         self._command = 0.0
         self._target = 0.0
         self._slope = 0.0
         self.set_tip_mass(params.tip_mass_kg)
-        self._apply_moves(0.0)   # so that f_true is the schedule's from the start
+        self._apply_moves(0.0)  # so that f_true is the schedule's from the start
 
     @property
     def t(self) -> float:
@@ -204,7 +219,7 @@ class ArmSimulator:
         p = replace(self.params, tip_mass_kg=float(m))
         f0 = p.natural_frequency_hz  # validates m
         self.params = p
-        inertia = m * p.length ** 2
+        inertia = m * p.length**2
         self._tip_inertia = inertia
         self._bar_damping = 2 * p.damping_ratio * (2 * math.pi * f0) * inertia
 
@@ -247,8 +262,12 @@ class ArmSimulator:
         qm, wm, qt, wt = x
         bend = p.stiffness * (qm - qt) + self._bar_damping * (wm - wt)
         n = p.gear_ratio
-        motor_torque = (p.motor_gain * u - p.viscous * n * wm
-                        - p.coulomb * math.tanh(n * wm / p.coulomb_velocity) - bend / n)
+        motor_torque = (
+            p.motor_gain * u
+            - p.viscous * n * wm
+            - p.coulomb * math.tanh(n * wm / p.coulomb_velocity)
+            - bend / n
+        )
         return (wm, motor_torque / (p.inertia * n), wt, bend / self._tip_inertia)
 
     def step(self) -> Tuple[float, float, float]:
@@ -275,8 +294,10 @@ class ArmSimulator:
             k2 = self._derivatives([a + 0.5 * h * b for a, b in zip(x, k1)], u)
             k3 = self._derivatives([a + 0.5 * h * b for a, b in zip(x, k2)], u)
             k4 = self._derivatives([a + h * b for a, b in zip(x, k3)], u)
-            x = [a + h / 6 * (b1 + 2 * b2 + 2 * b3 + b4)
-                 for a, b1, b2, b3, b4 in zip(x, k1, k2, k3, k4)]
+            x = [
+                a + h / 6 * (b1 + 2 * b2 + 2 * b3 + b4)
+                for a, b1, b2, b3, b4 in zip(x, k1, k2, k3, k4)
+            ]
         self._x = x
         return self._advance_command(t, y, f_true)
 
@@ -284,8 +305,9 @@ class ArmSimulator:
         """Move the scheduled ramp one sample on (a held command stays) and count the sample."""
         step = self._slope / self.rate_hz
         err = self._target - self._command
-        self._command = (self._target if abs(err) <= step
-                         else self._command + math.copysign(step, err))
+        self._command = (
+            self._target if abs(err) <= step else self._command + math.copysign(step, err)
+        )
         self._k += 1
         return t, y, f_true
 
@@ -299,16 +321,32 @@ class Recording:
     f_true: np.ndarray
 
 
-def simulate(duration: float, schedule: Sequence[Move] = (Move(0.0, 1.0),),
-             params: ArmParameters = ArmParameters(), rate_hz: float = 500.0,
-             noise_std: float = DEFAULT_NOISE_STD, seed: int = 0,
-             quantum: float = DEFAULT_QUANTUM, output: str = 'torque', offset: float = 0.0,
-             limit_cycle_voltage: float = 0.0) -> Recording:
+def simulate(
+    duration: float,
+    schedule: Sequence[Move] = (Move(0.0, 1.0),),
+    params: ArmParameters = ArmParameters(),
+    rate_hz: float = 500.0,
+    noise_std: float = DEFAULT_NOISE_STD,
+    seed: int = 0,
+    quantum: float = DEFAULT_QUANTUM,
+    output: str = 'torque',
+    offset: float = 0.0,
+    limit_cycle_voltage: float = 0.0,
+) -> Recording:
     """Simulate ``duration`` s of the arm under ``schedule`` and return the :class:`Recording`
     (its ``torque`` column holds the ``output``); ``offset``, ``quantum`` and
     ``limit_cycle_voltage``: :class:`ArmSimulator`."""
-    sim = ArmSimulator(params, rate_hz, noise_std, quantum, seed, schedule, output=output,
-                       offset=offset, limit_cycle_voltage=limit_cycle_voltage)
+    sim = ArmSimulator(
+        params,
+        rate_hz,
+        noise_std,
+        quantum,
+        seed,
+        schedule,
+        output=output,
+        offset=offset,
+        limit_cycle_voltage=limit_cycle_voltage,
+    )
     rows = np.array([sim.step() for _ in range(int(round(duration * rate_hz)))]).reshape(-1, 3)
     return Recording(rows[:, 0].copy(), rows[:, 1].copy(), rows[:, 2].copy())
 
@@ -317,8 +355,9 @@ def simulate(duration: float, schedule: Sequence[Move] = (Move(0.0, 1.0),),
 MASSES_5_5 = (0.030, 0.04555, 0.06117)
 
 
-def schedule_5_5(seconds_per_mass: float = 6.0,
-                 final_angles: Sequence[float] = (0.3, 1.0, 1.5)) -> Tuple[Move, ...]:
+def schedule_5_5(
+    seconds_per_mass: float = 6.0, final_angles: Sequence[float] = (0.3, 1.0, 1.5)
+) -> Tuple[Move, ...]:
     """Section 5.5's experiment: each mass of :data:`MASSES_5_5` for ``seconds_per_mass`` s.
 
     Each segment fits its mass, then moves the command from 0 to its entry of ``final_angles``,
@@ -358,17 +397,39 @@ class DrivenArmSimulator(ArmSimulator):
     each sample (``moves``: the schedule's ramps only, as the base class). Seeded (``seed + 1``,
     independent of the measurement noise's stream)."""
 
-    def __init__(self, params: ArmParameters = ArmParameters(), rate_hz: float = 500.0,
-                 noise_std: float = DEFAULT_NOISE_STD, quantum: float = DEFAULT_QUANTUM,
-                 seed: int = 0, schedule: Sequence[Move] = (Move(0.0, 0.0),),
-                 substeps: int = 8, output: str = 'torque', offset: float = 0.0,
-                 limit_cycle_voltage: float = 0.0, *, excitation: str = 'ambient',
-                 level: float = 0.02, bandwidth_hz: float = 2.0):
-        super().__init__(params, rate_hz, noise_std, quantum, seed, schedule, substeps, output,
-                         offset, limit_cycle_voltage)
+    def __init__(
+        self,
+        params: ArmParameters = ArmParameters(),
+        rate_hz: float = 500.0,
+        noise_std: float = DEFAULT_NOISE_STD,
+        quantum: float = DEFAULT_QUANTUM,
+        seed: int = 0,
+        schedule: Sequence[Move] = (Move(0.0, 0.0),),
+        substeps: int = 8,
+        output: str = 'torque',
+        offset: float = 0.0,
+        limit_cycle_voltage: float = 0.0,
+        *,
+        excitation: str = 'ambient',
+        level: float = 0.02,
+        bandwidth_hz: float = 2.0,
+    ):
+        super().__init__(
+            params,
+            rate_hz,
+            noise_std,
+            quantum,
+            seed,
+            schedule,
+            substeps,
+            output,
+            offset,
+            limit_cycle_voltage,
+        )
         if excitation not in EXCITATIONS:
-            raise ValueError(f'excitation must be one of {", ".join(EXCITATIONS)}, '
-                             f'got {excitation!r}')
+            raise ValueError(
+                f'excitation must be one of {", ".join(EXCITATIONS)}, got {excitation!r}'
+            )
         if not (level >= 0 and bandwidth_hz > 0):
             raise ValueError('level must be >= 0 and bandwidth_hz > 0')
         self.excitation = excitation
@@ -388,19 +449,35 @@ class DrivenArmSimulator(ArmSimulator):
         elif self.excitation == 'random':
             # first-order low-pass of white noise, scaled to a standard deviation of ``level``
             a = self._pole
-            self._random_angle = a * self._random_angle + math.sqrt(1 - a * a) * self.level * \
-                self._drive.standard_normal()
+            self._random_angle = (
+                a * self._random_angle
+                + math.sqrt(1 - a * a) * self.level * self._drive.standard_normal()
+            )
             self.set_command(self._random_angle)
         return super().step()
 
 
-def simulate_driven(duration: float, excitation: str = 'ambient', level: float = 0.02,
-                    params: ArmParameters = ArmParameters(), rate_hz: float = 500.0,
-                    noise_std: float = DEFAULT_NOISE_STD, seed: int = 0,
-                    output: str = 'torque') -> Recording:
+def simulate_driven(
+    duration: float,
+    excitation: str = 'ambient',
+    level: float = 0.02,
+    params: ArmParameters = ArmParameters(),
+    rate_hz: float = 500.0,
+    noise_std: float = DEFAULT_NOISE_STD,
+    seed: int = 0,
+    output: str = 'torque',
+) -> Recording:
     """``duration`` s of the arm driven by ``excitation`` (:class:`DrivenArmSimulator`)."""
-    sim = DrivenArmSimulator(params, rate_hz, noise_std, DEFAULT_QUANTUM, seed,
-                             (Move(0.0, 0.0),), output=output, excitation=excitation,
-                             level=level)
+    sim = DrivenArmSimulator(
+        params,
+        rate_hz,
+        noise_std,
+        DEFAULT_QUANTUM,
+        seed,
+        (Move(0.0, 0.0),),
+        output=output,
+        excitation=excitation,
+        level=level,
+    )
     rows = np.array([sim.step() for _ in range(int(round(duration * rate_hz)))]).reshape(-1, 3)
     return Recording(rows[:, 0].copy(), rows[:, 1].copy(), rows[:, 2].copy())
