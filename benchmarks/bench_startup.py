@@ -13,7 +13,8 @@ same run, on the same machine state.
 * ``estimator_node`` (default configuration, ``modes: 3``, ``band_hz: [1, 20]``): this process
   publishes a 5 Hz sine on ``coupling_torque`` (WrenchStamped, 500 samples/s of stamps, paced in
   real time) from one second after the node subscribes (discovery settled both ways). *live*:
-  spawn to the node's first ``/diagnostics``; *ready*: spawn to the first ``~/self_test`` answer
+  spawn to the node's first ``/diagnostics``, and the longest silence of ``/diagnostics`` after it
+  (a node blocked in a compile says nothing); *ready*: spawn to the first ``~/self_test`` answer
   that is not "busy" (called every 0.1 s: the kernels are compiled and the tones ran); *first estimate*: from the first sample
   sent to the first ``vibration/frequency``; *lost*: samples sent that the node never counted (its
   ``received`` + ``dropped_warmup`` against what was sent). Then SIGINT: the exit code.
@@ -97,6 +98,7 @@ class Probe:
     def reset(self):
         self.first_estimate = None
         self.first_diag = {}
+        self.diag_times = []
         self.last_values = {}
 
     def _on_frequency(self, msg):
@@ -104,6 +106,7 @@ class Probe:
             self.first_estimate = time.monotonic()
 
     def _on_diagnostics(self, msg):
+        self.diag_times.append(time.monotonic())
         for status in msg.status:
             self.first_diag.setdefault(status.name, time.monotonic())
             self.last_values[status.name] = {kv.key: kv.value for kv in status.values}
@@ -165,12 +168,15 @@ class Probe:
             latency = self.first_estimate - first if self.first_estimate else math.nan
             self.spin(1.5)  # a diagnostics period after the first estimate
             live = min(self.first_diag.values(), default=math.nan) - start
+            # the longest /diagnostics silence, from the first one to 1.5 s after ready
+            gaps = np.diff(self.diag_times)
+            silence = float(gaps.max()) if len(gaps) else math.nan
             values = next(iter(self.last_values.values()), {})
             counted = int(values.get('received', 0)) + int(values.get('dropped_warmup', 0))
             lost = sent - counted if values else -1
         finally:
             code = stop(proc)
-        return live, ready, latency, lost, code
+        return live, ready, latency, lost, code, silence
 
     def first_diagnostics(self, cmd, env):
         """(spawn to first /diagnostics s, exit code) of a node."""
@@ -265,12 +271,13 @@ def main(argv=None) -> int:
                     cache = tempfile.mkdtemp(dir=tmp)
                     cmd = node_command(tree, 'vib_estimator.nodes.estimator_node', params)
                     for kind in ('cold', 'warm'):
-                        live, ready, latency, lost, code = probe.estimator(
+                        live, ready, latency, lost, code, silence = probe.estimator(
                             cmd, environment(tree, cache)
                         )
-                        rows.append((case, label, kind, live, ready, lost, code, latency))
+                        rows.append((case, label, kind, live, ready, lost, code, latency, silence))
                         print(
-                            f'{case:28s} {label:8s} {kind}: live {live:6.2f} s, ready '
+                            f'{case:28s} {label:8s} {kind}: live {live:6.2f} s (longest '
+                            f'/diagnostics silence {silence:5.2f} s), ready '
                             f'{ready:6.2f} s, first estimate {latency:6.2f} s after the '
                             f'first sample, lost {lost}, exit {code}',
                             flush=True,
@@ -281,7 +288,9 @@ def main(argv=None) -> int:
                     cmd = node_command(tree, 'vib_estimator.nodes.shaper_node', [])
                     for kind in ('cold', 'warm'):
                         live, code = probe.first_diagnostics(cmd, environment(tree, cache))
-                        rows.append(('shaper_node', label, kind, live, live, 0, code, math.nan))
+                        rows.append(
+                            ('shaper_node', label, kind, live, live, 0, code, math.nan, math.nan)
+                        )
                         print(
                             f'{"shaper_node":28s} {label:8s} {kind}: live {live:6.2f} s, '
                             f'exit {code}',
@@ -293,7 +302,17 @@ def main(argv=None) -> int:
                     for kind in ('cold', 'warm'):
                         seconds = analyze_seconds(tree, environment(tree, cache), csv)
                         rows.append(
-                            ('analyze (20 s CSV)', label, kind, math.nan, seconds, 0, 0, math.nan)
+                            (
+                                'analyze (20 s CSV)',
+                                label,
+                                kind,
+                                math.nan,
+                                seconds,
+                                0,
+                                0,
+                                math.nan,
+                                math.nan,
+                            )
                         )
                         print(
                             f'{"analyze (20 s CSV)":28s} {label:8s} {kind}: {seconds:6.2f} s',
@@ -303,7 +322,8 @@ def main(argv=None) -> int:
             probe.close()
     print(
         f'\n| case | cold ready, today | cold, {args.ref} | warm ready, today | warm, '
-        f'{args.ref} | live (first /diagnostics), cold today / {args.ref} | first estimate after '
+        f'{args.ref} | live: first /diagnostics; longest silence, cold today / {args.ref} | '
+        f'first estimate after '
         f'the first sample, cold today / {args.ref} | samples lost, cold today / {args.ref} | '
         'exit on SIGINT |'
     )
@@ -316,7 +336,8 @@ def main(argv=None) -> int:
         codes = sorted({r[6] for r in get.values()})
         print(
             f'| {case} | {today_c[4]:.1f} s | {ref_c[4]:.1f} s | {today_w[4]:.2f} s | '
-            f'{ref_w[4]:.2f} s | {today_c[3]:.1f} / {ref_c[3]:.1f} s | '
+            f'{ref_w[4]:.2f} s | {today_c[3]:.1f}; {today_c[8]:.1f} / {ref_c[3]:.1f}; '
+            f'{ref_c[8]:.1f} s | '
             f'{today_c[7]:.1f} / {ref_c[7]:.1f} s | {today_c[5]} / {ref_c[5]} | {codes} |'
         )
     print(GOALS)
