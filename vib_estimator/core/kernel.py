@@ -818,6 +818,33 @@ def _long_window_spanned(p, s, c, m, one_sided, model, tau, f, damping):
 
 
 @jit(inline='always')
+def _publishable(p, s, c, seg, n, model, f, h, r2, amp, consistent, res):
+    """The gates, in order: finite numbers (:func:`_finite_estimate`), then the quality gate
+    (:func:`_quality_gate`, with the segment's spread and :func:`_confirmed`); the segment is then
+    chained to the next (:func:`_chain`). True if the estimate is published."""
+    inconsistent_before = c[C_INCONSISTENT]
+    published = _finite_estimate(c, f, r2, amp, res) and _quality_gate(
+        p, c, model, f, res[U.R_DAMP], h, r2, amp, consistent, _spread(seg, n), _confirmed(p, s, f)
+    )
+    _chain(s, c, f, published, inconsistent_before)
+    return published
+
+
+@jit(inline='always')
+def _write_estimate(out, row, t, f, tau, samples, r2, amp, res):
+    """The published estimate into ``out[row]`` (the O_* layout of :class:`EstimateArrays`)."""
+    out[row, O_T] = t
+    out[row, O_F] = f
+    out[row, O_CONV] = tau
+    out[row, O_SAMPLES] = samples
+    out[row, O_FIT] = r2
+    out[row, O_AMP] = amp
+    out[row, O_DAMP] = res[U.R_DAMP]
+    out[row, O_FSTD] = res[U.R_FSTD]
+    out[row, O_DSTD] = res[U.R_DSTD]
+
+
+@jit(inline='always')
 def step(p, s, c, seg, t, y, out, row, optional=None):
     """Feed one sample; return 1 and fill ``out[row]`` when an estimate is published, else 0.
 
@@ -882,31 +909,9 @@ def step(p, s, c, seg, t, y, out, row, optional=None):
         consistent = not local_start or abs(f - start) <= allowed
     else:
         r2, amp = _fit(seg, n_fit, TWO_PI * f)
-    inconsistent_before = c[C_INCONSISTENT]
-    published = _finite_estimate(c, f, r2, amp, res) and _quality_gate(
-        p,
-        c,
-        model,
-        f,
-        res[U.R_DAMP],
-        h,
-        r2,
-        amp,
-        consistent,
-        _spread(seg, n_fit),
-        _confirmed(p, s, f),
-    )
-    _chain(s, c, f, published, inconsistent_before)
+    published = _publishable(p, s, c, seg, n_fit, model, f, h, r2, amp, consistent, res)
     if published:
-        out[row, O_T] = t
-        out[row, O_F] = f
-        out[row, O_CONV] = tau
-        out[row, O_SAMPLES] = nseg + 1
-        out[row, O_FIT] = r2
-        out[row, O_AMP] = amp
-        out[row, O_DAMP] = res[U.R_DAMP]
-        out[row, O_FSTD] = res[U.R_FSTD]
-        out[row, O_DSTD] = res[U.R_DSTD]
+        _write_estimate(out, row, t, f, tau, nseg + 1, r2, amp, res)
         c[C_ESTIMATES] += 1
     reset_segment(s, c, seg, t, y)
     return 1 if published else 0

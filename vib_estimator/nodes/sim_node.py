@@ -292,6 +292,32 @@ PARAMETERS = {
 DEFAULT_EXCITATION_LEVEL = {'random': 0.3, 'ambient': 0.02}
 
 
+def make_simulator(p, schedule, output_type: str) -> ArmSimulator:
+    """The arm of the parameters ``p`` (name -> value): an :class:`ArmSimulator` following
+    ``schedule``, or with ``excitation`` other than ``moves`` a :class:`DrivenArmSimulator` that
+    never rests; :class:`StartupError` for an unknown excitation."""
+    if p['excitation'] not in EXCITATIONS:
+        raise StartupError(
+            f'excitation must be one of {", ".join(EXCITATIONS)}, got {p["excitation"]!r}'
+        )
+    driven = {}
+    if p['excitation'] != 'moves':
+        level = p['excitation_level'] or DEFAULT_EXCITATION_LEVEL[p['excitation']]
+        driven = {'excitation': p['excitation'], 'level': level}
+    return (DrivenArmSimulator if driven else ArmSimulator)(
+        ArmParameters(tip_mass_kg=p['tip_mass_kg'], damping_ratio=p['damping_ratio']),
+        rate_hz=p['rate_hz'],
+        noise_std=p['noise_std'],
+        quantum=p['quantum'],
+        seed=p['seed'],
+        schedule=schedule,
+        output='torque' if output_type == WRENCH_STAMPED else 'tip_acceleration',
+        offset=p['offset'],
+        limit_cycle_voltage=p['limit_cycle_voltage'],
+        **driven,
+    )
+
+
 class SimNode(Node):
     """The simulated arm publishing ``coupling_torque`` (or ``tip_imu``) and
     ``vibration/ground_truth``, following ``position_command`` once it arrives."""
@@ -336,30 +362,7 @@ class SimNode(Node):
         self._answered = True  # a command arrived since the last /clock (lockstep)
         self._clock_at = 0.0  # monotonic time of the last batch's /clock
         self.lockstep_timeouts = 0
-        if p['excitation'] not in EXCITATIONS:
-            raise StartupError(
-                f'excitation must be one of {", ".join(EXCITATIONS)}, got {p["excitation"]!r}'
-            )
-        driven = (
-            {}
-            if p['excitation'] == 'moves'
-            else {
-                'excitation': p['excitation'],
-                'level': p['excitation_level'] or DEFAULT_EXCITATION_LEVEL[p['excitation']],
-            }
-        )
-        self._sim = (DrivenArmSimulator if driven else ArmSimulator)(
-            ArmParameters(tip_mass_kg=p['tip_mass_kg'], damping_ratio=p['damping_ratio']),
-            rate_hz=self._rate,
-            noise_std=p['noise_std'],
-            quantum=p['quantum'],
-            seed=p['seed'],
-            schedule=schedule,
-            output='torque' if self._output_type == WRENCH_STAMPED else 'tip_acceleration',
-            offset=p['offset'],
-            limit_cycle_voltage=p['limit_cycle_voltage'],
-            **driven,
-        )
+        self._sim = make_simulator(p, schedule, self._output_type)
         self._sync_mass_parameter()
 
         msg_type, topic = OUTPUTS[self._output_type]
