@@ -14,9 +14,10 @@ same run, on the same machine state.
   publishes a 5 Hz sine on ``coupling_torque`` (WrenchStamped, 500 samples/s of stamps, paced in
   real time) from one second after the node subscribes (discovery settled both ways). *live*:
   spawn to the node's first ``/diagnostics``; *ready*: spawn to the first ``~/self_test`` answer
-  that is not "busy" (called every 0.1 s: the kernels are compiled and the tones ran); *first estimate*: from the first sample
-  sent to the first ``vibration/frequency``; *lost*: samples sent that the node never counted (its
-  ``received`` + ``dropped_warmup`` against what was sent). Then SIGINT: the exit code.
+  that is not "busy" (called every 0.1 s: the kernels are compiled and the tones ran); *first
+  estimate*: from the first sample sent to the first ``vibration/frequency``; *lost*: samples sent
+  that the node never counted (its ``received`` + ``dropped_warmup`` against what was sent). Then
+  SIGINT: the exit code.
 * ``shaper_node``: spawn to its first ``/diagnostics``.
 * ``analyze``: the whole ``vib-estimator analyze`` of a 20 s CSV (500 Hz).
 """
