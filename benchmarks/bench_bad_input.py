@@ -2,9 +2,9 @@
 switched off (``gap_intervals`` = 0, ``outlier_ratio`` = 0: the previous behaviour) beside the
 defaults.
 
-1. Lost samples: a 2 Hz sine at 500 Hz with 40 gaps of 40-400 ms cut out (noise-free; each gap below
-   ``max_gap``), 5 seeds per model: estimates published, how many > 5 % off, the worst error, and
-   the gaps / samples lost counted.
+1. Lost samples: a 2 Hz sine at 500 Hz with 40 gaps of 40-400 ms cut out (noise-free; each gap
+   below ``max_gap``), 5 seeds per model: estimates published, how many > 5 % off, the worst error,
+   and the gaps / samples lost counted.
 2. One absurd sample: a damped 3 Hz sine (zeta 0.01, 500 Hz, 10 s) with one sample at 1e6 or 1e300
    (a value beyond 1e100 is skipped even with the tests off):
    estimates, worst error, non-finite numbers published, outliers counted.

@@ -1,8 +1,10 @@
-"""Speed of the estimator core: batch throughput and streaming cost, against baselines in the same run.
+"""Speed of the estimator core: batch throughput and streaming cost, against baselines in the same
+run.
 
 Prints (one run, same machine, same signal: 2 M samples of a noisy 1.33 Hz sine at 500 Hz):
 - batch: ``FrequencyEstimator.process`` in M samples/s (goal >= 5), next to a bare
-  ``numpy.cumsum`` over the same array (the cheapest whole-array pass numpy can make) and the ratio;
+  ``numpy.cumsum`` over the same array (the cheapest whole-array pass numpy can make)
+  and the ratio;
 - streaming: ``FrequencyEstimator.update`` in us per sample (goal <= 3), next to an empty Python
   function call with the same arguments (the floor of any per-sample Python API) and the ratio;
 - batch cost of other configurations against the default: the paper's estimator (``refine`` = 0)
@@ -43,7 +45,8 @@ VARIANTS = {
 
 #: the commit whose kernel (one 169-line step, no refinement) is the speed baseline of issue 14
 PREVIOUS = '627a108'
-#: the kernel before the compile-time and speed work of issues 19 and 24 (the bit-identity reference)
+#: the kernel before the compile-time and speed work of issues 19 and 24
+#: (the bit-identity reference)
 SPLIT = '7374e6d'
 
 

@@ -80,7 +80,8 @@ def decay(freqs, amps, zetas, clip, seed, duration=11.0):
 
 
 class FftPeaks:
-    """PX4 ``gyro_fft``-like tracker: 1 s Hann window, hop 1/4, 3 peaks, parabolic interpolation."""
+    """PX4 ``gyro_fft``-like tracker: 1 s Hann window, hop 1/4, 3 peaks, parabolic
+    interpolation."""
 
     def __init__(self, fs, window_s=1.0, peaks=3):
         self.n = int(round(window_s * fs))

@@ -3,13 +3,13 @@
 For each model (sinusoid; biased-sinusoid with an offset of 3 amplitudes; damped-sinusoid with
 zeta = 0.01), each window (``min_periods`` = 0.25, 0.5, 1, 2, 5, 20 periods) and each SNR (20, 40,
 60 dB; SNR = A^2 / (2 sigma^2)), the estimator (the paper's configuration,
-``EstimatorConfig.paper``, but ``model`` and ``min_periods``) runs over seeded records of a 1.33 Hz mode sampled at 2 ms (A = 0.1, random
-phase). Printed: the number of estimates, the RMS error of the published frequencies, the exact
-bound (RMS over the estimates of :func:`vib_estimator.analysis.bounds.model_crb` on the samples
-each used), the ratio RMS(error / bound) over the estimates (the std in units of each
-estimate's own bound; the bound changes from window to window), the calibration RMS of
-error / ``frequency_std_hz`` (1 = calibrated), the median convergence time in periods, and a
-sliding matrix pencil
+``EstimatorConfig.paper``, but ``model`` and ``min_periods``) runs over seeded records of a 1.33 Hz
+mode sampled at 2 ms (A = 0.1, random phase). Printed: the number of estimates, the RMS error of
+the published frequencies, the exact bound (RMS over the estimates of
+:func:`vib_estimator.analysis.bounds.model_crb` on the samples each used), the ratio RMS(error /
+bound) over the estimates (the std in units of each estimate's own bound; the bound changes from
+window to window), the calibration RMS of error / ``frequency_std_hz`` (1 = calibrated), the median
+convergence time in periods, and a sliding matrix pencil
 (:func:`vib_estimator.analysis.baselines.matrix_pencil`, damped-exponential model, order 2, +1
 with an offset) on the same windows: its RMS(error / bound). Same run, same signals.
 

@@ -1,4 +1,5 @@
-"""Streaming readers and ``vib-estimator survey``: speed and memory, each beside a baseline run here.
+"""Streaming readers and ``vib-estimator survey``: speed and memory, each beside a baseline run
+here.
 
     python benchmarks/bench_survey.py [--rows 5000000] [--messages 5000000] [--work DIR]
 
@@ -17,7 +18,8 @@ Prints:
   started and warmed up before timing, as a long-lived cluster is). ``--jobs 1``, ``--jobs 2``
   and Dask run alternately, three rounds, so that all see the same load.
 Reader throughputs are per CPU second of the process (``time.process_time``, all threads); the
-survey times are wall-clock. Each time is the best of 2 runs (the surveys: of the 3 rounds). The generated files go to ``--work`` (default a temporary folder).
+survey times are wall-clock. Each time is the best of 2 runs (the surveys: of the 3 rounds). The
+generated files go to ``--work`` (default a temporary folder).
 """
 
 from __future__ import annotations
@@ -124,7 +126,8 @@ def bench_csv(work: Path, rows: int) -> Path:
     loadtxt = cpu(lambda: np.loadtxt(small, delimiter=',', skiprows=1), 1)
     exact = cpu(lambda: sum(1 for _ in iter_csv_rows(csv_layout(small))), 1)
     print(
-        f'csv   streaming {rows / fast / 1e6:6.2f} M rows/s   numpy.loadtxt {n / loadtxt / 1e6:6.2f}'
+        f'csv   streaming {rows / fast / 1e6:6.2f} M rows/s   '
+        f'numpy.loadtxt {n / loadtxt / 1e6:6.2f}'
         f'   row-by-row reader {n / exact / 1e6:6.2f}   ratio {loadtxt / n * rows / fast:5.1f}x / '
         f'{exact / n * rows / fast:5.1f}x   (goal >= 5 M rows/s)'
     )

@@ -5,9 +5,9 @@ argument; see its SOURCE.md) and prints two tables (``docs/real_arm.md`` quotes 
 
 1. Per configuration, the issue's goals on the recording: estimates after 4.5 s (the limit cycle,
    1.812 Hz), the share within 2 % and the number beyond 5 %, the longest wait between two of them
-   (the first one's time, then the longest gap), and the estimates during the ringing (3.2-4.5 s) with their worst error
-   against the local frequency (period by period from the upward crossings about a one-period
-   running mean: 1.60-1.65 Hz).
+   (the first one's time, then the longest gap), and the estimates during the ringing (3.2-4.5 s)
+   with their worst error against the local frequency (period by period from the upward crossings
+   about a one-period running mean: 1.60-1.65 Hz).
 2. The causes, one at a time: a synthetic limit cycle built from the recording's own fit (offset
    -4.8 mm, fundamental 10.1 mm at 1.8116 Hz, 2nd and 3rd harmonics 0.19 and 0.05 mm), with and
    without each of offset, harmonics and 1 mm quantisation: per configuration the number of

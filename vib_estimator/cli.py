@@ -1,9 +1,11 @@
-"""``vib-estimator``: the package's command line (offline analysis, paper figures, comparison, demo).
+"""``vib-estimator``: the package's command line (offline analysis, paper figures, comparison,
+demo).
 
-Each sub-command lives in its own module exposing ``add_arguments(parser)`` and ``run(args) -> int``;
-this module only dispatches, importing the chosen one lazily so ``--help`` stays fast. Input a
-command refuses (:mod:`vib_estimator.errors`) ends as one ``error:`` line and the exit code
-:func:`vib_estimator.errors.exit_code` gives it (2), here if the command does not report it itself.
+Each sub-command lives in its own module exposing ``add_arguments(parser)`` and
+``run(args) -> int``; this module only dispatches, importing the chosen one lazily so ``--help``
+stays fast. Input a command refuses (:mod:`vib_estimator.errors`) ends as one ``error:`` line and
+the exit code :func:`vib_estimator.errors.exit_code` gives it (2), here if the command does not
+report it itself.
 """
 
 from __future__ import annotations

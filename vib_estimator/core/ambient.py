@@ -15,10 +15,10 @@ Method, per analysis (every :data:`HOP_S` of input once ``ambient_window_s`` of 
    unbiased), their block Hankel matrix ``H = [R_{i+j+1}]`` (p = :data:`BLOCK_ROWS` rows), its
    SVD ``H = U S V^T``; at each model order n = :data:`ORDERS` the observability matrix
    ``O = U_n S_n^1/2``, the state matrix ``A = O_up^+ O_down`` and the output/next-state
-   covariance ``G`` (first column of ``S_n^1/2 V_n^T``). Each eigenvalue ``lambda`` of ``A`` gives a
-   pole ``s = ln(lambda) fs``: frequency ``|s| / 2 pi``, damping ratio ``-Re s / |s|``, and, from
-   the
-   modal decomposition ``R_k = sum_m c_m g_m lambda_m^(k-1)``, the mode's share of the variance.
+   covariance ``G`` (first column of ``S_n^1/2 V_n^T``). Each eigenvalue ``lambda`` of ``A`` gives
+   a pole ``s = ln(lambda) fs``: frequency ``|s| / 2 pi``, damping ratio ``-Re s / |s|``, and, from
+   the modal decomposition ``R_k = sum_m c_m g_m lambda_m^(k-1)``, the mode's share of the
+   variance.
 2. **Physical or spurious** (automated OMA): poles with a damping ratio outside
    (0, ``max_damping``], or above 0.45 fs (or outside ``band_hz`` when set), are dropped
    (``rejected_damping``); the others are clustered in frequency (neighbours within
@@ -35,9 +35,9 @@ Method, per analysis (every :data:`HOP_S` of input once ``ambient_window_s`` of 
    frequency std exceeds :data:`MAX_STD_REL` is too weak to tell (``rejected_uncertain``).
 4. **Identity over time** (stability across windows): each mode is matched to the nearest tracked
    mode within :data:`MATCH_TOL`; a new one publishes once seen by :data:`CONFIRM` consecutive
-   analyses (``modes_found``); one unseen for a window is lost (``modes_lost``). With ``modes`` >= 1
-   at most that many (the strongest) publish. Published modes are numbered by ascending frequency,
-   1 = the lowest, as the mode tracker's ``mode`` key.
+   analyses (``modes_found``); one unseen for a window is lost (``modes_lost``). With
+   ``modes`` >= 1 at most that many (the strongest) publish. Published modes are numbered by
+   ascending frequency, 1 = the lowest, as the mode tracker's ``mode`` key.
 
 Each estimate: ``t`` = the window's last stamp, ``convergence_time`` = the window's span (the
 window used), ``samples`` = its samples, ``amplitude`` = RMS of the modal response, ``fit`` = share

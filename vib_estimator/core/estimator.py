@@ -1,13 +1,14 @@
 """Algebraic on-line frequency estimator of Trapero, Sira-Ramirez & Feliu (pure numpy/numba core).
 
 Streaming: ``FrequencyEstimator.update(t, y)`` takes one timestamped sample and returns an
-:class:`Estimate` when the convergence test (Eqs. 16-17) fires; the estimator then resets and starts
-again, giving the consecutive estimates of Section 5.3. Batch: ``FrequencyEstimator.process(t, y)``
-runs the same compiled step over arrays and returns the same floats.
+:class:`Estimate` when the convergence test (Eqs. 16-17) fires; the estimator then resets and
+starts again, giving the consecutive estimates of Section 5.3. Batch:
+``FrequencyEstimator.process(t, y)`` runs the same compiled step over arrays and returns the same
+floats.
 
 The arithmetic lives in :mod:`vib_estimator.core.kernel` (its docstring derives Eqs. 7-12 and the
-corrected sign of Eq. 8). The configuration and its validation are in :mod:`vib_estimator.core.config`; this module
-holds the Python API.
+corrected sign of Eq. 8). The configuration and its validation are in
+:mod:`vib_estimator.core.config`; this module holds the Python API.
 
 Error budget behind the defaults (the integration rule and eps). The numerator ``n`` is a
 difference of terms of order A t^2 that cancel to w^2 A t^4 / 12, so an integration error e in the

@@ -1,9 +1,10 @@
 """Compiled per-sample step of the algebraic estimator (numba; no rclpy, no Python objects).
 
-This module holds the arithmetic of :mod:`vib_estimator.core.estimator` as one function, :func:`step`,
-that both the streaming API (one call per sample) and the batch API (:func:`run`, a compiled loop
-over arrays) execute, so the two give the same floats. The state lives in three flat arrays whose
-layout is the constants below; :class:`vib_estimator.core.estimator.FrequencyEstimator` owns them.
+This module holds the arithmetic of :mod:`vib_estimator.core.estimator` as one function,
+:func:`step`, that both the streaming API (one call per sample) and the batch API (:func:`run`, a
+compiled loop over arrays) execute, so the two give the same floats. The state lives in three flat
+arrays whose layout is the constants below;
+:class:`vib_estimator.core.estimator.FrequencyEstimator` owns them.
 
 Mathematics (equation numbers are those of Trapero, Sira-Ramirez & Feliu):
 
@@ -321,12 +322,13 @@ def _interval_moments(s, kmax, a, h, npts):
     """Add to M_0..M_kmax the exact integral over the newest interval of s^k p(s).
 
     ``p`` is the polynomial of degree npts-1 through the npts (default NH) newest samples and ``a``
-    the interval's left end in segment time (npts = 2 is the trapezoid, kept for comparison). The rule is causal (the interval is the newest of its stencil) and
-    holds for any spacing; its local error is O(h^(NH+1)). On a uniform stencil the rule is a fixed
-    set of weights, cached (``S_W``) until the step changes. On an irregular stencil, older
-    samples are used only while their intervals are at least h/4 long: after a gap (a long newest
-    interval next to closely spaced older samples) a high-degree polynomial would swing wildly
-    across the gap, so the rule falls back towards the trapezoid for that interval.
+    the interval's left end in segment time (npts = 2 is the trapezoid, kept for comparison). The
+    rule is causal (the interval is the newest of its stencil) and holds for any spacing; its local
+    error is O(h^(NH+1)). On a uniform stencil the rule is a fixed set of weights, cached (``S_W``)
+    until the step changes. On an irregular stencil, older samples are used only while their
+    intervals are at least h/4 long: after a gap (a long newest interval next to closely spaced
+    older samples) a high-degree polynomial would swing wildly across the gap, so the rule falls
+    back towards the trapezoid for that interval.
     """
     uniform = True
     for j in range(NH - 1):
@@ -1053,7 +1055,8 @@ def _target_reached_if_typed(optional, p, s, seg, n, model, f, damping):
 
 
 def _long_window_if(optional, p, s, c, m, one_sided, model, tau, f, damping):
-    """:func:`_long_window_spanned`, compiled only with optional features (:func:`_band_std_if`)."""
+    """:func:`_long_window_spanned`, compiled only with optional features
+    (:func:`_band_std_if`)."""
 
 
 @overload(_long_window_if, inline='always')

@@ -198,8 +198,8 @@ def esprit_poly(qt, n, p):
         for i in range(p):
             for j in range(p):
                 v = 0.0
-                for l in range(p):
-                    v += phi[i, l] * mk[l, j]
+                for col in range(p):
+                    v += phi[i, col] * mk[col, j]
                 nxt[i, j] = v
         mk, nxt = nxt, mk
         for i in range(p):

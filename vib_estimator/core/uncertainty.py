@@ -1,4 +1,5 @@
-"""Maximum-likelihood refinement of an estimate over its segment, and its standard deviation (numba).
+"""Maximum-likelihood refinement of an estimate over its segment, and its standard deviation
+(numba).
 
 The algebraic estimate (Eqs. 7-12) is exact for a clean signal of its model but, with noise, its
 spread grows with the window instead of falling (the moments weight the samples by powers of t,
@@ -9,9 +10,9 @@ gives the standard deviation of the result from the Fisher information.
 Models, on centred segment time u = tau - (tau_0 + tau_{n-1}) / 2 (centring decorrelates the
 frequency from the phase and keeps the normal equations well conditioned)::
 
-    sinusoid:          y = a sin(w u) + b cos(w u)                         theta = (a, b, w)
-    biased-sinusoid:   y = a sin(w u) + b cos(w u) + c                     theta = (a, b, w, c)
-    damped-sinusoid:   y = exp(-sigma u) (a sin(w_d u) + b cos(w_d u))     theta = (a, b, w_d, sigma)
+    sinusoid:          y = a sin(w u) + b cos(w u)                       theta = (a, b, w)
+    biased-sinusoid:   y = a sin(w u) + b cos(w u) + c                   theta = (a, b, w, c)
+    damped-sinusoid:   y = exp(-sigma u) (a sin(w_d u) + b cos(w_d u))   theta = (a, b, w_d, sigma)
 
 (the damped model's natural frequency is w_n = sqrt(w_d^2 + sigma^2), its damping ratio
 zeta = sigma / w_n: the quantities of the algebraic damped estimator.)
@@ -70,8 +71,9 @@ N_WORK = 96
 
 @jit
 def _workspace(work):
-    """Named views of the caller's scratch (``N_WORK`` floats): theta, the best theta, J^T r, J^T J,
-    its inverse, the best theta's inverse, Gauss-Jordan's augmented matrix and its scaling."""
+    """Named views of the caller's scratch (``N_WORK`` floats): theta, the best theta, J^T r,
+    J^T J, its inverse, the best theta's inverse, Gauss-Jordan's augmented matrix and its
+    scaling."""
     return (
         work[0:4],
         work[4:8],

@@ -70,7 +70,8 @@ def signal(samples: int = SAMPLES) -> Tuple[np.ndarray, np.ndarray]:
 
 
 def warm(config: EstimatorConfig) -> float:
-    """Compile (or load from the cache) every kernel ``config`` runs; return the seconds it took."""
+    """Compile (or load from the cache) every kernel ``config`` runs; return the seconds it
+    took."""
     start = time.perf_counter()
     t, y = signal()
     streaming = create_estimator(config)

@@ -3,17 +3,19 @@
 No rclpy import, so that the offline ``vib-estimator analyze`` command, ``scripts/make_bags.py``
 and the tests work without a ROS graph. Three things live here:
 
-* :func:`read_wrench_series` -- the header stamps and one field of a ``geometry_msgs/WrenchStamped``
-  topic, as numpy arrays, in recorded order (what ``analyze`` feeds the estimator);
+* :func:`read_wrench_series` -- the header stamps and one field of a
+  ``geometry_msgs/WrenchStamped`` topic, as numpy arrays, in recorded order (what ``analyze`` feeds
+  the estimator);
 * :class:`BagReader` -- the topics of a bag (type, count, offered QoS) and its messages as raw CDR
   bytes in log-time order (what the bag replayer publishes);
 * :class:`BagWriter` -- a rosbag2 directory (``metadata.yaml`` + one ``.mcap`` or ``.db3`` file)
   with message definitions embedded and the offered QoS profiles recorded per topic (what the
   recorder and ``make_bags.py`` write).
 
-Every problem with a bag -- missing path, not a bag, corrupt or truncated file, no messages, unknown
-topic, wrong or unknown message type -- is raised as :class:`~vib_estimator.errors.BagError` with
-one sentence that names the path (and the topics available, where that helps).
+Every problem with a bag -- missing path, not a bag, corrupt or truncated file, no messages,
+unknown topic, wrong or unknown message type -- is raised as
+:class:`~vib_estimator.errors.BagError` with one sentence that names the path (and the topics
+available, where that helps).
 
 Damaged records. MCAP storage files are read by :mod:`.mcap`, which checks each chunk (its CRC-32,
 which :class:`BagWriter` writes, and its size) and each message index entry; every message is also
@@ -152,8 +154,8 @@ def storage_reader(path: Path):
 class BagReader(DamageCount):
     """An open bag: an MCAP file, an sqlite3 ``.db3`` file, or a rosbag2 directory of either.
 
-    Use as a context manager. Raises :class:`BagError` if the path is missing or not a readable bag,
-    or holds no messages.
+    Use as a context manager. Raises :class:`BagError` if the path is missing or not a readable
+    bag, or holds no messages.
 
     Everything but the list of storage files (and their compression) comes from the storage files
     themselves, not from ``metadata.yaml``: topics, types, counts, offered QoS and the log-time
@@ -364,9 +366,9 @@ def read_wrench_series(
 ) -> WrenchSeries:
     """Header stamps and ``component`` of a WrenchStamped topic of a bag, in recorded order.
 
-    ``topic=None`` takes the bag's only WrenchStamped topic. Raises :class:`BagError` for a bag that
-    cannot be read, an unknown topic, a topic of another type, or no (or several) WrenchStamped
-    topics when ``topic`` is None; ``ValueError`` for an unknown ``component``.
+    ``topic=None`` takes the bag's only WrenchStamped topic. Raises :class:`BagError` for a bag
+    that cannot be read, an unknown topic, a topic of another type, or no (or several)
+    WrenchStamped topics when ``topic`` is None; ``ValueError`` for an unknown ``component``.
     """
     value_of = component_getter(component)
     with BagReader(path) as bag:
@@ -503,8 +505,9 @@ def write_metadata(directory: Path, info: dict) -> None:
     tmp.replace(directory / 'metadata.yaml')
 
 
-#: bytes of records per MCAP chunk written (rosbags: 1 MiB). A damaged chunk loses all its messages,
-#: so smaller chunks lose less: 64 KiB is ~600 WrenchStamped messages, for an index of 0.4 %
+#: bytes of records per MCAP chunk written (rosbags: 1 MiB). A damaged chunk loses all its
+#: messages, so smaller chunks lose less: 64 KiB is ~600 WrenchStamped messages, for an index of
+#: 0.4 %
 CHUNK_BYTES = 1 << 16
 
 

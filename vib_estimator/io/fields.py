@@ -12,7 +12,8 @@ Supported types (full names, as in ``input_type``) and their components:
 * ``geometry_msgs/msg/Vector3Stamped`` -- ``vector.x|y|z``
 * ``sensor_msgs/msg/JointState``       -- ``effort[NAME]``, ``position[NAME]``, ``velocity[NAME]``
   (the joint is looked up by name in every message; a message without it gives ``None``)
-* ``std_msgs/msg/Float64``             -- ``data`` (no header: the receiver's clock is the time base)
+* ``std_msgs/msg/Float64``             -- ``data``
+  (no header: the receiver's clock is the time base)
 """
 
 from __future__ import annotations
@@ -164,7 +165,7 @@ def seconds_since(stamp: int, origin: int) -> float:
     """Stamp relative to an origin, both integer ns, as float seconds.
 
     The estimator's time base. Subtracting in integers first keeps the full resolution of the
-    stamps (an epoch time in float seconds has only ~0.2 us resolution), and the node and the offline
-    ``analyze`` command both use this function so that they see the same floats.
+    stamps (an epoch time in float seconds has only ~0.2 us resolution), and the node and the
+    offline ``analyze`` command both use this function so that they see the same floats.
     """
     return (stamp - origin) * 1e-9

@@ -1,4 +1,5 @@
-"""``vib-estimator reindex BAG``: rebuild a bag's ``metadata.yaml`` from its storage files (``ros2 bag reindex``).
+"""``vib-estimator reindex BAG``: rebuild a bag's ``metadata.yaml`` from its storage files
+(``ros2 bag reindex``).
 
 :func:`reindex` takes a rosbag2 directory of ``.mcap`` or ``.db3`` files -- one or several (a split
 bag), with or without ``metadata.yaml`` -- and writes ``metadata.yaml`` from what the files hold:

@@ -23,8 +23,8 @@ A write that fails (disk full, file too large, I/O error) ends the recording wit
 line and exit code 2; what was flushed before stays readable (after ``reindex``).
 
 Splitting, like ``ros2 bag record``: with ``max_bag_duration`` or ``max_bag_size`` > 0 the bag is
-written as ``<name>_0.mcap``, ``<name>_1.mcap``, ... (``.db3`` for sqlite3), a new file begun before
-a message that would go into a file already that long (log time) or that large.
+written as ``<name>_0.mcap``, ``<name>_1.mcap``, ... (``.db3`` for sqlite3), a new file begun
+before a message that would go into a file already that long (log time) or that large.
 
 Parameters (all read-only):
     topics (string[]): topics to record (relative names resolve in the node's namespace).
@@ -86,8 +86,8 @@ def adapted_qos(
     """A QoS profile that matches every offered (reliability, durability) pair.
 
     rosbag2's adaptive rule: reliable only if every publisher offers reliable (a reliable reader
-    does not match a best-effort writer), transient-local only if every publisher offers it. With no
-    offer known, reliable and volatile.
+    does not match a best-effort writer), transient-local only if every publisher offers it. With
+    no offer known, reliable and volatile.
     """
     offered = list(offered)
     reliable = all(r == ReliabilityPolicy.RELIABLE for r, _ in offered)
@@ -284,7 +284,8 @@ class BagRecorder(Node):
             self._fail(err)
 
     def _fail(self, err: BagError) -> None:
-        """Stop recording after a failed write: one ``error:`` line (the first failure), exit code 2."""
+        """Stop recording after a failed write: one ``error:`` line (the first failure),
+        exit code 2."""
         if self.exit_code != 2:
             print(f'error: {err}', file=sys.stderr, flush=True)
         self.exit_code = 2

@@ -18,14 +18,14 @@ Start. Before the first message the replayer waits until every played topic (wit
 least one matched subscription -- or, once one of them has, :data:`~.playback.SETTLE_S` more for
 the others (a topic nobody subscribes to, say ``/vibration/ground_truth``, does not hold back the
 ones someone does), or ``wait_timeout`` s since it started with no subscriber at all -- then it
-plays, and names the topics still without one. Cross-process discovery takes a second or two, so without this a consumer
-started first would miss the start of the bag. ``wait_timeout: 0`` plays at once; ``delay`` is a
-minimum wait on top.
+plays, and names the topics still without one. Cross-process discovery takes a second or two, so
+without this a consumer started first would miss the start of the bag. ``wait_timeout: 0`` plays at
+once; ``delay`` is a minimum wait on top.
 
 QoS. Each publisher offers what the bag recorded as offered for its topic (reliable unless every
 recorded publisher was best effort; transient-local only if every one was), keep-last 1000 deep;
-without a recorded profile, reliable depth 1000. A best-effort subscriber (sensor-data QoS, like the
-estimator node's) matches a reliable publisher.
+without a recorded profile, reliable depth 1000. A best-effort subscriber (sensor-data QoS, like
+the estimator node's) matches a reliable publisher.
 
 Parameters:
     bag (string, required): the bag directory or ``.mcap``/``.db3`` file.
@@ -111,7 +111,8 @@ def offered_policies(info: TopicInfo):
 
 
 def parse_remaps(remap: List[str], bag: BagReader) -> Dict[str, str]:
-    """``['old:=new', ...]`` -> ``{old: new}``; ``StartupError`` for a bad rule or unknown topic."""
+    """``['old:=new', ...]`` -> ``{old: new}``; ``StartupError`` for a bad rule or unknown
+    topic."""
     rules = {}
     for rule in remap:
         old, sep, new = rule.partition(':=')

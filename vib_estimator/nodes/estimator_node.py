@@ -13,16 +13,18 @@ and the diagnostics bookkeeping, all without rclpy) and publishes what comes bac
   (std_msgs/Float64), then ``vibration/reset`` (std_msgs/Header: stamp and frame_id of the
   converging sample); with ``modes`` >= 1 these carry mode 1, and each mode k has
   ``vibration/mode<k>/frequency`` and ``vibration/mode<k>/reset``.
-* Services ``~/reset`` (a new segment now) and ``~/self_test`` (:mod:`.self_test`), std_srvs/Trigger,
-  with a request history of :data:`SERVICE_DEPTH`: a burst of calls is queued and every call
-  answered, in turn (a self-test takes ~8 ms at the defaults; the input history covers 2 s).
+* Services ``~/reset`` (a new segment now) and ``~/self_test`` (:mod:`.self_test`),
+  std_srvs/Trigger, with a request history of :data:`SERVICE_DEPTH`: a burst of calls is queued and
+  every call answered, in turn (a self-test takes ~8 ms at the defaults; the input history
+  covers 2 s).
 * ``/diagnostics`` at 1 Hz (steady clock): one status named after the node (:mod:`.health`).
 
 Time base: the header stamps (``t`` = stamp - first stamp, as the offline ``vib-estimator
-analyze``, so both give the same floats). A zero stamp, and every sample of a type without a header (``std_msgs/msg/Float64``), is
-stamped with the receipt time on the node clock (``use_sim_time`` applies). Non-finite values,
-duplicate and out-of-order stamps, gaps and backward jumps are the core's business (skipped or
-restarted, and counted); a JointState without the configured joint is skipped and counted here.
+analyze``, so both give the same floats). A zero stamp, and every sample of a type without a header
+(``std_msgs/msg/Float64``), is stamped with the receipt time on the node clock (``use_sim_time``
+applies). Non-finite values, duplicate and out-of-order stamps, gaps and backward jumps are the
+core's business (skipped or restarted, and counted); a JointState without the configured joint is
+skipped and counted here.
 """
 
 from __future__ import annotations
@@ -90,7 +92,8 @@ def message_class(input_type: str):
 
 
 class Outputs:
-    """The publishers of the estimates, and the publication of one estimate (see the module doc)."""
+    """The publishers of the estimates, and the publication of one estimate (see the module
+    doc)."""
 
     def __init__(self, node: Node):
         self._node = node

@@ -1,7 +1,7 @@
 """Diagnostics bookkeeping of ``estimator_node``, with no rclpy (tested alone).
 
-:class:`Health` keeps what ``/diagnostics`` reports: the counters since the node started (the core's,
-summed across the estimators that parameter changes replaced, and the node's own
+:class:`Health` keeps what ``/diagnostics`` reports: the counters since the node started (the
+core's, summed across the estimators that parameter changes replaced, and the node's own
 :data:`NODE_COUNTERS`), the last estimate of ``vibration/frequency`` and of each mode with the
 time it was published, the input and sampling rates, and the status level. The node calls
 :meth:`Health.record` on each published estimate and :meth:`Health.status` once per diagnostics
@@ -115,7 +115,8 @@ class Health:
             self._base[name] = self._base.get(name, 0) + value
 
     def totals(self, core_counters: Mapping[str, int]) -> Dict[str, int]:
-        """The counters since start: the core's (live estimator + replaced ones), then the node's."""
+        """The counters since start: the core's (live estimator + replaced ones), then the
+        node's."""
         totals = dict(self._base)
         for name, value in core_counters.items():
             totals[name] = totals.get(name, 0) + value
@@ -274,8 +275,8 @@ class Health:
         }
 
     def _mode_values(self, now: float, modes: int) -> Dict[str, float]:
-        """``mode<k>_frequency_hz``, ``mode<k>_frequency_std_hz``, ``mode<k>_age_s`` for k = 1..modes
-        (NaN for a mode not published yet)."""
+        """``mode<k>_frequency_hz``, ``mode<k>_frequency_std_hz``, ``mode<k>_age_s`` for
+        k = 1..modes (NaN for a mode not published yet)."""
         values = {}
         for k in range(1, modes + 1):
             last = self._modes.get(k)

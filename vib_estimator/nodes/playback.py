@@ -11,7 +11,8 @@ publishes them, and publishes :meth:`Playback.bag_time_ns` on ``/clock``.
 
 :class:`StartGate` decides when playing begins: not before ``delay`` has passed, and not before
 every played topic has a subscriber -- or ``wait_timeout`` has passed since the replayer started
-(``wait_timeout = 0``: do not wait). All times are integer nanoseconds of the caller's steady clock.
+(``wait_timeout = 0``: do not wait). All times are integer nanoseconds of the caller's steady
+clock.
 """
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """The one ``main`` every node of this package uses.
 
-It holds the Jazzy idiom (``init`` / spin / shutdown / ``destroy_node`` / ``try_shutdown``) once, so
-that the node modules only build their node.
+It holds the Jazzy idiom (``init`` / spin / shutdown / ``destroy_node`` / ``try_shutdown``) once,
+so that the node modules only build their node.
 
 Ctrl-C and SIGTERM only *ask* the spin loop to stop (:class:`StopRequest`, a flag checked between
 ``spin_once`` calls): rclpy's own handler raises ``KeyboardInterrupt`` or shuts the context down

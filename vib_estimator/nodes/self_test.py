@@ -63,7 +63,8 @@ class ToneResult:
 
 def default_band(sample_rate_hz: float) -> Tuple[float, float]:
     """The band the tones span without ``band_hz``: fs/250 to fs/25 (2 to 20 Hz at 500 Hz), where
-    the default configuration resolves a tone in about half a period with >= 25 samples a period."""
+    the default configuration resolves a tone in about half a period with >= 25 samples a
+    period."""
     return sample_rate_hz / 250, sample_rate_hz / 25
 
 

@@ -62,14 +62,16 @@ PARAMETERS = {
     'damping_ratio': (
         0.0,
         descriptor(
-            'damping ratio the shaper is designed for until a vibration/damping_ratio estimate arrives',
+            'damping ratio the shaper is designed for until a vibration/damping_ratio estimate '
+            'arrives',
             (0.0, MAX_DAMPING),
         ),
     ),
     'initial_frequency_hz': (
         0.0,
         descriptor(
-            'design frequency before the first estimate, Hz; 0 = pass the reference through until then',
+            'design frequency before the first estimate, Hz; 0 = pass the reference through '
+            'until then',
             (0.0, 1000.0),
         ),
     ),

@@ -1,4 +1,5 @@
-"""``sim_node``: the flexible arm of Section 5 (:mod:`vib_estimator.sim.arm_model`) as a ROS 2 node.
+"""``sim_node``: the flexible arm of Section 5 (:mod:`vib_estimator.sim.arm_model`) as a ROS 2
+node.
 
 Publishes the measured coupling torque (Eq. 21, scaled as in Fig. 5) as
 ``geometry_msgs/WrenchStamped`` on ``coupling_torque`` (``torque.z``) at ``rate_hz`` -- or, with
@@ -139,8 +140,8 @@ PARAMETERS = {
     'tip_mass_kg': (
         ArmParameters.tip_mass_kg,
         descriptor(
-            'tip mass m of Eqs. 19/23, kg; changing it while running changes the frequency abruptly '
-            '(Section 5.5)',
+            'tip mass m of Eqs. 19/23, kg; changing it while running changes the frequency '
+            'abruptly (Section 5.5)',
             TIP_MASS_RANGE_KG,
         ),
     ),
@@ -164,8 +165,8 @@ PARAMETERS = {
     'publish_clock': (
         False,
         descriptor(
-            'stamp in simulated time from 1 s and publish it on /clock even at speed 1 (always so at '
-            'any other speed)',
+            'stamp in simulated time from 1 s and publish it on /clock even at speed 1 (always so '
+            'at any other speed)',
             read_only=True,
         ),
     ),
@@ -185,8 +186,8 @@ PARAMETERS = {
         0.0,
         descriptor(
             "constant offset of the measurement (a strain-gauge bridge's imbalance), N m of "
-            "coupling torque (the tip acceleration: divided by m L); real rigs have one, the paper's "
-            'sinusoid model does not (docs/real_arm.md)',
+            'coupling torque (the tip acceleration: divided by m L); real rigs have one, the '
+            "paper's sinusoid model does not (docs/real_arm.md)",
             (-10.0, 10.0),
             read_only=True,
         ),
@@ -204,8 +205,8 @@ PARAMETERS = {
         0.0,
         descriptor(
             'closed-loop limit cycle: amplitude of a relay on the rate of bending added to the PD '
-            'voltage (the describing function of friction and backlash in a stiff loop), V; the link '
-            'then holds a sustained oscillation at its own frequency, ~1 N m per V (0 = off)',
+            'voltage (the describing function of friction and backlash in a stiff loop), V; the '
+            'link then holds a sustained oscillation at its own frequency, ~1 N m per V (0 = off)',
             (0.0, 10.0),
             read_only=True,
         ),
@@ -219,8 +220,8 @@ PARAMETERS = {
         [0.0, 1.0, 1.0, 0.0],
         descriptor(
             'motor command as flat groups [start s, final_angle rad, slope rad/s, tip_mass_kg '
-            '(0 = unchanged)]: from start, ramp towards final_angle at slope and set the tip mass; '
-            'default: the Section 5.3 ramp of slope 1 to 1 rad',
+            '(0 = unchanged)]: from start, ramp towards final_angle at slope and set the tip '
+            'mass; default: the Section 5.3 ramp of slope 1 to 1 rad',
             read_only=True,
             type=ParameterType.PARAMETER_DOUBLE_ARRAY,
         ),
@@ -254,28 +255,29 @@ PARAMETERS = {
         False,
         descriptor(
             'in simulated time, once commands flow, each batch of samples (at most '
-            f'{LOCKSTEP_BATCH_SECONDS * 1e3:g} ms) waits for a position_command received after the '
-            'previous /clock (at most 1 s): a commander answering every /clock (shaper_node with '
-            'use_sim_time) then acts at the simulated times it computed for, however loaded the '
-            'machine; the run goes as fast as that round trip allows, at most speed',
+            f'{LOCKSTEP_BATCH_SECONDS * 1e3:g} ms) waits for a position_command received after '
+            'the previous /clock (at most 1 s): a commander answering every /clock (shaper_node '
+            'with use_sim_time) then acts at the simulated times it computed for, however loaded '
+            'the machine; the run goes as fast as that round trip allows, at most speed',
             read_only=True,
         ),
     ),
     'output_type': (
         WRENCH_STAMPED,
         descriptor(
-            'message of the measurement: geometry_msgs/msg/WrenchStamped (coupling torque, torque.z, '
-            'on coupling_torque) or sensor_msgs/msg/Imu (tip acceleration, linear_acceleration.z, on '
-            'tip_imu)',
+            'message of the measurement: geometry_msgs/msg/WrenchStamped (coupling torque, '
+            'torque.z, on coupling_torque) or sensor_msgs/msg/Imu (tip acceleration, '
+            'linear_acceleration.z, on tip_imu)',
             read_only=True,
         ),
     ),
     'excitation': (
         'moves',
         descriptor(
-            "what drives the arm: moves (the schedule's ramps), random (a band-limited random motor "
-            'command of excitation_level rad std, 2 Hz) or ambient (a white disturbance torque at '
-            'the tip of excitation_level N m std): the arm never at rest (docs/operation.md)',
+            "what drives the arm: moves (the schedule's ramps), random (a band-limited random "
+            'motor command of excitation_level rad std, 2 Hz) or ambient (a white disturbance '
+            'torque at the tip of excitation_level N m std): the arm never at rest '
+            '(docs/operation.md)',
             read_only=True,
         ),
     ),

@@ -84,8 +84,9 @@ class ArmParameters:
         motor_gain: k, amplifier gain times torque constant, N m/V (0.21).
         gear_ratio: n (50).
         coulomb: Gamma_c, motor-side Coulomb friction, N m (0.015, ~7 % of the peak torque).
-        coulomb_velocity: w_c, motor-shaft velocity over which ``tanh`` smooths the friction's sign,
-            rad/s (0.1, well below any velocity of a move: 1 rad/s at the gear is 50 rad/s here).
+        coulomb_velocity: w_c, motor-shaft velocity over which ``tanh`` smooths the
+            friction's sign, rad/s (0.1, well below any velocity of a move: 1 rad/s at the gear is
+            50 rad/s here).
         max_voltage: amplifier input range, V (+-10 V, Section 5.2).
 
     PD loop on theta_m (Section 5.2):
@@ -314,7 +315,8 @@ class ArmSimulator:
 
 @dataclass
 class Recording:
-    """A simulated record, one entry per sample: time (s), measured torque (N m), Eq. 23 f0 (Hz)."""
+    """A simulated record, one entry per sample: time (s), measured torque (N m), Eq. 23 f0
+    (Hz)."""
 
     t: np.ndarray
     torque: np.ndarray
@@ -362,9 +364,9 @@ def schedule_5_5(
 
     Each segment fits its mass, then moves the command from 0 to its entry of ``final_angles``,
     alternately up and down (0 -> a1 -> a1 - a2 -> ...), in a 1 s ramp (slope = |step|, like
-    Section 5.3's ramp of slope and final value one). The residual vibration is then proportional to
-    the step: about 0.08, 0.32 and 0.29 N m, so the first mass has the lowest signal-to-noise ratio,
-    as in Fig. 7.
+    Section 5.3's ramp of slope and final value one). The residual vibration is then proportional
+    to the step: about 0.08, 0.32 and 0.29 N m, so the first mass has the lowest signal-to-noise
+    ratio, as in Fig. 7.
     """
     moves, angle = [], 0.0
     for i, (m, step) in enumerate(zip(MASSES_5_5, final_angles)):
@@ -379,7 +381,8 @@ def experiment_5_3(seed: int = 0) -> Recording:
 
 
 def experiment_5_5(seed: int = 0) -> Recording:
-    """Section 5.5 / Fig. 7: 30 -> 45.55 -> 61.17 g, 6 s each, of increasing vibration amplitude."""
+    """Section 5.5 / Fig. 7: 30 -> 45.55 -> 61.17 g, 6 s each, of increasing vibration
+    amplitude."""
     return simulate(18.0, schedule_5_5(), seed=seed)
 
 

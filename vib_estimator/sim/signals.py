@@ -1,4 +1,5 @@
-"""Test signals of the paper (pure numpy): the Fig. 1 sine and the normalised damped sine of Eq. 15."""
+"""Test signals of the paper (pure numpy): the Fig. 1 sine and the normalised damped
+sine of Eq. 15."""
 
 from __future__ import annotations
 
@@ -15,8 +16,8 @@ def fig1_signal(
 ) -> np.ndarray:
     """Section 4's signal: ``A sin(w t + phi)`` plus piecewise-constant uniform noise in [-e, e].
 
-    MATLAB's ``rand`` in a Simulink block holds each draw for one sample, hence one uniform draw per
-    sample (seeded, so every run sees the same noise).
+    MATLAB's ``rand`` in a Simulink block holds each draw for one sample, hence one uniform draw
+    per sample (seeded, so every run sees the same noise).
     """
     rng = np.random.default_rng(seed)
     return amplitude * np.sin(omega * t + phase) + rng.uniform(-noise, noise, size=len(t))
