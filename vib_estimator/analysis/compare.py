@@ -88,12 +88,13 @@ Record = Tuple[np.ndarray, np.ndarray, np.ndarray]
 
 @dataclass(frozen=True)
 class Case:
-    """A test signal: ``record(seed) -> Record`` and its noise std."""
+    """A test signal: ``record(seed) -> Record``, its noise std and the unit of its samples."""
 
     key: str
     title: str
     record: Callable[[int], Record]
     noise_std: float
+    unit: str = 'N·m'
 
 
 def _arm(experiment):
@@ -114,7 +115,8 @@ CASES = (
          _ARM_NOISE),
     Case('5.5', 'Section 5.5 / Fig. 7: 30 -> 45.55 -> 61.17 g', _arm(arm_model.experiment_5_5),
          _ARM_NOISE),
-    Case('fig1', 'Section 4 / Fig. 1: sin(10 t + 1) + U(-0.01, 0.01)', _fig1, 0.01 / math.sqrt(3)),
+    Case('fig1', 'Section 4 / Fig. 1: sin(10 t + 1) + U(-0.01, 0.01)', _fig1, 0.01 / math.sqrt(3),
+         'dimensionless'),
 )
 
 
@@ -339,11 +341,27 @@ def table_cells(rows: Sequence[Row]) -> List[Tuple[str, ...]]:
             for r in rows]
 
 
-def format_table(rows: Sequence[Row]) -> str:
-    """Fixed-width text table."""
+#: the text table's widest line, characters: its columns are split over blocks this wide
+TABLE_WIDTH = 100
+#: the columns of :data:`HEADER` every block of the text table repeats (case, f, method)
+KEY_COLUMNS = 3
+
+
+def format_table(rows: Sequence[Row], width: int = TABLE_WIDTH) -> str:
+    """Fixed-width text table, its columns split over blocks (separated by a blank line) of at
+    most ``width`` characters, each block starting with the :data:`KEY_COLUMNS`."""
     cells = [HEADER] + table_cells(rows)
     widths = [max(len(c[i]) for c in cells) for i in range(len(HEADER))]
-    return '\n'.join('  '.join(c.rjust(w) for c, w in zip(line, widths)) for line in cells)
+    key = list(range(KEY_COLUMNS))
+    blocks, block = [], list(key)
+    for i in range(KEY_COLUMNS, len(HEADER)):
+        if len(block) > KEY_COLUMNS and sum(widths[j] + 2 for j in block) + widths[i] > width:
+            blocks.append(block)
+            block = list(key)
+        block.append(i)
+    blocks.append(block)
+    return '\n\n'.join('\n'.join('  '.join(line[j].rjust(widths[j]) for j in b) for line in cells)
+                       for b in blocks)
 
 
 def format_markdown(rows: Sequence[Row], seeds: int) -> str:
@@ -378,28 +396,43 @@ def format_gains(cases: Sequence[Case] = CASES) -> str:
     return '\n'.join(lines) + '\n'
 
 
-def plot_case(path: str, case: Case, record: Record, runs: Dict[str, Run]) -> None:
-    """Figs. 6-7 layout: signal; every method's estimate with the truth dashed; a +-10 % zoom."""
+#: markers of the algebraic estimates, line styles of the trackers (with colours C0-C9: after ten
+#: methods a style repeats with another colour, so no two methods look alike)
+ALGEBRAIC_MARKERS = ('*', 'P', 'X', 'D')
+TRACKER_STYLES = ('-', '--', '-.', ':')
+
+
+def method_styles(count: int) -> List[Tuple[str, str]]:
+    """(colour, marker or line style) of each of ``count`` methods in :data:`METHODS` order, no
+    two alike: the algebraic ones (first) get markers, the trackers line styles."""
+    return [(f'C{i % 10}', ALGEBRAIC_MARKERS[i % len(ALGEBRAIC_MARKERS)] if name in ALGEBRAIC_CONFIGS
+             else TRACKER_STYLES[(i // 10) % len(TRACKER_STYLES)])
+            for i, name in enumerate(METHODS[:count])]
+
+
+def plot_case(path: str, case: Case, record: Record, runs: Dict[str, Run]):
+    """Figs. 6-7 layout: signal; every method's estimate with the truth dashed; a +-10 % zoom.
+    The algebraic estimates are markers drawn over the trackers' lines. Returns the Figure."""
     from .plotting import pyplot
 
     plt = pyplot()
     t, y, f_true = record
     fig, axes = plt.subplots(3, 1, figsize=(9, 9), sharex=True)
     axes[0].plot(t, y, lw=0.6)
-    axes[0].set_ylabel('signal')
+    axes[0].set_ylabel(f'signal ({case.unit})')
     axes[0].set_title(case.title)
     for ax in axes[1:]:
         for i, (a, b, f) in enumerate(segments(f_true)):
             ax.hlines(f, t[a], t[b - 1], colors='k', linestyles='--', zorder=4,
                       label='true f' if i == 0 else None)
-        for name, color in zip(METHODS, ('C3', 'C5', 'C0', 'C1', 'C2', 'C4', 'C6', 'C7', 'C8',
-                                         'C9', 'y')):
+        for name, (colour, style) in zip(METHODS, method_styles(len(METHODS))):
             run = runs[name]
-            if name in ALGEBRAIC_CONFIGS:
-                ax.plot(t[run.est_index], run.est_f, '*', ms=8, mec='k', mew=0.4, color=color,
-                        zorder=5, label=name)
+            if name in ALGEBRAIC_CONFIGS:      # on top of the trackers' noisy outputs
+                ax.plot(t[run.est_index], run.est_f, style, ms=9, mec='k', mew=0.5,
+                        color=colour, ls='none', zorder=6, label=name)
             else:
-                ax.plot(t, run.output, lw=0.8, alpha=0.8, color=color, label=name)
+                ax.plot(t, run.output, lw=0.8, alpha=0.7, color=colour, ls=style, zorder=2,
+                        label=name)
         ax.set_ylabel('frequency (Hz)')
         ax.grid(alpha=0.3)
     axes[1].set_ylim(0, 3.5)
@@ -410,6 +443,7 @@ def plot_case(path: str, case: Case, record: Record, runs: Dict[str, Run]) -> No
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+    return fig
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
