@@ -6,7 +6,8 @@ has no header: the log time). The recording is read block by block (:mod:`..io.s
 memory does not grow with its length. A bag's topic may be of any input type of
 :mod:`..io.fields`; ``--component`` is checked against it. Estimates go to stdout (jsonl, csv or a
 table); the sample counters go to stderr, then a summary (:mod:`.summary`: the modes found and
-the ``shaper_node`` command of the input shaper to use). Bad input gives one line on stderr and exit code 2.
+the ``shaper_node`` command of the input shaper to use). Bad input gives one line on stderr and
+exit code 2.
 
 Damaged bag records (an MCAP chunk whose checksum fails, an index entry that points at no message,
 a payload that does not decode as its type) are skipped: one ``warning:`` line on stderr says how

@@ -405,8 +405,8 @@ TRACKER_STYLES = ('-', '--', '-.', ':')
 def method_styles(count: int) -> List[Tuple[str, str]]:
     """(colour, marker or line style) of each of ``count`` methods in :data:`METHODS` order, no
     two alike: the algebraic ones (first) get markers, the trackers line styles."""
-    return [(f'C{i % 10}', ALGEBRAIC_MARKERS[i % len(ALGEBRAIC_MARKERS)] if name in ALGEBRAIC_CONFIGS
-             else TRACKER_STYLES[(i // 10) % len(TRACKER_STYLES)])
+    return [(f'C{i % 10}', ALGEBRAIC_MARKERS[i % len(ALGEBRAIC_MARKERS)]
+             if name in ALGEBRAIC_CONFIGS else TRACKER_STYLES[(i // 10) % len(TRACKER_STYLES)])
             for i, name in enumerate(METHODS[:count])]
 
 

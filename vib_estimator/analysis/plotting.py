@@ -94,7 +94,7 @@ def plot_estimates(path: str, t: np.ndarray, y: np.ndarray, est_t: np.ndarray,
 def welch_psd(t: np.ndarray, y: np.ndarray, lowest_hz: float = math.nan):
     """One-sided Welch PSD (scipy.signal.welch, Hann, 50 % overlap) of ``y`` sampled at the median
     interval of ``t``: (frequencies in Hz, PSD in unit^2/Hz). The segments are long enough to
-    resolve ``lowest_hz`` / :data:`PSD_RESOLUTION` when given, a quarter of the record otherwise."""
+    resolve ``lowest_hz`` / :data:`PSD_RESOLUTION` when given, else a quarter of the record."""
     from scipy.signal import welch
 
     y = np.asarray(y, dtype=float)

@@ -487,8 +487,8 @@ def plot_trend(rows: List[Dict], path: Path, base: Optional[Dict] = None,
             axes[1, 0].plot(x, [r['damping'] for r in line], marker='o', ms=3, color=colour,
                             label=label)
     ax_f.set_ylabel('median frequency (Hz)')
-    ax_f.set_title('frequency trend' + ('' if base is None else ': a recording alarms when its 95 % '
-                                        'interval lies wholly outside the band'), fontsize=10)
+    explain = ': a recording alarms when its 95 % interval lies wholly outside the band'
+    ax_f.set_title('frequency trend' + ('' if base is None else explain), fontsize=10)
     if damped:
         axes[1, 0].set_ylabel('median damping ratio')
     axes[-1, 0].set_xlabel('recording start (UTC)')
