@@ -326,7 +326,7 @@ def _duration(seconds: float, f: float) -> str:
     return f'{seconds:.3f} ({seconds * f:.2f})' if math.isfinite(seconds) else '-'
 
 
-HEADER = ('case', 'f (Hz)', 'method', 'n', 'bias (Hz)', 'var (Hz^2)', 'MSE (Hz^2)',
+HEADER = ('case', 'f (Hz)', 'method', 'n', 'bias (Hz)', 'var (Hz²)', 'MSE (Hz²)',
           'median err', '>5%', 'first s (periods)', 'tracked s (periods)', 'ok', 'CRLB (Hz)',
           'std/CRLB', 'us/sample')
 
@@ -341,25 +341,22 @@ def table_cells(rows: Sequence[Row]) -> List[Tuple[str, ...]]:
             for r in rows]
 
 
-#: the text table's widest line, characters: its columns are split over blocks this wide
+#: the text table's widest line, characters
 TABLE_WIDTH = 100
 #: the columns of :data:`HEADER` every block of the text table repeats (case, f, method)
 KEY_COLUMNS = 3
+#: the text table's blocks after the key columns: the accuracy, then the speed and the bound
+TEXT_BLOCKS = (('n', 'bias (Hz)', 'var (Hz²)', 'MSE (Hz²)', 'median err', '>5%', 'std/CRLB'),
+               ('first s (periods)', 'tracked s (periods)', 'ok', 'CRLB (Hz)', 'us/sample'))
 
 
-def format_table(rows: Sequence[Row], width: int = TABLE_WIDTH) -> str:
-    """Fixed-width text table, its columns split over blocks (separated by a blank line) of at
-    most ``width`` characters, each block starting with the :data:`KEY_COLUMNS`."""
+def format_table(rows: Sequence[Row]) -> str:
+    """Fixed-width text table in the :data:`TEXT_BLOCKS` (separated by a blank line), each
+    starting with the :data:`KEY_COLUMNS`, so that no line is wider than :data:`TABLE_WIDTH`."""
     cells = [HEADER] + table_cells(rows)
     widths = [max(len(c[i]) for c in cells) for i in range(len(HEADER))]
-    key = list(range(KEY_COLUMNS))
-    blocks, block = [], list(key)
-    for i in range(KEY_COLUMNS, len(HEADER)):
-        if len(block) > KEY_COLUMNS and sum(widths[j] + 2 for j in block) + widths[i] > width:
-            blocks.append(block)
-            block = list(key)
-        block.append(i)
-    blocks.append(block)
+    blocks = [list(range(KEY_COLUMNS)) + [HEADER.index(name) for name in block]
+              for block in TEXT_BLOCKS]
     return '\n\n'.join('\n'.join('  '.join(line[j].rjust(widths[j]) for j in b) for line in cells)
                        for b in blocks)
 
