@@ -422,10 +422,10 @@ def plot_case(path: str, case: Case, record: Record, runs: Dict[str, Run]):
         for i, (a, b, f) in enumerate(segments(f_true)):
             ax.hlines(f, t[a], t[b - 1], colors='k', linestyles='--', zorder=4,
                       label='true f' if i == 0 else None)
-        for name, (colour, style) in zip(METHODS, method_styles(len(METHODS))):
+        for i, (name, (colour, style)) in enumerate(zip(METHODS, method_styles(len(METHODS)))):
             run = runs[name]
-            if name in ALGEBRAIC_CONFIGS:      # on top of the trackers' noisy outputs
-                ax.plot(t[run.est_index], run.est_f, style, ms=9, mec='k', mew=0.5,
+            if name in ALGEBRAIC_CONFIGS:      # on top of the trackers, smaller ones nested
+                ax.plot(t[run.est_index], run.est_f, style, ms=11 - 2 * i, mec='k', mew=0.5,
                         color=colour, ls='none', zorder=6, label=name)
             else:
                 ax.plot(t, run.output, lw=0.8, alpha=0.7, color=colour, ls=style, zorder=2,

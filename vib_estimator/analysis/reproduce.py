@@ -112,7 +112,7 @@ def _plot_fig1(r: Fig1Result, path: str):
     axes[0].set_ylabel('y (dimensionless)')
     axes[0].set_title('Fig. 1 (Section 4): running estimate of omega, '
                       f'wc = {FIG1_WC:g} rad/s, Ts = {FIG1_TS * 1e3:g} ms')
-    axes[0].legend(loc='upper right', fontsize=8)
+    axes[0].legend(loc='lower left', fontsize=8)
     for ax, w, name in ((axes[1], r.omega_filtered, 'with invariant filtering'),
                         (axes[2], r.omega_unfiltered, 'without invariant filtering')):
         ax.plot(r.t, w, lw=1.0, label=name)
