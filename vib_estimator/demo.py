@@ -400,7 +400,7 @@ def _run_estimation(session: Session, args: argparse.Namespace, wall_start: floa
     plot_estimates(str(out), np.asarray(rec.t), np.asarray(rec.torque), np.asarray(rec.est_t),
                    np.asarray(rec.est_f), np.asarray(rec.est_conv), rec.truth,
                    title=f'Simulated arm, tip masses 30 / 45.55 / 61.17 g ({args.speed:g}x)',
-                   ylabel='coupling torque (N m)')
+                   ylabel='coupling torque', unit='N·m')
     print(f'\n{len(rec.t)} samples, {len(rec.est_t)} estimates in '
           f'{time.monotonic() - wall_start:.1f} s; figure: {out}')
     print('PASS: every median error within 3 %' if ok
