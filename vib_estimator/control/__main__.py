@@ -44,7 +44,7 @@ def plot(path: str, damping: float):
     ax.set(xlabel='true frequency / design frequency', ylabel='residual vibration (%)',
            ylim=(0, PLOT_TOP_PCT), title=f'Sensitivity curves (zeta = {damping:g})')
     ax.grid(alpha=0.3)
-    ax.legend(loc='lower right', fontsize=8)
+    ax.legend(loc='center', fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
