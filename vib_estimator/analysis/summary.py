@@ -1,11 +1,16 @@
 """The short summary ``vib-estimator analyze`` ends with: the modes found and the input shaper to
 use for them, as ``shaper_node`` parameters.
 
+A mode's frequency is the median of its estimates, ``±`` their robust standard deviation
+(:data:`MAD_TO_STD` x the median absolute deviation: an estimate the mode tracker labelled before
+it separated the modes does not inflate it; such estimates, farther than :data:`OUTLIER_STDS`
+robust stds, are counted and named).
+
 Shaper rule: ZVD (``shaper_node``'s default) unless the spread of the frequency estimates would
-leave ZVD more residual vibration than EI's tolerance: with ``s`` the largest relative distance of
-the 5th and 95th percentiles of the mode's estimates from their median, ZVD's worst residual over
-``f (1 +- s)`` (:func:`..control.shaping.sensitivity`, at the mode's damping) above ``EI_VTOL``
-(5 %) recommends EI, which stays within ``EI_VTOL`` over a wider band. ``shaper_node`` shapes one
+leave ZVD more residual vibration than EI's tolerance: with ``s`` = 2 robust stds / median (the
+95 % half-width of the estimates, relative), ZVD's worst residual over ``f (1 +- s)``
+(:func:`..control.shaping.sensitivity`, at the mode's damping) above ``EI_VTOL`` (5 %) recommends
+EI, which stays within ``EI_VTOL`` over a wider band. ``shaper_node`` shapes one
 mode: the recommendation is for the lowest one.
 """
 from __future__ import annotations
@@ -18,15 +23,20 @@ import numpy as np
 
 from ..control.shaping import EI_VTOL, MAX_DAMPING, design, sensitivity
 
-#: the percentiles of a mode's estimates whose distance from the median is its spread
-SPREAD_PERCENTILES = (5.0, 95.0)
+#: the standard deviation of a normal sample per unit of its median absolute deviation
+MAD_TO_STD = 1.4826
+#: an estimate farther than this many robust stds from its mode's median is an outlier
+OUTLIER_STDS = 5.0
+#: the spread of a mode's estimates, in robust stds each side of the median (~95 %)
+SPREAD_STDS = 2.0
 
 
 @dataclass(frozen=True)
 class ModeSummary:
     """One mode: its number (0: the single-mode estimator), how many estimates, their median
-    frequency and standard deviation (Hz), relative spread (:data:`SPREAD_PERCENTILES`) and median
-    damping ratio (NaN when the model estimates none)."""
+    frequency and robust standard deviation (Hz), relative spread (:data:`SPREAD_STDS` robust
+    stds / median), median damping ratio (NaN when the model estimates none) and the number of
+    outliers (:data:`OUTLIER_STDS`)."""
 
     mode: int
     count: int
@@ -34,6 +44,7 @@ class ModeSummary:
     frequency_std_hz: float
     spread_rel: float
     damping: float
+    outliers: int = 0
 
 
 def summarise_modes(frequency_hz, damping, mode=None) -> List[ModeSummary]:
@@ -48,13 +59,12 @@ def summarise_modes(frequency_hz, damping, mode=None) -> List[ModeSummary]:
             continue
         f = frequency_hz[sel]
         median = float(np.median(f))
-        lo, hi = np.percentile(f, SPREAD_PERCENTILES)
+        std = MAD_TO_STD * float(np.median(np.abs(f - median)))
         zeta = damping[sel]
         zeta = zeta[np.isfinite(zeta)]
-        out.append(ModeSummary(int(k), int(sel.sum()), median,
-                               float(np.std(f, ddof=1)) if len(f) > 1 else 0.0,
-                               float(max(hi / median - 1, 1 - lo / median)),
-                               float(np.median(zeta)) if len(zeta) else math.nan))
+        out.append(ModeSummary(int(k), int(sel.sum()), median, std, SPREAD_STDS * std / median,
+                               float(np.median(zeta)) if len(zeta) else math.nan,
+                               int(np.sum(np.abs(f - median) > OUTLIER_STDS * std)) if std else 0))
     return sorted(out, key=lambda m: m.frequency_hz)
 
 
@@ -91,15 +101,16 @@ def summary_lines(modes: List[ModeSummary]) -> List[str]:
         name = f'mode {m.mode}' if m.mode else 'mode'
         zeta = ('damping not estimated (--model damped-sinusoid estimates it)'
                 if not math.isfinite(m.damping) else f'damping ratio {m.damping:.4f}')
+        odd = (f', {m.outliers} outlier(s) beyond {OUTLIER_STDS:g} std' if m.outliers else '')
         lines.append(f'  {name}: f = {m.frequency_hz:.4f} ± {m.frequency_std_hz:.2g} Hz '
-                     f'(std of {m.count} estimates, 5-95 % spread ±{100 * m.spread_rel:.2g} %), '
-                     + zeta)
+                     f'(robust std of {m.count} estimates{odd}), ' + zeta)
     low = modes[0]
     shaper = recommend_shaper(low)
-    why = (f'the estimates spread ±{100 * low.spread_rel:.2g} %, where ZVD would leave more than '
+    spread = f'±{SPREAD_STDS:g} std = ±{100 * low.spread_rel:.2g} %'
+    why = (f'over the estimates\' spread, {spread}, ZVD would leave more than '
            f'{100 * EI_VTOL:g} % residual vibration' if shaper == 'ei' else
-           f'ZVD leaves under {100 * EI_VTOL:g} % residual vibration over the estimates\' '
-           f'±{100 * low.spread_rel:.2g} % spread')
+           f'ZVD leaves under {100 * EI_VTOL:g} % residual vibration over the estimates\' spread, '
+           + spread)
     lines.append(f'recommended input shaper: {shaper.upper()} for {low.frequency_hz:.4g} Hz '
                  f'({why}' + ('; shaper_node shapes one mode: the lowest' if len(modes) > 1
                               else '') + '):')
