@@ -385,7 +385,7 @@ def format_markdown(rows: Sequence[Row], seeds: int) -> str:
 def format_gains(cases: Sequence[Case] = CASES) -> str:
     """One line per case: the gains of the ``-A`` rows (:func:`tuned_gains`)."""
     lines = [f'amplitude-tuned gains (least MSE on seeds {TUNING_SEEDS[0]}-{TUNING_SEEDS[-1]}, '
-             'grid of the paper gain x ' + '/'.join(f'{k:g}' for k in GAIN_FACTORS) + '):']
+             'the paper gain x ' + '/'.join(f'{k:g}' for k in GAIN_FACTORS) + '):']
     for case in cases:
         gains = tuned_gains(case)
         lines.append(f'  {case.key}: ' + ', '.join(
@@ -464,7 +464,7 @@ def run(args: argparse.Namespace) -> int:
     keep: Dict[str, Tuple[Record, Dict[str, Run]]] = {}
     rows = compare(seeds, keep=keep)
     print(f'{seeds} noise seeds per case; estimates within {100 * TOLERANCE:.0f} % count as '
-          'converged (definitions: vib_estimator/compare.py)')
+          'converged\n(definitions: vib_estimator/analysis/compare.py)')
     print(format_table(rows))
     print(format_gains(), end='')
     os.makedirs(args.out, exist_ok=True)
