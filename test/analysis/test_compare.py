@@ -52,19 +52,29 @@ def test_compare_command_prints_every_method_and_writes_plots(tmp_path, capsys):
     assert cli.main(['compare', '--quick', '--seeds', '2', '--out', str(tmp_path),
                      '--markdown', str(md)]) == 0
     text = capsys.readouterr().out
-    lines = [ln.split() for ln in text.splitlines()]
+    table = text[text.index('\ncase') + 1:text.index('\namplitude-tuned')]
+    blocks = [[ln.split() for ln in block.splitlines()] for block in table.split('\n\n')]
+    assert len(blocks) == len(compare.TEXT_BLOCKS)
+    assert max(len(ln) for ln in table.splitlines()) <= compare.TABLE_WIDTH
     for case in compare.CASES:
         n_segs = 3 if case.key == '5.5' else 1
         for method in compare.METHODS:
-            rows = [ln for ln in lines if ln and ln[0] == case.key and method.split()[0] in ln]
-            assert len(rows) == n_segs, (case.key, method)
-        assert (tmp_path / f'compare_{case.key.replace(".", "_")}.png').stat().st_size > 10_000
-    # the algebraic method's and the DFT's rows are complete and finite
-    for ln in lines:
-        if ln and ln[0] in ('5.3', '5.5', 'fig1') and ln[2] in ('Algebraic', 'Sliding'):
-            numbers = ln[3:] if ln[2] == 'Algebraic' else ln[4:]
-            assert len(numbers) == len(compare.HEADER) - 1      # two durations in s (periods)
-            assert all(math.isfinite(float(v.strip('()%'))) for v in numbers), ln
+            for lines in blocks:
+                rows = [ln for ln in lines if ln[0] == case.key and method.split()[0] in ln]
+                assert len(rows) == n_segs, (case.key, method)
+        # what the figure shows: test_pictures.py, on the Figure plot_case returns
+        assert (tmp_path / f'compare_{case.key.replace(".", "_")}.png').is_file()
+    # the algebraic method's and the DFT's rows are complete and finite (across the blocks)
+    numbers = {}
+    for lines in blocks:
+        for ln in lines:
+            if ln[0] in ('5.3', '5.5', 'fig1') and ln[2] in ('Algebraic', 'Sliding'):
+                numbers.setdefault(tuple(ln[:3]), []).extend(ln[3:] if ln[2] == 'Algebraic'
+                                                             else ln[4:])
+    assert len(numbers) == 2 * sum(3 if c.key == '5.5' else 1 for c in compare.CASES)
+    for key, values in numbers.items():
+        assert len(values) == len(compare.HEADER) - 1, key   # two durations in s (periods)
+        assert all(math.isfinite(float(v.strip('()%'))) for v in values), key
     table = md.read_text()
     assert '7.0e-02' in table and '3.1e-05' in table
     assert all(m in table for m in compare.METHODS)

@@ -197,3 +197,37 @@ def test_every_entry_of_a_folder_is_accounted_for(tmp_path, capsys):
     strict = {Path(r['recording']).relative_to(tmp_path).as_posix(): r
               for r in jsonl(capsys.readouterr().out)}
     assert 'damaged' in strict['damaged/day_00']['error']
+
+
+def legend_texts(ax):
+    return [x.get_text() for x in ax.get_legend().get_texts()]
+
+
+def test_trend_plot_shows_the_baseline_and_the_alarm_band(tmp_path):
+    days = fleet(tmp_path / 'fleet', [1.3] * 4 + [1.3 * 0.95] * 2)
+    options = S.Options(EstimatorConfig(), (), (), None, False)
+    rows = S.survey(S.find_recordings([str(tmp_path / 'fleet')]), options)
+    base = S.baseline_rows(str(days[0]), options)
+    S.flag(rows, base, 0.02)
+    fig = S.plot_trend(rows, tmp_path / 'trend.png', base, 0.02)
+    assert len(fig.axes) == 1                      # no damping estimated: no damping panel
+    ax = fig.axes[0]
+    labels = legend_texts(ax)
+    f0 = base[None][0]
+    assert f'baseline {f0:.5g} Hz' in labels and 'alarm' in labels
+    assert 'no-alarm band: baseline 95 % interval ±2 %' in labels
+    assert ax.get_ylabel() == 'median frequency (Hz)'
+    baseline = [line for line in ax.get_lines() if line.get_label().startswith('baseline')][0]
+    assert np.allclose(baseline.get_ydata(), f0)
+    band = [p for p in ax.patches if p.get_label().startswith('no-alarm band')][0]
+    lo, hi = S.alarm_band(base[None], 0.02)
+    assert np.isclose(band.get_y(), lo) and np.isclose(band.get_y() + band.get_height(), hi)
+    for r in rows:                 # the picture's rule is flag()'s: interval wholly outside
+        outside = r['frequency_hi_hz'] < lo or r['frequency_lo_hz'] > hi
+        assert r['alarm'] == outside
+    assert sum(r['alarm'] for r in rows) == 2
+    for r in rows:
+        r['damping'] = 0.01
+    fig = S.plot_trend(rows, tmp_path / 'trend2.png', base, 0.02)
+    assert [a.get_ylabel() for a in fig.axes] == ['median frequency (Hz)', 'median damping ratio']
+    assert all(np.allclose(line.get_ydata(), 0.01) for line in fig.axes[1].get_lines())

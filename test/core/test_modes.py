@@ -175,10 +175,17 @@ def test_plot_colours_the_modes(tmp_path):
     y = decay(t, 0.5, 8.0, 1.0) + decay(t, 0.5, 21.0, 0.3, 0.001) + noise(t, 0.003, 0)
     e = ModeTracker(CFG).process(t, y)
     out = tmp_path / 'modes.png'
-    plot_estimates(str(out), t, y, e.t, e.frequency_hz, e.convergence_time, mode=e.mode)
-    assert out.stat().st_size > 10_000
-    plot_estimates(str(tmp_path / 'none.png'), t, y, e.t[:0], e.frequency_hz[:0],
-                   e.convergence_time[:0], mode=e.mode[:0])
+    fig = plot_estimates(str(out), t, y, e.t, e.frequency_hz, e.convergence_time, mode=e.mode)
+    estimates, spectrum = fig.axes[1], fig.axes[3]
+    series = {line.get_label(): line for line in estimates.get_lines()}
+    assert set(series) == {'mode 1', 'mode 2'}
+    assert series['mode 1'].get_color() != series['mode 2'].get_color()
+    marks = sorted(float(line.get_xdata()[0]) for line in spectrum.get_lines()[1:])
+    assert np.allclose(marks, [8.0, 21.0], rtol=0.01)
+    fig = plot_estimates(str(tmp_path / 'none.png'), t, y, e.t[:0], e.frequency_hz[:0],
+                         e.convergence_time[:0], mode=e.mode[:0])
+    spectrum = fig.axes[3]
+    assert [line.get_label() for line in spectrum.get_lines()] == ['Welch PSD']   # nothing marked
 
 
 REFERENCE = {30: 16.360, 40: 9.392, 50: 6.054, 60: 4.268}

@@ -139,7 +139,8 @@ def test_analyze_reports_damaged_records_and_strict_refuses(tmp_path):
     assert result.returncode == 0, result.stderr
     warnings = [line for line in result.stderr.splitlines() if 'warning:' in line]
     assert len(warnings) == 1 and 'damaged record' in warnings[0]
-    summary = result.stderr.splitlines()[-1]
+    summary = next(line for line in result.stderr.splitlines()     # the counters line
+                   if line.startswith('analyze: received='))
     counts = dict(kv.split('=') for kv in summary.split(': ', 1)[1].split(', '))
     assert int(counts['corrupt_records']) > 0
     assert int(counts['received']) + int(counts['corrupt_records']) == 5000

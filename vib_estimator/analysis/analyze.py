@@ -5,7 +5,9 @@ streaming core with time = header stamp - first stamp (``fields.seconds_since``;
 has no header: the log time). The recording is read block by block (:mod:`..io.streaming`), so
 memory does not grow with its length. A bag's topic may be of any input type of
 :mod:`..io.fields`; ``--component`` is checked against it. Estimates go to stdout (jsonl, csv or a
-table); the sample counters go to stderr. Bad input gives one line on stderr and exit code 2.
+table); the sample counters go to stderr, then a summary (:mod:`.summary`: the modes found and
+the ``shaper_node`` command of the input shaper to use). Bad input gives one line on stderr and
+exit code 2.
 
 Damaged bag records (an MCAP chunk whose checksum fails, an index entry that points at no message,
 a payload that does not decode as its type) are skipped: one ``warning:`` line on stderr says how
@@ -27,9 +29,10 @@ from ..core import MODELS, EstimateArrays, EstimatorConfig
 from ..core.config import EXCITATIONS, PAPER
 from ..core.modes import create_estimator
 from ..errors import VibEstimatorError, report
-from ..io.fields import INPUT_TYPES
+from ..io.fields import INPUT_TYPES, signal_unit
 from ..io.streaming import Signal, open_signal
 from .outputs import check_output
+from .summary import summarise_modes, summary_lines
 
 #: CLI option -> EstimatorConfig field for the estimator's scalar parameters
 _CONFIG_OPTIONS = {
@@ -227,13 +230,24 @@ def run(args: argparse.Namespace) -> int:
         extra += f', open_segment_samples={open_samples}'
     print('analyze: ' + ', '.join(f'{k}={v}' for k, v in counters.items()) + extra,
           file=sys.stderr)
+    mode = estimates.mode if config.modes else None
     if len(estimates) == 0:
         print('analyze: no estimate: ' + explain_no_estimate(counters, open_samples, config),
               file=sys.stderr)
+    for line in summary_lines(summarise_modes(estimates.frequency_hz, estimates.damping, mode)):
+        print('analyze: ' + line, file=sys.stderr)
     if args.plot:
-        from .plotting import plot_estimates
-
-        plot_estimates(args.plot, *result.samples, estimates.t, estimates.frequency_hz,
-                       estimates.convergence_time, title=f'{args.input}: {signal.label}',
-                       ylabel=signal.label, mode=estimates.mode if config.modes else None)
+        plot_run(args.plot, args.input, signal, result, mode)
     return 0
+
+
+def plot_run(path: str, name: str, signal: Signal, run: Run, mode=None):
+    """``--plot``: the estimates and spectrum figure of a run (``keep_samples``) of ``signal``,
+    its signal axis in the unit of the component or column (:func:`..io.fields.signal_unit`);
+    returns the Figure."""
+    from .plotting import plot_estimates
+
+    e = run.estimates
+    return plot_estimates(path, *run.samples, e.t, e.frequency_hz, e.convergence_time,
+                          title=f'{name}: {signal.label}', ylabel=signal.label, mode=mode,
+                          unit=signal_unit(signal.component or signal.label))

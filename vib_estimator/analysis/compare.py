@@ -88,12 +88,13 @@ Record = Tuple[np.ndarray, np.ndarray, np.ndarray]
 
 @dataclass(frozen=True)
 class Case:
-    """A test signal: ``record(seed) -> Record`` and its noise std."""
+    """A test signal: ``record(seed) -> Record``, its noise std and the unit of its samples."""
 
     key: str
     title: str
     record: Callable[[int], Record]
     noise_std: float
+    unit: str = 'N·m'
 
 
 def _arm(experiment):
@@ -114,7 +115,8 @@ CASES = (
          _ARM_NOISE),
     Case('5.5', 'Section 5.5 / Fig. 7: 30 -> 45.55 -> 61.17 g', _arm(arm_model.experiment_5_5),
          _ARM_NOISE),
-    Case('fig1', 'Section 4 / Fig. 1: sin(10 t + 1) + U(-0.01, 0.01)', _fig1, 0.01 / math.sqrt(3)),
+    Case('fig1', 'Section 4 / Fig. 1: sin(10 t + 1) + U(-0.01, 0.01)', _fig1, 0.01 / math.sqrt(3),
+         'dimensionless'),
 )
 
 
@@ -324,7 +326,7 @@ def _duration(seconds: float, f: float) -> str:
     return f'{seconds:.3f} ({seconds * f:.2f})' if math.isfinite(seconds) else '-'
 
 
-HEADER = ('case', 'f (Hz)', 'method', 'n', 'bias (Hz)', 'var (Hz^2)', 'MSE (Hz^2)',
+HEADER = ('case', 'f (Hz)', 'method', 'n', 'bias (Hz)', 'var (Hz²)', 'MSE (Hz²)',
           'median err', '>5%', 'first s (periods)', 'tracked s (periods)', 'ok', 'CRLB (Hz)',
           'std/CRLB', 'us/sample')
 
@@ -339,11 +341,24 @@ def table_cells(rows: Sequence[Row]) -> List[Tuple[str, ...]]:
             for r in rows]
 
 
+#: the text table's widest line, characters
+TABLE_WIDTH = 100
+#: the columns of :data:`HEADER` every block of the text table repeats (case, f, method)
+KEY_COLUMNS = 3
+#: the text table's blocks after the key columns: the accuracy, then the speed and the bound
+TEXT_BLOCKS = (('n', 'bias (Hz)', 'var (Hz²)', 'MSE (Hz²)', 'median err', '>5%', 'std/CRLB'),
+               ('first s (periods)', 'tracked s (periods)', 'ok', 'CRLB (Hz)', 'us/sample'))
+
+
 def format_table(rows: Sequence[Row]) -> str:
-    """Fixed-width text table."""
+    """Fixed-width text table in the :data:`TEXT_BLOCKS` (separated by a blank line), each
+    starting with the :data:`KEY_COLUMNS`, so that no line is wider than :data:`TABLE_WIDTH`."""
     cells = [HEADER] + table_cells(rows)
     widths = [max(len(c[i]) for c in cells) for i in range(len(HEADER))]
-    return '\n'.join('  '.join(c.rjust(w) for c, w in zip(line, widths)) for line in cells)
+    blocks = [list(range(KEY_COLUMNS)) + [HEADER.index(name) for name in block]
+              for block in TEXT_BLOCKS]
+    return '\n\n'.join('\n'.join('  '.join(line[j].rjust(widths[j]) for j in b) for line in cells)
+                       for b in blocks)
 
 
 def format_markdown(rows: Sequence[Row], seeds: int) -> str:
@@ -370,7 +385,7 @@ def format_markdown(rows: Sequence[Row], seeds: int) -> str:
 def format_gains(cases: Sequence[Case] = CASES) -> str:
     """One line per case: the gains of the ``-A`` rows (:func:`tuned_gains`)."""
     lines = [f'amplitude-tuned gains (least MSE on seeds {TUNING_SEEDS[0]}-{TUNING_SEEDS[-1]}, '
-             'grid of the paper gain x ' + '/'.join(f'{k:g}' for k in GAIN_FACTORS) + '):']
+             'the paper gain x ' + '/'.join(f'{k:g}' for k in GAIN_FACTORS) + '):']
     for case in cases:
         gains = tuned_gains(case)
         lines.append(f'  {case.key}: ' + ', '.join(
@@ -378,28 +393,43 @@ def format_gains(cases: Sequence[Case] = CASES) -> str:
     return '\n'.join(lines) + '\n'
 
 
-def plot_case(path: str, case: Case, record: Record, runs: Dict[str, Run]) -> None:
-    """Figs. 6-7 layout: signal; every method's estimate with the truth dashed; a +-10 % zoom."""
+#: markers of the algebraic estimates, line styles of the trackers (with colours C0-C9: after ten
+#: methods a style repeats with another colour, so no two methods look alike)
+ALGEBRAIC_MARKERS = ('*', 'P', 'X', 'D')
+TRACKER_STYLES = ('-', '--', '-.', ':')
+
+
+def method_styles(count: int) -> List[Tuple[str, str]]:
+    """(colour, marker or line style) of each of ``count`` methods in :data:`METHODS` order, no
+    two alike: the algebraic ones (first) get markers, the trackers line styles."""
+    return [(f'C{i % 10}', ALGEBRAIC_MARKERS[i % len(ALGEBRAIC_MARKERS)]
+             if name in ALGEBRAIC_CONFIGS else TRACKER_STYLES[(i // 10) % len(TRACKER_STYLES)])
+            for i, name in enumerate(METHODS[:count])]
+
+
+def plot_case(path: str, case: Case, record: Record, runs: Dict[str, Run]):
+    """Figs. 6-7 layout: signal; every method's estimate with the truth dashed; a +-10 % zoom.
+    The algebraic estimates are markers drawn over the trackers' lines. Returns the Figure."""
     from .plotting import pyplot
 
     plt = pyplot()
     t, y, f_true = record
     fig, axes = plt.subplots(3, 1, figsize=(9, 9), sharex=True)
     axes[0].plot(t, y, lw=0.6)
-    axes[0].set_ylabel('signal')
+    axes[0].set_ylabel(f'signal ({case.unit})')
     axes[0].set_title(case.title)
     for ax in axes[1:]:
         for i, (a, b, f) in enumerate(segments(f_true)):
             ax.hlines(f, t[a], t[b - 1], colors='k', linestyles='--', zorder=4,
                       label='true f' if i == 0 else None)
-        for name, color in zip(METHODS, ('C3', 'C5', 'C0', 'C1', 'C2', 'C4', 'C6', 'C7', 'C8',
-                                         'C9', 'y')):
+        for i, (name, (colour, style)) in enumerate(zip(METHODS, method_styles(len(METHODS)))):
             run = runs[name]
-            if name in ALGEBRAIC_CONFIGS:
-                ax.plot(t[run.est_index], run.est_f, '*', ms=8, mec='k', mew=0.4, color=color,
-                        zorder=5, label=name)
+            if name in ALGEBRAIC_CONFIGS:      # on top of the trackers, smaller ones nested
+                ax.plot(t[run.est_index], run.est_f, style, ms=11 - 2 * i, mec='k', mew=0.5,
+                        color=colour, ls='none', zorder=6, label=name)
             else:
-                ax.plot(t, run.output, lw=0.8, alpha=0.8, color=color, label=name)
+                ax.plot(t, run.output, lw=0.8, alpha=0.7, color=colour, ls=style, zorder=2,
+                        label=name)
         ax.set_ylabel('frequency (Hz)')
         ax.grid(alpha=0.3)
     axes[1].set_ylim(0, 3.5)
@@ -410,6 +440,7 @@ def plot_case(path: str, case: Case, record: Record, runs: Dict[str, Run]) -> No
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+    return fig
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -433,7 +464,7 @@ def run(args: argparse.Namespace) -> int:
     keep: Dict[str, Tuple[Record, Dict[str, Run]]] = {}
     rows = compare(seeds, keep=keep)
     print(f'{seeds} noise seeds per case; estimates within {100 * TOLERANCE:.0f} % count as '
-          'converged (definitions: vib_estimator/compare.py)')
+          'converged\n(definitions: vib_estimator/analysis/compare.py)')
     print(format_table(rows))
     print(format_gains(), end='')
     os.makedirs(args.out, exist_ok=True)

@@ -1,13 +1,25 @@
-"""Figures in the style of the paper's Fig. 5 (signal / estimates / convergence times).
+"""Figures in the style of the paper's Fig. 5 (signal / estimates / convergence times), and the
+signal's spectrum with the estimated modes marked.
 
 matplotlib is imported lazily with the non-interactive Agg backend, so nodes and the core never pay
 for it and no display is needed.
 """
 from __future__ import annotations
 
+import math
 from typing import Optional, Sequence, Tuple
 
 import numpy as np
+
+from ..io.fields import UNKNOWN_UNIT
+from .summary import summarise_modes
+
+#: the spectrum's segments resolve the lowest mode's frequency / this
+PSD_RESOLUTION = 8.0
+#: shortest Welch segment, samples
+PSD_MIN_SEGMENT = 256
+#: the spectrum's axis spans 0 .. this x the highest mode's frequency (or Nyquist)
+PSD_SPAN = 4.0
 
 
 def pyplot():
@@ -20,28 +32,40 @@ def pyplot():
     return plt
 
 
+def mode_colour(k: int) -> str:
+    """The colour of mode ``k`` (0: the single-mode estimator) in every panel."""
+    return 'C3' if k == 0 else f'C{(k - 1) % 10}'
+
+
 def plot_estimates(path: str, t: np.ndarray, y: np.ndarray, est_t: np.ndarray,
                    est_f: np.ndarray, est_conv: np.ndarray,
                    truth: Optional[Sequence[Tuple[float, float, float]]] = None,
                    title: str = '', ylabel: str = 'signal',
-                   mode: Optional[np.ndarray] = None) -> None:
-    """Write a three-panel PNG like Fig. 5.
+                   mode: Optional[np.ndarray] = None, unit: str = UNKNOWN_UNIT):
+    """Write a four-panel PNG: the three panels of Fig. 5 and the signal's spectrum; return the
+    Figure (closed: for inspection, not display).
 
     ``truth`` is a list of (t_start, t_end, f_true) segments drawn dashed in the middle panel.
     ``mode`` (the estimates' mode column, ``modes`` >= 1) colours the estimates by mode, with a
-    legend "mode k"; without it (or all 0) they are one series.
+    legend "mode k"; without it (or all 0) they are one series. ``unit`` labels the signal axis
+    (and the PSD's). The spectrum (:func:`welch_psd`) marks each mode's median estimate with a
+    vertical line labelled "f = ... Hz".
     """
     plt = pyplot()
-    fig, axes = plt.subplots(3, 1, figsize=(9, 7.5), sharex=True)
+    fig = plt.figure(figsize=(9, 10))
+    grid = fig.add_gridspec(4, 1, height_ratios=(1, 1, 1, 1.2))
+    axes = [fig.add_subplot(grid[0])]
+    axes += [fig.add_subplot(grid[i], sharex=axes[0]) for i in (1, 2)]
+    ax_psd = fig.add_subplot(grid[3])
     axes[0].plot(t, y, lw=0.7)
-    axes[0].set_ylabel(ylabel)
+    axes[0].set_ylabel(f'{ylabel} ({unit})')
     est_t, est_f, est_conv = (np.asarray(a) for a in (est_t, est_f, est_conv))
     mode = np.zeros(len(est_t), dtype=int) if mode is None else np.asarray(mode)
     for k in np.unique(mode) if len(mode) else [0]:
         sel = mode == k
-        label, colour = ('algebraic estimates', 'C3') if k == 0 else (f'mode {k}', f'C{k - 1}')
-        axes[1].plot(est_t[sel], est_f[sel], '*', color=colour, label=label)
-        axes[2].plot(est_t[sel], est_conv[sel], 'o', mfc='none', color=colour)
+        label = 'algebraic estimates' if k == 0 else f'mode {k}'
+        axes[1].plot(est_t[sel], est_f[sel], '*', color=mode_colour(k), label=label)
+        axes[2].plot(est_t[sel], est_conv[sel], 'o', mfc='none', color=mode_colour(k))
     for i, (t0, t1, f) in enumerate(truth or []):
         axes[1].hlines(f, t0, t1, colors='k', linestyles='--',
                        label='true frequency' if i == 0 else None)
@@ -57,8 +81,43 @@ def plot_estimates(path: str, t: np.ndarray, y: np.ndarray, est_t: np.ndarray,
     axes[2].set_xlabel('time (s)')
     if title:
         axes[0].set_title(title)
-    for ax in axes:
+    modes = summarise_modes(est_f, np.full(len(est_f), np.nan), mode)
+    plot_spectrum(ax_psd, t, y, modes, unit)
+    for ax in (*axes, ax_psd):
         ax.grid(alpha=0.3)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+    return fig
+
+
+def welch_psd(t: np.ndarray, y: np.ndarray, lowest_hz: float = math.nan):
+    """One-sided Welch PSD (scipy.signal.welch, Hann, 50 % overlap) of ``y`` sampled at the median
+    interval of ``t``: (frequencies in Hz, PSD in unit^2/Hz). The segments are long enough to
+    resolve ``lowest_hz`` / :data:`PSD_RESOLUTION` when given, else a quarter of the record."""
+    from scipy.signal import welch
+
+    y = np.asarray(y, dtype=float)
+    fs = 1.0 / float(np.median(np.diff(t)))
+    want = PSD_RESOLUTION * fs / lowest_hz if lowest_hz > 0 else len(y) / 4
+    nperseg = int(min(len(y), max(PSD_MIN_SEGMENT, want)))
+    return welch(y - np.mean(y), fs=fs, nperseg=nperseg)
+
+
+def plot_spectrum(ax, t: np.ndarray, y: np.ndarray, modes, unit: str = UNKNOWN_UNIT) -> None:
+    """The Welch PSD of the signal on ``ax`` (log scale), each of ``modes``
+    (:class:`.summary.ModeSummary`) marked at its median frequency, labelled "f = ... Hz"."""
+    if len(y) < 2:
+        ax.text(0.5, 0.5, 'too few samples for a spectrum', transform=ax.transAxes, ha='center')
+        return
+    f, psd = welch_psd(t, y, min((m.frequency_hz for m in modes), default=math.nan))
+    ax.semilogy(f[1:], psd[1:], lw=0.8, color='0.3', label='Welch PSD')
+    for m in modes:
+        ax.axvline(m.frequency_hz, color=mode_colour(m.mode), ls='--', lw=1.0,
+                   label=f'f = {m.frequency_hz:.5g} Hz' + (f' (mode {m.mode})' if m.mode else ''))
+    if modes:
+        ax.set_xlim(0, min(f[-1], PSD_SPAN * max(m.frequency_hz for m in modes)))
+    ax.set_xlabel('frequency (Hz)')
+    ax.set_ylabel(f'PSD (({unit})²/Hz)')
+    ax.set_title('spectrum, estimated modes marked (median of the estimates)', fontsize=9)
+    ax.legend(loc='upper right', fontsize=8)

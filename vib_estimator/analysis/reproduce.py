@@ -15,7 +15,7 @@ import argparse
 import math
 import sys
 from dataclasses import dataclass
-from typing import List
+from typing import List, Sequence
 
 import numpy as np
 
@@ -101,41 +101,68 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--out', help='PNG to write (default out/<figure>.png)')
 
 
-def _plot_fig1(r: Fig1Result, path: str) -> None:
+def _plot_fig1(r: Fig1Result, path: str):
+    """Fig. 1: the signal, and the running estimate with and without the invariant filtering
+    (truth 10 rad/s dashed). Returns the Figure."""
     from .plotting import pyplot
 
     plt = pyplot()
     fig, axes = plt.subplots(3, 1, figsize=(8, 7), sharex=True)
-    axes[0].plot(r.t, r.y, lw=0.8)
-    axes[0].set_ylabel('y(t)')
+    axes[0].plot(r.t, r.y, lw=0.8, label='y = sin(10 t + 1) + U[-0.01, 0.01]')
+    axes[0].set_ylabel('y (dimensionless)')
+    axes[0].set_title('Fig. 1 (Section 4): running estimate of omega, '
+                      f'wc = {FIG1_WC:g} rad/s, Ts = {FIG1_TS * 1e3:g} ms')
+    axes[0].legend(loc='lower left', fontsize=8)
     for ax, w, name in ((axes[1], r.omega_filtered, 'with invariant filtering'),
                         (axes[2], r.omega_unfiltered, 'without invariant filtering')):
         ax.plot(r.t, w, lw=1.0, label=name)
-        ax.axhline(10.0, color='k', ls='--', lw=0.8)
+        ax.axhline(10.0, color='k', ls='--', lw=0.8, label='true omega = 10 rad/s')
         ax.set_ylim(8, 12)
         ax.set_ylabel('omega (rad/s)')
-        ax.legend(loc='upper right')
+        ax.legend(loc='upper right', fontsize=8)
     axes[2].set_xlabel('t (s)')
+    for ax in axes:
+        ax.grid(alpha=0.3)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+    return fig
 
 
-def _plot_fig2(r: Fig2Result, path: str) -> None:
+#: Fig. 2's variants, in its table's and its legend's order: (name, fig2 keyword arguments)
+FIG2_VARIANTS = (('Eq. 16 as printed', PAPER_TEST), ('paper defaults', {}),
+                 ('damped-sinusoid', dict(model='damped-sinusoid')))
+
+
+def _plot_fig2(results: Sequence[Fig2Result], path: str, names: Sequence[str] = ()):
+    """Fig. 2: convergence time T* and MAE (Eq. 18) against zeta_n, one series per variant of
+    ``results`` (named ``names``, default :data:`FIG2_VARIANTS`); a variant without an estimate at
+    a zeta_n (NaN) leaves a gap, and one never converging is listed in the legend as such. Returns
+    the Figure."""
     from .plotting import pyplot
 
     plt = pyplot()
-    fig, axes = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
-    axes[0].plot(r.zetas, r.convergence_time, 'o-')
-    axes[0].set_ylabel('convergence time (normalised s)')
-    axes[1].semilogy(r.zetas, np.maximum(r.mae, 1e-12), 'o-')
+    names = list(names) or [name for name, _ in FIG2_VARIANTS]
+    fig, axes = plt.subplots(2, 1, figsize=(7, 6.5), sharex=True)
+    for (name, r), marker in zip(zip(names, results), 'osd^v'):
+        done = np.isfinite(r.convergence_time)
+        label = name if done.any() else f'{name} (no estimate)'
+        axes[0].plot(r.zetas, r.convergence_time, marker + '-', label=label)
+        axes[1].semilogy(r.zetas, np.maximum(r.mae, 1e-16), marker + '-', label=label)
+    axes[0].set_title('Fig. 2 (Eqs. 13-18): first estimate of the normalised damped sine, '
+                      'M = 10, Ts = 2 ms', fontsize=9)
+    axes[0].set_ylabel('convergence time T* (periods)')
+    axes[0].legend(fontsize=8)
     axes[1].axhline(1e-3, color='k', ls='--', lw=0.8, label='tolerance 1e-3')
-    axes[1].set_ylabel('MAE (Eq. 18)')
-    axes[1].set_xlabel('zeta_n')
-    axes[1].legend()
+    axes[1].set_ylabel('MAE |f(T*) - 1| (Eq. 18, floor 1e-16)')
+    axes[1].set_xlabel('zeta_n (damping ratio)')
+    axes[1].legend(fontsize=8)
+    for ax in axes:
+        ax.grid(alpha=0.3)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+    return fig
 
 
 def run(args: argparse.Namespace) -> int:
@@ -159,18 +186,17 @@ def run(args: argparse.Namespace) -> int:
               '(the spikes are the zero crossings of d_f)')
         _plot_fig1(r, path)
     else:
-        r = fig2(**PAPER_TEST)
-        columns = [r, fig2(), fig2(model='damped-sinusoid')]
+        columns = [fig2(**kwargs) for _, kwargs in FIG2_VARIANTS]
+        r = columns[0]
         print('Fig. 2: Eq. 15, phi = 0, M = 10, tolerance 1e-3, Ts = 2 ms (first estimate; '
               'T* in periods)')
-        print(f'{"":7} {"Eq. 16 as printed":>20} {"paper defaults":>20} '
-              f'{"damped-sinusoid":>20}')
+        print(f'{"":7}' + ''.join(f' {name:>20}' for name, _ in FIG2_VARIANTS))
         print(f'{"zeta_n":>7}' + f' {"T*":>8} {"MAE":>11}' * len(columns))
         for i, z in enumerate(r.zetas):
             print(f'{z:7.3f}' + ''.join(f' {c.convergence_time[i]:8.3f} {c.mae[i]:11.2e}'
                                         for c in columns))
         print('(nan: the two-sided test never sees the sinusoid model\'s estimate of a damped sine '
               'settle to 1e-3 within 5 periods; the damped-sinusoid model is exact)')
-        _plot_fig2(r, path)
+        _plot_fig2(columns, path)
     print(f'wrote {path}')
     return 0

@@ -441,16 +441,28 @@ def write_file(rows: List[Dict], path: Path) -> None:
         write_rows(rows, 'csv' if path.suffix == '.csv' else 'jsonl', handle)
 
 
-def plot_trend(rows: List[Dict], path: Path) -> None:
-    """Frequency and damping against recording time, one line per topic/component/mode, with
-    the 95 % intervals as bars and the flagged recordings marked."""
-    import matplotlib
-    matplotlib.use('Agg')
-    import matplotlib.pyplot as plt
+def alarm_band(ref: Tuple[float, float, float], alarm_rel: float) -> Tuple[float, float]:
+    """The frequencies (Hz) a recording's 95 % interval must leave wholly to alarm (:func:`flag`):
+    the baseline's interval ``ref`` = (median, lo, hi) widened by ``alarm_rel`` each side."""
+    return ref[1] * (1 - alarm_rel), ref[2] * (1 + alarm_rel)
 
-    fig, (ax_f, ax_d) = plt.subplots(2, 1, sharex=True, figsize=(9, 6))
+
+def plot_trend(rows: List[Dict], path: Path, base: Optional[Dict] = None,
+               alarm_rel: Optional[float] = None):
+    """Frequency (and damping, when estimated) against recording time, one line per
+    topic/component/mode, with the 95 % intervals as bars and the flagged recordings marked; with
+    the baseline ``base`` (:func:`baseline_rows`) its median and the alarm band
+    (:func:`alarm_band`) of ``alarm_rel``. Returns the Figure."""
+    from .plotting import pyplot
+
+    plt = pyplot()
     good = [r for r in rows if not r['error'] and np.isfinite(r['frequency_hz'])]
-    for key in sorted({_key(r) for r in good}):
+    damped = any(np.isfinite(r['damping']) for r in good)
+    fig, axes = plt.subplots(2 if damped else 1, 1, sharex=True, figsize=(9, 6 if damped else 4),
+                             squeeze=False)
+    ax_f = axes[0, 0]
+    for n, key in enumerate(sorted({_key(r) for r in good})):
+        colour = f'C{n % 10}'
         line = [r for r in good if _key(r) == key]
         x = [datetime.fromisoformat(r['start_utc'].replace('Z', '+00:00')) if r['start_utc']
              else i for i, r in enumerate(line)]
@@ -458,26 +470,37 @@ def plot_trend(rows: List[Dict], path: Path) -> None:
         err = np.abs(np.array([[r['frequency_lo_hz'] for r in line],
                                [r['frequency_hi_hz'] for r in line]]) - f)
         label = ' '.join(str(k) for k in key if k not in ('', 0))
-        ax_f.errorbar(x, f, yerr=np.nan_to_num(err), marker='o', ms=3, capsize=2, label=label)
+        ax_f.errorbar(x, f, yerr=np.nan_to_num(err), marker='o', ms=3, capsize=2, color=colour,
+                      label=f'{label}: median, 95 % interval')
         alarmed = [i for i, r in enumerate(line) if r['alarm']]
         ax_f.plot([x[i] for i in alarmed], f[alarmed], 'rx', ms=9,
                   label='alarm' if alarmed else None)
-        ax_d.plot(x, [r['damping'] for r in line], marker='o', ms=3, label=label)
-    if not any(np.isfinite(r['damping']) for r in good):
-        ax_d.text(0.5, 0.5, 'no damping estimates: the model has no damping\n'
-                  '(--model damped-sinusoid estimates it)', transform=ax_d.transAxes,
-                  ha='center', va='center', color='0.4')
+        ref = None if base is None else base.get(key, base.get(None))
+        if ref is not None:
+            ax_f.axhline(ref[0], color=colour, ls='--', lw=1.0,
+                         label=f'baseline {ref[0]:.5g} Hz')
+            if alarm_rel is not None:
+                lo, hi = alarm_band(ref, alarm_rel)
+                ax_f.axhspan(lo, hi, color=colour, alpha=0.12,
+                             label=f'no-alarm band: baseline 95 % interval ±{100 * alarm_rel:g} %')
+        if damped:
+            axes[1, 0].plot(x, [r['damping'] for r in line], marker='o', ms=3, color=colour,
+                            label=label)
     ax_f.set_ylabel('median frequency (Hz)')
-    ax_d.set_ylabel('median damping ratio')
-    ax_d.set_xlabel('recording start (UTC)')
-    ax_f.legend(fontsize=8)
-    ax_f.grid(alpha=0.3)
-    ax_d.grid(alpha=0.3)
+    explain = ': a recording alarms when its 95 % interval lies wholly outside the band'
+    ax_f.set_title('frequency trend' + ('' if base is None else explain), fontsize=10)
+    if damped:
+        axes[1, 0].set_ylabel('median damping ratio')
+    axes[-1, 0].set_xlabel('recording start (UTC)')
+    ax_f.legend(fontsize=8, loc='best')
+    for ax in axes[:, 0]:
+        ax.grid(alpha=0.3)
     fig.autofmt_xdate()
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=110)
     plt.close(fig)
+    return fig
 
 
 def report_entries(rows: List[Dict], ignored: Sequence[Path], out) -> None:
@@ -527,7 +550,7 @@ def run(args: argparse.Namespace) -> int:
     if args.out:
         write_file(rows, Path(args.out))
     if args.plot:
-        plot_trend(rows, Path(args.plot))
+        plot_trend(rows, Path(args.plot), base, args.alarm_rel)
     if args.fail_on_alarm and any(r['alarm'] for r in rows):
         return 3
     return 1 if args.strict and any(r['error'] for r in rows) else 0

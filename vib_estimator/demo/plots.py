@@ -17,7 +17,7 @@ def plot_estimation(path: str, rec: Record, speed: float) -> None:
     plot_estimates(path, np.asarray(rec.t), np.asarray(rec.torque), np.asarray(rec.est_t),
                    np.asarray(rec.est_f), np.asarray(rec.est_conv), rec.truth,
                    title=f'Simulated arm, tip masses 30 / 45.55 / 61.17 g ({speed:g}x)',
-                   ylabel='coupling torque (N m)')
+                   ylabel='coupling torque', unit='N·m')
 
 
 def plot_shaping(path: str, rec: Record, rows: List[dict], shaper: str, speed: float) -> None:

@@ -169,3 +169,40 @@ def seconds_since(stamp: int, origin: int) -> float:
     offline ``analyze`` command both use this function so that they see the same floats.
     """
     return (stamp - origin) * 1e-9
+
+
+#: unit of each field (the last attribute before the axis, or the JointState array), SI as
+#: the ROS message definitions (REP 103) give them
+FIELD_UNITS = {'force': 'N', 'torque': 'N·m', 'linear_acceleration': 'm/s²',
+               'angular_velocity': 'rad/s', 'linear': 'm/s²', 'angular': 'rad/s²',
+               'effort': 'N·m or N', 'position': 'rad or m', 'velocity': 'rad/s or m/s'}
+#: units spelled as a name's last ``_``-separated tokens (``accel_g``, ``tip_velocity_m_s``)
+SUFFIX_UNITS = {('m', 's2'): 'm/s²', ('rad', 's'): 'rad/s', ('m', 's'): 'm/s', ('rad',): 'rad',
+                ('deg',): 'deg', ('m',): 'm', ('mm',): 'mm', ('g',): 'g', ('n',): 'N',
+                ('nm',): 'N·m', ('v',): 'V', ('a',): 'A', ('pa',): 'Pa'}
+#: the unit of a signal whose name says none
+UNKNOWN_UNIT = 'signal units'
+_BRACKETED = re.compile(r'[\(\[]\s*([^\)\]]+?)\s*[\)\]]\s*$')
+
+
+def signal_unit(name: str) -> str:
+    """The unit of a signal named ``name``: a component (``torque.z``, ``effort[joint1]``), or a
+    CSV column that carries its unit in brackets (``torque (N·m)``, ``acc [g]``) or as its last
+    tokens (``accel_g``, ``tip_velocity_m_s``); :data:`UNKNOWN_UNIT` otherwise."""
+    name = name.strip()
+    joint = _JOINT.match(name)
+    if joint:
+        return FIELD_UNITS[joint.group(1)]
+    bracketed = _BRACKETED.search(name)
+    if bracketed:
+        return bracketed.group(1)
+    parts = name.split('.')
+    if len(parts) >= 2 and parts[-1] in XYZ and parts[-2] in FIELD_UNITS:
+        return FIELD_UNITS[parts[-2]]
+    if name in FIELD_UNITS:
+        return FIELD_UNITS[name]
+    tokens = tuple(name.lower().split('_'))
+    for suffix in sorted(SUFFIX_UNITS, key=len, reverse=True):
+        if len(tokens) > len(suffix) and tokens[-len(suffix):] == suffix:
+            return SUFFIX_UNITS[suffix]
+    return UNKNOWN_UNIT
