@@ -42,9 +42,13 @@ def test_algebraic_is_at_least_three_times_faster_on_section_5_3():
                for name in names}
     first = results[compare.ALGEBRAIC].first
     assert 0 < first < 0.5      # "less than 0.5 s" (Section 5.4), ~half a period
-    for name in (cls.name for cls in compare.TRACKERS):
-        tracked = results[name].tracked
-        assert (math.isnan(tracked) or tracked >= 3 * first), (name, tracked, first)
+    # a method whose output never stays within 2 % for a period (NaN) is slower than any bound;
+    # the claim is measured against the trackers that do settle on this record
+    settled = {name: results[name].tracked for name in (cls.name for cls in compare.TRACKERS)
+               if math.isfinite(results[name].tracked)}
+    assert {'Sliding DFT', 'Matrix pencil'} <= set(settled), settled
+    assert all(tracked >= 3 * first for tracked in settled.values()), (settled, first)
+    assert results[compare.ALGEBRAIC].tracked == first     # its first estimate holds
 
 
 def test_compare_command_prints_every_method_and_writes_plots(tmp_path, capsys):
@@ -58,13 +62,16 @@ def test_compare_command_prints_every_method_and_writes_plots(tmp_path, capsys):
         for method in compare.METHODS:
             rows = [ln for ln in lines if ln and ln[0] == case.key and method.split()[0] in ln]
             assert len(rows) == n_segs, (case.key, method)
-        assert (tmp_path / f'compare_{case.key.replace(".", "_")}.png').stat().st_size > 10_000
-    # the algebraic method's and the DFT's rows are complete and finite
+        assert (tmp_path / f'compare_{case.key.replace(".", "_")}.png').is_file()
+    # the algebraic method's and the DFT's rows (one per case and segment) are complete and finite
+    checked = {'Algebraic': 0, 'Sliding': 0}
     for ln in lines:
-        if ln and ln[0] in ('5.3', '5.5', 'fig1') and ln[2] in ('Algebraic', 'Sliding'):
+        if ln and ln[0] in ('5.3', '5.5', 'fig1') and ln[2] in checked:
             numbers = ln[3:] if ln[2] == 'Algebraic' else ln[4:]
             assert len(numbers) == len(compare.HEADER) - 1      # two durations in s (periods)
             assert all(math.isfinite(float(v.strip('()%'))) for v in numbers), ln
+            checked[ln[2]] += 1
+    assert checked == {'Algebraic': 5, 'Sliding': 5}           # 5.3: 1, 5.5: 3, fig1: 1
     table = md.read_text()
     assert '7.0e-02' in table and '3.1e-05' in table
     assert all(m in table for m in compare.METHODS)

@@ -168,17 +168,40 @@ def test_interface():
     assert len(e) > 10 and math.isclose(np.median(e.frequency_hz), 10.0, rel_tol=0.003)
 
 
-def test_plot_colours_the_modes(tmp_path):
+def test_plot_colours_the_modes(tmp_path, monkeypatch):
+    """Each mode is one series of its own colour and legend entry "mode k" in the frequency
+    panel, and its convergence times in the same colour below; no estimate: no mode series."""
+    import matplotlib.figure
     from vib_estimator.analysis.plotting import plot_estimates
 
+    saved = []
+    original = matplotlib.figure.Figure.savefig
+    monkeypatch.setattr(matplotlib.figure.Figure, 'savefig',
+                        lambda fig, *a, **k: (saved.append(fig), original(fig, *a, **k)))
     t = np.arange(0, 5, 1 / FS)
     y = decay(t, 0.5, 8.0, 1.0) + decay(t, 0.5, 21.0, 0.3, 0.001) + noise(t, 0.003, 0)
     e = ModeTracker(CFG).process(t, y)
+    modes = sorted(set(e.mode.tolist()))
+    assert modes[:2] == [1, 2]
     out = tmp_path / 'modes.png'
     plot_estimates(str(out), t, y, e.t, e.frequency_hz, e.convergence_time, mode=e.mode)
-    assert out.stat().st_size > 10_000
+    assert out.is_file() and len(saved) == 1
+    _, freq, conv = saved[0].axes
+    series = {line.get_label(): line for line in freq.get_lines()}
+    assert [text.get_text() for text in freq.get_legend().get_texts()] == [
+        f'mode {k}' for k in modes]
+    for k in modes:
+        line = series[f'mode {k}']
+        np.testing.assert_array_equal(line.get_ydata(), e.frequency_hz[e.mode == k])
+        assert line.get_color() == f'C{k - 1}'
+    assert len({series[f'mode {k}'].get_color() for k in modes}) == len(modes)
+    assert [line.get_color() for line in conv.get_lines()] == [f'C{k - 1}' for k in modes]
+    assert freq.get_yscale() == 'log'                  # modes a decade apart, each visible
     plot_estimates(str(tmp_path / 'none.png'), t, y, e.t[:0], e.frequency_hz[:0],
                    e.convergence_time[:0], mode=e.mode[:0])
+    assert (tmp_path / 'none.png').is_file() and len(saved) == 2
+    assert [len(line.get_xdata()) for line in saved[1].axes[1].get_lines()] == [0]
+    assert not any(line.get_label().startswith('mode') for line in saved[1].axes[1].get_lines())
 
 
 REFERENCE = {30: 16.360, 40: 9.392, 50: 6.054, 60: 4.268}
