@@ -86,7 +86,10 @@ def test_records_every_message_exactly(ros_context, executor, tmp_path):
     # the bytes as received; only the CDR alignment padding (3 bytes after the frame_id here, plus
     # the wire's padding to a multiple of 4) is left uninitialised by the publisher's serializer
     assert [len(d) for d in recorded] == [len(d) for d in sent]
-    assert [serialize_message(deserialize_message(d, WrenchStamped)) for d in recorded] == sent
+    # every field as sent (comparing re-serialised bytes was flaky: serialize_message leaves the
+    # padding uninitialised too, so the same message serialised twice can differ in it)
+    assert [deserialize_message(d, WrenchStamped) for d in recorded] == [
+        wrench(i) for i in range(n)]
 
 
 def test_sigint_leaves_a_complete_bag(ros_context, executor, tmp_path):
