@@ -42,9 +42,13 @@ def test_algebraic_is_at_least_three_times_faster_on_section_5_3():
                for name in names}
     first = results[compare.ALGEBRAIC].first
     assert 0 < first < 0.5      # "less than 0.5 s" (Section 5.4), ~half a period
-    for name in (cls.name for cls in compare.TRACKERS):
-        tracked = results[name].tracked
-        assert (math.isnan(tracked) or tracked >= 3 * first), (name, tracked, first)
+    # a method whose output never stays within 2 % for a period (NaN) is slower than any bound;
+    # the claim is measured against the trackers that do settle on this record
+    settled = {name: results[name].tracked for name in (cls.name for cls in compare.TRACKERS)
+               if math.isfinite(results[name].tracked)}
+    assert {'Sliding DFT', 'Matrix pencil'} <= set(settled), settled
+    assert all(tracked >= 3 * first for tracked in settled.values()), (settled, first)
+    assert results[compare.ALGEBRAIC].tracked == first     # its first estimate holds
 
 
 def test_compare_command_prints_every_method_and_writes_plots(tmp_path, capsys):

@@ -80,7 +80,10 @@ def test_biased_model_removes_an_offset_the_paper_model_cannot():
     paper = estimate(t, y, PAPER)
     biased = estimate(t, y, EstimatorConfig.paper(model='biased-sinusoid'))
     assert np.max(np.abs(biased.frequency_hz / 2.0 - 1)) < 1e-5
-    assert len(paper) == 0 or np.max(np.abs(paper.frequency_hz / 2.0 - 1)) > 0.01
+    # the paper's model publishes, but the offset biases every estimate (the sinusoid's offset
+    # enters Eq. 1 as a second 'mode': beyond 1 % off, some at several times the frequency)
+    assert len(paper) >= 5
+    assert np.min(np.abs(paper.frequency_hz / 2.0 - 1)) > 0.01, paper.frequency_hz
 
 
 @pytest.mark.parametrize('zeta', [0.0, 0.004, 0.02, 0.08])
@@ -192,7 +195,14 @@ def test_public_reset_starts_a_new_segment():
         out.append(est.update(a, b))
     assert all(o is None for o in out)
     out = [est.update(a + 2, b) for a, b in zip(t, y)]
-    assert any(o is not None for o in out)
+    # left alone, the new segment converges: its first window starts at the last reset (one
+    # sample before the second pass), as many estimates as a fresh estimator's, each exact
+    got = [o for o in out if o is not None]
+    fresh = estimate(t + 2, y, PAPER)
+    assert len(got) == len(fresh) >= 2
+    assert got[0].samples == fresh.samples[0] + 1
+    np.testing.assert_allclose([o.frequency_hz for o in got], 1.0, rtol=1e-9)
+    assert np.max(np.abs(fresh.frequency_hz - 1.0)) < 1e-5
 
 
 @pytest.mark.parametrize('changes', [

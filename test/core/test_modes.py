@@ -169,11 +169,15 @@ def test_interface():
 
 
 def test_plot_colours_the_modes(tmp_path):
+    """Each mode is one series of its own colour and legend entry "mode k" in the frequency
+    panel, and its frequency is marked on the spectrum; no estimate: nothing marked."""
     from vib_estimator.analysis.plotting import plot_estimates
 
     t = np.arange(0, 5, 1 / FS)
     y = decay(t, 0.5, 8.0, 1.0) + decay(t, 0.5, 21.0, 0.3, 0.001) + noise(t, 0.003, 0)
     e = ModeTracker(CFG).process(t, y)
+    modes = sorted(set(e.mode.tolist()))
+    assert modes[:2] == [1, 2]
     out = tmp_path / 'modes.png'
     fig = plot_estimates(str(out), t, y, e.t, e.frequency_hz, e.convergence_time, mode=e.mode)
     estimates, spectrum = fig.axes[1], fig.axes[3]

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -148,6 +149,13 @@ class Probe:
             [(a.status[0].level, a.status[0].message) for a in self.diagnostics[start:]]
         return next(a.status[0] for a in self.diagnostics[start:] if predicate(a.status[0]))
 
+    def status_age(self, status: DiagnosticStatus, since: float) -> float:
+        """Seconds from ``since`` (wall clock, before the samples were sent) to the stamp of the
+        /diagnostics array of ``status`` (the node's clock, wall time here): a bound on the age
+        of anything the status reports."""
+        stamp = next(a.header.stamp for a in self.diagnostics if a.status[0] is status)
+        return stamp.sec + 1e-9 * stamp.nanosec - since
+
 
 def values_of(status: DiagnosticStatus) -> dict:
     return {kv.key: kv.value for kv in status.values}
@@ -271,19 +279,43 @@ def test_bad_input_is_counted_and_estimation_resumes(make_probe):
     assert kv['estimates'] == str(p.node.counters['estimates'])
     assert abs(float(kv['last_frequency_hz']) - 1.33) < 1.33e-3
     assert 0 < float(kv['last_convergence_time_s']) < 1.0
-    assert float(kv['input_rate_hz']) >= 0
+    # input_rate_hz: the messages taken between two statuses over the time between them (the
+    # statuses' stamps, ~1 s apart); the input came in bursts, so some intervals saw none
+    seen = [(a.header.stamp.sec + 1e-9 * a.header.stamp.nanosec, values_of(a.status[0]))
+            for a in p.diagnostics]
+    pairs = [(int(kv['received']) - int(prev['received']), t - t_prev, float(kv['input_rate_hz']))
+             for (t_prev, prev), (t, kv) in zip(seen, seen[1:])]
+    assert sum(n for n, _, _ in pairs) == total - int(seen[0][1]['received'])
+    assert any(n > 0 for n, _, _ in pairs)
+    for n, dt, rate in pairs:
+        assert rate == pytest.approx(n / dt, rel=0.1, abs=1e-12), (n, dt, rate)
     assert set(kv) >= set(p.node.counters) | {'last_frequency_hz', 'last_convergence_time_s',
                                               'input_rate_hz'}
 
 
 def test_parameter_changes(make_probe):
+    """A refused change leaves the estimator running (its segment goes on); an accepted one
+    restarts it with the new configuration on the same time origin: the published estimates are
+    those of the offline estimator of each configuration over its samples."""
     p = make_probe()
-    stamps = sine_stamps(1500)
-    values = np.sin(2 * np.pi * 1.33 * np.arange(3000) / FS)
-    p.feed(stamps, values[:1500])
-    before = len(p.frequencies())
-    # invalid: refused with a reason, the estimator untouched
-    estimator = p.node._stream.estimator
+    parts = np.cumsum([0, 1500, 750, 1500, 1500, 750])
+    stamps = sine_stamps(parts[-1])
+    values = np.sin(2 * np.pi * 1.33 * np.arange(parts[-1]) / FS)
+
+    def feed(k, config):
+        """Feed part k; its estimates must be ``config``'s over the part (from its start)."""
+        before = len(p.frequencies())
+        a, b = parts[k], parts[k + 1]
+        p.feed(stamps[a:b], values[a:b])
+        expected = offline(stamps[a:b], values[a:b], config, origin=stamps[0])
+        assert len(expected) >= 2, (k, len(expected))
+        assert p.frequencies()[before:] == expected.frequency_hz.tolist(), k
+
+    feed(0, PAPER_CONFIG)
+    # invalid: refused with a reason, the parameters and the estimator untouched
+    names = ['window', 'lowpass_damping', 'band_hz', 'model', 'min_time', 'component',
+             'input_topic', 'input_type']
+    kept = {name: p.node.get_parameter(name).value for name in names}
     for name, value, reason in [
             ('window', 0, 'window out of range'), ('lowpass_damping', -1.0, 'out of range'),
             ('band_hz', [5.0, 1.0], 'band_hz must be'), ('model', 'foo', 'model must be'),
@@ -293,23 +325,22 @@ def test_parameter_changes(make_probe):
             ('component', 'linear_acceleration.z', 'component of geometry_msgs/msg/Wrench')]:
         result = p.node.set_parameters([Parameter(name, value=value)])[0]
         assert not result.successful and reason in result.reason, (name, result.reason)
-    assert p.node._stream.estimator is estimator
+    assert {name: p.node.get_parameter(name).value for name in names} == kept
+    # the segment went on through the refusals: the estimates of parts 0-1 as one stream
+    before = len(p.frequencies())
+    p.feed(stamps[parts[1]:parts[2]], values[parts[1]:parts[2]])
+    whole = offline(stamps[:parts[2]], values[:parts[2]])
+    assert len(whole) > before and p.frequencies() == whole.frequency_hz.tolist()
     # valid: a new estimator with the new configuration, same time origin
     assert p.node.set_parameters([Parameter('window', value=5)])[0].successful
-    assert p.node._stream.config.window == 5
     assert p.node.get_parameter('window').value == 5
-    later = sine_stamps(3000)[1500:]
-    p.feed(later, values[1500:])
-    expected = offline(later, values[1500:], PAPER_CONFIG.replace(window=5),
-                       origin=stamps[0])
-    assert len(expected) >= 2
-    assert p.frequencies()[before:] == expected.frequency_hz.tolist()
-    assert p.node.counters['received'] == 3000        # counters span the change
+    feed(2, PAPER_CONFIG.replace(window=5))
+    assert p.node.counters['received'] == parts[3]        # counters span the change
     assert p.node.set_parameters([Parameter('band_hz', value=[0.5, 5.0])])[0].successful
-    assert p.node._stream.config.band_hz == (0.5, 5.0)
+    feed(3, PAPER_CONFIG.replace(window=5, band_hz=(0.5, 5.0)))
     assert p.node.set_parameters(
         [Parameter('band_hz', Parameter.Type.DOUBLE_ARRAY, [])])[0].successful
-    assert p.node._stream.config.band_hz is None
+    feed(4, PAPER_CONFIG.replace(window=5))
 
 
 def test_sigint_shuts_down_cleanly(ros_context):
@@ -419,7 +450,16 @@ def test_joint_state_joint_found_by_name_absent_counted(make_probe):
     assert p.node.counters['skipped_joint_missing'] == len(absent)
     assert p.node.counters['received'] == len(kept)
     status = p.wait_status(lambda s: values_of(s)['skipped_joint_missing'] == str(len(absent)))
-    assert status.level == DiagnosticStatus.WARN or 'without the joint' not in status.message
+    # the status that counted them says so (WARN, how many); once none lack it, OK again
+    assert status.level == DiagnosticStatus.WARN, (status.level, status.message)
+    missing_then = int(values_of(status)['skipped_joint_missing'])
+    assert re.search(r'\b(\d+) messages without the joint', status.message), status.message
+    said = int(re.search(r'\b(\d+) messages without the joint', status.message).group(1))
+    assert 0 < said <= missing_then == len(absent)
+    p.feed(sine_stamps(50, stamps[-1] + 2_000_000), values[:50], component='position[wrist]')
+    ok = p.wait_status(lambda s: values_of(s)['received'] == str(len(kept) + 50)
+                       and 'without the joint' not in s.message)
+    assert values_of(ok)['skipped_joint_missing'] == str(len(absent))
 
 
 def test_component_is_checked_against_the_type(ros_context):
@@ -500,6 +540,7 @@ def test_modes_one_publishes_mode1_topics(make_probe):
     p = make_probe(modes=1)
     stamps = sine_stamps(3000)
     values = np.sin(2 * np.pi * 1.33 * np.arange(3000) / FS)
+    fed_at = time.time()
     p.feed(stamps, values)
     assert spin_until(p.executor, lambda: len(p.resets('mode1/reset'))
                       >= len(p.frequencies()), 5.0)
@@ -511,7 +552,9 @@ def test_modes_one_publishes_mode1_topics(make_probe):
     status = p.wait_status(lambda s: values_of(s)['estimates'] == str(
         p.node.counters['estimates']))
     kv = values_of(status)
-    assert float(kv['mode1_frequency_hz']) == pytest.approx(mode1[-1], rel=1e-8) and float(kv['mode1_age_s']) >= 0
+    assert float(kv['mode1_frequency_hz']) == pytest.approx(mode1[-1], rel=1e-8)
+    # the age of mode 1's last estimate: since it was published, on the node's clock
+    assert 0 <= float(kv['mode1_age_s']) <= p.status_age(status, since=fed_at)
     assert 'mode2_frequency_hz' not in kv
     # switching modes off: the mode topics go
     assert p.node.set_parameters([Parameter('modes', value=0)])[0].successful
@@ -572,8 +615,9 @@ def test_each_mode_on_its_own_topics(make_probe, monkeypatch):
     t = np.arange(n) / FS
     values = 0.5 * np.sin(2 * np.pi * 1.33 * t) + np.sin(2 * np.pi * 40.0 * t + 1.0)
     stamps = sine_stamps(n)
+    fed_at = time.time()
     p.feed(stamps, values)
-    tracker = TwoBandTracker(p.node._stream.estimator.config)
+    tracker = TwoBandTracker(EstimatorConfig.paper(modes=2))     # the node's parameters
     expected = [e for ti, y in zip(seconds_since(np.asarray(stamps), stamps[0]), values)
                 for e in tracker.update(ti, y)]
     assert spin_until(p.executor, lambda: len(p.resets('mode2/reset'))
@@ -589,11 +633,13 @@ def test_each_mode_on_its_own_topics(make_probe, monkeypatch):
     assert order == (OUTPUTS + ['mode1/frequency', 'mode1/reset']) * len(mode1)
     assert [e[0] for e in p.events if e[0].startswith('mode2')] == \
         ['mode2/frequency', 'mode2/reset'] * len(mode2)
-    kv = values_of(p.wait_status(lambda s: values_of(s)['estimates'] == str(
-        p.node.counters['estimates'])))
+    status = p.wait_status(lambda s: values_of(s)['estimates'] == str(
+        p.node.counters['estimates']))
+    kv = values_of(status)
     assert float(kv['mode1_frequency_hz']) == pytest.approx(mode1[-1], rel=1e-8)
     assert float(kv['mode2_frequency_hz']) == pytest.approx(mode2[-1], rel=1e-8)
-    assert float(kv['mode2_age_s']) >= 0 and 'mode2_frequency_std_hz' in kv
+    assert 0 <= float(kv['mode2_age_s']) <= p.status_age(status, since=fed_at)
+    assert float(kv['mode2_frequency_std_hz']) > 0
     assert int(kv['estimates']) == len(mode1) + len(mode2)
 
 
@@ -653,7 +699,9 @@ def test_names_are_relative_so_namespaces_apply(ros_context, executor):
             executor.add_node(n)
         assert spin_until(executor, lambda: expected_topics <= graph()[0]
                           and expected_services <= graph()[1], 10.0), graph()
-        assert node._subscription.topic_name == '/arm1/coupling_torque'
+        subscribed = {n for n, _ in probe.get_subscriber_names_and_types_by_node(
+            'estimator_node', '/arm1')}
+        assert '/arm1/coupling_torque' in subscribed, subscribed
     finally:
         for n in (node, probe):
             executor.remove_node(n)

@@ -16,6 +16,7 @@ from vib_estimator.core import EstimatorConfig
 from vib_estimator.core.config import PAPER
 from vib_estimator.io.fields import DEFAULT_COMPONENT, INPUT_TYPES, WRENCH_STAMPED
 from vib_estimator.nodes.estimator_node import EstimatorNode
+from vib_estimator.nodes.parameters import config_of
 
 ROOT = Path(__file__).resolve().parents[2]
 PARAMS = ROOT / 'config' / 'estimator.yaml'
@@ -48,7 +49,7 @@ def test_params_file_loads_into_the_node():
                args=['--ros-args', '--params-file', str(PARAMS)])
     try:
         node = EstimatorNode(context=context)
-        assert node._stream.config == EstimatorConfig()
+        assert config_of(node) == EstimatorConfig()     # every parameter as the file sets it
         assert node.get_parameter('band_hz').value == []
         assert node.get_parameter('input_type').value == WRENCH_STAMPED
         node.destroy_node()
@@ -143,7 +144,8 @@ def test_params_file_applies_under_any_namespace_and_name(tmp_path):
         context = rclpy.Context()
         try:
             node = _node_with(context, '-r', remap, '--params-file', str(changed))
-            assert node._stream.config.min_fit == 0.75, remap
+            assert node.get_parameter('min_fit').value == 0.75, remap
+            assert config_of(node).min_fit == 0.75, remap
             assert node.params_file_warnings == []
             node.destroy_node()
         finally:
@@ -159,7 +161,7 @@ def test_a_params_file_that_sets_nothing_for_the_node_is_warned_about(tmp_path):
     try:
         node = _node_with(context, '-r', '__ns:=/robot1', '--params-file', str(wrong),
                           '--params-file', str(unknown))
-        assert node._stream.config.min_fit == 0.9
+        assert node.get_parameter('min_fit').value == 0.9 == EstimatorConfig().min_fit
         first, second = node.params_file_warnings
         assert 'wrong.yaml sets nothing for /robot1/estimator_node' in first
         assert '"/**:"' in first and 'min_fitt' in second

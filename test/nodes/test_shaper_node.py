@@ -18,8 +18,10 @@ from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
 from std_msgs.msg import Float64
 
+from vib_estimator.demo import DEFAULT_MIN_REDUCTION, MIN_REDUCTION
 from vib_estimator.nodes.runner import StartupError, spin_until
 from vib_estimator.nodes.shaper_node import ShaperNode
+from vib_estimator.sim.arm_model import MASSES_5_5, natural_frequency_hz
 
 RATE = 500.0
 STEP_NS = 10_000_000        # the test's clock advances 10 ms (5 samples) a step
@@ -64,7 +66,7 @@ class Rig:
             published = self.node.counters['commands_published']
             sec, nsec = divmod(self.now_ns, 10 ** 9)
             self.clock_pub.publish(Clock(clock=Time(sec=sec, nanosec=nsec)))
-            if self.node._reference is not None:
+            if self.node.counters['references']:         # a reference to shape: a command
                 assert spin_until(self.executor, lambda: len(self.commands) > n
                                   and self.node.counters['commands_published'] > published, 5.0)
             else:
@@ -84,6 +86,11 @@ class Rig:
             n.destroy_node()
 
 
+def design(node) -> dict:
+    """The key/values of the node's /diagnostics status (:meth:`ShaperNode.status`)."""
+    return {kv.key: kv.value for kv in node.status().values}
+
+
 def test_step_reference_shaped_and_retuned_only_at_rest(ros_context, executor):
     node = shaper_node(ros_context, use_sim_time=True, shaper='zv', rate_hz=RATE)
     rig = Rig(ros_context, executor, node)
@@ -97,7 +104,9 @@ def test_step_reference_shaped_and_retuned_only_at_rest(ros_context, executor):
         rig.publish('vibration/damping_ratio', math.nan)     # a model without damping: ignored
         rig.wait(lambda: node.counters['frequency_estimates'] == 1)
         rig.tick(2)
-        assert node._shaper.shaper.name == 'zv' and node._shaper.retunes == 1
+        kv = design(node)
+        assert (kv['shaper'], kv['design_frequency_hz'], kv['retunes']) == ('zv', '1.25', '1')
+        assert kv['impulse_times_s'] == '0 0.4' and kv['impulse_amplitudes'] == '0.5 0.5'
         start = len(rig.commands)
         rig.publish('reference', 1.0)
         rig.wait(lambda: node.counters['references'] == 2)
@@ -108,7 +117,8 @@ def test_step_reference_shaped_and_retuned_only_at_rest(ros_context, executor):
         values = {round(v, 9) for _, v in rig.commands[start:]}
         assert values == {0.5, 1.0}, values              # the staircase, no other level
         assert rig.plateau(0.5, start) == pytest.approx(0.4, abs=0.011)   # old design kept
-        assert node._shaper.shaper.frequency_hz == 2.5 and node._shaper.retunes == 2
+        kv = design(node)
+        assert (kv['design_frequency_hz'], kv['retunes'], kv['pending_shaper']) == ('2.5', '2', '')
         # the next move uses the new design: ZV for 2.5 Hz, 0.2 s between impulses
         start = len(rig.commands)
         rig.publish('reference', 0.0)
@@ -124,7 +134,7 @@ def test_step_reference_shaped_and_retuned_only_at_rest(ros_context, executor):
         rig.publish('vibration/damping_ratio', 0.05)
         rig.wait(lambda: node.counters['damping_estimates'] == 1)
         rig.tick(2)
-        assert node._shaper.shaper.damping == 0.05
+        assert design(node)['design_damping_ratio'] == '0.05'
         assert node.design_mode()[2] == 'estimate'
         rig.wait(lambda: rig.diagnostics and rig.diagnostics[-1].name == '/shaper_node')
     finally:
@@ -144,7 +154,8 @@ def test_initial_frequency_and_bad_inputs(ros_context, executor):
         rig.wait(lambda: node.counters['references_skipped'] == 1
                  and node.counters['estimates_ignored'] == 3)
         rig.tick(2)
-        assert node._shaper.shaper.name == 'zvd' and node._shaper.shaper.frequency_hz == 1.25
+        kv = design(node)
+        assert (kv['shaper'], kv['design_frequency_hz']) == ('zvd', '1.25')
         assert rig.commands[-1][1] == 2.0                 # at rest: the reference itself
         start = len(rig.commands)
         rig.publish('reference', 3.0)
@@ -160,22 +171,29 @@ def test_parameters(ros_context, executor):
         shaper_node(ros_context, shaper='bang-bang')
     with pytest.raises(StartupError):
         shaper_node(ros_context, damping_ratio=0.9)
-    node = shaper_node(ros_context, initial_frequency_hz=2.0)
+    node = shaper_node(ros_context, use_sim_time=True, initial_frequency_hz=2.0)
+    rig = Rig(ros_context, executor, node)
     try:
         for name, value in (('shaper', 'foo'), ('damping_ratio', -0.1), ('rate_hz', 100.0),
                             ('median_of', 0), ('initial_frequency_hz', -1.0)):
             result = node.set_parameters([Parameter(name, value=value)])[0]
             assert not result.successful and result.reason, name
+        assert design(node)['shaper'] == 'none'
         assert node.set_parameters([Parameter('shaper', value='ei')])[0].successful
-        assert node._shaper.pending.name == 'ei'          # waits for the first reference
+        kv = design(node)                                  # waits for the first reference
+        assert kv['shaper'] == 'none' and kv['pending_shaper'].startswith('ei for 2.0000 Hz')
         assert node.set_parameters([Parameter('median_of', value=3)])[0].successful
-        for f in (1.0, 5.0, 1.2):
-            node._on_frequency(Float64(data=f))
+        for k, f in enumerate((1.0, 5.0, 1.2), 1):
+            rig.publish('vibration/frequency', f)
+            rig.wait(lambda: node.counters['frequency_estimates'] == k)
         assert node.design_mode()[0] == 1.2
-        node._on_frequency(Float64(data=1.4))
+        assert design(node)['estimate_frequency_hz'] == '1.2'
+        rig.publish('vibration/frequency', 1.4)
+        rig.wait(lambda: node.counters['frequency_estimates'] == 4)
         assert node.design_mode()[0] == 1.4               # median of 5.0, 1.2, 1.4
+        assert design(node)['estimate_frequency_hz'] == '1.4'
     finally:
-        node.destroy_node()
+        rig.close()
 
 
 def test_live_demo_short_run(tmp_path):
@@ -188,7 +206,20 @@ def test_live_demo_short_run(tmp_path):
          '--domain-id', os.environ['ROS_DOMAIN_ID'], '--out', str(out)],
         capture_output=True, text=True, timeout=240)
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
-    assert 'PASS' in proc.stdout and out.stat().st_size > 10_000
+    # the table it prints: per tip mass, the estimate near Eq. 23's frequency and the shaped
+    # move's added vibration cut by the shaper's MIN_REDUCTION (its pass criterion), consistent
+    lines = proc.stdout.splitlines()
+    first = lines.index(next(ln for ln in lines if ln.startswith('vibration each move adds'))) + 2
+    rows = [[float(v) for v in ln.split()] for ln in lines[first:first + len(MASSES_5_5)]]
+    assert [r[0] for r in rows] == pytest.approx([m * 1e3 for m in MASSES_5_5], abs=0.01)
+    need = MIN_REDUCTION.get('zvd', DEFAULT_MIN_REDUCTION) * 100
+    for mass_g, f0, estimate, error, unshaped, shaped, ratio, reduction in rows:
+        assert f0 == pytest.approx(natural_frequency_hz(mass_g * 1e-3), abs=1e-3)
+        assert abs(estimate / f0 - 1) < 0.03 and error == pytest.approx(
+            (estimate / f0 - 1) * 100, abs=0.05)   # f0 printed to 1e-3 Hz
+        assert ratio == pytest.approx(100 * shaped / unshaped, abs=0.5) and shaped < unshaped
+        assert reduction >= need and reduction == pytest.approx(100 - ratio, abs=0.1)
+    assert lines[-1].startswith('PASS') and out.is_file()
     bad = subprocess.run([str(exe), 'demo', '--shaping', '--seconds-per-mass', '3'],
                          capture_output=True, text=True, timeout=60)
     assert bad.returncode == 2 and bad.stderr.startswith('error:')
@@ -206,7 +237,7 @@ def test_only_garbage_estimates_turn_the_diagnostics_to_warn(ros_context, execut
         rig.publish('vibration/damping_ratio', 1.5)
         rig.wait(lambda: node.counters['estimates_ignored'] == 5)
         rig.tick(2)
-        assert node._shaper.shaper.name == 'none' and rig.commands[-1][1] == 1.0   # safe
+        assert design(node)['shaper'] == 'none' and rig.commands[-1][1] == 1.0   # safe
         status = node.status()
         assert status.level == DiagnosticStatus.WARN
         assert '5 estimates ignored' in status.message and 'damping ratio 1.5' in status.message

@@ -10,17 +10,19 @@ import os
 import numpy as np
 import pytest
 import rclpy
+from geometry_msgs.msg import WrenchStamped
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.qos import (DurabilityPolicy, QoSProfile, ReliabilityPolicy,
+                       qos_profile_sensor_data)
 from std_msgs.msg import Float64, Header
 
 from vib_estimator.core.config import PAPER
 from vib_estimator.sim.arm_model import MASSES_5_5, natural_frequency_hz, schedule_5_5
 from vib_estimator.nodes.estimator_node import EstimatorNode
 from vib_estimator.nodes.runner import StartupError, make_executor, spin_until
-from vib_estimator.nodes.sim_node import (SIM_TIME_ORIGIN_NS, SimNode, schedule_from_array,
-                                    schedule_to_array)
+from vib_estimator.nodes.sim_node import (GROUND_TRUTH_QOS, SIM_TIME_ORIGIN_NS, SimNode,
+                                          schedule_from_array, schedule_to_array)
 
 SECONDS_PER_MASS = 6.0
 SPEED = 10.0
@@ -205,6 +207,7 @@ def test_sim_follows_position_commands(ros_context, executor):
                    schedule=[0.0, 1.0, 1.0, 0.0, 1.0, 0.0, 1.0, 0.030])
     probe = Node('probe', context=ros_context)
     pub = probe.create_publisher(Float64, '/cmd_test/position_command', 10)
+    clock, truth = clock_and_truth(probe, '/cmd_test')
     for node in (sim, probe):
         executor.add_node(node)
     try:
@@ -213,14 +216,34 @@ def test_sim_follows_position_commands(ros_context, executor):
         pub.publish(Float64(data=float('nan')))
         assert spin_until(executor, lambda: sim.commands_received == 1
                           and sim.commands_skipped == 1, 10.0)
-        assert spin_until(executor, lambda: sim._sim.t > 4.0, 30.0)
-        assert sim._sim.command == -0.4                 # not the schedule's 1 rad, nor 0 at 1 s
-        assert sim._sim._x[0] == pytest.approx(-0.4, abs=2e-3)
-        assert sim._sim.params.tip_mass_kg == 0.030     # the schedule's mass change at 1 s
+        assert spin_until(executor, lambda: sim_seconds(clock) > 4.0, 30.0)
+        command, angle = sim.motor
+        assert command == -0.4                          # not the schedule's 1 rad, nor 0 at 1 s
+        assert angle == pytest.approx(-0.4, abs=2e-3)
+        # the schedule's mass change at 1 s: the parameter and the published ground truth
+        assert sim.get_parameter('tip_mass_kg').value == 0.030
+        assert truth[-1] == pytest.approx(natural_frequency_hz(0.030), rel=1e-12)
     finally:
         for node in (sim, probe):
             executor.remove_node(node)
             node.destroy_node()
+
+
+def clock_and_truth(probe, namespace):
+    """Lists the header stamps (ns) of the simulator's samples and its ground truth (Hz) are
+    appended to (the stamps are its simulated time)."""
+    stamps, truth = [], []
+    probe.create_subscription(
+        WrenchStamped, f'{namespace}/coupling_torque', lambda m: stamps.append(
+            m.header.stamp.sec * 10 ** 9 + m.header.stamp.nanosec), qos_profile_sensor_data)
+    probe.create_subscription(Float64, f'{namespace}/vibration/ground_truth',
+                              lambda m: truth.append(m.data), GROUND_TRUTH_QOS)
+    return stamps, truth
+
+
+def sim_seconds(clock) -> float:
+    """Simulated seconds of the last sample (0 before the first)."""
+    return (clock[-1] - SIM_TIME_ORIGIN_NS) * 1e-9 if clock else 0.0
 
 
 def test_lockstep_waits_for_the_commander(ros_context, executor):
@@ -238,22 +261,23 @@ def test_lockstep_waits_for_the_commander(ros_context, executor):
         Parameter('use_sim_time', value=True), Parameter('shaper', value='none')])
     probe = Node('probe', context=ros_context)
     ref = probe.create_publisher(Float64, '/lock/reference', 10)
+    clock, _ = clock_and_truth(probe, '/lock')
     for node in (sim, shaper, probe):
         executor.add_node(node)
     try:
         spin_until(executor, lambda: False, 0.3)
-        assert sim._sim.t == 0.0 and sim.commands_received == 0
+        assert sim_seconds(clock) == 0.0 and sim.commands_received == 0
         assert spin_until(executor, lambda: ref.get_subscription_count() >= 1, 10.0)
         ref.publish(Float64(data=0.2))
-        assert spin_until(executor, lambda: sim._sim.t > 1.0, 30.0)
+        assert spin_until(executor, lambda: sim_seconds(clock) > 1.0, 30.0)
         executor.remove_node(shaper)
         spin_until(executor, lambda: False, 0.1)             # in flight
-        stopped_at = sim._sim.t
+        stopped_at = sim_seconds(clock)
         spin_until(executor, lambda: False, 0.5)
-        assert sim._sim.t - stopped_at <= LOCKSTEP_BATCH_SECONDS + 1e-9
+        assert sim_seconds(clock) - stopped_at <= LOCKSTEP_BATCH_SECONDS + 1e-9
         executor.add_node(shaper)
-        assert spin_until(executor, lambda: sim._sim.t > stopped_at + 0.5, 30.0)
-        assert sim._sim.command == pytest.approx(0.2) and sim.lockstep_timeouts == 0
+        assert spin_until(executor, lambda: sim_seconds(clock) > stopped_at + 0.5, 30.0)
+        assert sim.motor[0] == pytest.approx(0.2) and sim.lockstep_timeouts == 0
     finally:
         for node in (sim, shaper, probe):
             if node in executor.get_nodes():

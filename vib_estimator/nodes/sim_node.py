@@ -36,7 +36,7 @@ from __future__ import annotations
 import math
 import sys
 import time
-from typing import List, Sequence
+from typing import List, Sequence, Tuple
 
 from geometry_msgs.msg import WrenchStamped
 from rcl_interfaces.msg import ParameterType, SetParametersResult
@@ -419,6 +419,12 @@ class SimNode(Node):
             accel.z = value
 
         return set_acceleration
+
+    @property
+    def motor(self) -> Tuple[float, float]:
+        """The simulated motor now: (the command it holds theta_m*, its angle theta_m), rad. Not
+        published (the node's outputs are the sensor's); what a position_command did."""
+        return self._sim.command, self._sim.motor_angle
 
     def _on_command(self, msg: Float64) -> None:
         """Hold a motor-angle command from the next sample; a non-finite one is skipped, counted

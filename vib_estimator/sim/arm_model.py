@@ -215,6 +215,11 @@ class ArmSimulator:
         """The current motor command theta_m*, rad."""
         return self._command
 
+    @property
+    def motor_angle(self) -> float:
+        """The motor angle theta_m now, rad."""
+        return self._x[0]
+
     def set_tip_mass(self, m: float) -> None:
         """Change the tip mass abruptly (Section 5.5); the bar's state is kept."""
         p = replace(self.params, tip_mass_kg=float(m))
