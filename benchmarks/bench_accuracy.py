@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Exactness on clean sines: the integration rule of the moments, against the trapezoid baseline.
 
 300 seeded random cases (f in [0.3, 30] Hz, amplitude 1e-3..1e3, any phase, fs/f in 20..1500),

@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Issue 22's bad-input cases, before and after, in one run: the gap test and the outlier test
 switched off (``gap_intervals`` = 0, ``outlier_ratio`` = 0: the previous behaviour) beside the
 defaults.

@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Reading a bag with its records checked (io/mcap.py) beside rosbags' own reader, same run.
 
 A 200 000-message WrenchStamped bag (64 KiB chunks with CRC-32, as BagWriter writes them) is read

@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Cold compile time of the compiled core per configuration, beside a previous commit's, same run.
 
 Each figure is one fresh Python process with an empty ``NUMBA_CACHE_DIR``: ``create_estimator``,

@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Speed of the estimator core: batch throughput and streaming cost, against baselines in the same
 run.
 

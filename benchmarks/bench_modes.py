@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Several modes at once (issue 10): the mode tracker beside a PX4-style FFT peak tracker.
 
 Runs ``ModeTracker`` (``modes: 3``, ``model: damped-sinusoid``, no ``band_hz``) and a baseline of

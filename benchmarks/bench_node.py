@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Throughput and latency of estimator_node; prints figures (not a test). About 1-2 minutes.
 
     .venv/bin/python benchmarks/bench_node.py

@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """In operation (ambient excitation): this package's ``excitation = ambient`` vs SSI-cov of pyOMA2
 vs the Whittle bound at the window used.
 

@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Precision against the exact Cramer-Rao bound, per model and window, beside a matrix pencil.
 
 For each model (sinusoid; biased-sinusoid with an offset of 3 amplitudes; damped-sinusoid with

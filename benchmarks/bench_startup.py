@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Start-to-ready of the nodes and of ``analyze``, cold and warm, beside a reference commit.
 
     .venv/bin/python benchmarks/bench_startup.py                 # this tree vs 7374e6d

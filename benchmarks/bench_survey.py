@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Streaming readers and ``vib-estimator survey``: speed and memory, each beside a baseline run
 here.
 

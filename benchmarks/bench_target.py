@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """``target_std_rel`` on the Fig. 1 signal: when the first estimate comes, and how close it is.
 
 The issue asks for the first estimate of ``--target-std-rel 0.01 --min-periods 0`` by t = 0.12 s

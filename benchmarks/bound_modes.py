@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """The exact Cramer-Rao bound of a close pair of modes: how much data a 2 % first estimate needs.
 
 The pair of ``bench_modes.py`` (10 and 13 Hz, 30 % apart, amplitudes 1 : 0.5, zeta = 0.003, white

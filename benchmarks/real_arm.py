@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """The real flexible-link arm (issue 25): why the paper's configuration fails, and the defaults.
 
 Reads ``flex8.csv`` of ``../shared/real-data/flexible_link_arm`` (or the real-data folder given as

@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Accuracy on real free-vibration recordings (not part of this project; read where they lie).
 
 Runs ``vib-estimator analyze``'s core over the aluminium-cantilever (ADXL357) recordings in

@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Launch the frequency estimator and the input shaper it drives: estimator_node + shaper_node.
 
 ``ros2 launch vib_estimator estimator_shaper.launch.py`` (needs launch_ros, i.e. a full ROS 2
@@ -13,6 +15,7 @@ sensor of its parameters file. Arguments (``name:=value``; ``--show-args`` lists
 * ``shaper``: the shaper (empty = the file's; settable at run time, ``ros2 param set``);
 * ``input_type``, ``input_topic``: the estimator's input (empty = the file's).
 """
+
 from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument, OpaqueFunction
 from launch.substitutions import LaunchConfiguration
@@ -29,30 +32,57 @@ from vib_estimator.nodes.launching import (
 
 
 def _node(executable, namespace, parameters):
-    return Node(package=PACKAGE, executable=executable, name=executable, namespace=namespace,
-                parameters=parameters, output='screen', emulate_tty=True)
+    return Node(
+        package=PACKAGE,
+        executable=executable,
+        name=executable,
+        namespace=namespace,
+        parameters=parameters,
+        output='screen',
+        emulate_tty=True,
+    )
 
 
 def _nodes(context):
     """estimator_node and shaper_node, the arguments' values over their files'."""
+
     def value(name):
         return LaunchConfiguration(name).perform(context)
+
     clock = {'use_sim_time': truthy(value('use_sim_time'))}
     namespace = LaunchConfiguration('namespace')
-    return [_node('estimator_node', namespace, [LaunchConfiguration('estimator_params_file'),
-                                                {**clock, **given(value, INPUT_ARGUMENTS)}]),
-            _node('shaper_node', namespace, [LaunchConfiguration('shaper_params_file'),
-                                             {**clock, **given(value, ['shaper'])}])]
+    return [
+        _node(
+            'estimator_node',
+            namespace,
+            [
+                LaunchConfiguration('estimator_params_file'),
+                {**clock, **given(value, INPUT_ARGUMENTS)},
+            ],
+        ),
+        _node(
+            'shaper_node',
+            namespace,
+            [LaunchConfiguration('shaper_params_file'), {**clock, **given(value, ['shaper'])}],
+        ),
+    ]
 
 
 def generate_launch_description():
     """estimator_node and shaper_node, their parameters from share/vib_estimator/config."""
-    arguments = dict([params_file_argument('estimator', 'estimator_node'),
-                      params_file_argument('shaper', 'shaper_node')])
+    arguments = dict(
+        [
+            params_file_argument('estimator', 'estimator_node'),
+            params_file_argument('shaper', 'shaper_node'),
+        ]
+    )
     arguments.update((name, COMMON_ARGUMENTS[name]) for name in ('namespace', 'use_sim_time'))
     arguments['shaper'] = ('', "input shaper (empty: the file's)")
     arguments.update((name, COMMON_ARGUMENTS[name]) for name in INPUT_ARGUMENTS)
     return LaunchDescription(
-        [DeclareLaunchArgument(name, default_value=default, description=description)
-         for name, (default, description) in arguments.items()]
-        + [OpaqueFunction(function=_nodes)])
+        [
+            DeclareLaunchArgument(name, default_value=default, description=description)
+            for name, (default, description) in arguments.items()
+        ]
+        + [OpaqueFunction(function=_nodes)]
+    )

@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Launch the frequency estimator on a recorded bag: bag_replayer + estimator_node.
 
 ``ros2 launch vib_estimator replay_estimator.launch.py bag:=<bag>`` (needs launch_ros, i.e. a full
@@ -14,6 +16,7 @@ ROS 2 install; ``bags/arm_5_3`` is a bag of the package). Arguments (``name:=val
   with ``use_sim_time``;
 * ``input_type``, ``input_topic``: the estimator's input (empty = the file's).
 """
+
 from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument, OpaqueFunction
 from launch.substitutions import LaunchConfiguration
@@ -30,36 +33,57 @@ from vib_estimator.nodes.launching import (
 
 
 def _node(executable, namespace, parameters):
-    return Node(package=PACKAGE, executable=executable, name=executable, namespace=namespace,
-                parameters=parameters, output='screen', emulate_tty=True)
+    return Node(
+        package=PACKAGE,
+        executable=executable,
+        name=executable,
+        namespace=namespace,
+        parameters=parameters,
+        output='screen',
+        emulate_tty=True,
+    )
 
 
 def _nodes(context):
     """bag_replayer playing ``bag`` (``rate``, ``clock_hz`` over its file); estimator_node with
     use_sim_time when the replayer publishes /clock."""
+
     def value(name):
         return LaunchConfiguration(name).perform(context)
+
     replayer_file = value('replayer_params_file')
     replayer = {'bag': value('bag'), **given(value, ['rate', 'clock_hz'], float)}
     clock_hz = replayer.get('clock_hz', file_parameter(replayer_file, 'clock_hz')) or 0.0
     estimator = {'use_sim_time': float(clock_hz) > 0, **given(value, INPUT_ARGUMENTS)}
     namespace = LaunchConfiguration('namespace')
-    return [_node('bag_replayer', namespace, [replayer_file, replayer]),
-            _node('estimator_node', namespace,
-                  [LaunchConfiguration('estimator_params_file'), estimator])]
+    return [
+        _node('bag_replayer', namespace, [replayer_file, replayer]),
+        _node(
+            'estimator_node', namespace, [LaunchConfiguration('estimator_params_file'), estimator]
+        ),
+    ]
 
 
 def generate_launch_description():
     """bag_replayer and estimator_node, their parameters from share/vib_estimator/config."""
     arguments = {'bag': (None, 'the bag directory, or .mcap / .db3 file, to play (required)')}
-    arguments.update([params_file_argument('replayer', 'bag_replayer'),
-                      params_file_argument('estimator', 'estimator_node')])
+    arguments.update(
+        [
+            params_file_argument('replayer', 'bag_replayer'),
+            params_file_argument('estimator', 'estimator_node'),
+        ]
+    )
     arguments['namespace'] = COMMON_ARGUMENTS['namespace']
     arguments['rate'] = ('', "playback speed factor (empty: the file's)")
-    arguments['clock_hz'] = ('', "publish /clock at this rate; > 0: use_sim_time (empty: the "
-                                 "file's)")
+    arguments['clock_hz'] = (
+        '',
+        "publish /clock at this rate; > 0: use_sim_time (empty: the file's)",
+    )
     arguments.update((name, COMMON_ARGUMENTS[name]) for name in INPUT_ARGUMENTS)
     return LaunchDescription(
-        [DeclareLaunchArgument(name, default_value=default, description=description)
-         for name, (default, description) in arguments.items()]
-        + [OpaqueFunction(function=_nodes)])
+        [
+            DeclareLaunchArgument(name, default_value=default, description=description)
+            for name, (default, description) in arguments.items()
+        ]
+        + [OpaqueFunction(function=_nodes)]
+    )

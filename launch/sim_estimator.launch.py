@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Launch the simulated arm and the frequency estimator on it: sim_node + estimator_node.
 
 ``ros2 launch vib_estimator sim_estimator.launch.py`` (needs launch_ros, i.e. a full ROS 2
@@ -14,6 +16,7 @@ The simulator publishes ``coupling_torque`` (``geometry_msgs/msg/WrenchStamped``
 the estimator's default input; its estimates appear on ``vibration/frequency`` etc., to compare
 with the simulator's ``vibration/ground_truth``.
 """
+
 from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument, OpaqueFunction
 from launch.substitutions import LaunchConfiguration
@@ -30,36 +33,63 @@ from vib_estimator.nodes.launching import (
 
 
 def _node(executable, namespace, parameters):
-    return Node(package=PACKAGE, executable=executable, name=executable, namespace=namespace,
-                parameters=parameters, output='screen', emulate_tty=True)
+    return Node(
+        package=PACKAGE,
+        executable=executable,
+        name=executable,
+        namespace=namespace,
+        parameters=parameters,
+        output='screen',
+        emulate_tty=True,
+    )
 
 
 def _nodes(context):
     """sim_node with the speed/publish_clock arguments over its file; estimator_node with
     use_sim_time when sim_node publishes /clock."""
+
     def value(name):
         return LaunchConfiguration(name).perform(context)
+
     sim_file = value('sim_params_file')
     sim = {**given(value, ['speed'], float), **given(value, ['publish_clock'], truthy)}
-    speed, publish_clock = (sim.get(name, file_parameter(sim_file, name))
-                            for name in ('speed', 'publish_clock'))
+    speed, publish_clock = (
+        sim.get(name, file_parameter(sim_file, name)) for name in ('speed', 'publish_clock')
+    )
     clock = truthy(publish_clock) or float(speed or 1.0) != 1.0
     namespace = LaunchConfiguration('namespace')
-    return [_node('sim_node', namespace, [sim_file, sim]),
-            _node('estimator_node', namespace, [LaunchConfiguration('estimator_params_file'),
-                                                {'use_sim_time': clock}])]
+    return [
+        _node('sim_node', namespace, [sim_file, sim]),
+        _node(
+            'estimator_node',
+            namespace,
+            [LaunchConfiguration('estimator_params_file'), {'use_sim_time': clock}],
+        ),
+    ]
 
 
 def generate_launch_description():
     """sim_node and estimator_node, their parameters from share/vib_estimator/config."""
-    arguments = dict([params_file_argument('sim', 'sim_node'),
-                      params_file_argument('estimator', 'estimator_node')])
+    arguments = dict(
+        [
+            params_file_argument('sim', 'sim_node'),
+            params_file_argument('estimator', 'estimator_node'),
+        ]
+    )
     arguments['namespace'] = COMMON_ARGUMENTS['namespace']
-    arguments['speed'] = ('', "simulated seconds per wall-clock second (empty: the file's); "
-                              'other than 1: /clock and use_sim_time')
-    arguments['publish_clock'] = ('', "true: /clock and use_sim_time even at speed 1 (empty: "
-                                      "the file's)")
+    arguments['speed'] = (
+        '',
+        "simulated seconds per wall-clock second (empty: the file's); "
+        'other than 1: /clock and use_sim_time',
+    )
+    arguments['publish_clock'] = (
+        '',
+        "true: /clock and use_sim_time even at speed 1 (empty: the file's)",
+    )
     return LaunchDescription(
-        [DeclareLaunchArgument(name, default_value=default, description=description)
-         for name, (default, description) in arguments.items()]
-        + [OpaqueFunction(function=_nodes)])
+        [
+            DeclareLaunchArgument(name, default_value=default, description=description)
+            for name, (default, description) in arguments.items()
+        ]
+        + [OpaqueFunction(function=_nodes)]
+    )

@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Put the licence header on every Python file of the repository that lacks it (idempotent).
 
     python scripts/add_license_headers.py          # add where missing
@@ -6,6 +8,7 @@
 The header (:data:`HEADER`) goes first, after a ``#!`` line if there is one. ``make test`` checks
 it (``test/test_lint.py``).
 """
+
 from __future__ import annotations
 
 import subprocess
@@ -13,15 +16,17 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-HEADER = ('# Copyright 2026 vib_estimator developers\n'
-          '# SPDX-License-Identifier: Apache-2.0\n')
+HEADER = '# Copyright 2026 vib_estimator developers\n# SPDX-License-Identifier: Apache-2.0\n'
 
 
 def python_files():
     """The tracked and the untracked (not ignored) ``.py`` files of the repository."""
-    out = subprocess.run(['git', '-C', str(ROOT), 'ls-files', '--cached', '--others',
-                          '--exclude-standard', '*.py'], capture_output=True, text=True,
-                         check=True).stdout
+    out = subprocess.run(
+        ['git', '-C', str(ROOT), 'ls-files', '--cached', '--others', '--exclude-standard', '*.py'],
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout
     return [ROOT / line for line in out.splitlines() if (ROOT / line).is_file()]
 
 

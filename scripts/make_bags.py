@@ -1,4 +1,6 @@
 #!/usr/bin/env python3
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Regenerate the simulated recordings in ``bags/`` (deterministic: seeded, no wall-clock time).
 
     python scripts/make_bags.py [--out bags] [--seed 0]

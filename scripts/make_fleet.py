@@ -1,4 +1,6 @@
 #!/usr/bin/env python3
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Simulate a fleet of daily recordings of the flexible arm, for ``vib-estimator survey``.
 
     python scripts/make_fleet.py [--out out/fleet] [--days 40] [--drop-day 30] [--seed 0]

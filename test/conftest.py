@@ -1,4 +1,7 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Shared fixtures: an isolated ROS domain per test run and a fresh rclpy context per test."""
+
 from __future__ import annotations
 
 import os
@@ -11,7 +14,7 @@ from hypothesis import settings
 settings.register_profile('deterministic', derandomize=True, database=None)
 settings.load_profile('deterministic')
 
-# One DDS domain per test run, so concurrent runs on one machine never see each other, and discovery
+# One DDS domain per test run (concurrent runs on one machine never see each other), and discovery
 # kept on this host. Set before rclpy is imported anywhere.
 os.environ.setdefault('ROS_DOMAIN_ID', str(1 + os.getpid() % 100))
 os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
@@ -39,5 +42,4 @@ def executor(ros_context):
     nodes = ex.get_nodes()
     ex.shutdown()
     for node in nodes:
-        node.destroy_node()   # idempotent: a test may have destroyed it already
-
+        node.destroy_node()  # idempotent: a test may have destroyed it already

@@ -1,5 +1,8 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """The README and docs/ are a tree a reader can navigate: every relative link reaches a file, and
 every ``#anchor`` a heading of it (GitHub's slugs); every docs page is linked from the README."""
+
 from __future__ import annotations
 
 import re
@@ -33,7 +36,7 @@ def test_every_relative_link_and_anchor_resolves():
     for page in PAGES:
         for target in links(page):
             if re.match(r'^[a-z]+:', target):
-                continue                       # http(s), mailto: not checked here
+                continue  # http(s), mailto: not checked here
             path, _, anchor = target.partition('#')
             dest = (page.parent / path).resolve() if path else page
             if not dest.exists():

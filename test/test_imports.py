@@ -1,5 +1,8 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """The package's import graph: no cycle, none hidden by imports inside functions, and no private
 name imported from another module of the package."""
+
 from __future__ import annotations
 
 import ast
@@ -28,7 +31,7 @@ def _resolve(module: str, node: ast.ImportFrom) -> str:
         return node.module or ''
     base = module.split('.')
     is_package = MODULES[module].name == '__init__.py'
-    base = base[:len(base) - node.level + (1 if is_package else 0)]
+    base = base[: len(base) - node.level + (1 if is_package else 0)]
     return '.'.join(base + ([node.module] if node.module else []))
 
 
@@ -53,9 +56,11 @@ def _imports(module: str, top_level_only: bool) -> List[Tuple[str, str]]:
 def _graph(top_level_only: bool) -> Dict[str, Set[str]]:
     graph = {}
     for module in MODULES:
-        graph[module] = {m for m, _ in _imports(module, top_level_only)
-                         if m in MODULES and m != module
-                         and not module.startswith(m + '.')}  # a package's own __init__
+        graph[module] = {
+            m
+            for m, _ in _imports(module, top_level_only)
+            if m in MODULES and m != module and not module.startswith(m + '.')
+        }  # a package's own __init__
     return graph
 
 
@@ -69,7 +74,7 @@ def _cycle(graph: Dict[str, Set[str]]) -> List[str]:
         stack.append(node)
         for nxt in sorted(graph[node]):
             if state.get(nxt) == 1:
-                return stack[stack.index(nxt):] + [nxt]
+                return stack[stack.index(nxt) :] + [nxt]
             if nxt not in state:
                 found = visit(nxt)
                 if found:
@@ -111,8 +116,12 @@ KNOWN_PRIVATE = set()
 
 
 def test_no_private_name_is_imported_from_another_module():
-    private = {(m, f'{target}.{name}') for m in MODULES
-               for target, name in _imports(m, False) if name.startswith('_')}
+    private = {
+        (m, f'{target}.{name}')
+        for m in MODULES
+        for target, name in _imports(m, False)
+        if name.startswith('_')
+    }
     assert private - KNOWN_PRIVATE == set()
 
 
@@ -120,8 +129,11 @@ def _constants(module: str) -> Set[str]:
     """The upper-case constants ``module`` assigns at top level (leading ``_`` dropped)."""
     names = set()
     for node in ast.parse(MODULES[module].read_text()).body:
-        targets = node.targets if isinstance(node, ast.Assign) else (
-            [node.target] if isinstance(node, ast.AnnAssign) else [])
+        targets = (
+            node.targets
+            if isinstance(node, ast.Assign)
+            else ([node.target] if isinstance(node, ast.AnnAssign) else [])
+        )
         for target in targets:
             elts = target.elts if isinstance(target, ast.Tuple) else [target]
             names.update(e.id.lstrip('_') for e in elts if isinstance(e, ast.Name))
@@ -140,8 +152,15 @@ def test_constants_are_defined_once():
     """The MCAP magic and opcodes, message type names, axes, 2 pi, the diagnostics period: one
     definition each (issue 23); and no constant is defined in two io/ modules."""
     where = _defined_in(MODULES)
-    for name in ('MAGIC', 'OP_CHUNK', 'OP_CHANNEL', 'WRENCH_STAMPED', 'XYZ', 'TWO_PI',
-                 'DIAGNOSTICS_PERIOD'):
+    for name in (
+        'MAGIC',
+        'OP_CHUNK',
+        'OP_CHANNEL',
+        'WRENCH_STAMPED',
+        'XYZ',
+        'TWO_PI',
+        'DIAGNOSTICS_PERIOD',
+    ):
         assert len(where.get(name, [])) == 1, (name, where.get(name))
     io = _defined_in(m for m in MODULES if m.startswith(f'{NAME}.io'))
     assert {n: m for n, m in io.items() if len(m) > 1} == {}
@@ -155,8 +174,9 @@ def test_the_exceptions_module_is_a_leaf_that_every_reader_uses():
     for module, path in MODULES.items():
         for node in ast.walk(ast.parse(path.read_text())):
             if isinstance(node, ast.ClassDef) and any(
-                    getattr(b, 'id', getattr(b, 'attr', '')).endswith(('Error', 'Exception'))
-                    for b in node.bases):
+                getattr(b, 'id', getattr(b, 'attr', '')).endswith(('Error', 'Exception'))
+                for b in node.bases
+            ):
                 classes[node.name] = module
     outside = {n: m for n, m in classes.items() if m != f'{NAME}.errors'}
     assert outside == {}

@@ -1,4 +1,7 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """The layout shows the architecture: pure libraries without rclpy, thin nodes, short functions."""
+
 from __future__ import annotations
 
 import ast
@@ -14,8 +17,17 @@ TOP = {'__init__.py', 'cli.py', 'errors.py'}
 #: no function longer than this (lines, decorators excluded)
 MAX_FUNCTION_LINES = 80
 #: ROS client/middleware modules a pure module must not import
-ROS_MODULES = {'rclpy', 'rcl_interfaces', 'std_msgs', 'geometry_msgs', 'sensor_msgs',
-               'diagnostic_msgs', 'rosgraph_msgs', 'std_srvs', 'builtin_interfaces'}
+ROS_MODULES = {
+    'rclpy',
+    'rcl_interfaces',
+    'std_msgs',
+    'geometry_msgs',
+    'sensor_msgs',
+    'diagnostic_msgs',
+    'rosgraph_msgs',
+    'std_srvs',
+    'builtin_interfaces',
+}
 
 
 def _modules():
@@ -53,8 +65,9 @@ def test_no_function_is_longer_than_the_limit():
             if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
                 lines = node.end_lineno - node.lineno + 1
                 if lines > MAX_FUNCTION_LINES:
-                    long.append(f'{path.relative_to(PACKAGE)}:{node.lineno} {node.name} '
-                                f'({lines} lines)')
+                    long.append(
+                        f'{path.relative_to(PACKAGE)}:{node.lineno} {node.name} ({lines} lines)'
+                    )
     assert not long, 'functions longer than {} lines: {}'.format(MAX_FUNCTION_LINES, long)
 
 

@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """vib_estimator: fast on-line frequency and damping estimation of lightly damped vibrations.
 
 Layout (one role per subpackage; nothing in ``core``, ``io``, ``sim``, ``analysis`` or ``control``

@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """``vib-estimator``: the package's command line (offline analysis, paper figures, comparison,
 demo).
 

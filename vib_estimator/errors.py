@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """The library's exceptions, in one module, and what each means at a command line.
 
 Every module of the package raises these (never defines its own), so a caller catches one family

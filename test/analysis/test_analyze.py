@@ -1,4 +1,7 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """``vib-estimator analyze`` on CSV files and bags, and its handling of bad input."""
+
 import json
 import re
 
@@ -25,8 +28,13 @@ def jsonl(text):
 def test_csv_estimates_equal_the_core(tmp_path, capsys, samples):
     t, y = samples
     path = tmp_path / 'sig.csv'
-    np.savetxt(path, np.column_stack([t, 5 * y, y]), delimiter=',', header='time,other,torque',
-               comments='')
+    np.savetxt(
+        path,
+        np.column_stack([t, 5 * y, y]),
+        delimiter=',',
+        header='time,other,torque',
+        comments='',
+    )
     assert main(['analyze', str(path), '--column', 'torque']) == 0
     rows = jsonl(capsys.readouterr().out)
     expected = estimate(t, y)
@@ -41,8 +49,24 @@ def test_csv_with_comments_and_no_header_and_options(tmp_path, capsys, samples):
     path = tmp_path / 'sig.csv'
     path.write_text('# recorded by hand\n' + '\n'.join(f'{a},{b + 0.5}' for a, b in zip(t, y)))
     png = tmp_path / 'fig.png'
-    assert main(['analyze', str(path), '--model', 'biased-sinusoid', '--band-hz', '0.5', '5',
-                 '--format', 'csv', '--plot', str(png)]) == 0
+    assert (
+        main(
+            [
+                'analyze',
+                str(path),
+                '--model',
+                'biased-sinusoid',
+                '--band-hz',
+                '0.5',
+                '5',
+                '--format',
+                'csv',
+                '--plot',
+                str(png),
+            ]
+        )
+        == 0
+    )
     out = capsys.readouterr()
     lines = out.out.splitlines()
     assert lines[0].startswith('t,frequency_hz')
@@ -52,7 +76,7 @@ def test_csv_with_comments_and_no_header_and_options(tmp_path, capsys, samples):
     column = lines[0].split(',').index('frequency_hz')
     assert [float(ln.split(',')[column]) for ln in lines[1:]] == expected.frequency_hz.tolist()
     assert re.search(rf'\bestimates={len(expected)}\b', out.err)
-    assert png.is_file()                 # what the figure shows: the plotting tests
+    assert png.is_file()  # what the figure shows: the plotting tests
 
 
 def test_bag_input_uses_header_stamps(tmp_path, capsys, samples):
@@ -63,28 +87,34 @@ def test_bag_input_uses_header_stamps(tmp_path, capsys, samples):
     rows = jsonl(capsys.readouterr().out)
     expected = estimate(seconds_since(stamps, stamps[0]), y)
     assert [r['frequency_hz'] for r in rows] == expected.frequency_hz.tolist()
-    assert rows[0]['stamp_ns'] == stamps[np.searchsorted(seconds_since(stamps, stamps[0]),
-                                                         expected.t[0])]
+    assert (
+        rows[0]['stamp_ns']
+        == stamps[np.searchsorted(seconds_since(stamps, stamps[0]), expected.t[0])]
+    )
     assert main(['analyze', str(tmp_path / 'bag'), '--format', 'table']) == 0
     header, *table = capsys.readouterr().out.splitlines()
     assert header.split()[:4] == ['t', '(s)', 'f', '(Hz)']
-    assert len(table) == len(expected) > 5           # one row per estimate: t, f as printed
+    assert len(table) == len(expected) > 5  # one row per estimate: t, f as printed
     np.testing.assert_allclose([float(r.split()[0]) for r in table], expected.t, atol=5e-5)
-    np.testing.assert_allclose([float(r.split()[1]) for r in table], expected.frequency_hz,
-                               atol=5e-7)
+    np.testing.assert_allclose(
+        [float(r.split()[1]) for r in table], expected.frequency_hz, atol=5e-7
+    )
     assert [int(r.split()[5]) for r in table] == expected.samples.tolist()
 
 
-@pytest.mark.parametrize('content, args, message', [
-    (None, [], 'no such file'),
-    ('t,y\n', [], 'no data rows'),
-    ('t,y\n0,1\n1,2\n', ['--column', 'z'], "no column 'z'"),
-    ('t,y\n0,1\n0.002,x\n', [], 'not numbers'),
-    ('t,y\n0,1\n0.002,2\n0.001,3\n', [], 'not strictly increasing'),
-    ('t,y\n0,1\n0,2\n', [], 'not strictly increasing'),
-    ('t,y\n0,1\n', ['--window', '0'], 'window'),
-    ('t,y\n0,1\n', ['--max-window', '-1'], 'max_window'),
-])
+@pytest.mark.parametrize(
+    'content, args, message',
+    [
+        (None, [], 'no such file'),
+        ('t,y\n', [], 'no data rows'),
+        ('t,y\n0,1\n1,2\n', ['--column', 'z'], "no column 'z'"),
+        ('t,y\n0,1\n0.002,x\n', [], 'not numbers'),
+        ('t,y\n0,1\n0.002,2\n0.001,3\n', [], 'not strictly increasing'),
+        ('t,y\n0,1\n0,2\n', [], 'not strictly increasing'),
+        ('t,y\n0,1\n', ['--window', '0'], 'window'),
+        ('t,y\n0,1\n', ['--max-window', '-1'], 'max_window'),
+    ],
+)
 def test_bad_input_is_one_line_and_exit_code_2(tmp_path, capsys, content, args, message):
     path = tmp_path / 'in.csv'
     if content is not None:
@@ -94,10 +124,13 @@ def test_bad_input_is_one_line_and_exit_code_2(tmp_path, capsys, content, args, 
     assert message in err and len(err.strip().splitlines()) == 1 and 'Traceback' not in err
 
 
-@pytest.mark.parametrize('make, message', [
-    (lambda p: p.mkdir(), 'bag'),
-    (lambda p: p.with_suffix('.mcap').write_bytes(b'not an mcap file at all'), 'mcap'),
-])
+@pytest.mark.parametrize(
+    'make, message',
+    [
+        (lambda p: p.mkdir(), 'bag'),
+        (lambda p: p.with_suffix('.mcap').write_bytes(b'not an mcap file at all'), 'mcap'),
+    ],
+)
 def test_bad_bags_are_refused(tmp_path, capsys, make, message):
     target = tmp_path / 'bag'
     make(target)
@@ -128,15 +161,21 @@ def test_every_input_type_of_a_bag_and_the_topic_choice(tmp_path, capsys, sample
         imu = bag.add_topic('/imu', 'sensor_msgs/msg/Imu')
         raw = bag.add_topic('/raw', 'std_msgs/msg/Float64')
         for s, v in zip(stamps.tolist(), y.tolist()):
-            header = T['std_msgs/msg/Header'](stamp=T['builtin_interfaces/msg/Time'](
-                sec=s // 10 ** 9, nanosec=s % 10 ** 9), frame_id='imu_link')
+            header = T['std_msgs/msg/Header'](
+                stamp=T['builtin_interfaces/msg/Time'](sec=s // 10**9, nanosec=s % 10**9),
+                frame_id='imu_link',
+            )
             vec = T['geometry_msgs/msg/Vector3']
             msg = T['sensor_msgs/msg/Imu'](
-                header=header, orientation=T['geometry_msgs/msg/Quaternion'](0.0, 0.0, 0.0, 1.0),
-                orientation_covariance=np.zeros(9), angular_velocity=vec(0.0, 0.0, 0.0),
-                angular_velocity_covariance=np.zeros(9), linear_acceleration=vec(v, 0.0, 9.8),
-                linear_acceleration_covariance=np.zeros(9))
-            bag.write_message(imu, s + 123_456, msg)            # received later than stamped
+                header=header,
+                orientation=T['geometry_msgs/msg/Quaternion'](0.0, 0.0, 0.0, 1.0),
+                orientation_covariance=np.zeros(9),
+                angular_velocity=vec(0.0, 0.0, 0.0),
+                angular_velocity_covariance=np.zeros(9),
+                linear_acceleration=vec(v, 0.0, 9.8),
+                linear_acceleration_covariance=np.zeros(9),
+            )
+            bag.write_message(imu, s + 123_456, msg)  # received later than stamped
             bag.write_message(raw, s, T['std_msgs/msg/Float64'](data=v))
     expected = estimate(seconds_since(stamps, stamps[0]), y).frequency_hz.tolist()
     for args in (['--topic', '/imu', '--component', 'linear_acceleration.x'], ['--topic', '/raw']):
@@ -144,15 +183,18 @@ def test_every_input_type_of_a_bag_and_the_topic_choice(tmp_path, capsys, sample
         assert [r['frequency_hz'] for r in jsonl(capsys.readouterr().out)] == expected
     assert main(['analyze', str(tmp_path / 'bag')]) == 2
     err = capsys.readouterr().err
-    assert f'choose one with --topic, e.g. `vib-estimator analyze {tmp_path / "bag"} --topic /imu`: ' \
+    assert (
+        f'choose one with --topic, e.g. `vib-estimator analyze {tmp_path / "bag"} --topic /imu`: '
         '/imu (sensor_msgs/msg/Imu), /raw' in err
-    assert main(['analyze', str(tmp_path / 'bag'), '--topic', '/imu', '--component',
-                 'torque.z']) == 2
+    )
+    assert (
+        main(['analyze', str(tmp_path / 'bag'), '--topic', '/imu', '--component', 'torque.z']) == 2
+    )
     assert 'linear_acceleration.x' in capsys.readouterr().err
 
 
 def test_band_above_nyquist_is_an_error(tmp_path, capsys, samples):
-    t, y = samples                                   # 500 Hz: Nyquist 250 Hz
+    t, y = samples  # 500 Hz: Nyquist 250 Hz
     path = tmp_path / 'sig.csv'
     np.savetxt(path, np.column_stack([t, y]), delimiter=',')
     assert main(['analyze', str(path), '--band-hz', '1', '300']) == 2

@@ -1,6 +1,9 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Issue 22 in the command line: a Hypothesis fuzz of the CSV reader through ``vib-estimator
 analyze`` (random bytes, random numbers in CSV rows), strict JSONL for every estimate, and a run
 without estimates that says why."""
+
 from __future__ import annotations
 
 import contextlib
@@ -11,13 +14,16 @@ import os
 import tempfile
 
 import numpy as np
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from vib_estimator import cli
 
-CELLS = st.one_of(st.floats(allow_nan=True, allow_infinity=True),
-                  st.sampled_from([1e308, -1e308, 5e-324, 0.0, 'nan', 'inf', '', 'x', '1e999']),
-                  st.floats(-5.0, 5.0))
+CELLS = st.one_of(
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.sampled_from([1e308, -1e308, 5e-324, 0.0, 'nan', 'inf', '', 'x', '1e999']),
+    st.floats(-5.0, 5.0),
+)
 
 
 def analyze(data: bytes, *options):
@@ -53,8 +59,11 @@ def test_fuzz_random_bytes_error_or_valid_output(data):
 
 
 @settings(max_examples=40, deadline=None)
-@given(rows=st.lists(st.tuples(CELLS, CELLS), max_size=60), header=st.booleans(),
-       keep_time=st.booleans())
+@given(
+    rows=st.lists(st.tuples(CELLS, CELLS), max_size=60),
+    header=st.booleans(),
+    keep_time=st.booleans(),
+)
 def test_fuzz_random_cells_mixed_into_a_sine(rows, header, keep_time):
     """Random cells replace values (``keep_time``: the stamps stay increasing, so the estimator
     sees them) or are inserted as rows (times too: mostly refused, one error line)."""
@@ -88,8 +97,10 @@ def test_no_estimate_says_why():
     """Issue 22 case 8: the default model on a clean damped sine gave 0 estimates, no word why."""
     t = np.arange(0, 10, 0.002)
     wn = 2 * np.pi * 3
-    text = 't,y\n' + ''.join(f'{a!r},{b!r}\n' for a, b in
-                             zip(t.tolist(), (np.exp(-0.02 * wn * t) * np.sin(wn * t)).tolist()))
+    text = 't,y\n' + ''.join(
+        f'{a!r},{b!r}\n'
+        for a, b in zip(t.tolist(), (np.exp(-0.02 * wn * t) * np.sin(wn * t)).tolist())
+    )
     code, out, err = analyze(text.encode(), '--format', 'table')
     assert code == 0 and 'estimates=0' in err
     why = [line for line in err.splitlines() if line.startswith('analyze: no estimate: ')]
@@ -103,11 +114,12 @@ def test_gaps_are_counted_in_analyze_and_survey_rows(tmp_path):
     t = np.arange(0, 20, 0.002)
     keep = np.ones(len(t), bool)
     for start in (1000, 3000, 6000):
-        keep[start:start + 100] = False                  # three 200 ms gaps (< max_gap)
+        keep[start : start + 100] = False  # three 200 ms gaps (< max_gap)
     path = tmp_path / 'gappy.csv'
     y = np.sin(2 * np.pi * 2 * t[keep])
-    path.write_text('t,y\n' + ''.join(f'{a!r},{b!r}\n' for a, b in zip(t[keep].tolist(),
-                                                                       y.tolist())))
+    path.write_text(
+        't,y\n' + ''.join(f'{a!r},{b!r}\n' for a, b in zip(t[keep].tolist(), y.tolist()))
+    )
     code, _, err = analyze(path.read_bytes())
     assert code == 0 and 'gaps=3' in err and 'samples_lost=300' in err
     out = io.StringIO()

@@ -1,5 +1,8 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Baseline trackers (Section 5.4): convergence with the paper's gains, step convergence of the ODE
 integration, streaming = batch, and the Cramer-Rao bound against a direct Fisher computation."""
+
 from __future__ import annotations
 
 import math
@@ -8,9 +11,15 @@ import numpy as np
 import pytest
 
 from vib_estimator.analysis import baselines
-from vib_estimator.analysis.baselines import (Hou, MojiriBakhshai, SlidingDFT,
-                                              SlidingMatrixPencil, ZiaraniKonrad, hold_last,
-                                              matrix_pencil)
+from vib_estimator.analysis.baselines import (
+    Hou,
+    MojiriBakhshai,
+    SlidingDFT,
+    SlidingMatrixPencil,
+    ZiaraniKonrad,
+    hold_last,
+    matrix_pencil,
+)
 from vib_estimator.analysis.bounds import crlb_frequency_std, fisher_frequency_std, window_crlb_std
 
 FS = 500.0
@@ -38,7 +47,7 @@ def test_converges_on_clean_sine_with_the_papers_gains(cls):
     t, y = sine(1.0)
     f_hat = cls().process(t, y)
     assert settle_time(t, f_hat, 1.33, 0.01) < 8.0
-    assert abs(f_hat[-1] / 1.33 - 1) < 2e-3    # the DFT's documented bias bound
+    assert abs(f_hat[-1] / 1.33 - 1) < 2e-3  # the DFT's documented bias bound
 
 
 def test_adaptation_slows_on_arm_scale_torque():
@@ -67,15 +76,16 @@ def test_streaming_equals_batch_and_skips_bad_samples(cls):
     t = t.copy()
     y = y.copy()
     y[100] = np.nan
-    t[200] = t[199]             # duplicate stamp
+    t[200] = t[199]  # duplicate stamp
     batch = cls().process(t, y)
     tracker = cls()
     stream = np.array([np.nan if (f := tracker.update(a, b)) is None else f for a, b in zip(t, y)])
     np.testing.assert_array_equal(stream, batch)
     np.testing.assert_array_equal(batch[[100, 200]], batch[[99, 199]])
     split = cls()
-    np.testing.assert_array_equal(np.concatenate([split.process(t[:777], y[:777]),
-                                                  split.process(t[777:], y[777:])]), batch)
+    np.testing.assert_array_equal(
+        np.concatenate([split.process(t[:777], y[:777]), split.process(t[777:], y[777:])]), batch
+    )
     tracker.reset()
     np.testing.assert_array_equal(tracker.process(t, y), batch)
 
@@ -88,7 +98,7 @@ def test_initial_estimates_are_3_hz_and_dft_waits_for_a_window():
     n = tracker.window_samples
     assert n == 1000
     dft = tracker.process(t, y)
-    assert np.isnan(dft[:n - 1]).all() and np.isfinite(dft[n - 1:]).all()
+    assert np.isnan(dft[: n - 1]).all() and np.isfinite(dft[n - 1 :]).all()
 
 
 def test_hold_last():
@@ -111,17 +121,19 @@ def test_window_crlb_uses_the_windows_amplitude_and_phase():
     for phase in (0.0, 1.0, 2.0):
         y = 0.2 * np.sin(2 * np.pi * 1.33 * t + phase) + 0.05
         assert window_crlb_std(y, 2e-3, 1.33, 0.004) == pytest.approx(
-            fisher_frequency_std(0.2, 1.33, phase, 0.004, 2e-3, 189), rel=1e-6)
+            fisher_frequency_std(0.2, 1.33, phase, 0.004, 2e-3, 189), rel=1e-6
+        )
     # scaling of the closed form: std ~ sigma / (A N^1.5)
     assert crlb_frequency_std(0.4, 0.004, 2e-3, 4000) == pytest.approx(
-        crlb_frequency_std(0.2, 0.004, 2e-3, 2000) / 2 / 2 ** 1.5, rel=1e-3)
+        crlb_frequency_std(0.2, 0.004, 2e-3, 2000) / 2 / 2**1.5, rel=1e-3
+    )
 
 
 @pytest.mark.parametrize('zeta', [0.0, 0.004, 0.02])
 def test_matrix_pencil_is_exact_on_a_clean_damped_sine_and_nan_on_too_short_a_window(zeta):
     t = np.arange(400) / FS
     wn = 2 * np.pi * 1.33
-    y = 0.1 * np.exp(-zeta * wn * t) * np.sin(wn * math.sqrt(1 - zeta ** 2) * t + 0.4)
+    y = 0.1 * np.exp(-zeta * wn * t) * np.sin(wn * math.sqrt(1 - zeta**2) * t + 0.4)
     f, z = matrix_pencil(y, 1 / FS)
     assert f == pytest.approx(1.33, rel=1e-9) and z == pytest.approx(zeta, abs=1e-9)
     assert math.isnan(matrix_pencil(y[:8], 1 / FS)[0])
@@ -133,9 +145,13 @@ def test_the_pencils_svd_runs_on_one_blas_thread(monkeypatch):
     svd = np.linalg.svd
 
     def spy(*args, **kwargs):
-        threads.extend(lib['num_threads'] for lib in baselines.blas_controller().info()
-                       if lib['user_api'] == 'blas')
+        threads.extend(
+            lib['num_threads']
+            for lib in baselines.blas_controller().info()
+            if lib['user_api'] == 'blas'
+        )
         return svd(*args, **kwargs)
+
     monkeypatch.setattr(np.linalg, 'svd', spy)
     t, y = sine(0.1, seconds=3.0)
     f = SlidingMatrixPencil(FS, window_s=1.0, hop=250).process(t, y)

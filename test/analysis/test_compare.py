@@ -1,14 +1,17 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """``vib-estimator compare``: the definitions it measures by, the speed claim of Section 5.4, and a
 smoke run of the command."""
+
 from __future__ import annotations
 
 import math
 
 import numpy as np
 
-from vib_estimator.sim import arm_model
 from vib_estimator import cli
 from vib_estimator.analysis import compare
+from vib_estimator.sim import arm_model
 
 
 def test_segments_of_the_three_mass_experiment():
@@ -21,13 +24,13 @@ def test_segments_of_the_three_mass_experiment():
 
 def test_tracked_index_needs_a_whole_period_within_tolerance():
     out = np.full(100, 1.0)
-    out[10:20] = 1.1          # outside 2 %
-    out[30] = np.nan          # no estimate: not tracked
+    out[10:20] = 1.1  # outside 2 %
+    out[30] = np.nan  # no estimate: not tracked
     assert compare.tracked_index(out, 1.0, 0, 100, 10) == 0
     assert compare.tracked_index(out, 1.0, 5, 100, 10) == 20
     assert compare.tracked_index(out, 1.0, 5, 100, 11) == 31
     assert compare.tracked_index(out, 1.0, 5, 40, 10) == 20
-    assert compare.tracked_index(out, 1.0, 21, 39, 10) is None   # 9 good samples, then NaN
+    assert compare.tracked_index(out, 1.0, 21, 39, 10) is None  # 9 good samples, then NaN
 
 
 def test_algebraic_is_at_least_three_times_faster_on_section_5_3():
@@ -37,26 +40,36 @@ def test_algebraic_is_at_least_three_times_faster_on_section_5_3():
     seg = compare.segments(f_true)[0]
     noise = compare.CASES[0].noise_std
     names = [compare.ALGEBRAIC] + [cls.name for cls in compare.TRACKERS]
-    results = {name: compare.evaluate(compare.run_method(name, t, y), t, y, seg, noise,
-                                      name in compare.ALGEBRAIC_CONFIGS)
-               for name in names}
+    results = {
+        name: compare.evaluate(
+            compare.run_method(name, t, y), t, y, seg, noise, name in compare.ALGEBRAIC_CONFIGS
+        )
+        for name in names
+    }
     first = results[compare.ALGEBRAIC].first
-    assert 0 < first < 0.5      # "less than 0.5 s" (Section 5.4), ~half a period
+    assert 0 < first < 0.5  # "less than 0.5 s" (Section 5.4), ~half a period
     # a method whose output never stays within 2 % for a period (NaN) is slower than any bound;
     # the claim is measured against the trackers that do settle on this record
-    settled = {name: results[name].tracked for name in (cls.name for cls in compare.TRACKERS)
-               if math.isfinite(results[name].tracked)}
+    settled = {
+        name: results[name].tracked
+        for name in (cls.name for cls in compare.TRACKERS)
+        if math.isfinite(results[name].tracked)
+    }
     assert {'Sliding DFT', 'Matrix pencil'} <= set(settled), settled
     assert all(tracked >= 3 * first for tracked in settled.values()), (settled, first)
-    assert results[compare.ALGEBRAIC].tracked == first     # its first estimate holds
+    assert results[compare.ALGEBRAIC].tracked == first  # its first estimate holds
 
 
 def test_compare_command_prints_every_method_and_writes_plots(tmp_path, capsys):
     md = tmp_path / 'table.md'
-    assert cli.main(['compare', '--quick', '--seeds', '2', '--out', str(tmp_path),
-                     '--markdown', str(md)]) == 0
+    assert (
+        cli.main(
+            ['compare', '--quick', '--seeds', '2', '--out', str(tmp_path), '--markdown', str(md)]
+        )
+        == 0
+    )
     text = capsys.readouterr().out
-    table = text[text.index('\ncase') + 1:text.index('\namplitude-tuned')]
+    table = text[text.index('\ncase') + 1 : text.index('\namplitude-tuned')]
     blocks = [[ln.split() for ln in block.splitlines()] for block in table.split('\n\n')]
     assert len(blocks) == len(compare.TEXT_BLOCKS)
     assert max(len(ln) for ln in table.splitlines()) <= compare.TABLE_WIDTH
@@ -73,16 +86,16 @@ def test_compare_command_prints_every_method_and_writes_plots(tmp_path, capsys):
     for lines in blocks:
         for ln in lines:
             if ln[0] in ('5.3', '5.5', 'fig1') and ln[2] in ('Algebraic', 'Sliding'):
-                numbers.setdefault(tuple(ln[:3]), []).extend(ln[3:] if ln[2] == 'Algebraic'
-                                                             else ln[4:])
+                numbers.setdefault(tuple(ln[:3]), []).extend(
+                    ln[3:] if ln[2] == 'Algebraic' else ln[4:]
+                )
     assert len(numbers) == 2 * sum(3 if c.key == '5.5' else 1 for c in compare.CASES)
     for key, values in numbers.items():
-        assert len(values) == len(compare.HEADER) - 1, key   # two durations in s (periods)
+        assert len(values) == len(compare.HEADER) - 1, key  # two durations in s (periods)
         assert all(math.isfinite(float(v.strip('()%'))) for v in values), key
     table = md.read_text()
     assert '7.0e-02' in table and '3.1e-05' in table
     assert all(m in table for m in compare.METHODS)
-
 
 
 def test_amplitude_tuned_gains_come_from_the_grid_and_help_on_scoring_seeds():
@@ -96,9 +109,12 @@ def test_amplitude_tuned_gains_come_from_the_grid_and_help_on_scoring_seeds():
         assert any(math.isclose(factor, k) for k in compare.GAIN_FACTORS), (name, factor)
     t, y, f_true = case.record(0)
     seg = compare.segments(f_true)[0]
-    tuned, paper = (compare.evaluate(compare.run_method(name, t, y, gains.get(name)), t, y, seg,
-                                     case.noise_std, False)
-                    for name in ('Mojiri-Bakhshai-A', 'Mojiri-Bakhshai'))
+    tuned, paper = (
+        compare.evaluate(
+            compare.run_method(name, t, y, gains.get(name)), t, y, seg, case.noise_std, False
+        )
+        for name in ('Mojiri-Bakhshai-A', 'Mojiri-Bakhshai')
+    )
     assert math.isfinite(tuned.tracked) and math.isnan(paper.tracked)
     truth = seg[2]
     assert np.mean(np.square(tuned.values - truth)) < np.mean(np.square(paper.values - truth))

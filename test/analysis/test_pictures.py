@@ -1,5 +1,8 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """The figures, checked for what a reader needs on them (labels, units, legend entries, the marked
 modes) through the matplotlib Figure each plotting function returns; and ``analyze``'s summary."""
+
 import json
 import re
 
@@ -29,17 +32,31 @@ def sine(seed=5, f=F0, zeta=0.0, duration=8.0):
     rng = np.random.default_rng(seed)
     t = np.arange(0, duration, 0.002)
     envelope = np.exp(-zeta * 2 * np.pi * f * t)
-    y = 0.2 * envelope * np.sin(2 * np.pi * f * np.sqrt(1 - zeta ** 2) * t + 0.4)
+    y = 0.2 * envelope * np.sin(2 * np.pi * f * np.sqrt(1 - zeta**2) * t + 0.4)
     return t, y + 0.002 * rng.standard_normal(len(t))
 
 
-@pytest.mark.parametrize('name, unit', [
-    ('torque.z', 'N·m'), ('force.x', 'N'), ('linear_acceleration.z', 'm/s²'),
-    ('angular_velocity.y', 'rad/s'), ('accel.linear.z', 'm/s²'), ('effort[joint1]', 'N·m or N'),
-    ('accel_g', 'g'), ('tip_velocity_m_s', 'm/s'), ('hub_angle_rad', 'rad'),
-    ('motor_voltage_V', 'V'), ('torque (N·m)', 'N·m'), ('acc [mg]', 'mg'),
-    ('data', UNKNOWN_UNIT), ('y', UNKNOWN_UNIT), ('1', UNKNOWN_UNIT), ('vector.z', UNKNOWN_UNIT),
-])
+@pytest.mark.parametrize(
+    'name, unit',
+    [
+        ('torque.z', 'N·m'),
+        ('force.x', 'N'),
+        ('linear_acceleration.z', 'm/s²'),
+        ('angular_velocity.y', 'rad/s'),
+        ('accel.linear.z', 'm/s²'),
+        ('effort[joint1]', 'N·m or N'),
+        ('accel_g', 'g'),
+        ('tip_velocity_m_s', 'm/s'),
+        ('hub_angle_rad', 'rad'),
+        ('motor_voltage_V', 'V'),
+        ('torque (N·m)', 'N·m'),
+        ('acc [mg]', 'mg'),
+        ('data', UNKNOWN_UNIT),
+        ('y', UNKNOWN_UNIT),
+        ('1', UNKNOWN_UNIT),
+        ('vector.z', UNKNOWN_UNIT),
+    ],
+)
 def test_signal_unit_of_components_and_columns(name, unit):
     assert signal_unit(name) == unit
 
@@ -62,7 +79,7 @@ def test_analyze_plot_has_the_unit_and_the_spectrum_with_the_modes_marked(tmp_pa
     psd_line, mark = psd_ax.get_lines()
     assert np.allclose(mark.get_xdata(), median)
     f, p = psd_line.get_data()
-    assert abs(f[np.argmax(p)] - F0) <= 1.5 * (f[1] - f[0])     # the marked mode is the peak
+    assert abs(f[np.argmax(p)] - F0) <= 1.5 * (f[1] - f[0])  # the marked mode is the peak
     assert psd_ax.get_xlim()[0] <= median <= psd_ax.get_xlim()[1]
 
 
@@ -80,12 +97,14 @@ def test_analyze_plot_of_two_modes_marks_both_and_a_bare_column_says_signal_unit
     assert len(marks) == 2
     assert abs(marks[0] / F0 - 1) < 0.01 and abs(marks[1] / 7.9 - 1) < 0.01
     assert [x for x in legend_texts(psd_ax) if x.startswith('f = ')] == [
-        f'f = {marks[0]:.5g} Hz (mode 1)', f'f = {marks[1]:.5g} Hz (mode 2)']
+        f'f = {marks[0]:.5g} Hz (mode 1)',
+        f'f = {marks[1]:.5g} Hz (mode 2)',
+    ]
 
 
 def summary_of(err):
     lines = [line.removeprefix('analyze: ') for line in err.splitlines()]
-    return lines[lines.index('modes found:'):]
+    return lines[lines.index('modes found:') :]
 
 
 def test_analyze_summary_gives_the_modes_and_the_shaper_node_command(tmp_path, capsys):
@@ -94,12 +113,15 @@ def test_analyze_summary_gives_the_modes_and_the_shaper_node_command(tmp_path, c
     np.savetxt(path, np.column_stack([t, y]), delimiter=',', header='t,torque', comments='')
     assert main(['analyze', str(path), '--model', 'damped-sinusoid']) == 0
     out = capsys.readouterr()
-    rows = [json.loads(line) for line in out.out.splitlines()]      # stdout stays jsonl
+    rows = [json.loads(line) for line in out.out.splitlines()]  # stdout stays jsonl
     f = np.array([r['frequency_hz'] for r in rows])
     zeta = np.array([r['damping'] for r in rows])
     summary = summary_of(out.err)
-    mode = re.match(r'  mode: f = ([\d.]+) ± ([\d.e-]+) Hz \(robust std of (\d+) estimates.*'
-                    r'damping ratio ([\d.]+)$', summary[1])
+    mode = re.match(
+        r'  mode: f = ([\d.]+) ± ([\d.e-]+) Hz \(robust std of (\d+) estimates.*'
+        r'damping ratio ([\d.]+)$',
+        summary[1],
+    )
     assert mode, summary
     assert float(mode[1]) == pytest.approx(np.median(f), abs=1e-4)
     mad = np.median(np.abs(f - np.median(f)))
@@ -107,18 +129,21 @@ def test_analyze_summary_gives_the_modes_and_the_shaper_node_command(tmp_path, c
     assert int(mode[3]) == len(rows) > 3
     assert float(mode[4]) == pytest.approx(0.004, abs=0.001)
     assert summary[2].startswith('recommended input shaper: ZVD')
-    command = re.fullmatch(r'  ros2 run vib_estimator shaper_node --ros-args -p shaper:=(\w+) '
-                           r'-p initial_frequency_hz:=([\d.]+) -p damping_ratio:=([\d.]+)',
-                           summary[3])
+    command = re.fullmatch(
+        r'  ros2 run vib_estimator shaper_node --ros-args -p shaper:=(\w+) '
+        r'-p initial_frequency_hz:=([\d.]+) -p damping_ratio:=([\d.]+)',
+        summary[3],
+    )
     assert command, summary[3]
     assert command[1] == 'zvd' and command[1] in SHAPERS
-    assert float(command[2]) == pytest.approx(F0 * np.sqrt(1 - 0.004 ** 2), rel=0.002)
+    assert float(command[2]) == pytest.approx(F0 * np.sqrt(1 - 0.004**2), rel=0.002)
     assert float(command[3]) == pytest.approx(np.median(zeta), abs=1e-4)
-    assert '.' in command[3]                        # a double literal: shaper_node's type
+    assert '.' in command[3]  # a double literal: shaper_node's type
 
 
 def test_analyze_summary_without_damping_designs_for_zero_and_no_estimate_no_summary(
-        tmp_path, capsys):
+    tmp_path, capsys
+):
     t, y = sine()
     path = tmp_path / 's.csv'
     np.savetxt(path, np.column_stack([t, y]), delimiter=',', header='t,torque', comments='')
@@ -177,7 +202,7 @@ def test_fig2_plots_the_three_variants_of_its_table(tmp_path):
     for line, r in zip(top.get_lines(), results):
         assert np.array_equal(line.get_ydata(), r.convergence_time, equal_nan=True)
     values = np.concatenate([line.get_ydata() for line in top.get_lines()])
-    assert np.ptp(values[np.isfinite(values)]) > 0.1          # not one flat line
+    assert np.ptp(values[np.isfinite(values)]) > 0.1  # not one flat line
 
 
 def fake_runs(t, f_true):
@@ -186,8 +211,14 @@ def fake_runs(t, f_true):
     runs = {}
     for name in compare.METHODS:
         index = np.array([len(t) // 4, len(t) // 2, 3 * len(t) // 4])
-        runs[name] = compare.Run(f_true * (1 + 0.05 * rng.standard_normal(len(t))), index,
-                                 f_true[index], np.full(3, 100), t[index] - 0.3, 0.0)
+        runs[name] = compare.Run(
+            f_true * (1 + 0.05 * rng.standard_normal(len(t))),
+            index,
+            f_true[index],
+            np.full(3, 100),
+            t[index] - 0.3,
+            0.0,
+        )
     return runs
 
 
@@ -201,12 +232,18 @@ def test_compare_plot_styles_are_distinct_and_the_algebraic_estimates_on_top(tmp
     assert len(compare.METHODS) > 10
     for ax in (full, zoom):
         lines = {line.get_label(): line for line in ax.get_lines()}
-        looks = {(line.get_color(), line.get_linestyle(), line.get_marker())
-                 for name, line in lines.items() if name in compare.METHODS}
+        looks = {
+            (line.get_color(), line.get_linestyle(), line.get_marker())
+            for name, line in lines.items()
+            if name in compare.METHODS
+        }
         assert len(looks) == len(compare.METHODS)
         algebraic = [lines[n].get_zorder() for n in compare.ALGEBRAIC_CONFIGS]
-        trackers = [line.get_zorder() for n, line in lines.items()
-                    if n in compare.METHODS and n not in compare.ALGEBRAIC_CONFIGS]
+        trackers = [
+            line.get_zorder()
+            for n, line in lines.items()
+            if n in compare.METHODS and n not in compare.ALGEBRAIC_CONFIGS
+        ]
         truth = max(c.get_zorder() for c in ax.collections)
         assert min(algebraic) > max(trackers) and min(algebraic) > truth
 
@@ -219,6 +256,6 @@ def test_sensitivity_plot_none_line_clears_the_frame(tmp_path):
     none = [line for line in ax.get_lines() if line.get_label() == 'none'][0]
     assert np.allclose(none.get_ydata(), 100)
     bottom, top = ax.get_ylim()
-    assert top > 100 + 0.05 * (top - bottom)       # visible, not on the top spine
+    assert top > 100 + 0.05 * (top - bottom)  # visible, not on the top spine
     for line in ax.get_lines():
         assert np.max(line.get_ydata()) < top

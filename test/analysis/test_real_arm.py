@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """The real flexible-link arm (``../shared/real-data/flexible_link_arm/flex8.csv``, issue 25).
 
 A Quanser-type rig: strain gauge on the link, 1 mm quantisation, an offset of half the amplitude,
@@ -8,6 +10,7 @@ estimates within 2 % of 1.812 Hz, none beyond 5 %, about one per second; during 
 estimates within 5 % of the local frequency or none; consecutive estimates never contradict each
 other. The paper's configuration (``--paper``) fails them: it alternates 1.43 / 2.59 Hz.
 """
+
 from __future__ import annotations
 
 import json
@@ -20,8 +23,10 @@ from vib_estimator.cli import main
 
 ROOT = Path(__file__).resolve().parents[2]
 #: ``../shared`` of the repository (a worktree may sit one level deeper: the nearest one above)
-SHARED = next((p / 'shared' for p in ROOT.parents if (p / 'shared' / 'real-data').is_dir()),
-              ROOT.parent / 'shared')
+SHARED = next(
+    (p / 'shared' for p in ROOT.parents if (p / 'shared' / 'real-data').is_dir()),
+    ROOT.parent / 'shared',
+)
 FLEX8 = SHARED / 'real-data' / 'flexible_link_arm' / 'flex8.csv'
 LIMIT_CYCLE_HZ = 1.812
 #: the ringing's frequencies, period by period (upward crossings about the running mean)
@@ -30,8 +35,12 @@ RINGING_S = (3.2, 4.5)
 
 
 def analyze(capsys, *options):
-    assert main(['analyze', str(FLEX8), '--column', 'tip_deflection_m', '--format', 'jsonl',
-                 *options]) == 0
+    assert (
+        main(
+            ['analyze', str(FLEX8), '--column', 'tip_deflection_m', '--format', 'jsonl', *options]
+        )
+        == 0
+    )
     rows = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
     return (np.array([r['t'] for r in rows]), np.array([r['frequency_hz'] for r in rows]))
 
@@ -44,8 +53,10 @@ def goal_failures(t, f):
     if len(late) < 5:
         failures.append(f'{len(late)} estimates after 4.5 s (5.5 s of limit cycle)')
     elif np.mean(err <= 0.02) < 0.95 or np.any(err > 0.05):
-        failures.append(f'after 4.5 s {100 * np.mean(err <= 0.02):.0f} % within 2 %, '
-                        f'{np.sum(err > 0.05)} beyond 5 %')
+        failures.append(
+            f'after 4.5 s {100 * np.mean(err <= 0.02):.0f} % within 2 %, '
+            f'{np.sum(err > 0.05)} beyond 5 %'
+        )
     steady = t[t >= RINGING_S[1]]
     if len(steady) > 1 and np.max(np.diff(steady)) > 1.0:
         failures.append(f'a gap of {np.max(np.diff(steady)):.2f} s between estimates')

@@ -1,4 +1,7 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """The paper's Figs. 1 and 2, reproduced (``vib-estimator reproduce``)."""
+
 import re
 
 import numpy as np
@@ -16,9 +19,9 @@ def test_fig1_invariant_filtering_is_within_one_percent_by_0_1_s():
 
 def test_fig2_shape_with_the_printed_test():
     r = reproduce.fig2(**reproduce.PAPER_TEST)
-    assert r.mae[0] < 1e-3                          # undamped: within the tolerance
-    assert np.all(np.diff(r.mae) > 0)               # MAE grows with zeta_n
-    assert np.all(r.convergence_time < 0.5)         # a fraction of a period
+    assert r.mae[0] < 1e-3  # undamped: within the tolerance
+    assert np.all(np.diff(r.mae) > 0)  # MAE grows with zeta_n
+    assert np.all(r.convergence_time < 0.5)  # a fraction of a period
 
 
 def test_fig2_package_defaults_are_exact_when_undamped():
@@ -34,15 +37,18 @@ def test_cli_prints_the_figures_numbers_and_writes_them(tmp_path, capsys):
     png = tmp_path / 'fig1.png'
     assert main(['reproduce', 'fig1', '--out', str(png)]) == 0
     lines = capsys.readouterr().out.splitlines()
-    assert lines[-1] == f'wrote {png}' and png.is_file()   # the figure itself: its own tests
+    assert lines[-1] == f'wrote {png}' and png.is_file()  # the figure itself: its own tests
     rows = {float(ln.split()[0]): [float(v) for v in ln.split()[1:]] for ln in lines[2:8]}
     assert sorted(rows) == [0.05, 0.1, 0.2, 0.3, 0.5, 0.9]
     assert all(abs(rows[when][0] / 10 - 1) < 0.01 for when in rows if when >= 0.1), rows
-    error = re.search(r'error at t = 0.1 s: ([0-9.]+) %.*: ([0-9.]+) % with invariant filtering, '
-                      r'([0-9.]+) % without', lines[8])
+    error = re.search(
+        r'error at t = 0.1 s: ([0-9.]+) %.*: ([0-9.]+) % with invariant filtering, '
+        r'([0-9.]+) % without',
+        lines[8],
+    )
     at_0_1, filtered, unfiltered = (float(v) for v in error.groups())
     assert at_0_1 < 1.0 and filtered < 0.1 * unfiltered
-    assert abs(rows[0.1][0] / 10 - 1) == pytest.approx(at_0_1 / 100, abs=1e-4)   # one number
+    assert abs(rows[0.1][0] / 10 - 1) == pytest.approx(at_0_1 / 100, abs=1e-4)  # one number
 
     png = tmp_path / 'fig2.png'
     assert main(['reproduce', 'fig2', '--out', str(png)]) == 0

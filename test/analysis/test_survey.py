@@ -1,4 +1,7 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """``vib-estimator survey``: rows equal per-file analyze, bad recordings, the alarm, Dask."""
+
 import json
 import math
 from pathlib import Path
@@ -11,12 +14,12 @@ from vib_estimator.cli import main
 from vib_estimator.core import EstimatorConfig
 from vib_estimator.io.bags import WrenchSeries, write_wrench_series
 
-EPOCH = 1_767_225_600 * 10 ** 9
-DAY = 86_400 * 10 ** 9
+EPOCH = 1_767_225_600 * 10**9
+DAY = 86_400 * 10**9
 
 
 def fleet(root, freqs, seed=0):
-    """One 9 s bag per day, a noisy sine of the day's frequency (>= 6 estimates of 1.25 periods)."""
+    """One 9 s bag per day, a noisy sine of the day's frequency (>= 6 estimates of 1.25 periods)"""
     rng = np.random.default_rng(seed)
     t = np.arange(0, 9, 0.002)
     for day, f in enumerate(freqs):
@@ -32,9 +35,13 @@ def jsonl(text):
 
 def test_rows_equal_per_file_analyze(tmp_path, capsys):
     days = fleet(tmp_path, [1.3, 1.31, 1.32])
-    np.savetxt(tmp_path / 'sine.csv', np.column_stack([np.arange(4500) * 0.002,
-                                                       np.sin(np.arange(4500) * 0.002 * 9)]),
-               delimiter=',', header='t,y', comments='')
+    np.savetxt(
+        tmp_path / 'sine.csv',
+        np.column_stack([np.arange(4500) * 0.002, np.sin(np.arange(4500) * 0.002 * 9)]),
+        delimiter=',',
+        header='t,y',
+        comments='',
+    )
     assert main(['survey', str(tmp_path), '--format', 'jsonl', '--jobs', '1']) == 0
     rows = jsonl(capsys.readouterr().out)
     assert [r['recording'] for r in rows] == [str(p) for p in days] + [str(tmp_path / 'sine.csv')]
@@ -46,10 +53,12 @@ def test_rows_equal_per_file_analyze(tmp_path, capsys):
         assert row['estimates'] == len(estimates) > 5
         assert row['frequency_hz'] == float(np.median(freqs))
         assert row['frequency_lo_hz'] <= row['frequency_hz'] <= row['frequency_hi_hz']
-        assert f"received={row['samples']}," in out.err
-        assert f"rejected_fit={row['rejected_fit']}," in out.err
-    assert rows[0]['start_utc'] == '2026-01-01T00:00:00Z' and rows[1]['start_utc'][:10] == \
-        '2026-01-02'
+        assert f'received={row["samples"]},' in out.err
+        assert f'rejected_fit={row["rejected_fit"]},' in out.err
+    assert (
+        rows[0]['start_utc'] == '2026-01-01T00:00:00Z'
+        and rows[1]['start_utc'][:10] == '2026-01-02'
+    )
     assert rows[-1]['start_utc'] == '' and rows[-1]['topic'] == ''
     assert math.isclose(rows[0]['duration_s'], 8.998)
 
@@ -73,30 +82,71 @@ def test_alarm_on_a_seeded_drift_and_none_without(tmp_path, capsys):
     drift = fleet(tmp_path / 'drift', [1.3] * 4 + [1.3 * 0.95] * 2)
     steady = fleet(tmp_path / 'steady', [1.3] * 6, seed=1)
     out = tmp_path / 'rows.parquet'
-    assert main(['survey', str(tmp_path / 'drift'), '--baseline', str(drift[0]), '--alarm-rel',
-                 '0.02', '--format', 'jsonl', '--jobs', '1', '--fail-on-alarm',
-                 '--out', str(out), '--plot', str(tmp_path / 'trend.png')]) == 3
+    assert (
+        main(
+            [
+                'survey',
+                str(tmp_path / 'drift'),
+                '--baseline',
+                str(drift[0]),
+                '--alarm-rel',
+                '0.02',
+                '--format',
+                'jsonl',
+                '--jobs',
+                '1',
+                '--fail-on-alarm',
+                '--out',
+                str(out),
+                '--plot',
+                str(tmp_path / 'trend.png'),
+            ]
+        )
+        == 3
+    )
     rows = jsonl(capsys.readouterr().out)
     assert [r['alarm'] for r in rows] == [False] * 4 + [True] * 2
     assert all(-0.06 < r['change_rel'] < -0.04 for r in rows[4:])
     import pyarrow.parquet as pq
+
     assert pq.read_table(out).column('alarm').to_pylist() == [r['alarm'] for r in rows]
-    assert (tmp_path / 'trend.png').is_file()        # its content: the figures' own tests
-    assert main(['survey', str(tmp_path / 'steady'), '--baseline', '1.3', '--alarm-rel', '0.02',
-                 '--format', 'jsonl', '--jobs', '1', '--fail-on-alarm']) == 0
+    assert (tmp_path / 'trend.png').is_file()  # its content: the figures' own tests
+    assert (
+        main(
+            [
+                'survey',
+                str(tmp_path / 'steady'),
+                '--baseline',
+                '1.3',
+                '--alarm-rel',
+                '0.02',
+                '--format',
+                'jsonl',
+                '--jobs',
+                '1',
+                '--fail-on-alarm',
+            ]
+        )
+        == 0
+    )
     rows = jsonl(capsys.readouterr().out)
     # every steady day is a row, measured against the 1.3 Hz baseline, within the band: no alarm
     assert [r['recording'] for r in rows] == [str(p) for p in steady]
-    assert all(abs(r['change_rel']) < 0.005 and r['change_lo'] <= r['change_rel'] <= r['change_hi']
-               for r in rows), [r['change_rel'] for r in rows]
+    assert all(
+        abs(r['change_rel']) < 0.005 and r['change_lo'] <= r['change_rel'] <= r['change_hi']
+        for r in rows
+    ), [r['change_rel'] for r in rows]
     assert [r['alarm'] for r in rows] == [False] * len(steady)
 
 
-@pytest.mark.parametrize('args, message', [
-    (['--baseline', 'nowhere'], 'neither a frequency'),
-    (['--out', 'x.xlsx'], '--out must end'),
-    (['--jobs', '0'], '--jobs'),
-])
+@pytest.mark.parametrize(
+    'args, message',
+    [
+        (['--baseline', 'nowhere'], 'neither a frequency'),
+        (['--out', 'x.xlsx'], '--out must end'),
+        (['--jobs', '0'], '--jobs'),
+    ],
+)
 def test_bad_arguments_exit_2(tmp_path, capsys, args, message):
     assert main(['survey', str(tmp_path)] + args) == 2
     err = capsys.readouterr().err
@@ -112,18 +162,20 @@ def test_median_interval():
 
 def test_dask_cluster_gives_identical_rows(tmp_path):
     distributed = pytest.importorskip('distributed')
-    recordings = S.find_recordings([str(p) for p in fleet(tmp_path, [1.3, 1.35, 1.4])]
-                                   + [str(tmp_path / 'missing.mcap')])
+    recordings = S.find_recordings(
+        [str(p) for p in fleet(tmp_path, [1.3, 1.35, 1.4])] + [str(tmp_path / 'missing.mcap')]
+    )
     options = S.Options(EstimatorConfig())
     local = S.survey(recordings, options, jobs=1)
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  dashboard_address=None) as cluster:
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+    ) as cluster:
         remote = S.survey(recordings, options, scheduler=cluster.scheduler_address)
     assert json.dumps(remote) == json.dumps(local)
     assert local[-1]['error'] and not local[0]['error']
 
 
-FAULTS = '''
+FAULTS = """
 import resource, sys
 from pathlib import Path
 from vib_estimator.analysis import survey as S
@@ -135,7 +187,7 @@ def faults(task):
     return resource.getrusage(resource.RUSAGE_SELF).ru_minflt - before
 S.survey_recording(path, options)                       # compile, import everything
 print(faults(S._recording_rows), faults(S.survey_recording))
-'''
+"""
 
 
 def test_a_worker_started_with_a_malloc_trim_threshold_streams_without_remapping(tmp_path):
@@ -145,13 +197,25 @@ def test_a_worker_started_with_a_malloc_trim_threshold_streams_without_remapping
     import os
     import subprocess
     import sys
+
     t = np.arange(400_000) * 0.002
-    np.savetxt(tmp_path / 'long.csv', np.column_stack([t, np.sin(9 * t)]), delimiter=',',
-               header='t,y', comments='', fmt='%.6f')
+    np.savetxt(
+        tmp_path / 'long.csv',
+        np.column_stack([t, np.sin(9 * t)]),
+        delimiter=',',
+        header='t,y',
+        comments='',
+        fmt='%.6f',
+    )
     env = {k: v for k, v in os.environ.items() if not k.startswith('MALLOC_')}
     env['MALLOC_TRIM_THRESHOLD_'] = '65536'
-    out = subprocess.run([sys.executable, '-c', FAULTS, str(tmp_path / 'long.csv')], env=env,
-                         capture_output=True, text=True, check=True).stdout
+    out = subprocess.run(
+        [sys.executable, '-c', FAULTS, str(tmp_path / 'long.csv')],
+        env=env,
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout
     plain, tuned = map(int, out.split())
     assert tuned < 0.5 * plain, (plain, tuned)
 
@@ -198,8 +262,10 @@ def test_every_entry_of_a_folder_is_accounted_for(tmp_path, capsys):
     assert sum('warning:' in line and 'damaged/day_00' in line for line in err) == 1
     assert any('notes.txt' in line for line in err) and any('README.md' in line for line in err)
     assert main(args + ['--strict']) == 1
-    strict = {Path(r['recording']).relative_to(tmp_path).as_posix(): r
-              for r in jsonl(capsys.readouterr().out)}
+    strict = {
+        Path(r['recording']).relative_to(tmp_path).as_posix(): r
+        for r in jsonl(capsys.readouterr().out)
+    }
     assert 'damaged' in strict['damaged/day_00']['error']
 
 
@@ -214,7 +280,7 @@ def test_trend_plot_shows_the_baseline_and_the_alarm_band(tmp_path):
     base = S.baseline_rows(str(days[0]), options)
     S.flag(rows, base, 0.02)
     fig = S.plot_trend(rows, tmp_path / 'trend.png', base, 0.02)
-    assert len(fig.axes) == 1                      # no damping estimated: no damping panel
+    assert len(fig.axes) == 1  # no damping estimated: no damping panel
     ax = fig.axes[0]
     labels = legend_texts(ax)
     f0 = base[None][0]
@@ -226,7 +292,7 @@ def test_trend_plot_shows_the_baseline_and_the_alarm_band(tmp_path):
     band = [p for p in ax.patches if p.get_label().startswith('no-alarm band')][0]
     lo, hi = S.alarm_band(base[None], 0.02)
     assert np.isclose(band.get_y(), lo) and np.isclose(band.get_y() + band.get_height(), hi)
-    for r in rows:                 # the picture's rule is flag()'s: interval wholly outside
+    for r in rows:  # the picture's rule is flag()'s: interval wholly outside
         outside = r['frequency_hi_hz'] < lo or r['frequency_lo_hz'] > hi
         assert r['alarm'] == outside
     assert sum(r['alarm'] for r in rows) == 2

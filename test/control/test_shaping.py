@@ -1,38 +1,56 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Input shapers against the closed forms of the input-shaping literature; sensitivity curves;
 the streaming shaper against the convolution; re-tuning only at rest."""
+
 from __future__ import annotations
 
 import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
-from vib_estimator.control.shaping import (EI_VTOL, SHAPERS, StreamingShaper, design,
-                                           discrete_kernel, ei, k_factor, none,
-                                           residual_vibration, sensitivity, zv, zvd, zvdd)
+from vib_estimator.control.shaping import (
+    EI_VTOL,
+    SHAPERS,
+    StreamingShaper,
+    design,
+    discrete_kernel,
+    ei,
+    k_factor,
+    none,
+    residual_vibration,
+    sensitivity,
+    zv,
+    zvd,
+    zvdd,
+)
 
 MODES = [(1.64, 0.0), (1.33, 0.004), (1.15, 0.02), (16.4, 0.1)]
 
 
 @pytest.mark.parametrize('f, zeta', MODES)
 def test_zv_closed_form(f, zeta):
-    k = math.exp(-zeta * math.pi / math.sqrt(1 - zeta ** 2))
+    k = math.exp(-zeta * math.pi / math.sqrt(1 - zeta**2))
     s = zv(f, zeta)
     np.testing.assert_allclose(s.amplitudes, [1 / (1 + k), k / (1 + k)], rtol=1e-14)
-    np.testing.assert_allclose(s.times, [0, 0.5 / (f * math.sqrt(1 - zeta ** 2))], rtol=1e-14)
+    np.testing.assert_allclose(s.times, [0, 0.5 / (f * math.sqrt(1 - zeta**2))], rtol=1e-14)
     assert k_factor(zeta) == pytest.approx(k, rel=1e-15)
 
 
 @pytest.mark.parametrize('f, zeta', MODES)
 def test_zvd_and_zvdd_closed_forms(f, zeta):
     k = k_factor(zeta)
-    td = 1 / (f * math.sqrt(1 - zeta ** 2))
-    np.testing.assert_allclose(zvd(f, zeta).amplitudes, np.array([1, 2 * k, k * k]) / (1 + k) ** 2,
-                               rtol=1e-14)
+    td = 1 / (f * math.sqrt(1 - zeta**2))
+    np.testing.assert_allclose(
+        zvd(f, zeta).amplitudes, np.array([1, 2 * k, k * k]) / (1 + k) ** 2, rtol=1e-14
+    )
     np.testing.assert_allclose(zvd(f, zeta).times, [0, td / 2, td], rtol=1e-14)
-    np.testing.assert_allclose(zvdd(f, zeta).amplitudes,
-                               np.array([1, 3 * k, 3 * k * k, k ** 3]) / (1 + k) ** 3, rtol=1e-14)
+    np.testing.assert_allclose(
+        zvdd(f, zeta).amplitudes, np.array([1, 3 * k, 3 * k * k, k**3]) / (1 + k) ** 3, rtol=1e-14
+    )
 
 
 def test_ei_undamped_closed_form_and_damped_literature_fit():
@@ -45,13 +63,15 @@ def test_ei_undamped_closed_form_and_damped_literature_fit():
     np.testing.assert_allclose(s.amplitudes, [(1 + v) / 4, (1 - v) / 2, (1 + v) / 4])
     np.testing.assert_allclose(s.times, [0, 0.25, 0.5])
     for zeta in (0.01, 0.05, 0.1):
-        a1 = (0.24968 + 0.24961 * v) + ((0.80008 + 1.23328 * v)
-                                        + (0.49599 + 3.17316 * v) * zeta) * zeta
-        a3 = (0.25149 + 0.21474 * v) + ((-0.83249 + 1.41498 * v)
-                                        + (0.85181 - 4.90094 * v) * zeta) * zeta
+        a1 = (0.24968 + 0.24961 * v) + (
+            (0.80008 + 1.23328 * v) + (0.49599 + 3.17316 * v) * zeta
+        ) * zeta
+        a3 = (0.25149 + 0.21474 * v) + (
+            (-0.83249 + 1.41498 * v) + (0.85181 - 4.90094 * v) * zeta
+        ) * zeta
         s = ei(2.0, zeta)
         np.testing.assert_allclose(s.amplitudes, [a1, 1 - a1 - a3, a3], atol=3e-3)
-        td = 1 / (2.0 * math.sqrt(1 - zeta ** 2))
+        td = 1 / (2.0 * math.sqrt(1 - zeta**2))
         np.testing.assert_allclose(s.times / td, [0, 0.5, 1.0], atol=5e-3)
 
 
@@ -70,7 +90,7 @@ def test_ei_residual_is_vtol_maximum_at_design_and_zero_around_it(f, zeta):
     v = sensitivity(s, r)
     i = int(np.argmin(abs(r - 1)))
     assert v[i] == pytest.approx(EI_VTOL, abs=1e-9)
-    assert v[i] == pytest.approx(v[i - 200:i + 201].max(), abs=1e-9)  # local maximum
+    assert v[i] == pytest.approx(v[i - 200 : i + 201].max(), abs=1e-9)  # local maximum
     assert v[r < 1].min() < 1e-3 and v[r > 1].min() < 1e-3
     assert np.all(v[(r > 0.86) & (r < 1.14)] <= EI_VTOL + 1e-9)
 
@@ -91,15 +111,18 @@ def test_residual_of_a_simulated_mode_matches_the_formula():
     one unit impulse): the formula is the physics, not just algebra."""
     f, zeta = 1.4, 0.03
     w = 2 * np.pi * f
-    wd = w * math.sqrt(1 - zeta ** 2)
-    s = zv(1.5, zeta)                        # 7 % mistuned
+    wd = w * math.sqrt(1 - zeta**2)
+    s = zv(1.5, zeta)  # 7 % mistuned
     t = s.duration + np.linspace(0, 2, 101)
-    y = sum(a * np.exp(-zeta * w * (t - ti)) * np.sin(wd * (t - ti))
-            for ti, a in zip(s.times, s.amplitudes))
+    y = sum(
+        a * np.exp(-zeta * w * (t - ti)) * np.sin(wd * (t - ti))
+        for ti, a in zip(s.times, s.amplitudes)
+    )
     envelope = np.exp(-zeta * w * (t - s.duration))
     amp = np.max(np.abs(y / envelope))
-    assert amp == pytest.approx(float(residual_vibration(s.times, s.amplitudes, f, zeta)),
-                                rel=2e-3)
+    assert amp == pytest.approx(
+        float(residual_vibration(s.times, s.amplitudes, f, zeta)), rel=2e-3
+    )
 
 
 def test_design_errors():
@@ -126,36 +149,37 @@ def test_discrete_kernel_keeps_sum_and_centroid(f, zeta, name):
 
 
 @settings(deadline=None, max_examples=50)
-@given(st.sampled_from(sorted(SHAPERS)), st.floats(0.5, 20.0), st.integers(0, 2 ** 32 - 1))
+@given(st.sampled_from(sorted(SHAPERS)), st.floats(0.5, 20.0), st.integers(0, 2**32 - 1))
 def test_streaming_equals_convolution(name, f, seed):
     rate = 200.0
     x = np.cumsum(np.random.default_rng(seed).normal(size=400)) + 3.0
     s = design(name, f, 0.01)
     h = discrete_kernel(s, rate)
     # the reference rested at x[0] before the first sample
-    expected = np.convolve(x - x[0], h)[:len(x)] + x[0]
+    expected = np.convolve(x - x[0], h)[: len(x)] + x[0]
     got = StreamingShaper(s, rate).process(x)
     np.testing.assert_allclose(got, expected, atol=1e-12)
 
 
 def test_shaped_step_is_the_staircase_of_the_impulses():
-    s = zvd(1.25, 0.0)                   # impulses at 0, 0.4, 0.8 s: exact samples at 500 Hz
+    s = zvd(1.25, 0.0)  # impulses at 0, 0.4, 0.8 s: exact samples at 500 Hz
     x = np.r_[np.zeros(10), np.ones(600)]
     y = StreamingShaper(s, 500.0).process(x)
-    np.testing.assert_allclose(y[[9, 10, 209, 210, 409, 410, -1]],
-                               [0, 0.25, 0.25, 0.75, 0.75, 1.0, 1.0], atol=1e-12)
+    np.testing.assert_allclose(
+        y[[9, 10, 209, 210, 409, 410, -1]], [0, 0.25, 0.25, 0.75, 0.75, 1.0, 1.0], atol=1e-12
+    )
 
 
 def test_retunes_only_at_rest():
     rate = 100.0
-    sh = StreamingShaper(zv(1.0), rate)          # kernel 51 samples
+    sh = StreamingShaper(zv(1.0), rate)  # kernel 51 samples
     sh.update(0.0)
     ramp = np.linspace(0.0, 1.0, 120)
     for i, x in enumerate(ramp):
         sh.update(x)
         if i == 10:
             sh.request(zvd(2.0))
-    assert sh.shaper.name == 'zv' and sh.pending is not None    # moving: no switch
+    assert sh.shaper.name == 'zv' and sh.pending is not None  # moving: no switch
     outputs = [sh.update(1.0) for _ in range(60)]
     assert sh.shaper.name == 'zvd' and sh.pending is None and sh.retunes == 1
     # the switch came once the reference had rested for the old kernel: output at rest, no jump

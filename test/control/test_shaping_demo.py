@@ -1,6 +1,9 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """The measurement behind ``vib-estimator demo --shaping`` (the vibration a move adds to a mode
 still ringing), its pass criterion on an offline run of the arm, and
 ``python -m vib_estimator.control`` (the live demo: test/nodes/test_shaper_node.py)."""
+
 from __future__ import annotations
 
 import math
@@ -11,10 +14,14 @@ import pytest
 from vib_estimator.control.__main__ import main as sensitivity_main
 from vib_estimator.control.residual import added_vibration, move_onset
 from vib_estimator.control.shaping import StreamingShaper, design, none
-from vib_estimator.demo import (Record, ShapedMove, measure_moves, shaping_events,
-                                summarise_shaping)
-from vib_estimator.sim.arm_model import (MASSES_5_5, ArmParameters, ArmSimulator, Move,
-                                         natural_frequency_hz)
+from vib_estimator.demo import Record, ShapedMove, measure_moves, shaping_events, summarise_shaping
+from vib_estimator.sim.arm_model import (
+    MASSES_5_5,
+    ArmParameters,
+    ArmSimulator,
+    Move,
+    natural_frequency_hz,
+)
 
 
 def test_added_vibration_separates_the_old_vibration_from_the_new():
@@ -24,10 +31,11 @@ def test_added_vibration_separates_the_old_vibration_from_the_new():
     t = np.arange(0, 10, 0.002)
     old = 0.6 * np.exp(-zeta * w * t) * np.sin(w * t + 0.3)
     t_move, t_settled = 4.0, 4.5
-    new = np.where(t >= t_move, 0.02 * np.exp(-zeta * w * (t - t_move))
-                   * np.cos(w * (t - t_move) + 1.0), 0.0)
+    new = np.where(
+        t >= t_move, 0.02 * np.exp(-zeta * w * (t - t_move)) * np.cos(w * (t - t_move) + 1.0), 0.0
+    )
     y = old + new + np.where(t >= t_settled, 0.1, 0.0) + 0.004 * rng.standard_normal(len(t))
-    y[(t >= t_move) & (t < t_settled)] = 5.0          # the move itself: not fitted
+    y[(t >= t_move) & (t < t_settled)] = 5.0  # the move itself: not fitted
     fit = added_vibration(t, y, t_move, t_settled, 3.5, 5.0, 1.01 * f, 0.0)
     decay = math.exp(-zeta * w * (t_settled - t_move))
     assert fit.added == pytest.approx(0.02 * decay, rel=0.03)
@@ -42,12 +50,16 @@ def test_added_vibration_separates_the_old_vibration_from_the_new():
 def offline_run(error: float, shaper: str = 'zvd', seconds_per_mass: float = 6.0):
     """The demo's timeline on the arm model without ROS: the shaper designed for the true
     frequency times (1 + error), the 'estimates' recorded just before each shaped move."""
-    sim = ArmSimulator(ArmParameters(tip_mass_kg=MASSES_5_5[0]),
-                       schedule=[Move(i * seconds_per_mass, 0.0, 1.0, m)
-                                 for i, m in enumerate(MASSES_5_5)], seed=2)
+    sim = ArmSimulator(
+        ArmParameters(tip_mass_kg=MASSES_5_5[0]),
+        schedule=[Move(i * seconds_per_mass, 0.0, 1.0, m) for i, m in enumerate(MASSES_5_5)],
+        seed=2,
+    )
     events = shaping_events(seconds_per_mass, shaper, 0.5)
-    truth = [(i * seconds_per_mass, (i + 1) * seconds_per_mass, natural_frequency_hz(m))
-             for i, m in enumerate(MASSES_5_5)]
+    truth = [
+        (i * seconds_per_mass, (i + 1) * seconds_per_mass, natural_frequency_hz(m))
+        for i, m in enumerate(MASSES_5_5)
+    ]
     rec, moves = Record(truth), []
     stream, reference = StreamingShaper(none(), 500.0), 0.0
     for k in range(int(3 * seconds_per_mass * 500)):
@@ -63,8 +75,7 @@ def offline_run(error: float, shaper: str = 'zvd', seconds_per_mass: float = 6.0
                     rec.est_f.append(f)
             else:
                 reference = value
-                moves.append(ShapedMove(int(t // seconds_per_mass), t - 0.05, value,
-                                        shaper=name))
+                moves.append(ShapedMove(int(t // seconds_per_mass), t - 0.05, value, shaper=name))
         sim.set_command(stream.update(reference))
         ts, y, _ = sim.step()
         rec.t.append(ts)
@@ -78,7 +89,7 @@ def test_pass_criterion_on_an_offline_run():
     lines, ok = summarise_shaping(rows, 'zvd')
     assert ok, '\n'.join(lines)
     assert all(r['ratio'] < 0.05 for r in rows) and len(lines) == 4
-    assert all(r['unshaped'] > 0.5 for r in rows)        # 0.5 rad steps ring at ~0.77 N m
+    assert all(r['unshaped'] > 0.5 for r in rows)  # 0.5 rad steps ring at ~0.77 N m
     # a shaper 35 % off leaves ~30 % of the vibration: the criterion fails
     rec, moves = offline_run(0.35)
     rows = measure_moves(rec, moves, 6.0)

@@ -1,4 +1,7 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """excitation = ambient: output-only identification of driven modes (seeded, tolerant)."""
+
 import math
 
 import numpy as np
@@ -26,9 +29,8 @@ def _run(modes, seed, duration=60.0, snr=26.0, config=AMBIENT):
 
 def test_whittle_bound_matches_the_issue_figures():
     # 5 Hz, zeta 1 %, 26 dB: 0.40 % over 20 s, 0.23 % over 60 s (issue 20)
-    noise = 10 ** -2.6
-    rel = [whittle_std([(5.0, 0.01, 1.0)], noise, FS, int(T * FS))[0][0] / 5.0
-           for T in (20, 60)]
+    noise = 10**-2.6
+    rel = [whittle_std([(5.0, 0.01, 1.0)], noise, FS, int(T * FS))[0][0] / 5.0 for T in (20, 60)]
     assert rel[0] == pytest.approx(0.0040, rel=0.03)
     assert rel[1] == pytest.approx(0.0023, rel=0.03)
 
@@ -39,7 +41,7 @@ def test_fisher_over_active_bins_equals_the_full_sum():
     theta = [x for m in modes for x in m] + [noise]
 
     def density(th):
-        return th[-1] + sum(sdof_psd(w, *th[3 * j:3 * j + 3], 1 / FS) for j in range(2))
+        return th[-1] + sum(sdof_psd(w, *th[3 * j : 3 * j + 3], 1 / FS) for j in range(2))
 
     s0 = density(theta)
     grads = []
@@ -52,21 +54,22 @@ def test_fisher_over_active_bins_equals_the_full_sum():
     full = np.array(grads) @ np.array(grads).T
     fast = whittle_fisher(modes, noise, FS, n)
     cov_full, cov_fast = np.linalg.inv(full), np.linalg.inv(fast)
-    np.testing.assert_allclose(np.diag(cov_fast)[[0, 1, 3, 4]], np.diag(cov_full)[[0, 1, 3, 4]],
-                               rtol=0.02)
+    np.testing.assert_allclose(
+        np.diag(cov_fast)[[0, 1, 3, 4]], np.diag(cov_full)[[0, 1, 3, 4]], rtol=0.02
+    )
 
 
 def test_single_mode():
     est, _ = _run([(5.0, 0.01, 1.0)], seed=1)
-    assert len(est) >= 35                             # one per second after the first window
+    assert len(est) >= 35  # one per second after the first window
     assert set(est.mode) == {1}
     err = np.abs(est.frequency_hz / 5.0 - 1)
     assert np.mean(err <= 0.02) >= 0.95 and err.max() < 0.05
     assert 0.5 < np.median(est.damping) / 0.01 < 2.0
-    assert 0.5 < np.median(est.amplitude) < 1.5       # RMS of the modal response, variance 1
-    assert np.all(est.convergence_time == pytest.approx(20.0, abs=0.01))   # the window used
+    assert 0.5 < np.median(est.amplitude) < 1.5  # RMS of the modal response, variance 1
+    assert np.all(est.convergence_time == pytest.approx(20.0, abs=0.01))  # the window used
     assert np.all(np.isfinite(est.frequency_std_hz)) and np.all(est.frequency_std_hz > 0)
-    assert np.all(np.diff(est.t) >= 0.99)             # updated every second
+    assert np.all(np.diff(est.t) >= 0.99)  # updated every second
 
 
 def test_two_modes_numbered_by_frequency():
@@ -100,7 +103,7 @@ def test_streaming_equals_batch_and_bad_samples_are_counted():
     y[3000] = np.nan
     t = np.delete(t, 5000)
     y = np.delete(y, 5000)
-    t[7000] = t[6999]                                 # a duplicate stamp
+    t[7000] = t[6999]  # a duplicate stamp
     batch = AmbientEstimator(AMBIENT)
     b = batch.process(t, y)
     stream = AmbientEstimator(AMBIENT)
@@ -116,7 +119,7 @@ def test_streaming_equals_batch_and_bad_samples_are_counted():
 
 def test_gap_starts_a_new_window():
     t, y, _ = ambient_record(55.0, FS, [(5.0, 0.01, 1.0)], 26.0, 6)
-    t = np.where(t > 27.0, t + 5.0, t)                # a 5 s gap
+    t = np.where(t > 27.0, t + 5.0, t)  # a 5 s gap
     est = AmbientEstimator(AMBIENT)
     e = est.process(t, y)
     assert est.counters['gap_resets'] == 1
@@ -127,13 +130,13 @@ def test_gap_starts_a_new_window():
 
 def test_reset_starts_a_new_window():
     t, y, _ = ambient_record(40.0, FS, [(5.0, 0.01, 1.0)], 26.0, 7)
-    half = FS * 25                                     # 25 s
+    half = FS * 25  # 25 s
     kept, reset = AmbientEstimator(AMBIENT), AmbientEstimator(AMBIENT)
     for est in (kept, reset):
-        est.process(t[:int(half)], y[:int(half)])
+        est.process(t[: int(half)], y[: int(half)])
     reset.reset()
-    assert len(kept.process(t[int(half):], y[int(half):])) > 0
-    assert len(reset.process(t[int(half):], y[int(half):])) == 0     # 15 s < the window
+    assert len(kept.process(t[int(half) :], y[int(half) :])) > 0
+    assert len(reset.process(t[int(half) :], y[int(half) :])) == 0  # 15 s < the window
 
 
 def test_factory_and_free_unchanged():
@@ -142,7 +145,9 @@ def test_factory_and_free_unchanged():
     t = np.arange(0, 20, 1e-3)
     y = fig1_signal(t)
     ref = FrequencyEstimator(EstimatorConfig()).process(t, y)
-    free = create_estimator(EstimatorConfig(excitation='free', ambient_window_s=99.0)).process(t, y)
+    free = create_estimator(EstimatorConfig(excitation='free', ambient_window_s=99.0)).process(
+        t, y
+    )
     assert len(ref) > 0
     np.testing.assert_array_equal(ref.frequency_hz, free.frequency_hz)
     np.testing.assert_array_equal(ref.frequency_std_hz, free.frequency_std_hz)

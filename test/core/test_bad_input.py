@@ -1,19 +1,28 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Issue 22, cases 1 and 2 in the core: lost samples and absurd samples never become a published
 wrong number, and every input is accounted for by the counters (no rclpy)."""
+
 import json
 import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from vib_estimator.core import EstimatorConfig, FrequencyEstimator
 from vib_estimator.core.modes import create_estimator
 
 FS, F0 = 500.0, 2.0
 #: every sample goes to exactly one of these
-FATES = ('used', 'skipped_non_finite', 'skipped_duplicate', 'skipped_out_of_order',
-         'skipped_outlier')
+FATES = (
+    'used',
+    'skipped_non_finite',
+    'skipped_duplicate',
+    'skipped_out_of_order',
+    'skipped_outlier',
+)
 
 
 def gappy_sine(seed, offset=0.0):
@@ -22,7 +31,7 @@ def gappy_sine(seed, offset=0.0):
     t = np.arange(0, 60, 1 / FS)
     keep = np.ones(len(t), bool)
     for start in rng.choice(len(t) - 300, 40, replace=False):
-        keep[start:start + int(rng.uniform(0.04, 0.4) * FS)] = False
+        keep[start : start + int(rng.uniform(0.04, 0.4) * FS)] = False
     return t[keep], np.sin(2 * np.pi * F0 * t[keep]) + offset, int((~keep).sum())
 
 
@@ -46,8 +55,9 @@ def test_gaps_below_max_gap_restart_the_estimate_and_are_counted(model, offset, 
 def test_gap_detection_off_mixes_the_gaps_into_fits():
     """The test above can fail: without the gap test, fits span the gaps (issue 22's figures)."""
     t, y, _ = gappy_sine(0, 0.3)
-    e = FrequencyEstimator(EstimatorConfig.paper(model='biased-sinusoid',
-                                                 gap_intervals=0)).process(t, y)
+    e = FrequencyEstimator(
+        EstimatorConfig.paper(model='biased-sinusoid', gap_intervals=0)
+    ).process(t, y)
     assert np.max(np.abs(e.frequency_hz / F0 - 1)) > 0.05
 
 
@@ -71,7 +81,7 @@ def test_jittered_stamps_are_not_gaps():
 
 def damped(t, f=3.0, zeta=0.01):
     wn = 2 * np.pi * f
-    return np.exp(-zeta * wn * t) * np.sin(wn * math.sqrt(1 - zeta ** 2) * t)
+    return np.exp(-zeta * wn * t) * np.sin(wn * math.sqrt(1 - zeta**2) * t)
 
 
 @pytest.mark.parametrize('value', [1e300, -1e300, 1e6, 1e12])
@@ -95,7 +105,7 @@ def test_one_absurd_sample_is_skipped_and_counted(value, model):
 
 def test_a_real_change_of_level_is_taken_after_a_few_samples():
     t = np.arange(0, 20, 1 / FS)
-    y = 1e-6 * np.sin(2 * np.pi * 7 * t)          # sensor noise at rest, then an impact
+    y = 1e-6 * np.sin(2 * np.pi * 7 * t)  # sensor noise at rest, then an impact
     y[t >= 5] = damped(t[t >= 5] - 5)
     est = FrequencyEstimator(EstimatorConfig(model='damped-sinusoid'))
     e = est.process(t, y)
@@ -117,17 +127,25 @@ def test_an_absurd_sample_is_skipped_even_with_the_outlier_test_off():
 
 
 #: random floats as the issue asks: NaN, +-inf, 1e308, subnormals, and ordinary values
-VALUES = st.one_of(st.floats(allow_nan=True, allow_infinity=True),
-                   st.sampled_from([1e308, -1e308, 5e-324, -5e-324, 0.0, 1e-310]),
-                   st.floats(-2.0, 2.0))
+VALUES = st.one_of(
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.sampled_from([1e308, -1e308, 5e-324, -5e-324, 0.0, 1e-310]),
+    st.floats(-2.0, 2.0),
+)
 
 
 @settings(max_examples=40, deadline=None)
-@given(values=st.lists(VALUES, min_size=0, max_size=300),
-       steps=st.lists(st.one_of(st.floats(allow_nan=True, allow_infinity=True),
-                                st.floats(-0.01, 0.5), st.just(0.002)), min_size=300,
-                      max_size=300),
-       modes=st.sampled_from([0, 2]))
+@given(
+    values=st.lists(VALUES, min_size=0, max_size=300),
+    steps=st.lists(
+        st.one_of(
+            st.floats(allow_nan=True, allow_infinity=True), st.floats(-0.01, 0.5), st.just(0.002)
+        ),
+        min_size=300,
+        max_size=300,
+    ),
+    modes=st.sampled_from([0, 2]),
+)
 def test_fuzz_random_samples_never_publish_a_non_finite_number(values, steps, modes):
     """Random values and stamps mixed into a clean signal: no exception, every published number
     finite (damping and stds NaN only where not computed), every input counted once, JSON valid."""
@@ -137,7 +155,7 @@ def test_fuzz_random_samples_never_publish_a_non_finite_number(values, steps, mo
     at = rng.choice(len(t), size=len(values), replace=False)
     y[at] = values
     t = t.copy()
-    t[at] = t[at] + np.asarray(steps[:len(values)], dtype=float)
+    t[at] = t[at] + np.asarray(steps[: len(values)], dtype=float)
     est = create_estimator(EstimatorConfig(modes=modes))
     e = est.process(t, y)
     c = est.counters
@@ -148,5 +166,8 @@ def test_fuzz_random_samples_never_publish_a_non_finite_number(values, steps, mo
     for name in ('damping', 'frequency_std_hz', 'damping_std'):
         assert not np.any(np.isinf(getattr(e, name))), name
     for row in e.to_list():
-        json.loads(json.dumps({k: None if v != v else v for k, v in row.as_dict().items()},
-                              allow_nan=False))
+        json.loads(
+            json.dumps(
+                {k: None if v != v else v for k, v in row.as_dict().items()}, allow_nan=False
+            )
+        )

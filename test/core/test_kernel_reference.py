@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """The compiled core's outputs, bit for bit, against stored reference results (seeded signal and
 configuration pairs).
 
@@ -17,6 +19,7 @@ round differently from one process to another (7374e6d itself gives R^2 values 1
 process runs only the modes cases), so its float columns are compared to ``MODES_ULP`` units in
 the last place, its counts and stamps exactly.
 """
+
 from __future__ import annotations
 
 import dataclasses
@@ -33,8 +36,18 @@ from vib_estimator.core.modes import create_estimator
 DATA = pathlib.Path(__file__).parent / 'data' / 'kernel_reference.npz'
 FS = 500.0
 MODES_ULP = 4
-COLUMNS = ('t', 'frequency_hz', 'convergence_time', 'samples', 'fit', 'amplitude', 'damping',
-           'frequency_std_hz', 'damping_std', 'mode')
+COLUMNS = (
+    't',
+    'frequency_hz',
+    'convergence_time',
+    'samples',
+    'fit',
+    'amplitude',
+    'damping',
+    'frequency_std_hz',
+    'damping_std',
+    'mode',
+)
 
 
 def _signal(kind: str, seed: int):
@@ -50,8 +63,9 @@ def _signal(kind: str, seed: int):
     else:
         t = np.arange(n) / FS
     if kind == 'two-modes':
-        y = (np.exp(-0.05 * t) * np.sin(2 * np.pi * 2.3 * t + 0.3)
-             + 0.6 * np.exp(-0.1 * t) * np.sin(2 * np.pi * 7.9 * t + 1.1))
+        y = np.exp(-0.05 * t) * np.sin(2 * np.pi * 2.3 * t + 0.3) + 0.6 * np.exp(
+            -0.1 * t
+        ) * np.sin(2 * np.pi * 7.9 * t + 1.1)
     else:
         # a lightly damped mode re-excited every 6 s
         tr = t % 6.0
@@ -76,12 +90,20 @@ CASES = [
     ('target-band', 'uniform', 8, {'target_std_rel': 0.005, 'band_hz': (1.0, 10.0)}),
     ('damped', 'uniform', 9, {'model': 'damped-sinusoid'}),
     ('damped-long', 'uniform', 10, {'model': 'damped-sinusoid', 'min_periods': 4.0}),
-    ('damped-band-refine0', 'irregular', 11,
-     {'model': 'damped-sinusoid', 'band_hz': (1.0, 10.0), 'refine': 0}),
+    (
+        'damped-band-refine0',
+        'irregular',
+        11,
+        {'model': 'damped-sinusoid', 'band_hz': (1.0, 10.0), 'refine': 0},
+    ),
     ('biased', 'irregular', 12, {'model': 'biased-sinusoid'}),
     ('biased-target', 'irregular', 13, {'model': 'biased-sinusoid', 'target_std_rel': 0.005}),
-    ('one-sided-trapezoid', 'uniform', 14,
-     {'one_sided_test': True, 'rule_points': 2, 'invariant_filter': False}),
+    (
+        'one-sided-trapezoid',
+        'uniform',
+        14,
+        {'one_sided_test': True, 'rule_points': 2, 'invariant_filter': False},
+    ),
     ('short-window', 'uniform', 15, {'max_window': 0.3, 'window': 5}),
     ('modes3', 'two-modes', 16, {'modes': 3}),
     ('modes3-band', 'two-modes', 17, {'modes': 3, 'band_hz': (1.0, 20.0)}),
@@ -90,18 +112,51 @@ CASES = [
 
 #: parameters added since the reference, with the value at which each is off (the kernel behaves as
 #: at 7374e6d): the consistency gate, gap detection, outlier rejection, the ambient estimator
-ADDED_SINCE = {'consistency': 0.0, 'gap_intervals': 0.0, 'outlier_ratio': 0.0,
-               'excitation': 'free'}
+ADDED_SINCE = {
+    'consistency': 0.0,
+    'gap_intervals': 0.0,
+    'outlier_ratio': 0.0,
+    'excitation': 'free',
+}
 #: the counters of 7374e6d's estimator and mode tracker, by name
 REFERENCE_COUNTERS = {
-    'single': ['estimates', 'gap_resets', 'max_window_resets', 'received', 'rejected_at_rest',
-               'rejected_damping', 'rejected_fit', 'rejected_nyquist', 'skipped_duplicate',
-               'skipped_non_finite', 'skipped_out_of_order', 'time_jump_resets', 'used'],
-    'modes': ['estimates', 'gap_resets', 'max_window_resets', 'modes_found', 'modes_lost',
-              'received', 'rejected_at_rest', 'rejected_band_edge', 'rejected_damping',
-              'rejected_fit', 'rejected_harmonic', 'rejected_inconsistent', 'rejected_noise',
-              'rejected_nyquist', 'rejected_unresolved', 'skipped_duplicate',
-              'skipped_non_finite', 'skipped_out_of_order', 'time_jump_resets', 'used'],
+    'single': [
+        'estimates',
+        'gap_resets',
+        'max_window_resets',
+        'received',
+        'rejected_at_rest',
+        'rejected_damping',
+        'rejected_fit',
+        'rejected_nyquist',
+        'skipped_duplicate',
+        'skipped_non_finite',
+        'skipped_out_of_order',
+        'time_jump_resets',
+        'used',
+    ],
+    'modes': [
+        'estimates',
+        'gap_resets',
+        'max_window_resets',
+        'modes_found',
+        'modes_lost',
+        'received',
+        'rejected_at_rest',
+        'rejected_band_edge',
+        'rejected_damping',
+        'rejected_fit',
+        'rejected_harmonic',
+        'rejected_inconsistent',
+        'rejected_noise',
+        'rejected_nyquist',
+        'rejected_unresolved',
+        'skipped_duplicate',
+        'skipped_non_finite',
+        'skipped_out_of_order',
+        'time_jump_resets',
+        'used',
+    ],
 }
 
 
@@ -175,8 +230,9 @@ def test_batch_results_are_bit_identical_to_the_reference(reference, name, kind,
     np.testing.assert_array_equal(counters, reference[f'{name}/counters'])
 
 
-@pytest.mark.parametrize('name', ['default-irregular', 'band', 'target', 'damped', 'biased',
-                                  'modes3'])
+@pytest.mark.parametrize(
+    'name', ['default-irregular', 'band', 'target', 'damped', 'biased', 'modes3']
+)
 def test_streaming_results_are_bit_identical_to_the_reference(reference, name):
     kind, seed = next(c[1:3] for c in CASES if c[0] == name)
     t, y = _signal(kind, seed)

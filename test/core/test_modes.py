@@ -1,4 +1,7 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Several modes at once: the mode tracker (pure core, no rclpy)."""
+
 import math
 from pathlib import Path
 
@@ -11,8 +14,9 @@ from vib_estimator.io.csv_reader import read_csv_series
 
 CFG = EstimatorConfig(modes=3, model='damped-sinusoid')
 FS = 1000.0
-REAL = Path(__file__).resolve().parents[3] / 'shared' / 'real-data' / \
-    'aluminium_cantilever_adxl357'
+REAL = (
+    Path(__file__).resolve().parents[3] / 'shared' / 'real-data' / 'aluminium_cantilever_adxl357'
+)
 
 
 def decay(t, t0, f, amplitude, zeta=0.002, phase=0.4):
@@ -45,14 +49,14 @@ def test_two_modes_numbered_by_frequency(seed):
     y = decay(t, 0.5, 8.0, 1.0) + decay(t, 0.5, 21.0, 0.3, 0.001) + noise(t, 0.003, seed)
     tr = ModeTracker(CFG)
     e = tr.process(t, y)
-    late = e.t > 3.0            # once both are numbered
+    late = e.t > 3.0  # once both are numbered
     for mode, f in ((1, 8.0), (2, 21.0)):
         sel = late & (e.mode == mode)
         assert np.sum(sel) > 10
         assert abs(np.median(e.frequency_hz[sel]) / f - 1) < 0.005
     status = tr.status()
     assert [s.mode for s in status] == [1, 2]
-    assert status[0].band_hz[1] <= status[1].band_hz[0]     # the bands do not overlap
+    assert status[0].band_hz[1] <= status[1].band_hz[0]  # the bands do not overlap
     assert set(tr.mode_counters()) == {1, 2}
     assert tr.counters['modes_found'] >= 2
 
@@ -79,9 +83,11 @@ def test_a_close_pair_is_estimated_within_two_periods():
     firsts = []
     for seed in range(5):
         phases = np.random.default_rng(seed).uniform(0, 6.28, 2)
-        y = decay(t, 1.0, 10.0, 1.0, 0.003, phases[0]) + \
-            decay(t, 1.0, 13.0, 0.5, 0.003, phases[1]) + noise(t, 0.5 / math.sqrt(2) * 10 ** -1.5,
-                                                               seed)
+        y = (
+            decay(t, 1.0, 10.0, 1.0, 0.003, phases[0])
+            + decay(t, 1.0, 13.0, 0.5, 0.003, phases[1])
+            + noise(t, 0.5 / math.sqrt(2) * 10**-1.5, seed)
+        )
         e = ModeTracker(CFG).process(t, y)
         rel = np.abs(e.frequency_hz[:, None] / np.array([10.0, 13.0]) - 1)
         assert np.mean(np.min(rel, axis=1) > 0.03) <= 0.05
@@ -91,8 +97,8 @@ def test_a_close_pair_is_estimated_within_two_periods():
 
 def test_a_mode_appears_and_one_disappears():
     t = np.arange(0, 16, 1 / FS)
-    first = decay(t, 0.5, 9.0, 1.0, 0.0) * (t < 7.0)          # stops at 7 s (into the noise)
-    second = decay(t, 6.0, 30.0, 0.5, 0.0)                    # starts at 6 s
+    first = decay(t, 0.5, 9.0, 1.0, 0.0) * (t < 7.0)  # stops at 7 s (into the noise)
+    second = decay(t, 6.0, 30.0, 0.5, 0.0)  # starts at 6 s
     y = first + second + noise(t, 0.002, 5)
     tr = ModeTracker(CFG)
     e = tr.process(t, y)
@@ -100,9 +106,9 @@ def test_a_mode_appears_and_one_disappears():
     near30 = np.abs(e.frequency_hz / 30 - 1) < 0.02
     assert np.mean(near9 | near30) > 0.98
     assert np.sum(near9) > 30 and np.sum(near30) > 100
-    assert e.t[near30].min() > 6.0 and e.t[near30].min() < 6.5     # picked up within 15 periods
-    assert e.t[near9].max() < 7.5                                  # stops with the mode
-    assert np.all(e.mode[near30 & (e.t > 9)] == 1)                # alone again: it is mode 1
+    assert e.t[near30].min() > 6.0 and e.t[near30].min() < 6.5  # picked up within 15 periods
+    assert e.t[near9].max() < 7.5  # stops with the mode
+    assert np.all(e.mode[near30 & (e.t > 9)] == 1)  # alone again: it is mode 1
     assert tr.counters['modes_lost'] >= 1
     assert [round(s.frequency_hz) for s in tr.status()] == [30]
 
@@ -132,7 +138,7 @@ def test_streaming_and_batch_give_the_same_floats():
     t = np.cumsum(rng.uniform(0.0008, 0.0012, 9000))
     y = decay(t, 0.3, 9.0, 1.0) + decay(t, 0.3, 25.0, 0.4) + noise(t, 0.003, 8) + 0.05
     y[1000] = np.nan
-    t[2000] = t[1999]                                          # a duplicate stamp
+    t[2000] = t[1999]  # a duplicate stamp
     batch = ModeTracker(CFG)
     parts = [batch.process(t[:4000], y[:4000]), batch.process(t[4000:], y[4000:])]
     stream = ModeTracker(CFG)
@@ -186,14 +192,21 @@ def test_plot_colours_the_modes(tmp_path):
     assert series['mode 1'].get_color() != series['mode 2'].get_color()
     marks = sorted(float(line.get_xdata()[0]) for line in spectrum.get_lines()[1:])
     assert np.allclose(marks, [8.0, 21.0], rtol=0.01)
-    fig = plot_estimates(str(tmp_path / 'none.png'), t, y, e.t[:0], e.frequency_hz[:0],
-                         e.convergence_time[:0], mode=e.mode[:0])
+    fig = plot_estimates(
+        str(tmp_path / 'none.png'),
+        t,
+        y,
+        e.t[:0],
+        e.frequency_hz[:0],
+        e.convergence_time[:0],
+        mode=e.mode[:0],
+    )
     spectrum = fig.axes[3]
-    assert [line.get_label() for line in spectrum.get_lines()] == ['Welch PSD']   # nothing marked
+    assert [line.get_label() for line in spectrum.get_lines()] == ['Welch PSD']  # nothing marked
 
 
 REFERENCE = {30: 16.360, 40: 9.392, 50: 6.054, 60: 4.268}
-REAL_F2 = {50: 39.63, 60: 27.35}          # the authors' second modes (benchmarks/bench_modes.py)
+REAL_F2 = {50: 39.63, 60: 27.35}  # the authors' second modes (benchmarks/bench_modes.py)
 
 
 @pytest.mark.skipif(not REAL.is_dir(), reason='../shared/real-data is not beside the repository')
@@ -213,6 +226,6 @@ def test_real_beams_mode_1_without_a_band(length):
         assert np.mean((np.abs(r - 1) > 0.03) & (r < 5)) <= 0.01
         others = e.frequency_hz[e.mode >= 2]
         near2 = np.abs(others / (6.45 * f1) - 1) < 0.03
-        if length >= 50:                # the second mode rings for seconds on the longer beams
+        if length >= 50:  # the second mode rings for seconds on the longer beams
             assert np.sum(near2) > 50
             assert abs(np.median(others[near2]) / REAL_F2[length] - 1) < 0.02

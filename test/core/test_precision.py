@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Seeded Monte Carlo: refined estimates at the exact Cramer-Rao bound, calibrated std, targets.
 
 Signals: the simulated arm's second mode (1.33 Hz, A = 0.1, Ts = 2 ms) at 40 dB SNR, random phase
@@ -5,6 +7,7 @@ per record; the bound is :func:`vib_estimator.analysis.bounds.model_crb` on the 
 estimate used. Seeds are fixed; the tolerances leave the ~10 % sampling error of a ratio over >= 50
 estimates (measured ratios 0.9-1.1, ``benchmarks/bench_precision.py``).
 """
+
 import math
 
 import numpy as np
@@ -18,7 +21,7 @@ from vib_estimator.sim.signals import fig1_signal
 PAPER = EstimatorConfig.paper()
 
 F0, AMP, TS = 1.33, 0.1, 0.002
-SD = AMP / math.sqrt(2 * 1e4)      # 40 dB
+SD = AMP / math.sqrt(2 * 1e4)  # 40 dB
 
 
 def _runs(model, periods, zeta=0.0, offset=0.0, records=12, refine=4):
@@ -28,22 +31,26 @@ def _runs(model, periods, zeta=0.0, offset=0.0, records=12, refine=4):
         t = np.arange(0.0, max(6.0, 3 * periods / F0), TS)
         phase = rng.uniform(0, 2 * math.pi)
         wn = 2 * math.pi * F0
-        y = AMP * np.exp(-zeta * wn * t) * np.sin(wn * math.sqrt(1 - zeta ** 2) * t + phase)
+        y = AMP * np.exp(-zeta * wn * t) * np.sin(wn * math.sqrt(1 - zeta**2) * t + phase)
         y = y + offset + rng.normal(0, SD, len(t))
         e = estimate(t, y, EstimatorConfig.paper(model=model, min_periods=periods, refine=refine))
         for k in range(len(e)):
             i1 = int(round(e.t[k] / TS))
-            b, _ = model_crb(model, t[i1 - int(e.samples[k]) + 1:i1 + 1], AMP, F0, phase, SD, zeta)
+            b, _ = model_crb(
+                model, t[i1 - int(e.samples[k]) + 1 : i1 + 1], AMP, F0, phase, SD, zeta
+            )
             err.append(e.frequency_hz[k] - F0)
             bound.append(b)
             norm.append((e.frequency_hz[k] - F0) / b)
             z.append((e.frequency_hz[k] - F0) / e.frequency_std_hz[k])
-    rms = lambda v: math.sqrt(np.mean(np.square(v)))   # noqa: E731
+    rms = lambda v: math.sqrt(np.mean(np.square(v)))  # noqa: E731
     return len(err), rms(norm), rms(z)
 
 
-@pytest.mark.parametrize('model,zeta,offset', [('sinusoid', 0, 0), ('damped-sinusoid', 0.01, 0),
-                                               ('biased-sinusoid', 0, 0.3)])
+@pytest.mark.parametrize(
+    'model,zeta,offset',
+    [('sinusoid', 0, 0), ('damped-sinusoid', 0.01, 0), ('biased-sinusoid', 0, 0.3)],
+)
 @pytest.mark.parametrize('periods', [0.5, 2, 10])
 def test_spread_within_1_5_bounds_and_std_calibrated(model, zeta, offset, periods):
     n, ratio, calib = _runs(model, periods, zeta, offset, records=12 if periods < 10 else 8)
@@ -86,7 +93,7 @@ def test_target_std_rel_publishes_fig1_within_a_fraction_of_a_period():
 
 def test_a_three_sigma_target_puts_every_fig1_seed_within_1_percent_in_a_third_of_a_period():
     first, errors, _ = _fig1_first_estimates(0.003)
-    assert first.max() <= 0.21              # 0.33 periods of 10 rad/s
+    assert first.max() <= 0.21  # 0.33 periods of 10 rad/s
     assert errors.max() < 0.01
 
 
@@ -95,8 +102,11 @@ def test_a_three_sigma_target_puts_every_fig1_seed_within_1_percent_in_a_third_o
 def test_clean_signals_stay_exact_with_and_without_refinement(model, refine):
     f = 2.0
     t = np.arange(0.0, 5.0, 1 / (150 * f))
-    y = 0.7 * np.exp(-0.01 * 2 * math.pi * f * t * (model == 'damped-sinusoid')) \
+    y = (
+        0.7
+        * np.exp(-0.01 * 2 * math.pi * f * t * (model == 'damped-sinusoid'))
         * np.sin(2 * math.pi * f * math.sqrt(1 - 1e-4 * (model == 'damped-sinusoid')) * t + 0.4)
+    )
     if model == 'biased-sinusoid':
         y = y + 0.5
     e = estimate(t, y, EstimatorConfig.paper(model=model, refine=refine))
@@ -122,15 +132,14 @@ def test_damped_model_publishes_long_decaying_windows_at_the_bound():
     assert 0.8 < calib < 1.25
 
 
-
 def _records(zeta, sd, periods, records, seed):
-    """Seeded records of the mode, 4 windows (at least 6 s) long, random phase (as the benchmark)."""
+    """Seeded records of the mode, 4 windows (>= 6 s) long, random phase (as the benchmark)."""
     rng = np.random.default_rng(seed)
     wn = 2 * math.pi * F0
     for _ in range(records):
         t = np.arange(0.0, max(6.0, 4 * periods / F0), TS)
         phase = rng.uniform(0, 2 * math.pi)
-        y = AMP * np.exp(-zeta * wn * t) * np.sin(wn * math.sqrt(1 - zeta ** 2) * t + phase)
+        y = AMP * np.exp(-zeta * wn * t) * np.sin(wn * math.sqrt(1 - zeta**2) * t + phase)
         yield t, y + rng.normal(0.0, sd, len(t)), phase
 
 
@@ -145,8 +154,9 @@ def test_long_damped_windows_start_from_the_half_period_damping():
         e = estimate(t, y, EstimatorConfig.paper(model='damped-sinusoid', min_periods=5))
         for k in range(len(e)):
             i1 = int(round(e.t[k] / TS))
-            b, _ = model_crb('damped-sinusoid', t[i1 - int(e.samples[k]) + 1:i1 + 1], AMP, F0,
-                             phase, sd, 0.01)
+            b, _ = model_crb(
+                'damped-sinusoid', t[i1 - int(e.samples[k]) + 1 : i1 + 1], AMP, F0, phase, sd, 0.01
+            )
             norm.append((e.frequency_hz[k] - F0) / b)
     assert len(norm) >= 20
     assert np.max(np.abs(norm)) < 5

@@ -1,10 +1,22 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """The subspace analysis of one window (pure core)."""
+
 import numpy as np
 import pytest
 
-from vib_estimator.core.subspace import (R_AMP, R_NU, R_ZETA, analyse, cholesky_solve,
-                                         fit_poles, hankel_cov, init_subspace, poly_roots,
-                                         refine_undamped)
+from vib_estimator.core.subspace import (
+    R_AMP,
+    R_NU,
+    R_ZETA,
+    analyse,
+    cholesky_solve,
+    fit_poles,
+    hankel_cov,
+    init_subspace,
+    poly_roots,
+    refine_undamped,
+)
 
 
 def window(m, parts, noise=0.0, seed=0):
@@ -13,7 +25,7 @@ def window(m, parts, noise=0.0, seed=0):
     x = np.zeros(m)
     for nu, zeta, amp, phase in parts:
         w = 2 * np.pi * nu
-        x += amp * np.exp(-zeta * w / np.sqrt(1 - zeta ** 2) * (n - m + 1)) * np.cos(w * n + phase)
+        x += amp * np.exp(-zeta * w / np.sqrt(1 - zeta**2) * (n - m + 1)) * np.cos(w * n + phase)
     return x + noise * np.random.default_rng(seed).standard_normal(m)
 
 
@@ -36,23 +48,23 @@ def test_building_blocks():
     x = rng.standard_normal(48)
     r = np.zeros((17, 17))
     hankel_cov(x, 16, r)
-    h = np.array([x[i:i + 17] for i in range(32)])
+    h = np.array([x[i : i + 17] for i in range(32)])
     np.testing.assert_allclose(r, h.T @ h, rtol=1e-12, atol=1e-12)
     a = rng.standard_normal((6, 6))
     a = a @ a.T + np.eye(6)
     b = rng.standard_normal((6, 2))
     np.testing.assert_allclose(cholesky_solve(a, b), np.linalg.solve(a, b), rtol=1e-9)
     roots = np.array([0.9 + 0.3j, 0.9 - 0.3j, 0.5, -0.2])
-    coef = np.poly(roots)[::-1].real[:-1]                 # monic, low coefficients first
+    coef = np.poly(roots)[::-1].real[:-1]  # monic, low coefficients first
     for start in (np.full((2, 4), np.nan), np.array([[0.89, 0.89, 0.5, -0.2], [0.3, -0.3, 0, 0]])):
         got = poly_roots(coef, start)
         assert np.max(np.min(np.abs(got[:, None] - roots[None, :]), axis=1)) < 1e-9
-        np.testing.assert_allclose(start[0] + 1j * start[1], got)     # kept for the next window
+        np.testing.assert_allclose(start[0] + 1j * start[1], got)  # kept for the next window
 
 
 def test_a_clean_window_gives_its_sinusoids_exactly():
     parts = [(0.03, 0.01, 1.0, 0.3), (0.041, 0.0, 0.5, 1.0), (0.15, 0.02, 0.05, 2.0)]
-    x = window(68, parts) + 0.2                               # an offset: a real pole
+    x = window(68, parts) + 0.2  # an offset: a real pole
     rows, var, r2 = run(x)
     assert len(rows) == 3 and r2 > 1 - 1e-12
     for row, (nu, zeta, amp, _) in zip(rows, parts):
@@ -74,7 +86,7 @@ def test_close_sinusoids_in_noise(seed):
 
 def test_noise_alone_has_few_sinusoids():
     counts = [len(run(np.random.default_rng(s).standard_normal(68))[0]) for s in range(20)]
-    assert np.mean(counts) <= 0.2         # the gap rule keeps the noise eigenvalues out
+    assert np.mean(counts) <= 0.2  # the gap rule keeps the noise eigenvalues out
 
 
 def residual_variance(x, poles):
@@ -94,9 +106,13 @@ def test_undamped_refinement_of_a_close_pair():
         x = window(136, parts, noise=0.5 / np.sqrt(2) * 10 ** (-30 / 20), seed=seed)
         fits = []
         for off in (0.015, -0.01):
-            pair = np.array([np.exp(2j * np.pi * p[0] * (1 + off * (-1) ** k)) * 0.999
-                             for k, p in enumerate(parts)])
-            start = np.concatenate([pair, pair.conj(), [1.0 + 0j]])     # twins, an offset
+            pair = np.array(
+                [
+                    np.exp(2j * np.pi * p[0] * (1 + off * (-1) ** k)) * 0.999
+                    for k, p in enumerate(parts)
+                ]
+            )
+            start = np.concatenate([pair, pair.conj(), [1.0 + 0j]])  # twins, an offset
             got = refine_undamped(x, start)
             assert np.all(np.abs(np.abs(got[:2]) - 1) < 1e-12)
             assert got[4] == start[4] and np.all(got[2:4] == start[2:4])
@@ -113,4 +129,4 @@ def test_undamped_refinement_leaves_lone_or_damped_pairs():
     lone = np.array([np.exp(2j * np.pi * 0.031) * 0.99, np.exp(-2j * np.pi * 0.031) * 0.99])
     assert np.all(refine_undamped(x, lone) == lone)
     damped = np.array([np.exp(2j * np.pi * 0.03) * 0.99, np.exp(2j * np.pi * 0.039) * 0.5])
-    assert np.all(refine_undamped(x, damped) == damped)    # the second is damped: no pair
+    assert np.all(refine_undamped(x, damped) == damped)  # the second is damped: no pair

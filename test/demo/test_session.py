@@ -1,6 +1,9 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """The demo's session and estimation table (vib_estimator.demo.session, .estimation): the domain
 choice, the simulator's parameters, the Listener's pairing of estimates with resets through topics,
 and the per-mass pass criterion. (The whole demo as processes: test/nodes/test_shaper_node.py.)"""
+
 from __future__ import annotations
 
 import argparse
@@ -26,9 +29,9 @@ TRUTH = [(8.0 * i, 8.0 * (i + 1), natural_frequency_hz(m)) for i, m in enumerate
 
 
 def test_domain_choice():
-    assert demo_domain(7, '12') == 7                       # --domain-id first
-    assert demo_domain(None, '12') == 12                   # then ROS_DOMAIN_ID
-    for env in (None, '', 'x', str(MAX_DOMAIN_ID + 1)):   # else one of DOMAINS, never 0
+    assert demo_domain(7, '12') == 7  # --domain-id first
+    assert demo_domain(None, '12') == 12  # then ROS_DOMAIN_ID
+    for env in (None, '', 'x', str(MAX_DOMAIN_ID + 1)):  # else one of DOMAINS, never 0
         assert demo_domain(None, env) in DOMAINS and 0 not in DOMAINS
     assert domain_id('0') == 0 and domain_id(str(MAX_DOMAIN_ID)) == MAX_DOMAIN_ID
     for bad in ('-1', str(MAX_DOMAIN_ID + 1), 'one'):
@@ -38,8 +41,13 @@ def test_domain_choice():
 
 def test_sim_params_are_ros_arguments_of_sim_node():
     params = sim_params(10, 24, [0.0, 0.03, 8.0, 0.0455], 2)
-    assert params == ['speed:=10.0', 'duration:=24.0', 'publish_clock:=true',
-                      'wait_for_subscribers:=2', 'schedule:=[0.0, 0.03, 8.0, 0.0455]']
+    assert params == [
+        'speed:=10.0',
+        'duration:=24.0',
+        'publish_clock:=true',
+        'wait_for_subscribers:=2',
+        'schedule:=[0.0, 0.03, 8.0, 0.0455]',
+    ]
 
 
 def test_mass_of_a_frequency_inverts_eq_23():
@@ -63,7 +71,7 @@ def test_summary_passes_only_when_every_mass_is_within_the_limit():
     assert ok and len(rows) == 1 + len(MASSES_5_5)
     assert [float(r.split()[3]) for r in rows[1:]] == pytest.approx([0.5, -1.0, 2.0], abs=0.01)
     assert not summarise(_record([0.5, -(MAX_MEDIAN_ERROR_PCT + 0.5), 0.0]))[1]
-    rec = _record([0.0, 0.0])                              # the last mass got no estimate
+    rec = _record([0.0, 0.0])  # the last mass got no estimate
     rows, ok = summarise(rec)
     assert not ok and 'no estimate' in rows[-1]
     rec = _record([0.0, 0.0, 0.0])
@@ -80,16 +88,22 @@ def test_listener_pairs_each_frequency_with_its_reset(ros_context, executor):
     executor.add_node(listener.node)
     talker = Node('demo_talker', context=ros_context)
     executor.add_node(talker)
-    pubs = {topic: talker.create_publisher(kind, topic, 10) for topic, kind in (
-        ('coupling_torque', WrenchStamped), ('vibration/frequency', Float64),
-        ('vibration/reset', Header))}
-    assert spin_until(executor, lambda: all(p.get_subscription_count() for p in pubs.values()),
-                      10.0)
+    pubs = {
+        topic: talker.create_publisher(kind, topic, 10)
+        for topic, kind in (
+            ('coupling_torque', WrenchStamped),
+            ('vibration/frequency', Float64),
+            ('vibration/reset', Header),
+        )
+    }
+    assert spin_until(
+        executor, lambda: all(p.get_subscription_count() for p in pubs.values()), 10.0
+    )
 
     def header(seconds):
         ns = SIM_TIME_ORIGIN_NS + int(seconds * 1e9)
         msg = Header()
-        msg.stamp.sec, msg.stamp.nanosec = divmod(ns, 10 ** 9)
+        msg.stamp.sec, msg.stamp.nanosec = divmod(ns, 10**9)
         return msg
 
     torque = WrenchStamped(header=header(0.25))
@@ -102,7 +116,7 @@ def test_listener_pairs_each_frequency_with_its_reset(ros_context, executor):
     assert spin_until(executor, lambda: len(rec.est_t) == 2 and rec.t, 10.0)
     assert rec.t == pytest.approx([0.25]) and rec.torque == [0.7]
     assert rec.est_t == pytest.approx([1.5, 9.0]) and rec.est_f == [1.2, 1.05]
-    assert rec.est_conv == pytest.approx([1.5, 7.5])      # since the start, then the last reset
+    assert rec.est_conv == pytest.approx([1.5, 7.5])  # since the start, then the last reset
     assert rec.truth_at(9.0) == TRUTH[1][2]
 
 

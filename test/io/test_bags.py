@@ -1,4 +1,7 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """bag_io: round trips through every storage layout, clear BagErrors, the shipped bags."""
+
 from __future__ import annotations
 
 import os
@@ -8,9 +11,17 @@ import numpy as np
 import pytest
 from mcap.reader import make_reader
 
-from vib_estimator.io.bags import (TYPESTORE, WRENCH_STAMPED, BagError, BagReader, BagWriter,
-                                  WrenchSeries, read_wrench_series, wrench_message,
-                                  write_wrench_series)
+from vib_estimator.io.bags import (
+    TYPESTORE,
+    WRENCH_STAMPED,
+    BagError,
+    BagReader,
+    BagWriter,
+    WrenchSeries,
+    read_wrench_series,
+    wrench_message,
+    write_wrench_series,
+)
 
 BAGS = Path(__file__).resolve().parents[2] / 'bags'
 
@@ -55,7 +66,9 @@ def test_other_component_and_topic_choice(tmp_path):
     read = read_wrench_series(tmp_path / 'bag', '/wrist', 'force.y')
     np.testing.assert_array_equal(read.values, written.values)
     assert not read_wrench_series(tmp_path / 'bag', '/wrist', 'torque.z').values.any()
-    with pytest.raises(ValueError, match='component of geometry_msgs/msg/WrenchStamped must be one of'):
+    with pytest.raises(
+        ValueError, match='component of geometry_msgs/msg/WrenchStamped must be one of'
+    ):
         read_wrench_series(tmp_path / 'bag', component='torque.w')
 
 
@@ -81,18 +94,28 @@ def test_reader_lists_topics_and_yields_raw_messages_in_order(tmp_path):
         a = bag.add_topic('/a', 'std_msgs/msg/Float64')
         b = bag.add_topic('/b', 'std_msgs/msg/String')
         for i in range(10):
-            bag.write_message(a if i % 2 else b, 1000 + i,
-                              TYPESTORE.types['std_msgs/msg/Float64'](data=float(i)) if i % 2
-                              else TYPESTORE.types['std_msgs/msg/String'](data=str(i)))
+            bag.write_message(
+                a if i % 2 else b,
+                1000 + i,
+                TYPESTORE.types['std_msgs/msg/Float64'](data=float(i))
+                if i % 2
+                else TYPESTORE.types['std_msgs/msg/String'](data=str(i)),
+            )
     with BagReader(tmp_path / 'bag') as reader:
         assert {t: (i.msgtype, i.count) for t, i in reader.topics.items()} == {
-            '/a': ('std_msgs/msg/Float64', 5), '/b': ('std_msgs/msg/String', 5)}
+            '/a': ('std_msgs/msg/Float64', 5),
+            '/b': ('std_msgs/msg/String', 5),
+        }
         assert (reader.start_ns, reader.end_ns, reader.message_count) == (1000, 1009, 10)
         messages = list(reader.messages())
         assert [m.log_time_ns for m in messages] == list(range(1000, 1010))
         assert [m.topic for m in messages[:2]] == ['/b', '/a']
         assert TYPESTORE.deserialize_cdr(messages[1].data, messages[1].msgtype).data == 1.0
-        assert [m.log_time_ns for m in reader.messages(['/a'], start_ns=1005)] == [1005, 1007, 1009]
+        assert [m.log_time_ns for m in reader.messages(['/a'], start_ns=1005)] == [
+            1005,
+            1007,
+            1009,
+        ]
 
 
 def bad_bag(tmp_path, kind, mcap_bag):
@@ -109,7 +132,7 @@ def bad_bag(tmp_path, kind, mcap_bag):
         return path
     if kind == 'truncated_dir':
         data = (mcap_bag / 'bag.mcap').read_bytes()
-        (mcap_bag / 'bag.mcap').write_bytes(data[:len(data) // 2])
+        (mcap_bag / 'bag.mcap').write_bytes(data[: len(data) // 2])
         return mcap_bag
     if kind == 'not_a_bag_dir':
         (tmp_path / 'plain').mkdir()
@@ -124,15 +147,18 @@ def bad_bag(tmp_path, kind, mcap_bag):
     raise AssertionError(kind)
 
 
-@pytest.mark.parametrize('kind, message', [
-    ('missing', 'does not exist'),
-    ('random_mcap', 'corrupt or truncated'),
-    ('random_db3', 'corrupt or truncated'),
-    ('truncated_dir', r'corrupt or truncated bag\?; `vib-estimator reindex .*` rebuilds it'),
-    ('not_a_bag_dir', 'has no metadata.yaml'),
-    ('text_file', 'is not a bag'),
-    ('empty', 'contains no messages'),
-])
+@pytest.mark.parametrize(
+    'kind, message',
+    [
+        ('missing', 'does not exist'),
+        ('random_mcap', 'corrupt or truncated'),
+        ('random_db3', 'corrupt or truncated'),
+        ('truncated_dir', r'corrupt or truncated bag\?; `vib-estimator reindex .*` rebuilds it'),
+        ('not_a_bag_dir', 'has no metadata.yaml'),
+        ('text_file', 'is not a bag'),
+        ('empty', 'contains no messages'),
+    ],
+)
 def test_unreadable_bags_raise_one_clear_sentence(tmp_path, mcap_bag, kind, message):
     path = bad_bag(tmp_path, kind, mcap_bag)
     with pytest.raises(BagError, match=message) as err:
@@ -151,24 +177,33 @@ def test_truncated_bare_mcap_file(tmp_path, mcap_bag):
 
 
 def test_wrong_topic_and_type_name_the_available_topics(tmp_path, mcap_bag):
-    with pytest.raises(BagError, match=r"no topic '/nope'; its topics are /coupling_torque "
-                                       r'\(geometry_msgs/msg/WrenchStamped\)'):
+    with pytest.raises(
+        BagError,
+        match=r"no topic '/nope'; its topics are /coupling_torque "
+        r'\(geometry_msgs/msg/WrenchStamped\)',
+    ):
         read_wrench_series(mcap_bag, '/nope')
     with BagWriter(tmp_path / 'mixed') as bag:
         conn = bag.add_topic('/f', 'std_msgs/msg/Float64')
         bag.write_message(conn, 1, TYPESTORE.types['std_msgs/msg/Float64'](data=1.0))
     with pytest.raises(BagError, match='has type std_msgs/msg/Float64, not geometry_msgs'):
         read_wrench_series(tmp_path / 'mixed', '/f')
-    with pytest.raises(BagError, match=r'no geometry_msgs/msg/WrenchStamped topic; its topics '
-                                       r'are /f \(std_msgs/msg/Float64\)'):
+    with pytest.raises(
+        BagError,
+        match=r'no geometry_msgs/msg/WrenchStamped topic; its topics '
+        r'are /f \(std_msgs/msg/Float64\)',
+    ):
         read_wrench_series(tmp_path / 'mixed')
 
 
 def test_several_wrench_topics_need_a_choice(tmp_path):
     with BagWriter(tmp_path / 'two') as bag:
         for topic in ('/left', '/right'):
-            bag.write_message(bag.add_topic(topic, WRENCH_STAMPED), 1,
-                              wrench_message(1_000_000_002, 'f', 'torque.z', 3.5))
+            bag.write_message(
+                bag.add_topic(topic, WRENCH_STAMPED),
+                1,
+                wrench_message(1_000_000_002, 'f', 'torque.z', 3.5),
+            )
     with pytest.raises(BagError, match='several .* choose one: /left, /right'):
         read_wrench_series(tmp_path / 'two')
     read = read_wrench_series(tmp_path / 'two', '/right')
@@ -188,17 +223,23 @@ def test_shipped_bags(name):
     samples, truths, frequencies = SHIPPED[name]
     read = read_wrench_series(BAGS / name)
     assert len(read) == samples and read.frame_id == 'arm_base'
-    assert read.stamps_ns[0] == 1_700_000_000 * 10 ** 9
+    assert read.stamps_ns[0] == 1_700_000_000 * 10**9
     assert np.all(np.diff(read.stamps_ns) > 0)
     with BagReader(BAGS / name) as bag:
         assert bag.topics['/vibration/ground_truth'].count == truths
-        truth = sorted({round(TYPESTORE.deserialize_cdr(m.data, m.msgtype).data, 4)
-                        for m in bag.messages(['/vibration/ground_truth'])}, reverse=True)
+        truth = sorted(
+            {
+                round(TYPESTORE.deserialize_cdr(m.data, m.msgtype).data, 4)
+                for m in bag.messages(['/vibration/ground_truth'])
+            },
+            reverse=True,
+        )
     assert tuple(truth) == tuple(sorted(frequencies, reverse=True))
 
 
 def test_make_bags_is_deterministic(tmp_path):
     import runpy
+
     script = runpy.run_path(str(BAGS.parent / 'scripts' / 'make_bags.py'))
     assert script['main'](['--out', str(tmp_path)]) == 0
     for name in SHIPPED:
@@ -209,8 +250,10 @@ def test_make_bags_is_deterministic(tmp_path):
 # -- bags written by rosbag2 itself, split bags, crash safety -------------------------------------
 
 # ../shared relative to the repo; VIB_SHARED names it elsewhere (a worktree)
-SHARED_BAGS = Path(os.environ.get('VIB_SHARED', Path(__file__).resolve().parents[3] / 'shared')
-                   ) / 'ros2-bags'
+SHARED_BAGS = (
+    Path(os.environ.get('VIB_SHARED', Path(__file__).resolve().parents[3] / 'shared'))
+    / 'ros2-bags'
+)
 needs_shared = pytest.mark.skipif(not SHARED_BAGS.is_dir(), reason='../shared/ros2-bags is absent')
 ROSBAG2_BAGS = ['mcap_talker', 'sqlite3_talker', 'mcap_wbag', 'sqlite3_wbag']
 
@@ -218,6 +261,7 @@ ROSBAG2_BAGS = ['mcap_talker', 'sqlite3_talker', 'mcap_wbag', 'sqlite3_wbag']
 def storage_counts(directory: Path) -> dict:
     """Messages per topic counted in the storage files themselves (mcap library, SQL)."""
     import sqlite3
+
     counts = {}
     for file in sorted(directory.iterdir()):
         if file.suffix == '.mcap':
@@ -226,8 +270,10 @@ def storage_counts(directory: Path) -> dict:
                     counts[channel.topic] = counts.get(channel.topic, 0) + 1
         elif file.suffix == '.db3':
             conn = sqlite3.connect(f'file:{file}?immutable=1', uri=True)  # no -wal/-shm
-            for topic, n in conn.execute('SELECT topics.name, count(*) FROM messages JOIN topics '
-                                         'ON messages.topic_id = topics.id GROUP BY topics.name'):
+            for topic, n in conn.execute(
+                'SELECT topics.name, count(*) FROM messages JOIN topics '
+                'ON messages.topic_id = topics.id GROUP BY topics.name'
+            ):
                 counts[topic] = counts.get(topic, 0) + n
             conn.close()
     return counts
@@ -246,8 +292,9 @@ def test_rosbag2_bags_read_completely_in_log_time_order(name):
         times = [m.log_time_ns for m in messages]
         assert times == sorted(times) and (times[0], times[-1]) == (bag.start_ns, bag.end_ns)
         middle = times[len(times) // 2]
-        assert [m.log_time_ns for m in bag.messages(start_ns=middle)] == \
-            [t for t in times if t >= middle]
+        assert [m.log_time_ns for m in bag.messages(start_ns=middle)] == [
+            t for t in times if t >= middle
+        ]
 
 
 @needs_shared
@@ -266,17 +313,24 @@ def test_start_filter_on_a_split_bag_with_close_log_times_and_wrong_metadata(tmp
             bag.write_message(conns[i % 3], 5000 + i // 2, float64(data=float(i)))
     assert len(bag.files) >= 4 and bag.files[0].name == 'bag_0.mcap'
     meta = tmp_path / 'bag' / 'metadata.yaml'
-    text = meta.read_text().replace('nanoseconds_since_epoch: 5000\n',
-                                    f'nanoseconds_since_epoch: {bag.files[-1].start_ns}\n', 1)
+    text = meta.read_text().replace(
+        'nanoseconds_since_epoch: 5000\n',
+        f'nanoseconds_since_epoch: {bag.files[-1].start_ns}\n',
+        1,
+    )
     meta.write_text(text)
     with BagReader(tmp_path / 'bag') as reader:
         assert reader.start_ns == 5000 and reader.end_ns == 5299
-        values = [TYPESTORE.deserialize_cdr(m.data, m.msgtype).data
-                  for m in reader.messages(start_ns=reader.start_ns)]
+        values = [
+            TYPESTORE.deserialize_cdr(m.data, m.msgtype).data
+            for m in reader.messages(start_ns=reader.start_ns)
+        ]
         assert values == [float(i) for i in range(600)]  # all, in order, ties in file order
         late_a = [float(i) for i in range(600) if i % 3 == 0 and 5000 + i // 2 >= 5100]
-        assert [TYPESTORE.deserialize_cdr(m.data, m.msgtype).data
-                for m in reader.messages(['/a'], start_ns=5100)] == late_a
+        assert [
+            TYPESTORE.deserialize_cdr(m.data, m.msgtype).data
+            for m in reader.messages(['/a'], start_ns=5100)
+        ] == late_a
 
 
 def test_split_by_duration_names_files_like_rosbag2(tmp_path):
@@ -293,11 +347,18 @@ def test_split_by_duration_names_files_like_rosbag2(tmp_path):
 
 def test_old_style_type_names_are_read_as_pkg_msg_name(tmp_path):
     from rosbags.rosbag2 import StoragePlugin, Writer
+
     with Writer(tmp_path / 'old', version=8, storage_plugin=StoragePlugin.SQLITE3) as bag:
-        conn = bag.add_connection('/s', 'std_msgs/String', msgdef='string data',
-                                  rihs01='RIHS01_' + '0' * 64)
-        bag.write(conn, 1, TYPESTORE.serialize_cdr(TYPESTORE.types['std_msgs/msg/String'](
-            data='x'), 'std_msgs/msg/String'))
+        conn = bag.add_connection(
+            '/s', 'std_msgs/String', msgdef='string data', rihs01='RIHS01_' + '0' * 64
+        )
+        bag.write(
+            conn,
+            1,
+            TYPESTORE.serialize_cdr(
+                TYPESTORE.types['std_msgs/msg/String'](data='x'), 'std_msgs/msg/String'
+            ),
+        )
     with BagReader(tmp_path / 'old') as reader:
         assert reader.topics['/s'].msgtype == 'std_msgs/msg/String'
         assert [m.msgtype for m in reader.messages()] == ['std_msgs/msg/String']
@@ -307,7 +368,9 @@ def test_old_style_type_names_are_read_as_pkg_msg_name(tmp_path):
 def test_flushed_messages_are_in_the_file_before_close(tmp_path, storage):
     """What a SIGKILL after flush() leaves: the file as it is on disk, reindexed."""
     import shutil
+
     from vib_estimator.io.reindex import reindex
+
     bag = BagWriter(tmp_path / 'bag', storage).open()
     conn = bag.add_topic('/a', 'std_msgs/msg/Float64')
     for i in range(30):
@@ -324,6 +387,7 @@ def test_flushed_messages_are_in_the_file_before_close(tmp_path, storage):
 
 def test_message_compressed_bag(tmp_path):
     from rosbags.rosbag2 import CompressionFormat, CompressionMode, StoragePlugin, Writer
+
     writer = Writer(tmp_path / 'zbag', version=8, storage_plugin=StoragePlugin.MCAP)
     writer.set_compression(CompressionMode.MESSAGE, CompressionFormat.ZSTD)
     float64 = TYPESTORE.types['std_msgs/msg/Float64']
@@ -332,5 +396,10 @@ def test_message_compressed_bag(tmp_path):
         for i in range(5):
             writer.write(conn, i, TYPESTORE.serialize_cdr(float64(data=i), conn.msgtype))
     with BagReader(tmp_path / 'zbag') as reader:
-        assert [TYPESTORE.deserialize_cdr(m.data, m.msgtype).data
-                for m in reader.messages()] == [0.0, 1.0, 2.0, 3.0, 4.0]
+        assert [TYPESTORE.deserialize_cdr(m.data, m.msgtype).data for m in reader.messages()] == [
+            0.0,
+            1.0,
+            2.0,
+            3.0,
+            4.0,
+        ]

@@ -1,5 +1,8 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Damaged bags (issue 22, case 4): damaged records are detected, skipped, counted and reported by
 every reader -- never used as data, never more messages than the intact file, never a traceback."""
+
 from __future__ import annotations
 
 import os
@@ -70,11 +73,11 @@ def is_sub_multiset(values, of) -> bool:
 
 def test_a_damaged_chunk_is_skipped_and_counted_by_every_reader(tmp_path, intact):
     path = damaged_copy(tmp_path, intact, lambda d: flip(d, chunk_middle(intact[0], 1), 64))
-    signal, values = read_signal(path)                    # analyze / survey (streaming)
+    signal, values = read_signal(path)  # analyze / survey (streaming)
     assert 0 < len(values) < N and signal.corrupt == N - len(values)
-    assert is_sub_multiset(values, intact[1])             # the damaged payloads are not used
+    assert is_sub_multiset(values, intact[1])  # the damaged payloads are not used
     assert 'damaged' in signal.damage
-    with BagReader(path) as bag:                          # the replayer
+    with BagReader(path) as bag:  # the replayer
         played = list(bag.messages())
         assert len(played) == len(values) and bag.corrupt == signal.corrupt
     series = read_wrench_series(path)
@@ -87,13 +90,15 @@ def test_a_damaged_chunk_is_skipped_and_counted_by_every_reader(tmp_path, intact
 
 def test_damaged_index_entries_never_give_more_messages(tmp_path, intact):
     """A message index whose entries point elsewhere (a duplicate, an offset into a payload)."""
+
     def edit(data):
         _, _, start, length, indexes = mcap.read_summary(intact[0] / 'bag.mcap').chunks[0]
         offset, size = next(iter(indexes.values()))
         entries = offset + mcap.RECORD_HEAD + 2 + 4
-        data[entries + 16 + 8:entries + 32] = data[entries + 8:entries + 16]  # entry 1 -> 0
-        data[entries + 40:entries + 48] = (7).to_bytes(8, 'little')          # entry 2 -> byte 7
+        data[entries + 16 + 8 : entries + 32] = data[entries + 8 : entries + 16]  # entry 1 -> 0
+        data[entries + 40 : entries + 48] = (7).to_bytes(8, 'little')  # entry 2 -> byte 7
         return data
+
     path = damaged_copy(tmp_path, intact, edit)
     signal, values = read_signal(path)
     assert len(values) == N - 2 and signal.corrupt == 2
@@ -105,6 +110,7 @@ def test_damaged_index_entries_never_give_more_messages(tmp_path, intact):
 def test_a_payload_that_does_not_decode_is_skipped(tmp_path, intact):
     """A message whose frame_id length runs past its payload (valid framing, no CRC): the CDR
     decode of every message finds it."""
+
     def edit(data):
         with (intact[0] / 'bag.mcap').open('rb') as handle:
             plan = mcap.read_plan([intact[0] / 'bag.mcap'], '/w')
@@ -112,10 +118,11 @@ def test_a_payload_that_does_not_decode_is_skipped(tmp_path, intact):
         # the chunk is uncompressed: its records sit right after the chunk record's header
         header = mcap.RECORD_HEAD + 8 + 8 + 8 + 4 + 4 + 8
         at = plan[0].start + header + int(first.offsets[5]) + 4 + 8
-        data[at:at + 4] = (10_000).to_bytes(4, 'little')        # frame_id length
+        data[at : at + 4] = (10_000).to_bytes(4, 'little')  # frame_id length
         crc_at = plan[0].start + mcap.CHUNK_CRC_AT
-        data[crc_at:crc_at + 4] = bytes(4)                       # as a writer without CRCs
+        data[crc_at : crc_at + 4] = bytes(4)  # as a writer without CRCs
         return data
+
     path = damaged_copy(tmp_path, intact, edit)
     signal, values = read_signal(path)
     assert len(values) == N - 1 and signal.corrupt == 1 and 'does not decode' in signal.damage
@@ -125,8 +132,12 @@ def test_a_payload_that_does_not_decode_is_skipped(tmp_path, intact):
 
 
 def analyze(*args):
-    return subprocess.run([sys.executable, '-m', 'vib_estimator.cli', 'analyze', *map(str, args)],
-                          capture_output=True, text=True, timeout=300)
+    return subprocess.run(
+        [sys.executable, '-m', 'vib_estimator.cli', 'analyze', *map(str, args)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
 
 
 def test_analyze_reports_damaged_records_and_strict_refuses(tmp_path):
@@ -139,8 +150,11 @@ def test_analyze_reports_damaged_records_and_strict_refuses(tmp_path):
     assert result.returncode == 0, result.stderr
     warnings = [line for line in result.stderr.splitlines() if 'warning:' in line]
     assert len(warnings) == 1 and 'damaged record' in warnings[0]
-    summary = next(line for line in result.stderr.splitlines()     # the counters line
-                   if line.startswith('analyze: received='))
+    summary = next(
+        line
+        for line in result.stderr.splitlines()  # the counters line
+        if line.startswith('analyze: received=')
+    )
     counts = dict(kv.split('=') for kv in summary.split(': ', 1)[1].split(', '))
     assert int(counts['corrupt_records']) > 0
     assert int(counts['received']) + int(counts['corrupt_records']) == 5000
@@ -173,6 +187,7 @@ def test_real_rosbag2_bags_read_without_damage_and_damage_is_found(tmp_path, nam
 
 # ------------------------------------------------------------------------------------ fuzzing
 
+
 def read_all(path):
     """Messages of the bag by the streaming reader and by the bag reader; or the BagError."""
     try:
@@ -190,44 +205,62 @@ def intact_payloads(intact):
         return [m.data for m in bag.messages()]
 
 
-@settings(max_examples=100, deadline=None, derandomize=True,
-          suppress_health_check=[HealthCheck.function_scoped_fixture])
-@given(edits=st.lists(st.tuples(st.floats(0, 1), st.integers(1, 64), st.binary(min_size=1,
-                                                                                max_size=64)),
-                      min_size=1, max_size=4),
-       mode=st.sampled_from(['flip', 'overwrite', 'truncate']))
-def test_fuzz_damaged_mcap_never_crashes_nor_adds_messages(tmp_path_factory, intact,
-                                                          intact_payloads, edits, mode):
+@settings(
+    max_examples=100,
+    deadline=None,
+    derandomize=True,
+    suppress_health_check=[HealthCheck.function_scoped_fixture],
+)
+@given(
+    edits=st.lists(
+        st.tuples(st.floats(0, 1), st.integers(1, 64), st.binary(min_size=1, max_size=64)),
+        min_size=1,
+        max_size=4,
+    ),
+    mode=st.sampled_from(['flip', 'overwrite', 'truncate']),
+)
+def test_fuzz_damaged_mcap_never_crashes_nor_adds_messages(
+    tmp_path_factory, intact, intact_payloads, edits, mode
+):
     def edit(data):
         for where, count, junk in edits:
             at = int(where * (len(data) - 1))
             if mode == 'flip':
                 flip(data, at, count)
             elif mode == 'overwrite':
-                data[at:at + len(junk)] = junk
+                data[at : at + len(junk)] = junk
             else:
                 del data[at:]
         return data
+
     path = damaged_copy(tmp_path_factory.mktemp('fuzz'), intact, edit)
     try:
         result = read_all(path)
-    except VibEstimatorError as err:   # anything else (a bug) fails the test with its traceback
+    except VibEstimatorError as err:  # anything else (a bug) fails the test with its traceback
         pytest.fail(f'{type(err).__name__} not a BagError: {err}')
     if result is None:
-        return                                      # refused: one error line at a command
+        return  # refused: one error line at a command
     values, corrupt, played, played_corrupt = result
     assert len(values) <= N and len(played) <= N
     assert is_sub_multiset(np.asarray(values), intact[1])
     assert not Counter(played) - Counter(intact_payloads)
-    assert len(values) + corrupt >= N or mode == 'truncate'   # every loss counted
+    assert len(values) + corrupt >= N or mode == 'truncate'  # every loss counted
     assert len(played) + played_corrupt >= N or mode == 'truncate'
 
 
-@settings(max_examples=30, deadline=None, derandomize=True,
-          suppress_health_check=[HealthCheck.function_scoped_fixture])
-@given(data=st.one_of(st.binary(max_size=4096),
-                      st.binary(max_size=4096).map(lambda b: mcap.MAGIC + b),
-                      st.binary(max_size=4096).map(lambda b: mcap.MAGIC + b + mcap.MAGIC)))
+@settings(
+    max_examples=30,
+    deadline=None,
+    derandomize=True,
+    suppress_health_check=[HealthCheck.function_scoped_fixture],
+)
+@given(
+    data=st.one_of(
+        st.binary(max_size=4096),
+        st.binary(max_size=4096).map(lambda b: mcap.MAGIC + b),
+        st.binary(max_size=4096).map(lambda b: mcap.MAGIC + b + mcap.MAGIC),
+    )
+)
 def test_fuzz_random_bytes_as_an_mcap_file_are_refused_in_one_sentence(tmp_path_factory, data):
     path = tmp_path_factory.mktemp('random') / 'x.mcap'
     path.write_bytes(data)
@@ -253,13 +286,18 @@ def test_the_layout_check_refuses_what_rosbags_cannot_decode():
             return False
 
     for frame in ('', 'a', 'arm_base', 'a_much_longer_frame_name'):
-        good = bytes(TYPESTORE.serialize_cdr(wrench_message(EPOCH, frame, 'torque.z', 1.5),
-                                             WRENCH_STAMPED))
-        end = 16 + len(frame)                      # the frame_id's NUL
-        bad = [good[:-1], good[:20], b'\x00\x00' + good[2:],
-               good[:12] + (999).to_bytes(4, 'little') + good[16:],
-               good[:end] + b'x' + good[end + 1:]]
+        good = bytes(
+            TYPESTORE.serialize_cdr(wrench_message(EPOCH, frame, 'torque.z', 1.5), WRENCH_STAMPED)
+        )
+        end = 16 + len(frame)  # the frame_id's NUL
+        bad = [
+            good[:-1],
+            good[:20],
+            b'\x00\x00' + good[2:],
+            good[:12] + (999).to_bytes(4, 'little') + good[16:],
+            good[:end] + b'x' + good[end + 1 :],
+        ]
         assert cdr.fits_layout(good, WRENCH_STAMPED) and rosbags_decodes(good)
         for payload in bad:
             assert not cdr.fits_layout(payload, WRENCH_STAMPED), (frame, payload)
-        assert not any(rosbags_decodes(p) for p in bad[:2])       # cut: rosbags refuses too
+        assert not any(rosbags_decodes(p) for p in bad[:2])  # cut: rosbags refuses too

@@ -1,4 +1,7 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """io/fields.py: types, components, getters and setters, on plain objects (no rclpy)."""
+
 from __future__ import annotations
 
 from types import SimpleNamespace as NS
@@ -10,7 +13,7 @@ from vib_estimator.io import fields as F
 
 def empty(input_type):
     """A stand-in message of ``input_type`` with the attributes the components name."""
-    xyz = lambda: NS(x=0.0, y=0.0, z=0.0)   # noqa: E731
+    xyz = lambda: NS(x=0.0, y=0.0, z=0.0)  # noqa: E731
     return {
         F.WRENCH_STAMPED: lambda: NS(wrench=NS(force=xyz(), torque=xyz())),
         F.IMU: lambda: NS(linear_acceleration=xyz(), angular_velocity=xyz()),
@@ -37,7 +40,7 @@ def test_joint_state_by_name_reordered_and_absent():
     assert get(NS(name=['elbow', 'wrist'], effort=[1.0, 2.0])) == 1.0
     assert get(NS(name=['wrist', 'elbow'], effort=[1.0, 2.0])) == 2.0
     assert get(NS(name=['wrist'], effort=[1.0])) is None
-    assert get(NS(name=['wrist', 'elbow'], effort=[1.0])) is None      # array shorter than names
+    assert get(NS(name=['wrist', 'elbow'], effort=[1.0])) is None  # array shorter than names
     msg = NS(name=['wrist'], effort=[3.0], position=[])
     F.component_setter('effort[elbow]', F.JOINT_STATE)(msg, 4.0)
     assert msg.name == ['wrist', 'elbow'] and msg.effort == [3.0, 4.0]

@@ -1,4 +1,7 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Streaming readers: same samples as the reference readers, every input type, bounded blocks."""
+
 import os
 import shutil
 import sys
@@ -8,8 +11,14 @@ import numpy as np
 import pytest
 
 from vib_estimator.io import csv_reader, mcap, streaming
-from vib_estimator.io.bags import (TYPESTORE, BagError, BagWriter, WrenchSeries, read_wrench_series,
-                                   write_wrench_series)
+from vib_estimator.io.bags import (
+    TYPESTORE,
+    BagError,
+    BagWriter,
+    WrenchSeries,
+    read_wrench_series,
+    write_wrench_series,
+)
 from vib_estimator.io.cdr import DOUBLE_INDEX
 from vib_estimator.io.csv_reader import CsvError, read_csv_series
 from vib_estimator.io.fields import INPUT_TYPES, JOINT_STATE, component_getter
@@ -17,8 +26,10 @@ from vib_estimator.io.streaming import open_signal
 
 EPOCH = 1_700_000_000_000_000_000
 # ../shared relative to the repo; VIB_SHARED names it elsewhere (a worktree)
-SHARED_BAGS = Path(os.environ.get('VIB_SHARED', Path(__file__).resolve().parents[3] / 'shared')
-                   ) / 'ros2-bags'
+SHARED_BAGS = (
+    Path(os.environ.get('VIB_SHARED', Path(__file__).resolve().parents[3] / 'shared'))
+    / 'ros2-bags'
+)
 
 
 def collect(signal):
@@ -29,43 +40,58 @@ def collect(signal):
 def make_message(msgtype, stamp, frame, value, k):
     """A rosbags message of ``msgtype`` whose every double is distinct (value + index)."""
     T = TYPESTORE.types
-    header = T['std_msgs/msg/Header'](stamp=T['builtin_interfaces/msg/Time'](
-        sec=stamp // 10 ** 9, nanosec=stamp % 10 ** 9), frame_id=frame)
+    header = T['std_msgs/msg/Header'](
+        stamp=T['builtin_interfaces/msg/Time'](sec=stamp // 10**9, nanosec=stamp % 10**9),
+        frame_id=frame,
+    )
     v3 = lambda a: T['geometry_msgs/msg/Vector3'](x=a, y=a + 1, z=a + 2)  # noqa: E731
     if msgtype == 'std_msgs/msg/Float64':
         return T[msgtype](data=value)
     if msgtype == 'geometry_msgs/msg/WrenchStamped':
-        return T[msgtype](header=header, wrench=T['geometry_msgs/msg/Wrench'](
-            force=v3(value), torque=v3(value + 3)))
+        return T[msgtype](
+            header=header,
+            wrench=T['geometry_msgs/msg/Wrench'](force=v3(value), torque=v3(value + 3)),
+        )
     if msgtype == 'geometry_msgs/msg/AccelStamped':
-        return T[msgtype](header=header, accel=T['geometry_msgs/msg/Accel'](
-            linear=v3(value), angular=v3(value + 3)))
+        return T[msgtype](
+            header=header,
+            accel=T['geometry_msgs/msg/Accel'](linear=v3(value), angular=v3(value + 3)),
+        )
     if msgtype == 'geometry_msgs/msg/Vector3Stamped':
         return T[msgtype](header=header, vector=v3(value))
     if msgtype == 'sensor_msgs/msg/Imu':
         q = T['geometry_msgs/msg/Quaternion'](x=0.0, y=0.0, z=0.0, w=1.0)
         cov = np.arange(9, dtype=np.float64)
-        return T[msgtype](header=header, orientation=q, orientation_covariance=cov,
-                          angular_velocity=v3(value), angular_velocity_covariance=cov,
-                          linear_acceleration=v3(value + 3), linear_acceleration_covariance=cov)
-    names = ['joint1', 'joint2'] if k % 3 else ['joint2']          # joint1 absent every 3rd
-    arr = np.array([value, -value][:len(names)])
+        return T[msgtype](
+            header=header,
+            orientation=q,
+            orientation_covariance=cov,
+            angular_velocity=v3(value),
+            angular_velocity_covariance=cov,
+            linear_acceleration=v3(value + 3),
+            linear_acceleration_covariance=cov,
+        )
+    names = ['joint1', 'joint2'] if k % 3 else ['joint2']  # joint1 absent every 3rd
+    arr = np.array([value, -value][: len(names)])
     return T[JOINT_STATE](header=header, name=names, position=arr, velocity=arr, effort=arr)
 
 
 @pytest.mark.parametrize('storage', ['mcap', 'sqlite3'])
 @pytest.mark.parametrize('msgtype', INPUT_TYPES)
 def test_every_type_equals_the_rosbags_deserialiser(tmp_path, msgtype, storage):
-    frames = ['', 'a', 'arm_base', 'seven77', 'a_much_longer_frame_name']   # all alignments
+    frames = ['', 'a', 'arm_base', 'seven77', 'a_much_longer_frame_name']  # all alignments
     n = 300
     stamps = EPOCH + np.arange(n, dtype=np.int64) * 2_000_000 + 7
     msgs = [make_message(msgtype, int(s), frames[k % 5], 0.1 * k, k) for k, s in enumerate(stamps)]
     with BagWriter(tmp_path / 'bag', storage) as bag:
         conn = bag.add_topic('/x', msgtype)
         for k, (s, m) in enumerate(zip(stamps.tolist(), msgs)):
-            bag.write_message(conn, s + 1000, m)     # log time after the stamp
-    components = (['effort[joint1]', 'position[joint2]'] if msgtype == JOINT_STATE
-                  else list(DOUBLE_INDEX[msgtype]))
+            bag.write_message(conn, s + 1000, m)  # log time after the stamp
+    components = (
+        ['effort[joint1]', 'position[joint2]']
+        if msgtype == JOINT_STATE
+        else list(DOUBLE_INDEX[msgtype])
+    )
     for component in components:
         get = component_getter(component, msgtype)
         keep = [k for k, m in enumerate(msgs) if get(m) is not None]
@@ -84,7 +110,7 @@ def test_fast_path_is_taken_and_matches_the_reference_reader(tmp_path):
     y = np.sin(np.arange(n) * 0.01)
     write_wrench_series(tmp_path / 'bag', WrenchSeries(stamps, y, 'arm', '/w'))
     plan = mcap.read_plan(sorted((tmp_path / 'bag').glob('*.mcap')), '/w')
-    assert len(plan) > 1                                        # several chunks, indexed
+    assert len(plan) > 1  # several chunks, indexed
     (t, values), parts = collect(open_signal(tmp_path / 'bag'))
     ref = read_wrench_series(tmp_path / 'bag')
     assert np.array_equal(values, ref.values)
@@ -109,17 +135,23 @@ def test_blocks_are_bounded_whatever_the_length(tmp_path, monkeypatch):
     assert len(parts) > 3 and max(len(p[0]) for p in parts) < 4096 + 20_000
 
 
-@pytest.mark.parametrize('text', [
-    '# comment\nt,y\n0,1\n# in between\n0.5, 2\n1,\n2,nan\n',     # exact-rules fallback
-    't,y,z\n0,1,9\n0.5,2,9\n1,3,9,extra\n',                         # ragged rows
-    '0,1\n0.5,2\n1,inf\n',                                          # no header
-])
+@pytest.mark.parametrize(
+    'text',
+    [
+        '# comment\nt,y\n0,1\n# in between\n0.5, 2\n1,\n2,nan\n',  # exact-rules fallback
+        't,y,z\n0,1,9\n0.5,2,9\n1,3,9,extra\n',  # ragged rows
+        '0,1\n0.5,2\n1,inf\n',  # no header
+    ],
+)
 def test_csv_fast_and_exact_paths_agree(tmp_path, text):
     path = tmp_path / 'a.csv'
     path.write_text(text)
     series = read_csv_series(path)
-    rows = [line.split(',') for line in text.splitlines()
-            if line and not line.startswith('#') and not line.startswith('t')]
+    rows = [
+        line.split(',')
+        for line in text.splitlines()
+        if line and not line.startswith('#') and not line.startswith('t')
+    ]
     expect = [float(r[1]) if r[1].strip() else float('nan') for r in rows]
     assert np.array_equal(series.y, expect, equal_nan=True)
 
@@ -142,8 +174,9 @@ def test_a_bag_of_several_inputs_gives_the_topic_the_node_reads_by_default(tmp_p
         torque = bag.add_topic('/coupling_torque', 'geometry_msgs/msg/WrenchStamped')
         for s in stamps.tolist():
             bag.write_message(truth, s, make_message('std_msgs/msg/Float64', s, 'f', 2.0, 0))
-            bag.write_message(torque, s, make_message('geometry_msgs/msg/WrenchStamped', s, 'f',
-                                                      1.0, 0))
+            bag.write_message(
+                torque, s, make_message('geometry_msgs/msg/WrenchStamped', s, 'f', 1.0, 0)
+            )
     signal = open_signal(tmp_path / 'sim')
     assert signal.topic == '/coupling_torque' and signal.component == 'torque.z'
 
@@ -154,12 +187,17 @@ def test_topic_choice_and_errors(tmp_path):
         a = bag.add_topic('/a', 'geometry_msgs/msg/WrenchStamped')
         b = bag.add_topic('/b', 'std_msgs/msg/Float64')
         for s in stamps.tolist():
-            bag.write_message(a, s, make_message('geometry_msgs/msg/WrenchStamped', s, 'f', 1.0, 0))
+            bag.write_message(
+                a, s, make_message('geometry_msgs/msg/WrenchStamped', s, 'f', 1.0, 0)
+            )
             bag.write_message(b, s, make_message('std_msgs/msg/Float64', s, 'f', 2.0, 0))
-    with pytest.raises(BagError, match=r'several input-type topics, choose one with --topic, '
-                                       r'e\.g\. `vib-estimator analyze \S+ --topic /a`: '
-                                       r'/a \(geometry_msgs/msg/WrenchStamped\)'
-                                       r'.*/b \(std_msgs/msg/Float64\)'):
+    with pytest.raises(
+        BagError,
+        match=r'several input-type topics, choose one with --topic, '
+        r'e\.g\. `vib-estimator analyze \S+ --topic /a`: '
+        r'/a \(geometry_msgs/msg/WrenchStamped\)'
+        r'.*/b \(std_msgs/msg/Float64\)',
+    ):
         open_signal(tmp_path / 'two')
     assert open_signal(tmp_path / 'two', '/b').component == 'data'
     with pytest.raises(ValueError, match='component of std_msgs/msg/Float64'):
@@ -189,6 +227,7 @@ def test_split_bag_is_read_across_its_files_in_log_time_order(tmp_path):
     split = tmp_path / 'split'
     split.mkdir()
     import yaml
+
     meta = yaml.safe_load((tmp_path / 'p0' / 'metadata.yaml').read_text())
     info = meta['rosbag2_bagfile_information']
     files = []
@@ -197,8 +236,15 @@ def test_split_bag_is_read_across_its_files_in_log_time_order(tmp_path):
         shutil.copy(src, split / f'split_{i}.mcap')
         files.append(f'split_{i}.mcap')
     info['relative_file_paths'] = files
-    info['files'] = [{'path': f, 'starting_time': info['starting_time'], 'duration':
-                      info['duration'], 'message_count': n // 2} for f in files]
+    info['files'] = [
+        {
+            'path': f,
+            'starting_time': info['starting_time'],
+            'duration': info['duration'],
+            'message_count': n // 2,
+        }
+        for f in files
+    ]
     info['message_count'] = n
     info['topics_with_message_count'][0]['message_count'] = n
     (split / 'metadata.yaml').write_text(yaml.safe_dump(meta))
@@ -212,7 +258,9 @@ def test_compressed_bags(tmp_path, mode):
     """zstd chunks (what rosbag2's MCAP writer does) on the fast path; whole-file and per-message
     compression through rosbags."""
     from rosbags.rosbag2 import CompressionFormat, CompressionMode, StoragePlugin, Writer
+
     from vib_estimator.io.bags import WRENCH_STAMPED, wrench_message
+
     n = 3000
     stamps = EPOCH + np.arange(n, dtype=np.int64) * 2_000_000
     values = np.cos(np.arange(n) * 0.1)
@@ -221,14 +269,17 @@ def test_compressed_bags(tmp_path, mode):
     with writer:
         conn = writer.add_connection('/w', WRENCH_STAMPED, typestore=TYPESTORE)
         for s, v in zip(stamps.tolist(), values.tolist()):
-            writer.write(conn, s, TYPESTORE.serialize_cdr(wrench_message(s, 'f', 'torque.z', v),
-                                                         WRENCH_STAMPED))
+            writer.write(
+                conn,
+                s,
+                TYPESTORE.serialize_cdr(wrench_message(s, 'f', 'torque.z', v), WRENCH_STAMPED),
+            )
     (t, y), _ = collect(open_signal(tmp_path / 'bag'))
     assert y.tolist() == values.tolist()
     assert np.array_equal(t, (stamps - stamps[0]) * 1e-9)
     if mode == 'STORAGE':
         plan = mcap.read_plan(sorted((tmp_path / 'bag').glob('*.mcap')), '/w')
-        with plan[0].path.open('rb') as handle:        # zstd chunks, read by the fast path
+        with plan[0].path.open('rb') as handle:  # zstd chunks, read by the fast path
             assert mcap.read_chunk(handle, plan[0]).offsets.size > 0
 
 
@@ -237,7 +288,7 @@ def test_a_csv_reads_the_same_without_pyarrow(tmp_path, monkeypatch):
     path = tmp_path / 'a.csv'
     path.write_text('t,y\n' + '\n'.join(f'{i * 0.002},{np.sin(i / 7):.12g}' for i in range(3000)))
     with_arrow = [np.concatenate(c) for c in zip(*open_signal(path).blocks())]
-    monkeypatch.setitem(sys.modules, 'pyarrow', None)       # import pyarrow -> ImportError
+    monkeypatch.setitem(sys.modules, 'pyarrow', None)  # import pyarrow -> ImportError
     monkeypatch.setitem(sys.modules, 'pyarrow.csv', None)
     without = [np.concatenate(c) for c in zip(*open_signal(path).blocks())]
     assert len(without[0]) == 3000

@@ -1,4 +1,7 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """bag_recorder: every published message recorded byte for byte; SIGINT leaves a complete bag."""
+
 from __future__ import annotations
 
 import os
@@ -26,9 +29,14 @@ RECORDER = [sys.executable, '-m', 'vib_estimator.nodes.bag_recorder']
 
 def recorder_process(output, topic, *params, **popen):
     args = ['topics:=[' + topic + ']', f'output:={output}', *params]
-    return subprocess.Popen(RECORDER + ['--ros-args'] + [a for p in args for a in ('-p', p)],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            env=dict(os.environ), **popen)
+    return subprocess.Popen(
+        RECORDER + ['--ros-args'] + [a for p in args for a in ('-p', p)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=dict(os.environ),
+        **popen,
+    )
 
 
 def recording(ros_context, executor, output, topic, msg_type, *params, **popen):
@@ -50,16 +58,18 @@ def wrench(i):
 
 
 def wait_for_subscriber(executor, publisher, timeout=15.0):
-    assert spin_until(executor, lambda: publisher.get_subscription_count() > 0, timeout), \
+    assert spin_until(executor, lambda: publisher.get_subscription_count() > 0, timeout), (
         'the recorder never subscribed'
+    )
 
 
 def test_records_every_message_exactly(ros_context, executor, tmp_path):
     """N messages published at 10x the sensor's 500 Hz into the real executable: all N recorded."""
     n, batch, period = 10_000, 10, 0.002  # 5000 messages/s
     topic = f'/rec_all_{os.getpid()}'
-    recorder, publisher = recording(ros_context, executor, tmp_path / 'bag', topic, WrenchStamped,
-                                    f'max_messages:={n}')
+    recorder, publisher = recording(
+        ros_context, executor, tmp_path / 'bag', topic, WrenchStamped, f'max_messages:={n}'
+    )
     try:
         wait_for_subscriber(executor, publisher)
         sent = [serialize_message(wrench(i)) for i in range(n)]
@@ -82,14 +92,15 @@ def test_records_every_message_exactly(ros_context, executor, tmp_path):
         recorded = [m.data for m in messages]
     assert all(m.topic == topic for m in messages)
     log_times = [m.log_time_ns for m in messages]
-    assert log_times == sorted(log_times)            # in the order received
+    assert log_times == sorted(log_times)  # in the order received
     # the bytes as received; only the CDR alignment padding (3 bytes after the frame_id here, plus
     # the wire's padding to a multiple of 4) is left uninitialised by the publisher's serializer
     assert [len(d) for d in recorded] == [len(d) for d in sent]
     # every field as sent (comparing re-serialised bytes was flaky: serialize_message leaves the
     # padding uninitialised too, so the same message serialised twice can differ in it)
     assert [deserialize_message(d, WrenchStamped) for d in recorded] == [
-        wrench(i) for i in range(n)]
+        wrench(i) for i in range(n)
+    ]
 
 
 def test_sigint_leaves_a_complete_bag(ros_context, executor, tmp_path):
@@ -113,23 +124,30 @@ def test_sigint_leaves_a_complete_bag(ros_context, executor, tmp_path):
     # the bytes received: the serialized message plus the wire's padding to a multiple of 4
     for i, data in enumerate(recorded):
         sent = serialize_message(String(data=f'message {i}'))
-        assert data[:len(sent)] == sent and len(data) % 4 == 0  # padding bytes: unspecified
+        assert data[: len(sent)] == sent and len(data) % 4 == 0  # padding bytes: unspecified
         assert deserialize_message(data, String).data == f'message {i}'
     assert len(recorded) == 50
 
 
-@pytest.mark.parametrize('params, message', [
-    ([], 'parameter topics is empty'),
-    (['topics:=[/x]'], 'parameter output is empty'),
-    (['topics:=[/x]', 'output:={existing}'], 'exists already'),
-    (['topics:=[/x]', 'output:={new}', 'storage:=rosbag1'], 'storage must be one of'),
-    (['topics:=[not a name]', 'output:={new}'], 'invalid topic name'),
-    (['topics:=[/x]', 'output:={new}', 'duration:=5'], "expecting type 'DOUBLE'"),
-])
+@pytest.mark.parametrize(
+    'params, message',
+    [
+        ([], 'parameter topics is empty'),
+        (['topics:=[/x]'], 'parameter output is empty'),
+        (['topics:=[/x]', 'output:={existing}'], 'exists already'),
+        (['topics:=[/x]', 'output:={new}', 'storage:=rosbag1'], 'storage must be one of'),
+        (['topics:=[not a name]', 'output:={new}'], 'invalid topic name'),
+        (['topics:=[/x]', 'output:={new}', 'duration:=5'], "expecting type 'DOUBLE'"),
+    ],
+)
 def test_bad_configuration_is_one_line_and_exit_2(tmp_path, params, message):
     params = [p.format(existing=tmp_path, new=tmp_path / 'new') for p in params]
-    result = subprocess.run(RECORDER + ['--ros-args'] + [a for p in params for a in ('-p', p)],
-                            capture_output=True, text=True, timeout=30)
+    result = subprocess.run(
+        RECORDER + ['--ros-args'] + [a for p in params for a in ('-p', p)],
+        capture_output=True,
+        text=True,
+        timeout=30,
+    )
     assert result.returncode == 2
     assert message in result.stderr and 'Traceback' not in result.stderr
     assert not (tmp_path / 'new').exists()
@@ -137,9 +155,14 @@ def test_bad_configuration_is_one_line_and_exit_2(tmp_path, params, message):
 
 def test_in_process_stops_after_max_messages(ros_context, executor, tmp_path):
     topic = f'/rec_max_{os.getpid()}'
-    recorder = BagRecorder(context=ros_context, parameter_overrides=[
-        Parameter('topics', value=[topic]), Parameter('output', value=str(tmp_path / 'bag')),
-        Parameter('max_messages', value=3)])
+    recorder = BagRecorder(
+        context=ros_context,
+        parameter_overrides=[
+            Parameter('topics', value=[topic]),
+            Parameter('output', value=str(tmp_path / 'bag')),
+            Parameter('max_messages', value=3),
+        ],
+    )
     node = Node('test_publisher', context=ros_context)
     publisher = node.create_publisher(String, topic, QoSProfile(depth=10))
     executor.add_node(recorder)
@@ -156,9 +179,14 @@ def test_in_process_stops_after_max_messages(ros_context, executor, tmp_path):
 
 
 def test_in_process_stops_after_duration(ros_context, executor, tmp_path):
-    recorder = BagRecorder(context=ros_context, parameter_overrides=[
-        Parameter('topics', value=['/nobody_publishes']),
-        Parameter('output', value=str(tmp_path / 'bag')), Parameter('duration', value=0.3)])
+    recorder = BagRecorder(
+        context=ros_context,
+        parameter_overrides=[
+            Parameter('topics', value=['/nobody_publishes']),
+            Parameter('output', value=str(tmp_path / 'bag')),
+            Parameter('duration', value=0.3),
+        ],
+    )
     executor.add_node(recorder)
     began = time.monotonic()
     assert spin_until(executor, lambda: recorder.finished, 5)
@@ -169,12 +197,13 @@ def test_in_process_stops_after_duration(ros_context, executor, tmp_path):
 
 # -- crash safety, splitting, write errors --------------------------------------------------------
 
+
 def publish_for(executor, publisher, seconds, period=0.002, count=None, first=0):
     """Publish Strings numbered from ``first`` for ``seconds`` (or ``count`` of them), paced at
     ``period``; their publication times (monotonic)."""
     times = []
     start = time.monotonic()
-    while (len(times) < count if count else time.monotonic() - start < seconds):
+    while len(times) < count if count else time.monotonic() - start < seconds:
         publisher.publish(String(data=f'message {first + len(times)}'))
         times.append(time.monotonic())
         executor.spin_once(timeout_sec=0)
@@ -187,11 +216,13 @@ def test_sigkill_loses_at_most_the_last_second(ros_context, executor, tmp_path, 
     """Killed with SIGKILL mid-recording, reindexed: rosbags reads every message published more
     than a second before the kill."""
     from rosbags.rosbag2 import Reader
+
     from vib_estimator.io.reindex import reindex
 
     topic = f'/rec_kill_{storage}_{os.getpid()}'
-    recorder, publisher = recording(ros_context, executor, tmp_path / 'bag', topic, String,
-                                    f'storage:={storage}')
+    recorder, publisher = recording(
+        ros_context, executor, tmp_path / 'bag', topic, String, f'storage:={storage}'
+    )
     try:
         wait_for_subscriber(executor, publisher)
         times = publish_for(executor, publisher, 3.0)
@@ -213,9 +244,15 @@ def test_split_recording_replays_in_order(ros_context, executor, tmp_path):
     from vib_estimator.nodes.bag_replayer import BagReplayer
 
     topic = f'/rec_split_{os.getpid()}'
-    recorder = BagRecorder(context=ros_context, parameter_overrides=[
-        Parameter('topics', value=[topic]), Parameter('output', value=str(tmp_path / 'bag')),
-        Parameter('max_bag_duration', value=0.3), Parameter('max_messages', value=400)])
+    recorder = BagRecorder(
+        context=ros_context,
+        parameter_overrides=[
+            Parameter('topics', value=[topic]),
+            Parameter('output', value=str(tmp_path / 'bag')),
+            Parameter('max_bag_duration', value=0.3),
+            Parameter('max_messages', value=400),
+        ],
+    )
     node = Node('test_publisher', context=ros_context)
     publisher = node.create_publisher(String, topic, QoSProfile(depth=1000))
     executor.add_node(recorder)
@@ -227,22 +264,30 @@ def test_split_recording_replays_in_order(ros_context, executor, tmp_path):
     files = sorted(p.name for p in (tmp_path / 'bag').glob('*.mcap'))
     assert len(files) >= 3 and files[:3] == ['bag_0.mcap', 'bag_1.mcap', 'bag_2.mcap']
 
-    replayer = BagReplayer(context=ros_context, parameter_overrides=[
-        Parameter('bag', value=str(tmp_path / 'bag')), Parameter('rate', value=4.0),
-        Parameter('remap', value=[f'{topic}:=/replayed_split'])])
+    replayer = BagReplayer(
+        context=ros_context,
+        parameter_overrides=[
+            Parameter('bag', value=str(tmp_path / 'bag')),
+            Parameter('rate', value=4.0),
+            Parameter('remap', value=[f'{topic}:=/replayed_split']),
+        ],
+    )
     received = []
-    node.create_subscription(String, '/replayed_split', lambda m: received.append(m.data),
-                             QoSProfile(depth=1000))
+    node.create_subscription(
+        String, '/replayed_split', lambda m: received.append(m.data), QoSProfile(depth=1000)
+    )
     executor.add_node(replayer)
     assert spin_until(executor, lambda: replayer.finished, 20)
     assert spin_until(executor, lambda: len(received) == 400, 5)
     assert received == [f'message {i}' for i in range(400)]
 
 
-def test_file_too_large_is_one_error_line_exit_2_and_the_bag_stays_readable(ros_context, executor,
-                                                                           tmp_path):
+def test_file_too_large_is_one_error_line_exit_2_and_the_bag_stays_readable(
+    ros_context, executor, tmp_path
+):
     """A write refused by the system (here RLIMIT_FSIZE, as a full disk would): exit 2."""
     import resource
+
     from vib_estimator.io.reindex import reindex
 
     topic = f'/rec_full_{os.getpid()}'
@@ -251,8 +296,15 @@ def test_file_too_large_is_one_error_line_exit_2_and_the_bag_stays_readable(ros_
     def small_disk():
         resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
 
-    recorder, publisher = recording(ros_context, executor, tmp_path / 'bag', topic, String,
-                                    'flush_period:=0.2', preexec_fn=small_disk)
+    recorder, publisher = recording(
+        ros_context,
+        executor,
+        tmp_path / 'bag',
+        topic,
+        String,
+        'flush_period:=0.2',
+        preexec_fn=small_disk,
+    )
     try:
         wait_for_subscriber(executor, publisher)
         deadline, sent = time.monotonic() + 20, 0
@@ -272,10 +324,13 @@ def test_file_too_large_is_one_error_line_exit_2_and_the_bag_stays_readable(ros_
 
 
 def test_an_output_that_cannot_be_created_is_one_plain_error_before_recording(tmp_path):
-    """``output:=/proc/newbag`` used to say "what was written before is kept" (issue 22, case 8)."""
-    result = subprocess.run(RECORDER + ['--ros-args', '-p', 'topics:=[/x]', '-p',
-                                        'output:=/proc/newbag'],
-                            capture_output=True, text=True, timeout=30)
+    """``output:=/proc/newbag`` used to say "what was written before is kept" (issue 22, 8)."""
+    result = subprocess.run(
+        RECORDER + ['--ros-args', '-p', 'topics:=[/x]', '-p', 'output:=/proc/newbag'],
+        capture_output=True,
+        text=True,
+        timeout=30,
+    )
     assert result.returncode == 2 and 'Traceback' not in result.stderr
     errors = [line for line in result.stderr.splitlines() if line.startswith('error: ')]
     assert len(errors) == 1 and 'cannot create bag directory /proc/newbag' in errors[0]

@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """config/<executable>.yaml of sim_node, shaper_node, bag_replayer and bag_recorder (issue 23).
 
 Each file holds exactly the parameters its node declares, with the node's defaults (read from a
@@ -5,6 +7,7 @@ node started without the file: a default changed in the node and not in the file
 comment on each, under ``/**:``; and it loads into the node through rcl's own parser
 (``--params-file``), under a namespace too. (estimator_node's file: test_launch_config.py.)
 """
+
 from __future__ import annotations
 
 import os
@@ -31,10 +34,18 @@ def _required(tmp_path):
     return {
         'sim.yaml': (SimNode, [], ('noise_std: 0.004', 'noise_std: 0.25'), ('noise_std', 0.25)),
         'shaper.yaml': (ShaperNode, [], ('median_of: 1', 'median_of: 5'), ('median_of', 5)),
-        'replayer.yaml': (BagReplayer, [f'bag:={BAG}'], ('wait_timeout: 5.0', 'wait_timeout: 2.5'),
-                          ('wait_timeout', 2.5)),
-        'recorder.yaml': (BagRecorder, [f'output:={tmp_path / "bag"}', 'topics:=[chatter]'],
-                          ('flush_period: 1.0', 'flush_period: 0.5'), ('flush_period', 0.5)),
+        'replayer.yaml': (
+            BagReplayer,
+            [f'bag:={BAG}'],
+            ('wait_timeout: 5.0', 'wait_timeout: 2.5'),
+            ('wait_timeout', 2.5),
+        ),
+        'recorder.yaml': (
+            BagRecorder,
+            [f'output:={tmp_path / "bag"}', 'topics:=[chatter]'],
+            ('flush_period: 1.0', 'flush_period: 0.5'),
+            ('flush_period', 0.5),
+        ),
     }
 
 
@@ -76,10 +87,10 @@ def test_file_holds_the_declared_parameters_with_their_defaults(name, tmp_path):
     assert set(params) == set(defaults)
     given = {value.split(':=')[0] for value in required}
     for key, value in params.items():
-        if key in given:                                   # required: the file leaves it empty
+        if key in given:  # required: the file leaves it empty
             assert value in ('', []), key
             continue
-        default = [] if defaults[key] is None else defaults[key]   # a string array without value
+        default = [] if defaults[key] is None else defaults[key]  # a string array without value
         assert value == default and type(value) is type(default), (key, value, default)
     lines = path.read_text().split('/**:', 1)[1].splitlines()
     for key in params:
@@ -95,8 +106,9 @@ def test_file_loads_into_the_node_under_any_namespace(name, tmp_path):
     text = path.read_text()
     assert text.count(old) == 1
     changed.write_text(text.replace(old, new))
-    values = _parameters(node_class, '-r', '__ns:=/robot1', '--params-file', str(changed),
-                         *_overrides(required))
+    values = _parameters(
+        node_class, '-r', '__ns:=/robot1', '--params-file', str(changed), *_overrides(required)
+    )
     assert values[key] == expected
     given = {value.split(':=')[0] for value in required}
     for param, value in data['/**']['ros__parameters'].items():

@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """estimator_node, in process (fresh context, isolated domain) and as an executable (SIGINT).
 
 Samples are published with explicit header stamps in batches as fast as the node takes them (each
@@ -5,6 +7,7 @@ batch waits for the node's counters), never in real time; samples without a head
 (std_msgs/Float64) are paced by a simulated /clock. Waits are on matched counts and counters, not
 sleeps.
 """
+
 from __future__ import annotations
 
 import math
@@ -27,15 +30,15 @@ from std_srvs.srv import Trigger
 from vib_estimator.core import Estimate, EstimatorConfig, FrequencyEstimator
 from vib_estimator.core.config import PAPER
 from vib_estimator.io import fields
-from vib_estimator.nodes.estimator_node import EstimatorNode, message_class
-from vib_estimator.nodes import stream
-from vib_estimator.nodes.runner import StartupError, spin_until
 from vib_estimator.io.fields import seconds_since
+from vib_estimator.nodes import stream
+from vib_estimator.nodes.estimator_node import EstimatorNode, message_class
+from vib_estimator.nodes.runner import StartupError, spin_until
 
-EPOCH_NS = 1_000_000_000 * 1_000_000_000   # synthetic stamps start in 2001, far from "now"
+EPOCH_NS = 1_000_000_000 * 1_000_000_000  # synthetic stamps start in 2001, far from "now"
 FS = 500.0
 FRAME = 'arm_base'
-BATCH = 50                                  # < the node's input depth: nothing is dropped
+BATCH = 50  # < the node's input depth: nothing is dropped
 #: the outputs of one estimate, in publication order
 OUTPUTS = ['frequency', 'damping_ratio', 'frequency_std', 'amplitude', 'reset']
 JOINTS = ['shoulder', 'elbow', 'wrist']
@@ -46,13 +49,14 @@ def message(input_type, component, stamp_ns, value, joints=JOINTS):
     component among ``joints``, in that order; the others get other values)."""
     msg = message_class(input_type)()
     if fields.has_header(input_type):
-        msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(int(stamp_ns), 10 ** 9)
+        msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(int(stamp_ns), 10**9)
         msg.header.frame_id = FRAME
     if input_type == fields.JOINT_STATE:
         array, joint = component[:-1].split('[')
         for i, name in enumerate(joints):
             fields.component_setter(f'{array}[{name}]', input_type)(
-                msg, value if name == joint else 100.0 + i)
+                msg, value if name == joint else 100.0 + i
+            )
     else:
         fields.component_setter(component, input_type)(msg, value)
     return msg
@@ -66,29 +70,45 @@ class Probe:
         self.node = node
         self.input_type = fields.check_input_type(node.get_parameter('input_type').value)
         self.probe = Node('probe', context=context)
-        self.pub = self.probe.create_publisher(message_class(self.input_type),
-                                               'coupling_torque', 1000)
-        self.events = []       # (topic, value) or ('reset', stamp ns, frame_id), in order
+        self.pub = self.probe.create_publisher(
+            message_class(self.input_type), 'coupling_torque', 1000
+        )
+        self.events = []  # (topic, value) or ('reset', stamp ns, frame_id), in order
         self.diagnostics = []
-        topics = OUTPUTS + [f'mode{k}/{n}' for k in range(1, modes + 1)
-                            for n in ('frequency', 'reset')]
+        topics = OUTPUTS + [
+            f'mode{k}/{n}' for k in range(1, modes + 1) for n in ('frequency', 'reset')
+        ]
         subs = [self._listen(topic) for topic in topics] + [
-            self.probe.create_subscription(DiagnosticArray, '/diagnostics',
-                                           self.diagnostics.append, 10)]
+            self.probe.create_subscription(
+                DiagnosticArray, '/diagnostics', self.diagnostics.append, 10
+            )
+        ]
         executor.add_node(node)
         executor.add_node(self.probe)
-        assert spin_until(executor, lambda: self.pub.get_subscription_count() >= 1
-                          and all(s.get_publisher_count() >= 1 for s in subs), 10.0)
+        assert spin_until(
+            executor,
+            lambda: (
+                self.pub.get_subscription_count() >= 1
+                and all(s.get_publisher_count() >= 1 for s in subs)
+            ),
+            10.0,
+        )
         self.sent = 0
         self.modes = modes
 
     def _listen(self, topic):
         if topic.endswith('reset'):
             return self.probe.create_subscription(
-                Header, f'vibration/{topic}', lambda m: self.events.append(
-                    (topic, m.stamp.sec * 1_000_000_000 + m.stamp.nanosec, m.frame_id)), 100)
+                Header,
+                f'vibration/{topic}',
+                lambda m: self.events.append(
+                    (topic, m.stamp.sec * 1_000_000_000 + m.stamp.nanosec, m.frame_id)
+                ),
+                100,
+            )
         return self.probe.create_subscription(
-            Float64, f'vibration/{topic}', lambda m: self.events.append((topic, m.data)), 100)
+            Float64, f'vibration/{topic}', lambda m: self.events.append((topic, m.data)), 100
+        )
 
     def taken(self):
         counters = self.node.counters
@@ -97,28 +117,35 @@ class Probe:
     def publish(self, msgs):
         """Publish messages in batches, each taken by the node before the next."""
         for start in range(0, len(msgs), BATCH):
-            for msg in msgs[start:start + BATCH]:
+            for msg in msgs[start : start + BATCH]:
                 self.pub.publish(msg)
                 self.sent += 1
-            assert spin_until(self.executor, lambda: self.taken() >= self.sent, 10.0), \
+            assert spin_until(self.executor, lambda: self.taken() >= self.sent, 10.0), (
                 f'node took {self.taken()} of {self.sent} samples'
+            )
         self.wait_outputs()
 
     def wait_outputs(self):
         """Until the outputs of every estimate so far arrived (of every mode, with modes)."""
+
         def arrived():
             estimates = self.node.counters['estimates']
             if self.modes:
                 mode1 = len(self.resets('mode1/reset'))
-                estimates = max(estimates - sum(len(self.resets(f'mode{k}/reset'))
-                                                for k in range(2, self.modes + 1)), mode1)
+                estimates = max(
+                    estimates
+                    - sum(len(self.resets(f'mode{k}/reset')) for k in range(2, self.modes + 1)),
+                    mode1,
+                )
             return len(self.resets()) >= estimates and len(self.frequencies()) >= estimates
+
         assert spin_until(self.executor, arrived, 5.0)
 
     def feed(self, stamps_ns, values, component='torque.z', joints=JOINTS):
         """Publish samples (stamp 0 = a zero stamp) of the node's input type."""
-        self.publish([message(self.input_type, component, s, v, joints)
-                      for s, v in zip(stamps_ns, values)])
+        self.publish(
+            [message(self.input_type, component, s, v, joints) for s, v in zip(stamps_ns, values)]
+        )
 
     def values(self, topic='frequency'):
         return [e[1] for e in self.events if e[0] == topic]
@@ -145,8 +172,10 @@ class Probe:
 
         def found():
             return any(predicate(a.status[0]) for a in self.diagnostics[start:])
-        assert spin_until(self.executor, found, timeout), \
-            [(a.status[0].level, a.status[0].message) for a in self.diagnostics[start:]]
+
+        assert spin_until(self.executor, found, timeout), [
+            (a.status[0].level, a.status[0].message) for a in self.diagnostics[start:]
+        ]
         return next(a.status[0] for a in self.diagnostics[start:] if predicate(a.status[0]))
 
     def status_age(self, status: DiagnosticStatus, since: float) -> float:
@@ -187,10 +216,13 @@ def make_probe(ros_context, executor):
         if modes:
             overrides['modes'] = modes
         overrides = {**PAPER, **overrides}
-        node = EstimatorNode(context=ros_context, parameter_overrides=[
-            Parameter(k, value=v) for k, v in overrides.items()])
+        node = EstimatorNode(
+            context=ros_context,
+            parameter_overrides=[Parameter(k, value=v) for k, v in overrides.items()],
+        )
         made.append(node)
         return Probe(ros_context, executor, node, modes)
+
     yield make
     for node in made:
         node.destroy_node()
@@ -208,35 +240,36 @@ def test_sine_gives_the_outputs_in_order(make_probe):
     assert all(abs(f - 1.33) < 1.33e-3 for f in freqs), freqs
     # frequency, damping ratio, its std, amplitude, then reset: one each per estimate
     assert [e[0] for e in p.events] == OUTPUTS * len(expected)
-    assert all(math.isnan(d) for d in p.values('damping_ratio'))      # sinusoid: no damping
+    assert all(math.isnan(d) for d in p.values('damping_ratio'))  # sinusoid: no damping
     np.testing.assert_array_equal(p.values('frequency_std'), expected.frequency_std_hz)
     assert p.values('amplitude') == expected.amplitude.tolist()
     assert all(abs(a - 0.7) < 0.7e-2 for a in p.values('amplitude'))
     # the reset stamped with the converging sample
-    converging = [stamps[i] for i in np.searchsorted(
-        seconds_since(np.asarray(stamps), stamps[0]), expected.t)]
+    converging = [
+        stamps[i]
+        for i in np.searchsorted(seconds_since(np.asarray(stamps), stamps[0]), expected.t)
+    ]
     assert p.resets() == [(s, FRAME) for s in converging]
 
 
 def test_node_and_offline_give_the_same_floats(make_probe):
     rng = np.random.default_rng(7)
     n = 4000
-    jitter = rng.integers(-200_000, 200_000, n)           # +-0.2 ms around 500 Hz
+    jitter = rng.integers(-200_000, 200_000, n)  # +-0.2 ms around 500 Hz
     stamps = [s + int(j) for s, j in zip(sine_stamps(n, EPOCH_NS + 123_456_789), jitter)]
     t = seconds_since(np.asarray(stamps), stamps[0])
-    values = (0.1 * np.exp(-0.03 * t) * np.sin(2 * np.pi * 1.33 * t + 0.4)
-              + rng.normal(0, 2e-4, n))
+    values = 0.1 * np.exp(-0.03 * t) * np.sin(2 * np.pi * 1.33 * t + 0.4) + rng.normal(0, 2e-4, n)
     p = make_probe(component='force.y')
     p.feed(stamps, values, component='force.y')
     expected = offline(stamps, values)
     assert len(expected) >= 5
-    assert p.frequencies() == expected.frequency_hz.tolist()   # exactly
+    assert p.frequencies() == expected.frequency_hz.tolist()  # exactly
     assert [r[0] for r in p.resets()] == [stamps[i] for i in np.searchsorted(t, expected.t)]
 
 
 def test_bad_input_is_counted_and_estimation_resumes(make_probe):
     p = make_probe(min_amplitude=0.05)
-    assert p.wait_status(lambda s: True).level == DiagnosticStatus.STALE   # no input yet
+    assert p.wait_status(lambda s: True).level == DiagnosticStatus.STALE  # no input yet
 
     def sine(n, start, amplitude=1.0):
         stamps = sine_stamps(n, start)
@@ -245,10 +278,16 @@ def test_bad_input_is_counted_and_estimation_resumes(make_probe):
     stamps, values = sine(500, EPOCH_NS)
     last = stamps[-1]
     step = stamps[1] - stamps[0]
-    bad = [(last + step, math.nan), (last + 2 * step, math.inf),   # non-finite
-           (last + 3 * step, 0.5), (last + 3 * step, 0.5),        # duplicate
-           (last + 2 * step + step // 2, 0.5),                     # out of order (< max_gap)
-           (0, 0.1), (0, 0.2), (0, 0.3)]                           # zero stamps: receipt time
+    bad = [
+        (last + step, math.nan),
+        (last + 2 * step, math.inf),  # non-finite
+        (last + 3 * step, 0.5),
+        (last + 3 * step, 0.5),  # duplicate
+        (last + 2 * step + step // 2, 0.5),  # out of order (< max_gap)
+        (0, 0.1),
+        (0, 0.2),
+        (0, 0.3),
+    ]  # zero stamps: receipt time
     stamps += [s for s, _ in bad]
     values += [v for _, v in bad]
     # back to the stream (a backward jump from the receipt time), then a 2 s gap, then rest
@@ -264,16 +303,17 @@ def test_bad_input_is_counted_and_estimation_resumes(make_probe):
     p.feed(resumed, resumed_values)
     assert p.node.counters['estimates'] >= estimates_before_rest + 3
     total = p.sent
-    ok = p.wait_status(lambda s: s.level == DiagnosticStatus.OK
-                       and values_of(s)['received'] == str(total))
+    ok = p.wait_status(
+        lambda s: s.level == DiagnosticStatus.OK and values_of(s)['received'] == str(total)
+    )
     kv = values_of(ok)
     assert ok.name == '/estimator_node' and ok.hardware_id == '/coupling_torque'
     assert kv['skipped_non_finite'] == '2'
     assert kv['skipped_duplicate'] == '1'
     assert kv['skipped_out_of_order'] == '1'
     assert kv['zero_stamps_replaced'] == '3'
-    assert kv['gap_resets'] == '2'          # to the receipt time, and the 2 s gap
-    assert kv['time_jump_resets'] == '1'    # from the receipt time back to the stream
+    assert kv['gap_resets'] == '2'  # to the receipt time, and the 2 s gap
+    assert kv['time_jump_resets'] == '1'  # from the receipt time back to the stream
     assert int(kv['rejected_at_rest']) >= 1
     assert int(kv['used']) == total - 4
     assert kv['estimates'] == str(p.node.counters['estimates'])
@@ -281,16 +321,23 @@ def test_bad_input_is_counted_and_estimation_resumes(make_probe):
     assert 0 < float(kv['last_convergence_time_s']) < 1.0
     # input_rate_hz: the messages taken between two statuses over the time between them (the
     # statuses' stamps, ~1 s apart); the input came in bursts, so some intervals saw none
-    seen = [(a.header.stamp.sec + 1e-9 * a.header.stamp.nanosec, values_of(a.status[0]))
-            for a in p.diagnostics]
-    pairs = [(int(kv['received']) - int(prev['received']), t - t_prev, float(kv['input_rate_hz']))
-             for (t_prev, prev), (t, kv) in zip(seen, seen[1:])]
+    seen = [
+        (a.header.stamp.sec + 1e-9 * a.header.stamp.nanosec, values_of(a.status[0]))
+        for a in p.diagnostics
+    ]
+    pairs = [
+        (int(kv['received']) - int(prev['received']), t - t_prev, float(kv['input_rate_hz']))
+        for (t_prev, prev), (t, kv) in zip(seen, seen[1:])
+    ]
     assert sum(n for n, _, _ in pairs) == total - int(seen[0][1]['received'])
     assert any(n > 0 for n, _, _ in pairs)
     for n, dt, rate in pairs:
         assert rate == pytest.approx(n / dt, rel=0.1, abs=1e-12), (n, dt, rate)
-    assert set(kv) >= set(p.node.counters) | {'last_frequency_hz', 'last_convergence_time_s',
-                                              'input_rate_hz'}
+    assert set(kv) >= set(p.node.counters) | {
+        'last_frequency_hz',
+        'last_convergence_time_s',
+        'input_rate_hz',
+    }
 
 
 def test_parameter_changes(make_probe):
@@ -313,33 +360,47 @@ def test_parameter_changes(make_probe):
 
     feed(0, PAPER_CONFIG)
     # invalid: refused with a reason, the parameters and the estimator untouched
-    names = ['window', 'lowpass_damping', 'band_hz', 'model', 'min_time', 'component',
-             'input_topic', 'input_type']
+    names = [
+        'window',
+        'lowpass_damping',
+        'band_hz',
+        'model',
+        'min_time',
+        'component',
+        'input_topic',
+        'input_type',
+    ]
     kept = {name: p.node.get_parameter(name).value for name in names}
     for name, value, reason in [
-            ('window', 0, 'window out of range'), ('lowpass_damping', -1.0, 'out of range'),
-            ('band_hz', [5.0, 1.0], 'band_hz must be'), ('model', 'foo', 'model must be'),
-            ('min_time', 20.0, 'must be below max_window'), ('component', 'torque.w', 'torque.w'),
-            ('input_topic', 'elsewhere', 'read-only'), ('window', 2.5, 'expected'),
-            ('input_type', fields.IMU, 'read-only'),
-            ('component', 'linear_acceleration.z', 'component of geometry_msgs/msg/Wrench')]:
+        ('window', 0, 'window out of range'),
+        ('lowpass_damping', -1.0, 'out of range'),
+        ('band_hz', [5.0, 1.0], 'band_hz must be'),
+        ('model', 'foo', 'model must be'),
+        ('min_time', 20.0, 'must be below max_window'),
+        ('component', 'torque.w', 'torque.w'),
+        ('input_topic', 'elsewhere', 'read-only'),
+        ('window', 2.5, 'expected'),
+        ('input_type', fields.IMU, 'read-only'),
+        ('component', 'linear_acceleration.z', 'component of geometry_msgs/msg/Wrench'),
+    ]:
         result = p.node.set_parameters([Parameter(name, value=value)])[0]
         assert not result.successful and reason in result.reason, (name, result.reason)
     assert {name: p.node.get_parameter(name).value for name in names} == kept
     # the segment went on through the refusals: the estimates of parts 0-1 as one stream
     before = len(p.frequencies())
-    p.feed(stamps[parts[1]:parts[2]], values[parts[1]:parts[2]])
-    whole = offline(stamps[:parts[2]], values[:parts[2]])
+    p.feed(stamps[parts[1] : parts[2]], values[parts[1] : parts[2]])
+    whole = offline(stamps[: parts[2]], values[: parts[2]])
     assert len(whole) > before and p.frequencies() == whole.frequency_hz.tolist()
     # valid: a new estimator with the new configuration, same time origin
     assert p.node.set_parameters([Parameter('window', value=5)])[0].successful
     assert p.node.get_parameter('window').value == 5
     feed(2, PAPER_CONFIG.replace(window=5))
-    assert p.node.counters['received'] == parts[3]        # counters span the change
+    assert p.node.counters['received'] == parts[3]  # counters span the change
     assert p.node.set_parameters([Parameter('band_hz', value=[0.5, 5.0])])[0].successful
     feed(3, PAPER_CONFIG.replace(window=5, band_hz=(0.5, 5.0)))
-    assert p.node.set_parameters(
-        [Parameter('band_hz', Parameter.Type.DOUBLE_ARRAY, [])])[0].successful
+    assert p.node.set_parameters([Parameter('band_hz', Parameter.Type.DOUBLE_ARRAY, [])])[
+        0
+    ].successful
     feed(4, PAPER_CONFIG.replace(window=5))
 
 
@@ -347,9 +408,12 @@ def test_sigint_shuts_down_cleanly(ros_context):
     probe = Node('sigint_probe', context=ros_context)
     proc = subprocess.Popen(
         [os.path.join(os.path.dirname(sys.executable), 'estimator_node')],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
         # a test run in a background job inherits SIGINT ignored: give the node the default
-        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
     try:
         deadline = time.monotonic() + 20
         while probe.count_subscribers('/coupling_torque') < 1 and time.monotonic() < deadline:
@@ -366,7 +430,7 @@ def test_sigint_shuts_down_cleanly(ros_context):
     assert 'Traceback' not in err, err
 
 
-SIM_START_NS = 5_000 * 10 ** 9     # simulated time, far from the wall clock
+SIM_START_NS = 5_000 * 10**9  # simulated time, far from the wall clock
 
 
 def feed_on_sim_clock(p, values, component):
@@ -376,10 +440,9 @@ def feed_on_sim_clock(p, values, component):
     clock = Clock()
     for i, value in enumerate(values):
         now_ns = SIM_START_NS + round(i * 1e9 / FS)
-        clock.clock.sec, clock.clock.nanosec = divmod(now_ns, 10 ** 9)
+        clock.clock.sec, clock.clock.nanosec = divmod(now_ns, 10**9)
         clock_pub.publish(clock)
-        assert spin_until(p.executor, lambda: p.node.get_clock().now().nanoseconds == now_ns,
-                          5.0)
+        assert spin_until(p.executor, lambda: p.node.get_clock().now().nanoseconds == now_ns, 5.0)
         p.pub.publish(message(p.input_type, component, 0, value))
         p.sent += 1
         assert spin_until(p.executor, lambda: p.node.counters['received'] >= p.sent, 5.0)
@@ -390,7 +453,7 @@ def feed_on_sim_clock(p, values, component):
 def test_use_sim_time_zero_stamps_follow_the_simulated_clock(make_probe):
     """With use_sim_time, a zero stamp becomes the /clock time at receipt; estimates follow it."""
     p = make_probe(use_sim_time=True)
-    values = np.sin(2 * np.pi * 1.33 * np.arange(800) / FS)     # 1.6 s at 500 Hz
+    values = np.sin(2 * np.pi * 1.33 * np.arange(800) / FS)  # 1.6 s at 500 Hz
     stamps = feed_on_sim_clock(p, values, 'torque.z')
     assert p.node.counters['zero_stamps_replaced'] == 800
     expected = offline(stamps, values)
@@ -400,10 +463,17 @@ def test_use_sim_time_zero_stamps_follow_the_simulated_clock(make_probe):
 
 
 # ---- input types ----------------------------------------------------------------------------
-@pytest.mark.parametrize('input_type, component', [
-    (fields.IMU, 'linear_acceleration.y'), (fields.IMU, 'angular_velocity.z'),
-    (fields.ACCEL_STAMPED, 'accel.linear.x'), (fields.VECTOR3_STAMPED, 'vector.z'),
-    (fields.JOINT_STATE, 'effort[elbow]'), (fields.WRENCH_STAMPED, 'force.x')])
+@pytest.mark.parametrize(
+    'input_type, component',
+    [
+        (fields.IMU, 'linear_acceleration.y'),
+        (fields.IMU, 'angular_velocity.z'),
+        (fields.ACCEL_STAMPED, 'accel.linear.x'),
+        (fields.VECTOR3_STAMPED, 'vector.z'),
+        (fields.JOINT_STATE, 'effort[elbow]'),
+        (fields.WRENCH_STAMPED, 'force.x'),
+    ],
+)
 def test_each_input_type_end_to_end(make_probe, input_type, component):
     p = make_probe(input_type=input_type, component=component)
     stamps = sine_stamps(2000)
@@ -419,7 +489,7 @@ def test_each_input_type_end_to_end(make_probe, input_type, component):
 
 def test_float64_input_is_timed_by_the_node_clock(make_probe):
     """std_msgs/Float64 has no header: receipt time on the node clock (here /clock)."""
-    p = make_probe(input_type='std_msgs/Float64', use_sim_time=True)   # short name accepted
+    p = make_probe(input_type='std_msgs/Float64', use_sim_time=True)  # short name accepted
     assert p.input_type == fields.FLOAT64 and p.node.get_parameter('component').value == 'data'
     values = np.sin(2 * np.pi * 1.33 * np.arange(800) / FS)
     stamps = feed_on_sim_clock(p, values, 'data')
@@ -427,8 +497,10 @@ def test_float64_input_is_timed_by_the_node_clock(make_probe):
     assert len(expected) >= 2 and p.frequencies() == expected.frequency_hz.tolist()
     assert all(abs(f / 1.33 - 1) < 1e-3 for f in p.frequencies())
     assert [e[0] for e in p.events] == OUTPUTS * len(expected)
-    converging = [stamps[i] for i in np.searchsorted(
-        seconds_since(np.asarray(stamps), stamps[0]), expected.t)]
+    converging = [
+        stamps[i]
+        for i in np.searchsorted(seconds_since(np.asarray(stamps), stamps[0]), expected.t)
+    ]
     assert p.resets() == [(s, '') for s in converging]
     assert p.node.counters['zero_stamps_replaced'] == 0
 
@@ -440,9 +512,16 @@ def test_joint_state_joint_found_by_name_absent_counted(make_probe):
     values = np.sin(2 * np.pi * 1.33 * np.arange(n) / FS)
     absent = set(range(300, 2000, 97))
     orders = [JOINTS, JOINTS[::-1], ['wrist', 'shoulder', 'elbow']]
-    msgs = [message(fields.JOINT_STATE, 'position[wrist]', s, v,
-                    ['shoulder', 'elbow'] if i in absent else orders[i % 3])
-            for i, (s, v) in enumerate(zip(stamps, values))]
+    msgs = [
+        message(
+            fields.JOINT_STATE,
+            'position[wrist]',
+            s,
+            v,
+            ['shoulder', 'elbow'] if i in absent else orders[i % 3],
+        )
+        for i, (s, v) in enumerate(zip(stamps, values))
+    ]
     p.publish(msgs)
     kept = [i for i in range(n) if i not in absent]
     expected = offline([stamps[i] for i in kept], values[kept])
@@ -457,27 +536,36 @@ def test_joint_state_joint_found_by_name_absent_counted(make_probe):
     said = int(re.search(r'\b(\d+) messages without the joint', status.message).group(1))
     assert 0 < said <= missing_then == len(absent)
     p.feed(sine_stamps(50, stamps[-1] + 2_000_000), values[:50], component='position[wrist]')
-    ok = p.wait_status(lambda s: values_of(s)['received'] == str(len(kept) + 50)
-                       and 'without the joint' not in s.message)
+    ok = p.wait_status(
+        lambda s: (
+            values_of(s)['received'] == str(len(kept) + 50)
+            and 'without the joint' not in s.message
+        )
+    )
     assert values_of(ok)['skipped_joint_missing'] == str(len(absent))
 
 
 def test_component_is_checked_against_the_type(ros_context):
     for overrides, reason in [
-            ({'input_type': fields.IMU, 'component': 'torque.z'}, 'component of sensor_msgs'),
-            ({'input_type': 'foo_msgs/msg/Bar'}, 'input_type must be one of'),
-            ({'input_type': fields.JOINT_STATE, 'component': 'effort'}, 'effort[NAME]')]:
+        ({'input_type': fields.IMU, 'component': 'torque.z'}, 'component of sensor_msgs'),
+        ({'input_type': 'foo_msgs/msg/Bar'}, 'input_type must be one of'),
+        ({'input_type': fields.JOINT_STATE, 'component': 'effort'}, 'effort[NAME]'),
+    ]:
         with pytest.raises(StartupError, match=reason.replace('[', r'\[')):
-            EstimatorNode(context=ros_context, parameter_overrides=[
-                Parameter(k, value=v) for k, v in overrides.items()])
-    node = EstimatorNode(context=ros_context, parameter_overrides=[
-        Parameter('input_type', value=fields.IMU)])
+            EstimatorNode(
+                context=ros_context,
+                parameter_overrides=[Parameter(k, value=v) for k, v in overrides.items()],
+            )
+    node = EstimatorNode(
+        context=ros_context, parameter_overrides=[Parameter('input_type', value=fields.IMU)]
+    )
     try:
         assert node.get_parameter('component').value == 'linear_acceleration.z'
         refused = node.set_parameters([Parameter('component', value='torque.z')])[0]
         assert not refused.successful and 'linear_acceleration.x' in refused.reason
-        assert node.set_parameters([Parameter('component', value='angular_velocity.x')])[0] \
-            .successful
+        assert node.set_parameters([Parameter('component', value='angular_velocity.x')])[
+            0
+        ].successful
         assert node.describe_parameter('input_type').read_only
     finally:
         node.destroy_node()
@@ -485,14 +573,24 @@ def test_component_is_checked_against_the_type(ros_context):
 
 def test_a_component_of_another_type_is_one_error_line_and_exit_2():
     result = subprocess.run(
-        [os.path.join(os.path.dirname(sys.executable), 'estimator_node'), '--ros-args',
-         '-p', 'input_type:=sensor_msgs/msg/Imu', '-p', 'component:=torque.z'],
-        capture_output=True, text=True, timeout=60)
+        [
+            os.path.join(os.path.dirname(sys.executable), 'estimator_node'),
+            '--ros-args',
+            '-p',
+            'input_type:=sensor_msgs/msg/Imu',
+            '-p',
+            'component:=torque.z',
+        ],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert result.returncode == 2
     assert result.stderr.strip().splitlines() == [
-        "error: component of sensor_msgs/msg/Imu must be one of linear_acceleration.x, "
-        "linear_acceleration.y, linear_acceleration.z, angular_velocity.x, angular_velocity.y, "
-        "angular_velocity.z, got 'torque.z'"]
+        'error: component of sensor_msgs/msg/Imu must be one of linear_acceleration.x, '
+        'linear_acceleration.y, linear_acceleration.z, angular_velocity.x, angular_velocity.y, '
+        "angular_velocity.z, got 'torque.z'"
+    ]
 
 
 # ---- services -------------------------------------------------------------------------------
@@ -508,16 +606,17 @@ def test_reset_service_starts_a_new_segment_counters_kept(make_probe):
     est = FrequencyEstimator(PAPER_CONFIG)
     first = est.process(t[:420], values[:420])
     est.reset()
-    with_reset = first.frequency_hz.tolist() + est.process(t[420:], values[420:]) \
-        .frequency_hz.tolist()
-    assert with_reset != offline(stamps, values).frequency_hz.tolist()   # the reset shows
+    with_reset = (
+        first.frequency_hz.tolist() + est.process(t[420:], values[420:]).frequency_hz.tolist()
+    )
+    assert with_reset != offline(stamps, values).frequency_hz.tolist()  # the reset shows
     assert p.frequencies() == with_reset
     assert p.node.counters['received'] == 2500
 
 
 def test_self_test_service_and_band_above_nyquist(make_probe):
     p = make_probe()
-    response = p.call('self_test')       # no input yet: the default rate and band
+    response = p.call('self_test')  # no input yet: the default rate and band
     assert response.success, response.message
     lines = response.message.splitlines()
     assert 'at 500 Hz sampling' in lines[0] and len(lines) == 4
@@ -542,15 +641,17 @@ def test_modes_one_publishes_mode1_topics(make_probe):
     values = np.sin(2 * np.pi * 1.33 * np.arange(3000) / FS)
     fed_at = time.time()
     p.feed(stamps, values)
-    assert spin_until(p.executor, lambda: len(p.resets('mode1/reset'))
-                      >= len(p.frequencies()), 5.0)
+    assert spin_until(
+        p.executor, lambda: len(p.resets('mode1/reset')) >= len(p.frequencies()), 5.0
+    )
     mode1 = p.values('mode1/frequency')
     assert len(mode1) >= 3 and mode1 == p.frequencies()
     assert p.resets('mode1/reset') == p.resets()
     assert abs(np.median(mode1) / 1.33 - 1) < 1e-3
     assert p.probe.count_publishers('/vibration/mode2/frequency') == 0
-    status = p.wait_status(lambda s: values_of(s)['estimates'] == str(
-        p.node.counters['estimates']))
+    status = p.wait_status(
+        lambda s: values_of(s)['estimates'] == str(p.node.counters['estimates'])
+    )
     kv = values_of(status)
     assert float(kv['mode1_frequency_hz']) == pytest.approx(mode1[-1], rel=1e-8)
     # the age of mode 1's last estimate: since it was published, on the node's clock
@@ -558,25 +659,30 @@ def test_modes_one_publishes_mode1_topics(make_probe):
     assert 'mode2_frequency_hz' not in kv
     # switching modes off: the mode topics go
     assert p.node.set_parameters([Parameter('modes', value=0)])[0].successful
-    assert spin_until(p.executor, lambda: p.probe.count_publishers(
-        '/vibration/mode1/frequency') == 0, 5.0)
+    assert spin_until(
+        p.executor, lambda: p.probe.count_publishers('/vibration/mode1/frequency') == 0, 5.0
+    )
 
 
 def test_two_separated_modes_get_their_own_topics(make_probe):
     p = make_probe(modes=2)
-    n = 5000                                                    # 10 s at 500 Hz
+    n = 5000  # 10 s at 500 Hz
     t = np.arange(n) / FS
     rng = np.random.default_rng(3)
-    values = (np.sin(2 * np.pi * 1.33 * t) + 0.5 * np.sin(2 * np.pi * 8.5 * t + 1.0)
-              + rng.normal(0, 1e-3, n))
+    values = (
+        np.sin(2 * np.pi * 1.33 * t)
+        + 0.5 * np.sin(2 * np.pi * 8.5 * t + 1.0)
+        + rng.normal(0, 1e-3, n)
+    )
     p.feed(sine_stamps(n), values)
-    assert spin_until(p.executor, lambda: len(p.values('mode1/frequency'))
-                      >= len(p.frequencies()), 5.0)      # mode 1's topic follows vibration/
+    assert spin_until(
+        p.executor, lambda: len(p.values('mode1/frequency')) >= len(p.frequencies()), 5.0
+    )  # mode 1's topic follows vibration/
     mode1, mode2 = p.values('mode1/frequency'), p.values('mode2/frequency')
     assert len(mode1) >= 3 and len(mode2) >= 3
     assert abs(np.median(mode1) / 1.33 - 1) < 0.01
     assert abs(np.median(mode2) / 8.5 - 1) < 0.01
-    assert p.frequencies() == mode1                 # vibration/frequency carries mode 1
+    assert p.frequencies() == mode1  # vibration/frequency carries mode 1
     kv = values_of(p.wait_status(lambda s: True))
     assert abs(float(kv['mode2_frequency_hz']) / 8.5 - 1) < 0.02
 
@@ -588,8 +694,10 @@ class TwoBandTracker:
 
     def __init__(self, config):
         self.config = config
-        self._estimators = [FrequencyEstimator(config.replace(modes=0, band_hz=band))
-                            for band in ((0.5, 2.5), (20.0, 80.0))]
+        self._estimators = [
+            FrequencyEstimator(config.replace(modes=0, band_hz=band))
+            for band in ((0.5, 2.5), (20.0, 80.0))
+        ]
 
     def update(self, t, y):
         found = [(k, e.update(t, y)) for k, e in enumerate(self._estimators, 1)]
@@ -599,8 +707,12 @@ class TwoBandTracker:
     def counters(self):
         """Samples counted once, estimates and rejections summed over the modes."""
         first = self._estimators[0].counters
-        return {name: first[name] if name in ('received', 'used') else
-                sum(e.counters[name] for e in self._estimators) for name in first}
+        return {
+            name: first[name]
+            if name in ('received', 'used')
+            else sum(e.counters[name] for e in self._estimators)
+            for name in first
+        }
 
     def reset(self):
         for e in self._estimators:
@@ -608,8 +720,11 @@ class TwoBandTracker:
 
 
 def test_each_mode_on_its_own_topics(make_probe, monkeypatch):
-    monkeypatch.setattr(stream, 'create_estimator', lambda config: TwoBandTracker(
-        config) if config.modes else FrequencyEstimator(config))
+    monkeypatch.setattr(
+        stream,
+        'create_estimator',
+        lambda config: TwoBandTracker(config) if config.modes else FrequencyEstimator(config),
+    )
     p = make_probe(modes=2)
     n = 3000
     t = np.arange(n) / FS
@@ -617,11 +732,17 @@ def test_each_mode_on_its_own_topics(make_probe, monkeypatch):
     stamps = sine_stamps(n)
     fed_at = time.time()
     p.feed(stamps, values)
-    tracker = TwoBandTracker(EstimatorConfig.paper(modes=2))     # the node's parameters
-    expected = [e for ti, y in zip(seconds_since(np.asarray(stamps), stamps[0]), values)
-                for e in tracker.update(ti, y)]
-    assert spin_until(p.executor, lambda: len(p.resets('mode2/reset'))
-                      >= len(p.values('mode2/frequency')) >= 1, 5.0)
+    tracker = TwoBandTracker(EstimatorConfig.paper(modes=2))  # the node's parameters
+    expected = [
+        e
+        for ti, y in zip(seconds_since(np.asarray(stamps), stamps[0]), values)
+        for e in tracker.update(ti, y)
+    ]
+    assert spin_until(
+        p.executor,
+        lambda: len(p.resets('mode2/reset')) >= len(p.values('mode2/frequency')) >= 1,
+        5.0,
+    )
     mode1, mode2 = p.values('mode1/frequency'), p.values('mode2/frequency')
     assert len(mode1) >= 3 and len(mode2) >= 3
     assert mode1 == [e.frequency_hz for e in expected if e.mode == 1]
@@ -631,10 +752,13 @@ def test_each_mode_on_its_own_topics(make_probe, monkeypatch):
     # mode 1: its five outputs, then its mode topics; mode 2: its mode topics only
     order = [e[0] for e in p.events if not e[0].startswith('mode2')]
     assert order == (OUTPUTS + ['mode1/frequency', 'mode1/reset']) * len(mode1)
-    assert [e[0] for e in p.events if e[0].startswith('mode2')] == \
-        ['mode2/frequency', 'mode2/reset'] * len(mode2)
-    status = p.wait_status(lambda s: values_of(s)['estimates'] == str(
-        p.node.counters['estimates']))
+    assert [e[0] for e in p.events if e[0].startswith('mode2')] == [
+        'mode2/frequency',
+        'mode2/reset',
+    ] * len(mode2)
+    status = p.wait_status(
+        lambda s: values_of(s)['estimates'] == str(p.node.counters['estimates'])
+    )
     kv = values_of(status)
     assert float(kv['mode1_frequency_hz']) == pytest.approx(mode1[-1], rel=1e-8)
     assert float(kv['mode2_frequency_hz']) == pytest.approx(mode2[-1], rel=1e-8)
@@ -649,58 +773,87 @@ def test_simulated_accelerometer_end_to_end(ros_context, executor):
     from vib_estimator.nodes.sim_node import SIM_TIME_ORIGIN_NS, SimNode
     from vib_estimator.sim.arm_model import natural_frequency_hz
 
-    estimator = EstimatorNode(context=ros_context, parameter_overrides=[
-        Parameter('input_type', value=fields.IMU),
-        Parameter('input_topic', value='/imu_e2e/tip_imu')])
+    estimator = EstimatorNode(
+        context=ros_context,
+        parameter_overrides=[
+            Parameter('input_type', value=fields.IMU),
+            Parameter('input_topic', value='/imu_e2e/tip_imu'),
+        ],
+    )
     probe = Node('probe', context=ros_context)
     frequencies, resets = [], []
-    subs = [probe.create_subscription(Float64, 'vibration/frequency',
-                                      lambda m: frequencies.append(m.data), 100),
-            probe.create_subscription(Header, 'vibration/reset', lambda m: resets.append(
-                m.stamp.sec * 10 ** 9 + m.stamp.nanosec), 100)]
-    sim = SimNode(context=ros_context, namespace='imu_e2e', parameter_overrides=[
-        Parameter('output_type', value=fields.IMU), Parameter('speed', value=10.0),
-        Parameter('duration', value=5.0), Parameter('wait_for_subscribers', value=1)])
+    subs = [
+        probe.create_subscription(
+            Float64, 'vibration/frequency', lambda m: frequencies.append(m.data), 100
+        ),
+        probe.create_subscription(
+            Header,
+            'vibration/reset',
+            lambda m: resets.append(m.stamp.sec * 10**9 + m.stamp.nanosec),
+            100,
+        ),
+    ]
+    sim = SimNode(
+        context=ros_context,
+        namespace='imu_e2e',
+        parameter_overrides=[
+            Parameter('output_type', value=fields.IMU),
+            Parameter('speed', value=10.0),
+            Parameter('duration', value=5.0),
+            Parameter('wait_for_subscribers', value=1),
+        ],
+    )
     nodes = (estimator, probe, sim)
     for node in nodes:
         executor.add_node(node)
     try:
-        assert spin_until(executor, lambda: all(s.get_publisher_count() >= 1 for s in subs),
-                          10.0)
+        assert spin_until(executor, lambda: all(s.get_publisher_count() >= 1 for s in subs), 10.0)
         assert spin_until(executor, lambda: sim.finished, 60.0)
-        assert spin_until(executor, lambda: len(frequencies) == len(resets)
-                          == estimator.counters['estimates'], 5.0)
+        assert spin_until(
+            executor,
+            lambda: len(frequencies) == len(resets) == estimator.counters['estimates'],
+            5.0,
+        )
     finally:
         for node in nodes:
             executor.remove_node(node)
             node.destroy_node()
-    t = (np.array(resets) - SIM_TIME_ORIGIN_NS) * 1e-9   # simulated s since the first sample
-    free = np.array(frequencies)[t > 1.5]                 # after the 1 s ramp
+    t = (np.array(resets) - SIM_TIME_ORIGIN_NS) * 1e-9  # simulated s since the first sample
+    free = np.array(frequencies)[t > 1.5]  # after the 1 s ramp
     assert len(free) >= 3
     assert np.median(free) == pytest.approx(natural_frequency_hz(0.04555), rel=0.01)
 
 
 def test_names_are_relative_so_namespaces_apply(ros_context, executor):
-    node = EstimatorNode(context=ros_context, namespace='arm1', parameter_overrides=[
-        Parameter('modes', value=2)])
+    node = EstimatorNode(
+        context=ros_context, namespace='arm1', parameter_overrides=[Parameter('modes', value=2)]
+    )
     probe = Node('probe', context=ros_context)
     expected_topics = {f'/arm1/vibration/{t}' for t in OUTPUTS} | {
-        f'/arm1/vibration/mode{k}/{t}' for k in (1, 2) for t in ('frequency', 'reset')}
+        f'/arm1/vibration/mode{k}/{t}' for k in (1, 2) for t in ('frequency', 'reset')
+    }
     expected_services = {'/arm1/estimator_node/reset', '/arm1/estimator_node/self_test'}
 
     def graph():
-        topics = {n for n, _ in probe.get_publisher_names_and_types_by_node(
-            'estimator_node', '/arm1')}
-        services = {n for n, _ in probe.get_service_names_and_types_by_node(
-            'estimator_node', '/arm1')}
+        topics = {
+            n for n, _ in probe.get_publisher_names_and_types_by_node('estimator_node', '/arm1')
+        }
+        services = {
+            n for n, _ in probe.get_service_names_and_types_by_node('estimator_node', '/arm1')
+        }
         return topics, services
+
     try:
         for n in (node, probe):
             executor.add_node(n)
-        assert spin_until(executor, lambda: expected_topics <= graph()[0]
-                          and expected_services <= graph()[1], 10.0), graph()
-        subscribed = {n for n, _ in probe.get_subscriber_names_and_types_by_node(
-            'estimator_node', '/arm1')}
+        assert spin_until(
+            executor,
+            lambda: expected_topics <= graph()[0] and expected_services <= graph()[1],
+            10.0,
+        ), graph()
+        subscribed = {
+            n for n, _ in probe.get_subscriber_names_and_types_by_node('estimator_node', '/arm1')
+        }
         assert '/arm1/coupling_torque' in subscribed, subscribed
     finally:
         for n in (node, probe):
@@ -716,22 +869,29 @@ def test_simultaneous_service_calls_are_all_answered_while_estimating(make_probe
 
     p = make_probe()
     qos = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
-    clients = {name: p.probe.create_client(Trigger, f'/estimator_node/{name}', qos_profile=qos)
-               for name in ('reset', 'self_test')}
+    clients = {
+        name: p.probe.create_client(Trigger, f'/estimator_node/{name}', qos_profile=qos)
+        for name in ('reset', 'self_test')
+    }
     for client in clients.values():
         assert spin_until(p.executor, client.service_is_ready, 60.0)
-    assert p.call('self_test').success           # compiled before the burst
+    assert p.call('self_test').success  # compiled before the burst
     stamps = sine_stamps(5000)
     values = np.sin(2 * np.pi * 1.33 * np.arange(5000) / FS)
     p.feed(stamps[:1000], values[:1000])
-    futures = [(name, clients[name].call_async(Trigger.Request()))
-               for _ in range(50) for name in ('reset', 'self_test')]
+    futures = [
+        (name, clients[name].call_async(Trigger.Request()))
+        for _ in range(50)
+        for name in ('reset', 'self_test')
+    ]
     p.feed(stamps[1000:], values[1000:])
-    assert spin_until(p.executor, lambda: all(f.done() for _, f in futures), 60.0), \
+    assert spin_until(p.executor, lambda: all(f.done() for _, f in futures), 60.0), (
         f'{sum(f.done() for _, f in futures)} of {len(futures)} answered'
+    )
     answers = [(name, f.result()) for name, f in futures]
     assert all(r.success for name, r in answers if name == 'reset')
-    assert all(r.success and r.message.startswith('passed')
-               for name, r in answers if name == 'self_test')
+    assert all(
+        r.success and r.message.startswith('passed') for name, r in answers if name == 'self_test'
+    )
     assert p.node.counters['received'] == 5000
     assert len(p.frequencies()) > 5 and all(abs(f / 1.33 - 1) < 0.01 for f in p.frequencies())

@@ -1,5 +1,8 @@
-"""The estimator node's diagnostics bookkeeping (nodes/health.py) and self-test (nodes/self_test.py)
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
+"""The estimator node's diagnostics bookkeeping (nodes/health.py), self-test (nodes/self_test.py)
 alone: no rclpy, no node, times given explicitly."""
+
 from __future__ import annotations
 
 import math
@@ -19,20 +22,30 @@ def core(**values):
 
 
 def estimate(f=1.33, mode=0, **kw):
-    return Estimate(t=1.0, frequency_hz=f, convergence_time=0.4, samples=200, fit=0.99,
-                    amplitude=0.5, mode=mode, **kw)
+    return Estimate(
+        t=1.0,
+        frequency_hz=f,
+        convergence_time=0.4,
+        samples=200,
+        fit=0.99,
+        amplitude=0.5,
+        mode=mode,
+        **kw,
+    )
 
 
 def test_health_and_self_test_import_no_rclpy():
-    code = ('import sys, vib_estimator.nodes.health, vib_estimator.nodes.self_test; '
-            'sys.exit(any(m.split(".")[0] == "rclpy" for m in sys.modules))')
+    code = (
+        'import sys, vib_estimator.nodes.health, vib_estimator.nodes.self_test; '
+        'sys.exit(any(m.split(".")[0] == "rclpy" for m in sys.modules))'
+    )
     assert subprocess.run([sys.executable, '-c', code]).returncode == 0
 
 
 def test_counters_add_up_across_replaced_estimators():
     h = H.Health(now=0.0)
     h.absorb(core(received=10, used=9, estimates=2))
-    h.absorb({'received': 5, 'finder_peaks': 3})        # a tracker's own counter
+    h.absorb({'received': 5, 'finder_peaks': 3})  # a tracker's own counter
     assert h.count('zero_stamps_replaced') == 1
     assert h.count('skipped_joint_missing', 4) == 4
     totals = h.totals(core(received=7, used=7))
@@ -40,7 +53,7 @@ def test_counters_add_up_across_replaced_estimators():
     assert totals['finder_peaks'] == 3
     assert totals['zero_stamps_replaced'] == 1 and totals['skipped_joint_missing'] == 4
     assert totals['band_above_nyquist'] == 0
-    assert list(totals)[-len(H.NODE_COUNTERS):] == list(H.NODE_COUNTERS)
+    assert list(totals)[-len(H.NODE_COUNTERS) :] == list(H.NODE_COUNTERS)
 
 
 def test_stale_ok_warn_and_the_rates():
@@ -66,14 +79,16 @@ def test_stale_ok_warn_and_the_rates():
     h.record(estimate(), 4.2, h.totals(held))
     assert h.status(5.0, h.totals({**held, 'received': 2000}), 4.0).level == H.OK
     # no input for more than STALE_AFTER
-    assert h.status(5.0 + H.STALE_AFTER + 0.1, h.totals({**held, 'received': 2000}),
-                    4.0).level == H.STALE
+    assert (
+        h.status(5.0 + H.STALE_AFTER + 0.1, h.totals({**held, 'received': 2000}), 4.0).level
+        == H.STALE
+    )
 
 
 def test_missing_joints_warn():
     h = H.Health(now=0.0)
     h.count('skipped_joint_missing', 30)
-    s = h.status(1.0, h.totals(core()), None)     # only skipped messages: input, but WARN
+    s = h.status(1.0, h.totals(core()), None)  # only skipped messages: input, but WARN
     assert s.level == H.WARN and '30 messages without the joint' in s.message
     assert s.values['input_rate_hz'] == 30
     assert h.status(2.0, h.totals(core(received=10)), 0.1).level == H.OK
@@ -86,11 +101,11 @@ def test_band_above_nyquist_warns_once_and_counts():
     assert s.log is not None and 'band_hz upper edge 60 Hz' in s.log
     assert s.values['band_above_nyquist'] == 101
     s = h.status(2.0, h.totals(core(received=201, used=201)), 2.0, band_hz=(10.0, 60.0))
-    assert s.log is None and s.values['band_above_nyquist'] == 201     # logged once
+    assert s.log is None and s.values['band_above_nyquist'] == 201  # logged once
     s = h.status(3.0, h.totals(core(received=301, used=301)), 3.0, band_hz=(10.0, 40.0))
     assert s.level == H.OK and s.log is None and s.values['band_above_nyquist'] == 201
     s = h.status(4.0, h.totals(core(received=401, used=401)), 4.0, band_hz=(10.0, 50.0))
-    assert s.level == H.WARN and s.log is not None                      # a new band: logged
+    assert s.level == H.WARN and s.log is not None  # a new band: logged
 
 
 def test_modes_have_their_last_frequency_and_age():
@@ -104,7 +119,7 @@ def test_modes_have_their_last_frequency_and_age():
     assert v['mode2_frequency_hz'] == 8.2 and v['mode2_age_s'] == 0.5
     assert v['mode2_frequency_std_hz'] == 0.01
     assert math.isnan(v['mode3_frequency_hz']) and math.isnan(v['mode3_age_s'])
-    assert v['last_frequency_hz'] == 1.3          # vibration/frequency carries mode 1
+    assert v['last_frequency_hz'] == 1.3  # vibration/frequency carries mode 1
     h.forget_modes(1)
     assert 'mode2_frequency_hz' not in h.status(3.0, totals, 0.1, modes=1).values
     assert not any(k.startswith('mode') for k in h.status(3.0, totals, 0.1).values)
@@ -115,8 +130,10 @@ def test_format_value():
     assert H.format_value(math.nan) == 'nan'
 
 
-@pytest.mark.parametrize('model, modes', [('sinusoid', 0), ('biased-sinusoid', 0),
-                                          ('damped-sinusoid', 0), ('sinusoid', 1)])
+@pytest.mark.parametrize(
+    'model, modes',
+    [('sinusoid', 0), ('biased-sinusoid', 0), ('damped-sinusoid', 0), ('sinusoid', 1)],
+)
 def test_self_test_passes_with_the_defaults(model, modes):
     ok, message = self_test(EstimatorConfig(model=model, modes=modes))
     lines = message.splitlines()
@@ -141,7 +158,7 @@ def test_self_test_fails_with_a_reason():
     assert not ok and message.startswith('FAILED')
     assert 'above the Nyquist frequency 250 Hz' in message.splitlines()[-1]
     ok, message = self_test(EstimatorConfig(min_amplitude=1e6, min_fit=0.0), 500.0)
-    assert ok   # the tones' amplitude follows the at-rest gate
+    assert ok  # the tones' amplitude follows the at-rest gate
 
 
 def test_an_estimate_of_any_mode_clears_held_back():
@@ -150,7 +167,7 @@ def test_an_estimate_of_any_mode_clears_held_back():
     assert h.status(1.0, held, 0.2, modes=2).level == H.WARN
     h.record(estimate(8.0, mode=2), 1.5, held)
     s = h.status(2.0, h.totals(core(received=200, used=200, rejected_fit=2)), 0.4, modes=2)
-    assert s.level == H.OK and s.message == 'waiting for a first estimate'   # of mode 1
+    assert s.level == H.OK and s.message == 'waiting for a first estimate'  # of mode 1
 
 
 def test_gaps_and_outliers_warn_and_are_logged_once_per_episode():
@@ -160,13 +177,22 @@ def test_gaps_and_outliers_warn_and_are_logged_once_per_episode():
     h.record(estimate(), 0.5, h.totals(core()))
     s = h.status(1.0, h.totals(core(received=500, used=500)), 1.0)
     assert s.level == H.OK and s.log is None
-    s = h.status(2.0, h.totals(core(received=900, used=899, gaps=2, samples_lost=100,
-                                    skipped_outlier=1)), 2.0)
+    s = h.status(
+        2.0,
+        h.totals(core(received=900, used=899, gaps=2, samples_lost=100, skipped_outlier=1)),
+        2.0,
+    )
     assert s.level == H.WARN and '2 gaps (100 samples lost' in s.message
     assert '1 outliers skipped' in s.message and s.log is not None
-    s = h.status(3.0, h.totals(core(received=1300, used=1298, gaps=3, samples_lost=150,
-                                    skipped_outlier=2)), 3.0)
+    s = h.status(
+        3.0,
+        h.totals(core(received=1300, used=1298, gaps=3, samples_lost=150, skipped_outlier=2)),
+        3.0,
+    )
     assert s.level == H.WARN and '1 gaps (50 samples lost' in s.message and s.log is None
-    s = h.status(4.0, h.totals(core(received=1800, used=1798, gaps=3, samples_lost=150,
-                                    skipped_outlier=2)), 4.0)
+    s = h.status(
+        4.0,
+        h.totals(core(received=1800, used=1798, gaps=3, samples_lost=150, skipped_outlier=2)),
+        4.0,
+    )
     assert s.level == H.OK and s.values['gaps'] == 3 and s.values['samples_lost'] == 150

@@ -1,8 +1,11 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """config/estimator.yaml and launch/estimator.launch.py, checked without launch_ros.
 
 The params file must hold EstimatorConfig's defaults (Section 5.3), load through rcl's own parser
 into the node, and be what the launch file starts ``estimator_node`` with.
 """
+
 from __future__ import annotations
 
 import ast
@@ -32,8 +35,9 @@ def test_params_file_holds_the_defaults():
     assert set(params) == set(EstimatorConfig.names())
     for name, value in params.items():
         default = getattr(defaults, name)
-        expected = [] if default is None else list(default) if isinstance(default, tuple) \
-            else default
+        expected = (
+            [] if default is None else list(default) if isinstance(default, tuple) else default
+        )
         assert value == expected and type(value) is type(expected), (name, value, expected)
 
 
@@ -45,11 +49,14 @@ def test_paper_params_file_holds_the_paper_configuration():
 
 def test_params_file_loads_into_the_node():
     context = rclpy.Context()
-    rclpy.init(context=context, domain_id=int(os.environ['ROS_DOMAIN_ID']),
-               args=['--ros-args', '--params-file', str(PARAMS)])
+    rclpy.init(
+        context=context,
+        domain_id=int(os.environ['ROS_DOMAIN_ID']),
+        args=['--ros-args', '--params-file', str(PARAMS)],
+    )
     try:
         node = EstimatorNode(context=context)
-        assert config_of(node) == EstimatorConfig()     # every parameter as the file sets it
+        assert config_of(node) == EstimatorConfig()  # every parameter as the file sets it
         assert node.get_parameter('band_hz').value == []
         assert node.get_parameter('input_type').value == WRENCH_STAMPED
         node.destroy_node()
@@ -79,8 +86,12 @@ def test_launch_file_starts_the_node_with_the_params_file():
     tree = ast.parse(LAUNCH.read_text())
     functions = [n.name for n in tree.body if isinstance(n, ast.FunctionDef)]
     assert 'generate_launch_description' in functions
-    nodes = [n for n in ast.walk(tree) if isinstance(n, ast.Call)
-             and getattr(n.func, 'id', getattr(n.func, 'attr', None)) == 'Node']
+    nodes = [
+        n
+        for n in ast.walk(tree)
+        if isinstance(n, ast.Call)
+        and getattr(n.func, 'id', getattr(n.func, 'attr', None)) == 'Node'
+    ]
     assert len(nodes) == 1
     keywords = {k.arg: k.value for k in nodes[0].keywords}
     assert ast.literal_eval(keywords['package']) == 'vib_estimator'
@@ -95,19 +106,28 @@ def test_launch_file_declares_the_arguments_a_deployment_needs():
     """params_file, namespace, use_sim_time and the input, each declared and each used."""
     tree = ast.parse(LAUNCH.read_text())
     calls = [n for n in ast.walk(tree) if isinstance(n, ast.Call)]
-    declared = {ast.literal_eval(n.args[0]) for n in calls
-                if getattr(n.func, 'id', None) == 'DeclareLaunchArgument'}
+    declared = {
+        ast.literal_eval(n.args[0])
+        for n in calls
+        if getattr(n.func, 'id', None) == 'DeclareLaunchArgument'
+    }
     assert declared == {'params_file', 'namespace', 'use_sim_time', 'input_type', 'input_topic'}
-    used = {ast.literal_eval(n.args[0]) for n in calls
-            if getattr(n.func, 'id', None) == 'LaunchConfiguration'
-            and isinstance(n.args[0], ast.Constant)}
-    inputs = next(ast.literal_eval(n.value) for n in tree.body if isinstance(n, ast.Assign)
-                  and n.targets[0].id == 'INPUT_ARGUMENTS')
+    used = {
+        ast.literal_eval(n.args[0])
+        for n in calls
+        if getattr(n.func, 'id', None) == 'LaunchConfiguration'
+        and isinstance(n.args[0], ast.Constant)
+    }
+    inputs = next(
+        ast.literal_eval(n.value)
+        for n in tree.body
+        if isinstance(n, ast.Assign) and n.targets[0].id == 'INPUT_ARGUMENTS'
+    )
     assert used | set(inputs) == declared
 
 
 def test_readme_parameter_table_states_the_defaults():
-    """The README's estimator-parameter table lists every EstimatorConfig field with its default."""
+    """The README's estimator-parameter table lists each EstimatorConfig field with its default."""
     text = (ROOT / 'README.md').read_text()
     table = text.split('### Estimator parameters', 1)[1].split('\n## ', 1)[0]
     rows = {}
@@ -131,8 +151,9 @@ def test_readme_parameter_table_states_the_defaults():
 
 
 def _node_with(context, *ros_args):
-    rclpy.init(context=context, domain_id=int(os.environ['ROS_DOMAIN_ID']),
-               args=['--ros-args', *ros_args])
+    rclpy.init(
+        context=context, domain_id=int(os.environ['ROS_DOMAIN_ID']), args=['--ros-args', *ros_args]
+    )
     return EstimatorNode(context=context, cli_args=['--ros-args', *ros_args])
 
 
@@ -159,8 +180,15 @@ def test_a_params_file_that_sets_nothing_for_the_node_is_warned_about(tmp_path):
     unknown.write_text('/**:\n  ros__parameters:\n    min_fitt: 0.75\n')
     context = rclpy.Context()
     try:
-        node = _node_with(context, '-r', '__ns:=/robot1', '--params-file', str(wrong),
-                          '--params-file', str(unknown))
+        node = _node_with(
+            context,
+            '-r',
+            '__ns:=/robot1',
+            '--params-file',
+            str(wrong),
+            '--params-file',
+            str(unknown),
+        )
         assert node.get_parameter('min_fit').value == 0.9 == EstimatorConfig().min_fit
         first, second = node.params_file_warnings
         assert 'wrong.yaml sets nothing for /robot1/estimator_node' in first

@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """launch/*.launch.py run against stand-ins of launch and launch_ros (not installed here).
 
 The stand-ins take the keywords of the real classes (``DeclareLaunchArgument(name, *,
@@ -8,6 +10,7 @@ its OpaqueFunction called with a context holding the arguments' values, and the 
 checked -- executables of setup.py, parameters files that exist under config/, each argument used,
 and the set-up each file is for (use_sim_time when /clock is published, the overrides).
 """
+
 from __future__ import annotations
 
 import ast
@@ -54,9 +57,21 @@ class LaunchConfiguration:
 
 
 class Node:
-    def __init__(self, *, executable, package=None, name=None, namespace=None, exec_name=None,
-                 parameters=None, remappings=None, ros_arguments=None, arguments=None,
-                 output='log', emulate_tty=False):
+    def __init__(
+        self,
+        *,
+        executable,
+        package=None,
+        name=None,
+        namespace=None,
+        exec_name=None,
+        parameters=None,
+        remappings=None,
+        ros_arguments=None,
+        arguments=None,
+        output='log',
+        emulate_tty=False,
+    ):
         self.executable, self.package, self.name = executable, package, name
         self.namespace, self.parameters = namespace, list(parameters or [])
 
@@ -64,9 +79,13 @@ class Node:
 def _entry_points():
     """The executables of setup.py's console_scripts."""
     tree = ast.parse((ROOT / 'setup.py').read_text())
-    scripts = next(ast.literal_eval(n.values[n.keys.index(k)]) for n in ast.walk(tree)
-                   if isinstance(n, ast.Dict) for k in n.keys
-                   if isinstance(k, ast.Constant) and k.value == 'console_scripts')
+    scripts = next(
+        ast.literal_eval(n.values[n.keys.index(k)])
+        for n in ast.walk(tree)
+        if isinstance(n, ast.Dict)
+        for k in n.keys
+        if isinstance(k, ast.Constant) and k.value == 'console_scripts'
+    )
     return {s.split('=')[0].strip() for s in scripts}
 
 
@@ -74,18 +93,25 @@ def _entry_points():
 def load(monkeypatch):
     """Import a launch file with the stand-ins; the package's share directory is the source tree
     (setup.py installs config/*.yaml and launch/*.py there as they are)."""
-    for name in ('launch', 'launch.actions', 'launch.substitutions', 'launch_ros',
-                 'launch_ros.actions'):
+    for name in (
+        'launch',
+        'launch.actions',
+        'launch.substitutions',
+        'launch_ros',
+        'launch_ros.actions',
+    ):
         monkeypatch.setitem(sys.modules, name, types.ModuleType(name))
     sys.modules['launch'].LaunchDescription = LaunchDescription
     sys.modules['launch.actions'].DeclareLaunchArgument = DeclareLaunchArgument
     sys.modules['launch.actions'].OpaqueFunction = OpaqueFunction
     sys.modules['launch.substitutions'].LaunchConfiguration = LaunchConfiguration
     sys.modules['launch_ros.actions'].Node = Node
+
     def share(package):
         if package != 'vib_estimator':
             raise LookupError(package)
         return str(ROOT)
+
     monkeypatch.setattr(ament_index_python.packages, 'get_package_share_directory', share)
 
     def load_file(name):
@@ -93,6 +119,7 @@ def load(monkeypatch):
         module = importlib.util.module_from_spec(spec)
         spec.loader.exec_module(module)
         return module
+
     return load_file
 
 
@@ -117,11 +144,13 @@ def _launch(module, **arguments):
 
     def value(v):
         return v.perform(context) if isinstance(v, LaunchConfiguration) else v
+
     started = {}
     for node in nodes:
         files = [value(p) for p in node.parameters if not isinstance(p, dict)]
-        overrides = {k: value(v) for p in node.parameters if isinstance(p, dict)
-                     for k, v in p.items()}
+        overrides = {
+            k: value(v) for p in node.parameters if isinstance(p, dict) for k, v in p.items()
+        }
         started[node.executable] = (value(node.namespace), files, overrides)
         assert node.package == 'vib_estimator' and node.name == node.executable
     return declared, started
@@ -140,7 +169,7 @@ def test_each_launch_file_starts_installed_executables_with_existing_files(name,
         if Path(files[0]).parent == CONFIG:
             assert '/**' in yaml.safe_load(Path(files[0]).read_text())
     assert {'namespace'} <= set(declared)
-    assert set(declared) == LaunchConfiguration.performed      # every argument is used
+    assert set(declared) == LaunchConfiguration.performed  # every argument is used
     for argument in declared.values():
         assert argument.description, argument.name
 
@@ -151,14 +180,14 @@ def test_sim_estimator_uses_sim_time_when_the_simulator_publishes_clock(load, tm
     assert set(started) == {'sim_node', 'estimator_node'}
     assert started['sim_node'][1] == [str(CONFIG / 'sim.yaml')] and started['sim_node'][2] == {}
     assert started['estimator_node'][1] == [str(CONFIG / 'estimator.yaml')]
-    assert started['estimator_node'][2] == {'use_sim_time': False}      # speed 1: real time
+    assert started['estimator_node'][2] == {'use_sim_time': False}  # speed 1: real time
     _, started = _launch(module, speed='10')
     assert started['sim_node'][2] == {'speed': 10.0}
     assert started['estimator_node'][2] == {'use_sim_time': True}
     _, started = _launch(module, publish_clock='true')
     assert started['sim_node'][2] == {'publish_clock': True}
     assert started['estimator_node'][2]['use_sim_time']
-    fast = tmp_path / 'fast.yaml'                      # a file's speed counts too
+    fast = tmp_path / 'fast.yaml'  # a file's speed counts too
     fast.write_text((CONFIG / 'sim.yaml').read_text().replace('speed: 1.0', 'speed: 5.0'))
     _, started = _launch(module, sim_params_file=str(fast))
     assert started['estimator_node'][2]['use_sim_time']
@@ -175,11 +204,12 @@ def test_replay_estimator_needs_a_bag_and_follows_the_replayers_clock(load):
     assert set(started) == {'bag_replayer', 'estimator_node'}
     assert started['bag_replayer'][1:] == ([str(CONFIG / 'replayer.yaml')], {'bag': bag})
     assert started['estimator_node'][2] == {'use_sim_time': False}
-    _, started = _launch(module, bag=bag, clock_hz='100', rate='2',
-                         input_topic='/coupling_torque')
+    _, started = _launch(module, bag=bag, clock_hz='100', rate='2', input_topic='/coupling_torque')
     assert started['bag_replayer'][2] == {'bag': bag, 'clock_hz': 100.0, 'rate': 2.0}
-    assert started['estimator_node'][2] == {'use_sim_time': True,
-                                            'input_topic': '/coupling_torque'}
+    assert started['estimator_node'][2] == {
+        'use_sim_time': True,
+        'input_topic': '/coupling_torque',
+    }
 
 
 def test_estimator_shaper_shares_the_clock_and_sets_the_shaper(load):
@@ -188,8 +218,11 @@ def test_estimator_shaper_shares_the_clock_and_sets_the_shaper(load):
     assert set(started) == {'estimator_node', 'shaper_node'}
     assert started['shaper_node'][1:] == ([str(CONFIG / 'shaper.yaml')], {'use_sim_time': False})
     assert started['estimator_node'][2] == {'use_sim_time': False}
-    _, started = _launch(module, use_sim_time='true', shaper='zv',
-                         input_type='sensor_msgs/msg/Imu')
+    _, started = _launch(
+        module, use_sim_time='true', shaper='zv', input_type='sensor_msgs/msg/Imu'
+    )
     assert started['shaper_node'][2] == {'use_sim_time': True, 'shaper': 'zv'}
-    assert started['estimator_node'][2] == {'use_sim_time': True,
-                                            'input_type': 'sensor_msgs/msg/Imu'}
+    assert started['estimator_node'][2] == {
+        'use_sim_time': True,
+        'input_type': 'sensor_msgs/msg/Imu',
+    }

@@ -1,4 +1,7 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """nodes.playback: the replayer's schedule on a fake steady clock, without rclpy."""
+
 from __future__ import annotations
 
 import subprocess

@@ -1,7 +1,10 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """shaper_node end to end, in process, on a simulated clock the test advances itself: a step
 reference in, the shaper's staircase out; a new estimate is switched in only at rest; damping and
 parameters; /diagnostics. Then the whole loop as processes: ``vib-estimator demo --shaping`` on a
 short run (its pass criterion)."""
+
 from __future__ import annotations
 
 import math
@@ -24,12 +27,14 @@ from vib_estimator.nodes.shaper_node import ShaperNode
 from vib_estimator.sim.arm_model import MASSES_5_5, natural_frequency_hz
 
 RATE = 500.0
-STEP_NS = 10_000_000        # the test's clock advances 10 ms (5 samples) a step
+STEP_NS = 10_000_000  # the test's clock advances 10 ms (5 samples) a step
 
 
 def shaper_node(context, **params):
-    return ShaperNode(context=context, parameter_overrides=[
-        Parameter(name, value=value) for name, value in params.items()])
+    return ShaperNode(
+        context=context,
+        parameter_overrides=[Parameter(name, value=value) for name, value in params.items()],
+    )
 
 
 class Rig:
@@ -39,20 +44,30 @@ class Rig:
         self.executor, self.node = executor, node
         self.probe = Node('probe', context=context)
         self.clock_pub = self.probe.create_publisher(Clock, '/clock', 10)
-        self.pubs = {topic: self.probe.create_publisher(Float64, topic, 10) for topic in
-                     ('reference', 'vibration/frequency', 'vibration/damping_ratio')}
-        self.commands = []                 # (clock ns when received, value)
+        self.pubs = {
+            topic: self.probe.create_publisher(Float64, topic, 10)
+            for topic in ('reference', 'vibration/frequency', 'vibration/damping_ratio')
+        }
+        self.commands = []  # (clock ns when received, value)
         self.diagnostics = []
         self.now_ns = 1_000_000_000
         self.sub = self.probe.create_subscription(
-            Float64, 'position_command', lambda m: self.commands.append((self.now_ns, m.data)), 100)
-        self.probe.create_subscription(DiagnosticArray, '/diagnostics',
-                                       lambda m: self.diagnostics.append(m.status[0]), 10)
+            Float64, 'position_command', lambda m: self.commands.append((self.now_ns, m.data)), 100
+        )
+        self.probe.create_subscription(
+            DiagnosticArray, '/diagnostics', lambda m: self.diagnostics.append(m.status[0]), 10
+        )
         for n in (node, self.probe):
             executor.add_node(n)
-        assert spin_until(executor, lambda: self.sub.get_publisher_count() >= 1 and all(
-            p.get_subscription_count() >= 1 for p in self.pubs.values())
-            and self.clock_pub.get_subscription_count() >= 1, 10.0)
+        assert spin_until(
+            executor,
+            lambda: (
+                self.sub.get_publisher_count() >= 1
+                and all(p.get_subscription_count() >= 1 for p in self.pubs.values())
+                and self.clock_pub.get_subscription_count() >= 1
+            ),
+            10.0,
+        )
         self.tick()
 
     def publish(self, topic, value):
@@ -64,11 +79,17 @@ class Rig:
             self.now_ns += STEP_NS
             n = len(self.commands)
             published = self.node.counters['commands_published']
-            sec, nsec = divmod(self.now_ns, 10 ** 9)
+            sec, nsec = divmod(self.now_ns, 10**9)
             self.clock_pub.publish(Clock(clock=Time(sec=sec, nanosec=nsec)))
-            if self.node.counters['references']:         # a reference to shape: a command
-                assert spin_until(self.executor, lambda: len(self.commands) > n
-                                  and self.node.counters['commands_published'] > published, 5.0)
+            if self.node.counters['references']:  # a reference to shape: a command
+                assert spin_until(
+                    self.executor,
+                    lambda: (
+                        len(self.commands) > n
+                        and self.node.counters['commands_published'] > published
+                    ),
+                    5.0,
+                )
             else:
                 spin_until(self.executor, lambda: False, 0.02)
 
@@ -101,7 +122,7 @@ def test_step_reference_shaped_and_retuned_only_at_rest(ros_context, executor):
         assert node.status().message.startswith('passing through')
         # first estimate: ZV for 1.25 Hz has impulses 0.5 at 0 and 0.5 at 0.4 s
         rig.publish('vibration/frequency', 1.25)
-        rig.publish('vibration/damping_ratio', math.nan)     # a model without damping: ignored
+        rig.publish('vibration/damping_ratio', math.nan)  # a model without damping: ignored
         rig.wait(lambda: node.counters['frequency_estimates'] == 1)
         rig.tick(2)
         kv = design(node)
@@ -110,13 +131,13 @@ def test_step_reference_shaped_and_retuned_only_at_rest(ros_context, executor):
         start = len(rig.commands)
         rig.publish('reference', 1.0)
         rig.wait(lambda: node.counters['references'] == 2)
-        rig.tick(20)                                    # 0.2 s into the move
-        rig.publish('vibration/frequency', 2.5)          # mid-move: must wait for rest
+        rig.tick(20)  # 0.2 s into the move
+        rig.publish('vibration/frequency', 2.5)  # mid-move: must wait for rest
         rig.wait(lambda: node.counters['frequency_estimates'] == 2)
         rig.tick(60)
         values = {round(v, 9) for _, v in rig.commands[start:]}
-        assert values == {0.5, 1.0}, values              # the staircase, no other level
-        assert rig.plateau(0.5, start) == pytest.approx(0.4, abs=0.011)   # old design kept
+        assert values == {0.5, 1.0}, values  # the staircase, no other level
+        assert rig.plateau(0.5, start) == pytest.approx(0.4, abs=0.011)  # old design kept
         kv = design(node)
         assert (kv['design_frequency_hz'], kv['retunes'], kv['pending_shaper']) == ('2.5', '2', '')
         # the next move uses the new design: ZV for 2.5 Hz, 0.2 s between impulses
@@ -142,8 +163,9 @@ def test_step_reference_shaped_and_retuned_only_at_rest(ros_context, executor):
 
 
 def test_initial_frequency_and_bad_inputs(ros_context, executor):
-    node = shaper_node(ros_context, use_sim_time=True, shaper='zvd', initial_frequency_hz=1.25,
-                       rate_hz=RATE)
+    node = shaper_node(
+        ros_context, use_sim_time=True, shaper='zvd', initial_frequency_hz=1.25, rate_hz=RATE
+    )
     rig = Rig(ros_context, executor, node)
     try:
         rig.publish('reference', 2.0)
@@ -151,12 +173,16 @@ def test_initial_frequency_and_bad_inputs(ros_context, executor):
         rig.publish('vibration/frequency', math.inf)
         rig.publish('vibration/frequency', -1.0)
         rig.publish('vibration/damping_ratio', 0.9)
-        rig.wait(lambda: node.counters['references_skipped'] == 1
-                 and node.counters['estimates_ignored'] == 3)
+        rig.wait(
+            lambda: (
+                node.counters['references_skipped'] == 1
+                and node.counters['estimates_ignored'] == 3
+            )
+        )
         rig.tick(2)
         kv = design(node)
         assert (kv['shaper'], kv['design_frequency_hz']) == ('zvd', '1.25')
-        assert rig.commands[-1][1] == 2.0                 # at rest: the reference itself
+        assert rig.commands[-1][1] == 2.0  # at rest: the reference itself
         start = len(rig.commands)
         rig.publish('reference', 3.0)
         rig.wait(lambda: node.counters['references'] == 2)
@@ -174,13 +200,18 @@ def test_parameters(ros_context, executor):
     node = shaper_node(ros_context, use_sim_time=True, initial_frequency_hz=2.0)
     rig = Rig(ros_context, executor, node)
     try:
-        for name, value in (('shaper', 'foo'), ('damping_ratio', -0.1), ('rate_hz', 100.0),
-                            ('median_of', 0), ('initial_frequency_hz', -1.0)):
+        for name, value in (
+            ('shaper', 'foo'),
+            ('damping_ratio', -0.1),
+            ('rate_hz', 100.0),
+            ('median_of', 0),
+            ('initial_frequency_hz', -1.0),
+        ):
             result = node.set_parameters([Parameter(name, value=value)])[0]
             assert not result.successful and result.reason, name
         assert design(node)['shaper'] == 'none'
         assert node.set_parameters([Parameter('shaper', value='ei')])[0].successful
-        kv = design(node)                                  # waits for the first reference
+        kv = design(node)  # waits for the first reference
         assert kv['shaper'] == 'none' and kv['pending_shaper'].startswith('ei for 2.0000 Hz')
         assert node.set_parameters([Parameter('median_of', value=3)])[0].successful
         for k, f in enumerate((1.0, 5.0, 1.2), 1):
@@ -190,7 +221,7 @@ def test_parameters(ros_context, executor):
         assert design(node)['estimate_frequency_hz'] == '1.2'
         rig.publish('vibration/frequency', 1.4)
         rig.wait(lambda: node.counters['frequency_estimates'] == 4)
-        assert node.design_mode()[0] == 1.4               # median of 5.0, 1.2, 1.4
+        assert node.design_mode()[0] == 1.4  # median of 5.0, 1.2, 1.4
         assert design(node)['estimate_frequency_hz'] == '1.4'
     finally:
         rig.close()
@@ -202,26 +233,45 @@ def test_live_demo_short_run(tmp_path):
     exe = Path(sys.executable).parent / 'vib-estimator'
     out = tmp_path / 'shaping.png'
     proc = subprocess.run(
-        [str(exe), 'demo', '--shaping', '--seconds-per-mass', '6', '--speed', '20',
-         '--domain-id', os.environ['ROS_DOMAIN_ID'], '--out', str(out)],
-        capture_output=True, text=True, timeout=240)
+        [
+            str(exe),
+            'demo',
+            '--shaping',
+            '--seconds-per-mass',
+            '6',
+            '--speed',
+            '20',
+            '--domain-id',
+            os.environ['ROS_DOMAIN_ID'],
+            '--out',
+            str(out),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=240,
+    )
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
     # the table it prints: per tip mass, the estimate near Eq. 23's frequency and the shaped
     # move's added vibration cut by the shaper's MIN_REDUCTION (its pass criterion), consistent
     lines = proc.stdout.splitlines()
     first = lines.index(next(ln for ln in lines if ln.startswith('vibration each move adds'))) + 2
-    rows = [[float(v) for v in ln.split()] for ln in lines[first:first + len(MASSES_5_5)]]
+    rows = [[float(v) for v in ln.split()] for ln in lines[first : first + len(MASSES_5_5)]]
     assert [r[0] for r in rows] == pytest.approx([m * 1e3 for m in MASSES_5_5], abs=0.01)
     need = MIN_REDUCTION.get('zvd', DEFAULT_MIN_REDUCTION) * 100
     for mass_g, f0, estimate, error, unshaped, shaped, ratio, reduction in rows:
         assert f0 == pytest.approx(natural_frequency_hz(mass_g * 1e-3), abs=1e-3)
         assert abs(estimate / f0 - 1) < 0.03 and error == pytest.approx(
-            (estimate / f0 - 1) * 100, abs=0.05)   # f0 printed to 1e-3 Hz
+            (estimate / f0 - 1) * 100, abs=0.05
+        )  # f0 printed to 1e-3 Hz
         assert ratio == pytest.approx(100 * shaped / unshaped, abs=0.5) and shaped < unshaped
         assert reduction >= need and reduction == pytest.approx(100 - ratio, abs=0.1)
     assert lines[-1].startswith('PASS') and out.is_file()
-    bad = subprocess.run([str(exe), 'demo', '--shaping', '--seconds-per-mass', '3'],
-                         capture_output=True, text=True, timeout=60)
+    bad = subprocess.run(
+        [str(exe), 'demo', '--shaping', '--seconds-per-mass', '3'],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert bad.returncode == 2 and bad.stderr.startswith('error:')
 
 
@@ -237,7 +287,7 @@ def test_only_garbage_estimates_turn_the_diagnostics_to_warn(ros_context, execut
         rig.publish('vibration/damping_ratio', 1.5)
         rig.wait(lambda: node.counters['estimates_ignored'] == 5)
         rig.tick(2)
-        assert design(node)['shaper'] == 'none' and rig.commands[-1][1] == 1.0   # safe
+        assert design(node)['shaper'] == 'none' and rig.commands[-1][1] == 1.0  # safe
         status = node.status()
         assert status.level == DiagnosticStatus.WARN
         assert '5 estimates ignored' in status.message and 'damping ratio 1.5' in status.message

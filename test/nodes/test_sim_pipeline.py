@@ -1,8 +1,11 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """sim_node -> estimator_node end to end, in process (fresh context, isolated domain), sped up.
 
 The simulated arm walks through Section 5.5's three tip masses; the estimator node's outputs are
 checked against Eq. 23. Waits are on matched counts and on the simulator's ``finished`` flag.
 """
+
 from __future__ import annotations
 
 import os
@@ -13,26 +16,34 @@ import rclpy
 from geometry_msgs.msg import WrenchStamped
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from rclpy.qos import (DurabilityPolicy, QoSProfile, ReliabilityPolicy,
-                       qos_profile_sensor_data)
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
 from std_msgs.msg import Float64, Header
 
 from vib_estimator.core.config import PAPER
-from vib_estimator.sim.arm_model import MASSES_5_5, natural_frequency_hz, schedule_5_5
 from vib_estimator.nodes.estimator_node import EstimatorNode
 from vib_estimator.nodes.runner import StartupError, make_executor, spin_until
-from vib_estimator.nodes.sim_node import (GROUND_TRUTH_QOS, SIM_TIME_ORIGIN_NS, SimNode,
-                                          schedule_from_array, schedule_to_array)
+from vib_estimator.nodes.sim_node import (
+    GROUND_TRUTH_QOS,
+    SIM_TIME_ORIGIN_NS,
+    SimNode,
+    schedule_from_array,
+    schedule_to_array,
+)
+from vib_estimator.sim.arm_model import MASSES_5_5, natural_frequency_hz, schedule_5_5
 
 SECONDS_PER_MASS = 6.0
 SPEED = 10.0
-LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
-                     durability=DurabilityPolicy.TRANSIENT_LOCAL)
+LATCHED = QoSProfile(
+    depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
+)
 
 
 def sim_node(context, namespace='', **params):
-    return SimNode(context=context, namespace=namespace, parameter_overrides=[
-        Parameter(name, value=value) for name, value in params.items()])
+    return SimNode(
+        context=context,
+        namespace=namespace,
+        parameter_overrides=[Parameter(name, value=value) for name, value in params.items()],
+    )
 
 
 class Listener:
@@ -42,14 +53,20 @@ class Listener:
         self.node = Node('listener', context=context)
         self.truth, self.frequencies, self.resets = [], [], []
         self.subs = [
-            self.node.create_subscription(Float64, 'vibration/ground_truth',
-                                          lambda m: self.truth.append(m.data), LATCHED),
-            self.node.create_subscription(Float64, 'vibration/frequency',
-                                          lambda m: self.frequencies.append(m.data), 100),
             self.node.create_subscription(
-                Header, 'vibration/reset',
-                lambda m: self.resets.append((m.stamp.sec * 10 ** 9 + m.stamp.nanosec
-                                              - SIM_TIME_ORIGIN_NS) * 1e-9), 100),
+                Float64, 'vibration/ground_truth', lambda m: self.truth.append(m.data), LATCHED
+            ),
+            self.node.create_subscription(
+                Float64, 'vibration/frequency', lambda m: self.frequencies.append(m.data), 100
+            ),
+            self.node.create_subscription(
+                Header,
+                'vibration/reset',
+                lambda m: self.resets.append(
+                    (m.stamp.sec * 10**9 + m.stamp.nanosec - SIM_TIME_ORIGIN_NS) * 1e-9
+                ),
+                100,
+            ),
         ]
 
     def estimates(self):
@@ -65,17 +82,25 @@ def pipeline_run():
     executor = make_executor(context)
     listener = Listener(context)
     # the demo's pipeline: the paper's configuration on Section 5.5 (vib_estimator.demo)
-    estimator = EstimatorNode(context=context, parameter_overrides=[
-        Parameter(name, value=value) for name, value in PAPER.items()])
-    sim = sim_node(context, speed=SPEED, duration=3 * SECONDS_PER_MASS, wait_for_subscribers=1,
-                   schedule=schedule_to_array(schedule_5_5(SECONDS_PER_MASS)))
+    estimator = EstimatorNode(
+        context=context,
+        parameter_overrides=[Parameter(name, value=value) for name, value in PAPER.items()],
+    )
+    sim = sim_node(
+        context,
+        speed=SPEED,
+        duration=3 * SECONDS_PER_MASS,
+        wait_for_subscribers=1,
+        schedule=schedule_to_array(schedule_5_5(SECONDS_PER_MASS)),
+    )
     for node in (listener.node, estimator, sim):
         executor.add_node(node)
     try:
-        assert spin_until(executor, lambda: all(s.get_publisher_count() >= 1
-                                                for s in listener.subs), 10.0)
+        assert spin_until(
+            executor, lambda: all(s.get_publisher_count() >= 1 for s in listener.subs), 10.0
+        )
         assert spin_until(executor, lambda: sim.finished, 60.0)
-        spin_until(executor, lambda: False, 0.3)   # the last outputs in flight
+        spin_until(executor, lambda: False, 0.3)  # the last outputs in flight
         yield listener
     finally:
         executor.shutdown()
@@ -85,8 +110,10 @@ def pipeline_run():
 
 
 def segments():
-    return [(i * SECONDS_PER_MASS, (i + 1) * SECONDS_PER_MASS, natural_frequency_hz(m))
-            for i, m in enumerate(MASSES_5_5)]
+    return [
+        (i * SECONDS_PER_MASS, (i + 1) * SECONDS_PER_MASS, natural_frequency_hz(m))
+        for i, m in enumerate(MASSES_5_5)
+    ]
 
 
 def test_estimates_within_3_percent_for_each_mass(pipeline_run):
@@ -114,8 +141,13 @@ def test_mass_change_tracked_within_one_new_period(pipeline_run):
 def test_schedule_parameter_round_trip_and_errors():
     moves = schedule_5_5()
     assert schedule_from_array(schedule_to_array(moves)) == list(moves)
-    for bad in ([0.0, 1.0, 1.0], [1.0, 1.0, 1.0, 0.0, 0.5, 1.0, 1.0, 0.0], [0.0, 1.0, 0.0, 0.0],
-                [0.0, 1.0, 1.0, -1.0], [0.0, float('nan'), 1.0, 0.0]):
+    for bad in (
+        [0.0, 1.0, 1.0],
+        [1.0, 1.0, 1.0, 0.0, 0.5, 1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0, 0.0],
+        [0.0, 1.0, 1.0, -1.0],
+        [0.0, float('nan'), 1.0, 0.0],
+    ):
         with pytest.raises(ValueError):
             schedule_from_array(bad)
 
@@ -127,17 +159,18 @@ def test_sim_node_parameters(ros_context, executor):
     sim = sim_node(ros_context, namespace='param_test', rate_hz=100.0)
     probe = Node('probe', context=ros_context)
     truth = []
-    sub = probe.create_subscription(Float64, '/param_test/vibration/ground_truth',
-                                    lambda m: truth.append(m.data), LATCHED)
+    sub = probe.create_subscription(
+        Float64, '/param_test/vibration/ground_truth', lambda m: truth.append(m.data), LATCHED
+    )
     executor.add_node(sim)
     executor.add_node(probe)
     try:
         assert spin_until(executor, lambda: sub.get_publisher_count() >= 1 and truth, 10.0)
         assert truth[-1] == pytest.approx(natural_frequency_hz(0.04555))
         refused = {
-            'tip_mass_kg': -1.0,        # descriptor range
+            'tip_mass_kg': -1.0,  # descriptor range
             'noise_std': float('nan'),  # descriptor range
-            'rate_hz': 1000.0,          # read-only
+            'rate_hz': 1000.0,  # read-only
         }
         for name, value in refused.items():
             result = sim.set_parameters([Parameter(name, value=value)])[0]
@@ -172,39 +205,61 @@ def test_imu_output_carries_the_models_tip_acceleration(ros_context, executor):
     from vib_estimator.io.fields import DEFAULT_COMPONENT, IMU, component_getter
     from vib_estimator.sim.arm_model import ArmParameters, ArmSimulator, Move
 
-    sim = sim_node(ros_context, namespace='imu_test', output_type='sensor_msgs/msg/Imu', seed=5,
-                   speed=20.0, wait_for_subscribers=1)
+    sim = sim_node(
+        ros_context,
+        namespace='imu_test',
+        output_type='sensor_msgs/msg/Imu',
+        seed=5,
+        speed=20.0,
+        wait_for_subscribers=1,
+    )
     probe = Node('probe', context=ros_context)
     for node in (sim, probe):
         executor.add_node(node)
     try:
         get = component_getter(DEFAULT_COMPONENT[IMU], IMU)
-        rows = _collect(executor, probe, Imu, '/imu_test/tip_imu', 2000,
-                        lambda m: (m.header.stamp.sec * 10 ** 9 + m.header.stamp.nanosec,
-                                   get(m), m.orientation_covariance[0]))
+        rows = _collect(
+            executor,
+            probe,
+            Imu,
+            '/imu_test/tip_imu',
+            2000,
+            lambda m: (
+                m.header.stamp.sec * 10**9 + m.header.stamp.nanosec,
+                get(m),
+                m.orientation_covariance[0],
+            ),
+        )
     finally:
         for node in (sim, probe):
             executor.remove_node(node)
             node.destroy_node()
     stamps, accel, orientation = map(np.array, zip(*rows))
-    model = ArmSimulator(ArmParameters(), seed=5, schedule=(Move(0.0, 1.0, 1.0),),
-                         output='tip_acceleration')
+    model = ArmSimulator(
+        ArmParameters(), seed=5, schedule=(Move(0.0, 1.0, 1.0),), output='tip_acceleration'
+    )
     expected = [model.step()[1] for _ in range(len(accel))]
     np.testing.assert_array_equal(accel, expected)
     assert np.all(orientation == -1.0)
     t = (stamps - stamps[0]) * 1e-9
     estimates = FrequencyEstimator().process(t, accel)
-    free = estimates.t > 1.5                       # after the 1 s ramp
+    free = estimates.t > 1.5  # after the 1 s ramp
     assert free.sum() >= 3
     assert np.median(estimates.frequency_hz[free]) == pytest.approx(
-        natural_frequency_hz(0.04555), rel=0.01)
+        natural_frequency_hz(0.04555), rel=0.01
+    )
 
 
 def test_sim_follows_position_commands(ros_context, executor):
     """The first position_command takes over from the schedule: the arm goes to it and holds it;
     the schedule's tip-mass change still applies; a NaN command is skipped and counted."""
-    sim = sim_node(ros_context, namespace='cmd_test', speed=20.0, noise_std=0.0,
-                   schedule=[0.0, 1.0, 1.0, 0.0, 1.0, 0.0, 1.0, 0.030])
+    sim = sim_node(
+        ros_context,
+        namespace='cmd_test',
+        speed=20.0,
+        noise_std=0.0,
+        schedule=[0.0, 1.0, 1.0, 0.0, 1.0, 0.0, 1.0, 0.030],
+    )
     probe = Node('probe', context=ros_context)
     pub = probe.create_publisher(Float64, '/cmd_test/position_command', 10)
     clock, truth = clock_and_truth(probe, '/cmd_test')
@@ -214,11 +269,12 @@ def test_sim_follows_position_commands(ros_context, executor):
         assert spin_until(executor, lambda: pub.get_subscription_count() >= 1, 10.0)
         pub.publish(Float64(data=-0.4))
         pub.publish(Float64(data=float('nan')))
-        assert spin_until(executor, lambda: sim.commands_received == 1
-                          and sim.commands_skipped == 1, 10.0)
+        assert spin_until(
+            executor, lambda: sim.commands_received == 1 and sim.commands_skipped == 1, 10.0
+        )
         assert spin_until(executor, lambda: sim_seconds(clock) > 4.0, 30.0)
         command, angle = sim.motor
-        assert command == -0.4                          # not the schedule's 1 rad, nor 0 at 1 s
+        assert command == -0.4  # not the schedule's 1 rad, nor 0 at 1 s
         assert angle == pytest.approx(-0.4, abs=2e-3)
         # the schedule's mass change at 1 s: the parameter and the published ground truth
         assert sim.get_parameter('tip_mass_kg').value == 0.030
@@ -234,10 +290,17 @@ def clock_and_truth(probe, namespace):
     appended to (the stamps are its simulated time)."""
     stamps, truth = [], []
     probe.create_subscription(
-        WrenchStamped, f'{namespace}/coupling_torque', lambda m: stamps.append(
-            m.header.stamp.sec * 10 ** 9 + m.header.stamp.nanosec), qos_profile_sensor_data)
-    probe.create_subscription(Float64, f'{namespace}/vibration/ground_truth',
-                              lambda m: truth.append(m.data), GROUND_TRUTH_QOS)
+        WrenchStamped,
+        f'{namespace}/coupling_torque',
+        lambda m: stamps.append(m.header.stamp.sec * 10**9 + m.header.stamp.nanosec),
+        qos_profile_sensor_data,
+    )
+    probe.create_subscription(
+        Float64,
+        f'{namespace}/vibration/ground_truth',
+        lambda m: truth.append(m.data),
+        GROUND_TRUTH_QOS,
+    )
     return stamps, truth
 
 
@@ -255,10 +318,15 @@ def test_lockstep_waits_for_the_commander(ros_context, executor):
 
     with pytest.raises(StartupError, match='lockstep needs simulated time'):
         sim_node(ros_context, lockstep=True)
-    sim = sim_node(ros_context, namespace='lock', speed=20.0, lockstep=True,
-                   wait_for_command=True)
-    shaper = ShaperNode(context=ros_context, namespace='lock', parameter_overrides=[
-        Parameter('use_sim_time', value=True), Parameter('shaper', value='none')])
+    sim = sim_node(ros_context, namespace='lock', speed=20.0, lockstep=True, wait_for_command=True)
+    shaper = ShaperNode(
+        context=ros_context,
+        namespace='lock',
+        parameter_overrides=[
+            Parameter('use_sim_time', value=True),
+            Parameter('shaper', value='none'),
+        ],
+    )
     probe = Node('probe', context=ros_context)
     ref = probe.create_publisher(Float64, '/lock/reference', 10)
     clock, _ = clock_and_truth(probe, '/lock')
@@ -271,7 +339,7 @@ def test_lockstep_waits_for_the_commander(ros_context, executor):
         ref.publish(Float64(data=0.2))
         assert spin_until(executor, lambda: sim_seconds(clock) > 1.0, 30.0)
         executor.remove_node(shaper)
-        spin_until(executor, lambda: False, 0.1)             # in flight
+        spin_until(executor, lambda: False, 0.1)  # in flight
         stopped_at = sim_seconds(clock)
         spin_until(executor, lambda: False, 0.5)
         assert sim_seconds(clock) - stopped_at <= LOCKSTEP_BATCH_SECONDS + 1e-9
@@ -293,22 +361,30 @@ def test_realism_parameters_reach_the_published_torque(ros_context, executor):
     from vib_estimator.sim.arm_model import ArmParameters, ArmSimulator, Move
 
     realism = {'offset': -0.15, 'quantum': 0.03, 'limit_cycle_voltage': 0.3}
-    sim = sim_node(ros_context, namespace='real_test', seed=3, speed=20.0, wait_for_subscribers=1,
-                   **realism)
+    sim = sim_node(
+        ros_context, namespace='real_test', seed=3, speed=20.0, wait_for_subscribers=1, **realism
+    )
     probe = Node('probe', context=ros_context)
     for node in (sim, probe):
         executor.add_node(node)
     try:
-        torque = _collect(executor, probe, WrenchStamped, '/real_test/coupling_torque', 2000,
-                          lambda m: m.wrench.torque.z)
+        torque = _collect(
+            executor,
+            probe,
+            WrenchStamped,
+            '/real_test/coupling_torque',
+            2000,
+            lambda m: m.wrench.torque.z,
+        )
     finally:
         for node in (sim, probe):
             executor.remove_node(node)
             node.destroy_node()
     model = ArmSimulator(ArmParameters(), seed=3, schedule=(Move(0.0, 1.0, 1.0),), **realism)
     np.testing.assert_array_equal(torque, [model.step()[1] for _ in range(len(torque))])
-    np.testing.assert_allclose(np.asarray(torque) / 0.03, np.round(np.asarray(torque) / 0.03),
-                               atol=1e-9)
+    np.testing.assert_allclose(
+        np.asarray(torque) / 0.03, np.round(np.asarray(torque) / 0.03), atol=1e-9
+    )
     with pytest.raises(StartupError, match='limit_cycle_voltage'):
         sim_node(ros_context, namespace='bad_real', limit_cycle_voltage=20.0)
 
@@ -320,23 +396,30 @@ def test_driven_arm_tracked_in_operation():
     rclpy.init(context=context, domain_id=int(os.environ['ROS_DOMAIN_ID']))
     executor = make_executor(context)
     listener = Listener(context)
-    estimator = EstimatorNode(context=context, parameter_overrides=[
-        Parameter('excitation', value='ambient'), Parameter('ambient_window_s', value=15.0)])
-    sim = sim_node(context, speed=20.0, duration=40.0, wait_for_subscribers=1,
-                   excitation='ambient', seed=3)
+    estimator = EstimatorNode(
+        context=context,
+        parameter_overrides=[
+            Parameter('excitation', value='ambient'),
+            Parameter('ambient_window_s', value=15.0),
+        ],
+    )
+    sim = sim_node(
+        context, speed=20.0, duration=40.0, wait_for_subscribers=1, excitation='ambient', seed=3
+    )
     nodes = (listener.node, estimator, sim)
     for node in nodes:
         executor.add_node(node)
     try:
-        assert spin_until(executor, lambda: all(s.get_publisher_count() >= 1
-                                                for s in listener.subs), 10.0)
+        assert spin_until(
+            executor, lambda: all(s.get_publisher_count() >= 1 for s in listener.subs), 10.0
+        )
         assert spin_until(executor, lambda: sim.finished, 60.0)
         spin_until(executor, lambda: False, 0.3)
         t, f = listener.estimates()
         f0 = natural_frequency_hz(0.04555)
         assert len(f) >= 15
         assert np.median(np.abs(f / f0 - 1)) < 0.01
-        assert np.all(np.diff(t) > 0.5)              # one per analysis, every second
+        assert np.all(np.diff(t) > 0.5)  # one per analysis, every second
     finally:
         executor.shutdown()
         for node in nodes:

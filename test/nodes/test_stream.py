@@ -1,15 +1,19 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """The estimator node's processing without ROS (nodes/stream.py): time base, estimator
 replacement, counters, status (the reset service: test_estimator_node.py)."""
+
 from __future__ import annotations
 
 import numpy as np
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from vib_estimator.core import EstimatorConfig, FrequencyEstimator
 from vib_estimator.nodes import health as H
 from vib_estimator.nodes.stream import EstimatorStream
 
-EPOCH_NS = 1_700_000_000 * 10 ** 9
+EPOCH_NS = 1_700_000_000 * 10**9
 
 
 def sine(n, start=0, fs=500.0):
@@ -22,7 +26,7 @@ def feed(stream, stamps, values):
 
 
 def test_same_floats_as_offline_with_epoch_stamps():
-    stamps, values = sine(4000)     # 8 s: >= 5 windows of 1.25 periods (the default)
+    stamps, values = sine(4000)  # 8 s: >= 5 windows of 1.25 periods (the default)
     stream = EstimatorStream(EstimatorConfig(), now=0.0)
     online = feed(stream, stamps, values)
     offline = FrequencyEstimator().process((stamps - stamps[0]) * 1e-9, values)
@@ -38,7 +42,8 @@ def test_configure_keeps_the_origin_and_the_counters():
     assert stream.config.window == 5
     later = feed(stream, stamps[1000:2000], values[1000:2000])
     expected = FrequencyEstimator(EstimatorConfig(window=5)).process(
-        (stamps[1000:2000] - stamps[0]) * 1e-9, values[1000:2000])
+        (stamps[1000:2000] - stamps[0]) * 1e-9, values[1000:2000]
+    )
     assert [e.frequency_hz for e in later] == expected.frequency_hz.tolist()
     assert stream.counters['received'] == 2000
     assert stream.counters['estimates'] == stream.health.totals({})['estimates'] + len(expected)
@@ -51,18 +56,26 @@ def test_status_knows_the_sampling_rate_and_the_last_estimate():
         stream.published(e, now=0.5)
     status = stream.status(now=1.0)
     assert status.values['sample_rate_hz'] == 500.0
-    assert status.level == H.WARN and 'Nyquist' in status.message      # 300 Hz > 250 Hz
+    assert status.level == H.WARN and 'Nyquist' in status.message  # 300 Hz > 250 Hz
     assert status.values['band_above_nyquist'] == 1001
     ok, message = stream.self_test()
     assert not ok and 'at 500 Hz sampling' in message
 
 
 @settings(max_examples=40, deadline=None)
-@given(samples=st.lists(st.tuples(
-    st.one_of(st.integers(0, 2 ** 63 - 1), st.integers(-10 ** 9, 10 ** 9)),
-    st.one_of(st.floats(allow_nan=True, allow_infinity=True),
-              st.sampled_from([1e308, -1e308, 5e-324, 0.0]), st.floats(-2.0, 2.0))),
-    max_size=200))
+@given(
+    samples=st.lists(
+        st.tuples(
+            st.one_of(st.integers(0, 2**63 - 1), st.integers(-(10**9), 10**9)),
+            st.one_of(
+                st.floats(allow_nan=True, allow_infinity=True),
+                st.sampled_from([1e308, -1e308, 5e-324, 0.0]),
+                st.floats(-2.0, 2.0),
+            ),
+        ),
+        max_size=200,
+    )
+)
 def test_fuzz_the_message_path_publishes_only_finite_numbers(samples):
     """Issue 22: random stamps (ns, any order) and values mixed into a clean 500 Hz sine through
     the node's message path: no exception, every estimate's numbers finite (damping and stds
@@ -73,17 +86,29 @@ def test_fuzz_the_message_path_publishes_only_finite_numbers(samples):
 
     s = EstimatorStream(EstimatorConfig(), 0.0)
     n = 3000
-    clean = [(10 ** 18 + i * 2_000_000, math.sin(2 * math.pi * 3 * i / 500)) for i in range(n)]
+    clean = [(10**18 + i * 2_000_000, math.sin(2 * math.pi * 3 * i / 500)) for i in range(n)]
     for i, sample in enumerate(samples):
-        clean.insert((i * 131) % n, (10 ** 18 + sample[0], sample[1]))
+        clean.insert((i * 131) % n, (10**18 + sample[0], sample[1]))
     estimates = [e for stamp, value in clean for e in s.feed(stamp, value)]
     c = s.counters
-    assert c['received'] == len(clean) == sum(
-        c[k] for k in ('used', 'skipped_non_finite', 'skipped_duplicate', 'skipped_out_of_order',
-                       'skipped_outlier'))
+    assert (
+        c['received']
+        == len(clean)
+        == sum(
+            c[k]
+            for k in (
+                'used',
+                'skipped_non_finite',
+                'skipped_duplicate',
+                'skipped_out_of_order',
+                'skipped_outlier',
+            )
+        )
+    )
     for e in estimates:
-        assert all(math.isfinite(v) for v in (e.t, e.frequency_hz, e.fit, e.amplitude,
-                                               e.convergence_time))
+        assert all(
+            math.isfinite(v) for v in (e.t, e.frequency_hz, e.fit, e.amplitude, e.convergence_time)
+        )
         assert not any(math.isinf(v) for v in (e.damping, e.frequency_std_hz, e.damping_std))
     status = s.status(1.0)
     assert all(isinstance(format_value(v), str) for v in status.values.values())
@@ -97,8 +122,11 @@ def test_a_burst_of_self_tests_runs_the_tones_once(monkeypatch):
 
     runs = []
     real = stream_module.self_test
-    monkeypatch.setattr(stream_module, 'self_test',
-                        lambda config, rate: runs.append((config, rate)) or real(config, rate))
+    monkeypatch.setattr(
+        stream_module,
+        'self_test',
+        lambda config, rate: runs.append((config, rate)) or real(config, rate),
+    )
     s = stream_module.EstimatorStream(EstimatorConfig(), 0.0)
     answers = [s.self_test() for _ in range(50)]
     assert len(runs) == 1 and answers[0][0] and len(set(answers)) == 1

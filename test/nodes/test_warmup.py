@@ -1,6 +1,9 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """A node is live from its first second: a cold start (empty numba cache) answers its services and
 publishes /diagnostics while its kernels compile, holds its input, and Ctrl-C leaves a cache the
 next start uses. The warm-up's bookkeeping itself is tested without ROS below."""
+
 from __future__ import annotations
 
 import math
@@ -11,7 +14,6 @@ import sys
 import time
 
 import numpy as np
-import pytest
 
 from vib_estimator.core import EstimatorConfig
 from vib_estimator.core.estimator import FrequencyEstimator
@@ -25,7 +27,7 @@ def _tone(n, rate=500.0, f=4.0):
 
 
 def test_held_samples_are_drained_in_order_into_the_estimator():
-    config = EstimatorConfig(refine=0)          # a compile key the session fixture did not warm
+    config = EstimatorConfig(refine=0)  # a compile key the session fixture did not warm
     stream = EstimatorStream(config, time.monotonic(), background=True)
     assert not stream.ready
     ok, why = stream.self_test()
@@ -44,24 +46,25 @@ def test_held_samples_are_drained_in_order_into_the_estimator():
         time.sleep(0.005)
     assert drained is not None and stream.ready
     got = [(tag, e.frequency_hz) for tag, estimates in drained for e in estimates]
-    base = np.array([seconds_since(int(s), int(stamps[0])) for s in stamps])   # the node's base
+    base = np.array([seconds_since(int(s), int(stamps[0])) for s in stamps])  # the node's base
     direct = FrequencyEstimator(config).process(base, y)
-    assert [f for _, f in got] == list(direct.frequency_hz)      # the same floats, in order
+    assert [f for _, f in got] == list(direct.frequency_hz)  # the same floats, in order
     tags = [tag for tag, _ in got]
     assert tags == sorted(tags) and len(tags) == len(direct) > 10
     assert stream.counters['received'] == len(t) and stream.counters['dropped_warmup'] == 0
 
 
 def test_a_full_warmup_buffer_drops_the_oldest_and_counts_them():
-    stream = EstimatorStream(EstimatorConfig(refine=0, model='damped-sinusoid'), time.monotonic(),
-                             background=True)
+    stream = EstimatorStream(
+        EstimatorConfig(refine=0, model='damped-sinusoid'), time.monotonic(), background=True
+    )
     first_drop = [stream.hold(k, 0.0, k) for k in range(WARMUP_BUFFER + 3)]
     assert first_drop.count(True) == 1 and first_drop[WARMUP_BUFFER]
     assert stream.health.node_counters['dropped_warmup'] == 3
     assert stream.held_samples == WARMUP_BUFFER
 
 
-# ---- a real cold start, in a subprocess with an empty NUMBA_CACHE_DIR ----------------------------
+# ---- a real cold start, in a subprocess with an empty NUMBA_CACHE_DIR ---------------------------
 class Watcher:
     """This test's ROS side: the node's /diagnostics, its services, and an input publisher."""
 
@@ -77,8 +80,9 @@ class Watcher:
         self.executor = make_executor(context)
         self.executor.add_node(self.node)
         self.statuses = []
-        self.node.create_subscription(DiagnosticArray, '/diagnostics',
-                                      lambda m: self.statuses.extend(m.status), 10)
+        self.node.create_subscription(
+            DiagnosticArray, '/diagnostics', lambda m: self.statuses.extend(m.status), 10
+        )
         self.pub = self.node.create_publisher(WrenchStamped, 'coupling_torque', 1000)
         self.msg = WrenchStamped()
         self.self_test = self.node.create_client(Trigger, '/estimator_node/self_test')
@@ -88,6 +92,7 @@ class Watcher:
 
     def spin_until(self, predicate, timeout):
         from vib_estimator.nodes.runner import spin_until
+
         return spin_until(self.executor, predicate, timeout)
 
     def call(self, client):
@@ -99,7 +104,7 @@ class Watcher:
     def publish(self, n):
         for _ in range(n):
             ns = 1_000_000_000 + self.sent * 2_000_000
-            self.msg.header.stamp.sec, self.msg.header.stamp.nanosec = divmod(ns, 10 ** 9)
+            self.msg.header.stamp.sec, self.msg.header.stamp.nanosec = divmod(ns, 10**9)
             self.msg.wrench.torque.z = math.sin(2 * math.pi * 4.0 * self.sent / 500.0)
             self.pub.publish(self.msg)
             self.sent += 1
@@ -116,8 +121,13 @@ class Watcher:
 def _start_node(cache):
     env = dict(os.environ, NUMBA_CACHE_DIR=str(cache))
     code = 'import sys; from vib_estimator.nodes.estimator_node import main; sys.exit(main())'
-    return subprocess.Popen([sys.executable, '-c', code], env=env, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)
+    return subprocess.Popen(
+        [sys.executable, '-c', code],
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
 
 
 def _interrupt(proc):
@@ -148,15 +158,19 @@ def test_a_cold_node_is_live_while_it_compiles_and_ctrl_c_keeps_the_cache(ros_co
             if warming and not result.success:
                 assert result.message.startswith('busy'), result.message
             assert watcher.spin_until(lambda: watcher.pub.get_subscription_count() > 0, 30)
-            watcher.spin_until(lambda: False, 1.0)     # discovery settles both ways
+            watcher.spin_until(lambda: False, 1.0)  # discovery settles both ways
             watcher.publish(400)
             ready = watcher.spin_until(
-                lambda: watcher.last()[0] is not None
-                and watcher.last()[0].message != WARMUP_MESSAGE, 240)
+                lambda: (
+                    watcher.last()[0] is not None and watcher.last()[0].message != WARMUP_MESSAGE
+                ),
+                240,
+            )
             assert ready, 'the kernels never became ready'
             watcher.publish(400)
             assert watcher.spin_until(
-                lambda: int(watcher.last()[1].get('received', 0)) >= watcher.sent, 10)
+                lambda: int(watcher.last()[1].get('received', 0)) >= watcher.sent, 10
+            )
             values = watcher.last()[1]
             assert int(values['received']) == watcher.sent and values['dropped_warmup'] == '0'
             assert int(values['estimates']) > 0

@@ -1,4 +1,7 @@
-"""The simulated flexible arm against the paper's model: Eq. 23 frequency, Eq. 24 damping, seeds."""
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
+"""The simulated flexible arm against the paper's model: Eq. 23 frequency, Eq. 24 damping, seed."""
+
 from __future__ import annotations
 
 import math
@@ -6,13 +9,21 @@ import math
 import numpy as np
 import pytest
 
-from vib_estimator.sim.arm_model import (MASSES_5_5, ArmParameters, ArmSimulator, Move,
-                                     experiment_5_3, experiment_5_5, natural_frequency_hz,
-                                     schedule_5_5, simulate)
+from vib_estimator.sim.arm_model import (
+    MASSES_5_5,
+    ArmParameters,
+    ArmSimulator,
+    Move,
+    experiment_5_3,
+    experiment_5_5,
+    natural_frequency_hz,
+    schedule_5_5,
+    simulate,
+)
 
 
 def free_vibration(m, duration=12.0):
-    """Noise-free coupling torque after a 1 s ramp to 1 rad (the Section 5.3 move), from t = 2 s."""
+    """Noise-free coupling torque after a 1 s ramp to 1 rad (the Section 5.3 move), from 2 s."""
     rec = simulate(duration, (Move(0.0, 1.0, 1.0, m),), noise_std=0.0, quantum=0.0)
     keep = rec.t >= 2.0
     return rec.t[keep], rec.torque[keep]
@@ -75,7 +86,7 @@ def test_experiment_5_5_masses_and_signal_to_noise():
         assert np.all(rec.f_true[seg] == natural_frequency_hz(m))
         late = (rec.t >= t0 + 2.0) & (rec.t < t1)
         amplitudes.append(np.percentile(np.abs(rec.torque[late] - rec.torque[late].mean()), 99))
-    assert amplitudes[0] < 0.5 * min(amplitudes[1:])   # first mass: lowest SNR (Fig. 7)
+    assert amplitudes[0] < 0.5 * min(amplitudes[1:])  # first mass: lowest SNR (Fig. 7)
 
 
 def test_schedule_and_abrupt_mass_change():
@@ -91,17 +102,18 @@ def test_schedule_and_abrupt_mass_change():
 def test_commands_take_over_from_the_schedule_but_not_its_masses():
     """set_command holds the motor reference; the schedule's later ramps no longer move it, its
     tip-mass changes still apply."""
-    sim = ArmSimulator(schedule=(Move(0.0, 1.0, 1.0, 0.03), Move(1.0, -2.0, 1.0, 0.06117)),
-                       noise_std=0.0)
+    sim = ArmSimulator(
+        schedule=(Move(0.0, 1.0, 1.0, 0.03), Move(1.0, -2.0, 1.0, 0.06117)), noise_std=0.0
+    )
     for _ in range(100):
         sim.step()
-    assert 0 < sim.command < 0.25                    # the first ramp, 0.2 s in
+    assert 0 < sim.command < 0.25  # the first ramp, 0.2 s in
     sim.set_command(0.5)
     assert sim.command == 0.5 and sim.commanded
-    for _ in range(1500):                            # past the second move's start
+    for _ in range(1500):  # past the second move's start
         sim.step()
     assert sim.command == 0.5
-    assert sim.params.tip_mass_kg == 0.06117         # the mass change applied
+    assert sim.params.tip_mass_kg == 0.06117  # the mass change applied
     assert sim._x[0] == pytest.approx(0.5, abs=1e-3)  # the PD loop holds the motor there
     with pytest.raises(ValueError):
         sim.set_command(float('nan'))
@@ -112,8 +124,9 @@ def test_tip_acceleration_output():
     damping term of the torque over m L; same frequency; noise scaled by 1 / (m L)."""
     m, length = 0.04555, 0.7
     torque = simulate(6.0, (Move(0.0, 1.0, 1.0, m),), noise_std=0.0, quantum=0.0)
-    accel = simulate(6.0, (Move(0.0, 1.0, 1.0, m),), noise_std=0.0, quantum=0.0,
-                     output='tip_acceleration')
+    accel = simulate(
+        6.0, (Move(0.0, 1.0, 1.0, m),), noise_std=0.0, quantum=0.0, output='tip_acceleration'
+    )
     free = torque.t >= 2.0
     scaled = torque.torque[free] / (m * length)
     amplitude = np.max(np.abs(scaled))
@@ -129,6 +142,7 @@ def test_tip_acceleration_output():
 
 
 # -- a real rig's realism (issue 25): offset, coarse quantisation, a closed-loop limit cycle -----
+
 
 def realistic(seed=2, duration=16.0, **changes):
     """The Section 5.3 move on a rig like ``flex8.csv``: an offset of half the amplitude, a

@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """``vib-estimator analyze``: run the estimator over a recorded signal (CSV, MCAP, rosbag2).
 
 The estimates are exactly those the estimator node publishes for the same samples: both use the
@@ -14,6 +16,7 @@ a payload that does not decode as its type) are skipped: one ``warning:`` line o
 many and what the first was, the counters line ends with ``corrupt_records=N``, and the exit code
 stays 0. With ``--strict`` the first one is an error instead (one ``error:`` line, exit code 2).
 """
+
 from __future__ import annotations
 
 import argparse
@@ -36,56 +39,103 @@ from .summary import summarise_modes, summary_lines
 
 #: CLI option -> EstimatorConfig field for the estimator's scalar parameters
 _CONFIG_OPTIONS = {
-    'lowpass_cutoff_hz': float, 'lowpass_damping': float, 'window': int, 'tolerance': float,
-    'min_time': float, 'min_periods': float, 'max_window': float, 'min_fit': float,
-    'min_amplitude': float, 'max_damping': float, 'max_gap': float, 'target_std_rel': float,
-    'gap_intervals': float, 'outlier_ratio': float,
-    'modes': int, 'refine': int, 'consistency': float, 'ambient_window_s': float,
+    'lowpass_cutoff_hz': float,
+    'lowpass_damping': float,
+    'window': int,
+    'tolerance': float,
+    'min_time': float,
+    'min_periods': float,
+    'max_window': float,
+    'min_fit': float,
+    'min_amplitude': float,
+    'max_damping': float,
+    'max_gap': float,
+    'target_std_rel': float,
+    'gap_intervals': float,
+    'outlier_ratio': float,
+    'modes': int,
+    'refine': int,
+    'consistency': float,
+    'ambient_window_s': float,
 }
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('input', help='CSV file, MCAP file, or rosbag2 directory')
-    parser.add_argument('--topic', help='topic of a bag (default: its only topic of a supported '
-                        f'type: {", ".join(t.split("/")[-1] for t in INPUT_TYPES)})')
-    parser.add_argument('--component', help='field of the messages, as the node\'s component '
-                        'parameter (default: the type\'s, e.g. torque.z of a WrenchStamped, '
-                        'linear_acceleration.z of an Imu)')
-    parser.add_argument('--column', help='CSV signal column, by header name or 0-based index '
-                        '(default: the second column)')
+    parser.add_argument(
+        '--topic',
+        help='topic of a bag (default: its only topic of a supported '
+        f'type: {", ".join(t.split("/")[-1] for t in INPUT_TYPES)})',
+    )
+    parser.add_argument(
+        '--component',
+        help="field of the messages, as the node's component "
+        "parameter (default: the type's, e.g. torque.z of a WrenchStamped, "
+        'linear_acceleration.z of an Imu)',
+    )
+    parser.add_argument(
+        '--column',
+        help='CSV signal column, by header name or 0-based index (default: the second column)',
+    )
     add_config_arguments(parser)
     parser.add_argument('--format', choices=('jsonl', 'csv', 'table'), default='jsonl')
     parser.add_argument('--plot', metavar='FILE.png', help='write a Fig. 5-like figure')
-    parser.add_argument('--strict', action='store_true', help='a damaged bag record is an error '
-                        '(exit 2) instead of a counted skip')
+    parser.add_argument(
+        '--strict',
+        action='store_true',
+        help='a damaged bag record is an error (exit 2) instead of a counted skip',
+    )
 
 
 def add_config_arguments(parser: argparse.ArgumentParser) -> None:
     """The estimator options (``--paper``, ``--model``, ``--band-hz``, one per scalar config
     field); an option not given keeps the default (or with ``--paper`` the paper's) value."""
     defaults, paper = EstimatorConfig(), EstimatorConfig.paper()
-    parser.add_argument('--paper', action='store_true',
-                        help='start from the paper\'s configuration (' + ', '.join(
-                            f'{k} {v}' for k, v in PAPER.items()) + ') instead of the defaults')
-    parser.add_argument('--model', choices=MODELS, default=None,
-                        help=f'(default {defaults.model}; --paper: {paper.model})')
-    parser.add_argument('--excitation', choices=EXCITATIONS, default=None,
-                        help=EstimatorConfig.describe('excitation')[0]
-                        + f' (default {defaults.excitation})')
-    parser.add_argument('--band-hz', nargs=2, type=float, metavar=('LO', 'HI'),
-                        help='band-pass prefilter [LO, HI] Hz (default off)')
+    parser.add_argument(
+        '--paper',
+        action='store_true',
+        help="start from the paper's configuration ("
+        + ', '.join(f'{k} {v}' for k, v in PAPER.items())
+        + ') instead of the defaults',
+    )
+    parser.add_argument(
+        '--model',
+        choices=MODELS,
+        default=None,
+        help=f'(default {defaults.model}; --paper: {paper.model})',
+    )
+    parser.add_argument(
+        '--excitation',
+        choices=EXCITATIONS,
+        default=None,
+        help=EstimatorConfig.describe('excitation')[0] + f' (default {defaults.excitation})',
+    )
+    parser.add_argument(
+        '--band-hz',
+        nargs=2,
+        type=float,
+        metavar=('LO', 'HI'),
+        help='band-pass prefilter [LO, HI] Hz (default off)',
+    )
     for name, kind in _CONFIG_OPTIONS.items():
         value, paper_value = getattr(defaults, name), getattr(paper, name)
-        parser.add_argument('--' + name.replace('_', '-'), type=kind, default=None,
-                            help=f'(default {value}' + (
-                                f'; --paper: {paper_value})' if paper_value != value else ')'))
+        parser.add_argument(
+            '--' + name.replace('_', '-'),
+            type=kind,
+            default=None,
+            help=f'(default {value}'
+            + (f'; --paper: {paper_value})' if paper_value != value else ')'),
+        )
 
 
 def make_config(args: argparse.Namespace) -> EstimatorConfig:
     """The estimator configuration of the command line (ValueError if out of range)."""
     base = EstimatorConfig.paper() if args.paper else EstimatorConfig()
-    given = {name: getattr(args, name) for name in ('model', 'excitation', *_CONFIG_OPTIONS)
-             if getattr(args, name) is not None}
+    given = {
+        name: getattr(args, name)
+        for name in ('model', 'excitation', *_CONFIG_OPTIONS)
+        if getattr(args, name) is not None
+    }
     return base.replace(band_hz=tuple(args.band_hz) if args.band_hz else None, **given)
 
 
@@ -95,8 +145,10 @@ def _check_times(t: np.ndarray, previous: float, count: int, name: str) -> None:
     if bad.size:
         i = int(bad[0]) + (0 if count else 1)
         before = previous if i == 0 else t[i - 1]
-        raise ValueError(f'{name}: time is not strictly increasing at sample {count + i} '
-                         f'(t = {float(before)!r} then {float(t[i])!r})')
+        raise ValueError(
+            f'{name}: time is not strictly increasing at sample {count + i} '
+            f'(t = {float(before)!r} then {float(t[i])!r})'
+        )
 
 
 def _check_nyquist(config: EstimatorConfig, t: np.ndarray, name: str) -> None:
@@ -105,8 +157,10 @@ def _check_nyquist(config: EstimatorConfig, t: np.ndarray, name: str) -> None:
         return
     nyquist = 0.5 / float(np.median(np.diff(t[:10_000])))
     if config.band_hz[1] > nyquist:
-        raise ValueError(f'--band-hz upper edge {config.band_hz[1]:g} Hz is above the Nyquist '
-                         f'frequency {nyquist:g} Hz of {name} (sampled at {2 * nyquist:g} Hz)')
+        raise ValueError(
+            f'--band-hz upper edge {config.band_hz[1]:g} Hz is above the Nyquist '
+            f'frequency {nyquist:g} Hz of {name} (sampled at {2 * nyquist:g} Hz)'
+        )
 
 
 @dataclass
@@ -135,8 +189,9 @@ def estimate_signal(signal: Signal, config: EstimatorConfig, keep_samples: bool 
             continue
         _check_times(t, previous, count, str(signal.path))
         if not nyquist_checked and count + len(t) >= 2:
-            _check_nyquist(config, np.concatenate(([previous], t)) if count else t,
-                           str(signal.path))
+            _check_nyquist(
+                config, np.concatenate(([previous], t)) if count else t, str(signal.path)
+            )
             nyquist_checked = True
         first_t = float(t[0]) if first_t is None else first_t
         count, previous = count + len(t), float(t[-1])
@@ -144,34 +199,50 @@ def estimate_signal(signal: Signal, config: EstimatorConfig, keep_samples: bool 
         if keep_samples:
             kept.append((t, y))
     if count == 0:
-        raise ValueError(f'{signal.path} holds no samples' if not signal.topic else
-                         f'topic {signal.topic} of {signal.path} has no messages')
+        raise ValueError(
+            f'{signal.path} holds no samples'
+            if not signal.topic
+            else f'topic {signal.topic} of {signal.path} has no messages'
+        )
     samples = tuple(np.concatenate(p) for p in zip(*kept)) if keep_samples else None
     return Run(estimator, EstimateArrays.concatenate(parts), first_t, previous, samples)
 
 
 def json_row(row: dict) -> dict:
     """``row`` with every non-finite float as None, so strict JSON can hold it (null)."""
-    return {k: None if isinstance(v, float) and not math.isfinite(v) else v
-            for k, v in row.items()}
+    return {
+        k: None if isinstance(v, float) and not math.isfinite(v) else v for k, v in row.items()
+    }
 
 
 def explain_no_estimate(counters, open_samples: Optional[int], config: EstimatorConfig) -> str:
     """Why a run gave no estimate, from its counters, and what to try."""
     held = {k: v for k, v in counters.items() if v and k.startswith('rejected_')}
     if held:
-        return ('every converged estimate was held back by the quality gate (' +
-                ', '.join(f'{k}={v}' for k, v in held.items()) + '): check --min-fit, '
-                '--max-damping, --min-amplitude, or the model (--model)')
+        return (
+            'every converged estimate was held back by the quality gate ('
+            + ', '.join(f'{k}={v}' for k, v in held.items())
+            + '): check --min-fit, '
+            '--max-damping, --min-amplitude, or the model (--model)'
+        )
     if counters.get('used', 0) == 0:
         return 'no sample was usable (see the skipped_* counters)'
     text = 'the convergence test (Eqs. 16-17) never fired'
     if open_samples:
         text += f' (the last segment ran {open_samples} samples without converging'
-        text += ', ' + ('max_window automatic: 10 s' if not config.max_window else
-                        f'max_window {config.max_window:g} s') + ')'
-    return (text + f': the signal may not follow --model {config.model} (a decay: try '
-            '--model damped-sinusoid), or try a larger --tolerance or a longer recording')
+        text += (
+            ', '
+            + (
+                'max_window automatic: 10 s'
+                if not config.max_window
+                else f'max_window {config.max_window:g} s'
+            )
+            + ')'
+        )
+    return (
+        text + f': the signal may not follow --model {config.model} (a decay: try '
+        '--model damped-sinusoid), or try a larger --tolerance or a longer recording'
+    )
 
 
 def _print(estimates, origin, fmt, modes: int = 0) -> None:
@@ -183,7 +254,7 @@ def _print(estimates, origin, fmt, modes: int = 0) -> None:
         rows.append(row)
     out = sys.stdout
     if fmt == 'jsonl':
-        for row in rows:     # strict JSON: NaN or inf (unknown, e.g. no damping) becomes null
+        for row in rows:  # strict JSON: NaN or inf (unknown, e.g. no damping) becomes null
             out.write(json.dumps(json_row(row), allow_nan=False) + '\n')
     elif fmt == 'csv':
         keys = list(rows[0]) if rows else ['t', 'frequency_hz', 'convergence_time_s']
@@ -192,48 +263,63 @@ def _print(estimates, origin, fmt, modes: int = 0) -> None:
             out.write(','.join(repr(row[k]) for k in keys) + '\n')
     else:
         mode = f'{"mode":>5} ' if modes else ''
-        out.write(f'{"t (s)":>12} {mode}{"f (Hz)":>12} {"f std (Hz)":>10} {"zeta":>8} '
-                  f'{"conv (s)":>9} {"samples":>8} {"fit":>6}\n')
+        out.write(
+            f'{"t (s)":>12} {mode}{"f (Hz)":>12} {"f std (Hz)":>10} {"zeta":>8} '
+            f'{"conv (s)":>9} {"samples":>8} {"fit":>6}\n'
+        )
         for row in rows:
             mode = f'{row["mode"]:5d} ' if modes else ''
-            out.write(f'{row["t"]:12.4f} {mode}{row["frequency_hz"]:12.6f} '
-                      f'{row["frequency_std_hz"]:10.3g} {row["damping"]:8.5f} '
-                      f'{row["convergence_time_s"]:9.4f} {row["samples"]:8d} {row["fit"]:6.3f}\n')
+            out.write(
+                f'{row["t"]:12.4f} {mode}{row["frequency_hz"]:12.6f} '
+                f'{row["frequency_std_hz"]:10.3g} {row["damping"]:8.5f} '
+                f'{row["convergence_time_s"]:9.4f} {row["samples"]:8d} {row["fit"]:6.3f}\n'
+            )
 
 
 def damage_warning(signal: Signal, prog: str) -> None:
     """The one ``warning:`` line on stderr for the damaged records a read skipped, if any."""
     if signal.corrupt:
-        print(f'{prog}: warning: skipped {signal.corrupt} damaged record(s) of {signal.topic} in '
-              f'{signal.path} (first: {signal.damage}); --strict makes this an error',
-              file=sys.stderr)
+        print(
+            f'{prog}: warning: skipped {signal.corrupt} damaged record(s) of {signal.topic} in '
+            f'{signal.path} (first: {signal.damage}); --strict makes this an error',
+            file=sys.stderr,
+        )
 
 
 def run(args: argparse.Namespace) -> int:
     try:
         config = make_config(args)
         check_output(args.plot, '--plot')
-        signal = open_signal(args.input, args.topic, args.component, args.column,
-                             strict=getattr(args, 'strict', False))
+        signal = open_signal(
+            args.input,
+            args.topic,
+            args.component,
+            args.column,
+            strict=getattr(args, 'strict', False),
+        )
         result = estimate_signal(signal, config, bool(args.plot))
     except (VibEstimatorError, ValueError) as err:
         return report(err, 'vib-estimator analyze')
     damage_warning(signal, 'vib-estimator analyze')
     estimates = result.estimates
-    _print(estimates, signal.origin_ns, args.format,
-           config.modes or config.excitation == 'ambient')
+    _print(
+        estimates, signal.origin_ns, args.format, config.modes or config.excitation == 'ambient'
+    )
     counters = result.estimator.counters
     extra = f', messages_without_component={signal.skipped}' if signal.skipped else ''
     extra += f', corrupt_records={signal.corrupt}' if signal.topic else ''
     open_samples = getattr(result.estimator, 'segment_samples', None)
     if open_samples is not None:
         extra += f', open_segment_samples={open_samples}'
-    print('analyze: ' + ', '.join(f'{k}={v}' for k, v in counters.items()) + extra,
-          file=sys.stderr)
+    print(
+        'analyze: ' + ', '.join(f'{k}={v}' for k, v in counters.items()) + extra, file=sys.stderr
+    )
     mode = estimates.mode if config.modes else None
     if len(estimates) == 0:
-        print('analyze: no estimate: ' + explain_no_estimate(counters, open_samples, config),
-              file=sys.stderr)
+        print(
+            'analyze: no estimate: ' + explain_no_estimate(counters, open_samples, config),
+            file=sys.stderr,
+        )
     for line in summary_lines(summarise_modes(estimates.frequency_hz, estimates.damping, mode)):
         print('analyze: ' + line, file=sys.stderr)
     if args.plot:
@@ -248,6 +334,14 @@ def plot_run(path: str, name: str, signal: Signal, run: Run, mode=None):
     from .plotting import plot_estimates
 
     e = run.estimates
-    return plot_estimates(path, *run.samples, e.t, e.frequency_hz, e.convergence_time,
-                          title=f'{name}: {signal.label}', ylabel=signal.label, mode=mode,
-                          unit=signal_unit(signal.component or signal.label))
+    return plot_estimates(
+        path,
+        *run.samples,
+        e.t,
+        e.frequency_hz,
+        e.convergence_time,
+        title=f'{name}: {signal.label}',
+        ylabel=signal.label,
+        mode=mode,
+        unit=signal_unit(signal.component or signal.label),
+    )

@@ -1,9 +1,13 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Baseline frequency trackers of Section 5.4, and a flight-controller-style windowed-DFT tracker.
 
-Every tracker has the streaming/batch shape of :class:`vib_estimator.core.estimator.FrequencyEstimator`:
+Every tracker has the streaming/batch shape of
+:class:`vib_estimator.core.estimator.FrequencyEstimator`:
 ``update(t, y)`` feeds one sample and returns the current estimate in Hz (a float at every sample,
 ``None`` while the tracker has none), ``reset()`` forgets the signal, and ``process(t, y)`` feeds
-arrays and returns the per-sample estimates (NaN where ``update`` returns ``None``), the same floats
+arrays and returns the per-sample estimates (NaN where ``update`` returns ``None``), the same
+floats
 as ``update`` gives. A sample whose value or stamp is not finite, or whose stamp does not increase,
 is skipped (the current estimate is returned).
 
@@ -28,6 +32,7 @@ Windowed DFT (:class:`SlidingDFT`): what PX4's ``gyro_fft`` and Betaflight's dyn
 a Hann-windowed FFT of the last ``window_s`` seconds every ``hop`` samples, the largest bin in the
 search band refined by two-bin interpolation.
 """
+
 from __future__ import annotations
 
 import functools
@@ -42,7 +47,7 @@ from ..core.uncertainty import TWO_PI
 ZIARANI, HOU, MOJIRI = 0, 1, 2
 
 # ---- state array layout of the ODE trackers ------------------------------------------------
-S_STARTED, S_TPREV, S_YPREV, S_X = 0, 1, 2, 3   # flag, last stamp, last value, ODE state (3)
+S_STARTED, S_TPREV, S_YPREV, S_X = 0, 1, 2, 3  # flag, last stamp, last value, ODE state (3)
 N_STATE = S_X + 3
 
 
@@ -162,7 +167,7 @@ class _OdeTracker:
             raise ValueError(f'substeps must be >= 1, got {substeps!r}')
         self._p = np.asarray(params, dtype=np.float64)
         self._x0 = np.zeros(3)
-        self._x0[:len(x0)] = x0
+        self._x0[: len(x0)] = x0
         self._substeps = int(substeps)
         self._s = np.zeros(N_STATE)
 
@@ -186,15 +191,22 @@ class _OdeTracker:
 class ZiaraniKonrad(_OdeTracker):
     """Ziarani & Konrad's enhanced PLL (Eqs. 25-26); defaults are the gains of Section 5.4.
 
-    States A, omega, gamma (= omega t + phi, integrated as gamma' = omega + mu3 omega'); A starts at
+    States A, omega, gamma (= omega t + phi, integrated as gamma' = omega + mu3 omega'); A starts
+    at
     0 and gamma at 0. Units: mu1 1/s, mu2 1/(s^2 unit^2), mu3 s.
     """
 
     kind = ZIARANI
     name = 'Ziarani-Konrad'
 
-    def __init__(self, mu1: float = 10.0, mu2: float = 3000.0, mu3: float = 0.1,
-                 omega0: float = 6 * math.pi, substeps: int = 4):
+    def __init__(
+        self,
+        mu1: float = 10.0,
+        mu2: float = 3000.0,
+        mu3: float = 0.1,
+        omega0: float = 6 * math.pi,
+        substeps: int = 4,
+    ):
         super().__init__((mu1, mu2, mu3), (0.0, omega0, 0.0), substeps)
 
 
@@ -209,9 +221,14 @@ class Hou(_OdeTracker):
     kind = HOU
     name = 'Hou'
 
-    def __init__(self, alpha1: float = 10.0, alpha2: float = 5000.0,
-                 omega0: float = 6 * math.pi, substeps: int = 4):
-        super().__init__((alpha1, alpha2), (0.0, omega0 ** 2), substeps)
+    def __init__(
+        self,
+        alpha1: float = 10.0,
+        alpha2: float = 5000.0,
+        omega0: float = 6 * math.pi,
+        substeps: int = 4,
+    ):
+        super().__init__((alpha1, alpha2), (0.0, omega0**2), substeps)
 
 
 class MojiriBakhshai(_OdeTracker):
@@ -224,8 +241,13 @@ class MojiriBakhshai(_OdeTracker):
     kind = MOJIRI
     name = 'Mojiri-Bakhshai'
 
-    def __init__(self, xi1: float = 0.1, xi2: float = 1.25,
-                 x0: Sequence[float] = (1.0, 1.0, 6 * math.pi), substeps: int = 4):
+    def __init__(
+        self,
+        xi1: float = 0.1,
+        xi2: float = 1.25,
+        x0: Sequence[float] = (1.0, 1.0, 6 * math.pi),
+        substeps: int = 4,
+    ):
         super().__init__((xi1, xi2), tuple(x0), substeps)
 
 
@@ -243,26 +265,35 @@ class SlidingDFT:
 
     This is the scheme of PX4's ``gyro_fft`` and Betaflight's dynamic notch (fixed-rate samples,
     Hann window, peak search, interpolation between bins). The interpolation is Jain, Collins &
-    Davis's (1979) ratio rule with the Hann window's kernel (Grandke 1983): with ``k`` the peak bin,
+    Davis's (1979) ratio rule with the Hann window's kernel (Grandke 1983): with ``k`` the peak
+    bin,
     ``a = |X[k+1]| / |X[k]|`` (or ``|X[k-1]|``, whichever neighbour is larger), the offset is
     ``delta = +-(2a - 1) / (a + 1)`` bins, exact for a complex exponential; for a real sinusoid the
     residual bias comes from the negative-frequency image: < 0.2 % from 2.3 cycles per window on.
 
     Parameters: ``rate_hz`` the (fixed) sampling rate the DFT assumes; ``window_s`` the window
-    (default 2 s: 2.3 cycles at the 1.15 Hz of Section 5.5, bins of 0.5 Hz); ``hop`` samples between
+    (default 2 s: 2.3 cycles at the 1.15 Hz of Section 5.5, bins of 0.5 Hz); ``hop`` samples
+    between
     two DFTs (default 10: a 50 Hz update at 500 Hz); ``band_hz`` the peak search band. The estimate
-    of a DFT is reported from its last sample until the next DFT; none before the first full window.
+    of a DFT is reported from its last sample until the next DFT; none before the first full
+    window.
     """
 
     name = 'Sliding DFT'
 
-    def __init__(self, rate_hz: float = 500.0, window_s: float = 2.0, hop: int = 10,
-                 band_hz: Sequence[float] = (0.5, 25.0)):
+    def __init__(
+        self,
+        rate_hz: float = 500.0,
+        window_s: float = 2.0,
+        hop: int = 10,
+        band_hz: Sequence[float] = (0.5, 25.0),
+    ):
         self._n = int(round(window_s * rate_hz))
         self._hop = int(hop)
         if self._n < 8 or self._hop < 1:
-            raise ValueError(f'window_s * rate_hz must be >= 8 samples and hop >= 1, got '
-                             f'{self._n}, {hop!r}')
+            raise ValueError(
+                f'window_s * rate_hz must be >= 8 samples and hop >= 1, got {self._n}, {hop!r}'
+            )
         self._df = rate_hz / self._n
         nbins = self._n // 2 + 1
         self._klo = max(1, int(math.ceil(band_hz[0] / self._df)))
@@ -288,7 +319,7 @@ class SlidingDFT:
         """Interpolated peak frequency (Hz) of each row of ``frames`` (n_frames x N)."""
         mag = np.abs(np.fft.rfft(frames * self._window, axis=1))
         rows = np.arange(len(frames))
-        k = self._klo + np.argmax(mag[:, self._klo:self._khi + 1], axis=1)
+        k = self._klo + np.argmax(mag[:, self._klo : self._khi + 1], axis=1)
         peak = mag[rows, k]
         up = mag[rows, k + 1]
         down = mag[rows, k - 1]
@@ -312,17 +343,18 @@ class SlidingDFT:
         if len(t):
             self._tmax = max(self._tmax, float(tmax[-1]))
         data = np.concatenate((self._buf, y[accepted]))
-        base = self._count - len(self._buf)        # global index of data[0]
-        g = self._count + np.arange(int(accepted.sum()))   # global index of each new sample
+        base = self._count - len(self._buf)  # global index of data[0]
+        g = self._count + np.arange(int(accepted.sum()))  # global index of each new sample
         ends = g[(g >= self._n - 1) & ((g - (self._n - 1)) % self._hop == 0)]
         est = np.full(len(t), np.nan)
         if len(ends):
-            frames = np.lib.stride_tricks.sliding_window_view(data, self._n)[ends - self._n + 1
-                                                                             - base]
+            frames = np.lib.stride_tricks.sliding_window_view(data, self._n)[
+                ends - self._n + 1 - base
+            ]
             est[np.flatnonzero(accepted)[ends - self._count]] = self._peak_frequencies(frames)
         out = hold_last(est, self._f)
         self._count += len(g)
-        self._buf = data[max(0, len(data) - (self._n - 1)):]
+        self._buf = data[max(0, len(data) - (self._n - 1)) :]
         if len(out):
             self._f = float(out[-1])
         return out
@@ -345,11 +377,13 @@ def blas_controller():
     threads it ran 20x slower on a 2-core machine busy with other work (88 s instead of 0.9 s for
     one 10 s record), so it runs on one thread."""
     from threadpoolctl import ThreadpoolController
+
     return ThreadpoolController()
 
 
-def matrix_pencil(y: np.ndarray, ts: float, order: int = 2,
-                  max_pencil: int = 256) -> Tuple[float, float]:
+def matrix_pencil(
+    y: np.ndarray, ts: float, order: int = 2, max_pencil: int = 256
+) -> Tuple[float, float]:
     """Matrix-pencil estimate (Hua & Sarkar 1990) of one damped mode: (natural frequency Hz, zeta).
 
     The damped-exponential model y_k = sum_i r_i z_i^k, fitted through the Hankel matrix of the
@@ -379,13 +413,20 @@ class SlidingMatrixPencil(SlidingDFT):
 
     name = 'Matrix pencil'
 
-    def __init__(self, rate_hz: float = 500.0, window_s: float = 2.0, hop: int = 25,
-                 order: int = 2, max_pencil: int = 64):
+    def __init__(
+        self,
+        rate_hz: float = 500.0,
+        window_s: float = 2.0,
+        hop: int = 25,
+        order: int = 2,
+        max_pencil: int = 64,
+    ):
         super().__init__(rate_hz, window_s, hop)
         self._ts = 1.0 / rate_hz
         self._order = int(order)
         self._max_pencil = int(max_pencil)
 
     def _peak_frequencies(self, frames: np.ndarray) -> np.ndarray:
-        return np.array([matrix_pencil(f, self._ts, self._order, self._max_pencil)[0]
-                         for f in frames])
+        return np.array(
+            [matrix_pencil(f, self._ts, self._order, self._max_pencil)[0] for f in frames]
+        )

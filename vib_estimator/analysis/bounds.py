@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Cramer-Rao lower bounds on the frequency (and damping) of the estimator's signal models.
 
 For ``N`` samples ``y_n = A sin(w n Ts + phi) + e_n``, ``e_n ~ N(0, sigma^2)``, with A, w and phi
@@ -11,6 +13,7 @@ Fisher information matrix, to check it; :func:`model_crb` is the exact bound of 
 estimator's models (sinusoid; with an offset; damped, bounding the natural frequency and the
 damping ratio) over the samples an estimate used.
 """
+
 from __future__ import annotations
 
 import math
@@ -28,16 +31,24 @@ def crlb_frequency_std(amplitude: float, noise_std: float, ts: float, n: int) ->
     """
     if n < 2 or amplitude == 0:
         return math.inf
-    var_w = 24.0 * noise_std ** 2 / (amplitude ** 2 * ts ** 2 * n * (n * n - 1.0))
+    var_w = 24.0 * noise_std**2 / (amplitude**2 * ts**2 * n * (n * n - 1.0))
     return math.sqrt(var_w) / (2 * math.pi)
 
 
-def fisher_frequency_std(amplitude: float, frequency_hz: float, phase: float, noise_std: float,
-                         ts: float, n: int, rel_step: float = 1e-6) -> float:
+def fisher_frequency_std(
+    amplitude: float,
+    frequency_hz: float,
+    phase: float,
+    noise_std: float,
+    ts: float,
+    n: int,
+    rel_step: float = 1e-6,
+) -> float:
     """Exact CRLB on the frequency's standard deviation (Hz) from the Fisher information.
 
     The Jacobian of ``s(theta) = A sin(w t + phi)``, ``t = k Ts``, with respect to
-    ``theta = (A, w, phi)`` is taken by central differences; ``FIM = J^T J / sigma^2`` and the bound
+    ``theta = (A, w, phi)`` is taken by central differences; ``FIM = J^T J / sigma^2`` and the
+    bound
     is ``sqrt([FIM^-1]_ww) / (2 pi)``.
     """
     t = np.arange(n) * ts
@@ -53,7 +64,7 @@ def fisher_frequency_std(amplitude: float, frequency_hz: float, phase: float, no
         up[i] += step
         down[i] -= step
         jac[:, i] = (model(up) - model(down)) / (2 * step)
-    fim = jac.T @ jac / noise_std ** 2
+    fim = jac.T @ jac / noise_std**2
     return math.sqrt(np.linalg.inv(fim)[1, 1]) / (2 * math.pi)
 
 
@@ -76,8 +87,15 @@ def window_crlb_std(y: np.ndarray, ts: float, frequency_hz: float, noise_std: fl
     return fisher_frequency_std(math.hypot(a, b), frequency_hz, math.atan2(b, a), noise_std, ts, n)
 
 
-def model_crb(model: str, t: np.ndarray, amplitude: float, frequency_hz: float, phase: float,
-              noise_std: float, damping: float = 0.0) -> Tuple[float, float]:
+def model_crb(
+    model: str,
+    t: np.ndarray,
+    amplitude: float,
+    frequency_hz: float,
+    phase: float,
+    noise_std: float,
+    damping: float = 0.0,
+) -> Tuple[float, float]:
     """Exact CRB (std of the natural frequency in Hz, std of the damping ratio) for one window.
 
     The signal is the model's, at its true parameters, on the sample times ``t`` (the samples the
@@ -111,10 +129,10 @@ def model_crb(model: str, t: np.ndarray, amplitude: float, frequency_hz: float, 
         cols.append(-u * env * np.sin(arg))
     jac = np.column_stack(cols)
     scale = 1.0 / np.sqrt(np.sum(jac * jac, axis=0))
-    cov = np.linalg.inv((jac * scale).T @ (jac * scale)) * np.outer(scale, scale) * noise_std ** 2
+    cov = np.linalg.inv((jac * scale).T @ (jac * scale)) * np.outer(scale, scale) * noise_std**2
     if model != 'damped-sinusoid':
         return math.sqrt(cov[2, 2]) / (2 * math.pi), math.nan
     g_w = np.array([wd / wn, sigma / wn])
-    g_z = np.array([-sigma * wd / wn ** 3, wd * wd / wn ** 3])
+    g_z = np.array([-sigma * wd / wn**3, wd * wd / wn**3])
     block = cov[2:4, 2:4]
     return (math.sqrt(g_w @ block @ g_w) / (2 * math.pi), math.sqrt(g_z @ block @ g_z))

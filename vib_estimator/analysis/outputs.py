@@ -1,5 +1,8 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Output paths of the command line, checked before any work starts (issue 22): a path that
 cannot be written fails at once with one ``error:`` line, not after the whole analysis."""
+
 from __future__ import annotations
 
 import os
@@ -31,5 +34,4 @@ def check_output(path: Optional[str], option: str, directory: bool = False) -> N
             if not existed:
                 target.unlink()
     except OSError as err:
-        raise ValueError(f'{option} {path}: cannot write there ({err.strerror or err})') \
-            from None
+        raise ValueError(f'{option} {path}: cannot write there ({err.strerror or err})') from None

@@ -1,9 +1,12 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Figures in the style of the paper's Fig. 5 (signal / estimates / convergence times), and the
 signal's spectrum with the estimated modes marked.
 
 matplotlib is imported lazily with the non-interactive Agg backend, so nodes and the core never pay
 for it and no display is needed.
 """
+
 from __future__ import annotations
 
 import math
@@ -37,11 +40,19 @@ def mode_colour(k: int) -> str:
     return 'C3' if k == 0 else f'C{(k - 1) % 10}'
 
 
-def plot_estimates(path: str, t: np.ndarray, y: np.ndarray, est_t: np.ndarray,
-                   est_f: np.ndarray, est_conv: np.ndarray,
-                   truth: Optional[Sequence[Tuple[float, float, float]]] = None,
-                   title: str = '', ylabel: str = 'signal',
-                   mode: Optional[np.ndarray] = None, unit: str = UNKNOWN_UNIT):
+def plot_estimates(
+    path: str,
+    t: np.ndarray,
+    y: np.ndarray,
+    est_t: np.ndarray,
+    est_f: np.ndarray,
+    est_conv: np.ndarray,
+    truth: Optional[Sequence[Tuple[float, float, float]]] = None,
+    title: str = '',
+    ylabel: str = 'signal',
+    mode: Optional[np.ndarray] = None,
+    unit: str = UNKNOWN_UNIT,
+):
     """Write a four-panel PNG: the three panels of Fig. 5 and the signal's spectrum; return the
     Figure (closed: for inspection, not display).
 
@@ -67,11 +78,12 @@ def plot_estimates(path: str, t: np.ndarray, y: np.ndarray, est_t: np.ndarray,
         axes[1].plot(est_t[sel], est_f[sel], '*', color=mode_colour(k), label=label)
         axes[2].plot(est_t[sel], est_conv[sel], 'o', mfc='none', color=mode_colour(k))
     for i, (t0, t1, f) in enumerate(truth or []):
-        axes[1].hlines(f, t0, t1, colors='k', linestyles='--',
-                       label='true frequency' if i == 0 else None)
+        axes[1].hlines(
+            f, t0, t1, colors='k', linestyles='--', label='true frequency' if i == 0 else None
+        )
     axes[1].set_ylabel('frequency (Hz)')
     if len(np.unique(mode)) > 1:
-        axes[1].set_yscale('log')          # modes a decade apart, each visible
+        axes[1].set_yscale('log')  # modes a decade apart, each visible
     elif len(est_f):
         lo, hi = np.percentile(est_f, [2, 98])
         pad = max(0.05 * (hi - lo), 0.02 * hi)
@@ -113,8 +125,13 @@ def plot_spectrum(ax, t: np.ndarray, y: np.ndarray, modes, unit: str = UNKNOWN_U
     f, psd = welch_psd(t, y, min((m.frequency_hz for m in modes), default=math.nan))
     ax.semilogy(f[1:], psd[1:], lw=0.8, color='0.3', label='Welch PSD')
     for m in modes:
-        ax.axvline(m.frequency_hz, color=mode_colour(m.mode), ls='--', lw=1.0,
-                   label=f'f = {m.frequency_hz:.5g} Hz' + (f' (mode {m.mode})' if m.mode else ''))
+        ax.axvline(
+            m.frequency_hz,
+            color=mode_colour(m.mode),
+            ls='--',
+            lw=1.0,
+            label=f'f = {m.frequency_hz:.5g} Hz' + (f' (mode {m.mode})' if m.mode else ''),
+        )
     if modes:
         ax.set_xlim(0, min(f[-1], PSD_SPAN * max(m.frequency_hz for m in modes)))
     ax.set_xlabel('frequency (Hz)')

@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """The short summary ``vib-estimator analyze`` ends with: the modes found and the input shaper to
 use for them, as ``shaper_node`` parameters.
 
@@ -13,6 +15,7 @@ leave ZVD more residual vibration than EI's tolerance: with ``s`` = 2 robust std
 EI, which stays within ``EI_VTOL`` over a wider band. ``shaper_node`` shapes one
 mode: the recommendation is for the lowest one.
 """
+
 from __future__ import annotations
 
 import math
@@ -62,9 +65,17 @@ def summarise_modes(frequency_hz, damping, mode=None) -> List[ModeSummary]:
         std = MAD_TO_STD * float(np.median(np.abs(f - median)))
         zeta = damping[sel]
         zeta = zeta[np.isfinite(zeta)]
-        out.append(ModeSummary(int(k), int(sel.sum()), median, std, SPREAD_STDS * std / median,
-                               float(np.median(zeta)) if len(zeta) else math.nan,
-                               int(np.sum(np.abs(f - median) > OUTLIER_STDS * std)) if std else 0))
+        out.append(
+            ModeSummary(
+                int(k),
+                int(sel.sum()),
+                median,
+                std,
+                SPREAD_STDS * std / median,
+                float(np.median(zeta)) if len(zeta) else math.nan,
+                int(np.sum(np.abs(f - median) > OUTLIER_STDS * std)) if std else 0,
+            )
+        )
     return sorted(out, key=lambda m: m.frequency_hz)
 
 
@@ -86,10 +97,12 @@ def ros_double(value: float, decimals: int) -> str:
 def shaper_command(mode: ModeSummary, shaper: Optional[str] = None) -> str:
     """The ``ros2 run`` line starting ``shaper_node`` designed for the mode."""
     zeta = 0.0 if not math.isfinite(mode.damping) else min(max(mode.damping, 0.0), MAX_DAMPING)
-    return ('ros2 run vib_estimator shaper_node --ros-args '
-            f'-p shaper:={shaper or recommend_shaper(mode)} '
-            f'-p initial_frequency_hz:={ros_double(mode.frequency_hz, 4)} '
-            f'-p damping_ratio:={ros_double(zeta, 4)}')
+    return (
+        'ros2 run vib_estimator shaper_node --ros-args '
+        f'-p shaper:={shaper or recommend_shaper(mode)} '
+        f'-p initial_frequency_hz:={ros_double(mode.frequency_hz, 4)} '
+        f'-p damping_ratio:={ros_double(zeta, 4)}'
+    )
 
 
 def summary_lines(modes: List[ModeSummary]) -> List[str]:
@@ -99,20 +112,29 @@ def summary_lines(modes: List[ModeSummary]) -> List[str]:
     lines = ['modes found:']
     for m in modes:
         name = f'mode {m.mode}' if m.mode else 'mode'
-        zeta = ('damping not estimated (--model damped-sinusoid estimates it)'
-                if not math.isfinite(m.damping) else f'damping ratio {m.damping:.4f}')
-        odd = (f', {m.outliers} outlier(s) beyond {OUTLIER_STDS:g} std' if m.outliers else '')
-        lines.append(f'  {name}: f = {m.frequency_hz:.4f} ± {m.frequency_std_hz:.2g} Hz '
-                     f'(robust std of {m.count} estimates{odd}), ' + zeta)
+        zeta = (
+            'damping not estimated (--model damped-sinusoid estimates it)'
+            if not math.isfinite(m.damping)
+            else f'damping ratio {m.damping:.4f}'
+        )
+        odd = f', {m.outliers} outlier(s) beyond {OUTLIER_STDS:g} std' if m.outliers else ''
+        lines.append(
+            f'  {name}: f = {m.frequency_hz:.4f} ± {m.frequency_std_hz:.2g} Hz '
+            f'(robust std of {m.count} estimates{odd}), ' + zeta
+        )
     low = modes[0]
     shaper = recommend_shaper(low)
     spread = f'±{SPREAD_STDS:g} std = ±{100 * low.spread_rel:.2g} %'
-    why = (f'over the estimates\' spread, {spread}, ZVD would leave more than '
-           f'{100 * EI_VTOL:g} % residual vibration' if shaper == 'ei' else
-           f'ZVD leaves under {100 * EI_VTOL:g} % residual vibration over the estimates\' spread, '
-           + spread)
-    lines.append(f'recommended input shaper: {shaper.upper()} for {low.frequency_hz:.4g} Hz '
-                 f'({why}' + ('; shaper_node shapes one mode: the lowest' if len(modes) > 1
-                              else '') + '):')
+    why = (
+        f"over the estimates' spread, {spread}, ZVD would leave more than "
+        f'{100 * EI_VTOL:g} % residual vibration'
+        if shaper == 'ei'
+        else f'ZVD leaves under {100 * EI_VTOL:g} % residual vibration over the '
+        f"estimates' spread, {spread}"
+    )
+    lines.append(
+        f'recommended input shaper: {shaper.upper()} for {low.frequency_hz:.4g} Hz '
+        f'({why}' + ('; shaper_node shapes one mode: the lowest' if len(modes) > 1 else '') + '):'
+    )
     lines.append('  ' + shaper_command(low, shaper))
     return lines

@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """``vib-estimator survey``: many recordings at once, one summary row each, and a health alarm.
 
 Inputs are files, directories (searched recursively: a directory with ``metadata.yaml`` is one
@@ -13,7 +15,8 @@ of its median frequency is beyond ``--alarm-rel`` with 95 % confidence, i.e. the
 of the change (both medians' intervals combined) lies outside [-R, R].
 
 Recordings are independent tasks: ``--jobs N`` runs them on a local process pool
-(``concurrent.futures``), ``--scheduler ADDRESS`` on a Dask distributed cluster (``dask scheduler``,
+(``concurrent.futures``), ``--scheduler ADDRESS`` on a Dask distributed cluster
+(``dask scheduler``,
 ``dask worker ADDRESS``; every worker must have this package and see the files). Rows come back in
 the order of the sorted recordings, whatever finished first, so every engine gives the same rows.
 A recording that fails is one row with ``error`` set, and one line on stderr. Every entry of a
@@ -24,6 +27,7 @@ per folder. Damaged bag records are skipped and counted (column ``corrupt_record
 Exit status: 0; 3 when ``--fail-on-alarm`` and a row is flagged; 1 when ``--strict`` and a row has
 an error; 2 for bad arguments.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -51,15 +55,35 @@ from ..io.streaming import bag_topics, is_csv, open_signal, supported_topics
 from .analyze import add_config_arguments, estimate_signal, make_config
 from .outputs import check_output
 
-_STATS = ('start_utc', 'duration_s', 'samples', 'estimates', 'frequency_hz', 'frequency_lo_hz',
-          'frequency_hi_hz', 'damping', 'amplitude')
+_STATS = (
+    'start_utc',
+    'duration_s',
+    'samples',
+    'estimates',
+    'frequency_hz',
+    'frequency_lo_hz',
+    'frequency_hi_hz',
+    'damping',
+    'amplitude',
+)
 _COUNTERS = tuple(c for c in COUNTER_NAMES if c not in ('received', 'estimates'))
 #: the columns of a row, in order
-COLUMNS = (('recording', 'topic', 'component', 'mode') + _STATS + _COUNTERS
-           + ('messages_without_component', 'corrupt_records', 'change_rel', 'change_lo', 'change_hi', 'alarm',
-              'error'))
+COLUMNS = (
+    ('recording', 'topic', 'component', 'mode')
+    + _STATS
+    + _COUNTERS
+    + (
+        'messages_without_component',
+        'corrupt_records',
+        'change_rel',
+        'change_lo',
+        'change_hi',
+        'alarm',
+        'error',
+    )
+)
 _OUT_SUFFIXES = ('.csv', '.parquet', '.jsonl')
-_UNIX_2000 = 946_684_800.0   # a CSV time column at least this large is taken as Unix time
+_UNIX_2000 = 946_684_800.0  # a CSV time column at least this large is taken as Unix time
 
 
 @dataclass(frozen=True)
@@ -75,32 +99,64 @@ class Options:
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument('inputs', nargs='+', metavar='INPUT',
-                        help='recordings: files, directories (searched recursively), globs')
-    parser.add_argument('--topic', action='append', default=[],
-                        help='topic to read (repeatable; default: every topic of a supported type)')
-    parser.add_argument('--component', action='append', default=[],
-                        help="component to read (repeatable; each topic takes those valid for its "
-                        "type; default: the type's default)")
+    parser.add_argument(
+        'inputs',
+        nargs='+',
+        metavar='INPUT',
+        help='recordings: files, directories (searched recursively), globs',
+    )
+    parser.add_argument(
+        '--topic',
+        action='append',
+        default=[],
+        help='topic to read (repeatable; default: every topic of a supported type)',
+    )
+    parser.add_argument(
+        '--component',
+        action='append',
+        default=[],
+        help='component to read (repeatable; each topic takes those valid for its '
+        "type; default: the type's default)",
+    )
     parser.add_argument('--column', help='CSV signal column (default: the second)')
     add_config_arguments(parser)
     parser.add_argument('--format', choices=('table', 'csv', 'jsonl'), default='table')
-    parser.add_argument('--out', metavar='FILE', help='also write the rows to FILE (.csv, .parquet, '
-                        '.jsonl)')
-    parser.add_argument('--plot', metavar='FILE.png', help='frequency and damping vs recording time')
+    parser.add_argument(
+        '--out', metavar='FILE', help='also write the rows to FILE (.csv, .parquet, .jsonl)'
+    )
+    parser.add_argument(
+        '--plot', metavar='FILE.png', help='frequency and damping vs recording time'
+    )
     parser.add_argument('--baseline', help='a recording, or a frequency in Hz, to compare against')
-    parser.add_argument('--alarm-rel', type=float, default=0.01,
-                        help='relative frequency change that raises the alarm (default 0.01)')
-    parser.add_argument('--fail-on-alarm', action='store_true', help='exit 3 if any row is flagged')
-    parser.add_argument('--strict', action='store_true', help='a damaged bag record fails its '
-                        'recording; exit 1 if any recording failed')
-    parser.add_argument('--jobs', type=int, default=os.cpu_count() or 1,
-                        help='local worker processes (default: the number of cores)')
-    parser.add_argument('--scheduler', metavar='ADDRESS',
-                        help='run on this Dask distributed scheduler (e.g. tcp://host:8786)')
+    parser.add_argument(
+        '--alarm-rel',
+        type=float,
+        default=0.01,
+        help='relative frequency change that raises the alarm (default 0.01)',
+    )
+    parser.add_argument(
+        '--fail-on-alarm', action='store_true', help='exit 3 if any row is flagged'
+    )
+    parser.add_argument(
+        '--strict',
+        action='store_true',
+        help='a damaged bag record fails its recording; exit 1 if any recording failed',
+    )
+    parser.add_argument(
+        '--jobs',
+        type=int,
+        default=os.cpu_count() or 1,
+        help='local worker processes (default: the number of cores)',
+    )
+    parser.add_argument(
+        '--scheduler',
+        metavar='ADDRESS',
+        help='run on this Dask distributed scheduler (e.g. tcp://host:8786)',
+    )
 
 
 # ------------------------------------------------------------------------------ finding recordings
+
 
 def _is_bag_dir(path: Path) -> bool:
     return (path / 'metadata.yaml').is_file()
@@ -119,10 +175,12 @@ def _in_directory(root: Path, ignored: List[Path]) -> Iterable[Path]:
             yield here
             continue
         dirs.sort()
-        recordings = [here / n for n in sorted(files)
-                      if Path(n).suffix.lower() in _RECORDING_SUFFIXES]
-        ignored.extend(here / n for n in sorted(files)
-                       if Path(n).suffix.lower() not in _RECORDING_SUFFIXES)
+        recordings = [
+            here / n for n in sorted(files) if Path(n).suffix.lower() in _RECORDING_SUFFIXES
+        ]
+        ignored.extend(
+            here / n for n in sorted(files) if Path(n).suffix.lower() not in _RECORDING_SUFFIXES
+        )
         if not recordings and not dirs:
             yield here
         yield from recordings
@@ -145,6 +203,7 @@ def find_recordings(inputs: Sequence[str], ignored: Optional[List[Path]] = None)
 
 
 # ---------------------------------------------------------------------------------- one recording
+
 
 def median_interval(values: np.ndarray) -> Tuple[float, float, float]:
     """Median of the finite values and its distribution-free 95 % interval (order statistics of
@@ -169,8 +228,15 @@ def _iso(seconds: Optional[float]) -> str:
 
 def _row(recording: Path, topic: str, component: str, mode: int, **fields) -> Dict:
     row = dict.fromkeys(COLUMNS, math.nan)
-    row.update(recording=str(recording), topic=topic, component=component, mode=mode,
-               start_utc='', alarm=False, error='')
+    row.update(
+        recording=str(recording),
+        topic=topic,
+        component=component,
+        mode=mode,
+        start_utc='',
+        alarm=False,
+        error='',
+    )
     row.update(fields)
     return row
 
@@ -178,23 +244,35 @@ def _row(recording: Path, topic: str, component: str, mode: int, **fields) -> Di
 def _stat_rows(recording: Path, signal, result, modes: int) -> List[Dict]:
     """The rows of one streamed signal: one, or one per mode."""
     est = result.estimates
-    start = (signal.origin_ns * 1e-9 if signal.origin_ns is not None else result.first_t)
+    start = signal.origin_ns * 1e-9 if signal.origin_ns is not None else result.first_t
     rows = []
-    modes = modes or int(est.mode.max(initial=0))     # excitation ambient numbers its modes
-    for mode in (range(1, modes + 1) if modes else [0]):
+    modes = modes or int(est.mode.max(initial=0))  # excitation ambient numbers its modes
+    for mode in range(1, modes + 1) if modes else [0]:
         take = est.mode == mode
-        counters = (result.estimator.mode_counters().get(mode, {}) if modes
-                    else result.estimator.counters)
+        counters = (
+            result.estimator.mode_counters().get(mode, {}) if modes else result.estimator.counters
+        )
         f, lo, hi = median_interval(est.frequency_hz[take])
-        rows.append(_row(
-            recording, signal.topic, signal.component or signal.label, mode,
-            start_utc=_iso(start), duration_s=result.last_t - result.first_t,
-            samples=result.estimator.counters['received'], estimates=int(take.sum()),
-            frequency_hz=f, frequency_lo_hz=lo, frequency_hi_hz=hi,
-            damping=median_interval(est.damping[take])[0],
-            amplitude=median_interval(est.amplitude[take])[0],
-            messages_without_component=signal.skipped, corrupt_records=signal.corrupt,
-            **{c: counters.get(c, 0) for c in _COUNTERS}))
+        rows.append(
+            _row(
+                recording,
+                signal.topic,
+                signal.component or signal.label,
+                mode,
+                start_utc=_iso(start),
+                duration_s=result.last_t - result.first_t,
+                samples=result.estimator.counters['received'],
+                estimates=int(take.sum()),
+                frequency_hz=f,
+                frequency_lo_hz=lo,
+                frequency_hi_hz=hi,
+                damping=median_interval(est.damping[take])[0],
+                amplitude=median_interval(est.amplitude[take])[0],
+                messages_without_component=signal.skipped,
+                corrupt_records=signal.corrupt,
+                **{c: counters.get(c, 0) for c in _COUNTERS},
+            )
+        )
     return rows
 
 
@@ -203,17 +281,21 @@ def _targets(path: Path, options: Options) -> List[Tuple[Optional[str], Optional
     if is_csv(path):
         return [(None, None)]
     topics = bag_topics(path)
-    chosen = ({t: topics.get(t, '') for t in options.topics} if options.topics
-              else supported_topics(topics))
+    chosen = (
+        {t: topics.get(t, '') for t in options.topics}
+        if options.topics
+        else supported_topics(topics)
+    )
     if not chosen:
-        open_signal(path)                        # raises the error naming the bag's topics
+        open_signal(path)  # raises the error naming the bag's topics
     pairs = []
     for topic, kind in sorted(chosen.items()):
         valid = [c for c in options.components if _valid(c, kind)]
         if options.components and not valid and not options.topics:
             continue
-        for component in valid or [options.components[0] if options.components
-                                   else DEFAULT_COMPONENT.get(kind)]:
+        for component in valid or [
+            options.components[0] if options.components else DEFAULT_COMPONENT.get(kind)
+        ]:
             pairs.append((topic, component))
     return pairs
 
@@ -226,9 +308,9 @@ def _valid(component: str, kind: str) -> bool:
         return False
 
 
-_M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD = -1, -3     # glibc's mallopt parameters
+_M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD = -1, -3  # glibc's mallopt parameters
 _GLIBC_DEFAULT_MMAP = 128 * 1024
-_tuned_tasks = 0                  # survey tasks running with raised thresholds
+_tuned_tasks = 0  # survey tasks running with raised thresholds
 _tuned_lock = threading.Lock()
 
 
@@ -257,8 +339,10 @@ def streaming_malloc():
         with _tuned_lock:
             _tuned_tasks -= 1
             if _tuned_tasks == 0:
-                mallopt(_M_MMAP_THRESHOLD,
-                        int(os.environ.get('MALLOC_MMAP_THRESHOLD_', _GLIBC_DEFAULT_MMAP)))
+                mallopt(
+                    _M_MMAP_THRESHOLD,
+                    int(os.environ.get('MALLOC_MMAP_THRESHOLD_', _GLIBC_DEFAULT_MMAP)),
+                )
                 mallopt(_M_TRIM_THRESHOLD, int(trim))
 
 
@@ -277,8 +361,11 @@ def _recording_rows(path: Path, options: Options) -> List[Dict]:
     for topic, component in targets:
         try:
             signal = open_signal(path, topic, component, options.column, options.strict)
-            rows.extend(_stat_rows(path, signal, estimate_signal(signal, options.config),
-                                   options.config.modes))
+            rows.extend(
+                _stat_rows(
+                    path, signal, estimate_signal(signal, options.config), options.config.modes
+                )
+            )
         except Exception as err:  # noqa: BLE001 -- as above
             rows.append(_error_row(path, topic or '', component or '', err))
     return rows
@@ -291,6 +378,7 @@ def _error_row(path: Path, topic: str, component: str, err: BaseException) -> Di
 
 # ------------------------------------------------------------------------------- running them all
 
+
 def _progress(total: int):
     from tqdm import tqdm
 
@@ -298,8 +386,9 @@ def _progress(total: int):
     return tqdm(total=total, unit='recording', disable=not on_terminal, file=sys.stderr)
 
 
-def survey(recordings: Sequence[Path], options: Options, jobs: int = 1,
-           scheduler: Optional[str] = None) -> List[Dict]:
+def survey(
+    recordings: Sequence[Path], options: Options, jobs: int = 1, scheduler: Optional[str] = None
+) -> List[Dict]:
     """The rows of every recording, in the order of ``recordings``: in this process
     (``jobs`` 1), on a local process pool, or on the Dask scheduler at ``scheduler``."""
     bar = _progress(len(recordings))
@@ -345,6 +434,7 @@ def _result(future, path: Path) -> List[Dict]:
 
 # ------------------------------------------------------------------------------ health monitoring
 
+
 def _key(row: Dict) -> Tuple[str, str, int]:
     return row['topic'], row['component'], row['mode']
 
@@ -362,12 +452,16 @@ def baseline_rows(baseline: str, options: Options) -> Dict[Tuple, Tuple[float, f
         return {None: (hz, hz, hz)}
     if not Path(baseline).exists():
         raise ValueError(f'--baseline {baseline!r} is neither a frequency (Hz) nor a recording')
-    rows = [r for r in survey_recording(Path(baseline), options)
-            if not r['error'] and np.isfinite(r['frequency_hz'])]
+    rows = [
+        r
+        for r in survey_recording(Path(baseline), options)
+        if not r['error'] and np.isfinite(r['frequency_hz'])
+    ]
     if not rows:
         raise ValueError(f'baseline {baseline} gives no frequency estimate')
-    table = {_key(r): (r['frequency_hz'], r['frequency_lo_hz'], r['frequency_hi_hz'])
-             for r in rows}
+    table = {
+        _key(r): (r['frequency_hz'], r['frequency_lo_hz'], r['frequency_hi_hz']) for r in rows
+    }
     if len(rows) == 1:
         table[None] = next(iter(table.values()))
     return table
@@ -388,6 +482,7 @@ def flag(rows: List[Dict], base: Dict, alarm_rel: float) -> None:
 
 # ------------------------------------------------------------------------------------- output
 
+
 def _plain(value):
     """JSON/CSV-friendly scalar: NaN as None, numpy scalars as Python ones."""
     if isinstance(value, (float, np.floating)):
@@ -406,26 +501,38 @@ def write_rows(rows: List[Dict], fmt: str, out) -> None:
         writer = csv.writer(out, lineterminator='\n')
         writer.writerow(COLUMNS)
         for row in rows:
-            writer.writerow(['' if _plain(row[k]) is None else repr(_plain(row[k]))
-                             if isinstance(row[k], float) else row[k] for k in COLUMNS])
+            writer.writerow(
+                [
+                    ''
+                    if _plain(row[k]) is None
+                    else repr(_plain(row[k]))
+                    if isinstance(row[k], float)
+                    else row[k]
+                    for k in COLUMNS
+                ]
+            )
     else:
-        out.write(f'{"recording":<28} {"topic":<18} {"component":<22} {"mode":>4} '
-                  f'{"start (UTC)":<20} {"dur (s)":>8} {"samples":>9} {"est":>5} '
-                  f'{"f (Hz)":>10} {"95% interval":>21} {"damping":>8} {"change":>8} alarm\n')
+        out.write(
+            f'{"recording":<28} {"topic":<18} {"component":<22} {"mode":>4} '
+            f'{"start (UTC)":<20} {"dur (s)":>8} {"samples":>9} {"est":>5} '
+            f'{"f (Hz)":>10} {"95% interval":>21} {"damping":>8} {"change":>8} alarm\n'
+        )
         for r in rows:
             if r['error']:
                 out.write(f'{_short(r["recording"]):<28} {r["topic"]:<18} error: {r["error"]}\n')
                 continue
-            out.write(f'{_short(r["recording"]):<28} {r["topic"]:<18} {r["component"]:<22} '
-                      f'{r["mode"]:>4} {r["start_utc"][:19]:<20} {r["duration_s"]:8.1f} '
-                      f'{r["samples"]:9d} {r["estimates"]:5d} {r["frequency_hz"]:10.5f} '
-                      f'[{r["frequency_lo_hz"]:9.5f},{r["frequency_hi_hz"]:9.5f}] '
-                      f'{r["damping"]:8.5f} {r["change_rel"]:+8.2%} '
-                      f'{"ALARM" if r["alarm"] else ""}\n')
+            out.write(
+                f'{_short(r["recording"]):<28} {r["topic"]:<18} {r["component"]:<22} '
+                f'{r["mode"]:>4} {r["start_utc"][:19]:<20} {r["duration_s"]:8.1f} '
+                f'{r["samples"]:9d} {r["estimates"]:5d} {r["frequency_hz"]:10.5f} '
+                f'[{r["frequency_lo_hz"]:9.5f},{r["frequency_hi_hz"]:9.5f}] '
+                f'{r["damping"]:8.5f} {r["change_rel"]:+8.2%} '
+                f'{"ALARM" if r["alarm"] else ""}\n'
+            )
 
 
 def _short(name: str, width: int = 28) -> str:
-    return name if len(name) <= width else '...' + name[-(width - 3):]
+    return name if len(name) <= width else '...' + name[-(width - 3) :]
 
 
 def write_file(rows: List[Dict], path: Path) -> None:
@@ -447,8 +554,9 @@ def alarm_band(ref: Tuple[float, float, float], alarm_rel: float) -> Tuple[float
     return ref[1] * (1 - alarm_rel), ref[2] * (1 + alarm_rel)
 
 
-def plot_trend(rows: List[Dict], path: Path, base: Optional[Dict] = None,
-               alarm_rel: Optional[float] = None):
+def plot_trend(
+    rows: List[Dict], path: Path, base: Optional[Dict] = None, alarm_rel: Optional[float] = None
+):
     """Frequency (and damping, when estimated) against recording time, one line per
     topic/component/mode, with the 95 % intervals as bars and the flagged recordings marked; with
     the baseline ``base`` (:func:`baseline_rows`) its median and the alarm band
@@ -458,34 +566,53 @@ def plot_trend(rows: List[Dict], path: Path, base: Optional[Dict] = None,
     plt = pyplot()
     good = [r for r in rows if not r['error'] and np.isfinite(r['frequency_hz'])]
     damped = any(np.isfinite(r['damping']) for r in good)
-    fig, axes = plt.subplots(2 if damped else 1, 1, sharex=True, figsize=(9, 6 if damped else 4),
-                             squeeze=False)
+    fig, axes = plt.subplots(
+        2 if damped else 1, 1, sharex=True, figsize=(9, 6 if damped else 4), squeeze=False
+    )
     ax_f = axes[0, 0]
     for n, key in enumerate(sorted({_key(r) for r in good})):
         colour = f'C{n % 10}'
         line = [r for r in good if _key(r) == key]
-        x = [datetime.fromisoformat(r['start_utc'].replace('Z', '+00:00')) if r['start_utc']
-             else i for i, r in enumerate(line)]
+        x = [
+            datetime.fromisoformat(r['start_utc'].replace('Z', '+00:00')) if r['start_utc'] else i
+            for i, r in enumerate(line)
+        ]
         f = np.array([r['frequency_hz'] for r in line])
-        err = np.abs(np.array([[r['frequency_lo_hz'] for r in line],
-                               [r['frequency_hi_hz'] for r in line]]) - f)
+        err = np.abs(
+            np.array([[r['frequency_lo_hz'] for r in line], [r['frequency_hi_hz'] for r in line]])
+            - f
+        )
         label = ' '.join(str(k) for k in key if k not in ('', 0))
-        ax_f.errorbar(x, f, yerr=np.nan_to_num(err), marker='o', ms=3, capsize=2, color=colour,
-                      label=f'{label}: median, 95 % interval')
+        ax_f.errorbar(
+            x,
+            f,
+            yerr=np.nan_to_num(err),
+            marker='o',
+            ms=3,
+            capsize=2,
+            color=colour,
+            label=f'{label}: median, 95 % interval',
+        )
         alarmed = [i for i, r in enumerate(line) if r['alarm']]
-        ax_f.plot([x[i] for i in alarmed], f[alarmed], 'rx', ms=9,
-                  label='alarm' if alarmed else None)
+        ax_f.plot(
+            [x[i] for i in alarmed], f[alarmed], 'rx', ms=9, label='alarm' if alarmed else None
+        )
         ref = None if base is None else base.get(key, base.get(None))
         if ref is not None:
-            ax_f.axhline(ref[0], color=colour, ls='--', lw=1.0,
-                         label=f'baseline {ref[0]:.5g} Hz')
+            ax_f.axhline(ref[0], color=colour, ls='--', lw=1.0, label=f'baseline {ref[0]:.5g} Hz')
             if alarm_rel is not None:
                 lo, hi = alarm_band(ref, alarm_rel)
-                ax_f.axhspan(lo, hi, color=colour, alpha=0.12,
-                             label=f'no-alarm band: baseline 95 % interval ±{100 * alarm_rel:g} %')
+                ax_f.axhspan(
+                    lo,
+                    hi,
+                    color=colour,
+                    alpha=0.12,
+                    label=f'no-alarm band: baseline 95 % interval ±{100 * alarm_rel:g} %',
+                )
         if damped:
-            axes[1, 0].plot(x, [r['damping'] for r in line], marker='o', ms=3, color=colour,
-                            label=label)
+            axes[1, 0].plot(
+                x, [r['damping'] for r in line], marker='o', ms=3, color=colour, label=label
+            )
     ax_f.set_ylabel('median frequency (Hz)')
     explain = ': a recording alarms when its 95 % interval lies wholly outside the band'
     ax_f.set_title('frequency trend' + ('' if base is None else explain), fontsize=10)
@@ -511,15 +638,19 @@ def report_entries(rows: List[Dict], ignored: Sequence[Path], out) -> None:
         if row['error']:
             out.write(f'{prog}: error: {row["recording"]}: {row["error"]}\n')
         elif row['corrupt_records']:
-            out.write(f'{prog}: warning: {row["recording"]}: skipped {row["corrupt_records"]} '
-                      f'damaged record(s) of {row["topic"]} (`vib-estimator analyze` says '
-                      f'which); --strict makes this an error\n')
+            out.write(
+                f'{prog}: warning: {row["recording"]}: skipped {row["corrupt_records"]} '
+                f'damaged record(s) of {row["topic"]} (`vib-estimator analyze` says '
+                f'which); --strict makes this an error\n'
+            )
     folders: Dict[Path, List[str]] = {}
     for path in ignored:
         folders.setdefault(path.parent, []).append(path.name)
     for folder, names in sorted(folders.items()):
-        out.write(f'{prog}: {folder}: {len(names)} file(s) not a recording (not .mcap, .db3, '
-                  f'.csv), ignored: {", ".join(names)}\n')
+        out.write(
+            f'{prog}: {folder}: {len(names)} file(s) not a recording (not .mcap, .db3, '
+            f'.csv), ignored: {", ".join(names)}\n'
+        )
 
 
 def _options(args: argparse.Namespace) -> Options:
@@ -531,8 +662,9 @@ def _options(args: argparse.Namespace) -> Options:
         raise ValueError(f'--jobs must be >= 1, got {args.jobs}')
     if not args.alarm_rel >= 0:
         raise ValueError(f'--alarm-rel must be >= 0, got {args.alarm_rel}')
-    return Options(make_config(args), tuple(args.topic), tuple(args.component), args.column,
-                   args.strict)
+    return Options(
+        make_config(args), tuple(args.topic), tuple(args.component), args.column, args.strict
+    )
 
 
 def run(args: argparse.Namespace) -> int:

@@ -1,7 +1,10 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """``python -m vib_estimator.control [--damping Z] [--plot FILE.png]``: what an error of the
 frequency estimate costs each shaper -- the residual vibration (% of an unshaped move's) when the
 true frequency is off the design by 1, 2, 5, 10 and 20 %, the shaper's delay in periods, and the
 sensitivity curves as a figure."""
+
 from __future__ import annotations
 
 import argparse
@@ -17,8 +20,10 @@ ERRORS_PCT = (1.0, 2.0, 5.0, 10.0, 20.0)
 
 def table(damping: float) -> List[str]:
     """Rows: shaper, delay in periods, residual % at each error (worst of -e and +e)."""
-    rows = [f'{"shaper":>7} {"delay (periods)":>15} '
-            + ' '.join(f'{"±%g %%" % e:>8}' for e in ERRORS_PCT)]
+    rows = [
+        f'{"shaper":>7} {"delay (periods)":>15} '
+        + ' '.join(f'{"±%g %%" % e:>8}' for e in ERRORS_PCT)
+    ]
     for name in SHAPERS:
         s = design(name, 1.0, damping)
         worst = [100 * np.max(sensitivity(s, [1 - e / 100, 1 + e / 100])) for e in ERRORS_PCT]
@@ -41,8 +46,12 @@ def plot(path: str, damping: float):
     for name in SHAPERS:
         style = dict(color='k', ls='--', lw=1.0) if name == 'none' else {}
         ax.plot(r, 100 * sensitivity(design(name, 1.0, damping), r), label=name, **style)
-    ax.set(xlabel='true frequency / design frequency', ylabel='residual vibration (%)',
-           ylim=(0, PLOT_TOP_PCT), title=f'Sensitivity curves (zeta = {damping:g})')
+    ax.set(
+        xlabel='true frequency / design frequency',
+        ylabel='residual vibration (%)',
+        ylim=(0, PLOT_TOP_PCT),
+        title=f'Sensitivity curves (zeta = {damping:g})',
+    )
     ax.grid(alpha=0.3)
     ax.legend(loc='center', fontsize=8)
     fig.tight_layout()
@@ -52,10 +61,15 @@ def plot(path: str, damping: float):
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
-    parser = argparse.ArgumentParser(prog='python -m vib_estimator.control',
-                                     description=__doc__.splitlines()[0])
-    parser.add_argument('--damping', type=float, default=0.0,
-                        help='damping ratio of the mode and of the design (default 0)')
+    parser = argparse.ArgumentParser(
+        prog='python -m vib_estimator.control', description=__doc__.splitlines()[0]
+    )
+    parser.add_argument(
+        '--damping',
+        type=float,
+        default=0.0,
+        help='damping ratio of the mode and of the design (default 0)',
+    )
     parser.add_argument('--plot', help='write the sensitivity curves to this PNG')
     args = parser.parse_args(argv)
     try:

@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """The residual vibration a move adds to a mode that is still ringing (pure numpy/scipy).
 
 A lightly damped structure keeps ringing from its previous moves (zeta = 0.004 decays with a
@@ -14,6 +16,7 @@ move only ``(a + p, b + q)`` is seen. It is linear in the six coefficients; the 
 and damping are fitted too (variable projection: Nelder-Mead over (f, zeta), least squares
 inside), starting from a guess.
 """
+
 from __future__ import annotations
 
 import math
@@ -46,13 +49,21 @@ class AddedVibration:
 def _design(s: np.ndarray, after: np.ndarray, frequency_hz: float, damping: float) -> np.ndarray:
     w = 2 * math.pi * frequency_hz
     decay = np.exp(-damping * w * s)
-    phase = w * math.sqrt(max(1 - damping ** 2, 0.0)) * s
+    phase = w * math.sqrt(max(1 - damping**2, 0.0)) * s
     c, d = decay * np.cos(phase), decay * np.sin(phase)
     return np.column_stack([~after, after, c, d, c * after, d * after]).astype(float)
 
 
-def added_vibration(t, y, t_move: float, t_settled: float, before_s: float, after_s: float,
-                    frequency_hz: float, damping: float = 0.0) -> AddedVibration:
+def added_vibration(
+    t,
+    y,
+    t_move: float,
+    t_settled: float,
+    before_s: float,
+    after_s: float,
+    frequency_hz: float,
+    damping: float = 0.0,
+) -> AddedVibration:
     """Fit the model above on ``[t_move - before_s, t_move)`` and ``[t_settled, t_settled +
     after_s)``; ``frequency_hz`` and ``damping`` are the starting guess of the mode."""
     from scipy.optimize import minimize
@@ -73,20 +84,36 @@ def added_vibration(t, y, t_move: float, t_settled: float, before_s: float, afte
 
     start = np.array([frequency_hz, damping])
     simplex = np.array([start, start + [2e-3 * frequency_hz, 0], start + [0, 2e-3]])
-    best = minimize(lambda x: solve(x)[1], start, method='Nelder-Mead',
-                    options={'initial_simplex': simplex, 'xatol': 1e-8, 'fatol': 1e-12,
-                             'maxiter': 400})
+    best = minimize(
+        lambda x: solve(x)[1],
+        start,
+        method='Nelder-Mead',
+        options={'initial_simplex': simplex, 'xatol': 1e-8, 'fatol': 1e-12, 'maxiter': 400},
+    )
     f, zeta = best.x
     coef, rss = solve(best.x)
     decay = math.exp(-zeta * 2 * math.pi * f * (t_settled - t_move))
-    return AddedVibration(added=math.hypot(coef[4], coef[5]) * decay,
-                          previous=math.hypot(coef[2], coef[3]) * decay, frequency_hz=float(f),
-                          damping=float(zeta), rms_residual=math.sqrt(rss / len(yk)),
-                          t_move=t_move, coefficients=tuple(float(c) for c in coef))
+    return AddedVibration(
+        added=math.hypot(coef[4], coef[5]) * decay,
+        previous=math.hypot(coef[2], coef[3]) * decay,
+        frequency_hz=float(f),
+        damping=float(zeta),
+        rms_residual=math.sqrt(rss / len(yk)),
+        t_move=t_move,
+        coefficients=tuple(float(c) for c in coef),
+    )
 
 
-def move_onset(t, y, t_command: float, frequency_hz: float, damping: float = 0.0,
-               window_s: float = 1.0, horizon_s: float = 2.0, threshold: float = 10.0) -> float:
+def move_onset(
+    t,
+    y,
+    t_command: float,
+    frequency_hz: float,
+    damping: float = 0.0,
+    window_s: float = 1.0,
+    horizon_s: float = 2.0,
+    threshold: float = 10.0,
+) -> float:
     """When a move commanded at ``t_command`` shows in the signal: the first sample after it that
     leaves the free vibration fitted on the ``window_s`` before it (offset plus a decaying
     sinusoid of the given mode) by more than ``threshold`` times the fit's rms residual; NaN if

@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Input shapers for one lightly damped mode (f, zeta), their sensitivity, and a streaming shaper.
 
 An input shaper is a sequence of impulses ``A_i`` at times ``t_i`` (``sum A_i = 1``, ``t_1 = 0``);
@@ -18,6 +20,7 @@ The residual vibration (Singer & Seering's percentage vibration) of a shaper on 
 impulse (:func:`residual_vibration`); as a function of the frequency error it is the shaper's
 sensitivity curve (:func:`sensitivity`).
 """
+
 from __future__ import annotations
 
 import math
@@ -52,8 +55,7 @@ class Shaper:
         if self.name == 'none':
             return 'none (pass-through)'
         pairs = ', '.join(f'{a:.4f}@{t:.4f}s' for t, a in zip(self.times, self.amplitudes))
-        return (f'{self.name} for {self.frequency_hz:.4f} Hz, zeta {self.damping:.4f}: '
-                f'{pairs}')
+        return f'{self.name} for {self.frequency_hz:.4f} Hz, zeta {self.damping:.4f}: {pairs}'
 
 
 def _check_mode(frequency_hz: float, damping: float) -> None:
@@ -65,19 +67,19 @@ def _check_mode(frequency_hz: float, damping: float) -> None:
 
 def damped_period(frequency_hz: float, damping: float) -> float:
     """``Td = 1 / (f sqrt(1 - zeta^2))``, s."""
-    return 1.0 / (frequency_hz * math.sqrt(1.0 - damping ** 2))
+    return 1.0 / (frequency_hz * math.sqrt(1.0 - damping**2))
 
 
 def k_factor(damping: float) -> float:
-    """``K = exp(-zeta pi / sqrt(1 - zeta^2))``: the decay of the mode over half a damped period."""
-    return math.exp(-damping * math.pi / math.sqrt(1.0 - damping ** 2))
+    """``K = exp(-zeta pi / sqrt(1 - zeta^2))``: the mode's decay over half a damped period."""
+    return math.exp(-damping * math.pi / math.sqrt(1.0 - damping**2))
 
 
 def _binomial(name: str, order: int, frequency_hz: float, damping: float) -> Shaper:
     """ZV (order 1), ZVD (2), ZVDD (3): ``(1 + K z)^order / (1 + K)^order`` at half periods."""
     _check_mode(frequency_hz, damping)
     k = k_factor(damping)
-    amps = np.array([math.comb(order, i) * k ** i for i in range(order + 1)]) / (1 + k) ** order
+    amps = np.array([math.comb(order, i) * k**i for i in range(order + 1)]) / (1 + k) ** order
     times = 0.5 * damped_period(frequency_hz, damping) * np.arange(order + 1)
     return Shaper(name, times, amps, frequency_hz, damping)
 
@@ -102,8 +104,9 @@ def none(frequency_hz: float = math.nan, damping: float = math.nan) -> Shaper:
     return Shaper('none', np.zeros(1), np.ones(1), frequency_hz, damping)
 
 
-def residual_vibration(times: Sequence[float], amplitudes: Sequence[float], frequency_hz,
-                       damping: float = 0.0):
+def residual_vibration(
+    times: Sequence[float], amplitudes: Sequence[float], frequency_hz, damping: float = 0.0
+):
     """Residual vibration of impulses on the mode ``(frequency_hz, damping)``, relative to one
     unit impulse (Singer & Seering)::
 
@@ -118,7 +121,7 @@ def residual_vibration(times: Sequence[float], amplitudes: Sequence[float], freq
     t = np.asarray(times, dtype=float)
     a = np.asarray(amplitudes, dtype=float)
     w = 2 * np.pi * np.asarray(frequency_hz, dtype=float)[..., None]
-    wd = w * math.sqrt(1.0 - damping ** 2)
+    wd = w * math.sqrt(1.0 - damping**2)
     weight = a * np.exp(damping * w * (t - t[-1]))
     return np.abs(np.sum(weight * np.exp(1j * wd * t), axis=-1))
 
@@ -127,8 +130,12 @@ def sensitivity(shaper: Shaper, frequency_ratio, damping: Optional[float] = None
     """The sensitivity curve: residual vibration when the mode's true frequency is
     ``frequency_ratio`` times the design frequency (damping: the design's unless given)."""
     zeta = shaper.damping if damping is None else damping
-    return residual_vibration(shaper.times, shaper.amplitudes,
-                              shaper.frequency_hz * np.asarray(frequency_ratio, dtype=float), zeta)
+    return residual_vibration(
+        shaper.times,
+        shaper.amplitudes,
+        shaper.frequency_hz * np.asarray(frequency_ratio, dtype=float),
+        zeta,
+    )
 
 
 def _ei_equations(x: np.ndarray, frequency_hz: float, damping: float, vtol: float) -> np.ndarray:
@@ -140,8 +147,9 @@ def _ei_equations(x: np.ndarray, frequency_hz: float, damping: float, vtol: floa
 
     def phasor(r):
         w = 2 * np.pi * frequency_hz * r
-        return np.sum(amps * np.exp((damping * w + 1j * w * math.sqrt(1 - damping ** 2))
-                                    * (times - t3)))
+        return np.sum(
+            amps * np.exp((damping * w + 1j * w * math.sqrt(1 - damping**2)) * (times - t3))
+        )
 
     h = 1e-6
     v = residual_vibration(times, amps, frequency_hz * np.array([1 - h, 1.0, 1 + h]), damping)
@@ -164,22 +172,34 @@ def ei(frequency_hz: float, damping: float = 0.0, vtol: float = EI_VTOL) -> Shap
     period = damped_period(frequency_hz, damping)
     a = (1 + vtol) / 4
     if damping == 0:
-        return Shaper('ei', np.array([0.0, period / 2, period]),
-                      np.array([a, (1 - vtol) / 2, a]), frequency_hz, 0.0)
-    zero = math.acos(-(1 - vtol) / (1 + vtol)) / math.pi   # undamped zeros at r and 2 - r
+        return Shaper(
+            'ei',
+            np.array([0.0, period / 2, period]),
+            np.array([a, (1 - vtol) / 2, a]),
+            frequency_hz,
+            0.0,
+        )
+    zero = math.acos(-(1 - vtol) / (1 + vtol)) / math.pi  # undamped zeros at r and 2 - r
     x0 = np.array([a, (1 - vtol) / 2, period / 2, period, zero, 2 - zero])
-    x, _, ok, msg = fsolve(_ei_equations, x0, args=(frequency_hz, damping, vtol),
-                           full_output=True, xtol=1e-12)
+    x, _, ok, msg = fsolve(
+        _ei_equations, x0, args=(frequency_hz, damping, vtol), full_output=True, xtol=1e-12
+    )
     if ok != 1 or np.max(np.abs(_ei_equations(x, frequency_hz, damping, vtol))) > 1e-8:
         raise ValueError(f'EI design for zeta {damping} did not converge: {msg}')
     a1, a2, t2, t3 = x[:4]
-    return Shaper('ei', np.array([0.0, t2, t3]), np.array([a1, a2, 1 - a1 - a2]),
-                  frequency_hz, damping)
+    return Shaper(
+        'ei', np.array([0.0, t2, t3]), np.array([a1, a2, 1 - a1 - a2]), frequency_hz, damping
+    )
 
 
 #: the shapers by name (``shaper`` parameter of shaper_node)
 SHAPERS: Dict[str, Callable[[float, float], Shaper]] = {
-    'none': none, 'zv': zv, 'zvd': zvd, 'zvdd': zvdd, 'ei': ei}
+    'none': none,
+    'zv': zv,
+    'zvd': zvd,
+    'zvdd': zvdd,
+    'ei': ei,
+}
 
 
 def design(name: str, frequency_hz: float, damping: float = 0.0) -> Shaper:
@@ -231,7 +251,7 @@ class StreamingShaper:
         self._kernel = discrete_kernel(shaper, self.rate_hz)
         self._taps = np.flatnonzero(self._kernel)
         self._weights = self._kernel[self._taps]
-        self._history = np.full(len(self._kernel), value)   # circular, newest at self._head
+        self._history = np.full(len(self._kernel), value)  # circular, newest at self._head
         self._head = 0
 
     @property
@@ -246,7 +266,7 @@ class StreamingShaper:
     def update(self, x: float) -> float:
         """Feed one reference sample, return the shaped command for it."""
         x = float(x)
-        if math.isnan(self._history[0]):            # first sample: it has rested there
+        if math.isnan(self._history[0]):  # first sample: it has rested there
             self._history[:] = x
             self._rest_value, self._rest_count = x, len(self._kernel)
         if abs(x - self._rest_value) <= self.rest_tolerance:

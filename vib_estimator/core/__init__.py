@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """The mathematics, with no rclpy: configuration, the compiled kernel, the estimator API.
 
 Public API: :class:`EstimatorConfig`, :class:`FrequencyEstimator`, :class:`Estimate`,

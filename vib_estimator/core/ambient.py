@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Output-only (operational, ambient) identification of the modes of a driven structure.
 
 ``excitation = ambient``: the structure is driven by broadband, unmeasured forces (wind, traffic, a

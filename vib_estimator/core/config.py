@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Configuration of the estimator: every parameter with its description and range, validated.
 
 One source for :meth:`EstimatorConfig.validate`, the nodes' ``ParameterDescriptor``, the command

@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Algebraic on-line frequency estimator of Trapero, Sira-Ramirez & Feliu (pure numpy/numba core).
 
 Streaming: ``FrequencyEstimator.update(t, y)`` takes one timestamped sample and returns an

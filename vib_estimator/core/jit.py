@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """The compiled core's decorator: numba's ``njit(cache=True)``, compiled once per argument types.
 
 numba types a constant argument (a literal, or a module constant such as a state offset) as

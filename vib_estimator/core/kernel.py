@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Compiled per-sample step of the algebraic estimator (numba; no rclpy, no Python objects).
 
 This module holds the arithmetic of :mod:`vib_estimator.core.estimator` as one function,

@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Several modes at once (``modes`` >= 1): find up to K modes and track each, no frequency given.
 
 Interface:

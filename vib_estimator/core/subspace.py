@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Subspace analysis of one short window: the damped sinusoids it holds (compiled, numba).
 
 A window ``x[0..m-1]`` of uniformly spaced samples is modelled as a sum of damped complex

@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Maximum-likelihood refinement of an estimate over its segment, and its standard deviation
 (numba).
 

@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Compile, ahead of the data, the kernels a configuration runs (numba; no rclpy).
 
 numba compiles a kernel the first time it is called and, with ``cache=True``, keeps the machine

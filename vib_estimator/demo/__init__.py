@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """``vib-estimator demo``: the simulated arm and the estimator node live, through three tip masses.
 
 Starts ``sim_node`` (Section 5.5's masses 30 -> 45.55 -> 61.17 g, sped up, publishing ``/clock``)
@@ -14,6 +16,7 @@ By role: :mod:`.session` (the domain, this process's node, the node subprocesses
 measurement and table), :mod:`.plots` (both figures); this module holds the command's arguments
 and :func:`run`.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -36,35 +39,80 @@ from .shaping import (
     summarise_shaping,
 )
 
-__all__ = ['add_arguments', 'run', 'Listener', 'Record', 'Session', 'ShapedMove', 'ShapingDriver',
-           'PAPER_PARAMS', 'REAL_ARM_SIM_PARAMS', 'demo_domain', 'domain_id', 'mass_g',
-           'measure_moves', 'plot_estimation', 'plot_shaping', 'shaping_events', 'sim_params',
-           'summarise', 'summarise_shaping']
+__all__ = [
+    'add_arguments',
+    'run',
+    'Listener',
+    'Record',
+    'Session',
+    'ShapedMove',
+    'ShapingDriver',
+    'PAPER_PARAMS',
+    'REAL_ARM_SIM_PARAMS',
+    'demo_domain',
+    'domain_id',
+    'mass_g',
+    'measure_moves',
+    'plot_estimation',
+    'plot_shaping',
+    'shaping_events',
+    'sim_params',
+    'summarise',
+    'summarise_shaping',
+]
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """The arguments of ``vib-estimator demo``."""
-    parser.add_argument('--speed', type=float, default=10.0,
-                        help='simulated seconds per wall-clock second (default 10)')
-    parser.add_argument('--seconds-per-mass', type=float, default=8.0,
-                        help='simulated seconds spent on each tip mass (default 8)')
-    parser.add_argument('--out', default=None,
-                        help='figure path (default out/demo.png, with --shaping out/shaping.png)')
-    parser.add_argument('--domain-id', type=domain_id, default=None,
-                        help='ROS domain of the demo, 0-232 (default: ROS_DOMAIN_ID when set, '
-                             'else one of 1-101 from the process id)')
-    parser.add_argument('--real-arm', action='store_true',
-                        help='the same schedule on a realistic rig (strain-gauge offset, coarse '
-                             'quantisation, a closed-loop limit cycle) with the estimator\'s '
-                             'defaults instead of the paper\'s configuration (docs/real_arm.md)')
-    parser.add_argument('--shaping', action='store_true',
-                        help='input shaping: per mass a move unshaped, then the same move shaped '
-                             'by shaper_node for the estimate (figure out/shaping.png)')
-    parser.add_argument('--shaper', default='zvd', choices=sorted(SHAPERS),
-                        help='with --shaping: the shaper of the shaped moves (default zvd)')
-    parser.add_argument('--step', type=float, default=0.5,
-                        help='with --shaping: size of each move (a reference step), rad '
-                             '(default 0.5)')
+    parser.add_argument(
+        '--speed',
+        type=float,
+        default=10.0,
+        help='simulated seconds per wall-clock second (default 10)',
+    )
+    parser.add_argument(
+        '--seconds-per-mass',
+        type=float,
+        default=8.0,
+        help='simulated seconds spent on each tip mass (default 8)',
+    )
+    parser.add_argument(
+        '--out',
+        default=None,
+        help='figure path (default out/demo.png, with --shaping out/shaping.png)',
+    )
+    parser.add_argument(
+        '--domain-id',
+        type=domain_id,
+        default=None,
+        help='ROS domain of the demo, 0-232 (default: ROS_DOMAIN_ID when set, '
+        'else one of 1-101 from the process id)',
+    )
+    parser.add_argument(
+        '--real-arm',
+        action='store_true',
+        help='the same schedule on a realistic rig (strain-gauge offset, coarse '
+        "quantisation, a closed-loop limit cycle) with the estimator's "
+        "defaults instead of the paper's configuration (docs/real_arm.md)",
+    )
+    parser.add_argument(
+        '--shaping',
+        action='store_true',
+        help='input shaping: per mass a move unshaped, then the same move shaped '
+        'by shaper_node for the estimate (figure out/shaping.png)',
+    )
+    parser.add_argument(
+        '--shaper',
+        default='zvd',
+        choices=sorted(SHAPERS),
+        help='with --shaping: the shaper of the shaped moves (default zvd)',
+    )
+    parser.add_argument(
+        '--step',
+        type=float,
+        default=0.5,
+        help='with --shaping: size of each move (a reference step), rad (default 0.5)',
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -74,14 +122,19 @@ def run(args: argparse.Namespace) -> int:
     if args.speed <= 0 or args.seconds_per_mass <= 2:
         print('error: --speed must be > 0 and --seconds-per-mass > 2', file=sys.stderr)
         return 2
-    if args.shaping and (args.seconds_per_mass < MIN_SECONDS_PER_MOVE_PAIR
-                         or not 0 < args.step <= MAX_STEP):
-        print(f'error: with --shaping, --seconds-per-mass must be >= '
-              f'{MIN_SECONDS_PER_MOVE_PAIR:g} and --step in (0, {MAX_STEP:g}] rad',
-              file=sys.stderr)
+    if args.shaping and (
+        args.seconds_per_mass < MIN_SECONDS_PER_MOVE_PAIR or not 0 < args.step <= MAX_STEP
+    ):
+        print(
+            f'error: with --shaping, --seconds-per-mass must be >= '
+            f'{MIN_SECONDS_PER_MOVE_PAIR:g} and --step in (0, {MAX_STEP:g}] rad',
+            file=sys.stderr,
+        )
         return 2
-    truth = [(i * args.seconds_per_mass, (i + 1) * args.seconds_per_mass, natural_frequency_hz(m))
-             for i, m in enumerate(MASSES_5_5)]
+    truth = [
+        (i * args.seconds_per_mass, (i + 1) * args.seconds_per_mass, natural_frequency_hz(m))
+        for i, m in enumerate(MASSES_5_5)
+    ]
     wall_start = time.monotonic()
     session = Session(args, truth)
     try:

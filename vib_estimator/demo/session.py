@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """The demo's ROS session: its domain, this process's node (:class:`Listener`, recording into a
 :class:`Record`) and the node subprocesses it starts and stops (:class:`Session`).
 
@@ -7,6 +9,7 @@ publishes frequency, then reset), and its convergence time the time since the pr
 the start for the first): an estimate the node's quality gate held back also restarts a segment
 without a reset message, so this may over-state a few convergence times.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -61,9 +64,13 @@ def demo_domain(asked: Optional[int], env: Optional[str]) -> int:
 
 def sim_params(speed: float, duration: float, schedule, subscribers: int) -> List[str]:
     """sim_node's parameters for a demo run in simulated time."""
-    return [f'speed:={float(speed)}', f'duration:={float(duration)}', 'publish_clock:=true',
-            f'wait_for_subscribers:={subscribers}',
-            'schedule:=[' + ', '.join(map(repr, schedule)) + ']']
+    return [
+        f'speed:={float(speed)}',
+        f'duration:={float(duration)}',
+        'publish_clock:=true',
+        f'wait_for_subscribers:={subscribers}',
+        'schedule:=[' + ', '.join(map(repr, schedule)) + ']',
+    ]
 
 
 @dataclass
@@ -76,7 +83,7 @@ class Record:
 
     truth: List[Tuple[float, float, float]]
     heard_truth: List[float] = field(default_factory=list)
-    t: List[float] = field(default_factory=list)           # torque samples
+    t: List[float] = field(default_factory=list)  # torque samples
     torque: List[float] = field(default_factory=list)
     est_t: List[float] = field(default_factory=list)
     est_f: List[float] = field(default_factory=list)
@@ -111,13 +118,14 @@ class Listener:
         self._frequencies: deque = deque()
         self._resets: deque = deque()
         reliable = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
-        latched = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
-                             durability=DurabilityPolicy.TRANSIENT_LOCAL)
-        self.node.create_subscription(WrenchStamped, 'coupling_torque', self._on_torque,
-                                      reliable)
+        latched = QoSProfile(
+            depth=1,
+            reliability=ReliabilityPolicy.RELIABLE,
+            durability=DurabilityPolicy.TRANSIENT_LOCAL,
+        )
+        self.node.create_subscription(WrenchStamped, 'coupling_torque', self._on_torque, reliable)
         self.node.create_subscription(Float64, 'vibration/ground_truth', self._on_truth, latched)
-        self.node.create_subscription(Float64, 'vibration/frequency', self._on_frequency,
-                                      reliable)
+        self.node.create_subscription(Float64, 'vibration/frequency', self._on_frequency, reliable)
         self.node.create_subscription(Header, 'vibration/reset', self._on_reset, reliable)
         self.node.create_subscription(DiagnosticArray, '/diagnostics', self._on_diagnostics, 10)
         #: node names whose /diagnostics say they estimate (not warming up)
@@ -129,8 +137,11 @@ class Listener:
             if status.message == self._warmup_message:
                 if status.name not in self._warming:
                     self._warming.add(status.name)
-                    print(f'{status.name}: {status.message}; the demo starts the simulator when '
-                          'it is ready', flush=True)
+                    print(
+                        f'{status.name}: {status.message}; the demo starts the simulator when '
+                        'it is ready',
+                        flush=True,
+                    )
             else:
                 self.ready.add(status.name)
 
@@ -163,9 +174,11 @@ class Listener:
             rec.est_conv.append(t - self._last_reset)
             self._last_reset = t
             f0 = rec.truth_at(t)
-            print(f'[{t:6.2f} s] estimate {f:.4f} Hz   true {f0:.4f} Hz   error '
-                  f'{(f - f0) / f0 * 100:+6.2f} %   converged in {rec.est_conv[-1]:.3f} s',
-                  flush=True)
+            print(
+                f'[{t:6.2f} s] estimate {f:.4f} Hz   true {f0:.4f} Hz   error '
+                f'{(f - f0) / f0 * 100:+6.2f} %   converged in {rec.est_conv[-1]:.3f} s',
+                flush=True,
+            )
 
     def counts(self, topic: str) -> Tuple[int, int]:
         """(publishers, subscribers) of a topic as this node sees them."""
@@ -178,8 +191,12 @@ def _start(exe: str, params: List[str], env: dict) -> subprocess.Popen:
         cmd += ['-p', p]
     # a demo started from a background job inherits SIGINT ignored: give the nodes the default,
     # so that _stop's SIGINT ends them cleanly
-    return subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL,
-                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    return subprocess.Popen(
+        cmd,
+        env=env,
+        stdout=subprocess.DEVNULL,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
 
 
 def _stop(proc: subprocess.Popen) -> None:
@@ -203,7 +220,7 @@ class Session:
         from ..nodes.runner import make_executor
 
         self.domain = demo_domain(args.domain_id, os.environ.get('ROS_DOMAIN_ID'))
-        os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'   # read by rclpy.init below
+        os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'  # read by rclpy.init below
         self.env = dict(os.environ, ROS_DOMAIN_ID=str(self.domain))
         self.context = rclpy.Context()
         rclpy.init(context=self.context, domain_id=self.domain)
@@ -214,26 +231,38 @@ class Session:
 
     def spin_until(self, predicate, timeout: float) -> bool:
         from ..nodes.runner import spin_until
+
         return spin_until(self.executor, predicate, timeout)
 
-    def start(self, exe: str, params: List[str], ready,
-              timeout: float = STARTUP_TIMEOUT) -> subprocess.Popen:
+    def start(
+        self, exe: str, params: List[str], ready, timeout: float = STARTUP_TIMEOUT
+    ) -> subprocess.Popen:
         """Start a node; wait until ``ready()`` (or its exit); raise RuntimeError if it failed."""
         proc = _start(exe, params, self.env)
         self.procs.append(proc)
         up = self.spin_until(lambda: proc.poll() is not None or ready(), timeout)
         if not up or proc.poll() is not None:
-            raise RuntimeError(f'{exe} did not come up' if proc.poll() is None
-                               else f'{exe} exited with {proc.returncode}')
+            raise RuntimeError(
+                f'{exe} did not come up'
+                if proc.poll() is None
+                else f'{exe} exited with {proc.returncode}'
+            )
         return proc
 
     def start_estimator(self, params: Sequence[str] = ()) -> subprocess.Popen:
         """Start estimator_node (sim time, ``params`` on top) and wait until its kernels are
         compiled (its /diagnostics stop saying it warms up) and it sees the demo's topics."""
         listener = self.listener
-        return self.start('estimator_node', ['use_sim_time:=true', *params], lambda: (
-            '/estimator_node' in listener.ready and listener.counts('vibration/frequency')[0]
-            and listener.counts('coupling_torque')[1]), WARMUP_TIMEOUT)
+        return self.start(
+            'estimator_node',
+            ['use_sim_time:=true', *params],
+            lambda: (
+                '/estimator_node' in listener.ready
+                and listener.counts('vibration/frequency')[0]
+                and listener.counts('coupling_torque')[1]
+            ),
+            WARMUP_TIMEOUT,
+        )
 
     def start_sim(self, params: List[str]) -> subprocess.Popen:
         sim = _start('sim_node', params, self.env)
@@ -243,10 +272,16 @@ class Session:
     def finish_sim(self, sim: subprocess.Popen, duration: float, speed: float) -> None:
         """Spin until sim_node exits; RuntimeError if it failed."""
         self.spin_until(lambda: sim.poll() is not None, STARTUP_TIMEOUT + duration / speed)
-        self.spin_until(lambda: False, 0.5)   # the last messages in flight
+        self.spin_until(lambda: False, 0.5)  # the last messages in flight
         if sim.returncode != 0:
-            raise RuntimeError('sim_node ' + ('did not finish in time' if sim.returncode is None
-                                              else f'exited with {sim.returncode}'))
+            raise RuntimeError(
+                'sim_node '
+                + (
+                    'did not finish in time'
+                    if sim.returncode is None
+                    else f'exited with {sim.returncode}'
+                )
+            )
 
     def close(self) -> None:
         for proc in reversed(self.procs):

@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """``vib-estimator demo --shaping``: input shaping with the on-line estimate.
 
 Per tip mass of Section 5.5 a move unshaped, then, once ``estimator_node`` has estimated the
@@ -6,6 +8,7 @@ free vibration since, the same move back shaped by ``shaper_node`` for that esti
 mode still ringing is measured from the recorded torque (:func:`measure_moves`) and each shaped
 move must cut it by the shaper's :data:`MIN_REDUCTION` (:func:`summarise_shaping`).
 """
+
 from __future__ import annotations
 
 import argparse
@@ -50,16 +53,21 @@ class ShapedMove:
         return self.shaper.duration if self.shaper is not None else 0.0
 
 
-def shaping_events(seconds_per_mass: float, shaper: str, step: float
-                   ) -> List[Tuple[float, str, object]]:
+def shaping_events(
+    seconds_per_mass: float, shaper: str, step: float
+) -> List[Tuple[float, str, object]]:
     """(simulated time, 'shaper' or 'move', value) for each mass: the shaper off, a move unshaped;
     half-way, the shaper on (it is designed for the estimates of the free vibration since), and
     the same move back."""
     events: List[Tuple[float, str, object]] = []
     for i in range(len(MASSES_5_5)):
         t0, half = i * seconds_per_mass, seconds_per_mass / 2
-        events += [(t0 + 0.5, 'shaper', 'none'), (t0 + 1.0, 'move', step),
-                   (t0 + half + 0.25, 'shaper', shaper), (t0 + half + 0.5, 'move', 0.0)]
+        events += [
+            (t0 + 0.5, 'shaper', 'none'),
+            (t0 + 1.0, 'move', step),
+            (t0 + half + 0.25, 'shaper', shaper),
+            (t0 + half + 0.5, 'move', 0.0),
+        ]
     return events
 
 
@@ -106,16 +114,17 @@ def _drive(session: Session, driver: ShapingDriver, sim, args) -> List[ShapedMov
     moves: List[ShapedMove] = []
     name = 'none'
     for t, kind, value in shaping_events(args.seconds_per_mass, args.shaper, args.step):
-        session.spin_until(lambda: sim.poll() is not None or driver.now() >= t,
-                           STARTUP_TIMEOUT + 3 * args.seconds_per_mass / args.speed)
+        session.spin_until(
+            lambda: sim.poll() is not None or driver.now() >= t,
+            STARTUP_TIMEOUT + 3 * args.seconds_per_mass / args.speed,
+        )
         if sim.poll() is not None:
             break
         if kind == 'shaper':
             driver.set_shaper(value)
             name = value
             continue
-        moves.append(ShapedMove(int(t // args.seconds_per_mass), driver.now(), value,
-                                shaper=name))
+        moves.append(ShapedMove(int(t // args.seconds_per_mass), driver.now(), value, shaper=name))
         driver.move(value)
         print(f'[{moves[-1].t:6.2f} s] move to {value:g} rad, {name}', flush=True)
     return moves
@@ -158,14 +167,31 @@ def measure_moves(rec: Record, moves: List[ShapedMove], seconds_per_mass: float)
         t_mass, t_next = i * seconds_per_mass, min((i + 1) * seconds_per_mass, t[-1])
         u_settled = unshaped.t + SETTLE_S
         s_settled = shaped.t + shaped.duration + SETTLE_S
-        fit_u = added_vibration(t, y, unshaped.t, u_settled, unshaped.t - t_mass - 0.05,
-                                shaped.t - u_settled, f0, 0.004)
-        fit_s = added_vibration(t, y, shaped.t, s_settled, shaped.t - u_settled,
-                                t_next - s_settled, f0, 0.004)
-        rows.append({'mass_g': m * 1e3, 'f0': f0, 'estimate': shaped.estimate,
-                     'unshaped': fit_u.added, 'shaped': fit_s.added,
-                     'ratio': fit_s.added / fit_u.added, 'moves': (unshaped, shaped),
-                     'fits': (fit_u, fit_s)})
+        fit_u = added_vibration(
+            t,
+            y,
+            unshaped.t,
+            u_settled,
+            unshaped.t - t_mass - 0.05,
+            shaped.t - u_settled,
+            f0,
+            0.004,
+        )
+        fit_s = added_vibration(
+            t, y, shaped.t, s_settled, shaped.t - u_settled, t_next - s_settled, f0, 0.004
+        )
+        rows.append(
+            {
+                'mass_g': m * 1e3,
+                'f0': f0,
+                'estimate': shaped.estimate,
+                'unshaped': fit_u.added,
+                'shaped': fit_s.added,
+                'ratio': fit_s.added / fit_u.added,
+                'moves': (unshaped, shaped),
+                'fits': (fit_u, fit_s),
+            }
+        )
     return rows
 
 
@@ -173,14 +199,18 @@ def summarise_shaping(rows: List[dict], shaper: str) -> Tuple[List[str], bool]:
     """The table of :func:`measure_moves` and whether every mass's shaped move cut the added
     vibration by at least the shaper's MIN_REDUCTION."""
     need = MIN_REDUCTION.get(shaper, DEFAULT_MIN_REDUCTION)
-    lines = [f'{"mass g":>7} {"f0 Hz":>6} {"estimate Hz":>11} {"err %":>6} '
-             f'{"unshaped N m":>12} {shaper + " N m":>10} {"ratio %":>7} {"reduction %":>11}']
+    lines = [
+        f'{"mass g":>7} {"f0 Hz":>6} {"estimate Hz":>11} {"err %":>6} '
+        f'{"unshaped N m":>12} {shaper + " N m":>10} {"ratio %":>7} {"reduction %":>11}'
+    ]
     ok = len(rows) == len(MASSES_5_5)
     for r in rows:
         ok &= r['ratio'] <= 1 - need
-        lines.append(f'{r["mass_g"]:7.2f} {r["f0"]:6.3f} {r["estimate"]:11.4f} '
-                     f'{(r["estimate"] / r["f0"] - 1) * 100:+6.2f} {r["unshaped"]:12.4f} '
-                     f'{r["shaped"]:10.4f} {r["ratio"] * 100:7.2f} {(1 - r["ratio"]) * 100:11.1f}')
+        lines.append(
+            f'{r["mass_g"]:7.2f} {r["f0"]:6.3f} {r["estimate"]:11.4f} '
+            f'{(r["estimate"] / r["f0"] - 1) * 100:+6.2f} {r["unshaped"]:12.4f} '
+            f'{r["shaped"]:10.4f} {r["ratio"] * 100:7.2f} {(1 - r["ratio"]) * 100:11.1f}'
+        )
     return lines, bool(ok)
 
 
@@ -191,20 +221,30 @@ def run_shaping(session: Session, args: argparse.Namespace, wall_start: float) -
 
     listener = session.listener
     p = args.seconds_per_mass
-    print(f'demo --shaping: ROS domain {session.domain}, {3 * p:g} s simulated at '
-          f'{args.speed:g}x, {args.shaper}, steps of {args.step:g} rad, tip masses '
-          + ' -> '.join(f'{m * 1e3:g} g' for m in MASSES_5_5), flush=True)
+    print(
+        f'demo --shaping: ROS domain {session.domain}, {3 * p:g} s simulated at '
+        f'{args.speed:g}x, {args.shaper}, steps of {args.step:g} rad, tip masses '
+        + ' -> '.join(f'{m * 1e3:g} g' for m in MASSES_5_5),
+        flush=True,
+    )
     session.start_estimator(PAPER_PARAMS)
     driver = ShapingDriver(session)
-    session.start('shaper_node', ['use_sim_time:=true', 'shaper:=none'], lambda: (
-        driver.reference_pub.get_subscription_count()
-        and listener.counts('position_command')[0]))
-    driver.move(0.0)                                    # the shaper holds the arm at 0
+    session.start(
+        'shaper_node',
+        ['use_sim_time:=true', 'shaper:=none'],
+        lambda: (
+            driver.reference_pub.get_subscription_count()
+            and listener.counts('position_command')[0]
+        ),
+    )
+    driver.move(0.0)  # the shaper holds the arm at 0
     masses = [Move(i * p, 0.0, 1.0, m) for i, m in enumerate(MASSES_5_5)]
-    lockstep = args.speed != 1        # in real time the arm takes the commands as they come
+    lockstep = args.speed != 1  # in real time the arm takes the commands as they come
     sim_start = time.monotonic()
-    sim = session.start_sim(sim_params(args.speed, 3 * p, schedule_to_array(masses), 2)
-                            + ['wait_for_command:=true', f'lockstep:={str(lockstep).lower()}'])
+    sim = session.start_sim(
+        sim_params(args.speed, 3 * p, schedule_to_array(masses), 2)
+        + ['wait_for_command:=true', f'lockstep:={str(lockstep).lower()}']
+    )
     moves = _drive(session, driver, sim, args)
     session.finish_sim(sim, 3 * p, args.speed)
     sim_wall = time.monotonic() - sim_start
@@ -216,10 +256,15 @@ def run_shaping(session: Session, args: argparse.Namespace, wall_start: float) -
     out.parent.mkdir(parents=True, exist_ok=True)
     plot_shaping(str(out), listener.record, rows, args.shaper, args.speed)
     need = MIN_REDUCTION.get(args.shaper, DEFAULT_MIN_REDUCTION) * 100
-    print(f'\n{len(listener.record.t)} samples; {3 * p:g} s simulated in {sim_wall:.1f} s '
-          f'({3 * p / sim_wall:.1f}x achieved of {args.speed:g}x'
-          f'{", lockstep" if lockstep else ""}), '
-          f'{time.monotonic() - wall_start:.1f} s in all; figure: {out}')
-    print(f'PASS: every shaped move cut the vibration it adds by >= {need:g} %' if ok else
-          f'FAIL: a shaped move cut the vibration it adds by less than {need:g} %')
+    print(
+        f'\n{len(listener.record.t)} samples; {3 * p:g} s simulated in {sim_wall:.1f} s '
+        f'({3 * p / sim_wall:.1f}x achieved of {args.speed:g}x'
+        f'{", lockstep" if lockstep else ""}), '
+        f'{time.monotonic() - wall_start:.1f} s in all; figure: {out}'
+    )
+    print(
+        f'PASS: every shaped move cut the vibration it adds by >= {need:g} %'
+        if ok
+        else f'FAIL: a shaped move cut the vibration it adds by less than {need:g} %'
+    )
     return 0 if ok else 1

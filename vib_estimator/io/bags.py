@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Reading and writing rosbag2 bags (MCAP or sqlite3 storage) without ROS: built on ``rosbags``.
 
 No rclpy import, so that the offline ``vib-estimator analyze`` command, ``scripts/make_bags.py``

@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Vectorised CDR decoding of the fixed-layout input messages: one numpy pass over many payloads.
 
 A bag stores each message as its CDR serialisation: a 4-byte encapsulation header (``00 01 00 00``

@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Reading a signal from a CSV file (pure Python/numpy; no rclpy).
 
 Format: optional ``#`` comment lines, an optional header row, then rows whose first column is the

@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """The input message types, their scalar fields (``component``), and the stamp time base.
 
 No rclpy import: the functions only use attribute access, which both rclpy's generated classes and
@@ -173,13 +175,33 @@ def seconds_since(stamp: int, origin: int) -> float:
 
 #: unit of each field (the last attribute before the axis, or the JointState array), SI as
 #: the ROS message definitions (REP 103) give them
-FIELD_UNITS = {'force': 'N', 'torque': 'N·m', 'linear_acceleration': 'm/s²',
-               'angular_velocity': 'rad/s', 'linear': 'm/s²', 'angular': 'rad/s²',
-               'effort': 'N·m or N', 'position': 'rad or m', 'velocity': 'rad/s or m/s'}
+FIELD_UNITS = {
+    'force': 'N',
+    'torque': 'N·m',
+    'linear_acceleration': 'm/s²',
+    'angular_velocity': 'rad/s',
+    'linear': 'm/s²',
+    'angular': 'rad/s²',
+    'effort': 'N·m or N',
+    'position': 'rad or m',
+    'velocity': 'rad/s or m/s',
+}
 #: units spelled as a name's last ``_``-separated tokens (``accel_g``, ``tip_velocity_m_s``)
-SUFFIX_UNITS = {('m', 's2'): 'm/s²', ('rad', 's'): 'rad/s', ('m', 's'): 'm/s', ('rad',): 'rad',
-                ('deg',): 'deg', ('m',): 'm', ('mm',): 'mm', ('g',): 'g', ('n',): 'N',
-                ('nm',): 'N·m', ('v',): 'V', ('a',): 'A', ('pa',): 'Pa'}
+SUFFIX_UNITS = {
+    ('m', 's2'): 'm/s²',
+    ('rad', 's'): 'rad/s',
+    ('m', 's'): 'm/s',
+    ('rad',): 'rad',
+    ('deg',): 'deg',
+    ('m',): 'm',
+    ('mm',): 'mm',
+    ('g',): 'g',
+    ('n',): 'N',
+    ('nm',): 'N·m',
+    ('v',): 'V',
+    ('a',): 'A',
+    ('pa',): 'Pa',
+}
 #: the unit of a signal whose name says none
 UNKNOWN_UNIT = 'signal units'
 _BRACKETED = re.compile(r'[\(\[]\s*([^\)\]]+?)\s*[\)\]]\s*$')
@@ -203,6 +225,6 @@ def signal_unit(name: str) -> str:
         return FIELD_UNITS[name]
     tokens = tuple(name.lower().split('_'))
     for suffix in sorted(SUFFIX_UNITS, key=len, reverse=True):
-        if len(tokens) > len(suffix) and tokens[-len(suffix):] == suffix:
+        if len(tokens) > len(suffix) and tokens[-len(suffix) :] == suffix:
             return SUFFIX_UNITS[suffix]
     return UNKNOWN_UNIT

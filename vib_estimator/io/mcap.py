@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """The package's one MCAP reader: records, the summary's indexes, and checked chunks.
 
 MCAP (https://mcap.dev/spec) is a sequence of records ``opcode (u8) | length (u64) | body`` between

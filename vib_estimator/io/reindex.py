@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """``vib-estimator reindex BAG``: rebuild a bag's ``metadata.yaml`` from its storage files
 (``ros2 bag reindex``).
 

@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Streaming readers: a recorded signal as a sequence of numpy blocks, in constant memory.
 
 Three sources, one interface (:func:`open_signal` -> :class:`Signal`, whose ``blocks()`` yields

@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """``bag_recorder``: record topics of any message type into a rosbag2 bag (MCAP storage).
 
 A stand-in for ``ros2 bag record`` where only rclpy is installed. Each topic of ``topics`` is

@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """``bag_replayer``: play a rosbag2 bag (MCAP or sqlite3) or a bare ``.mcap``/``.db3`` file.
 
 A stand-in for ``ros2 bag play`` where only rclpy is installed; its parameters carry the names of

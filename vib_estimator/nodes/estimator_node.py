@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """ROS 2 node running the algebraic frequency estimator on one field of a sensor stream.
 
 ``ros2 run vib_estimator estimator_node``. A thin shell: it declares the parameters, converts each

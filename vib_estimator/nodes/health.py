@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Diagnostics bookkeeping of ``estimator_node``, with no rclpy (tested alone).
 
 :class:`Health` keeps what ``/diagnostics`` reports: the counters since the node started (the

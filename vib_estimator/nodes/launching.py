@@ -1,6 +1,9 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """What the launch files in ``launch/`` share, without launch or launch_ros (so it is tested
 where they are not installed): the package's parameters files, the arguments several files
 declare, a value a parameters file sets, and the arguments given over a file's settings."""
+
 from __future__ import annotations
 
 import os
@@ -29,21 +32,27 @@ def config_file(name: str) -> str:
 def params_file_argument(prefix: str, executable: str) -> Tuple[str, Tuple[str, str]]:
     """The launch argument ``<prefix>_params_file`` of ``executable``: its name, default
     (config/``<prefix>``.yaml) and description."""
-    return f'{prefix}_params_file', (config_file(f'{prefix}.yaml'),
-                                     f'parameters file of {executable}')
+    return f'{prefix}_params_file', (
+        config_file(f'{prefix}.yaml'),
+        f'parameters file of {executable}',
+    )
 
 
 def file_parameter(path: str, name: str):
     """The value a parameters file gives ``name`` (under any node key), or None."""
     with open(path) as f:
         data = yaml.safe_load(f) or {}
-    values = [section.get('ros__parameters', {}).get(name) for section in data.values()
-              if isinstance(section, dict)]
+    values = [
+        section.get('ros__parameters', {}).get(name)
+        for section in data.values()
+        if isinstance(section, dict)
+    ]
     return next((v for v in values if v is not None), None)
 
 
-def given(value: Callable[[str], str], names: Iterable[str],
-          convert: Optional[Callable] = None) -> dict:
+def given(
+    value: Callable[[str], str], names: Iterable[str], convert: Optional[Callable] = None
+) -> dict:
     """The arguments among ``names`` given a non-empty value (``value(name)``, a launch
     argument's text), converted: the parameters they override in a node's file."""
     found = {name: value(name) for name in names}

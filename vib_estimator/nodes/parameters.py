@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Parameter declaration shared by the package's nodes: descriptors with ranges, one place where
 a value the node cannot start with becomes a :class:`~vib_estimator.nodes.runner.StartupError`, and
 the estimator's parameters (one per :class:`EstimatorConfig` field) declared and read back.

@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """The bag replayer's schedule, without ROS: when each recorded message is due.
 
 :class:`Playback` maps a steady (monotonic) clock to the bag's log-time axis::

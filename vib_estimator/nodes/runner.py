@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """The one ``main`` every node of this package uses.
 
 It holds the Jazzy idiom (``init`` / spin / shutdown / ``destroy_node`` / ``try_shutdown``) once,

@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """The estimator node's self-test, with no rclpy: known tones through a fresh estimator.
 
 :func:`self_test` runs three seeded tones (a sine at 40 dB SNR each, one after the other, each

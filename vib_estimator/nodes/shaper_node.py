@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """``shaper_node``: the reference shaped for the estimated vibration, as the position command.
 
 ``ros2 run vib_estimator shaper_node``. A thin shell around

@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """``sim_node``: the flexible arm of Section 5 (:mod:`vib_estimator.sim.arm_model`) as a ROS 2
 node.
 

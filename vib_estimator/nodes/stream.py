@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """The estimator node's processing without ROS (no rclpy; tested alone).
 
 :class:`EstimatorStream` holds what the node does between a converted message and a publication:

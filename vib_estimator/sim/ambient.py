@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Records of structures under ambient excitation (pure numpy/scipy): white-noise-driven modes.
 
 Each mode is an SDOF ``x'' + 2 zeta wn x' + wn^2 x = w(t)``, ``w`` continuous white noise, sampled

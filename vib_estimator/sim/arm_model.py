@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Single-link flexible arm of Section 5 (Eqs. 19-23), simulated (pure numpy, no rclpy).
 
 Model (Trapero, Sira-Ramirez & Feliu, Section 5.1; Fig. 3):

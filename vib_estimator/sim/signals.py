@@ -1,3 +1,5 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
 """Test signals of the paper (pure numpy): the Fig. 1 sine and the normalised damped
 sine of Eq. 15."""
 
