@@ -24,23 +24,11 @@ from launch_ros.actions import Node
 from vib_estimator.nodes.launching import (
     COMMON_ARGUMENTS,
     INPUT_ARGUMENTS,
-    PACKAGE,
     given,
+    node_action,
     params_file_argument,
     truthy,
 )
-
-
-def _node(executable, namespace, parameters):
-    return Node(
-        package=PACKAGE,
-        executable=executable,
-        name=executable,
-        namespace=namespace,
-        parameters=parameters,
-        output='screen',
-        emulate_tty=True,
-    )
 
 
 def _nodes(context):
@@ -52,7 +40,8 @@ def _nodes(context):
     clock = {'use_sim_time': truthy(value('use_sim_time'))}
     namespace = LaunchConfiguration('namespace')
     return [
-        _node(
+        node_action(
+            Node,
             'estimator_node',
             namespace,
             [
@@ -60,7 +49,8 @@ def _nodes(context):
                 {**clock, **given(value, INPUT_ARGUMENTS)},
             ],
         ),
-        _node(
+        node_action(
+            Node,
             'shaper_node',
             namespace,
             [LaunchConfiguration('shaper_params_file'), {**clock, **given(value, ['shaper'])}],

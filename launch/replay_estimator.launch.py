@@ -25,23 +25,11 @@ from launch_ros.actions import Node
 from vib_estimator.nodes.launching import (
     COMMON_ARGUMENTS,
     INPUT_ARGUMENTS,
-    PACKAGE,
     file_parameter,
     given,
+    node_action,
     params_file_argument,
 )
-
-
-def _node(executable, namespace, parameters):
-    return Node(
-        package=PACKAGE,
-        executable=executable,
-        name=executable,
-        namespace=namespace,
-        parameters=parameters,
-        output='screen',
-        emulate_tty=True,
-    )
 
 
 def _nodes(context):
@@ -57,9 +45,12 @@ def _nodes(context):
     estimator = {'use_sim_time': float(clock_hz) > 0, **given(value, INPUT_ARGUMENTS)}
     namespace = LaunchConfiguration('namespace')
     return [
-        _node('bag_replayer', namespace, [replayer_file, replayer]),
-        _node(
-            'estimator_node', namespace, [LaunchConfiguration('estimator_params_file'), estimator]
+        node_action(Node, 'bag_replayer', namespace, [replayer_file, replayer]),
+        node_action(
+            Node,
+            'estimator_node',
+            namespace,
+            [LaunchConfiguration('estimator_params_file'), estimator],
         ),
     ]
 

@@ -24,24 +24,12 @@ from launch_ros.actions import Node
 
 from vib_estimator.nodes.launching import (
     COMMON_ARGUMENTS,
-    PACKAGE,
     file_parameter,
     given,
+    node_action,
     params_file_argument,
     truthy,
 )
-
-
-def _node(executable, namespace, parameters):
-    return Node(
-        package=PACKAGE,
-        executable=executable,
-        name=executable,
-        namespace=namespace,
-        parameters=parameters,
-        output='screen',
-        emulate_tty=True,
-    )
 
 
 def _nodes(context):
@@ -59,8 +47,9 @@ def _nodes(context):
     clock = truthy(publish_clock) or float(speed or 1.0) != 1.0
     namespace = LaunchConfiguration('namespace')
     return [
-        _node('sim_node', namespace, [sim_file, sim]),
-        _node(
+        node_action(Node, 'sim_node', namespace, [sim_file, sim]),
+        node_action(
+            Node,
             'estimator_node',
             namespace,
             [LaunchConfiguration('estimator_params_file'), {'use_sim_time': clock}],

@@ -20,14 +20,10 @@ they do not need).
 
 from importlib import import_module
 
-_CORE = (
-    'MODELS',
-    'COUNTER_NAMES',
-    'EstimatorConfig',
-    'Estimate',
-    'EstimateArrays',
-    'FrequencyEstimator',
-    'estimate',
+#: the names of ``vib_estimator.core.__all__`` (written out: importing core would load numba)
+_CORE = tuple(
+    'MODELS COUNTER_NAMES EstimatorConfig Estimate EstimateArrays FrequencyEstimator '
+    'estimate'.split()
 )
 __all__ = list(_CORE)
 

@@ -21,7 +21,7 @@ from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
 from std_msgs.msg import Float64
 
-from vib_estimator.demo import DEFAULT_MIN_REDUCTION, MIN_REDUCTION
+from vib_estimator.demo.shaping import DEFAULT_MIN_REDUCTION, MIN_REDUCTION
 from vib_estimator.nodes.runner import StartupError, spin_until
 from vib_estimator.nodes.shaper_node import ShaperNode
 from vib_estimator.sim.arm_model import MASSES_5_5, natural_frequency_hz

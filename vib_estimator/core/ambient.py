@@ -59,7 +59,7 @@ import numpy as np
 from scipy.signal import butter, sosfiltfilt
 
 from .config import EstimatorConfig
-from .estimator import Estimate, EstimateArrays, as_series
+from .estimator import INPUT_COUNTERS, Estimate, EstimateArrays, as_series
 
 #: seconds of input between two analyses (the estimates' update period)
 HOP_S = 1.0
@@ -102,14 +102,7 @@ MERGE_TOL = 0.02
 #: frequency (run forwards and backwards: no phase, gain 0.96 at the owned band's top edge)
 DECIMATE_SOS = butter(8, 0.45, output='sos')
 
-COUNTER_NAMES = (
-    'received',
-    'used',
-    'skipped_non_finite',
-    'skipped_duplicate',
-    'skipped_out_of_order',
-    'time_jump_resets',
-    'gap_resets',
+COUNTER_NAMES = INPUT_COUNTERS + (
     'analyses',
     'rejected_damping',
     'rejected_unstable',

@@ -37,8 +37,8 @@ import numpy as np
 from . import kernel as K
 from .config import EstimatorConfig
 
-#: counter names, in the order of :mod:`vib_estimator.core.kernel`'s counter array
-COUNTER_NAMES = (
+#: the input counters every estimator keeps (the first of the kernel's counter array, in order)
+INPUT_COUNTERS = (
     'received',
     'used',
     'skipped_non_finite',
@@ -46,6 +46,9 @@ COUNTER_NAMES = (
     'skipped_out_of_order',
     'time_jump_resets',
     'gap_resets',
+)
+#: counter names, in the order of :mod:`vib_estimator.core.kernel`'s counter array
+COUNTER_NAMES = INPUT_COUNTERS + (
     'rejected_at_rest',
     'rejected_fit',
     'rejected_nyquist',

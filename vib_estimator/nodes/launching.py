@@ -62,3 +62,17 @@ def given(
 def truthy(text) -> bool:
     """A launch argument's or a parameters file's boolean (``true``/``True``/True)."""
     return str(text).lower() == 'true'
+
+
+def node_action(node_class, executable: str, namespace, parameters):
+    """A ``launch_ros.actions.Node`` (``node_class``: this module imports no launch package) of
+    this package's ``executable``, named after it, output on the screen."""
+    return node_class(
+        package=PACKAGE,
+        executable=executable,
+        name=executable,
+        namespace=namespace,
+        parameters=parameters,
+        output='screen',
+        emulate_tty=True,
+    )
