@@ -15,18 +15,10 @@ defaults.
 import numpy as np
 
 from vib_estimator.core import EstimatorConfig, FrequencyEstimator
+from vib_estimator.sim.signals import gappy_sine
 
 FS, F0 = 500.0, 2.0
 OFF = {'gap_intervals': 0.0, 'outlier_ratio': 0.0}
-
-
-def gappy(seed, offset):
-    rng = np.random.default_rng(seed)
-    t = np.arange(0, 60, 1 / FS)
-    keep = np.ones(len(t), bool)
-    for start in rng.choice(len(t) - 300, 40, replace=False):
-        keep[start : start + int(rng.uniform(0.04, 0.4) * FS)] = False
-    return t[keep], np.sin(2 * np.pi * F0 * t[keep]) + offset, int((~keep).sum())
 
 
 def row(label, est, e, truth):
@@ -50,7 +42,7 @@ def main() -> None:
     print(head)
     for model, offset in (('sinusoid', 0.0), ('biased-sinusoid', 0.3)):
         for seed in range(5):
-            t, y, lost = gappy(seed, offset)
+            t, y, lost = gappy_sine(seed, offset)
             for name, extra in (('tests off', OFF), ('default', {})):
                 est = FrequencyEstimator(EstimatorConfig(model=model, **extra))
                 row(f'{model} seed {seed} [{lost}] {name}', est, est.process(t, y), F0)

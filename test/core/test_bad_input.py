@@ -13,6 +13,7 @@ from hypothesis import strategies as st
 
 from vib_estimator.core import EstimatorConfig, FrequencyEstimator
 from vib_estimator.core.modes import create_estimator
+from vib_estimator.sim.signals import gappy_sine
 
 FS, F0 = 500.0, 2.0
 #: every sample goes to exactly one of these
@@ -23,16 +24,6 @@ FATES = (
     'skipped_out_of_order',
     'skipped_outlier',
 )
-
-
-def gappy_sine(seed, offset=0.0):
-    """Issue 22 case 1: a 2 Hz sine at 500 Hz with 40 gaps of 40-400 ms cut out (noise-free)."""
-    rng = np.random.default_rng(seed)
-    t = np.arange(0, 60, 1 / FS)
-    keep = np.ones(len(t), bool)
-    for start in rng.choice(len(t) - 300, 40, replace=False):
-        keep[start : start + int(rng.uniform(0.04, 0.4) * FS)] = False
-    return t[keep], np.sin(2 * np.pi * F0 * t[keep]) + offset, int((~keep).sum())
 
 
 @pytest.mark.parametrize('model,offset', [('sinusoid', 0.0), ('biased-sinusoid', 0.3)])

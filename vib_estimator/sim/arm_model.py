@@ -189,6 +189,7 @@ class ArmSimulator:
         self.rate_hz = float(rate_hz)
         self.noise_std = float(noise_std)
         self.quantum = float(quantum)
+        self.seed = seed
         self._rng = np.random.default_rng(seed)
         self._moves = sorted(schedule, key=lambda mv: mv.start)
         self._next_move = 0
@@ -410,32 +411,15 @@ class DrivenArmSimulator(ArmSimulator):
     def __init__(
         self,
         params: ArmParameters = ArmParameters(),
-        rate_hz: float = 500.0,
-        noise_std: float = DEFAULT_NOISE_STD,
-        quantum: float = DEFAULT_QUANTUM,
-        seed: int = 0,
-        schedule: Sequence[Move] = (Move(0.0, 0.0),),
-        substeps: int = 8,
-        output: str = 'torque',
-        offset: float = 0.0,
-        limit_cycle_voltage: float = 0.0,
-        *,
+        *args,
         excitation: str = 'ambient',
         level: float = 0.02,
         bandwidth_hz: float = 2.0,
+        **kwargs,
     ):
-        super().__init__(
-            params,
-            rate_hz,
-            noise_std,
-            quantum,
-            seed,
-            schedule,
-            substeps,
-            output,
-            offset,
-            limit_cycle_voltage,
-        )
+        """``params``, ``args``, ``kwargs``: those of :class:`ArmSimulator` (pass
+        ``schedule=(Move(0.0, 0.0),)`` to hold the motor at 0 rad: it drives the arm by itself)."""
+        super().__init__(params, *args, **kwargs)
         if excitation not in EXCITATIONS:
             raise ValueError(
                 f'excitation must be one of {", ".join(EXCITATIONS)}, got {excitation!r}'
@@ -444,7 +428,7 @@ class DrivenArmSimulator(ArmSimulator):
             raise ValueError('level must be >= 0 and bandwidth_hz > 0')
         self.excitation = excitation
         self.level = float(level)
-        self._drive = np.random.default_rng(seed + 1)
+        self._drive = np.random.default_rng(self.seed + 1)
         self._pole = math.exp(-2 * math.pi * bandwidth_hz / self.rate_hz)
         self._disturbance = 0.0
         self._random_angle = 0.0

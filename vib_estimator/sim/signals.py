@@ -5,6 +5,8 @@ sine of Eq. 15."""
 
 from __future__ import annotations
 
+from typing import Tuple
+
 import numpy as np
 
 
@@ -30,3 +32,16 @@ def normalised_damped_sine(t_hat: np.ndarray, zeta: float, phase: float = 0.0) -
     return np.exp(-2 * np.pi * zeta / np.sqrt(1 - zeta**2) * t_hat) * np.sin(
         2 * np.pi * t_hat + phase
     )
+
+
+def gappy_sine(
+    seed: int, offset: float = 0.0, rate_hz: float = 500.0, f: float = 2.0
+) -> Tuple[np.ndarray, np.ndarray, int]:
+    """Issue 22's lost samples: a ``f`` Hz sine sampled at ``rate_hz`` for 60 s with 40 gaps of
+    40-400 ms cut out (seeded, noise-free), plus ``offset``; returns (t, y, samples cut out)."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(0, 60, 1 / rate_hz)
+    keep = np.ones(len(t), bool)
+    for start in rng.choice(len(t) - 300, 40, replace=False):
+        keep[start : start + int(rng.uniform(0.04, 0.4) * rate_hz)] = False
+    return t[keep], np.sin(2 * np.pi * f * t[keep]) + offset, int((~keep).sum())
