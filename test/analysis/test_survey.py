@@ -78,6 +78,24 @@ def test_a_corrupt_recording_is_one_error_row(tmp_path, capsys):
     capsys.readouterr()
 
 
+def survey_args(folder, baseline):
+    """``survey`` of a folder against a baseline (recording or Hz): 2 % alarm, JSONL, one job,
+    exit 3 on an alarm."""
+    return [
+        'survey',
+        str(folder),
+        '--baseline',
+        str(baseline),
+        '--alarm-rel',
+        '0.02',
+        '--format',
+        'jsonl',
+        '--jobs',
+        '1',
+        '--fail-on-alarm',
+    ]
+
+
 def test_alarm_on_a_seeded_drift_and_none_without(tmp_path, capsys):
     drift = fleet(tmp_path / 'drift', [1.3] * 4 + [1.3 * 0.95] * 2)
     steady = fleet(tmp_path / 'steady', [1.3] * 6, seed=1)
@@ -85,17 +103,7 @@ def test_alarm_on_a_seeded_drift_and_none_without(tmp_path, capsys):
     assert (
         main(
             [
-                'survey',
-                str(tmp_path / 'drift'),
-                '--baseline',
-                str(drift[0]),
-                '--alarm-rel',
-                '0.02',
-                '--format',
-                'jsonl',
-                '--jobs',
-                '1',
-                '--fail-on-alarm',
+                *survey_args(tmp_path / 'drift', drift[0]),
                 '--out',
                 str(out),
                 '--plot',
@@ -114,17 +122,7 @@ def test_alarm_on_a_seeded_drift_and_none_without(tmp_path, capsys):
     assert (
         main(
             [
-                'survey',
-                str(tmp_path / 'steady'),
-                '--baseline',
-                '1.3',
-                '--alarm-rel',
-                '0.02',
-                '--format',
-                'jsonl',
-                '--jobs',
-                '1',
-                '--fail-on-alarm',
+                *survey_args(tmp_path / 'steady', 1.3),
             ]
         )
         == 0
