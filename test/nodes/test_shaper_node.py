@@ -240,7 +240,7 @@ def test_live_demo_short_run(tmp_path):
             '--seconds-per-mass',
             '6',
             '--speed',
-            '20',
+            '10',
             '--domain-id',
             os.environ['ROS_DOMAIN_ID'],
             '--out',

@@ -20,6 +20,7 @@ and :func:`run`.
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
 import time
 
@@ -115,6 +116,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
+def _interrupt(signum, frame) -> None:
+    raise KeyboardInterrupt
+
+
 def run(args: argparse.Namespace) -> int:
     """Run the estimation demo (or with ``--shaping`` the shaping demo); the exit status."""
     from rclpy.executors import ExternalShutdownException
@@ -137,6 +142,8 @@ def run(args: argparse.Namespace) -> int:
     ]
     wall_start = time.monotonic()
     session = Session(args, truth)
+    # SIGTERM (a `kill`, a CI timeout) unwinds like Ctrl-C, so the nodes started are stopped too
+    signal.signal(signal.SIGTERM, _interrupt)
     try:
         if args.shaping:
             return run_shaping(session, args, wall_start)

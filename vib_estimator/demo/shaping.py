@@ -34,6 +34,10 @@ DEFAULT_MIN_REDUCTION = 0.9
 MIN_SECONDS_PER_MOVE_PAIR = 6.0
 MAX_STEP = 2.0
 SETTLE_S = 0.3
+#: shaper_node designs for the median of this many estimates (its ``median_of``): one estimate
+#: taken while a move's transient still rings (the paper's configuration publishes those) does not
+#: steer the design
+MEDIAN_OF = 3
 
 
 @dataclass
@@ -103,9 +107,10 @@ class ShapingDriver:
         self.reference_pub.publish(self._msg(data=float(reference)))
 
 
-def _last_estimate_before(rec: Record, t: float) -> float:
-    before = [f for te, f in zip(rec.est_t, rec.est_f) if te <= t]
-    return before[-1] if before else float('nan')
+def design_estimate(rec: Record, t: float) -> float:
+    """The estimate shaper_node designs for at time ``t``: the median of the last MEDIAN_OF."""
+    last = [f for te, f in zip(rec.est_t, rec.est_f) if te <= t][-MEDIAN_OF:]
+    return float(np.median(last)) if last else float('nan')
 
 
 def _drive(session: Session, driver: ShapingDriver, sim, args) -> List[ShapedMove]:
@@ -142,7 +147,7 @@ def _locate(rec: Record, move: ShapedMove, f0: float) -> None:
     move.t = onset
     name, move.shaper = move.shaper, None
     if name != 'none':
-        move.estimate = _last_estimate_before(rec, onset)
+        move.estimate = design_estimate(rec, onset)
         if not math.isfinite(move.estimate):
             raise RuntimeError(f'no estimate before the shaped move at {onset:.2f} s')
         move.shaper = design(name, move.estimate, 0.0)
@@ -167,19 +172,25 @@ def measure_moves(rec: Record, moves: List[ShapedMove], seconds_per_mass: float)
         t_mass, t_next = i * seconds_per_mass, min((i + 1) * seconds_per_mass, t[-1])
         u_settled = unshaped.t + SETTLE_S
         s_settled = shaped.t + shaped.duration + SETTLE_S
-        fit_u = added_vibration(
-            t,
-            y,
-            unshaped.t,
-            u_settled,
-            unshaped.t - t_mass - 0.05,
-            shaped.t - u_settled,
-            f0,
-            0.004,
-        )
-        fit_s = added_vibration(
-            t, y, shaped.t, s_settled, shaped.t - u_settled, t_next - s_settled, f0, 0.004
-        )
+        try:
+            fit_u = added_vibration(
+                t,
+                y,
+                unshaped.t,
+                u_settled,
+                unshaped.t - t_mass - 0.05,
+                shaped.t - u_settled,
+                f0,
+                0.004,
+            )
+            fit_s = added_vibration(
+                t, y, shaped.t, s_settled, shaped.t - u_settled, t_next - s_settled, f0, 0.004
+            )
+        except ValueError as err:  # a move came too late: this machine lagged the clock
+            raise RuntimeError(
+                f'the moves of {m * 1e3:g} g at {unshaped.t:.2f} and {shaped.t:.2f} s cannot be '
+                f'measured ({err}): this machine is too busy for --speed; try a lower one'
+            ) from None
         rows.append(
             {
                 'mass_g': m * 1e3,
@@ -231,7 +242,7 @@ def run_shaping(session: Session, args: argparse.Namespace, wall_start: float) -
     driver = ShapingDriver(session)
     session.start(
         'shaper_node',
-        ['use_sim_time:=true', 'shaper:=none'],
+        ['use_sim_time:=true', 'shaper:=none', f'median_of:={MEDIAN_OF}'],
         lambda: (
             driver.reference_pub.get_subscription_count()
             and listener.counts('position_command')[0]
