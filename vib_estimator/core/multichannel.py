@@ -33,8 +33,8 @@ are reused) with matrices in place of scalars:
    :data:`..ambient.MIN_PEAK_RATIO` above the noise on **at least one** channel (a mode
    invisible on some channels is still found on the others).
 3. **Standard deviations**: the Whittle bound (:func:`..ambient.whittle_std`) on the channel where
-   the mode stands highest above its noise, calibrated across windows as the single-channel
-   identifier's (:class:`..ambient.ModeTrack`).
+   the mode stands highest above its noise (with the modes there within :data:`NEIGHBOURS`),
+   calibrated across windows as the single-channel identifier's (:class:`..ambient.ModeTrack`).
 4. **Identity over time**: a window's mode continues the tracked mode nearest in frequency (within
    :data:`..ambient.MATCH_TOL`) whose last shape it matches (MAC >= :data:`MAC_MATCH`); the MAC
    between the two is published with the estimate (``mac``, NaN for a mode's first window).
@@ -90,6 +90,9 @@ MAC_MATCH = 0.5
 #: ``rows x channels`` above the highest order; the SVD costs 8 times less; on the shear frame,
 #: two seeds, as accurate as 40 rows)
 JOINT_BLOCK_ROWS = BLOCK_ROWS // 2
+#: a mode's Whittle bound counts the modes within this relative frequency of it (farther
+#: ones' skirts carry no information on it, and each bound then costs a few modes, not all)
+NEIGHBOURS = 0.2
 #: the fewest channels of a joint identification (one channel is the single-channel identifier's)
 MIN_CHANNELS = 2
 
@@ -118,8 +121,15 @@ def correlation_matrices(y: np.ndarray, lags: int) -> np.ndarray:
     y = y - y.mean(axis=0)
     size = 1 << math.ceil(math.log2(n + lags + 1))
     spec = np.fft.rfft(y, size, axis=0).T  # channels x bins
-    r = np.fft.irfft(spec[:, None, :] * np.conj(spec[None, :, :]), size, axis=-1)
-    return np.moveaxis(r[:, :, : lags + 1], -1, 0) / np.arange(n, n - lags - 1, -1)[:, None, None]
+    m = y.shape[1]
+    a, b = np.triu_indices(m)
+    # one inverse transform per pair a <= b: its start holds R_k[a, b], its end R_k[b, a]
+    circ = np.fft.irfft(spec[a] * np.conj(spec[b]), size, axis=-1)
+    r = np.empty((lags + 1, m, m))
+    r[:, a, b] = circ[:, : lags + 1].T
+    r[0, b, a] = circ[:, 0]
+    r[1:, b, a] = circ[:, : -lags - 1 : -1].T
+    return r / np.arange(n, n - lags - 1, -1)[:, None, None]
 
 
 def joint_poles(
@@ -304,13 +314,14 @@ def identify_joint(
             )
     rows, shapes, spread, noise, best = strong
     std = np.full((len(rows), 2), math.nan)
-    for c in set(best.tolist()):
-        on = np.flatnonzero(rows[:, 2 + c] > 0)  # the modes seen on channel c
-        triples = [(rows[j, 0], rows[j, 1], rows[j, 2 + c]) for j in on]
+    for j, c in enumerate(best):
+        # the bound on the mode's best channel, with the modes there within NEIGHBOURS of it
+        near = np.flatnonzero(
+            (rows[:, 2 + c] > 0) & (np.abs(rows[:, 0] / rows[j, 0] - 1) <= NEIGHBOURS)
+        )
+        triples = [(rows[i, 0], rows[i, 1], rows[i, 2 + c]) for i in near]
         cstd = np.array(whittle_std(triples, noise[c], fs, len(y))).reshape(-1, 2)
-        for j, sd in zip(on, cstd):
-            if best[j] == c:
-                std[j] = sd
+        std[j] = cstd[int(np.flatnonzero(near == j)[0])]
     modes = JointModes(rows[:, 0], rows[:, 1], rows[:, 2:], std[:, 0], std[:, 1], shapes, spread)
     weak = ~(modes.frequency_std <= MAX_STD_REL * modes.frequency)
     counts['rejected_uncertain'] += int(np.count_nonzero(weak))
@@ -402,11 +413,11 @@ class JointAmbientEstimator:
         self._next = math.inf
 
     # ---- input --------------------------------------------------------------------------------
-    def _room(self) -> None:
-        """Make room for one more sample (compact, or grow)."""
+    def _room(self, more: int = 1) -> None:
+        """Make room for ``more`` samples (compact, or grow)."""
         keep = self._n - self._start
-        if keep + 1 > len(self._t) // 2:
-            size = 2 * len(self._t)
+        if keep + more > len(self._t) // 2:
+            size = 1 << math.ceil(math.log2(2 * (keep + more)))
             t, y = np.empty(size), np.empty((size, len(self._channels)))
         else:
             t, y = self._t, self._y
@@ -465,9 +476,36 @@ class JointAmbientEstimator:
                 f't must be 1-D and y samples x {len(self._channels)} channels, '
                 f'got {t.shape}, {y.shape}'
             )
+        finite = np.isfinite(y).all(axis=1) & np.isfinite(t)
+        gap = self._config.max_gap
         out: list[JointEstimate] = []
-        for ti, yi in zip(t, y):
-            out.extend(self.update(ti, yi))
+        i, n = 0, len(t)
+        while i < n:
+            # the longest clean run from i: finite, increasing, no gap (else one sample at a time)
+            j = i
+            if finite[i] and t[i] > self._last and (t[i] - self._last <= gap or not self._n):
+                d = np.diff(t[i : min(n, i + 65536)])
+                bad = ~((d > 0) & (d <= gap)) | ~finite[i + 1 : i + 1 + len(d)]
+                j = i + 1 + (int(np.argmax(bad)) if bad.any() else len(d))
+            if j == i:
+                out.extend(self.update(t[i], y[i]))
+                i += 1
+                continue
+            while i < j:
+                if not self._n:
+                    self._next = float(t[i]) + self._window
+                k = min(j, int(np.searchsorted(t[i:j], self._next, 'left')) + i + 1)
+                self._c['received'] += k - i
+                self._c['used'] += k - i
+                while self._n + (k - i) > len(self._t):
+                    self._room(k - i)
+                self._t[self._n : self._n + k - i] = t[i:k]
+                self._y[self._n : self._n + k - i] = y[i:k]
+                self._n += k - i
+                self._last = float(t[k - 1])
+                i = k
+                if self._last >= self._next:
+                    out.extend(self._analyse())
         return self._columns(out)
 
     def _columns(self, out: list[JointEstimate]) -> JointEstimates:
