@@ -138,7 +138,7 @@ def plot_shapes(path: str, title: str, result: JointEstimates, unit: str = UNKNO
     ax.set_ylabel('frequency (Hz)')
     ax.set_title(f'{title}: joint SSI-cov over {len(result.channels)} channels')
     if shapes:
-        ax.legend(fontsize='small', ncol=min(len(shapes), 6))
+        ax.legend(fontsize='small', loc='center left', bbox_to_anchor=(1.0, 0.5))
     x = np.arange(len(result.channels))
     for col, (k, (f, amp, std)) in enumerate(shapes.items()):
         sub = fig.add_subplot(grid[1, col])
