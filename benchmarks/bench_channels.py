@@ -23,31 +23,25 @@
 from __future__ import annotations
 
 import argparse
-import logging
-import os
 import time
 import warnings
 from pathlib import Path
 
 import numpy as np
+from bench_operation import HCT_FILE, HCT_MODES, REAL_DATA, ssi_cov_window  # benchmarks/
 
 from vib_estimator.core import EstimatorConfig
 from vib_estimator.core.ambient import AmbientEstimator
-from vib_estimator.core.multichannel import JointAmbientEstimator, mac
+from vib_estimator.core.multichannel import JOINT_BLOCK_ROWS, JointAmbientEstimator, mac
 from vib_estimator.sim.frame import frame_record, modal_record
 
 warnings.filterwarnings('ignore', category=RuntimeWarning)
-os.environ.setdefault('TQDM_DISABLE', '1')  # pyOMA2's progress bars
-logging.disable(logging.WARNING)  # pyOMA2's INFO/WARNING chatter
 FRAME_FS = 50.0
 FRAME_S = 600.0
 WINDOW_S = 60.0
 ZETA = 0.02
-PEER_ORDER = 20
-PEER_HC = {'xi_max': 0.2, 'mpc_lim': None, 'mpd_lim': None, 'CoV_max': None}
-REAL_DATA = Path(__file__).resolve().parents[2] / 'shared' / 'real-data'
-HCT_FILE = Path('heritage_court_tower') / 'hct_setup1.csv'
-HCT_MODES = (1.23, 1.29, 1.45, 3.85, 4.26, 5.35)
+#: the peer's block rows (those of the joint identifier, ``multichannel.JOINT_BLOCK_ROWS``)
+PEER_ROWS = JOINT_BLOCK_ROWS
 #: an estimate counts for a mode within this relative distance
 NEAR = 0.05
 
@@ -69,24 +63,12 @@ def rms(x):
 def peer(y, fs, freqs):
     """pyOMA2 multi-channel SSI-cov on consecutive :data:`WINDOW_S` windows: per mode the
     relative errors and damping ratios."""
-    from pyoma2.algorithms import SSI
-    from pyoma2.setup import SingleSetup
-
     errs = [[] for _ in freqs]
     zetas = [[] for _ in freqs]
     n = int(WINDOW_S * fs)
     for start in range(0, len(y) - n + 1, n):
-        setup = SingleSetup(y[start : start + n], fs)
-        algo = SSI(name='cov', method='cov', br=20, ordmax=30, calc_unc=False, hc=PEER_HC)
-        setup.add_algorithms(algo)
-        setup.run_by_name('cov')
-        try:
-            setup.mpe('cov', sel_freq=list(freqs), order_in=PEER_ORDER)
-        except Exception:  # noqa: BLE001, S112 -- pyOMA2 raises plain errors (mode absent)
-            continue
-        for j, (f, fn, xi) in enumerate(
-            zip(freqs, np.ravel(algo.result.Fn), np.ravel(algo.result.Xi))
-        ):
+        res = ssi_cov_window(y[start : start + n], fs, freqs, PEER_ROWS)
+        for j, (f, fn, xi) in enumerate(zip(freqs, *(res or ((), ())))):
             if np.isfinite(fn) and abs(fn / f - 1) <= NEAR:
                 errs[j].append(fn / f - 1)
                 zetas[j].append(xi)
