@@ -42,6 +42,7 @@ bench-all: bench
 	$(VENV)/bin/python benchmarks/bound_modes.py
 	$(VENV)/bin/python benchmarks/bench_survey.py
 	$(VENV)/bin/python benchmarks/real_data.py
+	$(VENV)/bin/python benchmarks/bench_channels.py
 
 reproduce: setup
 	$(VENV)/bin/vib-estimator reproduce fig1 --out out/fig1.png
