@@ -64,7 +64,7 @@ survey: setup
 survey-ambient: setup
 	$(VENV)/bin/python scripts/make_fleet.py --out out/fleet_ambient --excitation ambient
 	$(VENV)/bin/vib-estimator survey out/fleet_ambient --excitation ambient \
-		--baseline out/fleet_ambient/day_00 --alarm-rel 0.005 \
+		--baseline out/fleet_ambient/day_00 --alarm-rel 0.0025 \
 		--out out/fleet_ambient_survey.csv --plot out/fleet_ambient_trend.png
 
 clean:

@@ -77,3 +77,18 @@ def test_damped_days_unbiased_and_covered():
     assert abs(np.median(errors)) < 5e-4
     assert np.mean(f_in) >= 0.85
     assert np.mean(z_in) >= 0.75
+
+
+def test_summary_median_is_the_former_summary():
+    t, y = plucked_decays(7)
+    est = create_estimator(EstimatorConfig(model=S.DEFAULT_MODEL)).process(t, y)
+    take = np.ones(len(est), dtype=bool)
+    old = S.summarise(est, take, 'median')
+    assert (old['frequency_hz'], old['frequency_lo_hz'], old['frequency_hi_hz']) == (
+        S.median_interval(est.frequency_hz)
+    )
+    assert 'frequency_std_hz' not in old and old['damping'] == np.median(est.damping)
+    new = S.summarise(est, take)
+    assert new['frequency_median_hz'] == old['frequency_hz']
+    assert new['damping_lo'] < new['damping'] < new['damping_hi']
+    assert new['effective_estimates'] > 10
