@@ -615,6 +615,17 @@ def alarm_band(ref: Tuple[float, float, float], alarm_rel: float) -> Tuple[float
     return ref[1] * (1 - alarm_rel), ref[2] * (1 + alarm_rel)
 
 
+def _bars(ax, x, line: List[Dict], name: str, colour: str, label: str) -> np.ndarray:
+    """Plot the rows' ``name`` (frequency or damping) with their 95 % intervals as bars."""
+    value = np.array([r[name + '_hz' if name == 'frequency' else name] for r in line])
+    ends = ('_lo_hz', '_hi_hz') if name == 'frequency' else ('_lo', '_hi')
+    err = np.abs(np.array([[r[name + end] for r in line] for end in ends]) - value)
+    ax.errorbar(
+        x, value, yerr=np.nan_to_num(err), marker='o', ms=3, capsize=2, color=colour, label=label
+    )
+    return value
+
+
 def plot_trend(
     rows: List[Dict], path: Path, base: Optional[Dict] = None, alarm_rel: Optional[float] = None
 ):
@@ -638,22 +649,8 @@ def plot_trend(
             datetime.fromisoformat(r['start_utc'].replace('Z', '+00:00')) if r['start_utc'] else i
             for i, r in enumerate(line)
         ]
-        f = np.array([r['frequency_hz'] for r in line])
-        err = np.abs(
-            np.array([[r['frequency_lo_hz'] for r in line], [r['frequency_hi_hz'] for r in line]])
-            - f
-        )
         label = ' '.join(str(k) for k in key if k not in ('', 0))
-        ax_f.errorbar(
-            x,
-            f,
-            yerr=np.nan_to_num(err),
-            marker='o',
-            ms=3,
-            capsize=2,
-            color=colour,
-            label=f'{label}: frequency, 95 % interval',
-        )
+        f = _bars(ax_f, x, line, 'frequency', colour, f'{label}: frequency, 95 % interval')
         alarmed = [i for i, r in enumerate(line) if r['alarm']]
         ax_f.plot(
             [x[i] for i in alarmed], f[alarmed], 'rx', ms=9, label='alarm' if alarmed else None
@@ -671,20 +668,7 @@ def plot_trend(
                     label=f'no-alarm band: baseline 95 % interval ±{100 * alarm_rel:g} %',
                 )
         if damped:
-            z = np.array([r['damping'] for r in line])
-            z_err = np.abs(
-                np.array([[r['damping_lo'] for r in line], [r['damping_hi'] for r in line]]) - z
-            )
-            axes[1, 0].errorbar(
-                x,
-                z,
-                yerr=np.nan_to_num(z_err),
-                marker='o',
-                ms=3,
-                capsize=2,
-                color=colour,
-                label=label,
-            )
+            _bars(axes[1, 0], x, line, 'damping', colour, label)
     ax_f.set_ylabel('frequency (Hz)')
     explain = ': a recording alarms when its 95 % interval lies wholly outside the band'
     ax_f.set_title('frequency trend' + ('' if base is None else explain), fontsize=10)
