@@ -93,10 +93,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def add_config_arguments(parser: argparse.ArgumentParser) -> None:
+def add_config_arguments(parser: argparse.ArgumentParser, model: Optional[str] = None) -> None:
     """The estimator options (``--paper``, ``--model``, ``--band-hz``, one per scalar config
-    field); an option not given keeps the default (or with ``--paper`` the paper's) value."""
-    defaults, paper = EstimatorConfig(), EstimatorConfig.paper()
+    field); an option not given keeps the default (or with ``--paper`` the paper's) value, the
+    help of ``--model`` says ``model`` if the command has its own default."""
+    defaults, paper = (
+        EstimatorConfig(model=model or EstimatorConfig.model),
+        EstimatorConfig.paper(),
+    )
     parser.add_argument(
         '--paper',
         action='store_true',
