@@ -131,12 +131,8 @@ def compare_split(t, y):
             f'batch {name:>20} {m / min(now) / 1e6:8.2f} this {m / min(then) / 1e6:8.2f} '
             f'{SPLIT}   this/then {min(then) / min(now):5.2f}'
         )
-    m = 200_000
-    tl, yl = t[:m].tolist(), y[:m].tolist()
-
-    def stream(update):
-        for a, b in zip(tl, yl):
-            update(a, b)
+    m = STREAMED
+    stream = streamer(t, y)
 
     now, then = [], []
     for _ in range(3):
@@ -146,6 +142,21 @@ def compare_split(t, y):
         f'streaming {"paper()":>16} {min(now) / m * 1e6:8.3f} this {min(then) / m * 1e6:8.3f} '
         f'{SPLIT}   this/then {min(then) / min(now):5.2f}'
     )
+
+
+#: samples of the streaming comparisons
+STREAMED = 200_000
+
+
+def streamer(t, y):
+    """A function feeding the first STREAMED samples, as Python floats, to an ``update``."""
+    tl, yl = t[:STREAMED].tolist(), y[:STREAMED].tolist()
+
+    def stream(update):
+        for a, b in zip(tl, yl):
+            update(a, b)
+
+    return stream
 
 
 def compare_dispatch(t, y):
@@ -162,12 +173,8 @@ def compare_dispatch(t, y):
 
         return update
 
-    m = 200_000
-    tl, yl = t[:m].tolist(), y[:m].tolist()
-
-    def stream(update):
-        for a, b in zip(tl, yl):
-            update(a, b)
+    m = STREAMED
+    stream = streamer(t, y)
 
     now, then = [], []
     for _ in range(5):
