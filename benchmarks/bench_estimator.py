@@ -12,10 +12,13 @@ Prints (one run, same machine, same signal: 2 M samples of a noisy 1.33 Hz sine 
 - batch cost of other configurations against the default: the paper's estimator (``refine`` = 0)
   long windows (``min_periods`` = 5, 20; ``target_std_rel`` = 1e-4) and the band prefilter
   (``band_hz`` = [f/2, 2f]: its std is a sandwich over the prefilter's noise covariance).
+- streaming through the compiled entry (``core.jit.entry``, today's ``update``) beside the same
+  kernel called through numba's dispatcher (``update`` before), alternately;
 - the previous kernel (``PREVIOUS``, before the split into per-equation functions and before
   refinement; loaded at run time with ``git show`` into a temporary package, "skipped" without git)
-  on the same signal, ``refine`` = 0 (it also computes each estimate's std) and the default
-  against it, timed alternately (the ratios hold when the machine is loaded; the rates do not).
+  on the same signal, ``EstimatorConfig.paper(refine=0)`` (it also computes each estimate's std)
+  and ``EstimatorConfig.paper()`` against it (the paper's configuration: the previous kernel's
+  defaults), timed alternately (the ratios hold when the machine is loaded; the rates do not).
 - the kernel of ``SPLIT`` (before issues 19 and 24: the compile-time and speed restructuring),
   loaded the same way, beside this one for each configuration, ``modes`` = 3 and streaming,
   timed alternately: rates and this/then ratios (the outputs are bit-identical,
@@ -109,11 +112,15 @@ def compare_split(t, y):
     then_config = importlib.import_module('vib_split.config').EstimatorConfig
     then_create = importlib.import_module('vib_split.modes').create_estimator
     n = len(t)
-    print(f"\nthis kernel beside {SPLIT}'s (batch M samples/s; streaming us/sample)")
+    print(
+        f"\nthis kernel beside {SPLIT}'s (batch M samples/s; streaming us/sample; each row's"
+        f" configuration applied to EstimatorConfig.paper(), {SPLIT}'s defaults)"
+    )
     rows = [('default', {}), *VARIANTS.items(), ('modes=3', dict(modes=3))]
     for name, changes in rows:
+        name = 'paper()' if name == 'default' else name
         m = n // 4 if 'modes' in changes else n
-        now_cfg, then_cfg = EstimatorConfig(**changes), then_config(**changes)
+        now_cfg, then_cfg = EstimatorConfig.paper(**changes), then_config(**changes)
         create_estimator(now_cfg).process(t[:5000], y[:5000])
         then_create(then_cfg).process(t[:5000], y[:5000])
         now, then = [], []
@@ -124,20 +131,58 @@ def compare_split(t, y):
             f'batch {name:>20} {m / min(now) / 1e6:8.2f} this {m / min(then) / 1e6:8.2f} '
             f'{SPLIT}   this/then {min(then) / min(now):5.2f}'
         )
-    m = 200_000
-    tl, yl = t[:m].tolist(), y[:m].tolist()
+    m = STREAMED
+    stream = streamer(t, y)
+
+    now, then = [], []
+    for _ in range(3):
+        now.append(best(lambda: stream(create_estimator(EstimatorConfig.paper()).update), 1))
+        then.append(best(lambda: stream(then_create(then_config()).update), 1))
+    print(
+        f'streaming {"paper()":>16} {min(now) / m * 1e6:8.3f} this {min(then) / m * 1e6:8.3f} '
+        f'{SPLIT}   this/then {min(then) / min(now):5.2f}'
+    )
+
+
+#: samples of the streaming comparisons
+STREAMED = 200_000
+
+
+def streamer(t, y):
+    """A function feeding the first STREAMED samples, as Python floats, to an ``update``."""
+    tl, yl = t[:STREAMED].tolist(), y[:STREAMED].tolist()
 
     def stream(update):
         for a, b in zip(tl, yl):
             update(a, b)
 
+    return stream
+
+
+def compare_dispatch(t, y):
+    """Streaming through the compiled entry (``update`` today) beside the same kernel called
+    through numba's dispatcher with numpy item assignment (``update`` before), alternating, best
+    of 5."""
+    from vib_estimator.core import kernel as K
+
+    def dispatched(e):
+        def update(a, b):
+            e._t1[0] = a
+            e._y1[0] = b
+            return K.run(e._p, e._s, e._c, e._seg, e._t1, e._y1, e._row, 0, e._optional)[0]
+
+        return update
+
+    m = STREAMED
+    stream = streamer(t, y)
+
     now, then = [], []
-    for _ in range(3):
-        now.append(best(lambda: stream(create_estimator(EstimatorConfig()).update), 1))
-        then.append(best(lambda: stream(then_create(then_config()).update), 1))
+    for _ in range(5):
+        now.append(best(lambda: stream(FrequencyEstimator().update), 1))
+        then.append(best(lambda: stream(dispatched(FrequencyEstimator())), 1))
     print(
-        f'streaming {"default":>16} {min(now) / m * 1e6:8.3f} this {min(then) / m * 1e6:8.3f} '
-        f'{SPLIT}   this/then {min(then) / min(now):5.2f}'
+        f'streaming {min(now) / m * 1e6:8.3f} us/sample (compiled entry)   through the dispatcher '
+        f'{min(then) / m * 1e6:8.3f} us/sample   dispatcher/entry {min(then) / min(now):5.2f}'
     )
 
 
@@ -149,12 +194,12 @@ def compare_previous(t, y):
         print(f'previous kernel ({PREVIOUS})   skipped (git or the commit is not available)')
         return
     old_estimator, old_config = previous
-    paper = EstimatorConfig(refine=0)
+    paper = EstimatorConfig.paper(refine=0)  # the previous kernel's defaults, no refinement
     old_estimator(old_config()).process(t[:5000], y[:5000])
     now, default, old = [], [], []
     for _ in range(3):
         now.append(best(lambda: FrequencyEstimator(paper).process(t, y), 1))
-        default.append(best(lambda: FrequencyEstimator().process(t, y), 1))
+        default.append(best(lambda: FrequencyEstimator(EstimatorConfig.paper()).process(t, y), 1))
         old.append(best(lambda: old_estimator(old_config()).process(t, y), 1))
     n = len(t)
     print(
@@ -162,7 +207,7 @@ def compare_previous(t, y):
         f'{n / min(now) / 1e6:8.2f} M samples/s   today/previous {min(old) / min(now):5.2f}'
     )
     print(
-        f'{"":27}{"":22}   default today  {n / min(default) / 1e6:8.2f} M samples/s   '
+        f'{"":27}{"":22}   paper() today  {n / min(default) / 1e6:8.2f} M samples/s   '
         f'today/previous {min(old) / min(default):5.2f}'
     )
 
@@ -218,6 +263,7 @@ def main() -> None:
         print(
             f'batch {name:>20} {n / v / 1e6:8.2f} M samples/s   ratio to default {batch / v:6.2f}'
         )
+    compare_dispatch(t, y)
     compare_previous(t, y)
     compare_split(t, y)
 

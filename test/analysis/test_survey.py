@@ -4,6 +4,8 @@
 
 import json
 import math
+import os
+from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 
 import numpy as np
@@ -181,6 +183,20 @@ def test_dask_cluster_gives_identical_rows(tmp_path):
         remote = S.survey(recordings, options, scheduler=cluster.scheduler_address)
     assert json.dumps(remote) == json.dumps(local)
     assert local[-1]['error'] and not local[0]['error']
+
+
+def test_kept_pool_gives_identical_rows_and_outlives_a_dead_worker(tmp_path):
+    recordings = S.find_recordings([str(p) for p in fleet(tmp_path, [1.3, 1.35, 1.4])])
+    options = S.Options(EstimatorConfig())
+    local = S.survey(recordings, options, jobs=1)
+    first = S.survey(recordings, options, jobs=2)
+    pool = S.local_pool(2)
+    assert json.dumps(S.survey(recordings, options, jobs=2)) == json.dumps(local)
+    assert S.local_pool(2) is pool and json.dumps(first) == json.dumps(local)
+    with pytest.raises(BrokenProcessPool):
+        pool.submit(os._exit, 1).result()  # a worker dies: the kept pool is broken for good
+    assert json.dumps(S.survey(recordings, options, jobs=2)) == json.dumps(local)
+    assert S.local_pool(2) is not pool
 
 
 FAULTS = """

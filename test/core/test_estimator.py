@@ -3,6 +3,7 @@
 """Pure-core tests of the algebraic estimator (no rclpy)."""
 
 import math
+import pickle
 
 import numpy as np
 import pytest
@@ -290,3 +291,16 @@ def test_a_flat_quantised_segment_is_at_rest_whatever_its_fit():
     est = FrequencyEstimator(EstimatorConfig.paper(model='biased-sinusoid'))
     assert len(est.process(t, np.full(len(t), -0.004))) == 0
     assert est.counters['rejected_at_rest'] > 0
+
+
+def test_a_pickled_estimator_streams_on_as_the_original():
+    t = np.arange(4000) * 0.002
+    y = sine(t, 1.33) + 0.01 * np.random.default_rng(0).standard_normal(len(t))
+    first = FrequencyEstimator()
+    for a, b in zip(t[:1500], y[:1500]):
+        first.update(a, b)
+    second = pickle.loads(pickle.dumps(first))
+    rest = list(zip(t[1500:], y[1500:]))
+    ours, theirs = [first.update(a, b) for a, b in rest], [second.update(a, b) for a, b in rest]
+    assert sum(e is not None for e in ours) >= 3
+    assert repr(theirs) == repr(ours) and second.counters == first.counters

@@ -33,6 +33,7 @@ an error; 2 for bad arguments.
 from __future__ import annotations
 
 import argparse
+import atexit
 import contextlib
 import ctypes
 import ctypes.util
@@ -43,6 +44,7 @@ import os
 import sys
 import threading
 from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
 from datetime import datetime, timezone
 from pathlib import Path
@@ -466,6 +468,23 @@ def survey(
     return [row for part in parts for row in part]
 
 
+_local_pools: Dict[int, ProcessPoolExecutor] = {}  # jobs -> the pool kept for later surveys
+
+
+def local_pool(jobs: int, fresh: bool = False) -> ProcessPoolExecutor:
+    """The process pool of ``jobs`` workers: started by the first survey that asks for it and kept
+    for the later ones of this process (shut down at exit), so a process that surveys repeatedly
+    (a monitoring loop, the benchmark) starts its workers, and loads the kernels in them, once.
+    ``fresh``: replace the kept pool (one whose worker died is broken for good)."""
+    pool = _local_pools.get(jobs)
+    if pool is None or fresh:
+        if pool is not None:
+            pool.shutdown(wait=False, cancel_futures=True)
+        pool = _local_pools[jobs] = ProcessPoolExecutor(max_workers=jobs)
+        atexit.register(pool.shutdown)
+    return pool
+
+
 def _on_executor(recordings, options, jobs, scheduler, bar) -> List[List[Dict]]:
     client = None
     if scheduler is not None:
@@ -474,15 +493,19 @@ def _on_executor(recordings, options, jobs, scheduler, bar) -> List[List[Dict]]:
         client = Client(scheduler)
         executor = client.get_executor(pure=False)
     else:
-        executor = ProcessPoolExecutor(max_workers=jobs)
+        executor = local_pool(jobs)
     try:
-        futures = [executor.submit(survey_recording, path, options) for path in recordings]
+        try:
+            futures = [executor.submit(survey_recording, path, options) for path in recordings]
+        except BrokenProcessPool:  # a worker of the kept pool died in an earlier survey
+            executor = local_pool(jobs, fresh=True)
+            futures = [executor.submit(survey_recording, path, options) for path in recordings]
         for _ in as_completed(futures):
             bar.update()
         return [_result(future, path) for future, path in zip(futures, recordings)]
     finally:
-        executor.shutdown()
         if client is not None:
+            executor.shutdown()
             client.close()
 
 

@@ -18,7 +18,7 @@ and optimises and emits the whole again).
 
 from __future__ import annotations
 
-from numba import njit, types
+from numba import njit, typeof, types
 
 
 def _plain(ty):
@@ -42,3 +42,14 @@ def jit(fn=None, **options):
 
     dispatcher.get_call_template = get_call_template
     return dispatcher
+
+
+def entry(dispatcher, args):
+    """The compiled code of ``dispatcher`` for the types of ``args`` (loaded from the cache or
+    compiled, as a call would), to be called with arguments of those types only.
+
+    A call through the dispatcher resolves the type of every argument first (numba's
+    ``typeof`` per argument, then the overload lookup); the returned function skips that and only
+    unboxes them. For a per-sample call with many array arguments that is a third of its cost.
+    """
+    return dispatcher.compile(tuple(typeof(a) for a in args))
