@@ -124,23 +124,29 @@ def streamed(work: Path, suffix: str, n: int, write):
     return big, small, cpu(lambda: drain(streaming.open_signal(big)))
 
 
+def report(label: str, unit: str, count: int, fast: float, refs: dict, goal: str) -> None:
+    """One line: the streaming reader's rate over ``count`` items in ``fast`` s beside each
+    reference's (timed on a tenth of them), M items/s, and the ratios."""
+    n = count // 10
+    rates = '   '.join(f'{name} {n / sec / 1e6:6.2f}' for name, sec in refs.items())
+    ratios = ' / '.join(f'{sec / n * count / fast:5.1f}x' for sec in refs.values())
+    print(
+        f'{label:5s} streaming {count / fast / 1e6:6.2f} M {unit}/s   {rates}   ratio {ratios}'
+        f'   (goal {goal})'
+    )
+
+
 def bench_csv(work: Path, rows: int) -> Path:
     big, small, fast = streamed(work, '.csv', rows, write_csv)
-    n = rows // 10
     loadtxt = cpu(lambda: np.loadtxt(small, delimiter=',', skiprows=1), 1)
     exact = cpu(lambda: sum(1 for _ in iter_csv_rows(csv_layout(small))), 1)
-    print(
-        f'csv   streaming {rows / fast / 1e6:6.2f} M rows/s   '
-        f'numpy.loadtxt {n / loadtxt / 1e6:6.2f}'
-        f'   row-by-row reader {n / exact / 1e6:6.2f}   ratio {loadtxt / n * rows / fast:5.1f}x / '
-        f'{exact / n * rows / fast:5.1f}x   (goal >= 5 M rows/s)'
-    )
+    refs = {'numpy.loadtxt': loadtxt, 'row-by-row reader': exact}
+    report('csv', 'rows', rows, fast, refs, '>= 5 M rows/s')
     return big
 
 
 def bench_bag(work: Path, messages: int) -> Path:
     big, small, fast = streamed(work, '_bag', messages, write_bag)
-    n = messages // 10
     from rosbags.rosbag2 import Reader
 
     def generic():
@@ -150,12 +156,8 @@ def bench_bag(work: Path, messages: int) -> Path:
 
     gen = cpu(generic, 1)
     ref = cpu(lambda: read_wrench_series(small), 1)
-    print(
-        f'mcap  streaming {messages / fast / 1e6:6.2f} M msg/s    rosbags deserialize_cdr '
-        f'{n / gen / 1e6:6.2f}   read_wrench_series {n / ref / 1e6:6.2f}   ratio '
-        f'{gen / n * messages / fast:5.1f}x / {ref / n * messages / fast:5.1f}x   '
-        f'(goal >= 1 M msg/s per core)'
-    )
+    refs = {'rosbags deserialize_cdr': gen, 'read_wrench_series': ref}
+    report('mcap', 'msg', messages, fast, refs, '>= 1 M msg/s per core')
     return big
 
 

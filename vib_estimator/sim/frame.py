@@ -60,15 +60,7 @@ def modal_record(
     return np.arange(n) / fs, y
 
 
-def frame_record(
-    duration_s: float,
-    fs: float,
-    zeta: float = 0.02,
-    snr_db: float = 20.0,
-    seed: int = 0,
-    storeys: int = 5,
-    f1_hz: float = 0.89,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def frame_record(duration_s, fs, zeta=0.02, snr_db=20.0, seed=0, storeys=5, f1_hz=0.89):
     """``(t, Y, frequencies, shapes)``: a :func:`shear_frame` record (:func:`modal_record`,
     every mode damped ``zeta``, of unit modal variance) with its exact modes."""
     freqs, shapes = shear_frame(storeys, f1_hz)

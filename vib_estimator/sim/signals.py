@@ -47,15 +47,7 @@ def gappy_sine(
     return t[keep], np.sin(2 * np.pi * f * t[keep]) + offset, int((~keep).sum())
 
 
-def plucked_decays(
-    seed: int,
-    f: float = 5.0,
-    zeta: float = 0.004,
-    snr_db: float = 30.0,
-    plucks: int = 3,
-    every_s: float = 20.0,
-    rate_hz: float = 500.0,
-) -> Tuple[np.ndarray, np.ndarray]:
+def plucked_decays(seed, f=5.0, zeta=0.004, snr_db=30.0, plucks=3, every_s=20.0, rate_hz=500.0):
     """A day of free decays (issue 20's survey fleet): ``plucks`` decays of an ``f`` Hz mode of
     damping ratio ``zeta``, one every ``every_s`` s (each of random phase, amplitude 0.5-2, the
     last ones' tails still ringing), plus white noise ``snr_db`` below a unit pluck's power,
