@@ -21,7 +21,7 @@ by more than :data:`RISE` after the most energetic block, or falls by more than 
 peak comes three or more blocks after the onset still rising by more than :data:`RISE` over its
 last two blocks; fewer than :data:`MIN_BLOCKS` blocks since an onset, or a decay, stay free. A
 driven stretch stays driven (a driven response's energy also wanders down for a while) until an
-onset, or until :data:`MIN_BLOCKS` consecutive blocks are :data:`DROP` times below its median
+onset, or until :data:`QUIET_BLOCKS` consecutive blocks are :data:`DROP` times below its median
 block: the structure rang down after the forcing stopped. A record starts free.
 
 A free-decay estimate publishes when its sample ends in a free stretch, an ambient estimate when
@@ -57,17 +57,19 @@ HORIZON_BLOCKS = 10
 #: fewest blocks since an onset before a stretch can be called driven
 MIN_BLOCKS = 3
 #: a rise of the block energy after its peak (or a fall before it) by more than this: driven
-RISE = 2.0
+RISE = 1.5
 #: a block this many times as energetic as the one before is an onset (a new free decay)
 ONSET = 10.0
-#: a driven stretch ends (back to free) when MIN_BLOCKS consecutive blocks are this many times less
-#: energetic than the median block of the driven stretch (its last BLOCKS_PER_WINDOW blocks): the
-#: structure rang down after the forcing stopped
-DROP = 4.0
 #: ... or more than RISE times, when its log rise is this many times the largest |log ratio| of
 #: consecutive blocks before it since the last onset (at least MIN_BLOCKS of them): sudden against
 #: a smooth decay (a move while the structure still rings), not a driven response's wandering
-SHARP = 4.0
+SHARP = 6.0
+#: a driven stretch ends (back to free) when QUIET_BLOCKS consecutive blocks are this many times
+#: less energetic than the median block of the driven stretch (its last BLOCKS_PER_WINDOW blocks):
+#: the structure rang down after the forcing stopped
+DROP = 10.0
+#: ... for this many consecutive blocks
+QUIET_BLOCKS = 6
 #: block energies below this fraction of the horizon's largest count as this fraction (a signal at
 #: exact rest does not make ratios of zeros)
 FLOOR = 1e-6
@@ -123,6 +125,7 @@ class Envelope:
         self._driven: list[float] = []  # the driven stretch's last BLOCKS_PER_WINDOW blocks
         self._quiet = 0  # consecutive blocks DROP below the driven stretch's median
         self.blocks = {FREE: 0, DRIVEN: 0}  # blocks closed in each state
+        self.changes = {'onsets': 0, 'rang_down': 0, 'became_driven': 0}
 
     def update(self, t: float, y: float) -> None:
         """One sample (skipped unless finite and later than the last)."""
@@ -151,12 +154,14 @@ class Envelope:
         onset = bool(e) and _is_onset(e, energy)
         if onset:
             e.clear()
+            self.changes['onsets'] += 1
         e.append(energy)
         del e[:-HORIZON_BLOCKS]
         if self.state == DRIVEN:
             level = float(np.median(self._driven))
             self._quiet = self._quiet + 1 if energy * DROP < level else 0
-            if onset or self._quiet >= MIN_BLOCKS:
+            if onset or self._quiet >= QUIET_BLOCKS:
+                self.changes['rang_down'] += not onset
                 self.state = FREE
                 self._driven = []
                 e[:] = e[-1:] if onset else e[-MIN_BLOCKS:]
@@ -164,6 +169,7 @@ class Envelope:
                 self._driven = (self._driven + [energy])[-BLOCKS_PER_WINDOW:]
         elif is_driven(e):
             self.state = DRIVEN
+            self.changes['became_driven'] += 1
             self._driven, self._quiet = list(e), 0
         self.blocks[self.state] += 1
 
@@ -208,6 +214,7 @@ class AutoEstimator:
                 c[name] = n
             elif name == 'estimates':
                 c['ambient_estimates'] = n
+        c.update(self._envelope.changes)
         c['free_blocks'] = self._envelope.blocks[FREE]
         c['driven_blocks'] = self._envelope.blocks[DRIVEN]
         c['estimates_free'] = self._published[FREE]
