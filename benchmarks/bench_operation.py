@@ -4,7 +4,7 @@
 vs the Whittle bound at the window used.
 
     .venv/bin/python benchmarks/bench_operation.py [--seeds 3] [--window 30] [--no-peer]
-        [--real-data ../shared/real-data] [--real-only]
+        [--real-data ../shared/real-data] [--real-only] [--arm-only] [--free-only]
 
 Synthetic records (``vib_estimator.sim.ambient``: white-noise-driven modes, 500 Hz, 180 s, the
 estimates of the whole record, i.e. from the first full window on) and the real Heritage Court
