@@ -97,3 +97,27 @@ def test_envelope_test_and_config():
     assert isinstance(create_estimator(AUTO), AutoEstimator)
     with pytest.raises(ValueError, match='excitation'):
         EstimatorConfig(excitation='sometimes').validate()
+
+
+def test_a_driven_stretch_ends_when_the_structure_rings_down():
+    """Driven (an amplitude that wanders smoothly up and down), then the forcing off: the state
+    goes back to free once the envelope has rung down, with no onset."""
+    from vib_estimator.core.auto import DRIVEN as DRIVEN_STATE
+    from vib_estimator.core.auto import FREE as FREE_STATE
+    from vib_estimator.core.auto import Envelope
+
+    rng = np.random.default_rng(1)
+    t = np.arange(0.0, 80.0, 1 / FS)
+    on = t < 40.0
+    amp = np.where(on, 1 + 0.6 * np.sin(2 * np.pi * t / 7), 0.0)
+    off = amp[on][-1] * np.exp(-0.6 * (t - 40.0))  # then a free decay
+    amp = np.where(on, amp, off)
+    y = amp * np.sin(2 * np.pi * F * t) + 1e-4 * rng.standard_normal(len(t))
+    env = Envelope(1.0)
+    states = []
+    for a, b in zip(t.tolist(), y.tolist()):
+        env.update(a, b)
+        states.append(env.state)
+    states = np.array(states)
+    assert np.mean(states[(t > 15) & (t < 40)] == DRIVEN_STATE) == 1.0
+    assert np.all(states[t > 60] == FREE_STATE) and env.changes['rang_down'] == 1
