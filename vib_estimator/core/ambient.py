@@ -586,7 +586,7 @@ class AmbientEstimator:
                 i = k
                 if self._last >= self._next:
                     out.extend(self._analyse())
-        return EstimateArrays.from_list(out)
+        return _columns(out)
 
     # ---- analysis -----------------------------------------------------------------------------
     def _analyse(self) -> list[Estimate]:
@@ -679,3 +679,18 @@ class AmbientEstimator:
                 )
         self._c['estimates'] += len(out)
         return out
+
+
+def _columns(estimates: list[Estimate]) -> EstimateArrays:
+    """Estimates as the columns of :class:`EstimateArrays`."""
+    names = list(EstimateArrays.__dataclass_fields__)
+    ints = ('samples', 'mode')
+    return EstimateArrays(
+        **{
+            name: np.array(
+                [getattr(e, name) for e in estimates],
+                dtype=np.int64 if name in ints else np.float64,
+            )
+            for name in names
+        }
+    )

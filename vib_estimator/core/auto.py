@@ -247,7 +247,10 @@ class AutoEstimator:
             chosen = [] if free is None else (free if isinstance(free, list) else [free])
         else:
             chosen = ambient
-        return [self._number(e, self._envelope.state) for e in chosen]
+        state = self._envelope.state
+        return [
+            dataclasses.replace(e, mode=self._rank(e.frequency_hz, e.t, state)) for e in chosen
+        ]
 
     def process(self, t: Sequence[float], y: Sequence[float]) -> EstimateArrays:
         """Feed arrays (continuing the stream); the same estimates as :meth:`update`, by time."""
@@ -260,21 +263,28 @@ class AutoEstimator:
         for i, (a, b) in enumerate(zip(t.tolist(), y.tolist())):
             env.update(a, b)
             states[i] = env.state == DRIVEN
-        out = []
-        for kind, est, want in ((FREE, free, False), (DRIVEN, ambient, True)):
-            if not len(est):
-                continue
+        names = list(EstimateArrays.__dataclass_fields__)
+        parts, driven = [], []
+        for est, want in ((free, False), (ambient, True)):
             # an estimate's sample: the last one with its stamp (stamps increase where it counts)
-            idx = np.searchsorted(t, est.t, 'right') - 1
-            keep = states[np.clip(idx, 0, len(t) - 1)] == want
-            out += [(e, kind) for e, k in zip(est.to_list(), keep) if k]
-        out.sort(key=lambda p: p[0].t)  # stable: an analysis's modes keep their order
-        return EstimateArrays.from_list([self._number(e, kind) for e, kind in out])
+            idx = np.clip(np.searchsorted(t, est.t, 'right') - 1, 0, max(len(t) - 1, 0))
+            keep = states[idx] == want if len(t) else np.zeros(0, dtype=bool)
+            parts.append(EstimateArrays(**{n: getattr(est, n)[keep] for n in names}))
+            driven.append(np.full(int(np.sum(keep)), want))
+        # by time, stable: at one stamp the free estimate first, an analysis's modes in order
+        kind = np.concatenate(driven)[
+            np.argsort(np.concatenate([p.t for p in parts]), kind='stable')
+        ]
+        out = EstimateArrays.concatenate(parts)
+        out.mode[:] = [
+            self._rank(f, s, DRIVEN if k else FREE)
+            for f, s, k in zip(out.frequency_hz.tolist(), out.t.tolist(), kind.tolist())
+        ]
+        return out
 
-    def _number(self, e: Estimate, kind: str) -> Estimate:
-        """``e`` with the mode number of the shared scheme."""
+    def _rank(self, f: float, t: float, kind: str) -> int:
+        """The mode number, in the shared scheme, of a ``kind`` estimate of ``f`` Hz at ``t``."""
         self._published[kind] += 1
-        f, t = e.frequency_hz, e.t
         window = self._config.ambient_window_s
         self._modes = [m for m in self._modes if t - m[1] <= window]
         near = min(self._modes, key=lambda m: abs(f / m[0] - 1), default=None)
@@ -282,5 +292,4 @@ class AutoEstimator:
             near = [f, t, 0]
             self._modes.append(near)
         near[0], near[1], near[2] = f, t, near[2] + 1
-        rank = 1 + sum(m[0] < f for m in self._modes if m is not near)
-        return dataclasses.replace(e, mode=rank)
+        return 1 + sum(m[0] < f for m in self._modes if m is not near)

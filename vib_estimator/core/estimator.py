@@ -156,22 +156,6 @@ class EstimateArrays:
         order = np.argsort(cols['t'], kind='stable')
         return cls(**{n: c[order] for n, c in cols.items()})
 
-    @classmethod
-    def from_list(cls, estimates: Sequence['Estimate']) -> 'EstimateArrays':
-        """The columns of a list of estimates, in its order."""
-        if not estimates:
-            return cls.concatenate([])
-        ints = ('samples', 'mode')
-        return cls(
-            **{
-                name: np.array(
-                    [getattr(e, name) for e in estimates],
-                    dtype=np.int64 if name in ints else np.float64,
-                )
-                for name in cls.__dataclass_fields__
-            }
-        )
-
     def __len__(self) -> int:
         return len(self.t)
 
