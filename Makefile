@@ -4,7 +4,7 @@ VENV    := .venv
 STAMP   := $(VENV)/.installed
 export ROS_AUTOMATIC_DISCOVERY_RANGE := LOCALHOST
 
-.PHONY: setup demo shaping test bench bench-all reproduce compare bags survey clean
+.PHONY: setup demo shaping test bench bench-all reproduce compare bags survey survey-ambient clean
 
 setup: $(STAMP)
 
@@ -41,7 +41,9 @@ bench-all: bench
 	$(VENV)/bin/python benchmarks/bench_modes.py
 	$(VENV)/bin/python benchmarks/bound_modes.py
 	$(VENV)/bin/python benchmarks/bench_survey.py
+	$(VENV)/bin/python benchmarks/bench_survey_accuracy.py
 	$(VENV)/bin/python benchmarks/real_data.py
+	$(VENV)/bin/python benchmarks/bench_channels.py
 
 reproduce: setup
 	$(VENV)/bin/vib-estimator reproduce fig1 --out out/fig1.png
@@ -58,6 +60,13 @@ survey: setup
 	$(VENV)/bin/python scripts/make_fleet.py --out out/fleet
 	$(VENV)/bin/vib-estimator survey out/fleet --baseline out/fleet/day_00 --alarm-rel 0.0025 \
 		--out out/fleet_survey.csv --plot out/fleet_trend.png
+
+# 40 operational (ambient) days of a 5 Hz mode, drifting down 0.2 %/day from day 30, against day 0
+survey-ambient: setup
+	$(VENV)/bin/python scripts/make_fleet.py --out out/fleet_ambient --excitation ambient
+	$(VENV)/bin/vib-estimator survey out/fleet_ambient --excitation ambient \
+		--baseline out/fleet_ambient/day_00 --alarm-rel 0.0025 \
+		--out out/fleet_ambient_survey.csv --plot out/fleet_ambient_trend.png
 
 clean:
 	rm -rf $(VENV) build install log out *.egg-info

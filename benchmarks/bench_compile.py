@@ -125,12 +125,8 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument('--ref', default='7374e6d', help='previous commit to compare with')
     ap.add_argument('--warm', action='store_true', help='also a second run on the filled cache')
-    ap.add_argument(
-        '--config',
-        action='append',
-        choices=sorted(CONFIGS),
-        help='configurations to measure (default: all)',
-    )
+    every = 'configurations to measure (default: all)'
+    ap.add_argument('--config', action='append', choices=sorted(CONFIGS), help=every)
     ap.add_argument(
         '--profile',
         metavar='CONFIG',

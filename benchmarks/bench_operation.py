@@ -70,10 +70,26 @@ PEER_ORDER = 20
 PEER_HC = {'xi_max': 0.2, 'mpc_lim': None, 'mpd_lim': None, 'CoV_max': None}
 
 
-def peer_ssi(t, y, fs, freqs):
-    """pyOMA2 SSI-cov on consecutive 20 s windows: {true frequency: [(f, zeta)]}."""
+def ssi_cov_window(data, fs, freqs, rows):
+    """pyOMA2 SSI-cov of one window ``data`` (samples x channels): block rows ``rows``, orders to
+    30, the poles nearest ``freqs`` at order :data:`PEER_ORDER` (told the frequencies): ``(Fn,
+    Xi)`` flat, or None when pyOMA2 finds none."""
     from pyoma2.algorithms import SSI
     from pyoma2.setup import SingleSetup
+
+    setup = SingleSetup(data, fs)
+    algo = SSI(name='cov', method='cov', br=rows, ordmax=30, calc_unc=False, hc=PEER_HC)
+    setup.add_algorithms(algo)
+    setup.run_by_name('cov')
+    try:
+        setup.mpe('cov', sel_freq=list(freqs), order_in=PEER_ORDER)
+    except Exception:  # noqa: BLE001 -- pyOMA2 raises plain errors (mode absent)
+        return None
+    return np.ravel(algo.result.Fn), np.ravel(algo.result.Xi)
+
+
+def peer_ssi(t, y, fs, freqs):
+    """pyOMA2 SSI-cov on consecutive 20 s windows: {true frequency: [(f, zeta)]}."""
     from scipy.signal import decimate
 
     q = max(1, int(fs // (4 * max(freqs))))
@@ -83,16 +99,10 @@ def peer_ssi(t, y, fs, freqs):
         seg = y[start : start + n]
         if q > 1:
             seg = decimate(seg, q, ftype='fir', zero_phase=True)
-        setup = SingleSetup(seg[:, None], fs / q)
-        algo = SSI(name='cov', method='cov', br=40, ordmax=30, calc_unc=False, hc=PEER_HC)
-        setup.add_algorithms(algo)
-        setup.run_by_name('cov')
-        try:
-            setup.mpe('cov', sel_freq=list(freqs), order_in=PEER_ORDER)
-        except Exception:  # noqa: BLE001, S112 -- pyOMA2 raises plain errors (mode absent)
+        res = ssi_cov_window(seg[:, None], fs / q, freqs, 40)
+        if res is None:
             continue
-        res = algo.result
-        for f, fn, xi in zip(freqs, np.ravel(res.Fn), np.ravel(res.Xi)):
+        for f, fn, xi in zip(freqs, *res):
             if np.isfinite(fn):
                 out[f].append((float(fn), float(xi)))
     return out

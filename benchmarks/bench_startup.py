@@ -240,6 +240,14 @@ def checkout(ref: str, where: Path) -> Path:
     return where / 'tree'
 
 
+def noted(rows: list, row: tuple, text: str) -> None:
+    """Keep a result row (case, tree, cold/warm, live, ready, lost, exit, first estimate, longest
+    silence) and print it as it comes."""
+    rows.append(row)
+    case, label, kind = row[:3]
+    print(f'{case:28s} {label:8s} {kind}: {text}', flush=True)
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--ref', default='7374e6d', help='reference commit (default 7374e6d)')
@@ -277,13 +285,12 @@ def main(argv=None) -> int:
                         live, ready, latency, lost, code, silence = probe.estimator(
                             cmd, environment(tree, cache)
                         )
-                        rows.append((case, label, kind, live, ready, lost, code, latency, silence))
-                        print(
-                            f'{case:28s} {label:8s} {kind}: live {live:6.2f} s (longest '
-                            f'/diagnostics silence {silence:5.2f} s), ready '
-                            f'{ready:6.2f} s, first estimate {latency:6.2f} s after the '
-                            f'first sample, lost {lost}, exit {code}',
-                            flush=True,
+                        noted(
+                            rows,
+                            (case, label, kind, live, ready, lost, code, latency, silence),
+                            f'live {live:6.2f} s (longest /diagnostics silence {silence:5.2f} '
+                            f's), ready {ready:6.2f} s, first estimate {latency:6.2f} s after '
+                            f'the first sample, lost {lost}, exit {code}',
                         )
             if 'shaper_node' in only:
                 for label, tree in trees.items():
@@ -291,36 +298,15 @@ def main(argv=None) -> int:
                     cmd = node_command(tree, 'vib_estimator.nodes.shaper_node', [])
                     for kind in ('cold', 'warm'):
                         live, code = probe.first_diagnostics(cmd, environment(tree, cache))
-                        rows.append(
-                            ('shaper_node', label, kind, live, live, 0, code, math.nan, math.nan)
-                        )
-                        print(
-                            f'{"shaper_node":28s} {label:8s} {kind}: live {live:6.2f} s, '
-                            f'exit {code}',
-                            flush=True,
-                        )
+                        row = ('shaper_node', label, kind, live, live, 0, code)
+                        noted(rows, row + (math.nan,) * 2, f'live {live:6.2f} s, exit {code}')
             if 'analyze' in only:
                 for label, tree in trees.items():
                     cache = tempfile.mkdtemp(dir=tmp)
                     for kind in ('cold', 'warm'):
                         seconds = analyze_seconds(tree, environment(tree, cache), csv)
-                        rows.append(
-                            (
-                                'analyze (20 s CSV)',
-                                label,
-                                kind,
-                                math.nan,
-                                seconds,
-                                0,
-                                0,
-                                math.nan,
-                                math.nan,
-                            )
-                        )
-                        print(
-                            f'{"analyze (20 s CSV)":28s} {label:8s} {kind}: {seconds:6.2f} s',
-                            flush=True,
-                        )
+                        row = ('analyze (20 s CSV)', label, kind, math.nan, seconds, 0, 0)
+                        noted(rows, row + (math.nan,) * 2, f'{seconds:6.2f} s')
         finally:
             probe.close()
     print(

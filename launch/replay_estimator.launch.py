@@ -43,15 +43,12 @@ def _nodes(context):
     replayer = {'bag': value('bag'), **given(value, ['rate', 'clock_hz'], float)}
     clock_hz = replayer.get('clock_hz', file_parameter(replayer_file, 'clock_hz')) or 0.0
     estimator = {'use_sim_time': float(clock_hz) > 0, **given(value, INPUT_ARGUMENTS)}
-    namespace = LaunchConfiguration('namespace')
+    namespace, estimator_file = (
+        LaunchConfiguration(name) for name in ('namespace', 'estimator_params_file')
+    )
     return [
         node_action(Node, 'bag_replayer', namespace, [replayer_file, replayer]),
-        node_action(
-            Node,
-            'estimator_node',
-            namespace,
-            [LaunchConfiguration('estimator_params_file'), estimator],
-        ),
+        node_action(Node, 'estimator_node', namespace, [estimator_file, estimator]),
     ]
 
 

@@ -45,15 +45,12 @@ def _nodes(context):
         sim.get(name, file_parameter(sim_file, name)) for name in ('speed', 'publish_clock')
     )
     clock = truthy(publish_clock) or float(speed or 1.0) != 1.0
-    namespace = LaunchConfiguration('namespace')
+    namespace, estimator_file = (
+        LaunchConfiguration(name) for name in ('namespace', 'estimator_params_file')
+    )
     return [
         node_action(Node, 'sim_node', namespace, [sim_file, sim]),
-        node_action(
-            Node,
-            'estimator_node',
-            namespace,
-            [LaunchConfiguration('estimator_params_file'), {'use_sim_time': clock}],
-        ),
+        node_action(Node, 'estimator_node', namespace, [estimator_file, {'use_sim_time': clock}]),
     ]
 
 

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from vib_estimator.analysis import survey as S
+from vib_estimator.analysis.interval import combine
 from vib_estimator.cli import main
 from vib_estimator.core import EstimatorConfig
 from vib_estimator.io.bags import WrenchSeries, write_wrench_series
@@ -46,12 +47,21 @@ def test_rows_equal_per_file_analyze(tmp_path, capsys):
     rows = jsonl(capsys.readouterr().out)
     assert [r['recording'] for r in rows] == [str(p) for p in days] + [str(tmp_path / 'sine.csv')]
     for row in rows:
-        assert main(['analyze', row['recording'], '--format', 'jsonl']) == 0
+        analyze = ['analyze', row['recording'], '--model', S.DEFAULT_MODEL, '--format', 'jsonl']
+        assert main(analyze) == 0
         out = capsys.readouterr()
         estimates = jsonl(out.out)
         freqs = np.array([e['frequency_hz'] for e in estimates])
         assert row['estimates'] == len(estimates) > 5
-        assert row['frequency_hz'] == float(np.median(freqs))
+        assert row['frequency_median_hz'] == float(np.median(freqs))
+        combined = combine(
+            freqs,
+            np.array([e['frequency_std_hz'] for e in estimates]),
+            np.array([e['t'] for e in estimates]),
+            np.array([e['convergence_time_s'] for e in estimates]),
+        )
+        assert math.isclose(row['frequency_hz'], combined.value, rel_tol=1e-12)
+        assert math.isclose(row['frequency_std_hz'], combined.std, rel_tol=1e-9)
         assert row['frequency_lo_hz'] <= row['frequency_hz'] <= row['frequency_hi_hz']
         assert f'received={row["samples"]},' in out.err
         assert f'rejected_fit={row["rejected_fit"]},' in out.err
@@ -177,6 +187,7 @@ FAULTS = """
 import resource, sys
 from pathlib import Path
 from vib_estimator.analysis import survey as S
+from vib_estimator.analysis.interval import combine
 from vib_estimator.core import EstimatorConfig
 path, options = Path(sys.argv[1]), S.Options(EstimatorConfig())
 def faults(task):
@@ -284,7 +295,7 @@ def test_trend_plot_shows_the_baseline_and_the_alarm_band(tmp_path):
     f0 = base[None][0]
     assert f'baseline {f0:.5g} Hz' in labels and 'alarm' in labels
     assert 'no-alarm band: baseline 95 % interval ±2 %' in labels
-    assert ax.get_ylabel() == 'median frequency (Hz)'
+    assert ax.get_ylabel() == 'frequency (Hz)'
     baseline = [line for line in ax.get_lines() if line.get_label().startswith('baseline')][0]
     assert np.allclose(baseline.get_ydata(), f0)
     band = [p for p in ax.patches if p.get_label().startswith('no-alarm band')][0]
@@ -297,5 +308,5 @@ def test_trend_plot_shows_the_baseline_and_the_alarm_band(tmp_path):
     for r in rows:
         r['damping'] = 0.01
     fig = S.plot_trend(rows, tmp_path / 'trend2.png', base, 0.02)
-    assert [a.get_ylabel() for a in fig.axes] == ['median frequency (Hz)', 'median damping ratio']
+    assert [a.get_ylabel() for a in fig.axes] == ['frequency (Hz)', 'damping ratio']
     assert all(np.allclose(line.get_ydata(), 0.01) for line in fig.axes[1].get_lines())

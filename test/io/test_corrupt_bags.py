@@ -5,6 +5,7 @@ every reader -- never used as data, never more messages than the intact file, ne
 
 from __future__ import annotations
 
+import functools
 import os
 import shutil
 import subprocess
@@ -199,18 +200,22 @@ def read_all(path):
         return None
 
 
+#: seeded (derandomized) Hypothesis runs, no deadline (a parse may compile or hit the disk)
+fuzz_settings = functools.partial(
+    settings,
+    deadline=None,
+    derandomize=True,
+    suppress_health_check=[HealthCheck.function_scoped_fixture],
+)
+
+
 @pytest.fixture(scope='module')
 def intact_payloads(intact):
     with BagReader(intact[0]) as bag:
         return [m.data for m in bag.messages()]
 
 
-@settings(
-    max_examples=100,
-    deadline=None,
-    derandomize=True,
-    suppress_health_check=[HealthCheck.function_scoped_fixture],
-)
+@fuzz_settings(max_examples=100)
 @given(
     edits=st.lists(
         st.tuples(st.floats(0, 1), st.integers(1, 64), st.binary(min_size=1, max_size=64)),
@@ -248,12 +253,7 @@ def test_fuzz_damaged_mcap_never_crashes_nor_adds_messages(
     assert len(played) + played_corrupt >= N or mode == 'truncate'
 
 
-@settings(
-    max_examples=30,
-    deadline=None,
-    derandomize=True,
-    suppress_health_check=[HealthCheck.function_scoped_fixture],
-)
+@fuzz_settings(max_examples=30)
 @given(
     data=st.one_of(
         st.binary(max_size=4096),

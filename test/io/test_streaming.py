@@ -166,31 +166,31 @@ def test_csv_error_in_a_late_block_names_the_row(tmp_path, monkeypatch):
         list(open_signal(path).blocks())
 
 
+WRENCH = 'geometry_msgs/msg/WrenchStamped'
+
+
+def write_topics(path, topics):
+    """A bag of 10 messages on each of ``topics`` (name: type), interleaved; value k + 1 on the
+    k-th topic."""
+    with BagWriter(path) as bag:
+        ids = [(bag.add_topic(name, kind), kind) for name, kind in topics.items()]
+        for s in (EPOCH + np.arange(10, dtype=np.int64)).tolist():
+            for k, (topic, kind) in enumerate(ids):
+                bag.write_message(topic, s, make_message(kind, s, 'f', k + 1.0, 0))
+
+
 def test_a_bag_of_several_inputs_gives_the_topic_the_node_reads_by_default(tmp_path):
     """bags/README's example: the simulator's bag holds coupling_torque and the ground truth."""
-    stamps = EPOCH + np.arange(10, dtype=np.int64)
-    with BagWriter(tmp_path / 'sim') as bag:
-        truth = bag.add_topic('/vibration/ground_truth', 'std_msgs/msg/Float64')
-        torque = bag.add_topic('/coupling_torque', 'geometry_msgs/msg/WrenchStamped')
-        for s in stamps.tolist():
-            bag.write_message(truth, s, make_message('std_msgs/msg/Float64', s, 'f', 2.0, 0))
-            bag.write_message(
-                torque, s, make_message('geometry_msgs/msg/WrenchStamped', s, 'f', 1.0, 0)
-            )
+    write_topics(
+        tmp_path / 'sim',
+        {'/vibration/ground_truth': 'std_msgs/msg/Float64', '/coupling_torque': WRENCH},
+    )
     signal = open_signal(tmp_path / 'sim')
     assert signal.topic == '/coupling_torque' and signal.component == 'torque.z'
 
 
 def test_topic_choice_and_errors(tmp_path):
-    stamps = EPOCH + np.arange(10, dtype=np.int64)
-    with BagWriter(tmp_path / 'two') as bag:
-        a = bag.add_topic('/a', 'geometry_msgs/msg/WrenchStamped')
-        b = bag.add_topic('/b', 'std_msgs/msg/Float64')
-        for s in stamps.tolist():
-            bag.write_message(
-                a, s, make_message('geometry_msgs/msg/WrenchStamped', s, 'f', 1.0, 0)
-            )
-            bag.write_message(b, s, make_message('std_msgs/msg/Float64', s, 'f', 2.0, 0))
+    write_topics(tmp_path / 'two', {'/a': WRENCH, '/b': 'std_msgs/msg/Float64'})
     with pytest.raises(
         BagError,
         match=r'several input-type topics, choose one with --topic, '

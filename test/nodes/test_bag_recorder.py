@@ -48,6 +48,21 @@ def recording(ros_context, executor, output, topic, msg_type, *params, **popen):
     return recorder, publisher
 
 
+def in_process(ros_context, executor, tmp_path, topic, **params):
+    """A BagRecorder node on ``topic`` into ``tmp_path/bag`` with ``params``, and a String
+    publisher of the topic, both spun by ``executor``: ``(recorder, publisher)``."""
+    overrides = {'topics': [topic], 'output': str(tmp_path / 'bag'), **params}
+    recorder = BagRecorder(
+        context=ros_context,
+        parameter_overrides=[Parameter(k, value=v) for k, v in overrides.items()],
+    )
+    node = Node('test_publisher', context=ros_context)
+    publisher = node.create_publisher(String, topic, QoSProfile(depth=1000))
+    executor.add_node(recorder)
+    executor.add_node(node)
+    return recorder, publisher
+
+
 def wrench(i):
     msg = WrenchStamped()
     stamp = 1_700_000_000_000_000_000 + i * 2_000_000
@@ -155,18 +170,7 @@ def test_bad_configuration_is_one_line_and_exit_2(tmp_path, params, message):
 
 def test_in_process_stops_after_max_messages(ros_context, executor, tmp_path):
     topic = f'/rec_max_{os.getpid()}'
-    recorder = BagRecorder(
-        context=ros_context,
-        parameter_overrides=[
-            Parameter('topics', value=[topic]),
-            Parameter('output', value=str(tmp_path / 'bag')),
-            Parameter('max_messages', value=3),
-        ],
-    )
-    node = Node('test_publisher', context=ros_context)
-    publisher = node.create_publisher(String, topic, QoSProfile(depth=10))
-    executor.add_node(recorder)
-    executor.add_node(node)
+    recorder, publisher = in_process(ros_context, executor, tmp_path, topic, max_messages=3)
     wait_for_subscriber(executor, publisher)
     for i in range(5):
         publisher.publish(String(data=str(i)))
@@ -179,15 +183,7 @@ def test_in_process_stops_after_max_messages(ros_context, executor, tmp_path):
 
 
 def test_in_process_stops_after_duration(ros_context, executor, tmp_path):
-    recorder = BagRecorder(
-        context=ros_context,
-        parameter_overrides=[
-            Parameter('topics', value=['/nobody_publishes']),
-            Parameter('output', value=str(tmp_path / 'bag')),
-            Parameter('duration', value=0.3),
-        ],
-    )
-    executor.add_node(recorder)
+    recorder, _ = in_process(ros_context, executor, tmp_path, '/nobody_publishes', duration=0.3)
     began = time.monotonic()
     assert spin_until(executor, lambda: recorder.finished, 5)
     assert 0.25 < time.monotonic() - began < 2.0
@@ -244,19 +240,9 @@ def test_split_recording_replays_in_order(ros_context, executor, tmp_path):
     from vib_estimator.nodes.bag_replayer import BagReplayer
 
     topic = f'/rec_split_{os.getpid()}'
-    recorder = BagRecorder(
-        context=ros_context,
-        parameter_overrides=[
-            Parameter('topics', value=[topic]),
-            Parameter('output', value=str(tmp_path / 'bag')),
-            Parameter('max_bag_duration', value=0.3),
-            Parameter('max_messages', value=400),
-        ],
+    recorder, publisher = in_process(
+        ros_context, executor, tmp_path, topic, max_bag_duration=0.3, max_messages=400
     )
-    node = Node('test_publisher', context=ros_context)
-    publisher = node.create_publisher(String, topic, QoSProfile(depth=1000))
-    executor.add_node(recorder)
-    executor.add_node(node)
     wait_for_subscriber(executor, publisher)
     publish_for(executor, publisher, None, period=0.0025, count=400)
     assert spin_until(executor, lambda: recorder.finished, 10)
@@ -273,9 +259,11 @@ def test_split_recording_replays_in_order(ros_context, executor, tmp_path):
         ],
     )
     received = []
-    node.create_subscription(
+    listener = Node('test_listener', context=ros_context)
+    listener.create_subscription(
         String, '/replayed_split', lambda m: received.append(m.data), QoSProfile(depth=1000)
     )
+    executor.add_node(listener)
     executor.add_node(replayer)
     assert spin_until(executor, lambda: replayer.finished, 20)
     assert spin_until(executor, lambda: len(received) == 400, 5)

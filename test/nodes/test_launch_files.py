@@ -57,23 +57,19 @@ class LaunchConfiguration:
 
 
 class Node:
-    def __init__(
-        self,
-        *,
-        executable,
-        package=None,
-        name=None,
-        namespace=None,
-        exec_name=None,
-        parameters=None,
-        remappings=None,
-        ros_arguments=None,
-        arguments=None,
-        output='log',
-        emulate_tty=False,
-    ):
-        self.executable, self.package, self.name = executable, package, name
-        self.namespace, self.parameters = namespace, list(parameters or [])
+    #: launch_ros.actions.Node's keyword arguments (Jazzy): any other is a TypeError there
+    ARGUMENTS = frozenset(
+        'executable package name namespace exec_name parameters remappings ros_arguments '
+        'arguments output emulate_tty'.split()
+    )
+
+    def __init__(self, **kwargs):
+        unknown = set(kwargs) - self.ARGUMENTS
+        if unknown or 'executable' not in kwargs:
+            raise TypeError(f'launch_ros Node: unexpected {sorted(unknown)} or no executable')
+        self.executable, self.package = kwargs['executable'], kwargs.get('package')
+        self.name, self.namespace = kwargs.get('name'), kwargs.get('namespace')
+        self.parameters = list(kwargs.get('parameters') or [])
 
 
 def _entry_points():

@@ -74,13 +74,17 @@ class Listener:
         return np.array(self.resets[:n]), np.array(self.frequencies[:n])
 
 
+def start_rig():
+    """A fresh context on this run's domain, its executor and a :class:`Listener`."""
+    context = rclpy.Context()
+    rclpy.init(context=context, domain_id=int(os.environ['ROS_DOMAIN_ID']))
+    return context, make_executor(context), Listener(context)
+
+
 @pytest.fixture(scope='module')
 def pipeline_run():
     """One sped-up run through the three masses (shared by the accuracy and tracking tests)."""
-    context = rclpy.Context()
-    rclpy.init(context=context, domain_id=int(os.environ['ROS_DOMAIN_ID']))
-    executor = make_executor(context)
-    listener = Listener(context)
+    context, executor, listener = start_rig()
     # the demo's pipeline: the paper's configuration on Section 5.5 (vib_estimator.demo)
     estimator = EstimatorNode(
         context=context,
@@ -392,10 +396,7 @@ def test_realism_parameters_reach_the_published_torque(ros_context, executor):
 def test_driven_arm_tracked_in_operation():
     """sim_node excitation ambient (the arm never at rest) -> estimator_node excitation ambient:
     the bar's mode on vibration/frequency (mode 1), every second once a window is in."""
-    context = rclpy.Context()
-    rclpy.init(context=context, domain_id=int(os.environ['ROS_DOMAIN_ID']))
-    executor = make_executor(context)
-    listener = Listener(context)
+    context, executor, listener = start_rig()
     estimator = EstimatorNode(
         context=context,
         parameter_overrides=[

@@ -34,6 +34,7 @@ from ..core.modes import create_estimator
 from ..errors import VibEstimatorError, report
 from ..io.fields import INPUT_TYPES, signal_unit
 from ..io.streaming import Signal, open_signal
+from .channels import channel_names, run_joint
 from .outputs import check_output
 from .summary import summarise_modes, summary_lines
 
@@ -77,6 +78,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         '--column',
         help='CSV signal column, by header name or 0-based index (default: the second column)',
     )
+    parser.add_argument(
+        '--columns',
+        help='several CSV signal columns, comma-separated names or indices, or all: one set of '
+        'modes with their shapes (needs --excitation ambient; docs/channels.md)',
+    )
     add_config_arguments(parser)
     parser.add_argument('--format', choices=('jsonl', 'csv', 'table'), default='jsonl')
     parser.add_argument('--plot', metavar='FILE.png', help='write a Fig. 5-like figure')
@@ -87,10 +93,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def add_config_arguments(parser: argparse.ArgumentParser) -> None:
+def add_config_arguments(parser: argparse.ArgumentParser, model: Optional[str] = None) -> None:
     """The estimator options (``--paper``, ``--model``, ``--band-hz``, one per scalar config
-    field); an option not given keeps the default (or with ``--paper`` the paper's) value."""
-    defaults, paper = EstimatorConfig(), EstimatorConfig.paper()
+    field); an option not given keeps the default (or with ``--paper`` the paper's) value, the
+    help of ``--model`` says ``model`` if the command has its own default."""
+    defaults, paper = (
+        EstimatorConfig(model=model or EstimatorConfig.model),
+        EstimatorConfig.paper(),
+    )
     parser.add_argument(
         '--paper',
         action='store_true',
@@ -290,6 +300,11 @@ def run(args: argparse.Namespace) -> int:
     try:
         config = make_config(args)
         check_output(args.plot, '--plot')
+        if getattr(args, 'columns', None) is not None:
+            names = channel_names(args)
+            if len(names) > 1:
+                return run_joint(args, config, names, json_row, 'analyze')
+            args.column = names[0]  # one column: exactly --column
         signal = open_signal(
             args.input,
             args.topic,

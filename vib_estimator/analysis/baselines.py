@@ -45,6 +45,8 @@ from numba import njit
 from ..core.uncertainty import TWO_PI
 
 ZIARANI, HOU, MOJIRI = 0, 1, 2
+#: the ODE trackers' initial frequency, rad/s: the 3 Hz Section 5.5 starts all three at
+OMEGA0 = 3 * TWO_PI
 
 # ---- state array layout of the ODE trackers ------------------------------------------------
 S_STARTED, S_TPREV, S_YPREV, S_X = 0, 1, 2, 3  # flag, last stamp, last value, ODE state (3)
@@ -192,21 +194,13 @@ class ZiaraniKonrad(_OdeTracker):
     """Ziarani & Konrad's enhanced PLL (Eqs. 25-26); defaults are the gains of Section 5.4.
 
     States A, omega, gamma (= omega t + phi, integrated as gamma' = omega + mu3 omega'); A starts
-    at
-    0 and gamma at 0. Units: mu1 1/s, mu2 1/(s^2 unit^2), mu3 s.
+    at 0 and gamma at 0. Units: mu1 1/s, mu2 1/(s^2 unit^2), mu3 s.
     """
 
     kind = ZIARANI
     name = 'Ziarani-Konrad'
 
-    def __init__(
-        self,
-        mu1: float = 10.0,
-        mu2: float = 3000.0,
-        mu3: float = 0.1,
-        omega0: float = 6 * math.pi,
-        substeps: int = 4,
-    ):
+    def __init__(self, mu1=10.0, mu2=3000.0, mu3=0.1, omega0=OMEGA0, substeps=4):
         super().__init__((mu1, mu2, mu3), (0.0, omega0, 0.0), substeps)
 
 
@@ -221,13 +215,7 @@ class Hou(_OdeTracker):
     kind = HOU
     name = 'Hou'
 
-    def __init__(
-        self,
-        alpha1: float = 10.0,
-        alpha2: float = 5000.0,
-        omega0: float = 6 * math.pi,
-        substeps: int = 4,
-    ):
+    def __init__(self, alpha1=10.0, alpha2=5000.0, omega0=OMEGA0, substeps=4):
         super().__init__((alpha1, alpha2), (0.0, omega0**2), substeps)
 
 
@@ -241,13 +229,7 @@ class MojiriBakhshai(_OdeTracker):
     kind = MOJIRI
     name = 'Mojiri-Bakhshai'
 
-    def __init__(
-        self,
-        xi1: float = 0.1,
-        xi2: float = 1.25,
-        x0: Sequence[float] = (1.0, 1.0, 6 * math.pi),
-        substeps: int = 4,
-    ):
+    def __init__(self, xi1=0.1, xi2=1.25, x0=(1.0, 1.0, OMEGA0), substeps=4):
         super().__init__((xi1, xi2), tuple(x0), substeps)
 
 
@@ -273,21 +255,14 @@ class SlidingDFT:
 
     Parameters: ``rate_hz`` the (fixed) sampling rate the DFT assumes; ``window_s`` the window
     (default 2 s: 2.3 cycles at the 1.15 Hz of Section 5.5, bins of 0.5 Hz); ``hop`` samples
-    between
-    two DFTs (default 10: a 50 Hz update at 500 Hz); ``band_hz`` the peak search band. The estimate
-    of a DFT is reported from its last sample until the next DFT; none before the first full
-    window.
+    between two DFTs (default 10: a 50 Hz update at 500 Hz); ``band_hz`` the peak search band. The
+    estimate of a DFT is reported from its last sample until the next DFT; none before the first
+    full window.
     """
 
     name = 'Sliding DFT'
 
-    def __init__(
-        self,
-        rate_hz: float = 500.0,
-        window_s: float = 2.0,
-        hop: int = 10,
-        band_hz: Sequence[float] = (0.5, 25.0),
-    ):
+    def __init__(self, rate_hz=500.0, window_s=2.0, hop=10, band_hz=(0.5, 25.0)):
         self._n = int(round(window_s * rate_hz))
         self._hop = int(hop)
         if self._n < 8 or self._hop < 1:
@@ -413,14 +388,7 @@ class SlidingMatrixPencil(SlidingDFT):
 
     name = 'Matrix pencil'
 
-    def __init__(
-        self,
-        rate_hz: float = 500.0,
-        window_s: float = 2.0,
-        hop: int = 25,
-        order: int = 2,
-        max_pencil: int = 64,
-    ):
+    def __init__(self, rate_hz=500.0, window_s=2.0, hop=25, order=2, max_pencil=64):
         super().__init__(rate_hz, window_s, hop)
         self._ts = 1.0 / rate_hz
         self._order = int(order)

@@ -35,6 +35,16 @@ def pyplot():
     return plt
 
 
+def save_figure(fig, axes, path: str):
+    """Grid every axis, lay the figure out, write it (110 dpi), close it; returns ``fig``."""
+    for ax in axes:
+        ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    pyplot().close(fig)
+    return fig
+
+
 def mode_colour(k: int) -> str:
     """The colour of mode ``k`` (0: the single-mode estimator) in every panel."""
     return 'C3' if k == 0 else f'C{(k - 1) % 10}'
@@ -95,12 +105,7 @@ def plot_estimates(
         axes[0].set_title(title)
     modes = summarise_modes(est_f, np.full(len(est_f), np.nan), mode)
     plot_spectrum(ax_psd, t, y, modes, unit)
-    for ax in (*axes, ax_psd):
-        ax.grid(alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return fig
+    return save_figure(fig, (*axes, ax_psd), path)
 
 
 def welch_psd(t: np.ndarray, y: np.ndarray, lowest_hz: float = math.nan):

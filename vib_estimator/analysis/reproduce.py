@@ -25,6 +25,7 @@ import numpy as np
 from ..core import EstimatorConfig, FrequencyEstimator
 from ..sim.signals import fig1_signal, normalised_damped_sine
 from .outputs import check_output
+from .plotting import pyplot, save_figure
 
 FIG1_WC = 15.0  # rad/s
 #: s; the paper gives neither the solver step nor the noise's hold time. At 0.1 ms the noise is
@@ -120,7 +121,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def _plot_fig1(r: Fig1Result, path: str):
     """Fig. 1: the signal, and the running estimate with and without the invariant filtering
     (truth 10 rad/s dashed). Returns the Figure."""
-    from .plotting import pyplot
 
     plt = pyplot()
     fig, axes = plt.subplots(3, 1, figsize=(8, 7), sharex=True)
@@ -141,12 +141,7 @@ def _plot_fig1(r: Fig1Result, path: str):
         ax.set_ylabel('omega (rad/s)')
         ax.legend(loc='upper right', fontsize=8)
     axes[2].set_xlabel('t (s)')
-    for ax in axes:
-        ax.grid(alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return fig
+    return save_figure(fig, axes, path)
 
 
 #: Fig. 2's variants, in its table's and its legend's order: (name, fig2 keyword arguments)
@@ -162,7 +157,6 @@ def _plot_fig2(results: Sequence[Fig2Result], path: str, names: Sequence[str] = 
     ``results`` (named ``names``, default :data:`FIG2_VARIANTS`); a variant without an estimate at
     a zeta_n (NaN) leaves a gap, and one never converging is listed in the legend as such. Returns
     the Figure."""
-    from .plotting import pyplot
 
     plt = pyplot()
     names = list(names) or [name for name, _ in FIG2_VARIANTS]
@@ -182,12 +176,7 @@ def _plot_fig2(results: Sequence[Fig2Result], path: str, names: Sequence[str] = 
     axes[1].set_ylabel('MAE |f(T*) - 1| (Eq. 18, floor 1e-16)')
     axes[1].set_xlabel('zeta_n (damping ratio)')
     axes[1].legend(fontsize=8)
-    for ax in axes:
-        ax.grid(alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return fig
+    return save_figure(fig, axes, path)
 
 
 def run(args: argparse.Namespace) -> int:

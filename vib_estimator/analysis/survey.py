@@ -6,13 +6,15 @@ Inputs are files, directories (searched recursively: a directory with ``metadata
 rosbag2 bag; ``.mcap``, ``.db3`` and ``.csv`` files elsewhere are recordings) and globs. Each
 recording is streamed (:mod:`..io.streaming`) through the same estimator as ``analyze``; a row is
 written per recording x topic x component (x mode with ``--modes``): first stamp (ISO 8601 UTC),
-duration, samples, estimates, the median frequency and its distribution-free 95 % interval, the
-median damping ratio and amplitude, and the estimator's counters.
+duration, samples, estimates, the frequency and damping ratio with their 95 % intervals (by
+default the weighted mean of the estimates, the interval from their stds and their scatter,
+correlated estimates counted as such: :mod:`.interval`; ``--summary median``: the median and its
+distribution-free interval), the median amplitude, and the estimator's counters.
 
 Health monitoring: against ``--baseline`` (a recording, whose rows are matched by topic,
 component and mode, or a frequency in Hz), a row is flagged (``alarm``) when the relative change
-of its median frequency is beyond ``--alarm-rel`` with 95 % confidence, i.e. the whole interval
-of the change (both medians' intervals combined) lies outside [-R, R].
+of its frequency is beyond ``--alarm-rel`` with 95 % confidence, i.e. the whole interval
+of the change (both frequencies' intervals combined) lies outside [-R, R].
 
 Recordings are independent tasks: ``--jobs N`` runs them on a local process pool
 (``concurrent.futures``), ``--scheduler ADDRESS`` on a Dask distributed cluster
@@ -53,6 +55,7 @@ from ..errors import VibEstimatorError, report
 from ..io.fields import DEFAULT_COMPONENT, check_component
 from ..io.streaming import bag_topics, is_csv, open_signal, supported_topics
 from .analyze import add_config_arguments, estimate_signal, make_config
+from .interval import combine
 from .outputs import check_output
 
 _STATS = (
@@ -66,6 +69,22 @@ _STATS = (
     'damping',
     'amplitude',
 )
+#: columns of the weighted summary (:mod:`.interval`), after the counters
+_INTERVAL_STATS = (
+    'frequency_std_hz',
+    'frequency_median_hz',
+    'damping_lo',
+    'damping_hi',
+    'damping_std',
+    'effective_estimates',
+    'frequency_birge',
+)
+#: ``--summary``: the weighted mean of the estimates and its interval from their stds and
+#: scatter (:func:`.interval.combine`), or their median and its order-statistic interval
+SUMMARIES = ('weighted', 'median')
+#: survey's model when neither ``--model`` nor ``--paper`` is given: the damped sinusoid, whose
+#: natural frequency carries no bias on decaying records and which estimates the damping trended
+DEFAULT_MODEL = 'damped-sinusoid'
 _COUNTERS = tuple(c for c in COUNTER_NAMES if c not in ('received', 'estimates'))
 #: the columns of a row, in order
 COLUMNS = (
@@ -75,6 +94,9 @@ COLUMNS = (
     + (
         'messages_without_component',
         'corrupt_records',
+    )
+    + _INTERVAL_STATS
+    + (
         'change_rel',
         'change_lo',
         'change_hi',
@@ -96,6 +118,8 @@ class Options:
     column: Optional[str] = None
     #: a damaged bag record makes the recording an error row (instead of a counted skip)
     strict: bool = False
+    #: how a recording's estimates are summarised (:data:`SUMMARIES`)
+    summary: str = SUMMARIES[0]
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -119,7 +143,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "type; default: the type's default)",
     )
     parser.add_argument('--column', help='CSV signal column (default: the second)')
-    add_config_arguments(parser)
+    add_config_arguments(parser, DEFAULT_MODEL)
+    parser.add_argument(
+        '--summary',
+        choices=SUMMARIES,
+        default=SUMMARIES[0],
+        help="a recording's frequency and damping: the weighted mean of the estimates with an "
+        'interval from their stds and scatter (default), or their median with an order-statistic '
+        'interval (the former default)',
+    )
     parser.add_argument('--format', choices=('table', 'csv', 'jsonl'), default='table')
     parser.add_argument(
         '--out', metavar='FILE', help='also write the rows to FILE (.csv, .parquet, .jsonl)'
@@ -241,7 +273,37 @@ def _row(recording: Path, topic: str, component: str, mode: int, **fields) -> Di
     return row
 
 
-def _stat_rows(recording: Path, signal, result, modes: int) -> List[Dict]:
+def summarise(est, take: np.ndarray, summary: str = SUMMARIES[0]) -> Dict:
+    """The frequency, damping and amplitude fields of the estimates ``est[take]`` (an
+    :class:`~vib_estimator.core.EstimateArrays` and a mask), by ``summary`` (:data:`SUMMARIES`)."""
+    f_median, f_lo, f_hi = median_interval(est.frequency_hz[take])
+    fields = dict(
+        frequency_hz=f_median,
+        frequency_lo_hz=f_lo,
+        frequency_hi_hz=f_hi,
+        frequency_median_hz=f_median,
+        damping=median_interval(est.damping[take])[0],
+        amplitude=median_interval(est.amplitude[take])[0],
+    )
+    if summary == 'median':
+        return fields
+    t, span = est.t[take], est.convergence_time[take]
+    f = combine(est.frequency_hz[take], est.frequency_std_hz[take], t, span)
+    fields.update(
+        frequency_hz=f.value,
+        frequency_lo_hz=f.lo,
+        frequency_hi_hz=f.hi,
+        frequency_std_hz=f.std,
+        effective_estimates=f.n_eff,
+        frequency_birge=f.birge,
+    )
+    if np.isfinite(est.damping[take]).any():
+        d = combine(est.damping[take], est.damping_std[take], t, span)
+        fields.update(damping=d.value, damping_lo=d.lo, damping_hi=d.hi, damping_std=d.std)
+    return fields
+
+
+def _stat_rows(recording: Path, signal, result, modes: int, summary: str) -> List[Dict]:
     """The rows of one streamed signal: one, or one per mode."""
     est = result.estimates
     start = signal.origin_ns * 1e-9 if signal.origin_ns is not None else result.first_t
@@ -252,7 +314,6 @@ def _stat_rows(recording: Path, signal, result, modes: int) -> List[Dict]:
         counters = (
             result.estimator.mode_counters().get(mode, {}) if modes else result.estimator.counters
         )
-        f, lo, hi = median_interval(est.frequency_hz[take])
         rows.append(
             _row(
                 recording,
@@ -263,13 +324,9 @@ def _stat_rows(recording: Path, signal, result, modes: int) -> List[Dict]:
                 duration_s=result.last_t - result.first_t,
                 samples=result.estimator.counters['received'],
                 estimates=int(take.sum()),
-                frequency_hz=f,
-                frequency_lo_hz=lo,
-                frequency_hi_hz=hi,
-                damping=median_interval(est.damping[take])[0],
-                amplitude=median_interval(est.amplitude[take])[0],
                 messages_without_component=signal.skipped,
                 corrupt_records=signal.corrupt,
+                **summarise(est, take, summary),
                 **{c: counters.get(c, 0) for c in _COUNTERS},
             )
         )
@@ -363,7 +420,11 @@ def _recording_rows(path: Path, options: Options) -> List[Dict]:
             signal = open_signal(path, topic, component, options.column, options.strict)
             rows.extend(
                 _stat_rows(
-                    path, signal, estimate_signal(signal, options.config), options.config.modes
+                    path,
+                    signal,
+                    estimate_signal(signal, options.config),
+                    options.config.modes,
+                    options.summary,
                 )
             )
         except Exception as err:  # noqa: BLE001 -- as above
@@ -554,6 +615,17 @@ def alarm_band(ref: Tuple[float, float, float], alarm_rel: float) -> Tuple[float
     return ref[1] * (1 - alarm_rel), ref[2] * (1 + alarm_rel)
 
 
+def _bars(ax, x, line: List[Dict], name: str, colour: str, label: str) -> np.ndarray:
+    """Plot the rows' ``name`` (frequency or damping) with their 95 % intervals as bars."""
+    value = np.array([r[name + '_hz' if name == 'frequency' else name] for r in line])
+    ends = ('_lo_hz', '_hi_hz') if name == 'frequency' else ('_lo', '_hi')
+    err = np.abs(np.array([[r[name + end] for r in line] for end in ends]) - value)
+    ax.errorbar(
+        x, value, yerr=np.nan_to_num(err), marker='o', ms=3, capsize=2, color=colour, label=label
+    )
+    return value
+
+
 def plot_trend(
     rows: List[Dict], path: Path, base: Optional[Dict] = None, alarm_rel: Optional[float] = None
 ):
@@ -577,22 +649,8 @@ def plot_trend(
             datetime.fromisoformat(r['start_utc'].replace('Z', '+00:00')) if r['start_utc'] else i
             for i, r in enumerate(line)
         ]
-        f = np.array([r['frequency_hz'] for r in line])
-        err = np.abs(
-            np.array([[r['frequency_lo_hz'] for r in line], [r['frequency_hi_hz'] for r in line]])
-            - f
-        )
         label = ' '.join(str(k) for k in key if k not in ('', 0))
-        ax_f.errorbar(
-            x,
-            f,
-            yerr=np.nan_to_num(err),
-            marker='o',
-            ms=3,
-            capsize=2,
-            color=colour,
-            label=f'{label}: median, 95 % interval',
-        )
+        f = _bars(ax_f, x, line, 'frequency', colour, f'{label}: frequency, 95 % interval')
         alarmed = [i for i, r in enumerate(line) if r['alarm']]
         ax_f.plot(
             [x[i] for i in alarmed], f[alarmed], 'rx', ms=9, label='alarm' if alarmed else None
@@ -610,14 +668,12 @@ def plot_trend(
                     label=f'no-alarm band: baseline 95 % interval ±{100 * alarm_rel:g} %',
                 )
         if damped:
-            axes[1, 0].plot(
-                x, [r['damping'] for r in line], marker='o', ms=3, color=colour, label=label
-            )
-    ax_f.set_ylabel('median frequency (Hz)')
+            _bars(axes[1, 0], x, line, 'damping', colour, label)
+    ax_f.set_ylabel('frequency (Hz)')
     explain = ': a recording alarms when its 95 % interval lies wholly outside the band'
     ax_f.set_title('frequency trend' + ('' if base is None else explain), fontsize=10)
     if damped:
-        axes[1, 0].set_ylabel('median damping ratio')
+        axes[1, 0].set_ylabel('damping ratio')
     axes[-1, 0].set_xlabel('recording start (UTC)')
     ax_f.legend(fontsize=8, loc='best')
     for ax in axes[:, 0]:
@@ -662,8 +718,16 @@ def _options(args: argparse.Namespace) -> Options:
         raise ValueError(f'--jobs must be >= 1, got {args.jobs}')
     if not args.alarm_rel >= 0:
         raise ValueError(f'--alarm-rel must be >= 0, got {args.alarm_rel}')
+    config = make_config(args)
+    if args.model is None and not args.paper:
+        config = config.replace(model=DEFAULT_MODEL)
     return Options(
-        make_config(args), tuple(args.topic), tuple(args.component), args.column, args.strict
+        config,
+        tuple(args.topic),
+        tuple(args.component),
+        args.column,
+        args.strict,
+        args.summary,
     )
 
 

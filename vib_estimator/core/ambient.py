@@ -275,15 +275,20 @@ def ssi_poles(
     return out
 
 
-def cluster_modes(
+def stable_clusters(
     poles: list[np.ndarray],
     fs: float,
     max_damping: float,
     band: tuple[float, float],
     counts: dict[str, int],
-) -> np.ndarray:
-    """The physical modes of a stabilisation diagram ``poles`` (:func:`ssi_poles`): rows
-    (frequency, damping, variance, support), ascending; counts the rejected poles/clusters."""
+) -> list[np.ndarray]:
+    """The stable clusters of a stabilisation diagram ``poles`` (one array per model order whose
+    first three columns are frequency, damping, variance; further columns ride along): poles with
+    a damping ratio in (0, ``max_damping``], below :data:`NU_MAX` fs and in ``band``, grouped in
+    frequency (neighbours within :data:`CLUSTER_TOL`, a group no wider than :data:`CLUSTER_SPAN`);
+    a group is kept when it holds a pole at :data:`MIN_SUPPORT` of the orders. Each cluster: its
+    poles' rows with two columns appended, the order's index and the row's index in that order;
+    ascending frequency. Counts the rejected poles/clusters."""
     rows = []
     for k, p in enumerate(poles):
         ok = (
@@ -294,10 +299,11 @@ def cluster_modes(
             & (p[:, 0] <= band[1])
         )
         counts['rejected_damping'] += int(np.count_nonzero(~ok))
-        rows.append(np.column_stack((p[ok], np.full(np.count_nonzero(ok), k))))
-    allp = np.concatenate(rows) if rows else np.empty((0, 4))
+        rows.append(np.column_stack((p[ok], np.full(np.count_nonzero(ok), k), np.flatnonzero(ok))))
+    width = (poles[0].shape[1] if poles else 3) + 2
+    allp = np.concatenate(rows) if rows else np.empty((0, width))
     allp = allp[np.argsort(allp[:, 0])]
-    modes = []
+    clusters = []
     start = 0
     n_orders = len(poles)
     for i in range(1, len(allp) + 1):
@@ -309,18 +315,32 @@ def cluster_modes(
             continue
         group = allp[start:i]
         start = i
-        support = len(np.unique(group[:, 3])) / n_orders
-        if support < MIN_SUPPORT:
+        if len(np.unique(group[:, -2])) / n_orders < MIN_SUPPORT:
             counts['rejected_unstable'] += 1
             continue
-        modes.append(
-            (
-                np.median(group[:, 0]),
-                np.median(group[:, 1]),
-                max(np.median(group[:, 2]), 0.0),
-                support,
-            )
+        clusters.append(group)
+    return clusters
+
+
+def cluster_modes(
+    poles: list[np.ndarray],
+    fs: float,
+    max_damping: float,
+    band: tuple[float, float],
+    counts: dict[str, int],
+) -> np.ndarray:
+    """The physical modes of a stabilisation diagram ``poles`` (:func:`ssi_poles`): rows
+    (frequency, damping, variance, support), ascending; counts the rejected poles/clusters
+    (:func:`stable_clusters`)."""
+    modes = [
+        (
+            np.median(group[:, 0]),
+            np.median(group[:, 1]),
+            max(np.median(group[:, 2]), 0.0),
+            len(np.unique(group[:, -2])) / len(poles),
         )
+        for group in stable_clusters(poles, fs, max_damping, band, counts)
+    ]
     return np.array(modes).reshape(-1, 4)
 
 
@@ -694,3 +714,10 @@ def _columns(estimates: list[Estimate]) -> EstimateArrays:
             for name in names
         }
     )
+
+
+#: a mode followed across windows (public for the multi-channel identifier,
+#: :mod:`vib_estimator.core.multichannel`)
+ModeTrack = _Track
+#: estimates as the columns of :class:`EstimateArrays` (public for the multi-channel identifier)
+estimate_columns = _columns

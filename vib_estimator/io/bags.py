@@ -106,6 +106,30 @@ RELIABLE_VOLATILE = Qos(
 )
 
 
+def _bag_time(duration) -> QosTime:
+    return QosTime(*divmod(duration.nanoseconds, 1_000_000_000))
+
+
+def bag_qos(profile) -> Qos:
+    """An offered QoS profile (an ``rclpy.qos.QoSProfile``: its policies as ints, durations with
+    ``nanoseconds``) as rosbag2 records it in the bag's metadata."""
+
+    def enum(cls, policy):
+        return cls(int(policy)) if int(policy) in {e.value for e in cls} else cls.UNKNOWN
+
+    return Qos(
+        enum(QosHistory, profile.history),
+        profile.depth,
+        enum(QosReliability, profile.reliability),
+        enum(QosDurability, profile.durability),
+        _bag_time(profile.deadline),
+        _bag_time(profile.lifespan),
+        enum(QosLiveliness, profile.liveliness),
+        _bag_time(profile.liveliness_lease_duration),
+        profile.avoid_ros_namespace_conventions,
+    )
+
+
 @dataclass(frozen=True)
 class WrenchSeries:
     """One field of a WrenchStamped topic.

@@ -210,3 +210,36 @@ def read_csv_series(path, column: Optional[str] = None) -> Series:
     parts = list(csv_blocks(layout)) or [(np.empty(0), np.empty(0))]
     t, y = (np.concatenate(p) for p in zip(*parts))
     return Series(t, y, layout.name)
+
+
+def column_names(path, columns: str) -> List[str]:
+    """The signal columns of ``--columns``: ``all`` (every column but the time) or a
+    comma-separated list of header names or 0-based indices (as text). Raises :class:`CsvError`
+    for an unknown or repeated column."""
+    layout = csv_layout(path)
+    names = _names(layout)
+    if columns.strip() == 'all':
+        return names[1:]
+    out = []
+    for item in (c.strip() for c in columns.split(',')):
+        name = names[_column_index(layout.path, item, names, layout.width)]
+        if name in out:
+            raise CsvError(f'column {item!r} of {layout.path} is given twice')
+        out.append(name)
+    return out
+
+
+def _names(layout: CsvLayout) -> List[str]:
+    """The header's names of ``layout``'s file (or the indices, as text, without a header)."""
+    if not layout.has_header:
+        return [str(i) for i in range(layout.width)]
+    with layout.path.open('rb') as handle:
+        return [name.strip() for name in next(_rows(handle))[2]]
+
+
+def read_csv_columns(path, columns: str) -> Tuple[np.ndarray, np.ndarray, List[str]]:
+    """``(t, Y, names)``: time and the ``columns`` (:func:`column_names`) as the columns of
+    ``Y``, each read by :func:`read_csv_series`'s rules."""
+    names = column_names(path, columns)
+    series = [read_csv_series(path, name) for name in names]
+    return series[0].t, np.column_stack([s.y for s in series]), names

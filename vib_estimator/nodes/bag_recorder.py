@@ -48,21 +48,12 @@ from functools import partial
 from typing import Dict, Iterable, Tuple
 
 from rclpy.clock import Clock, ClockType
-from rclpy.duration import Duration
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
-from rosbags.interfaces import (
-    Qos,
-    QosDurability,
-    QosHistory,
-    QosLiveliness,
-    QosReliability,
-    QosTime,
-)
 
 from ..errors import BagError, StartupError
-from ..io.bags import STORAGES, BagWriter
+from ..io.bags import STORAGES, BagWriter, bag_qos
 from .parameters import declare, descriptor
 from .runner import run
 
@@ -99,29 +90,6 @@ def adapted_qos(
         depth=depth,
         reliability=ReliabilityPolicy.RELIABLE if reliable else ReliabilityPolicy.BEST_EFFORT,
         durability=DurabilityPolicy.TRANSIENT_LOCAL if latched else DurabilityPolicy.VOLATILE,
-    )
-
-
-def _bag_time(duration: Duration) -> QosTime:
-    return QosTime(*divmod(duration.nanoseconds, 1_000_000_000))
-
-
-def bag_qos(profile: QoSProfile) -> Qos:
-    """An offered rclpy QoS profile as rosbag2 records it in the bag's metadata."""
-
-    def enum(cls, policy):
-        return cls(int(policy)) if int(policy) in {e.value for e in cls} else cls.UNKNOWN
-
-    return Qos(
-        enum(QosHistory, profile.history),
-        profile.depth,
-        enum(QosReliability, profile.reliability),
-        enum(QosDurability, profile.durability),
-        _bag_time(profile.deadline),
-        _bag_time(profile.lifespan),
-        enum(QosLiveliness, profile.liveliness),
-        _bag_time(profile.liveliness_lease_duration),
-        profile.avoid_ros_namespace_conventions,
     )
 
 

@@ -298,10 +298,11 @@ class EstimatorNode(Node):
                 else Header(stamp=Time(nanoseconds=self._stream.origin).to_msg()),
             )
         self._ready = True
+        dropped = self._stream.health.node_counters['dropped_warmup']
+        seconds = self._stream.warmup_seconds
         self.get_logger().info(
-            f'estimator kernels ready after {self._stream.warmup_seconds:.1f} s'
-            f' ({held} samples held meanwhile, '
-            f'{self._stream.health.node_counters["dropped_warmup"]} dropped)'
+            f'estimator kernels ready after {seconds:.1f} s ({held} samples held meanwhile, '
+            f'{dropped} dropped)'
         )
 
     def _replace_zero_stamp(self, header: Header) -> None:

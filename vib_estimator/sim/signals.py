@@ -45,3 +45,29 @@ def gappy_sine(
     for start in rng.choice(len(t) - 300, 40, replace=False):
         keep[start : start + int(rng.uniform(0.04, 0.4) * rate_hz)] = False
     return t[keep], np.sin(2 * np.pi * f * t[keep]) + offset, int((~keep).sum())
+
+
+def plucked_decays(
+    seed: int,
+    f: float = 5.0,
+    zeta: float = 0.004,
+    snr_db: float = 30.0,
+    plucks: int = 3,
+    every_s: float = 20.0,
+    rate_hz: float = 500.0,
+) -> Tuple[np.ndarray, np.ndarray]:
+    """A day of free decays (issue 20's survey fleet): ``plucks`` decays of an ``f`` Hz mode of
+    damping ratio ``zeta``, one every ``every_s`` s (each of random phase, amplitude 0.5-2, the
+    last ones' tails still ringing), plus white noise ``snr_db`` below a unit pluck's power,
+    ``plucks * every_s`` s at ``rate_hz``; returns (t, y)."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(round(plucks * every_s * rate_hz)) / rate_hz
+    w = 2 * np.pi * f
+    y = np.zeros_like(t)
+    for k in range(plucks):
+        u = t - k * every_s
+        a, phase = rng.uniform(0.5, 2.0), rng.uniform(0, 2 * np.pi)
+        ring = a * np.exp(-zeta * w * u) * np.sin(w * np.sqrt(1 - zeta**2) * u + phase)
+        y += np.where(u >= 0, ring, 0.0)
+    noise = np.sqrt(0.5 / 10 ** (snr_db / 10))
+    return t, y + noise * rng.standard_normal(len(t))

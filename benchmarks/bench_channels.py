@@ -1,0 +1,214 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
+"""Several channels, one set of modes: the joint identifier (``analyze --columns``,
+``core.multichannel``) vs pyOMA2's multi-channel SSI-cov vs each channel alone.
+
+    .venv/bin/python benchmarks/bench_channels.py [--seeds 3] [--no-peer]
+        [--real-data ../shared/real-data]
+
+1. The 5-storey shear frame (``vib_estimator.sim.frame``: modes 0.89-6.00 Hz, zeta 2 %, one
+   channel per storey, 20 dB, 50 Hz, 600 s; window 60 s): per mode the median and RMS relative
+   frequency error, the damping median over the truth and the median MAC against the exact shape;
+   the peer: pyOMA2 SSI-cov on the consecutive non-overlapping 60 s windows of the same records
+   (all channels, block rows 20, orders to 30, the pole nearest the true frequency at order 20:
+   ``mpe(order_in=20)`` -- told the frequencies, a generous peer); each channel alone
+   (``excitation ambient``, the single-channel identifier): the best channel's RMS error per mode.
+2. A mode invisible on two of three channels (2.5 Hz on channel c only): found or not, and how far.
+3. The real Heritage Court Tower record (6 channels, 40 Hz, 327.7 s, window 120 s, band 0.5-6 Hz):
+   published modes found (>= 10 estimates within 2 %), share of estimates > 2 % from every one.
+4. Cost: 8 channels at 500 Hz (4 modes 3-40 Hz, 120 s, window 30 s) as multiples of real time,
+   beside one channel of the same record through the single-channel identifier, same run.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+from bench_operation import HCT_FILE, HCT_MODES, REAL_DATA, ssi_cov_window  # benchmarks/
+
+from vib_estimator.core import EstimatorConfig
+from vib_estimator.core.ambient import AmbientEstimator
+from vib_estimator.core.multichannel import JOINT_BLOCK_ROWS, JointAmbientEstimator, mac
+from vib_estimator.sim.frame import frame_record, modal_record
+
+warnings.filterwarnings('ignore', category=RuntimeWarning)
+FRAME_FS = 50.0
+FRAME_S = 600.0
+WINDOW_S = 60.0
+ZETA = 0.02
+#: the peer's block rows (those of the joint identifier, ``multichannel.JOINT_BLOCK_ROWS``)
+PEER_ROWS = JOINT_BLOCK_ROWS
+#: an estimate counts for a mode within this relative distance
+NEAR = 0.05
+
+
+def per_mode(freq, truth):
+    """Per true mode: the relative errors of the estimates nearest to it within :data:`NEAR`."""
+    truth = np.asarray(truth)
+    if not len(freq):
+        return [np.empty(0)] * len(truth)
+    rel = freq[:, None] / truth[None, :] - 1
+    near = np.argmin(np.abs(rel), axis=1)
+    return [rel[(near == j) & (np.abs(rel[:, j]) <= NEAR), j] for j in range(len(truth))]
+
+
+def rms(x):
+    return float(np.sqrt(np.mean(np.square(x)))) if len(x) else float('nan')
+
+
+def peer(y, fs, freqs):
+    """pyOMA2 multi-channel SSI-cov on consecutive :data:`WINDOW_S` windows: per mode the
+    relative errors and damping ratios."""
+    errs = [[] for _ in freqs]
+    zetas = [[] for _ in freqs]
+    n = int(WINDOW_S * fs)
+    for start in range(0, len(y) - n + 1, n):
+        res = ssi_cov_window(y[start : start + n], fs, freqs, PEER_ROWS)
+        for j, (f, fn, xi) in enumerate(zip(freqs, *(res or ((), ())))):
+            if np.isfinite(fn) and abs(fn / f - 1) <= NEAR:
+                errs[j].append(fn / f - 1)
+                zetas[j].append(xi)
+    return [np.array(e) for e in errs], [np.array(z) for z in zetas]
+
+
+def frame(seeds, with_peer):
+    config = EstimatorConfig(excitation='ambient', ambient_window_s=WINDOW_S)
+    print(
+        f'## 5-storey shear frame: {FRAME_FS:g} Hz, {FRAME_S:g} s, zeta {ZETA:g}, 20 dB, '
+        f'{seeds} seeds, window {WINDOW_S:g} s'
+    )
+    joint = {k: [] for k in ('err', 'zeta', 'mac')}
+    peer_err, peer_zeta, single = None, None, None
+    for seed in range(1, seeds + 1):
+        t, y, freqs, shapes = frame_record(FRAME_S, FRAME_FS, ZETA, 20.0, seed)
+        names = [f's{i}' for i in range(1, 6)]
+        r = JointAmbientEstimator(config, names).process(t, y)
+        e = r.estimates
+        errs = per_mode(e.frequency_hz, freqs)
+        rel = e.frequency_hz[:, None] / freqs[None, :] - 1
+        near = np.argmin(np.abs(rel), axis=1)
+        if seed == 1:
+            joint = {k: [[] for _ in freqs] for k in ('err', 'zeta', 'mac')}
+            peer_err = [[] for _ in freqs]
+            peer_zeta = [[] for _ in freqs]
+            single = [[[] for _ in freqs] for _ in names]
+        for j in range(len(freqs)):
+            m = (near == j) & (np.abs(rel[:, j]) <= NEAR)
+            joint['err'][j].extend(errs[j])
+            joint['zeta'][j].extend(e.damping[m])
+            joint['mac'][j].extend(mac(s, shapes[:, j]) for s in r.shapes[m])
+        for c in range(len(names)):
+            s = AmbientEstimator(config).process(t, y[:, c])
+            for j, x in enumerate(per_mode(s.frequency_hz, freqs)):
+                single[c][j].extend(x)
+        if with_peer:
+            pe, pz = peer(y, FRAME_FS, freqs)
+            for j in range(len(freqs)):
+                peer_err[j].extend(pe[j])
+                peer_zeta[j].extend(pz[j])
+    print(
+        '| mode | f (Hz) | joint: estimates | median err | RMS err | damping / true | MAC '
+        '| pyOMA2 SSI-cov: windows | RMS err | damping / true | best single channel RMS err |'
+    )
+    print('|---|---|---|---|---|---|---|---|---|---|---|')
+    for j, f in enumerate(freqs):
+        err = np.array(joint['err'][j])
+        best = min(
+            ((rms(single[c][j]), c, len(single[c][j])) for c in range(len(single))),
+            key=lambda x: (np.isnan(x[0]), x[0]),
+        )
+        pe = np.array(peer_err[j]) if with_peer else np.empty(0)
+        pz = np.array(peer_zeta[j]) if with_peer else np.empty(0)
+        print(
+            f'| {j + 1} | {f:.3f} | {len(err)} | {100 * np.median(err):+.2f} % '
+            f'| {100 * rms(err):.2f} % | {np.median(joint["zeta"][j]) / ZETA:.2f} '
+            f'| {np.median(joint["mac"][j]):.4f} | {len(pe)} | {100 * rms(pe):.2f} % '
+            f'| {np.median(pz) / ZETA if len(pz) else float("nan"):.2f} '
+            f'| {100 * best[0]:.2f} % (s{best[1] + 1}, {best[2]} estimates) |'
+        )
+
+
+def invisible():
+    config = EstimatorConfig(excitation='ambient', ambient_window_s=WINDOW_S)
+    modes = [(1.0, 0.02, 1.0), (2.5, 0.02, 0.3), (4.0, 0.02, 1.0)]
+    shapes = np.array([[1.0, 0.0, 0.6], [0.8, 0.0, -0.7], [0.5, 1.0, 0.9]])
+    t, y = modal_record(400.0, 20.0, modes, shapes, 20.0, 3)
+    r = JointAmbientEstimator(config, ['a', 'b', 'c']).process(t, y)
+    print('\n## A mode invisible on channels a and b (2.5 Hz on c only), 3 channels, 20 Hz, 400 s')
+    for (f, _, _), err in zip(modes, per_mode(r.estimates.frequency_hz, [m[0] for m in modes])):
+        print(
+            f'  {f:g} Hz: {len(err)} estimates, median error '
+            + (f'{100 * np.median(err):+.2f} %' if len(err) else 'not found')
+        )
+
+
+def real_hct(real_data):
+    hct = Path(real_data) / HCT_FILE
+    if not hct.exists():
+        print(f'\n(Heritage Court Tower record not found at {hct}: skipped)')
+        return
+    data = np.loadtxt(hct, delimiter=',', skiprows=1)
+    t, y = data[:, 0], data[:, 1:]
+    config = EstimatorConfig(excitation='ambient', ambient_window_s=120.0, band_hz=(0.5, 6.0))
+    start = time.perf_counter()
+    r = JointAmbientEstimator(config, [f'ch{i}' for i in range(1, 7)]).process(t, y)
+    elapsed = time.perf_counter() - start
+    f = r.estimates.frequency_hz
+    rel = np.abs(f[:, None] / np.array(HCT_MODES)[None, :] - 1)
+    idx, dist = np.argmin(rel, axis=1), np.min(rel, axis=1)
+    found = [
+        m for i, m in enumerate(HCT_MODES) if np.count_nonzero((idx == i) & (dist <= 0.02)) >= 10
+    ]
+    print('\n## Heritage Court Tower, 6 channels (40 Hz, 327.7 s), window 120 s, band 0.5-6 Hz')
+    print(
+        f'estimates {len(f)}; published modes found (>= 10 estimates within 2 %): '
+        f'{len(found)} of 6 {found}; estimates > 2 % from every published mode: '
+        f'{100 * np.mean(dist > 0.02):.1f} %; cost {t[-1] / elapsed:.0f}x real time'
+    )
+    for k in sorted(set(r.estimates.mode.tolist())):
+        m = r.estimates.mode == k
+        print(
+            f'  mode {k}: {np.count_nonzero(m)} estimates, median {np.median(f[m]):.3f} Hz, '
+            f'damping {100 * np.median(r.estimates.damping[m]):.2f} %, '
+            f'median MAC with the previous window {np.nanmedian(r.mac[m]):.4f}'
+        )
+
+
+def cost():
+    fs, duration, channels = 500.0, 120.0, 8
+    modes = [(3.0, 0.02, 1.0), (9.0, 0.01, 0.5), (21.0, 0.01, 0.3), (40.0, 0.005, 0.2)]
+    rng = np.random.default_rng(7)
+    shapes = rng.uniform(-1, 1, (channels, len(modes)))
+    t, y = modal_record(duration, fs, modes, shapes, 20.0, 8)
+    config = EstimatorConfig(excitation='ambient', ambient_window_s=30.0)
+    start = time.perf_counter()
+    r = JointAmbientEstimator(config, [f'c{i}' for i in range(channels)]).process(t, y)
+    joint = time.perf_counter() - start
+    start = time.perf_counter()
+    AmbientEstimator(config).process(t, y[:, 0])
+    one = time.perf_counter() - start
+    print(f'\n## Cost: {channels} channels at {fs:g} Hz, {duration:g} s, window 30 s (batch)')
+    print(
+        f'joint {duration / joint:.0f}x real time ({len(r)} estimates); one channel through the '
+        f'single-channel identifier, same run: {duration / one:.0f}x real time'
+    )
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument('--seeds', type=int, default=3)
+    parser.add_argument('--no-peer', action='store_true')
+    parser.add_argument('--real-data', default=str(REAL_DATA))
+    args = parser.parse_args()
+    frame(args.seeds, not args.no_peer)
+    invisible()
+    real_hct(args.real_data)
+    cost()
+
+
+if __name__ == '__main__':
+    main()

@@ -1,0 +1,113 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
+"""Several channels, one set of modes: joint SSI-cov with mode shapes (seeded, tolerant)."""
+
+import math
+
+import numpy as np
+import pytest
+
+from vib_estimator.core import EstimatorConfig
+from vib_estimator.core.multichannel import (
+    JointAmbientEstimator,
+    correlation_matrices,
+    mac,
+    normalise_shape,
+)
+from vib_estimator.sim.frame import frame_record, modal_record, shear_frame
+
+#: 6 Hz at 0.3 of the rate: the frame's modes without decimation (a short test)
+FS = 20.0
+CONFIG = EstimatorConfig(excitation='ambient', ambient_window_s=60.0)
+
+
+def _per_mode(result, freqs, shapes):
+    """For each true mode: (median relative error, median damping, median MAC) of the
+    estimates nearest to it."""
+    e = result.estimates
+    near = np.argmin(np.abs(e.frequency_hz[:, None] / freqs[None, :] - 1), axis=1)
+    out = []
+    for j, f in enumerate(freqs):
+        m = near == j
+        if not np.any(m):
+            out.append((math.inf, math.nan, 0.0))
+            continue
+        macs = [mac(s, shapes[:, j]) for s in result.shapes[m]]
+        out.append(
+            (
+                abs(np.median(e.frequency_hz[m]) / f - 1),
+                float(np.median(e.damping[m])),
+                float(np.median(macs)),
+            )
+        )
+    return out
+
+
+def test_shear_frame_modes():
+    freqs, _ = shear_frame()
+    assert freqs[0] == pytest.approx(0.89) and 5.9 < freqs[-1] < 6.1
+
+
+@pytest.mark.parametrize('seed', [1, 2])
+def test_five_storey_frame_five_modes_with_shapes(seed):
+    t, y, freqs, shapes = frame_record(600.0, FS, zeta=0.02, snr_db=20.0, seed=seed)
+    result = JointAmbientEstimator(CONFIG, [f'storey{i}' for i in range(1, 6)]).process(t, y)
+    assert len(result) > 100
+    for err, zeta, similarity in _per_mode(result, freqs, shapes):
+        assert err <= 0.01
+        assert 0.65 * 0.02 <= zeta <= 1.5 * 0.02
+        assert similarity >= 0.95
+    # the shapes: normalised, their stds finite, the MAC between consecutive windows near 1
+    assert np.allclose(np.linalg.norm(result.shapes, axis=1), 1.0)
+    assert np.all(np.isfinite(result.shape_std))
+    assert np.nanmedian(result.mac) > 0.95
+
+
+def test_a_mode_invisible_on_some_channels_is_found():
+    modes = [(1.0, 0.02, 1.0), (2.5, 0.02, 0.3), (4.0, 0.02, 1.0)]
+    shapes = np.array([[1.0, 0.0, 0.6], [0.8, 0.0, -0.7], [0.5, 1.0, 0.9]])
+    t, y = modal_record(400.0, FS, modes, shapes, snr_db=20.0, seed=3)
+    result = JointAmbientEstimator(CONFIG, ['a', 'b', 'c']).process(t, y)
+    freqs = np.array([f for f, _, _ in modes])
+    per = _per_mode(result, freqs, shapes / np.linalg.norm(shapes, axis=0))
+    for err, _, similarity in per:
+        assert err <= 0.01 and similarity >= 0.95
+    e = result.estimates
+    hidden = np.abs(e.frequency_hz / 2.5 - 1) <= 0.01
+    # the 2.5 Hz mode lives on channel c only: its shape says so
+    assert np.all(np.abs(result.shapes[hidden][:, :2]) < 0.2)
+
+
+def test_correlation_matrices_are_the_direct_sums():
+    rng = np.random.default_rng(0)
+    y = rng.standard_normal((300, 3))
+    r = correlation_matrices(y, 4)
+    d = y - y.mean(axis=0)
+    for k in range(5):
+        direct = d[k:].T @ d[: len(d) - k] / (len(d) - k)
+        assert np.allclose(r[k], direct)
+
+
+def test_mac_and_normalisation():
+    a = np.array([1.0, -2.0, 0.5])
+    assert mac(a, (0.3 - 2j) * a) == pytest.approx(1.0)
+    assert mac(a, np.array([2.0, 1.0, 0.0])) == pytest.approx(0.0)
+    s = normalise_shape((0.3 - 2j) * a)
+    assert np.linalg.norm(s) == pytest.approx(1.0)
+    assert np.allclose(s, a / -np.linalg.norm(a))  # the largest entry (-2) real and positive
+
+
+def test_one_channel_is_refused_and_bad_samples_are_counted():
+    with pytest.raises(ValueError, match='at least 2 channels'):
+        JointAmbientEstimator(CONFIG, ['a'])
+    est = JointAmbientEstimator(CONFIG, ['a', 'b'])
+    t = np.arange(10) / FS
+    y = np.ones((10, 2))
+    y[3, 1] = np.nan
+    t[6] = t[5]
+    result = est.process(t, y)
+    assert len(result) == 0
+    c = est.counters
+    assert (c['received'], c['skipped_non_finite'], c['skipped_duplicate']) == (10, 1, 1)
+    with pytest.raises(ValueError, match='2 channels'):
+        est.process(t, np.ones((10, 3)))

@@ -1,0 +1,178 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
+"""``analyze --columns a,b,c|all``: several CSV channels, one set of modes with their shapes.
+
+One column (``--columns b``) is exactly ``--column b``. Two or more need ``--excitation ambient``
+and go to the joint identifier (:mod:`..core.multichannel`). Each estimate row (JSONL, CSV,
+table) gains, per channel ``<name>``: ``shape_<name>`` (the normalised shape's real part, the
+largest entry +1 / |shape|), ``shape_phase_deg_<name>`` (its phase, degrees, 0 or 180 for a
+real mode), ``shape_std_<name>`` (its uncertainty) and ``mac`` (with the same mode's previous
+estimate; null at its first). ``--plot``: the estimates over time by mode and each mode's shape as
+a bar plot of the channel amplitudes (signed real parts, median over the mode's estimates).
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+
+import numpy as np
+
+from ..core.config import EstimatorConfig
+from ..core.multichannel import JointAmbientEstimator, JointEstimates
+from ..errors import CsvError
+from ..io.csv_reader import column_names, read_csv_columns
+from ..io.fields import UNKNOWN_UNIT
+from ..io.streaming import is_csv
+from .summary import summarise_modes, summary_lines
+
+
+def channel_names(args) -> list[str]:
+    """The ``--columns`` of the CSV input (CsvError for a bag, with ``--column`` too, or for an
+    unknown column)."""
+    if not is_csv(args.input):
+        raise CsvError('--columns reads CSV files only (a bag: one --component)')
+    if args.column is not None:
+        raise CsvError('give --column or --columns, not both')
+    return column_names(args.input, args.columns)
+
+
+def joint_run(t: np.ndarray, y: np.ndarray, names, config: EstimatorConfig):
+    """``(estimator, estimates)``: the joint identification of the channels (ValueError
+    without ``excitation ambient``, for time not strictly increasing)."""
+    if config.excitation != 'ambient':
+        raise ValueError(
+            f'{len(names)} channels need --excitation ambient (the joint identification); '
+            'free decays take one --column'
+        )
+    bad = np.flatnonzero(~(np.diff(t) > 0))
+    if bad.size:
+        raise ValueError(f'time is not strictly increasing at sample {int(bad[0]) + 1}')
+    estimator = JointAmbientEstimator(config, names)
+    return estimator, estimator.process(t, y)
+
+
+def shape_fields(result: JointEstimates, i: int) -> dict:
+    """The shape fields of estimate ``i`` (see the module doc)."""
+    row = {}
+    shape, std = result.shapes[i], result.shape_std[i]
+    for name, s in zip(result.channels, shape):
+        row[f'shape_{name}'] = float(abs(s) * math.copysign(1.0, s.real))
+    for name, s in zip(result.channels, shape):
+        row[f'shape_phase_deg_{name}'] = float(np.degrees(np.angle(s)))
+    for name, s in zip(result.channels, std):
+        row[f'shape_std_{name}'] = float(s)
+    row['mac'] = float(result.mac[i])
+    return row
+
+
+def rows(result: JointEstimates) -> list[dict]:
+    """One dict per estimate: the estimate's fields and its shape's."""
+    return [
+        {**e.as_dict(), **shape_fields(result, i)}
+        for i, e in enumerate(result.estimates.to_list())
+    ]
+
+
+def print_rows(table: list[dict], fmt: str, json_row) -> None:
+    out = sys.stdout
+    if fmt == 'jsonl':
+        import json
+
+        for row in table:
+            out.write(json.dumps(json_row(row), allow_nan=False) + '\n')
+        return
+    if fmt == 'csv':
+        keys = list(table[0]) if table else ['t', 'mode', 'frequency_hz']
+        out.write(','.join(keys) + '\n')
+        for row in table:
+            out.write(','.join(repr(row[k]) for k in keys) + '\n')
+        return
+    names = [k[len('shape_') :] for k in (table[0] if table else {}) if k.startswith('shape_')]
+    names = [n for n in names if not n.startswith(('phase_deg_', 'std_'))]
+    out.write(
+        f'{"t (s)":>10} {"mode":>4} {"f (Hz)":>10} {"f std":>8} {"zeta":>8} {"MAC":>6}  shape '
+        + ' '.join(names)
+        + '\n'
+    )
+    for row in table:
+        shape = ' '.join(f'{row["shape_" + n]:+.3f}' for n in names)
+        out.write(
+            f'{row["t"]:10.3f} {row["mode"]:4d} {row["frequency_hz"]:10.5f} '
+            f'{row["frequency_std_hz"]:8.2g} {row["damping"]:8.5f} {row["mac"]:6.3f}  {shape}\n'
+        )
+
+
+def mode_shapes(result: JointEstimates) -> dict[int, tuple[float, np.ndarray, np.ndarray]]:
+    """Per mode number: (median frequency, median signed shape amplitude per channel, median
+    shape std per channel)."""
+    e = result.estimates
+    signed = np.abs(result.shapes) * np.sign(result.shapes.real)
+    return {
+        int(k): (
+            float(np.median(e.frequency_hz[e.mode == k])),
+            np.median(signed[e.mode == k], axis=0),
+            np.median(result.shape_std[e.mode == k], axis=0),
+        )
+        for k in sorted(set(e.mode.tolist()))
+    }
+
+
+def plot_shapes(path: str, title: str, result: JointEstimates, unit: str = UNKNOWN_UNIT):
+    """``--plot`` of a joint run: the estimates' frequencies over time by mode (the
+    stabilisation over windows) and each mode's shape (bars of the channel amplitudes, error bars
+    their std); returns the Figure."""
+    from .plotting import mode_colour, pyplot
+
+    plt = pyplot()
+    shapes = mode_shapes(result)
+    cols = max(1, len(shapes))
+    fig = plt.figure(figsize=(max(8.0, 2.4 * cols), 7.0))
+    grid = fig.add_gridspec(2, cols, height_ratios=(1.2, 1.0))
+    ax = fig.add_subplot(grid[0, :])
+    e = result.estimates
+    for k in shapes:
+        m = e.mode == k
+        ax.plot(e.t[m], e.frequency_hz[m], '.', ms=3, color=mode_colour(k), label=f'mode {k}')
+    ax.set_xlabel('time (s)')
+    ax.set_ylabel('frequency (Hz)')
+    ax.set_title(f'{title}: joint SSI-cov over {len(result.channels)} channels')
+    if shapes:
+        ax.legend(fontsize='small', loc='center left', bbox_to_anchor=(1.0, 0.5))
+    x = np.arange(len(result.channels))
+    for col, (k, (f, amp, std)) in enumerate(shapes.items()):
+        sub = fig.add_subplot(grid[1, col])
+        sub.bar(x, amp, yerr=std, color=mode_colour(k), capsize=2)
+        sub.axhline(0.0, color='k', lw=0.5)
+        sub.set_xticks(x, result.channels, rotation=60, fontsize='small')
+        sub.set_ylim(-1.05, 1.05)
+        sub.set_title(f'mode {k}: {f:.3f} Hz', fontsize='small')
+        if col == 0:
+            sub.set_ylabel(f'shape ({unit}, normalised)')
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return fig
+
+
+def run_joint(args, config: EstimatorConfig, names, json_row, prog: str) -> int:
+    """``analyze --columns`` with two or more channels ``names``: estimates with their shapes on
+    stdout, the counters and the summary on stderr, ``--plot``. Bad input raises (CsvError,
+    ValueError) before anything is printed."""
+    t, y, names = read_csv_columns(args.input, ','.join(names))
+    estimator, result = joint_run(t, y, names, config)
+    print_rows(rows(result), args.format, json_row)
+    print(
+        f'{prog}: channels={",".join(names)}, '
+        + ', '.join(f'{k}={v}' for k, v in estimator.counters.items()),
+        file=sys.stderr,
+    )
+    e = result.estimates
+    for line in summary_lines(summarise_modes(e.frequency_hz, e.damping, e.mode)):
+        print(f'{prog}: ' + line, file=sys.stderr)
+    for k, (f, amp, _) in mode_shapes(result).items():
+        shape = ', '.join(f'{n} {a:+.2f}' for n, a in zip(names, amp))
+        print(f'{prog}: mode {k} ({f:.3f} Hz) shape: {shape}', file=sys.stderr)
+    if args.plot:
+        plot_shapes(args.plot, str(args.input), result)
+    return 0

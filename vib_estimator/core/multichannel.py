@@ -1,0 +1,614 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
+"""Several channels, one set of modes: multi-channel covariance-driven SSI with mode shapes.
+
+``excitation = ambient`` with two or more channels (several accelerometers, the three axes of an
+IMU, the joints of an arm): the modes are identified jointly from all channels' output
+correlations, each with its **shape** -- how much, and in which phase, each channel moves in it.
+One channel is not routed here: it stays :class:`..ambient.AmbientEstimator`, bit for bit.
+
+Interface: :class:`JointAmbientEstimator` ``(config, channels)`` ``.process(t, Y) ->``
+:class:`JointEstimates` (``Y``: samples x channels), ``.update(t, y) -> list[JointEstimate]``,
+``.counters``, ``.reset()``, ``.restart()``, ``.config``, ``.channels``.
+
+Method, per analysis (every :data:`..ambient.HOP_S` of input once ``ambient_window_s`` of samples
+are in), as the single-channel identifier (:mod:`..ambient`, whose stabilisation and clustering
+are reused) with matrices in place of scalars:
+
+1. **Joint SSI-cov**: the correlation matrices ``R_k = E[y_t+k y_t^T]`` (channels x channels,
+   k = 0 .. 2 p, by FFT, unbiased), their block Hankel matrix ``H = [R_{i+j+1}]`` (p =
+   :data:`JOINT_BLOCK_ROWS` block rows, every channel a reference), its SVD; at each model
+   order ``O = U_n S_n^1/2``, ``A = O_up^+ O_down``, ``C`` = the first block row of ``O``, ``G``
+   = the first block column of ``S_n^1/2 V_n^T``. Each eigenvalue ``lambda`` (eigenvector
+   ``v``) of ``A`` is a pole of every channel at once; its **shape** is ``phi = C v``, its share
+   of channel c's variance ``2 Re(phi_c g_c / lambda)`` (``g = v^-1 G``).
+2. **Physical or spurious**: the poles of all orders go through
+   :func:`..ambient.stable_clusters` (damping, band, frequency clusters stable over the orders),
+   their shapes riding along. A cluster's shape is the mean of its poles' shapes, each first
+   rotated onto the cluster's strongest pole's (complex scale), normalised to unit length with
+   its largest entry real and positive; its **uncertainty** the per-channel RMS deviation of the
+   poles' shapes from that mean (the spread over the stable model orders). Two clusters within
+   :data:`..ambient.MERGE_TOL` are one mode only if their shapes agree (MAC >=
+   :data:`MAC_SAME`): close modes with different shapes stay two. A mode must stand
+   :data:`..ambient.MIN_PEAK_RATIO` above the noise on **at least one** channel (a mode
+   invisible on some channels is still found on the others).
+3. **Standard deviations**: the Whittle bound (:func:`..ambient.whittle_std`) on the channel where
+   the mode stands highest above its noise (with the modes there within :data:`NEIGHBOURS`),
+   calibrated across windows as the single-channel identifier's (:class:`..ambient.ModeTrack`).
+4. **Identity over time**: a window's mode continues the tracked mode nearest in frequency (within
+   :data:`..ambient.MATCH_TOL`) whose last shape it matches (MAC >= :data:`MAC_MATCH`); the MAC
+   between the two is published with the estimate (``mac``, NaN for a mode's first window).
+   Confirmation, loss and numbering are the single-channel identifier's.
+
+Each estimate: the fields of :class:`..estimator.Estimate` (``amplitude`` = the RMS over channels
+of the modal response summed in quadrature, ``fit`` = share of the summed channel variances the
+modes explain) plus the shape, its uncertainty and the MAC.
+
+Bad samples never raise: a sample with any non-finite channel is skipped (``skipped_non_finite``);
+stamps are handled as the single-channel identifier's (duplicates, out of order, gaps and jumps).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.signal import sosfiltfilt
+
+from .ambient import (
+    BLOCK_ROWS,
+    CONFIRM,
+    COUNTER_NAMES,
+    DECIMATE_SOS,
+    HOP_S,
+    MATCH_TOL,
+    MAX_STD_REL,
+    MAX_TRACKS,
+    MERGE_TOL,
+    MIN_PEAK_RATIO,
+    MIN_SAMPLES,
+    NU_MAX,
+    ORDERS,
+    SEARCH_EVERY,
+    TOP_NU,
+    ModeTrack,
+    estimate_columns,
+    sdof_psd,
+    stable_clusters,
+    whittle_std,
+)
+from .config import EstimatorConfig
+from .estimator import Estimate, EstimateArrays
+
+#: two clusters closer than ``MERGE_TOL`` are one mode only if their shapes' MAC is at least this
+MAC_SAME = 0.9
+#: a window's mode continues a tracked one only if their shapes' MAC is at least this
+MAC_MATCH = 0.5
+#: block rows of the joint Hankel matrix: half the single channel's (the model orders need only
+#: ``rows x channels`` above the highest order; the SVD costs 8 times less; on the shear frame,
+#: two seeds, as accurate as 40 rows)
+JOINT_BLOCK_ROWS = BLOCK_ROWS // 2
+#: a mode's Whittle bound counts the modes within this relative frequency of it (farther
+#: ones' skirts carry no information on it, and each bound then costs a few modes, not all)
+NEIGHBOURS = 0.2
+#: the fewest channels of a joint identification (one channel is the single-channel identifier's)
+MIN_CHANNELS = 2
+
+
+def mac(a: np.ndarray, b: np.ndarray) -> float:
+    """Modal assurance criterion ``|a^H b|^2 / (|a|^2 |b|^2)`` of two (complex) shapes: 1 for
+    shapes equal up to a complex scale, 0 for orthogonal ones."""
+    a, b = np.asarray(a), np.asarray(b)
+    den = float(np.vdot(a, a).real * np.vdot(b, b).real)
+    return float(abs(np.vdot(a, b)) ** 2 / den) if den > 0 else 0.0
+
+
+def normalise_shape(phi: np.ndarray) -> np.ndarray:
+    """``phi`` scaled to unit length with its largest entry real and positive."""
+    k = int(np.argmax(np.abs(phi)))
+    scale = phi[k] / abs(phi[k]) * np.linalg.norm(phi) if abs(phi[k]) > 0 else 1.0
+    return phi / scale
+
+
+# ---- one window ---------------------------------------------------------------------------------
+def correlation_matrices(y: np.ndarray, lags: int) -> np.ndarray:
+    """Unbiased correlation matrices ``R_k[a, b] = sum_t y_a,t+k y_b,t / (N - k)``, k = 0 ..
+    ``lags``, of the mean-removed columns of ``y`` (samples x channels), by FFT: (lags + 1,
+    channels, channels)."""
+    n = len(y)
+    y = y - y.mean(axis=0)
+    size = 1 << math.ceil(math.log2(n + lags + 1))
+    spec = np.fft.rfft(y, size, axis=0).T  # channels x bins
+    m = y.shape[1]
+    a, b = np.triu_indices(m)
+    # one inverse transform per pair a <= b: its start holds R_k[a, b], its end R_k[b, a]
+    circ = np.fft.irfft(spec[a] * np.conj(spec[b]), size, axis=-1)
+    r = np.empty((lags + 1, m, m))
+    r[:, a, b] = circ[:, : lags + 1].T
+    r[0, b, a] = circ[:, 0]
+    r[1:, b, a] = circ[:, : -lags - 1 : -1].T
+    return r / np.arange(n, n - lags - 1, -1)[:, None, None]
+
+
+def joint_poles(
+    r: np.ndarray, fs: float, rows: int = JOINT_BLOCK_ROWS, orders: Sequence[int] = ORDERS
+) -> list[np.ndarray]:
+    """Joint SSI-cov poles of correlation matrices ``r`` (:func:`correlation_matrices`) at each
+    model order: per order an array with a row per complex pair (upper half plane): frequency Hz,
+    damping ratio, variance summed over channels, each channel's variance, the real then the
+    imaginary parts of the (unnormalised) shape."""
+    m = r.shape[1]
+    idx = 1 + np.add.outer(np.arange(rows), np.arange(rows))
+    hankel = r[idx].transpose(0, 2, 1, 3).reshape(rows * m, rows * m)
+    u, s, vt = np.linalg.svd(hankel)
+    width = 3 + 3 * m
+    out = []
+    for order in orders:
+        root = np.sqrt(s[:order])
+        obs = u[:, :order] * root
+        up = obs[:-m]
+        try:
+            a = np.linalg.lstsq(up, obs[m:], rcond=None)[0]
+            lam, vec = np.linalg.eig(a)
+            g_modal = np.linalg.solve(vec, root[:, None] * vt[:order, :m])
+        except np.linalg.LinAlgError:
+            out.append(np.empty((0, width)))
+            continue
+        keep = lam.imag > 1e-12
+        lam_k = lam[keep]
+        phi = (obs[:m] @ vec)[:, keep]  # channels x poles
+        share = 2.0 * (phi * g_modal[keep].T / lam_k).real  # each channel's variance
+        pole = np.log(lam_k) * fs
+        freq = np.abs(pole) / (2 * math.pi)
+        zeta = -pole.real / np.abs(pole)
+        out.append(
+            np.column_stack((freq, zeta, share.sum(axis=0), share.T, phi.real.T, phi.imag.T))
+        )
+    return out
+
+
+@dataclass
+class JointModes:
+    """The modes of one window, ascending: columns frequency, damping, summed variance, each
+    channel's variance (``variances``), stds; shapes (modes x channels, complex, normalised) and
+    their per-channel uncertainty."""
+
+    frequency: np.ndarray
+    damping: np.ndarray
+    variances: np.ndarray
+    frequency_std: np.ndarray
+    damping_std: np.ndarray
+    shapes: np.ndarray
+    shape_std: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.frequency)
+
+    def take(self, keep) -> 'JointModes':
+        return JointModes(*(getattr(self, f)[keep] for f in self.__dataclass_fields__))
+
+
+def _cluster_shape(group: np.ndarray, m: int) -> tuple[np.ndarray, np.ndarray]:
+    """The cluster's shape and its per-channel uncertainty (see the module doc, step 2)."""
+    phis = group[:, 3 + m : 3 + 2 * m] + 1j * group[:, 3 + 2 * m : 3 + 3 * m]
+    phis = np.array([normalise_shape(p) for p in phis])
+    ref = phis[int(np.argmax(group[:, 2]))]
+    rot = np.array([np.vdot(p, ref) for p in phis])
+    phis = phis * (rot / np.maximum(np.abs(rot), 1e-300))[:, None]
+    mean = phis.mean(axis=0)
+    spread = np.sqrt(np.mean(np.abs(phis - mean) ** 2, axis=0))
+    return normalise_shape(mean), spread
+
+
+def joint_modes_at(
+    y: np.ndarray, fs: float, max_damping: float, band: tuple[float, float], counts: dict
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The clustered modes of ``y`` (samples x channels) at ``fs``: (rows of frequency, damping,
+    each channel's variance; shapes; shape stds), close clusters merged when their shapes agree;
+    and the channels' variances ``R_0``."""
+    m = y.shape[1]
+    r = correlation_matrices(y, 2 * JOINT_BLOCK_ROWS)
+    clusters = stable_clusters(
+        joint_poles(r, fs), fs, max_damping, (band[0], min(band[1], NU_MAX * fs)), counts
+    )
+    rows, shapes, stds, support = [], [], [], []
+    for group in clusters:
+        shape, spread = _cluster_shape(group, m)
+        row = np.concatenate(
+            (
+                [np.median(group[:, 0]), np.median(group[:, 1])],
+                np.maximum(np.median(group[:, 3 : 3 + m], axis=0), 0.0),
+            )
+        )
+        sup = len(np.unique(group[:, -2]))
+        if rows and row[0] <= rows[-1][0] * (1 + MERGE_TOL) and mac(shape, shapes[-1]) >= MAC_SAME:
+            if sup > support[-1]:
+                rows[-1], shapes[-1], stds[-1], support[-1] = row, shape, spread, sup
+            continue
+        rows.append(row)
+        shapes.append(shape)
+        stds.append(spread)
+        support.append(sup)
+    return (
+        np.array(rows).reshape(-1, 2 + m),
+        np.array(shapes, dtype=complex).reshape(-1, m),
+        np.array(stds).reshape(-1, m),
+    )
+
+
+def _densities(rows: np.ndarray, fs: float) -> np.ndarray:
+    """Each mode's density at each mode's frequency on each channel: (at, modes, channels)."""
+    dt = 1.0 / fs
+    w = 2 * math.pi * rows[:, 0] * dt
+    m = rows.shape[1] - 2
+    out = np.zeros((len(rows), len(rows), m))
+    for j, (f, z) in enumerate(rows[:, :2]):
+        unit = sdof_psd(w, f, z, 1.0, dt)  # linear in the variance
+        out[:, j, :] = unit[:, None] * rows[j, 2:][None, :]
+    return out
+
+
+def strong_joint(rows, shapes, stds, totals, fs, counts):
+    """The modes that stand :data:`..ambient.MIN_PEAK_RATIO` above everything else at their
+    frequency on at least one channel (the weakest dropped first, then the others judged again);
+    with each channel's noise variance and each mode's best channel's peak ratio."""
+    while True:
+        noise = np.maximum(totals - rows[:, 2:].sum(axis=0), 1e-3 * totals)
+        if not len(rows):
+            return rows, shapes, stds, noise, np.empty(0, dtype=int)
+        dens = _densities(rows, fs)
+        k = np.arange(len(rows))
+        own = dens[k, k, :]  # modes x channels
+        ratio = own / (noise[None, :] + dens.sum(axis=1) - own)
+        best = ratio.max(axis=1)
+        if np.all(best >= MIN_PEAK_RATIO):
+            return rows, shapes, stds, noise, np.argmax(ratio, axis=1)
+        worst = int(np.argmin(best))
+        counts['rejected_weak'] += 1
+        rows, shapes, stds = (np.delete(x, worst, axis=0) for x in (rows, shapes, stds))
+
+
+def joint_decimate(y: np.ndarray, fs: float, top_hz: float) -> tuple[np.ndarray, float]:
+    """:func:`..ambient.decimate` of every column of ``y`` (samples x channels)."""
+    while top_hz <= 0.5 * TOP_NU * fs and len(y) // 2 >= MIN_SAMPLES:
+        y = sosfiltfilt(DECIMATE_SOS, y, axis=0)[::2]
+        fs *= 0.5
+    return y, fs
+
+
+def identify_joint(
+    y: np.ndarray,
+    fs: float,
+    max_damping: float = 0.1,
+    band: tuple[float, float] = (0.0, math.inf),
+    counts: dict[str, int] | None = None,
+    top_hz: float = 0.0,
+    search: bool = True,
+) -> tuple[JointModes, float]:
+    """Modes of one window ``y`` (samples x channels) at ``fs``, the passes of
+    :func:`..ambient.identify` (a search from the full rate down, then the rate that puts the
+    highest mode at :data:`..ambient.TOP_NU`): (:class:`JointModes`, the summed variance)."""
+    counts = dict.fromkeys(COUNTER_NAMES, 0) if counts is None else counts
+    y = np.asarray(y, dtype=np.float64)
+    m = y.shape[1]
+    totals = np.var(y, axis=0)
+    found = (np.empty((0, 2 + m)), np.empty((0, m), complex), np.empty((0, m)))
+    strong = (*found, totals, np.empty(0, dtype=int))
+    if search or top_hz <= 0:
+        yk, rate = y, fs
+        while True:
+            strong = strong_joint(
+                *joint_modes_at(yk, rate, max_damping, band, counts), totals, fs, counts
+            )
+            if len(strong[0]) or len(yk) // 2 < MIN_SAMPLES:
+                break
+            yk, rate = sosfiltfilt(DECIMATE_SOS, yk, axis=0)[::2], 0.5 * rate
+    top = max(float(np.max(strong[0][:, 0])) if len(strong[0]) else 0.0, top_hz)
+    if top > 0:
+        yq, rate = joint_decimate(y, fs, top)
+        if rate < fs or not (search or top_hz <= 0):  # (no search pass ran at fs)
+            strong = strong_joint(
+                *joint_modes_at(yq, rate, max_damping, band, counts), totals, fs, counts
+            )
+    rows, shapes, spread, noise, best = strong
+    std = np.full((len(rows), 2), math.nan)
+    for j, c in enumerate(best):
+        # the bound on the mode's best channel, with the modes there within NEIGHBOURS of it
+        near = np.flatnonzero(
+            (rows[:, 2 + c] > 0) & (np.abs(rows[:, 0] / rows[j, 0] - 1) <= NEIGHBOURS)
+        )
+        triples = [(rows[i, 0], rows[i, 1], rows[i, 2 + c]) for i in near]
+        cstd = np.array(whittle_std(triples, noise[c], fs, len(y))).reshape(-1, 2)
+        std[j] = cstd[int(np.flatnonzero(near == j)[0])]
+    modes = JointModes(rows[:, 0], rows[:, 1], rows[:, 2:], std[:, 0], std[:, 1], shapes, spread)
+    weak = ~(modes.frequency_std <= MAX_STD_REL * modes.frequency)
+    counts['rejected_uncertain'] += int(np.count_nonzero(weak))
+    return modes.take(~weak), float(np.sum(totals))
+
+
+# ---- streaming ----------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class JointEstimate:
+    """One published mode of a joint identification: the :class:`..estimator.Estimate` fields,
+    the mode's normalised complex ``shape`` (one entry per channel), its per-channel
+    ``shape_std`` and the ``mac`` with the same mode's previous shape (NaN at its first)."""
+
+    estimate: Estimate
+    shape: np.ndarray
+    shape_std: np.ndarray
+    mac: float
+
+
+@dataclass
+class JointEstimates:
+    """Estimates of a batch run: the columns of :class:`..estimator.EstimateArrays`, the shapes
+    (estimates x channels, complex), their stds and the MACs, in the estimates' order."""
+
+    estimates: EstimateArrays
+    shapes: np.ndarray
+    shape_std: np.ndarray
+    mac: np.ndarray
+    channels: tuple[str, ...]
+
+    def __len__(self) -> int:
+        return len(self.estimates)
+
+
+class _ShapeTrack(ModeTrack):
+    """A tracked mode with its last shape."""
+
+    __slots__ = ('shape',)
+
+
+class JointAmbientEstimator:
+    """Sliding-window joint output-only identification; see the module docstring.
+
+    ``channels``: the channel names (their count is the number of columns fed)."""
+
+    def __init__(self, config: EstimatorConfig, channels: Sequence[str]):
+        config.validate()
+        channels = tuple(str(c) for c in channels)
+        if len(channels) < MIN_CHANNELS:
+            raise ValueError(
+                f'a joint identification needs at least {MIN_CHANNELS} channels, '
+                f'got {len(channels)} (one channel: excitation ambient, one column)'
+            )
+        self._config = config
+        self._channels = channels
+        self._window = config.ambient_window_s
+        self._band = config.band_hz or (0.0, math.inf)
+        self._c = dict.fromkeys(COUNTER_NAMES, 0)
+        self._t = np.empty(1 << 14)
+        self._y = np.empty((1 << 14, len(channels)))
+        self._tracks: list[_ShapeTrack] = []
+        self.restart()
+
+    @property
+    def config(self) -> EstimatorConfig:
+        return self._config
+
+    @property
+    def channels(self) -> tuple[str, ...]:
+        return self._channels
+
+    @property
+    def counters(self) -> dict[str, int]:
+        return dict(self._c)
+
+    def restart(self) -> None:
+        """Forget the signal and the tracked modes; counters are kept."""
+        self._tracks = []
+        self._last = -math.inf
+        self._clear()
+
+    def reset(self) -> None:
+        """Start a new window at the next sample (the tracked modes are kept)."""
+        self._clear()
+
+    def _clear(self) -> None:
+        self._n = 0
+        self._start = 0
+        self._next = math.inf
+
+    # ---- input --------------------------------------------------------------------------------
+    def _room(self, more: int = 1) -> None:
+        """Make room for ``more`` samples (compact, or grow)."""
+        keep = self._n - self._start
+        if keep + more > len(self._t) // 2:
+            size = 1 << math.ceil(math.log2(2 * (keep + more)))
+            t, y = np.empty(size), np.empty((size, len(self._channels)))
+        else:
+            t, y = self._t, self._y
+        t[:keep] = self._t[self._start : self._n]
+        y[:keep] = self._y[self._start : self._n]
+        self._t, self._y, self._n, self._start = t, y, keep, 0
+
+    def _accept(self, t: float, finite: bool) -> bool:
+        """Count one sample; False if skipped. A gap or a long jump back clears the window."""
+        c = self._c
+        c['received'] += 1
+        if not (finite and math.isfinite(t)):
+            c['skipped_non_finite'] += 1
+            return False
+        last = self._last
+        if t <= last:
+            if last - t > self._config.max_gap:
+                c['time_jump_resets'] += 1
+                self._clear()
+            else:
+                c['skipped_duplicate' if t == last else 'skipped_out_of_order'] += 1
+                return False
+        elif t - last > self._config.max_gap and self._n:
+            c['gap_resets'] += 1
+            self._clear()
+        self._last = t
+        c['used'] += 1
+        return True
+
+    def update(self, t: float, y: Sequence[float]) -> list[JointEstimate]:
+        """Feed one sample (one value per channel); the estimates of an analysis it completes."""
+        y = np.asarray(y, dtype=np.float64).reshape(-1)
+        if len(y) != len(self._channels):
+            raise ValueError(f'expected {len(self._channels)} channel values, got {len(y)}')
+        t = float(t)
+        if not self._accept(t, bool(np.all(np.isfinite(y)))):
+            return []
+        if self._n == len(self._t):
+            self._room()
+        if self._n == 0:
+            self._next = t + self._window
+        self._t[self._n] = t
+        self._y[self._n] = y
+        self._n += 1
+        if t >= self._next:
+            return self._analyse()
+        return []
+
+    def process(self, t: Sequence[float], y: np.ndarray) -> JointEstimates:
+        """Feed arrays (``y``: samples x channels; continuing the stream); the estimates by
+        time."""
+        t = np.ascontiguousarray(t, dtype=np.float64)
+        y = np.ascontiguousarray(y, dtype=np.float64)
+        if t.ndim != 1 or y.shape != (len(t), len(self._channels)):
+            raise ValueError(
+                f't must be 1-D and y samples x {len(self._channels)} channels, '
+                f'got {t.shape}, {y.shape}'
+            )
+        finite = np.isfinite(y).all(axis=1) & np.isfinite(t)
+        gap = self._config.max_gap
+        out: list[JointEstimate] = []
+        i, n = 0, len(t)
+        while i < n:
+            # the longest clean run from i: finite, increasing, no gap (else one sample at a time)
+            j = i
+            if finite[i] and t[i] > self._last and (t[i] - self._last <= gap or not self._n):
+                d = np.diff(t[i : min(n, i + 65536)])
+                bad = ~((d > 0) & (d <= gap)) | ~finite[i + 1 : i + 1 + len(d)]
+                j = i + 1 + (int(np.argmax(bad)) if bad.any() else len(d))
+            if j == i:
+                out.extend(self.update(t[i], y[i]))
+                i += 1
+                continue
+            while i < j:
+                if not self._n:
+                    self._next = float(t[i]) + self._window
+                k = min(j, int(np.searchsorted(t[i:j], self._next, 'left')) + i + 1)
+                self._c['received'] += k - i
+                self._c['used'] += k - i
+                while self._n + (k - i) > len(self._t):
+                    self._room(k - i)
+                self._t[self._n : self._n + k - i] = t[i:k]
+                self._y[self._n : self._n + k - i] = y[i:k]
+                self._n += k - i
+                self._last = float(t[k - 1])
+                i = k
+                if self._last >= self._next:
+                    out.extend(self._analyse())
+        return self._columns(out)
+
+    def _columns(self, out: list[JointEstimate]) -> JointEstimates:
+        m = len(self._channels)
+        return JointEstimates(
+            estimate_columns([e.estimate for e in out]),
+            np.array([e.shape for e in out], dtype=complex).reshape(-1, m),
+            np.array([e.shape_std for e in out]).reshape(-1, m),
+            np.array([e.mac for e in out]),
+            self._channels,
+        )
+
+    # ---- analysis -----------------------------------------------------------------------------
+    def _analyse(self) -> list[JointEstimate]:
+        t_end = self._t[self._n - 1]
+        self._next += HOP_S
+        if self._next <= t_end:
+            self._next = t_end + HOP_S
+        first = self._start + int(
+            np.searchsorted(self._t[self._start : self._n], t_end - self._window, 'left')
+        )
+        self._start = first
+        ts, ys = self._t[first : self._n], self._y[first : self._n]
+        n = len(ts)
+        if n < 4 * BLOCK_ROWS + 2:
+            return []
+        span = float(ts[-1] - ts[0])
+        fs = (n - 1) / span
+        self._c['analyses'] += 1
+        known = max((tr.frequency for tr in self._tracks if tr.published), default=0.0)
+        search = self._c['analyses'] % SEARCH_EVERY == 1
+        modes, total = identify_joint(
+            ys, fs, self._config.max_damping, self._band, self._c, known, search
+        )
+        return self._track(modes, total, float(t_end), span, n)
+
+    def _match(self, modes: JointModes) -> dict[int, int]:
+        """Each window mode's track: nearest in frequency within ``MATCH_TOL`` among those whose
+        shape it matches (published tracks first)."""
+        tracks = self._tracks
+        pairs = []
+        for i in range(len(modes)):
+            for j, tr in enumerate(tracks):
+                dist = abs(modes.frequency[i] / tr.frequency - 1)
+                if dist <= MATCH_TOL and mac(modes.shapes[i], tr.shape) >= MAC_MATCH:
+                    pairs.append((not tr.published, dist, i, j))
+        match: dict[int, int] = {}
+        used = set()
+        for _, _, i, j in sorted(pairs):
+            if i not in match and j not in used:
+                match[i] = j
+                used.add(j)
+        return match
+
+    def _track(
+        self, modes: JointModes, total: float, t: float, span: float, n: int
+    ) -> list[JointEstimate]:
+        """Match the window's modes to the tracked ones, publish the confirmed ones."""
+        tracks = self._tracks
+        match = self._match(modes)
+        seen: dict[int, tuple[int, float]] = {}
+        for i in range(len(modes)):
+            if i in match:
+                tr = tracks[match[i]]
+                tr.seen += 1
+                similarity = mac(modes.shapes[i], tr.shape)
+            elif len(tracks) < MAX_TRACKS:
+                tr = _ShapeTrack(float(modes.frequency[i]), t)
+                tracks.append(tr)
+                similarity = math.nan
+            else:
+                continue
+            tr.frequency, tr.last_t = float(modes.frequency[i]), t
+            tr.amplitude = math.sqrt(float(np.sum(modes.variances[i])))
+            tr.shape = modes.shapes[i]
+            seen[id(tr)] = (i, similarity)
+        for tr in list(tracks):
+            if id(tr) not in seen:
+                tr.seen = 0
+                if not tr.published or t - tr.last_t > self._window:
+                    tracks.remove(tr)
+                    self._c['modes_lost'] += tr.published
+        ready = [tr for tr in tracks if id(tr) in seen and tr.seen >= CONFIRM]
+        if self._config.modes:
+            ready = sorted(ready, key=lambda tr: -tr.amplitude)[: self._config.modes]
+        for tr in ready:
+            if not tr.published:
+                tr.published = True
+                self._c['modes_found'] += 1
+        numbered = sorted((tr for tr in tracks if tr.published), key=lambda tr: tr.frequency)
+        explained = min(1.0, float(np.sum(modes.variances)) / total) if total > 0 else 0.0
+        out = []
+        for k, tr in enumerate(numbered, 1):
+            if tr not in ready:
+                continue
+            i, similarity = seen[id(tr)]
+            f, z = float(modes.frequency[i]), float(modes.damping[i])
+            fstd, zstd = float(modes.frequency_std[i]), float(modes.damping_std[i])
+            scale = tr.calibration(t, f, fstd, z, zstd, self._window)
+            tr.estimates += 1
+            est = Estimate(
+                t, f, span, n, explained, tr.amplitude, z, fstd * scale, zstd * scale, k
+            )
+            out.append(JointEstimate(est, modes.shapes[i], modes.shape_std[i], similarity))
+        self._c['estimates'] += len(out)
+        return out
