@@ -4,7 +4,7 @@
 vs the Whittle bound at the window used.
 
     .venv/bin/python benchmarks/bench_operation.py [--seeds 3] [--window 30] [--no-peer]
-        [--real-data ../shared/real-data] [--real-only]
+        [--real-data ../shared/real-data] [--real-only] [--arm-only] [--free-only]
 
 Synthetic records (``vib_estimator.sim.ambient``: white-noise-driven modes, 500 Hz, 180 s, the
 estimates of the whole record, i.e. from the first full window on) and the real Heritage Court
@@ -17,12 +17,17 @@ noise-driven mode in white noise over the window's samples) and the RMS error ov
 (pyOMA2 SSI-cov on consecutive 20 s windows, decimated to >= 4x the highest true frequency,
 block rows 40, orders to 30, the pole nearest the true frequency at order 20:
 ``mpe(order_in=PEER_ORDER)`` -- told the frequencies, a generous peer) median error, share within
-2 %, damping median ratio; and the cost as multiples of real time.
+2 %, damping median ratio; and the cost as multiples of real time. Each driven record is run
+with ``excitation`` ambient and auto (a row each). Last, ``excitation = auto`` on the free-decay
+benchmarks' records (bench_precision, bench_modes, the real beams): the share of ``excitation =
+free``'s estimates it publishes unchanged, what it adds, and the seconds it judged driven
+(``--free-only``: that section alone).
 """
 
 from __future__ import annotations
 
 import argparse
+import itertools
 import logging
 import math
 import os
@@ -56,6 +61,8 @@ CASES = {
 }
 REAL_DATA = Path(__file__).resolve().parents[2] / 'shared' / 'real-data'
 HCT_FILE = Path('heritage_court_tower') / 'hct_setup1.csv'
+#: this package's excitations benchmarked on the driven records (a row each)
+EXCITATIONS = ('ambient', 'auto')
 HCT_MODES = (1.23, 1.29, 1.45, 3.85, 4.26, 5.35)
 PEER_WINDOW_S = 20.0
 PEER_ORDER = 20
@@ -115,7 +122,6 @@ def assign(freq, truth):
 
 
 def synthetic(seeds, window, peer):
-    config = EstimatorConfig(excitation='ambient', ambient_window_s=window)
     n_window = int(window * FS) + 1
     print(f'## Synthetic records: {FS:g} Hz, {DURATION:g} s, {seeds} seeds, window {window:g} s')
     print(
@@ -124,7 +130,9 @@ def synthetic(seeds, window, peer):
         '| spurious | cost (x real time) |'
     )
     print('|---|---|---|---|---|---|---|---|---|---|---|---|')
-    for name, (modes, snr) in CASES.items():
+    for (name, (modes, snr)), excitation in itertools.product(CASES.items(), EXCITATIONS):
+        config = EstimatorConfig(excitation=excitation, ambient_window_s=window)
+        run_peer = peer and excitation == 'ambient'  # the peer does not change with ours
         truth = [m[0] for m in modes]
         err = {k: [] for k in range(len(modes))}
         zs = {k: [] for k in range(len(modes))}
@@ -147,7 +155,7 @@ def synthetic(seeds, window, peer):
                 err[k].extend(rel)
                 zs[k].extend(e.damping[m])
                 cal[k].extend((e.frequency_hz[m] - truth[k]) / e.frequency_std_hz[m])
-            if peer:
+            if run_peer:
                 for k, (f, vals) in enumerate(peer_ssi(t, y, FS, truth).items()):
                     peer_err[k].extend(abs(v[0] / f - 1) for v in vals)
                     peer_z[k].extend(v[1] for v in vals)
@@ -164,12 +172,15 @@ def synthetic(seeds, window, peer):
                 )
                 if len(pe)
                 else 'n/a'
+                if excitation == 'ambient'
+                else 'as above'
             )
             print(
-                f'| {name if k == 0 else ""} | {f:g} Hz | {100 * bound:.2f} % | '
+                f'| {f"{name}, {excitation}" if k == 0 else ""} | {f:g} Hz | '
+                f'{100 * bound:.2f} % | '
                 f'{100 * rms:.2f} % ({rms / bound:.2f}) | {100 * np.median(a):.2f} % | '
                 f'{100 * np.mean(a <= 0.02):.1f} % | {int(np.count_nonzero(a > 0.05))} | '
-                f'{np.median(zs[k]) / z:.2f} | {math.sqrt(np.mean(np.square(cal[k]))):.2f} | '
+                f'{np.nanmedian(zs[k]) / z:.2f} | {math.sqrt(np.mean(np.square(cal[k]))):.2f} | '
                 f'{peer_txt} | '
                 f'{(f"{100 * spurious / max(total, 1):.1f} % of {total}") if k == 0 else ""} | '
                 f'{(f"{seeds * DURATION / cost:.0f}") if k == 0 else ""} |'
@@ -181,7 +192,6 @@ def arm(seeds, window):
     """The simulated arm (Eqs. 19-23, 45.55 g: 1.33 Hz, zeta 0.4 %) never at rest."""
     from vib_estimator.sim.arm_model import simulate_driven
 
-    config = EstimatorConfig(excitation='ambient', ambient_window_s=window)
     print(
         f'\n## Simulated arm under continuous motion (coupling torque, 500 Hz, {DURATION:g} s, '
         f'{seeds} seeds, window {window:g} s)'
@@ -191,7 +201,9 @@ def arm(seeds, window):
         'damping med / true | RMS err/std | estimates |'
     )
     print('|---|---|---|---|---|---|---|---|---|---|')
-    for excitation, level in (('random', 0.3), ('ambient', 0.02)):
+    drives = (('random', 0.3), ('ambient', 0.02))
+    for (excitation, level), ours_excitation in itertools.product(drives, EXCITATIONS):
+        config = EstimatorConfig(excitation=ours_excitation, ambient_window_s=window)
         rel, zs, cal, n_spur, n = [], [], [], 0, 0
         for seed in range(seeds):
             rec = simulate_driven(DURATION, excitation, level, seed=seed)
@@ -206,10 +218,11 @@ def arm(seeds, window):
             cal.extend((e.frequency_hz[m] - f0) / e.frequency_std_hz[m])
         a = np.abs(np.array(rel))
         print(
-            f'| {excitation} (level {level:g}) | {f0:.4f} Hz | {100 * np.median(a):.2f} % | '
+            f'| {excitation} (level {level:g}), {ours_excitation} | {f0:.4f} Hz | '
+            f'{100 * np.median(a):.2f} % | '
             f'{100 * math.sqrt(np.mean(a**2)):.2f} % | {100 * np.mean(a <= 0.02):.1f} % | '
             f'{int(np.count_nonzero(a > 0.05))} | {100 * n_spur / max(n, 1):.1f} % | '
-            f'{np.median(zs) / 0.004:.2f} | {math.sqrt(np.mean(np.square(cal))):.2f} | {n} |'
+            f'{np.nanmedian(zs) / 0.004:.2f} | {math.sqrt(np.mean(np.square(cal))):.2f} | {n} |'
         )
         sys.stdout.flush()
 
@@ -261,6 +274,69 @@ def real_hct(peer, real_data):
         )
 
 
+def free_decays(real_data):
+    """excitation auto on the free-decay benchmarks' records: the share of excitation free's
+    estimates it publishes unchanged (same t, frequency, damping, std) and what it adds."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from bench_modes import CASES as MODE_CASES
+    from bench_modes import CONFIG as MODE_CONFIG
+    from bench_modes import decay
+    from bench_precision import AMP, records
+    from bench_precision import CASES as PRECISION_CASES
+    from real_data import REFERENCE
+
+    from vib_estimator.io.csv_reader import read_csv_series
+    from vib_estimator.sim.arm_model import Move, simulate
+
+    def runs():
+        for label, (model, zeta, offset, band) in PRECISION_CASES.items():
+            cfg = EstimatorConfig.paper(model=model, band_hz=band)
+            sd = AMP / math.sqrt(2 * 10 ** (40 / 20))
+            for periods in (0.5, 2.0, 20.0):
+                recs = [(t, y) for t, y, _, _ in records(zeta, offset, sd, periods, 1)]
+                yield (
+                    f'bench_precision {label}, {periods:g} periods',
+                    cfg.replace(min_periods=periods),
+                    recs,
+                )
+        for label, (freqs, amps, zetas, clip) in MODE_CASES.items():
+            recs = [decay(freqs, amps, zetas, clip, seed) for seed in range(3)]
+            yield f'bench_modes {label}', MODE_CONFIG, recs
+        sched = (Move(0.0, 1.0, 1.0, 0.030), Move(12.0, 0.0, 1.0, 0.06117))
+        rec = simulate(24.0, sched)
+        yield 'bench_modes tip-mass change (arm)', MODE_CONFIG, [(rec.t, rec.torque)]
+        folder = Path(real_data) / 'aluminium_cantilever_adxl357'
+        if folder.is_dir():
+            for length in REFERENCE:
+                s = read_csv_series(folder / f'{length}cm_uniform_1000Hz.csv')
+                for name, cfg in (('defaults', EstimatorConfig()), ('modes 3', MODE_CONFIG)):
+                    yield f'real beam {length} cm, {name}', cfg, [(s.t, s.y)]
+
+    print('\n## Free decays: excitation auto against free on the free-decay benchmarks')
+    print('| records | free estimates | published unchanged by auto | added by auto | driven s |')
+    print('|---|---|---|---|---|')
+    for label, cfg, recs in runs():
+        n_free = same = added = 0
+        driven = 0.0
+        for t, y in recs:
+            free = create_estimator(cfg).process(t, y)
+            auto = create_estimator(cfg.replace(excitation='auto'))
+            e = auto.process(t, y)
+            key = lambda a: set(  # noqa: E731
+                map(repr, zip(a.t.tolist(), a.frequency_hz.tolist(), a.damping.tolist()))
+            )
+            kf, ka = key(free), key(e)
+            n_free += len(kf)
+            same += len(kf & ka)
+            added += len(ka - kf)
+            driven += auto.counters['driven_blocks'] * auto.block_s
+        print(
+            f'| {label} ({len(recs)}) | {n_free} | {100 * same / max(n_free, 1):.1f} % | '
+            f'{added} | {driven:.0f} |'
+        )
+        sys.stdout.flush()
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--seeds', type=int, default=3)
@@ -273,7 +349,13 @@ def main():
     )
     parser.add_argument('--real-only', action='store_true', help='only the real record')
     parser.add_argument('--arm-only', action='store_true', help='only the simulated arm')
+    parser.add_argument(
+        '--free-only', action='store_true', help='only excitation auto on the free decays'
+    )
     args = parser.parse_args()
+    if args.free_only:
+        free_decays(args.real_data)
+        return
     if args.arm_only:
         arm(args.seeds, args.window)
         return
@@ -281,6 +363,7 @@ def main():
         synthetic(args.seeds, args.window, not args.no_peer)
         arm(args.seeds, args.window)
     real_hct(not args.no_peer, args.real_data)
+    free_decays(args.real_data)
 
 
 if __name__ == '__main__':

@@ -220,3 +220,20 @@ def test_excitation_ambient_equals_the_core_and_bad_window_is_refused(tmp_path, 
     assert main(['analyze', str(path), '--excitation', 'ambient', '--ambient-window-s', '1']) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert err[-1].startswith('vib-estimator analyze: error: ambient_window_s')
+
+
+def test_excitation_auto_equals_the_core_and_free_on_a_free_decay(tmp_path, capsys):
+    from vib_estimator.core.modes import create_estimator
+
+    t = np.arange(0.0, 8.0, 0.002)
+    y = np.exp(-0.2 * t) * np.sin(2 * np.pi * 1.33 * t + 0.4) + 1e-3 * np.cos(40.0 * t)
+    path = tmp_path / 'decay.csv'
+    np.savetxt(path, np.column_stack((t, y)), delimiter=',', header='t,y', comments='')
+    assert main(['analyze', str(path), '--excitation', 'auto']) == 0
+    rows = jsonl(capsys.readouterr().out)
+    t, y = np.loadtxt(path, delimiter=',', skiprows=1).T
+    ref = create_estimator(EstimatorConfig(excitation='auto')).process(t, y)
+    free = create_estimator(EstimatorConfig()).process(t, y)
+    assert len(rows) == len(ref) == len(free) > 0
+    assert [r['frequency_hz'] for r in rows] == list(ref.frequency_hz) == list(free.frequency_hz)
+    assert {r['mode'] for r in rows} == {1}

@@ -317,9 +317,7 @@ def run(args: argparse.Namespace) -> int:
         return report(err, 'vib-estimator analyze')
     damage_warning(signal, 'vib-estimator analyze')
     estimates = result.estimates
-    _print(
-        estimates, signal.origin_ns, args.format, config.modes or config.excitation == 'ambient'
-    )
+    _print(estimates, signal.origin_ns, args.format, config.modes or config.excitation != 'free')
     counters = result.estimator.counters
     extra = f', messages_without_component={signal.skipped}' if signal.skipped else ''
     extra += f', corrupt_records={signal.corrupt}' if signal.topic else ''

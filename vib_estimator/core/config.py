@@ -19,8 +19,9 @@ from . import kernel as K
 
 MODELS = ('sinusoid', 'biased-sinusoid', 'damped-sinusoid')
 #: what drives the structure: ``free`` (it rings freely after a pluck: the paper's estimators) or
-#: ``ambient`` (unmeasured broadband forces: output-only identification, :mod:`.ambient`)
-EXCITATIONS = ('free', 'ambient')
+#: ``ambient`` (unmeasured broadband forces: output-only identification, :mod:`.ambient`) or
+#: ``auto`` (decided per stretch of signal from its envelope, :mod:`.auto`)
+EXCITATIONS = ('free', 'ambient', 'auto')
 
 INF = math.inf
 
@@ -214,7 +215,9 @@ class EstimatorConfig:
         'forces: covariance-driven subspace identification over a sliding '
         'window of ambient_window_s, every mode numbered as the mode '
         "tracker's, "
-        'at most modes of them if modes >= 1)',
+        'at most modes of them if modes >= 1) or auto (both, each publishing in '
+        'the stretches its envelope says: a decay after an onset is free, a '
+        'stationary one driven; docs/operation.md)',
     )
     ambient_window_s: float = _param(
         30.0,

@@ -68,6 +68,7 @@ from typing import Dict, List, Sequence, Union
 import numpy as np
 
 from .ambient import AmbientEstimator
+from .auto import AutoEstimator
 from .config import EstimatorConfig
 from .estimator import COUNTER_NAMES, Estimate, EstimateArrays, FrequencyEstimator, as_series
 from .jit import jit
@@ -875,9 +876,12 @@ class ModeTracker:
 
 def create_estimator(
     config: EstimatorConfig,
-) -> Union[FrequencyEstimator, ModeTracker, AmbientEstimator]:
+) -> Union[FrequencyEstimator, ModeTracker, AmbientEstimator, AutoEstimator]:
     """The estimator of a configuration: with ``excitation`` = ambient the output-only
-    identifier (:mod:`.ambient`); else one estimator (``modes`` = 0) or a mode tracker."""
+    identifier (:mod:`.ambient`), with auto both, each in its stretches (:mod:`.auto`); else one
+    estimator (``modes`` = 0) or a mode tracker."""
     if config.excitation == 'ambient':
         return AmbientEstimator(config)
+    if config.excitation == 'auto':
+        return AutoEstimator(config, create_estimator(config.replace(excitation='free')))
     return FrequencyEstimator(config) if config.modes == 0 else ModeTracker(config)

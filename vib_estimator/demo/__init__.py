@@ -10,6 +10,8 @@ printed as it arrives next to the true (Eq. 23) frequency; at the end a Fig. 5/7
 written and a table per mass printed. Exit status 0 only if every mass's median error is within
 3 %.
 ``--shaping`` adds ``shaper_node`` and moves the arm, unshaped then shaped for the estimate.
+``--operation`` drives the arm continuously, never at rest, and runs the estimator with
+``excitation`` ambient (or auto) (:mod:`.operation`).
 
 By role: :mod:`.session` (the domain, this process's node, the node subprocesses),
 :mod:`.estimation` (the estimation demo and its table), :mod:`.shaping` (the shaping demo, its
@@ -27,6 +29,8 @@ import time
 from ..control.shaping import SHAPERS
 from ..sim.arm_model import MASSES_5_5, natural_frequency_hz
 from .estimation import REAL_ARM_SIM_PARAMS, mass_g, run_estimation, summarise
+from .operation import ESTIMATOR_EXCITATIONS, SIM_EXCITATIONS, run_operation
+from .operation import truth as operation_truth
 from .plots import plot_estimation, plot_shaping
 from .session import PAPER_PARAMS, Listener, Record, Session, demo_domain, domain_id, sim_params
 from .shaping import (
@@ -114,6 +118,34 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default=0.5,
         help='with --shaping: size of each move (a reference step), rad (default 0.5)',
     )
+    _add_operation_arguments(parser)
+
+
+def _add_operation_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        '--operation',
+        action='store_true',
+        help='in operation: the arm driven continuously (never at rest), the estimator with '
+        'excitation ambient (docs/operation.md)',
+    )
+    parser.add_argument(
+        '--excitation',
+        default='ambient',
+        choices=ESTIMATOR_EXCITATIONS,
+        help="with --operation: estimator_node's excitation (default ambient)",
+    )
+    parser.add_argument(
+        '--sim-excitation',
+        default='ambient',
+        choices=SIM_EXCITATIONS,
+        help="with --operation: sim_node's excitation (default ambient)",
+    )
+    parser.add_argument(
+        '--duration',
+        type=float,
+        default=80.0,
+        help='with --operation: simulated seconds (default 80; > 30)',
+    )
 
 
 def _interrupt(signum, frame) -> None:
@@ -136,10 +168,18 @@ def run(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 2
+    operation = getattr(args, 'operation', False)
+    if operation and (args.shaping or not args.duration > 30):
+        print(
+            'error: --operation takes no --shaping, and --duration must be > 30', file=sys.stderr
+        )
+        return 2
     truth = [
         (i * args.seconds_per_mass, (i + 1) * args.seconds_per_mass, natural_frequency_hz(m))
         for i, m in enumerate(MASSES_5_5)
     ]
+    if operation:
+        truth = operation_truth(args.duration)
     wall_start = time.monotonic()
     session = Session(args, truth)
     # SIGTERM (a `kill`, a CI timeout) unwinds like Ctrl-C, so the nodes started are stopped too
@@ -147,6 +187,8 @@ def run(args: argparse.Namespace) -> int:
     try:
         if args.shaping:
             return run_shaping(session, args, wall_start)
+        if operation:
+            return run_operation(session, args, wall_start)
         return run_estimation(session, args, wall_start)
     except RuntimeError as err:
         print(f'error: {err}', file=sys.stderr)

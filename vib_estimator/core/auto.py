@@ -1,0 +1,295 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
+"""``excitation = auto``: free decay or driven, decided per stretch of signal (pure numpy).
+
+Both estimators run on every sample: the free-decay one (the algebraic estimator, or the mode
+tracker with ``modes`` >= 1, exactly as ``excitation = free``) and the output-only identifier of
+:mod:`.ambient`. What publishes is decided by the **envelope**, the variance of the signal over
+consecutive blocks of ``ambient_window_s / BLOCKS_PER_WINDOW`` s (at least :data:`MIN_BLOCK_S`):
+
+- a free decay rings down from an onset: after its most energetic block the block energy never
+  rises again, and before it (the rest or noise ahead of the onset) it never falls, beyond the
+  jitter of a block of a few periods (:data:`RISE`); it peaks at once after the onset;
+- a driven response is stationary: its energy falls and rises again, by the statistics of its
+  modes' random amplitudes.
+
+An **onset** is a block more than :data:`ONSET` times as energetic as the one before (a pluck, a
+move from rest), or more than :data:`RISE` times and sudden against the blocks before it
+(:data:`SHARP`: a move while the structure still rings). A free stretch becomes **driven** when,
+over the blocks since the last onset (at most the last :data:`HORIZON_BLOCKS`), the energy rises
+by more than :data:`RISE` after the most energetic block, or falls by more than it before, or the
+peak comes three or more blocks after the onset still rising by more than :data:`RISE` over its
+last two blocks; fewer than :data:`MIN_BLOCKS` blocks since an onset, or a decay, stay free. A
+driven stretch stays driven (a driven response's energy also wanders down for a while) until an
+onset, or until :data:`QUIET_BLOCKS` consecutive blocks are :data:`DROP` times below its median
+block: the structure rang down after the forcing stopped. A record starts free.
+
+A free-decay estimate publishes when its sample ends in a free stretch, an ambient estimate when
+it ends in a driven one: on a record that is a free decay throughout the output is the free
+estimator's (the identifier needs a whole window and confirmations before it publishes at all),
+on a driven one the identifier's, after the first blocks (which are free until the envelope has
+shown it is driven: a few seconds of free-decay estimates of a driven signal).
+
+One ``mode`` scheme: every published estimate continues the mode within
+:data:`~.ambient.MATCH_TOL` of its frequency (else starts one), modes are numbered by ascending
+frequency, 1 = the lowest, as the mode tracker and the identifier number theirs; a mode unseen for
+a window is forgotten.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Sequence
+
+import numpy as np
+
+from .ambient import MATCH_TOL, AmbientEstimator
+from .config import EstimatorConfig
+from .estimator import Estimate, EstimateArrays, as_series
+
+#: envelope blocks per ambient window
+BLOCKS_PER_WINDOW = 30
+#: shortest envelope block, s
+MIN_BLOCK_S = 0.25
+#: most blocks (since the last onset) the envelope test looks back over
+HORIZON_BLOCKS = 10
+#: fewest blocks since an onset before a stretch can be called driven
+MIN_BLOCKS = 3
+#: a rise of the block energy after its peak (or a fall before it) by more than this: driven
+RISE = 1.5
+#: a block this many times as energetic as the one before is an onset (a new free decay)
+ONSET = 10.0
+#: ... or more than RISE times, when its log rise is this many times the largest |log ratio| of
+#: consecutive blocks before it since the last onset (at least MIN_BLOCKS of them): sudden against
+#: a smooth decay (a move while the structure still rings), not a driven response's wandering
+SHARP = 6.0
+#: a driven stretch ends (back to free) when QUIET_BLOCKS consecutive blocks are this many times
+#: less energetic than the median block of the driven stretch (its last BLOCKS_PER_WINDOW blocks):
+#: the structure rang down after the forcing stopped
+DROP = 10.0
+#: ... for this many consecutive blocks
+QUIET_BLOCKS = 6
+#: block energies below this fraction of the horizon's largest count as this fraction (a signal at
+#: exact rest does not make ratios of zeros)
+FLOOR = 1e-6
+#: the states of a stretch
+FREE, DRIVEN = 'free', 'driven'
+
+
+def is_driven(energies: Sequence[float]) -> bool:
+    """The envelope test on consecutive block energies (see the module docstring)."""
+    e = np.asarray(energies, dtype=np.float64)
+    if len(e) < MIN_BLOCKS:
+        return False
+    e = np.maximum(e, FLOOR * float(e.max()) + 1e-300)
+    p = int(np.argmax(e))
+    if p >= 3 and e[p] > RISE * e[p - 2]:  # still rising 3 blocks after an onset: no pluck
+        return True
+    after = e[p + 1 :]
+    if len(after) > 1 and float(np.max(after[1:] / np.minimum.accumulate(after)[:-1])) > RISE:
+        return True
+    before = e[:p]
+    return (
+        len(before) > 1 and float(np.max(np.maximum.accumulate(before)[:-1] / before[1:])) > RISE
+    )
+
+
+def _is_onset(energies: Sequence[float], energy: float) -> bool:
+    """Whether a block of ``energy`` after the blocks ``energies`` (since the last onset) is an
+    onset (see :data:`ONSET`, :data:`SHARP`)."""
+    e = np.asarray(energies, dtype=np.float64)
+    e = np.maximum(e, FLOOR * float(e.max()) + 1e-300)
+    rise = energy / e[-1]
+    if rise > ONSET:
+        return True
+    if rise <= RISE or len(e) < MIN_BLOCKS + 1:
+        return False
+    return math.log(rise) > SHARP * float(np.max(np.abs(np.diff(np.log(e)))))
+
+
+class Envelope:
+    """Block energies of the stream and the free/driven state after each completed block."""
+
+    def __init__(self, block_s: float):
+        self.block_s = block_s
+        self.restart()
+
+    def restart(self) -> None:
+        self.state = FREE
+        self._t0 = None
+        self._last = -math.inf
+        self._k = 0
+        self._n, self._s1, self._s2 = 0, 0.0, 0.0
+        self._energies: list[float] = []  # since the last onset, at most HORIZON_BLOCKS
+        self._driven: list[float] = []  # the driven stretch's last BLOCKS_PER_WINDOW blocks
+        self._quiet = 0  # consecutive blocks DROP below the driven stretch's median
+        self.blocks = {FREE: 0, DRIVEN: 0}  # blocks closed in each state
+        self.changes = {'onsets': 0, 'rang_down': 0, 'became_driven': 0}
+
+    def update(self, t: float, y: float) -> None:
+        """One sample (skipped unless finite and later than the last)."""
+        if not (math.isfinite(t) and math.isfinite(y)) or t <= self._last:
+            return
+        self._last = t
+        if self._t0 is None:
+            self._t0 = t
+        k = int((t - self._t0) // self.block_s)
+        if k != self._k:
+            self._close()
+            self._k = k
+        self._n += 1
+        self._s1 += y
+        self._s2 += y * y
+
+    def _close(self) -> None:
+        n = self._n
+        if n < 2:  # an empty block (a gap): nothing to add
+            self._n, self._s1, self._s2 = 0, 0.0, 0.0
+            return
+        m = self._s1 / n
+        energy = max(0.0, self._s2 / n - m * m)
+        self._n, self._s1, self._s2 = 0, 0.0, 0.0
+        e = self._energies
+        onset = bool(e) and _is_onset(e, energy)
+        if onset:
+            e.clear()
+            self.changes['onsets'] += 1
+        e.append(energy)
+        del e[:-HORIZON_BLOCKS]
+        if self.state == DRIVEN:
+            level = float(np.median(self._driven))
+            self._quiet = self._quiet + 1 if energy * DROP < level else 0
+            if onset or self._quiet >= QUIET_BLOCKS:
+                self.changes['rang_down'] += not onset
+                self.state = FREE
+                self._driven = []
+                e[:] = e[-1:] if onset else e[-MIN_BLOCKS:]
+            else:
+                self._driven = (self._driven + [energy])[-BLOCKS_PER_WINDOW:]
+        elif is_driven(e):
+            self.state = DRIVEN
+            self.changes['became_driven'] += 1
+            self._driven, self._quiet = list(e), 0
+        self.blocks[self.state] += 1
+
+
+class AutoEstimator:
+    """The free-decay estimator and the ambient identifier, each publishing in its own stretches
+    (see the module docstring)."""
+
+    def __init__(self, config: EstimatorConfig, free):
+        """``free``: the estimator of ``config`` with ``excitation = free`` (a
+        :class:`~.estimator.FrequencyEstimator` or a mode tracker: ``create_estimator``)."""
+        config.validate()
+        self._config = config
+        self._free = free
+        self._ambient = AmbientEstimator(config.replace(excitation='ambient'))
+        self._envelope = Envelope(max(MIN_BLOCK_S, config.ambient_window_s / BLOCKS_PER_WINDOW))
+        self._modes: list[list[float]] = []  # [frequency, last t] of the known modes
+        self._published = {FREE: 0, DRIVEN: 0}
+
+    @property
+    def config(self) -> EstimatorConfig:
+        return self._config
+
+    @property
+    def block_s(self) -> float:
+        """The envelope's block, s."""
+        return self._envelope.block_s
+
+    @property
+    def state(self) -> str:
+        """``free`` or ``driven``: the stretch the last sample ends."""
+        return self._envelope.state
+
+    @property
+    def counters(self) -> dict[str, int]:
+        """The free-decay estimator's counters, the identifier's own (``ambient_`` + name) and
+        the envelope's blocks in each state (``free_blocks``, ``driven_blocks``) and the estimates
+        each published (``estimates_free``, ``estimates_driven``)."""
+        c = dict(self._free.counters)
+        for name, n in self._ambient.counters.items():
+            if name not in c:
+                c[name] = n
+            elif name == 'estimates':
+                c['ambient_estimates'] = n
+        c.update(self._envelope.changes)
+        c['free_blocks'] = self._envelope.blocks[FREE]
+        c['driven_blocks'] = self._envelope.blocks[DRIVEN]
+        c['estimates_free'] = self._published[FREE]
+        c['estimates_driven'] = self._published[DRIVEN]
+        c['estimates'] = self._published[FREE] + self._published[DRIVEN]
+        return c
+
+    def mode_counters(self) -> dict[int, dict[str, int]]:
+        """Each known mode's estimates, by its number."""
+        order = sorted(self._modes, key=lambda m: m[0])
+        return {k: {'estimates': int(m[2])} for k, m in enumerate(order, 1)}
+
+    def restart(self) -> None:
+        self._free.restart()
+        self._ambient.restart()
+        self._envelope.restart()
+        self._modes = []
+
+    def reset(self) -> None:
+        self._free.reset()
+        self._ambient.reset()
+
+    # ---- streaming ----------------------------------------------------------------------------
+    def update(self, t: float, y: float) -> list[Estimate]:
+        """Feed one sample; the estimates it completes that belong to the current stretch."""
+        self._envelope.update(float(t), float(y))
+        free = self._free.update(t, y)
+        ambient = self._ambient.update(t, y)
+        if self._envelope.state == FREE:
+            chosen = [] if free is None else (free if isinstance(free, list) else [free])
+        else:
+            chosen = ambient
+        state = self._envelope.state
+        return [
+            dataclasses.replace(e, mode=self._rank(e.frequency_hz, e.t, state)) for e in chosen
+        ]
+
+    def process(self, t: Sequence[float], y: Sequence[float]) -> EstimateArrays:
+        """Feed arrays (continuing the stream); the same estimates as :meth:`update`, by time."""
+        t, y = as_series(t, y)
+        free = self._free.process(t, y)
+        ambient = self._ambient.process(t, y)
+        # the state after each sample (a sample completes at most one block's decision)
+        env = self._envelope
+        states = np.empty(len(t), dtype=bool)
+        for i, (a, b) in enumerate(zip(t.tolist(), y.tolist())):
+            env.update(a, b)
+            states[i] = env.state == DRIVEN
+        names = list(EstimateArrays.__dataclass_fields__)
+        parts, driven = [], []
+        for est, want in ((free, False), (ambient, True)):
+            # an estimate's sample: the last one with its stamp (stamps increase where it counts)
+            idx = np.clip(np.searchsorted(t, est.t, 'right') - 1, 0, max(len(t) - 1, 0))
+            keep = states[idx] == want if len(t) else np.zeros(0, dtype=bool)
+            parts.append(EstimateArrays(**{n: getattr(est, n)[keep] for n in names}))
+            driven.append(np.full(int(np.sum(keep)), want))
+        # by time, stable: at one stamp the free estimate first, an analysis's modes in order
+        kind = np.concatenate(driven)[
+            np.argsort(np.concatenate([p.t for p in parts]), kind='stable')
+        ]
+        out = EstimateArrays.concatenate(parts)
+        out.mode[:] = [
+            self._rank(f, s, DRIVEN if k else FREE)
+            for f, s, k in zip(out.frequency_hz.tolist(), out.t.tolist(), kind.tolist())
+        ]
+        return out
+
+    def _rank(self, f: float, t: float, kind: str) -> int:
+        """The mode number, in the shared scheme, of a ``kind`` estimate of ``f`` Hz at ``t``."""
+        self._published[kind] += 1
+        window = self._config.ambient_window_s
+        self._modes = [m for m in self._modes if t - m[1] <= window]
+        near = min(self._modes, key=lambda m: abs(f / m[0] - 1), default=None)
+        if near is None or abs(f / near[0] - 1) > MATCH_TOL:
+            near = [f, t, 0]
+            self._modes.append(near)
+        near[0], near[1], near[2] = f, t, near[2] + 1
+        return 1 + sum(m[0] < f for m in self._modes if m is not near)
