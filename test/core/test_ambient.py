@@ -187,3 +187,16 @@ def test_modes_limits_to_the_strongest():
     one = AmbientEstimator(AMBIENT.replace(modes=1)).process(t, y)
     assert set(both.mode) == {1, 2}
     assert set(one.mode) == {1} and np.all(np.abs(one.frequency_hz / 5.0 - 1) < 0.02)
+
+
+def test_a_record_too_slow_to_decimate_is_identified_at_every_analysis():
+    """At 20 Hz the modes at 2 and 6 Hz leave no halving to make: the analyses that do not search
+    (4 in 5) identify at the input rate instead of finding nothing."""
+    t, y, _ = ambient_record(180, 20.0, [(2.0, 0.01, 1.0), (6.0, 0.01, 0.5)], 25, seed=1)
+    estimator = AmbientEstimator(EstimatorConfig(excitation='ambient', ambient_window_s=30.0))
+    est = estimator.process(t, y)
+    analyses = estimator.counters['analyses']
+    for f in (2.0, 6.0):
+        near = np.abs(est.frequency_hz / f - 1) < 0.03
+        assert near.sum() >= 0.8 * analyses, (f, near.sum(), analyses)
+        assert abs(np.median(est.frequency_hz[near]) / f - 1) < 0.01

@@ -322,13 +322,7 @@ def stable_clusters(
     return clusters
 
 
-def cluster_modes(
-    poles: list[np.ndarray],
-    fs: float,
-    max_damping: float,
-    band: tuple[float, float],
-    counts: dict[str, int],
-) -> np.ndarray:
+def cluster_modes(poles, fs, max_damping, band, counts) -> np.ndarray:
     """The physical modes of a stabilisation diagram ``poles`` (:func:`ssi_poles`): rows
     (frequency, damping, variance, support), ascending; counts the rejected poles/clusters
     (:func:`stable_clusters`)."""
@@ -347,9 +341,9 @@ def cluster_modes(
 def decimate(y: np.ndarray, fs: float, top_hz: float) -> tuple[np.ndarray, float]:
     """``y`` at the lowest rate fs / 2^k that keeps ``top_hz`` at or below :data:`TOP_NU` of it
     and :data:`MIN_SAMPLES` samples in the window (each halving behind the zero-phase anti-alias
-    filter :data:`DECIMATE_SOS`): ``(samples, rate)``."""
+    filter :data:`DECIMATE_SOS`): ``(samples, rate)``; ``y`` may hold one channel a column."""
     while top_hz <= 0.5 * TOP_NU * fs and len(y) // 2 >= MIN_SAMPLES:
-        y = sosfiltfilt(DECIMATE_SOS, y)[::2]
+        y = sosfiltfilt(DECIMATE_SOS, y, axis=0)[::2]
         fs *= 0.5
     return y, fs
 
@@ -397,15 +391,7 @@ def _strong(modes: np.ndarray, total: float, fs: float, counts: dict[str, int]):
         modes = np.delete(modes, worst, axis=0)
 
 
-def identify(
-    y: np.ndarray,
-    fs: float,
-    max_damping: float = 0.1,
-    band: tuple[float, float] = (0.0, math.inf),
-    counts: dict[str, int] | None = None,
-    top_hz: float = 0.0,
-    search: bool = True,
-):
+def identify(y, fs, max_damping=0.1, band=(0.0, math.inf), counts=None, top_hz=0.0, search=True):
     """Modes of one window ``y`` sampled at ``fs``: (rows of frequency, damping, variance,
     frequency std, damping std, ascending; the white noise variance left over; the window's
     variance). A first pass at ``fs`` (or, if it finds none, at the first of the rates halved in
@@ -430,7 +416,7 @@ def identify(
     top = max(float(np.max(modes[:, 0])) if len(modes) else 0.0, top_hz)
     if top > 0:
         yq, rate = decimate(y, fs, top)
-        if rate < fs:
+        if rate < fs or not (search or top_hz <= 0):  # (no search pass ran at fs)
             modes, noise = _strong(
                 _modes_at(yq, rate, max_damping, band, counts), total, fs, counts
             )
@@ -476,18 +462,23 @@ class _Track:
         return max(1.0, math.sqrt(float(np.mean(d * d))))
 
 
-class AmbientEstimator:
-    """Sliding-window output-only mode identification; see the module docstring."""
+class SlidingWindowIdentifier:
+    """The sliding window both output-only identifiers share (this module's, one channel, and
+    :class:`vib_estimator.core.multichannel.JointAmbientEstimator`): the samples' buffer (``y``:
+    one value or one row of ``channels`` values a sample), their checks and counters, the runs of
+    clean samples of a batch, and the window each analysis reads. A subclass analyses a window
+    (``_analyse``) and tracks its modes."""
 
-    def __init__(self, config: EstimatorConfig):
+    def __init__(self, config: EstimatorConfig, channels: int = 0):
         config.validate()
         self._config = config
         self._window = config.ambient_window_s
         self._band = config.band_hz or (0.0, math.inf)
         self._c = dict.fromkeys(COUNTER_NAMES, 0)
+        self._row = (channels,) if channels else ()  # the shape of one sample's values
         self._t = np.empty(1 << 14)
-        self._y = np.empty(1 << 14)
-        self._tracks: list[_Track] = []
+        self._y = np.empty((1 << 14, *self._row))
+        self._tracks: list = []
         self.restart()
 
     @property
@@ -497,13 +488,6 @@ class AmbientEstimator:
     @property
     def counters(self) -> dict[str, int]:
         return dict(self._c)
-
-    def mode_counters(self) -> dict[int, dict[str, int]]:
-        """Each current mode's estimates (as the mode tracker's ``mode_counters``)."""
-        published = sorted(
-            (tr for tr in self._tracks if tr.published), key=lambda tr: tr.frequency
-        )
-        return {k: {'estimates': tr.estimates} for k, tr in enumerate(published, 1)}
 
     def restart(self) -> None:
         """Forget the signal and the tracked modes; counters are kept."""
@@ -529,7 +513,9 @@ class AmbientEstimator:
             if keep + m > len(self._t) // 2:  # grow
                 size = 1 << math.ceil(math.log2(2 * (keep + m)))
                 self._t = np.concatenate((self._t[self._start : self._n], np.empty(size - keep)))
-                self._y = np.concatenate((self._y[self._start : self._n], np.empty(size - keep)))
+                self._y = np.concatenate(
+                    (self._y[self._start : self._n], np.empty((size - keep, *self._row)))
+                )
             else:  # compact
                 self._t[:keep] = self._t[self._start : self._n]
                 self._y[:keep] = self._y[self._start : self._n]
@@ -540,11 +526,12 @@ class AmbientEstimator:
             self._next = float(t[0]) + self._window
         self._n += m
 
-    def _accept(self, t: float, y: float) -> bool:
-        """Count one sample; False if skipped. A gap or a long jump back clears the window."""
+    def _accept(self, t: float, finite: bool) -> bool:
+        """Count one sample (``finite``: its values are); False if skipped. A gap or a long jump
+        back clears the window."""
         c = self._c
         c['received'] += 1
-        if not (math.isfinite(t) and math.isfinite(y)):
+        if not (finite and math.isfinite(t)):
             c['skipped_non_finite'] += 1
             return False
         last = self._last
@@ -562,34 +549,18 @@ class AmbientEstimator:
         c['used'] += 1
         return True
 
-    def update(self, t: float, y: float) -> list[Estimate]:
-        """Feed one sample; the estimates of an analysis it completes (ascending mode)."""
-        t, y = float(t), float(y)
-        if not self._accept(t, y):
-            return []
-        self._append(np.array((t,)), np.array((y,)))
-        if t >= self._next:
-            return self._analyse()
-        return []
-
-    def process(self, t: Sequence[float], y: Sequence[float]) -> EstimateArrays:
-        """Feed arrays of samples (continuing the stream); the estimates as columns, by time."""
-        t, y = as_series(t, y)
-        out: list[Estimate] = []
+    def _feed(self, t: np.ndarray, y: np.ndarray, finite: np.ndarray) -> list:
+        """Feed a batch (``finite``: per sample, its values are): each clean run (finite,
+        increasing, no gap) at once up to the next analysis, any other sample through
+        ``update``; the estimates of the analyses, in order."""
+        out: list = []
+        gap = self._config.max_gap
         i, n = 0, len(t)
         while i < n:
-            # the longest clean run from i: finite, increasing, no gap (else one sample at a time)
             j = i
-            if (
-                math.isfinite(t[i])
-                and math.isfinite(y[i])
-                and t[i] > self._last
-                and (t[i] - self._last <= self._config.max_gap or not self._n)
-            ):
+            if finite[i] and t[i] > self._last and (t[i] - self._last <= gap or not self._n):
                 d = np.diff(t[i : min(n, i + 65536)])
-                bad = ~((d > 0) & (d <= self._config.max_gap)) | ~np.isfinite(
-                    y[i + 1 : i + 1 + len(d)]
-                )
+                bad = ~((d > 0) & (d <= gap)) | ~finite[i + 1 : i + 1 + len(d)]
                 j = i + 1 + (int(np.argmax(bad)) if bad.any() else len(d))
             if j == i:
                 out.extend(self.update(t[i], y[i]))
@@ -606,10 +577,34 @@ class AmbientEstimator:
                 i = k
                 if self._last >= self._next:
                     out.extend(self._analyse())
-        return _columns(out)
+        return out
 
-    # ---- analysis -----------------------------------------------------------------------------
-    def _analyse(self) -> list[Estimate]:
+    def _confirm(self, seen: dict, t: float) -> tuple[list, list]:
+        """After an analysis at ``t`` (``seen``: the tracks it saw, by id): forget the unseen
+        unpublished tracks and the published ones unseen for a window, publish those seen
+        ``CONFIRM`` analyses running (the ``modes`` strongest if set); ``(the tracks to publish
+        now, every published track by ascending frequency: the mode numbers)``."""
+        tracks = self._tracks
+        for tr in list(tracks):
+            if id(tr) not in seen:
+                tr.seen = 0
+                if not tr.published or t - tr.last_t > self._window:
+                    tracks.remove(tr)
+                    self._c['modes_lost'] += tr.published
+        ready = [tr for tr in tracks if id(tr) in seen and tr.seen >= CONFIRM]
+        if self._config.modes:
+            ready = sorted(ready, key=lambda tr: -tr.amplitude)[: self._config.modes]
+        for tr in ready:
+            if not tr.published:
+                tr.published = True
+                self._c['modes_found'] += 1
+        numbered = sorted((tr for tr in tracks if tr.published), key=lambda tr: tr.frequency)
+        return ready, numbered
+
+    def _next_window(self):
+        """Advance to the next analysis; ``(samples' times, values, rate, span, the highest
+        published mode's frequency (0: none), whether to search the whole band)`` of the window
+        it reads, or None when the window is too short."""
         t_end = self._t[self._n - 1]
         self._next += HOP_S
         if self._next <= t_end:
@@ -619,18 +614,50 @@ class AmbientEstimator:
         )
         self._start = first
         ts, ys = self._t[first : self._n], self._y[first : self._n]
-        n = len(ts)
-        if n < 4 * BLOCK_ROWS + 2:
-            return []
+        if len(ts) < 4 * BLOCK_ROWS + 2:
+            return None
         span = float(ts[-1] - ts[0])
-        fs = (n - 1) / span
         self._c['analyses'] += 1
         known = max((tr.frequency for tr in self._tracks if tr.published), default=0.0)
         search = self._c['analyses'] % SEARCH_EVERY == 1
+        return ts, ys, (len(ts) - 1) / span, span, known, search
+
+
+class AmbientEstimator(SlidingWindowIdentifier):
+    """Sliding-window output-only mode identification; see the module docstring."""
+
+    def mode_counters(self) -> dict[int, dict[str, int]]:
+        """Each current mode's estimates (as the mode tracker's ``mode_counters``)."""
+        published = sorted(
+            (tr for tr in self._tracks if tr.published), key=lambda tr: tr.frequency
+        )
+        return {k: {'estimates': tr.estimates} for k, tr in enumerate(published, 1)}
+
+    def update(self, t: float, y: float) -> list[Estimate]:
+        """Feed one sample; the estimates of an analysis it completes (ascending mode)."""
+        t, y = float(t), float(y)
+        if not self._accept(t, math.isfinite(y)):
+            return []
+        self._append(np.array((t,)), np.array((y,)))
+        if t >= self._next:
+            return self._analyse()
+        return []
+
+    def process(self, t: Sequence[float], y: Sequence[float]) -> EstimateArrays:
+        """Feed arrays of samples (continuing the stream); the estimates as columns, by time."""
+        t, y = as_series(t, y)
+        return _columns(self._feed(t, y, np.isfinite(t) & np.isfinite(y)))
+
+    # ---- analysis -----------------------------------------------------------------------------
+    def _analyse(self) -> list[Estimate]:
+        window = self._next_window()
+        if window is None:
+            return []
+        ts, ys, fs, span, known, search = window
         modes, _noise, total = identify(
             ys, fs, self._config.max_damping, self._band, self._c, known, search
         )
-        return self._track(modes, total, float(t_end), span, n)
+        return self._track(modes, total, float(ts[-1]), span, len(ts))
 
     def _track(
         self, modes: np.ndarray, total: float, t: float, span: float, n: int
@@ -661,20 +688,7 @@ class AmbientEstimator:
                 continue
             tr.frequency, tr.last_t, tr.amplitude = m[0], t, math.sqrt(m[2])
             seen[id(tr)] = m
-        for tr in list(tracks):
-            if id(tr) not in seen:
-                tr.seen = 0
-                if not tr.published or t - tr.last_t > self._window:
-                    tracks.remove(tr)
-                    self._c['modes_lost'] += tr.published
-        ready = [tr for tr in tracks if id(tr) in seen and tr.seen >= CONFIRM]
-        if self._config.modes:
-            ready = sorted(ready, key=lambda tr: -tr.amplitude)[: self._config.modes]
-        for tr in ready:
-            if not tr.published:
-                tr.published = True
-                self._c['modes_found'] += 1
-        numbered = sorted((tr for tr in tracks if tr.published), key=lambda tr: tr.frequency)
+        ready, numbered = self._confirm(seen, t)
         explained = min(1.0, float(np.sum(modes[:, 2])) / total) if total > 0 else 0.0
         out = []
         for k, tr in enumerate(numbered, 1):

@@ -59,10 +59,8 @@ from scipy.signal import sosfiltfilt
 
 from .ambient import (
     BLOCK_ROWS,
-    CONFIRM,
     COUNTER_NAMES,
     DECIMATE_SOS,
-    HOP_S,
     MATCH_TOL,
     MAX_STD_REL,
     MAX_TRACKS,
@@ -71,9 +69,9 @@ from .ambient import (
     MIN_SAMPLES,
     NU_MAX,
     ORDERS,
-    SEARCH_EVERY,
-    TOP_NU,
     ModeTrack,
+    SlidingWindowIdentifier,
+    decimate,
     estimate_columns,
     sdof_psd,
     stable_clusters,
@@ -270,14 +268,6 @@ def strong_joint(rows, shapes, stds, totals, fs, counts):
         rows, shapes, stds = (np.delete(x, worst, axis=0) for x in (rows, shapes, stds))
 
 
-def joint_decimate(y: np.ndarray, fs: float, top_hz: float) -> tuple[np.ndarray, float]:
-    """:func:`..ambient.decimate` of every column of ``y`` (samples x channels)."""
-    while top_hz <= 0.5 * TOP_NU * fs and len(y) // 2 >= MIN_SAMPLES:
-        y = sosfiltfilt(DECIMATE_SOS, y, axis=0)[::2]
-        fs *= 0.5
-    return y, fs
-
-
 def identify_joint(
     y: np.ndarray,
     fs: float,
@@ -307,7 +297,7 @@ def identify_joint(
             yk, rate = sosfiltfilt(DECIMATE_SOS, yk, axis=0)[::2], 0.5 * rate
     top = max(float(np.max(strong[0][:, 0])) if len(strong[0]) else 0.0, top_hz)
     if top > 0:
-        yq, rate = joint_decimate(y, fs, top)
+        yq, rate = decimate(y, fs, top)
         if rate < fs or not (search or top_hz <= 0):  # (no search pass ran at fs)
             strong = strong_joint(
                 *joint_modes_at(yq, rate, max_damping, band, counts), totals, fs, counts
@@ -362,90 +352,24 @@ class _ShapeTrack(ModeTrack):
     __slots__ = ('shape',)
 
 
-class JointAmbientEstimator:
+class JointAmbientEstimator(SlidingWindowIdentifier):
     """Sliding-window joint output-only identification; see the module docstring.
 
     ``channels``: the channel names (their count is the number of columns fed)."""
 
     def __init__(self, config: EstimatorConfig, channels: Sequence[str]):
-        config.validate()
         channels = tuple(str(c) for c in channels)
         if len(channels) < MIN_CHANNELS:
             raise ValueError(
                 f'a joint identification needs at least {MIN_CHANNELS} channels, '
                 f'got {len(channels)} (one channel: excitation ambient, one column)'
             )
-        self._config = config
         self._channels = channels
-        self._window = config.ambient_window_s
-        self._band = config.band_hz or (0.0, math.inf)
-        self._c = dict.fromkeys(COUNTER_NAMES, 0)
-        self._t = np.empty(1 << 14)
-        self._y = np.empty((1 << 14, len(channels)))
-        self._tracks: list[_ShapeTrack] = []
-        self.restart()
-
-    @property
-    def config(self) -> EstimatorConfig:
-        return self._config
+        super().__init__(config, len(channels))
 
     @property
     def channels(self) -> tuple[str, ...]:
         return self._channels
-
-    @property
-    def counters(self) -> dict[str, int]:
-        return dict(self._c)
-
-    def restart(self) -> None:
-        """Forget the signal and the tracked modes; counters are kept."""
-        self._tracks = []
-        self._last = -math.inf
-        self._clear()
-
-    def reset(self) -> None:
-        """Start a new window at the next sample (the tracked modes are kept)."""
-        self._clear()
-
-    def _clear(self) -> None:
-        self._n = 0
-        self._start = 0
-        self._next = math.inf
-
-    # ---- input --------------------------------------------------------------------------------
-    def _room(self, more: int = 1) -> None:
-        """Make room for ``more`` samples (compact, or grow)."""
-        keep = self._n - self._start
-        if keep + more > len(self._t) // 2:
-            size = 1 << math.ceil(math.log2(2 * (keep + more)))
-            t, y = np.empty(size), np.empty((size, len(self._channels)))
-        else:
-            t, y = self._t, self._y
-        t[:keep] = self._t[self._start : self._n]
-        y[:keep] = self._y[self._start : self._n]
-        self._t, self._y, self._n, self._start = t, y, keep, 0
-
-    def _accept(self, t: float, finite: bool) -> bool:
-        """Count one sample; False if skipped. A gap or a long jump back clears the window."""
-        c = self._c
-        c['received'] += 1
-        if not (finite and math.isfinite(t)):
-            c['skipped_non_finite'] += 1
-            return False
-        last = self._last
-        if t <= last:
-            if last - t > self._config.max_gap:
-                c['time_jump_resets'] += 1
-                self._clear()
-            else:
-                c['skipped_duplicate' if t == last else 'skipped_out_of_order'] += 1
-                return False
-        elif t - last > self._config.max_gap and self._n:
-            c['gap_resets'] += 1
-            self._clear()
-        self._last = t
-        c['used'] += 1
-        return True
 
     def update(self, t: float, y: Sequence[float]) -> list[JointEstimate]:
         """Feed one sample (one value per channel); the estimates of an analysis it completes."""
@@ -455,13 +379,7 @@ class JointAmbientEstimator:
         t = float(t)
         if not self._accept(t, bool(np.all(np.isfinite(y)))):
             return []
-        if self._n == len(self._t):
-            self._room()
-        if self._n == 0:
-            self._next = t + self._window
-        self._t[self._n] = t
-        self._y[self._n] = y
-        self._n += 1
+        self._append(np.array((t,)), y[None, :])
         if t >= self._next:
             return self._analyse()
         return []
@@ -476,37 +394,7 @@ class JointAmbientEstimator:
                 f't must be 1-D and y samples x {len(self._channels)} channels, '
                 f'got {t.shape}, {y.shape}'
             )
-        finite = np.isfinite(y).all(axis=1) & np.isfinite(t)
-        gap = self._config.max_gap
-        out: list[JointEstimate] = []
-        i, n = 0, len(t)
-        while i < n:
-            # the longest clean run from i: finite, increasing, no gap (else one sample at a time)
-            j = i
-            if finite[i] and t[i] > self._last and (t[i] - self._last <= gap or not self._n):
-                d = np.diff(t[i : min(n, i + 65536)])
-                bad = ~((d > 0) & (d <= gap)) | ~finite[i + 1 : i + 1 + len(d)]
-                j = i + 1 + (int(np.argmax(bad)) if bad.any() else len(d))
-            if j == i:
-                out.extend(self.update(t[i], y[i]))
-                i += 1
-                continue
-            while i < j:
-                if not self._n:
-                    self._next = float(t[i]) + self._window
-                k = min(j, int(np.searchsorted(t[i:j], self._next, 'left')) + i + 1)
-                self._c['received'] += k - i
-                self._c['used'] += k - i
-                while self._n + (k - i) > len(self._t):
-                    self._room(k - i)
-                self._t[self._n : self._n + k - i] = t[i:k]
-                self._y[self._n : self._n + k - i] = y[i:k]
-                self._n += k - i
-                self._last = float(t[k - 1])
-                i = k
-                if self._last >= self._next:
-                    out.extend(self._analyse())
-        return self._columns(out)
+        return self._columns(self._feed(t, y, np.isfinite(y).all(axis=1) & np.isfinite(t)))
 
     def _columns(self, out: list[JointEstimate]) -> JointEstimates:
         m = len(self._channels)
@@ -520,27 +408,14 @@ class JointAmbientEstimator:
 
     # ---- analysis -----------------------------------------------------------------------------
     def _analyse(self) -> list[JointEstimate]:
-        t_end = self._t[self._n - 1]
-        self._next += HOP_S
-        if self._next <= t_end:
-            self._next = t_end + HOP_S
-        first = self._start + int(
-            np.searchsorted(self._t[self._start : self._n], t_end - self._window, 'left')
-        )
-        self._start = first
-        ts, ys = self._t[first : self._n], self._y[first : self._n]
-        n = len(ts)
-        if n < 4 * BLOCK_ROWS + 2:
+        window = self._next_window()
+        if window is None:
             return []
-        span = float(ts[-1] - ts[0])
-        fs = (n - 1) / span
-        self._c['analyses'] += 1
-        known = max((tr.frequency for tr in self._tracks if tr.published), default=0.0)
-        search = self._c['analyses'] % SEARCH_EVERY == 1
+        ts, ys, fs, span, known, search = window
         modes, total = identify_joint(
             ys, fs, self._config.max_damping, self._band, self._c, known, search
         )
-        return self._track(modes, total, float(t_end), span, n)
+        return self._track(modes, total, float(ts[-1]), span, len(ts))
 
     def _match(self, modes: JointModes) -> dict[int, int]:
         """Each window mode's track: nearest in frequency within ``MATCH_TOL`` among those whose
@@ -582,20 +457,7 @@ class JointAmbientEstimator:
             tr.amplitude = math.sqrt(float(np.sum(modes.variances[i])))
             tr.shape = modes.shapes[i]
             seen[id(tr)] = (i, similarity)
-        for tr in list(tracks):
-            if id(tr) not in seen:
-                tr.seen = 0
-                if not tr.published or t - tr.last_t > self._window:
-                    tracks.remove(tr)
-                    self._c['modes_lost'] += tr.published
-        ready = [tr for tr in tracks if id(tr) in seen and tr.seen >= CONFIRM]
-        if self._config.modes:
-            ready = sorted(ready, key=lambda tr: -tr.amplitude)[: self._config.modes]
-        for tr in ready:
-            if not tr.published:
-                tr.published = True
-                self._c['modes_found'] += 1
-        numbered = sorted((tr for tr in tracks if tr.published), key=lambda tr: tr.frequency)
+        ready, numbered = self._confirm(seen, t)
         explained = min(1.0, float(np.sum(modes.variances)) / total) if total > 0 else 0.0
         out = []
         for k, tr in enumerate(numbered, 1):
