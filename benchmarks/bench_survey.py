@@ -9,8 +9,9 @@ Prints:
 - CSV: the streaming reader (pyarrow blocks) in M rows/s on a ``--rows`` numeric CSV (goal >= 5),
   beside ``numpy.loadtxt`` and the exact row-by-row reader (today's rules) on a tenth of it;
 - MCAP: the streaming reader in M messages/s on a ``--messages`` WrenchStamped bag (goal >= 1 per
-  core), beside rosbags' generic ``deserialize_cdr`` and the reference ``read_wrench_series`` on a
-  tenth of it;
+  core), beside rosbags' generic ``deserialize_cdr``, the reference ``read_wrench_series`` and the
+  streaming reader decoding chunk by chunk (``MCAP_BATCH_MESSAGES`` 1, as before the batches) on
+  a tenth of it;
 - peak RSS of a fresh process that streams the whole CSV / bag through the estimator (goal
   <= 300 MB), beside the RSS of the same process that only imports the package (the floor);
 - survey of 8 recordings (CSV, 1 M rows each): ``--jobs 2`` against ``--jobs 1`` (goal >= 1.7x;
@@ -20,7 +21,9 @@ Prints:
   started and warmed up before timing, as a long-lived cluster is). ``--jobs 1``, ``--jobs 2``
   and Dask run alternately, three rounds, so that all see the same load; ``--jobs 2`` uses the pool
   kept from the survey before (``survey.local_pool``), beside it (a fourth alternated run) a pool
-  started inside the timed survey, as a one-off ``vib-estimator survey`` does.
+  started inside the timed survey, as a one-off ``vib-estimator survey`` does;
+- survey of 8 MCAP bags x 250 000 ``WrenchStamped`` messages (issue 24's fleet): M messages/s with
+  ``--jobs 1`` and ``--jobs 2`` (goal >= 3 M msgs/s), and the speed-up (goal >= 1.7x).
 Reader throughputs are per CPU second of the process (``time.process_time``, all threads); the
 survey times are wall-clock. Each time is the best of 2 runs (the surveys: of the 3 rounds). The
 generated files go to ``--work`` (default a temporary folder).
@@ -156,7 +159,16 @@ def bench_bag(work: Path, messages: int) -> Path:
 
     gen = cpu(generic, 1)
     ref = cpu(lambda: read_wrench_series(small), 1)
-    refs = {'rosbags deserialize_cdr': gen, 'read_wrench_series': ref}
+    batch, streaming.MCAP_BATCH_MESSAGES = streaming.MCAP_BATCH_MESSAGES, 1
+    try:  # the streaming reader one chunk at a time (before the batches of chunks)
+        one_chunk = cpu(lambda: drain(streaming.open_signal(small)), 1)
+    finally:
+        streaming.MCAP_BATCH_MESSAGES = batch
+    refs = {
+        'rosbags deserialize_cdr': gen,
+        'read_wrench_series': ref,
+        'chunk by chunk': one_chunk,
+    }
     report('mcap', 'msg', messages, fast, refs, '>= 1 M msg/s per core')
     return big
 
@@ -226,6 +238,35 @@ def bench_survey(work: Path) -> None:
     )
 
 
+def bench_survey_bags(work: Path, messages: int = 250_000, bags: int = 8) -> None:
+    """Issue 24's fleet: ``bags`` MCAP bags of ``messages`` WrenchStamped each, surveyed with
+    ``--jobs 1`` and ``--jobs 2`` (the kept pool) alternately, three rounds, best of each; M
+    messages/s of the fleet, wall-clock."""
+    folder = work / 'bag_fleet'
+    folder.mkdir(exist_ok=True)
+    for i in range(bags):
+        write_bag(folder / f'bag_{i}', messages)
+    recordings = S.find_recordings([str(folder)])
+    options = S.Options(EstimatorConfig())
+    S.survey(recordings[:1], options)  # compile, warm caches
+    S.survey(recordings[:2], options, jobs=2)  # start the kept pool
+    rounds = [
+        (
+            with_cpu(lambda: S.survey(recordings, options, jobs=1), 1),
+            with_cpu(lambda: S.survey(recordings, options, jobs=2), 1),
+        )
+        for _ in range(3)
+    ]
+    (one, cpu_one), (two, cpu_two) = (min(r[i] for r in rounds) for i in (0, 1))
+    total = messages * bags / 1e6
+    print(
+        f'survey {bags} bags x {messages} msgs  --jobs 1 {one:6.2f} s ({total / one:5.2f} M '
+        f'msgs/s, {cpu_one:5.2f} CPU s)   --jobs 2 {two:6.2f} s ({total / two:5.2f} M msgs/s, '
+        f'{cpu_two:5.2f} CPU s)   speed-up {one / two:5.2f}x   (goals >= 3 M msgs/s with '
+        f'--jobs 2, speed-up >= 1.7)'
+    )
+
+
 def with_cpu(fn, repeats=2):
     """(wall s, CPU s of this process and of its children, finished or running: the kept pool's
     workers) of ``fn``, best of ``repeats``."""
@@ -257,14 +298,19 @@ def main() -> None:
     parser.add_argument('--rows', type=int, default=5_000_000)
     parser.add_argument('--messages', type=int, default=5_000_000)
     parser.add_argument('--work', type=Path)
+    parser.add_argument('--only-bags', action='store_true', help='only the MCAP fleet survey')
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         work = args.work or Path(tmp)
         work.mkdir(parents=True, exist_ok=True)
+        if args.only_bags:
+            bench_survey_bags(work)
+            return
         csv_path = bench_csv(work, args.rows)
         bag_path = bench_bag(work, args.messages)
         bench_rss(csv_path, bag_path)
         bench_survey(work)
+        bench_survey_bags(work)
 
 
 if __name__ == '__main__':

@@ -108,6 +108,33 @@ def test_damaged_index_entries_never_give_more_messages(tmp_path, intact):
         assert len(list(bag.messages())) == N - 2 and bag.corrupt == 2
 
 
+def test_chunks_read_together_are_the_chunks_read_one_by_one(tmp_path, intact):
+    """``read_chunks`` (the streaming reader's batches) gives each chunk's messages, in order,
+    and counts the same damage as ``read_chunk`` chunk by chunk: a damaged chunk between intact
+    ones, and an index entry of another pointing into a payload."""
+
+    def edit(data):
+        _, _, _, _, indexes = mcap.read_summary(intact[0] / 'bag.mcap').chunks[0]
+        offset, _ = next(iter(indexes.values()))
+        entries = offset + mcap.RECORD_HEAD + 2 + 4
+        data[entries + 40 : entries + 48] = (7).to_bytes(8, 'little')  # entry 2 -> byte 7
+        return flip(data, chunk_middle(intact[0], 2), 64)
+
+    path = damaged_copy(tmp_path, intact, edit)
+    plan = mcap.read_plan([path / 'bag.mcap'], '/w')
+    assert len(plan) >= 4
+    with (path / 'bag.mcap').open('rb') as handle:
+        each = [mcap.read_chunk(handle, chunk) for chunk in plan]
+        together = mcap.read_chunks(handle, plan)
+    payloads = [p for messages in each for p in messages.payloads()]
+    assert list(together.payloads()) == payloads
+    with (intact[0] / 'bag.mcap').open('rb') as handle:
+        lost = len(mcap.read_chunk(handle, plan[2]).offsets)  # the damaged chunk's, intact
+    assert together.skipped == sum(m.skipped for m in each) == 1 + lost
+    assert together.damage == '; '.join(m.damage for m in each if m.damage)
+    assert together.damage.count('damaged') == 1 and 'do not point' in together.damage
+
+
 def test_a_payload_that_does_not_decode_is_skipped(tmp_path, intact):
     """A message whose frame_id length runs past its payload (valid framing, no CRC): the CDR
     decode of every message finds it."""

@@ -120,6 +120,7 @@ def test_fast_path_is_taken_and_matches_the_reference_reader(tmp_path):
 def test_blocks_are_bounded_whatever_the_length(tmp_path, monkeypatch):
     """Constant memory by construction: no block exceeds the block size, however long the file."""
     monkeypatch.setattr(streaming, 'BLOCK_SAMPLES', 4096)
+    monkeypatch.setattr(streaming, 'MCAP_BATCH_MESSAGES', 2048)
     monkeypatch.setattr(csv_reader, 'CSV_BLOCK_BYTES', 1 << 16)
     n = 200_000
     t = np.arange(n) * 0.001
@@ -131,8 +132,9 @@ def test_blocks_are_bounded_whatever_the_length(tmp_path, monkeypatch):
     stamps = EPOCH + np.arange(60_000, dtype=np.int64) * 1_000_000
     write_wrench_series(tmp_path / 'bag', WrenchSeries(stamps, np.zeros(60_000), 'f', '/w'))
     _, parts = collect(open_signal(tmp_path / 'bag'))
-    # one chunk of the file (~13k messages of 1 MB) on top of a full block at most
-    assert len(parts) > 3 and max(len(p[0]) for p in parts) < 4096 + 20_000
+    # a batch of chunks (the batch size, plus one chunk of ~13k messages of 1 MB) on top of a
+    # full block at most
+    assert len(parts) > 3 and max(len(p[0]) for p in parts) < 4096 + 2048 + 20_000
 
 
 @pytest.mark.parametrize(

@@ -57,6 +57,8 @@ from .fields import (
 
 #: samples per block handed to the estimator (bags: chunks are grouped up to this size)
 BLOCK_SAMPLES = 1 << 18
+#: messages of an MCAP file read and decoded together, about (whole chunks: :func:`_mcap_batches`)
+MCAP_BATCH_MESSAGES = 1 << 15
 
 Block = Tuple[np.ndarray, np.ndarray]
 
@@ -318,18 +320,34 @@ def _pack(batch) -> Tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
 
 
 def _mcap_batches(plan: List[mcap.ChunkRead], signal: Signal):
-    """(buf, payload offsets, lengths, log times) of the topic's messages, chunk by chunk; the
-    damaged records of each chunk counted."""
+    """(buf, payload offsets, lengths, log times) of the topic's messages, consecutive chunks of
+    a file read together up to about :data:`MCAP_BATCH_MESSAGES` messages
+    (:func:`.mcap.read_chunks`); the damaged
+    records of each chunk counted."""
     handles: Dict[Path, object] = {}
     try:
-        for chunk in plan:
-            handle = handles.get(chunk.path) or handles.setdefault(
-                chunk.path, chunk.path.open('rb')
-            )
-            messages = mcap.read_chunk(handle, chunk)
+        for group in _chunk_groups(plan, MCAP_BATCH_MESSAGES):
+            path = group[0].path
+            handle = handles.get(path) or handles.setdefault(path, path.open('rb'))
+            messages = mcap.read_chunks(handle, group)
             signal.count_damage(messages.skipped, messages.damage)
             if len(messages.offsets):
                 yield messages.records, messages.offsets, messages.lengths, messages.log_times
     finally:
         for handle in handles.values():
             handle.close()
+
+
+def _chunk_groups(plan: List[mcap.ChunkRead], size: int) -> Iterator[List[mcap.ChunkRead]]:
+    """Runs of consecutive chunks of one file holding about ``size`` messages (counted from
+    their message indexes' lengths: an entry is 16 bytes)."""
+    group: List[mcap.ChunkRead] = []
+    count = 0
+    for chunk in plan:
+        if group and (chunk.path != group[0].path or count >= size):
+            yield group
+            group, count = [], 0
+        group.append(chunk)
+        count += sum(length for _, _, length in chunk.index_offsets) // mcap.INDEX_ENTRY.itemsize
+    if group:
+        yield group
