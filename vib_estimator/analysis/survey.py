@@ -55,7 +55,7 @@ import numpy as np
 from ..core import COUNTER_NAMES, EstimatorConfig
 from ..errors import VibEstimatorError, report
 from ..io.fields import DEFAULT_COMPONENT, check_component
-from ..io.streaming import bag_topics, is_csv, open_signal, supported_topics
+from ..io.streaming import BagInfo, bag_info, is_csv, open_signal, supported_topics
 from .analyze import add_config_arguments, estimate_signal, make_config
 from .interval import combine
 from .outputs import check_output
@@ -335,18 +335,21 @@ def _stat_rows(recording: Path, signal, result, modes: int, summary: str) -> Lis
     return rows
 
 
-def _targets(path: Path, options: Options) -> List[Tuple[Optional[str], Optional[str]]]:
-    """(topic, component) pairs to read from a recording."""
+def _targets(
+    path: Path, options: Options
+) -> Tuple[List[Tuple[Optional[str], Optional[str]]], Optional[BagInfo]]:
+    """(topic, component) pairs to read from a recording, and the bag's metadata (read once)."""
     if is_csv(path):
-        return [(None, None)]
-    topics = bag_topics(path)
+        return [(None, None)], None
+    info = bag_info(path)
+    topics = info.topics
     chosen = (
         {t: topics.get(t, '') for t in options.topics}
         if options.topics
         else supported_topics(topics)
     )
     if not chosen:
-        open_signal(path)  # raises the error naming the bag's topics
+        open_signal(path, info=info)  # raises the error naming the bag's topics
     pairs = []
     for topic, kind in sorted(chosen.items()):
         valid = [c for c in options.components if _valid(c, kind)]
@@ -356,7 +359,7 @@ def _targets(path: Path, options: Options) -> List[Tuple[Optional[str], Optional
             options.components[0] if options.components else DEFAULT_COMPONENT.get(kind)
         ]:
             pairs.append((topic, component))
-    return pairs
+    return pairs, info
 
 
 def _valid(component: str, kind: str) -> bool:
@@ -413,13 +416,13 @@ def survey_recording(path: Path, options: Options) -> List[Dict]:
 
 def _recording_rows(path: Path, options: Options) -> List[Dict]:
     try:
-        targets = _targets(path, options)
+        targets, info = _targets(path, options)
     except Exception as err:  # noqa: BLE001 -- a bad recording is a row, not the end of the survey
         return [_error_row(path, '', '', err)]
     rows: List[Dict] = []
     for topic, component in targets:
         try:
-            signal = open_signal(path, topic, component, options.column, options.strict)
+            signal = open_signal(path, topic, component, options.column, options.strict, info)
             rows.extend(
                 _stat_rows(
                     path,

@@ -108,13 +108,14 @@ def open_signal(
     component: Optional[str] = None,
     column: Optional[str] = None,
     strict: bool = False,
+    info: Optional[BagInfo] = None,
 ) -> Signal:
     """Open a CSV file or a bag for streaming; raises CsvError, BagError or ValueError (bad
-    component) before any sample is read."""
+    component) before any sample is read. ``info``: the bag's :func:`bag_info`, if already read."""
     path = Path(path)
     if is_csv(path):
         return csv_signal(path, column)
-    return bag_signal(path, topic, component, strict)
+    return bag_signal(path, topic, component, strict, info)
 
 
 def csv_signal(path: Path, column: Optional[str]) -> Signal:
@@ -134,13 +135,36 @@ def open_rosbags(path: Path):
     return reader
 
 
-def bag_topics(path) -> Dict[str, str]:
-    """``{topic: full type name}`` of the bag's topics, in the bag's order."""
-    reader = open_rosbags(Path(path))
+@dataclass(frozen=True)
+class BagInfo:
+    """What a bag's metadata says, read once: ``{topic: full type name}`` in the bag's order,
+    its storage files (see :func:`_storage_files`) and each topic's message count."""
+
+    topics: Dict[str, str]
+    files: List[Path]
+    counts: Dict[str, int]
+
+
+def bag_info(path) -> BagInfo:
+    """The :class:`BagInfo` of the bag ``path`` (BagError if it is none)."""
+    path = Path(path)
+    reader = open_rosbags(path)
     try:
-        return {c.topic: normalise_type(c.msgtype) for c in reader.connections}
+        counts: Dict[str, int] = {}
+        for c in reader.connections:
+            counts[c.topic] = counts.get(c.topic, 0) + c.msgcount
+        return BagInfo(
+            {c.topic: normalise_type(c.msgtype) for c in reader.connections},
+            _storage_files(reader, path),
+            counts,
+        )
     finally:
         reader.close()
+
+
+def bag_topics(path) -> Dict[str, str]:
+    """``{topic: full type name}`` of the bag's topics, in the bag's order."""
+    return bag_info(path).topics
 
 
 def supported_topics(topics: Dict[str, str]) -> Dict[str, str]:
@@ -174,20 +198,19 @@ def choose_topic(path: Path, topics: Dict[str, str], topic: Optional[str]) -> st
 
 
 def bag_signal(
-    path: Path, topic: Optional[str], component: Optional[str], strict: bool = False
+    path: Path,
+    topic: Optional[str],
+    component: Optional[str],
+    strict: bool = False,
+    info: Optional[BagInfo] = None,
 ) -> Signal:
     """A topic of a bag; ``component`` defaults to the type's ``DEFAULT_COMPONENT``."""
-    reader = open_rosbags(path)
-    try:
-        topics = {c.topic: normalise_type(c.msgtype) for c in reader.connections}
-        topic = choose_topic(path, topics, topic)
-        msgtype = topics[topic]
-        component = check_component(component or DEFAULT_COMPONENT[msgtype], msgtype)
-        files = _storage_files(reader, path)
-        expected = sum(c.msgcount for c in reader.connections if c.topic == topic)
-    finally:
-        reader.close()
+    info = info or bag_info(path)
+    topic = choose_topic(path, info.topics, topic)
+    msgtype = info.topics[topic]
+    component = check_component(component or DEFAULT_COMPONENT[msgtype], msgtype)
     signal = Signal(path, f'{topic} {component}', topic, msgtype, component, strict=strict)
+    files, expected = info.files, info.counts[topic]
     signal._source = lambda: _counted(signal, _bag_blocks(signal, files), expected)
     return signal
 
