@@ -158,6 +158,33 @@ def test_csv_fast_and_exact_paths_agree(tmp_path, text):
     assert np.array_equal(series.y, expect, equal_nan=True)
 
 
+@pytest.mark.parametrize(
+    'text',
+    [
+        't,a,b,c\n' + '\n'.join(f'{i * 0.01},{i},{-i},{i % 7}' for i in range(3000)),  # arrow
+        '# comment\nt,a,b,c\n0,1,2,3\n# in between\n0.1,2,,4\n0.2,3,4,nan\n0.3,4,5,6\n',  # exact
+        '0,1,2,3\n0.5,2,3,4\n1,inf,4,5\n',  # no header
+    ],
+)
+def test_csv_columns_in_one_pass_are_each_column_read_alone(tmp_path, monkeypatch, text):
+    monkeypatch.setattr(csv_reader, 'CSV_BLOCK_BYTES', 1 << 12)  # several arrow blocks
+    path = tmp_path / 'a.csv'
+    path.write_text(text)
+    names = csv_reader.column_names(path, 'all')
+    t, y, got = csv_reader.read_csv_columns(path, ','.join(reversed(names)))
+    assert got == names[::-1] and y.shape == (len(t), len(names))
+    for k, name in enumerate(got):
+        alone = read_csv_series(path, name)
+        assert np.array_equal(t, alone.t) and np.array_equal(y[:, k], alone.y, equal_nan=True)
+
+
+def test_csv_columns_name_the_row_and_columns_that_are_not_numbers(tmp_path):
+    path = tmp_path / 'a.csv'
+    path.write_text('t,a,b\n0,1,2\n0.1,2,x\n')
+    with pytest.raises(CsvError, match=r'data row 3 is not numbers in columns 0 and 1, 2'):
+        csv_reader.read_csv_columns(path, 'all')
+
+
 def test_csv_error_in_a_late_block_names_the_row(tmp_path, monkeypatch):
     monkeypatch.setattr(csv_reader, 'CSV_BLOCK_BYTES', 1 << 12)
     lines = [f'{i * 0.01},{i}' for i in range(5000)]

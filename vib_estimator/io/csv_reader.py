@@ -17,7 +17,7 @@ read by the exact rules instead, so the result and the error messages are those 
 from __future__ import annotations
 
 import csv
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Iterator, List, Optional, Tuple
 
@@ -45,7 +45,9 @@ class Series:
 
 @dataclass(frozen=True)
 class CsvLayout:
-    """Where a CSV file's data are: the signal column, the header, the first data row's byte."""
+    """Where a CSV file's data are: the signal column, the header, the first data row's byte;
+    ``indices``: every signal column read (one pass of :func:`csv_column_blocks`), ``index``
+    first."""
 
     path: Path
     index: int
@@ -53,6 +55,11 @@ class CsvLayout:
     width: int
     has_header: bool
     data_offset: int
+    indices: Tuple[int, ...] = ()
+
+    @property
+    def columns(self) -> Tuple[int, ...]:
+        return self.indices or (self.index,)
 
 
 def _number(cell: str) -> float:
@@ -120,17 +127,24 @@ def _column_index(path: Path, column: Optional[str], names: List[str], width: in
 def iter_csv_rows(layout: CsvLayout) -> Iterator[Tuple[float, float]]:
     """(t, value) of every data row, by the exact rules; CsvError names a row that is not
     numbers (by its data-row number, counting the header as row 1)."""
+    for t, values in iter_csv_column_rows(layout):
+        yield t, values[0]
+
+
+def iter_csv_column_rows(layout: CsvLayout) -> Iterator[Tuple[float, List[float]]]:
+    """(t, [value of each of ``layout.columns``]) of every data row, by the exact rules."""
+    columns = layout.columns
     try:
         with layout.path.open('rb') as handle:
             handle.seek(layout.data_offset)
             for count, (_, _, row) in enumerate(_rows(handle)):
                 try:
-                    yield _number(row[0]), _number(row[layout.index])
+                    yield _number(row[0]), [_number(row[i]) for i in columns]
                 except (ValueError, IndexError):
                     line = count + 2 if layout.has_header else count + 1
                     raise CsvError(
                         f'{layout.path}: data row {line} is not numbers in columns 0 '
-                        f'and {layout.index}: {",".join(row)!r}'
+                        f'and {", ".join(map(str, columns))}: {",".join(row)!r}'
                     ) from None
     except (OSError, UnicodeDecodeError, csv.Error) as err:
         raise CsvError(f'cannot read {layout.path} as CSV: {err}') from None
@@ -139,9 +153,17 @@ def iter_csv_rows(layout: CsvLayout) -> Iterator[Tuple[float, float]]:
 def csv_blocks(
     layout: CsvLayout, block_rows: int = EXACT_BLOCK_ROWS
 ) -> Iterator[Tuple[np.ndarray, np.ndarray]]:
-    """``(t, y)`` blocks of the file by pyarrow; on a file it refuses, the rest by the exact rules
-    (``block_rows`` rows per block); all of it by the exact rules where pyarrow is not installed
-    (rosdep alone does not bring it)."""
+    """``(t, y)`` blocks of the file's signal column (:func:`csv_column_blocks`)."""
+    for t, y in csv_column_blocks(layout, block_rows):
+        yield t, y[:, 0]
+
+
+def csv_column_blocks(
+    layout: CsvLayout, block_rows: int = EXACT_BLOCK_ROWS
+) -> Iterator[Tuple[np.ndarray, np.ndarray]]:
+    """``(t, Y)`` blocks of the file, ``Y[:, k]`` its ``layout.columns[k]``, by pyarrow; on a file
+    it refuses, the rest by the exact rules (``block_rows`` rows per block); all of it by the exact
+    rules where pyarrow is not installed (rosdep alone does not bring it)."""
     try:
         import pyarrow as pa
         import pyarrow.csv as pacsv
@@ -150,7 +172,7 @@ def csv_blocks(
         return
 
     names = [f'c{i}' for i in range(layout.width)]
-    wanted = [names[0], names[layout.index]]
+    wanted = [names[0]] + [names[i] for i in layout.columns]
     done = 0
     try:
         # read by arrow itself, not through a Python file: a Python read allocates a fresh 2 MB
@@ -174,9 +196,12 @@ def csv_blocks(
                 ),
             )
             for batch in reader:
-                t, y = (batch.column(i).to_numpy(zero_copy_only=False) for i in range(2))
+                t = np.asarray(batch.column(names[0]).to_numpy(zero_copy_only=False), np.float64)
+                y = np.empty((len(t), len(layout.columns)))
+                for k, i in enumerate(layout.columns):
+                    y[:, k] = batch.column(names[i]).to_numpy(zero_copy_only=False)
                 done += len(t)
-                yield np.asarray(t, np.float64), np.asarray(y, np.float64)
+                yield t, y
     except (pa.ArrowInvalid, pa.ArrowTypeError, pa.ArrowNotImplementedError):
         yield from _exact_blocks(layout, done, block_rows)
 
@@ -184,19 +209,20 @@ def csv_blocks(
 def _exact_blocks(
     layout: CsvLayout, skip: int, block_rows: int
 ) -> Iterator[Tuple[np.ndarray, np.ndarray]]:
-    """The exact rules, block by block, after the first ``skip`` data rows."""
+    """The exact rules, block by block, after the first ``skip`` data rows: ``(t, Y)``."""
+    width = len(layout.columns)
     t: List[float] = []
-    y: List[float] = []
-    for i, (ti, yi) in enumerate(iter_csv_rows(layout)):
+    y: List[List[float]] = []
+    for i, (ti, yi) in enumerate(iter_csv_column_rows(layout)):
         if i < skip:
             continue
         t.append(ti)
         y.append(yi)
         if len(t) == block_rows:
-            yield np.array(t), np.array(y)
+            yield np.array(t), np.array(y).reshape(-1, width)
             t, y = [], []
     if t:
-        yield np.array(t), np.array(y)
+        yield np.array(t), np.array(y).reshape(-1, width)
 
 
 def read_csv_series(path, column: Optional[str] = None) -> Series:
@@ -239,7 +265,11 @@ def _names(layout: CsvLayout) -> List[str]:
 
 def read_csv_columns(path, columns: str) -> Tuple[np.ndarray, np.ndarray, List[str]]:
     """``(t, Y, names)``: time and the ``columns`` (:func:`column_names`) as the columns of
-    ``Y``, each read by :func:`read_csv_series`'s rules."""
+    ``Y``, read in one pass by :func:`read_csv_series`'s rules."""
     names = column_names(path, columns)
-    series = [read_csv_series(path, name) for name in names]
-    return series[0].t, np.column_stack([s.y for s in series]), names
+    layout = csv_layout(path, names[0])
+    every = _names(layout)
+    layout = replace(layout, indices=tuple(every.index(name) for name in names))
+    parts = list(csv_column_blocks(layout)) or [(np.empty(0), np.empty((0, len(names))))]
+    t, y = (np.concatenate(p) for p in zip(*parts))
+    return t, y, names
