@@ -48,7 +48,7 @@ from std_msgs.msg import Float64, Float64MultiArray, Header, MultiArrayDimension
 from std_srvs.srv import Trigger
 
 from ..core.config import EstimatorConfig
-from ..core.multichannel import JointEstimate
+from ..core.multichannel import MIN_CHANNELS, JointEstimate
 from ..core.shapes import SHAPE_ROWS, phases_deg, signed_amplitudes
 from ..errors import StartupError
 from ..io.fields import (
@@ -125,14 +125,19 @@ class Outputs:
 
     def set_channels(self, channels, modes: int) -> None:
         """The layout of the shapes of ``channels`` (several: publishers of modes 1..``modes``
-        made now, the others on a first estimate; one: none, those made are destroyed)."""
-        if len(channels) < 2:
-            for k in list(self._shapes):
-                self._node.destroy_publisher(self._shapes.pop(k))
+        made now, those of higher modes destroyed and made again on an estimate, as
+        :meth:`set_modes` does; one channel: none)."""
+        joint = len(channels) >= MIN_CHANNELS
+        keep = modes if joint else 0
+        for k in [k for k in self._shapes if k > keep]:
+            self._node.destroy_publisher(self._shapes.pop(k))
+        if not joint:
             return
         m = len(channels)
         self._shape.layout.dim = [
-            MultiArrayDimension(label=','.join(SHAPE_ROWS), size=len(SHAPE_ROWS), stride=3 * m),
+            MultiArrayDimension(
+                label=','.join(SHAPE_ROWS), size=len(SHAPE_ROWS), stride=len(SHAPE_ROWS) * m
+            ),
             MultiArrayDimension(label=','.join(channels), size=m, stride=m),
         ]
         for k in range(1, modes + 1):
