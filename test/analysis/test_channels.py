@@ -80,9 +80,9 @@ JOINTS = ['effort[shoulder]', 'effort[elbow]', 'effort[wrist]']
 
 @pytest.fixture(scope='module')
 def bags(tmp_path_factory):
-    """The same 100 s of three channels as an Imu bag, a JointState bag and a CSV file whose time
+    """The same 80 s of three channels as an Imu bag, a JointState bag and a CSV file whose time
     column is the bags' time base (stamps since the first, as the node's)."""
-    t, y = modal_record(100.0, 20.0, MODES, SHAPES, snr_db=20.0, seed=4)
+    t, y = modal_record(80.0, 20.0, MODES, SHAPES, snr_db=20.0, seed=4)
     stamps = EPOCH_NS + np.round(t * 1e9).astype(np.int64)
     folder = tmp_path_factory.mktemp('channel_bags')
     write_channels(folder / 'imu', '/imu', IMU, AXES, stamps, y, 'tip')

@@ -920,7 +920,7 @@ IMU_AXES = [f'linear_acceleration.{a}' for a in 'xyz']
 EFFORTS = [f'effort[{j}]' for j in JOINTS]
 
 
-def modal_samples(seconds=120.0, seed=4, fs=20.0):
+def modal_samples(seconds=90.0, seed=4, fs=20.0):
     """(stamps ns, Y): CHANNEL_MODES on three channels."""
     t, y = modal_record(seconds, fs, CHANNEL_MODES, CHANNEL_SHAPES, snr_db=20.0, seed=seed)
     return [EPOCH_NS + round(s * 1e9) for s in t], y
