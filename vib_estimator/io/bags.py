@@ -458,8 +458,8 @@ def wrench_message(stamp: int, frame_id: str, component: str, value: float):
 
 
 def zero_message(msgtype: str):
-    """A rosbags message of ``msgtype`` (a Jazzy type) with every field zero, empty or
-    ``False``."""
+    """A rosbags message of ``msgtype`` (a Jazzy type whose arrays and sequences hold base
+    values, as every input type's) with every field zero, empty or ``False``."""
     args = {}
     for name, (kind, detail) in TYPESTORE.fielddefs[msgtype][1]:
         if kind == Nodetype.NAME:
