@@ -1,6 +1,7 @@
 # Copyright 2026 vib_estimator developers
 # SPDX-License-Identifier: Apache-2.0
-"""``analyze --columns``: several CSV channels, one set of modes with their shapes."""
+"""``analyze --columns`` (CSV) and ``--components`` (bags): several channels, one set of modes
+with their shapes."""
 
 import json
 
@@ -8,6 +9,8 @@ import numpy as np
 import pytest
 
 from vib_estimator.cli import main
+from vib_estimator.io.bags import write_channels
+from vib_estimator.io.fields import IMU, JOINT_STATE, seconds_since
 from vib_estimator.sim.frame import modal_record
 
 MODES = [(1.0, 0.02, 1.0), (2.5, 0.02, 0.5)]
@@ -67,3 +70,83 @@ def test_bad_columns_are_one_error_line(record, capsys, options, message):
     assert main(['analyze', str(record), *options]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and 'error:' in err[0] and message in err[0]
+
+
+# ---- bags: analyze BAG --components ------------------------------------------------------------
+EPOCH_NS = 10**18
+AXES = ['linear_acceleration.x', 'linear_acceleration.y', 'linear_acceleration.z']
+JOINTS = ['effort[shoulder]', 'effort[elbow]', 'effort[wrist]']
+
+
+@pytest.fixture(scope='module')
+def bags(tmp_path_factory):
+    """The same 80 s of three channels as an Imu bag, a JointState bag and a CSV file whose time
+    column is the bags' time base (stamps since the first, as the node's)."""
+    t, y = modal_record(80.0, 20.0, MODES, SHAPES, snr_db=20.0, seed=4)
+    stamps = EPOCH_NS + np.round(t * 1e9).astype(np.int64)
+    folder = tmp_path_factory.mktemp('channel_bags')
+    write_channels(folder / 'imu', '/imu', IMU, AXES, stamps, y, 'tip')
+    write_channels(folder / 'joints', '/joint_states', JOINT_STATE, JOINTS, stamps, y)
+    csv = folder / 'same.csv'
+    lines = [
+        f'{s!r},{a!r},{b!r},{c!r}'
+        for s, (a, b, c) in zip(seconds_since(stamps, stamps[0]).tolist(), y.tolist())
+    ]
+    csv.write_text('time,a,b,c\n' + '\n'.join(lines) + '\n')
+    return folder
+
+
+def renamed(row, names):
+    """``row`` with the shape fields of channels ``names`` named as the CSV's a, b, c."""
+    out = {}
+    for key, value in row.items():
+        for name, column in zip(names, 'abc'):
+            if key.endswith('_' + name):
+                key = key[: -len(name)] + column
+        out[key] = value
+    return out
+
+
+def joint_rows(capsys, *argv):
+    assert main(['analyze', *map(str, argv), *AMBIENT]) == 0
+    out = capsys.readouterr()
+    return [json.loads(line) for line in out.out.splitlines()], out.err
+
+
+def test_components_of_a_bag_give_the_rows_of_the_same_csv_columns(bags, capsys):
+    csv, _ = joint_rows(capsys, bags / 'same.csv', '--columns', 'all')
+    assert len(csv) > 20
+    for bag, names in ((bags / 'imu', AXES), (bags / 'joints', JOINTS)):
+        rows, err = joint_rows(capsys, bag, '--components', ','.join(names))
+        assert f'channels={",".join(names)}' in err and 'corrupt_records=0' in err
+        assert [r.pop('stamp_ns') for r in rows] == [EPOCH_NS + round(r['t'] * 1e9) for r in rows]
+        assert [renamed(r, names) for r in rows] == csv
+
+
+def test_one_component_is_exactly_component(bags, capsys):
+    one, _ = joint_rows(capsys, bags / 'imu', '--components', AXES[1])
+    assert one == joint_rows(capsys, bags / 'imu', '--component', AXES[1])[0] and one
+
+
+@pytest.mark.parametrize(
+    'options, message',
+    [
+        (
+            ['--components', ','.join(AXES[:2]), '--excitation', 'free'],
+            'need --excitation ambient',
+        ),
+        (['--components', 'linear_acceleration.x,torque.z', *AMBIENT], 'component of'),
+        (['--components', 'linear_acceleration.x,,linear_acceleration.y', *AMBIENT], 'empty'),
+        (['--components', ','.join(AXES), '--component', AXES[0], *AMBIENT], 'not both'),
+        (['--columns', 'all', *AMBIENT], 'CSV files only'),
+    ],
+)
+def test_bad_components_are_one_error_line(bags, capsys, options, message):
+    assert main(['analyze', str(bags / 'imu'), *options]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and 'error:' in err[0] and message in err[0], err
+
+
+def test_components_of_a_csv_file_are_refused(record, capsys):
+    assert main(['analyze', str(record), '--components', 'a,b', *AMBIENT]) == 2
+    assert '--components reads bags only' in capsys.readouterr().err

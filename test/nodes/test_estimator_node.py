@@ -1,6 +1,7 @@
 # Copyright 2026 vib_estimator developers
 # SPDX-License-Identifier: Apache-2.0
-"""estimator_node, in process (fresh context, isolated domain) and as an executable (SIGINT).
+"""estimator_node, in process (fresh context, isolated domain) and as an executable (SIGINT);
+with several components (a 3-axis IMU, several joints), the joint identification and the shapes.
 
 Samples are published with explicit header stamps in batches as fast as the node takes them (each
 batch waits for the node's counters), never in real time; samples without a header
@@ -24,16 +25,20 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
-from std_msgs.msg import Float64, Header
+from std_msgs.msg import Float64, Float64MultiArray, Header
 from std_srvs.srv import Trigger
 
 from vib_estimator.core import Estimate, EstimatorConfig, FrequencyEstimator
 from vib_estimator.core.config import PAPER
+from vib_estimator.core.multichannel import JointAmbientEstimator
+from vib_estimator.core.shapes import SHAPE_ROWS
 from vib_estimator.io import fields
 from vib_estimator.io.fields import seconds_since
 from vib_estimator.nodes import stream
 from vib_estimator.nodes.estimator_node import EstimatorNode, message_class
+from vib_estimator.nodes.parameters import config_of
 from vib_estimator.nodes.runner import StartupError, spin_until
+from vib_estimator.sim.frame import modal_record
 
 EPOCH_NS = 1_000_000_000 * 1_000_000_000  # synthetic stamps start in 2001, far from "now"
 FS = 500.0
@@ -83,6 +88,15 @@ class Probe:
                 DiagnosticArray, '/diagnostics', self.diagnostics.append, 10
             )
         ]
+        #: several components: each mode's vibration/mode<k>/shape messages
+        self.shapes = {k: [] for k in range(1, modes + 1)}
+        if len(node.get_parameter('components').value) >= 2:
+            subs += [
+                self.probe.create_subscription(
+                    Float64MultiArray, f'vibration/mode{k}/shape', self.shapes[k].append, 100
+                )
+                for k in self.shapes
+            ]
         executor.add_node(node)
         executor.add_node(self.probe)
         assert spin_until(
@@ -895,3 +909,119 @@ def test_simultaneous_service_calls_are_all_answered_while_estimating(make_probe
     )
     assert p.node.counters['received'] == 5000
     assert len(p.frequencies()) > 5 and all(abs(f / 1.33 - 1) < 0.01 for f in p.frequencies())
+
+
+# ---- several components of one message: the joint identification ------------------------------
+#: two modes seen by three channels (the 2.5 Hz one weak on the first), 20 Hz
+CHANNEL_MODES = [(1.0, 0.02, 1.0), (2.5, 0.02, 0.5)]
+CHANNEL_SHAPES = np.array([[1.0, 0.2], [0.6, -0.9], [0.2, 0.8]])
+AMBIENT = {'excitation': 'ambient', 'ambient_window_s': 40.0}
+IMU_AXES = [f'linear_acceleration.{a}' for a in 'xyz']
+EFFORTS = [f'effort[{j}]' for j in JOINTS]
+
+
+def modal_samples(seconds=90.0, seed=4, fs=20.0):
+    """(stamps ns, Y): CHANNEL_MODES on three channels."""
+    t, y = modal_record(seconds, fs, CHANNEL_MODES, CHANNEL_SHAPES, snr_db=20.0, seed=seed)
+    return [EPOCH_NS + round(s * 1e9) for s in t], y
+
+
+def channels_message(input_type, components, stamp_ns, values, joints=JOINTS):
+    """A message with ``values`` in ``components`` (JointState: those of ``joints`` only)."""
+    msg = message(input_type, components[0], stamp_ns, values[0], joints)
+    for component, value in zip(components[1:], values[1:]):
+        if input_type != fields.JOINT_STATE or component[:-1].split('[')[1] in joints:
+            fields.component_setter(component, input_type)(msg, value)
+    return msg
+
+
+def check_modes_and_shapes(p, stamps, y, skip=()):
+    """The node published the joint identifier's estimates of the samples it took (all but
+    ``skip``) on mode<k>/frequency, and each one's shape on mode<k>/shape: near the true ones."""
+    keep = np.setdiff1d(np.arange(len(stamps)), list(skip))
+    kept = np.asarray(stamps, dtype=np.int64)[keep]
+    names = p.node.get_parameter('components').value
+    expected = JointAmbientEstimator(config_of(p.node), names).process(
+        seconds_since(kept, kept[0]), y[keep]
+    )
+    e = expected.estimates
+    assert len(e) > 20 and set(e.mode.tolist()) == {1, 2}
+    assert spin_until(p.executor, lambda: sum(map(len, p.shapes.values())) == len(e), 5.0)
+    m = len(names)
+    for k, (f, _, _), true in zip((1, 2), CHANNEL_MODES, CHANNEL_SHAPES.T):
+        assert p.values(f'mode{k}/frequency') == e.frequency_hz[e.mode == k].tolist()
+        assert abs(np.median(p.values(f'mode{k}/frequency')) / f - 1) < 0.02
+        rows, cols = p.shapes[k][-1].layout.dim
+        assert (rows.label, cols.label) == (','.join(SHAPE_ROWS), ','.join(names))
+        assert (rows.size, rows.stride, cols.size, cols.stride) == (3, 3 * m, m, m)
+        data = np.array([msg.data for msg in p.shapes[k]])
+        unit = true / np.linalg.norm(true)
+        unit *= np.sign(unit[np.argmax(np.abs(unit))])  # the largest entry positive
+        assert np.allclose(np.median(data[:, :m], axis=0), unit, atol=0.1), (k, data[-1])
+        off_real = np.abs((data[:, m : 2 * m] + 90) % 180 - 90)  # phase: degrees from 0 or 180
+        assert np.all(np.median(off_real, axis=0) < 10)  # a real mode
+
+
+def test_three_axis_imu_gives_the_modes_with_their_shapes(make_probe):
+    p = make_probe(2, input_type=fields.IMU, components=IMU_AXES, **AMBIENT)
+    stamps, y = modal_samples()
+    p.publish([channels_message(fields.IMU, IMU_AXES, s, v) for s, v in zip(stamps, y)])
+    check_modes_and_shapes(p, stamps, y)
+    status = p.wait_status(lambda s: 'channels' in values_of(s))  # /diagnostics names them
+    assert values_of(status)['channels'] == ','.join(IMU_AXES)
+
+
+def test_several_joints_a_message_without_one_is_skipped_and_counted(make_probe):
+    p = make_probe(2, input_type=fields.JOINT_STATE, components=EFFORTS, **AMBIENT)
+    stamps, y = modal_samples(seed=5)
+    absent = set(range(300, len(stamps), 97))
+    orders = [JOINTS, JOINTS[::-1], ['wrist', 'shoulder', 'elbow']]
+    joints = [['shoulder', 'wrist'] if i in absent else orders[i % 3] for i in range(len(y))]
+    p.publish(
+        [
+            channels_message(fields.JOINT_STATE, EFFORTS, s, v, j)
+            for s, v, j in zip(stamps, y, joints)
+        ]
+    )
+    assert p.node.counters['skipped_joint_missing'] == len(absent)
+    check_modes_and_shapes(p, stamps, y, absent)
+
+
+@pytest.mark.parametrize(
+    'overrides, reason',
+    [
+        ({'components': IMU_AXES}, 'need excitation ambient'),
+        ({'components': ['linear_acceleration.x', 'torque.z'], **AMBIENT}, 'component of'),
+        ({'components': ['linear_acceleration.x'] * 2, **AMBIENT}, 'given twice'),
+    ],
+)
+def test_bad_components_stop_the_start(ros_context, overrides, reason):
+    with pytest.raises(StartupError, match=reason):
+        EstimatorNode(
+            context=ros_context,
+            parameter_overrides=[
+                Parameter(k, value=v) for k, v in {'input_type': fields.IMU, **overrides}.items()
+            ],
+        )
+
+
+def test_components_are_validated_at_run_time(ros_context):
+    node = EstimatorNode(
+        context=ros_context, parameter_overrides=[Parameter('input_type', value=fields.IMU)]
+    )
+    try:
+        assert node.get_parameter('components').value == []
+        assert node.describe_parameter('components').description.startswith('several fields')
+        refused = node.set_parameters([Parameter('components', value=IMU_AXES)])[0]
+        assert not refused.successful and 'need excitation ambient' in refused.reason
+        both = node.set_parameters_atomically(
+            [Parameter('components', value=IMU_AXES), Parameter('excitation', value='ambient')]
+        )
+        assert both.successful
+        refused = node.set_parameters([Parameter('excitation', value='free')])[0]
+        assert not refused.successful and '3 components' in refused.reason
+        empty = Parameter('components', Parameter.Type.STRING_ARRAY, [])
+        assert node.set_parameters([empty])[0].successful
+        assert node.set_parameters([Parameter('excitation', value='free')])[0].successful
+    finally:
+        node.destroy_node()

@@ -31,6 +31,7 @@ def test_params_file_holds_the_defaults():
     assert params.pop('input_type') == WRENCH_STAMPED
     assert params.pop('input_topic') == 'coupling_torque'
     assert params.pop('component') == DEFAULT_COMPONENT[WRENCH_STAMPED]
+    assert params.pop('components') == []
     defaults = EstimatorConfig()
     assert set(params) == set(EstimatorConfig.names())
     for name, value in params.items():
@@ -58,6 +59,7 @@ def test_params_file_loads_into_the_node():
         node = EstimatorNode(context=context)
         assert config_of(node) == EstimatorConfig()  # every parameter as the file sets it
         assert node.get_parameter('band_hz').value == []
+        assert node.get_parameter('components').value == []
         assert node.get_parameter('input_type').value == WRENCH_STAMPED
         node.destroy_node()
     finally:

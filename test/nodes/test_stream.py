@@ -6,6 +6,7 @@ replacement, counters, status (the reset service: test_estimator_node.py)."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -132,3 +133,40 @@ def test_a_burst_of_self_tests_runs_the_tones_once(monkeypatch):
     assert len(runs) == 1 and answers[0][0] and len(set(answers)) == 1
     s.configure(EstimatorConfig(window=5))
     assert s.self_test()[0] and len(runs) == 2
+
+
+# ---- several channels (the node's components) ---------------------------------------------------
+def test_channels_one_is_the_single_channel_stream_several_the_joint_identifier():
+    from vib_estimator.core.multichannel import JointAmbientEstimator, JointEstimate
+    from vib_estimator.nodes.stream import check_channels
+    from vib_estimator.sim.frame import modal_record
+
+    stamps, values = sine(4000)
+    one = EstimatorStream(EstimatorConfig(), now=0.0, channels=('torque.z',))
+    plain = EstimatorStream(EstimatorConfig(), now=0.0)
+
+    def floats(stream):
+        return [
+            (e.t, e.frequency_hz, e.frequency_std_hz, e.amplitude)
+            for e in feed(stream, stamps, values)
+        ]
+
+    assert floats(one) == floats(plain)  # bit for bit
+    names = ('a', 'b', 'c')
+    with pytest.raises(ValueError, match='3 components .* need excitation ambient'):
+        check_channels(names, EstimatorConfig())
+    config = EstimatorConfig(excitation='ambient', ambient_window_s=20.0)
+    t, y = modal_record(60.0, 20.0, [(1.0, 0.02, 1.0)], np.array([[1.0], [0.5], [-0.3]]), 20.0)
+    stamps = EPOCH_NS + np.round(t * 1e9).astype(np.int64)
+    stream = EstimatorStream(config, now=0.0, channels=names)
+    got = [e for s, row in zip(stamps, y.tolist()) for e in stream.feed(int(s), tuple(row))]
+    expected = JointAmbientEstimator(config, names).process((stamps - stamps[0]) * 1e-9, y)
+    assert all(isinstance(e, JointEstimate) for e in got) and len(got) == len(expected) > 10
+    assert [e.estimate.frequency_hz for e in got] == expected.estimates.frequency_hz.tolist()
+    for e in got:
+        stream.published(e.estimate, now=0.5)
+    assert stream.status(now=1.0).values['channels'] == 'a,b,c'
+    with pytest.raises(ValueError, match='need excitation ambient'):
+        stream.configure(EstimatorConfig(), names)  # refused: the stream is unchanged
+    stream.configure(config, ())  # back to one channel: counters kept, no channels key
+    assert stream.counters['received'] == len(t) and 'channels' not in stream.status(2.0).values

@@ -34,7 +34,7 @@ from ..core.modes import create_estimator
 from ..errors import VibEstimatorError, report
 from ..io.fields import INPUT_TYPES, signal_unit
 from ..io.streaming import Signal, open_signal
-from .channels import channel_names, run_joint
+from .channels import channel_names, component_names, run_joint
 from .outputs import check_output
 from .summary import summarise_modes, summary_lines
 
@@ -73,6 +73,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="field of the messages, as the node's component "
         "parameter (default: the type's, e.g. torque.z of a WrenchStamped, "
         'linear_acceleration.z of an Imu)',
+    )
+    parser.add_argument(
+        '--components',
+        help='several fields of the bag topic, comma-separated (e.g. linear_acceleration.x,'
+        'linear_acceleration.y,linear_acceleration.z): one set of modes with their shapes '
+        '(needs --excitation ambient; docs/channels.md)',
     )
     parser.add_argument(
         '--column',
@@ -305,6 +311,11 @@ def run(args: argparse.Namespace) -> int:
             if len(names) > 1:
                 return run_joint(args, config, names, json_row, 'analyze')
             args.column = names[0]  # one column: exactly --column
+        if getattr(args, 'components', None) is not None:
+            names = component_names(args)
+            if len(names) > 1:
+                return run_joint(args, config, names, json_row, 'analyze', damage_warning)
+            args.component = names[0]  # one component: exactly --component
         signal = open_signal(
             args.input,
             args.topic,

@@ -1,29 +1,32 @@
 # Copyright 2026 vib_estimator developers
 # SPDX-License-Identifier: Apache-2.0
-"""``analyze --columns a,b,c|all``: several CSV channels, one set of modes with their shapes.
+"""``analyze --columns a,b,c|all`` (CSV) and ``analyze BAG --components a,b,c`` (several fields
+of one bag topic): several channels, one set of modes with their shapes.
 
-One column (``--columns b``) is exactly ``--column b``. Two or more need ``--excitation ambient``
-and go to the joint identifier (:mod:`..core.multichannel`). Each estimate row (JSONL, CSV,
-table) gains, per channel ``<name>``: ``shape_<name>`` (the normalised shape's real part, the
-largest entry +1 / |shape|), ``shape_phase_deg_<name>`` (its phase, degrees, 0 or 180 for a
-real mode), ``shape_std_<name>`` (its uncertainty) and ``mac`` (with the same mode's previous
-estimate; null at its first). ``--plot``: the estimates over time by mode and each mode's shape as
-a bar plot of the channel amplitudes (signed real parts, median over the mode's estimates).
+One column (``--columns b``) is exactly ``--column b``, one component exactly ``--component``.
+Two or more need ``--excitation ambient`` and go to the joint identifier
+(:mod:`..core.multichannel`). Each estimate row (JSONL, CSV, table) gains, per channel
+``<name>``: ``shape_<name>`` (the signed amplitude, :func:`..core.shapes.signed_amplitudes`),
+``shape_phase_deg_<name>`` (its phase, degrees, 0 or 180 for a real mode), ``shape_std_<name>``
+(its uncertainty) and ``mac`` (with the same mode's previous estimate; null at its first); a
+bag's rows also ``stamp_ns``, as ``--component``'s. ``--plot``: the estimates over time by mode
+and each mode's shape as a bar plot of the channel amplitudes (median over the mode's
+estimates).
 """
 
 from __future__ import annotations
 
-import math
 import sys
 
 import numpy as np
 
 from ..core.config import EstimatorConfig
 from ..core.multichannel import JointAmbientEstimator, JointEstimates
-from ..errors import CsvError
+from ..core.shapes import SHAPE_ROWS, phases_deg, signed_amplitudes
+from ..errors import BagError, CsvError
 from ..io.csv_reader import column_names, read_csv_columns
-from ..io.fields import UNKNOWN_UNIT
-from ..io.streaming import is_csv
+from ..io.fields import UNKNOWN_UNIT, signal_unit
+from ..io.streaming import is_csv, open_signal
 from .summary import summarise_modes, summary_lines
 
 
@@ -31,10 +34,37 @@ def channel_names(args) -> list[str]:
     """The ``--columns`` of the CSV input (CsvError for a bag, with ``--column`` too, or for an
     unknown column)."""
     if not is_csv(args.input):
-        raise CsvError('--columns reads CSV files only (a bag: one --component)')
+        raise CsvError('--columns reads CSV files only (a bag: --components)')
     if args.column is not None:
         raise CsvError('give --column or --columns, not both')
     return column_names(args.input, args.columns)
+
+
+def component_names(args) -> list[str]:
+    """The ``--components`` of the bag input (BagError for a CSV file or with ``--component``
+    too; the fields are checked against the topic's type when the bag is opened)."""
+    if is_csv(args.input):
+        raise BagError('--components reads bags only (a CSV file: --columns)')
+    if args.component is not None:
+        raise BagError('give --component or --components, not both')
+    names = [c.strip() for c in args.components.split(',')]
+    if not all(names):
+        raise BagError(f'--components {args.components!r} has an empty field')
+    return names
+
+
+def read_channels(args, names, strict: bool = False):
+    """``(t, Y, names, signal)``: the channels of the input (CSV ``--columns``: ``signal`` None;
+    a bag's ``--components``: its :class:`..io.streaming.Signal`, read whole)."""
+    if is_csv(args.input):
+        t, y, names = read_csv_columns(args.input, ','.join(names))
+        return t, y, names, None
+    signal = open_signal(args.input, args.topic, strict=strict, components=names)
+    blocks = [(t, y) for t, y in signal.blocks() if len(t)]
+    if not blocks:
+        raise ValueError(f'topic {signal.topic} of {signal.path} has no messages')
+    t, y = (np.concatenate(part) for part in zip(*blocks))
+    return t, y, list(signal.components), signal
 
 
 def joint_run(t: np.ndarray, y: np.ndarray, names, config: EstimatorConfig):
@@ -54,14 +84,13 @@ def joint_run(t: np.ndarray, y: np.ndarray, names, config: EstimatorConfig):
 
 def shape_fields(result: JointEstimates, i: int) -> dict:
     """The shape fields of estimate ``i`` (see the module doc)."""
-    row = {}
-    shape, std = result.shapes[i], result.shape_std[i]
-    for name, s in zip(result.channels, shape):
-        row[f'shape_{name}'] = float(abs(s) * math.copysign(1.0, s.real))
-    for name, s in zip(result.channels, shape):
-        row[f'shape_phase_deg_{name}'] = float(np.degrees(np.angle(s)))
-    for name, s in zip(result.channels, std):
-        row[f'shape_std_{name}'] = float(s)
+    shape = result.shapes[i]
+    parts = (signed_amplitudes(shape), phases_deg(shape), result.shape_std[i])
+    row = {
+        f'{field}_{name}': float(value)
+        for field, values in zip(SHAPE_ROWS, parts)
+        for name, value in zip(result.channels, values)
+    }
     row['mac'] = float(result.mac[i])
     return row
 
@@ -155,16 +184,27 @@ def plot_shapes(path: str, title: str, result: JointEstimates, unit: str = UNKNO
     return fig
 
 
-def run_joint(args, config: EstimatorConfig, names, json_row, prog: str) -> int:
-    """``analyze --columns`` with two or more channels ``names``: estimates with their shapes on
-    stdout, the counters and the summary on stderr, ``--plot``. Bad input raises (CsvError,
+def run_joint(args, config: EstimatorConfig, names, json_row, prog: str, warn=None) -> int:
+    """``analyze --columns`` or ``--components`` with two or more channels ``names``: estimates
+    with their shapes on stdout, the counters and the summary on stderr, ``--plot``; ``warn``
+    (signal, prog) says what a bag's read skipped. Bad input raises (CsvError, BagError,
     ValueError) before anything is printed."""
-    t, y, names = read_csv_columns(args.input, ','.join(names))
+    t, y, names, signal = read_channels(args, names, getattr(args, 'strict', False))
     estimator, result = joint_run(t, y, names, config)
-    print_rows(rows(result), args.format, json_row)
+    table = rows(result)
+    extra = ''
+    if signal is not None:
+        if warn is not None:
+            warn(signal, prog)
+        for row in table:
+            row['stamp_ns'] = signal.origin_ns + round(row['t'] * 1e9)
+        extra = f', messages_without_component={signal.skipped}' if signal.skipped else ''
+        extra += f', corrupt_records={signal.corrupt}'
+    print_rows(table, args.format, json_row)
     print(
         f'{prog}: channels={",".join(names)}, '
-        + ', '.join(f'{k}={v}' for k, v in estimator.counters.items()),
+        + ', '.join(f'{k}={v}' for k, v in estimator.counters.items())
+        + extra,
         file=sys.stderr,
     )
     e = result.estimates
@@ -174,5 +214,6 @@ def run_joint(args, config: EstimatorConfig, names, json_row, prog: str) -> int:
         shape = ', '.join(f'{n} {a:+.2f}' for n, a in zip(names, amp))
         print(f'{prog}: mode {k} ({f:.3f} Hz) shape: {shape}', file=sys.stderr)
     if args.plot:
-        plot_shapes(args.plot, str(args.input), result)
+        unit = signal_unit(names[0]) if signal is not None else UNKNOWN_UNIT
+        plot_shapes(args.plot, str(args.input), result, unit)
     return 0

@@ -422,7 +422,7 @@ def _recording_rows(path: Path, options: Options) -> List[Dict]:
     rows: List[Dict] = []
     for topic, component in targets:
         try:
-            signal = open_signal(path, topic, component, options.column, options.strict, info)
+            signal = open_signal(path, topic, component, options.column, options.strict, info=info)
             rows.extend(
                 _stat_rows(
                     path,

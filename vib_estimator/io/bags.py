@@ -54,6 +54,7 @@ from rosbags.interfaces import (
     ConnectionExtRosbag2,
     MessageDefinition,
     MessageDefinitionFormat,
+    Nodetype,
     Qos,
     QosDurability,
     QosHistory,
@@ -70,10 +71,12 @@ from rosbags.typesys import Stores, get_typestore
 from ..errors import BagError, DamageCount, McapFormatError, as_bag_error
 from . import cdr, mcap
 from .fields import (
+    JOINT_STATE,
     WRENCH_STAMPED,
     XYZ,
     check_component,
     component_getter,
+    component_setter,
     normalise_type,
     stamp_ns,
 )
@@ -452,6 +455,54 @@ def wrench_message(stamp: int, frame_id: str, component: str, value: float):
             force=vector(*vec['force']), torque=vector(*vec['torque'])
         ),
     )
+
+
+def zero_message(msgtype: str):
+    """A rosbags message of ``msgtype`` (a Jazzy type whose arrays and sequences hold base
+    values, as every input type's) with every field zero, empty or ``False``."""
+    args = {}
+    for name, (kind, detail) in TYPESTORE.fielddefs[msgtype][1]:
+        if kind == Nodetype.NAME:
+            args[name] = zero_message(detail)
+        elif kind == Nodetype.BASE:
+            args[name] = _ZERO_BASE.get(detail[0], 0)
+        else:  # an array (fixed size) or a sequence of base values
+            (_, (base, _)), size = detail
+            args[name] = [] if base == 'string' else np.zeros(size, _NUMPY_BASE.get(base, base))
+    return TYPESTORE.types[msgtype](**args)
+
+
+def channels_message(msgtype: str, stamp: int, frame_id: str, channels: Sequence[str], values):
+    """A rosbags message of an input type with header ``stamp`` (ns) and ``frame_id`` whose
+    ``channels`` (components, :mod:`.fields`) hold ``values``, everything else zero."""
+    msg = zero_message(msgtype)
+    if hasattr(msg, 'header'):
+        msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(int(stamp), 1_000_000_000)
+        msg.header.frame_id = frame_id
+    for channel, value in zip(channels, values):
+        component_setter(channel, msgtype)(msg, value)
+    if msgtype == JOINT_STATE:  # the setter's lists as the arrays the serialiser takes
+        for name in ('position', 'velocity', 'effort'):
+            setattr(msg, name, np.asarray(getattr(msg, name), dtype=np.float64))
+    return msg
+
+
+def write_channels(
+    path, topic: str, msgtype: str, channels: Sequence[str], stamps, values, frame_id: str = ''
+) -> None:
+    """A one-topic bag of ``msgtype`` messages, the columns of ``values`` (samples x channels)
+    in ``channels``, header stamps ``stamps`` (ns; log time the same: a clean recording)."""
+    with BagWriter(path) as bag:
+        conn = bag.add_topic(topic, msgtype)
+        for stamp, row in zip(np.asarray(stamps).tolist(), np.asarray(values).tolist()):
+            bag.write_message(
+                conn, stamp, channels_message(msgtype, stamp, frame_id, channels, row)
+            )
+
+
+#: zero values of the base types that are not integers, and numpy names of the others'
+_ZERO_BASE = {'string': '', 'bool': False, 'float32': 0.0, 'float64': 0.0}
+_NUMPY_BASE = {'octet': 'uint8', 'char': 'uint8', 'byte': 'uint8'}
 
 
 _NO_MESSAGE = 2**63 - 1  # start time of a file without messages, as rosbags keeps it

@@ -126,6 +126,52 @@ def component_getter(
     return joint_value
 
 
+def check_components(components, input_type: str = WRENCH_STAMPED) -> Tuple[str, ...]:
+    """``components`` (several fields of one message, one channel each) checked: each a component
+    of ``input_type`` (:func:`check_component`), none given twice, none with a comma (the outputs
+    join the channel names with commas); ``ValueError`` otherwise."""
+    out: list = []
+    for component in components:
+        check_component(component, input_type)
+        if ',' in component:
+            raise ValueError(
+                f'component {component!r} has a comma (channel names are joined by one)'
+            )
+        if component in out:
+            raise ValueError(f'component {component!r} is given twice in components')
+        out.append(component)
+    return tuple(out)
+
+
+def channels_of(component: str, components, input_type: str = WRENCH_STAMPED) -> Tuple[str, ...]:
+    """The channels a reader takes: ``components`` (checked) if any, else ``(component,)``."""
+    if components:
+        return check_components(components, input_type)
+    return (check_component(component, input_type),)
+
+
+def channels_getter(
+    channels: Tuple[str, ...], input_type: str = WRENCH_STAMPED
+) -> Callable[[object], Optional[object]]:
+    """A function returning the ``channels`` of a message: one channel, its value
+    (:func:`component_getter`, unchanged); several, the tuple of their values (fixed fields: one
+    ``operator.attrgetter``), or ``None`` when a ``JointState`` message lacks one of the joints."""
+    full = check_input_type(input_type)
+    check_components(channels, full)
+    if len(channels) == 1:
+        return component_getter(channels[0], full)
+    if full != JOINT_STATE:
+        prefix = 'wrench.' if full == WRENCH_STAMPED else ''
+        return attrgetter(*(prefix + c for c in channels))
+    getters = [component_getter(c, full) for c in channels]
+
+    def joint_values(msg) -> Optional[tuple]:
+        values = tuple(get(msg) for get in getters)
+        return None if None in values else values
+
+    return joint_values
+
+
 def component_setter(
     component: str, input_type: str = WRENCH_STAMPED
 ) -> Callable[[object, float], None]:

@@ -34,7 +34,7 @@ from __future__ import annotations
 import heapq
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable, Dict, Iterable, Iterator, List, Optional, Tuple
+from typing import Callable, Dict, Iterable, Iterator, List, Optional, Sequence, Tuple
 
 import numpy as np
 from rosbags.rosbag2 import Reader
@@ -48,8 +48,9 @@ from .fields import (
     DEFAULT_INPUT_TOPIC,
     FLOAT64,
     INPUT_TYPES,
+    channels_getter,
     check_component,
-    component_getter,
+    check_components,
     normalise_type,
     seconds_since,
     stamp_ns,
@@ -68,7 +69,8 @@ class Signal(DamageCount):
     """An opened recording: where the samples come from and how to stream them.
 
     ``blocks()`` yields ``(t, y)``: time in s (bags: since the first stamp, ``origin_ns``; CSV: the
-    time column as written) and the values. ``skipped`` counts messages without the component
+    time column as written) and the values (a bag's ``components``: one column each, a sample
+    only from a message that has them all). ``skipped`` counts messages without the component
     (``JointState`` without the joint), ``corrupt`` the damaged records skipped (``damage``: the
     first one, described), both known once ``blocks()`` is exhausted. ``strict``: a damaged
     record raises :class:`~vib_estimator.errors.CorruptRecordError` instead.
@@ -79,6 +81,7 @@ class Signal(DamageCount):
     topic: str = ''
     msgtype: str = ''
     component: str = ''
+    components: Tuple[str, ...] = ()
     origin_ns: Optional[int] = None
     skipped: int = 0
     corrupt: int = 0
@@ -108,14 +111,16 @@ def open_signal(
     component: Optional[str] = None,
     column: Optional[str] = None,
     strict: bool = False,
+    components: Optional[Sequence[str]] = None,
     info: Optional[BagInfo] = None,
 ) -> Signal:
     """Open a CSV file or a bag for streaming; raises CsvError, BagError or ValueError (bad
-    component) before any sample is read. ``info``: the bag's :func:`bag_info`, if already read."""
+    component) before any sample is read. ``components`` (bags): several fields of the topic,
+    the columns of each block's values. ``info``: the bag's :func:`bag_info`, if already read."""
     path = Path(path)
     if is_csv(path):
         return csv_signal(path, column)
-    return bag_signal(path, topic, component, strict, info)
+    return bag_signal(path, topic, component, strict, components, info)
 
 
 def csv_signal(path: Path, column: Optional[str]) -> Signal:
@@ -202,15 +207,21 @@ def bag_signal(
     topic: Optional[str],
     component: Optional[str],
     strict: bool = False,
+    components: Optional[Sequence[str]] = None,
     info: Optional[BagInfo] = None,
 ) -> Signal:
-    """A topic of a bag; ``component`` defaults to the type's ``DEFAULT_COMPONENT``."""
+    """A topic of a bag; ``component`` defaults to the type's ``DEFAULT_COMPONENT``; with
+    ``components``, those fields instead (one column each)."""
     info = info or bag_info(path)
     topic = choose_topic(path, info.topics, topic)
     msgtype = info.topics[topic]
-    component = check_component(component or DEFAULT_COMPONENT[msgtype], msgtype)
-    signal = Signal(path, f'{topic} {component}', topic, msgtype, component, strict=strict)
+    fields = check_components(components, msgtype) if components else ()
+    component = check_component(
+        fields[0] if fields else component or DEFAULT_COMPONENT[msgtype], msgtype
+    )
     files, expected = info.files, info.counts[topic]
+    label = f'{topic} {",".join(fields) or component}'
+    signal = Signal(path, label, topic, msgtype, component, fields, strict=strict)
     signal._source = lambda: _counted(signal, _bag_blocks(signal, files), expected)
     return signal
 
@@ -269,17 +280,24 @@ def _group(blocks: Iterable[Block]) -> Iterator[Block]:
 def _decode(batches, signal: Signal) -> Iterator[Block]:
     """(stamps_ns, values) of each raw batch (buf, offsets, lengths, log_times)."""
     getter = None
+    fields = signal.components or (signal.component,)
     for buf, offsets, lengths, log_times in batches:
         if cdr.is_fixed_layout(signal.msgtype):
             try:
-                stamps, values = cdr.decode_fixed(
-                    buf, offsets, lengths, signal.msgtype, signal.component
+                columns = [
+                    cdr.decode_fixed(buf, offsets, lengths, signal.msgtype, c) for c in fields
+                ]
+                stamps = columns[0][0]
+                values = (
+                    np.column_stack([v for _, v in columns])
+                    if signal.components
+                    else columns[0][1]
                 )
                 yield (log_times if stamps is None else stamps), values
                 continue
             except CdrLayoutError:
                 pass
-        getter = getter or component_getter(signal.component, signal.msgtype)
+        getter = getter or channels_getter(fields, signal.msgtype)
         yield _decode_general(buf, offsets, lengths, log_times, signal, getter)
 
 
@@ -287,7 +305,8 @@ def _decode_general(buf, offsets, lengths, log_times, signal: Signal, getter) ->
     """The rosbags deserialiser, message by message (JointState, big-endian CDR, ...); a payload
     that does not decode as its type is a damaged record."""
     stamps: List[int] = []
-    values: List[float] = []
+    values: list = []
+    several = len(signal.components)
     raw = buf.tobytes() if isinstance(buf, np.ndarray) else buf
     for off, size, log_time in zip(offsets.tolist(), lengths.tolist(), log_times.tolist()):
         try:
@@ -305,8 +324,9 @@ def _decode_general(buf, offsets, lengths, log_times, signal: Signal, getter) ->
             signal.skipped += 1
             continue
         stamps.append(stamp)
-        values.append(float(value))
-    return np.array(stamps, dtype=np.int64), np.array(values, dtype=np.float64)
+        values.append(value if several else float(value))
+    shape = (len(values), several) if several else (len(values),)
+    return np.array(stamps, dtype=np.int64), np.array(values, dtype=np.float64).reshape(shape)
 
 
 def _rosbags_batches(files: List[Path], signal: Signal, size: int = 1 << 16):
@@ -345,8 +365,7 @@ def _pack(batch) -> Tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
 def _mcap_batches(plan: List[mcap.ChunkRead], signal: Signal):
     """(buf, payload offsets, lengths, log times) of the topic's messages, consecutive chunks of
     a file read together up to about :data:`MCAP_BATCH_MESSAGES` messages
-    (:func:`.mcap.read_chunks`); the damaged
-    records of each chunk counted."""
+    (:func:`.mcap.read_chunks`); the damaged records of each chunk counted."""
     handles: Dict[Path, object] = {}
     try:
         for group in _chunk_groups(plan, MCAP_BATCH_MESSAGES):

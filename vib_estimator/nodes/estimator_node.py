@@ -9,12 +9,14 @@ and the diagnostics bookkeeping, all without rclpy) and publishes what comes bac
 
 * Input: ``coupling_torque`` (parameter ``input_topic``, read-only) of type ``input_type``
   (read-only; the types and components of :mod:`vib_estimator.io.fields`), best-effort sensor-data
-  QoS with a deeper history (:data:`INPUT_DEPTH`); field ``component``.
+  QoS with a deeper history (:data:`INPUT_DEPTH`); field ``component``, or with ``components``
+  several fields of each message, identified jointly (``excitation`` ambient: docs/channels.md).
 * Output, on each estimate and in this order (:class:`Outputs`): ``vibration/frequency``,
   ``vibration/damping_ratio``, ``vibration/frequency_std``, ``vibration/amplitude``
   (std_msgs/Float64), then ``vibration/reset`` (std_msgs/Header: stamp and frame_id of the
   converging sample); with ``modes`` >= 1 these carry mode 1, and each mode k has
-  ``vibration/mode<k>/frequency`` and ``vibration/mode<k>/reset``.
+  ``vibration/mode<k>/frequency`` and ``vibration/mode<k>/reset``; with several components also
+  ``vibration/mode<k>/shape`` (std_msgs/Float64MultiArray, :meth:`Outputs.publish_shape`).
 * Services ``~/reset`` (a new segment now) and ``~/self_test`` (:mod:`.self_test`),
   std_srvs/Trigger, with a request history of :data:`SERVICE_DEPTH`: a burst of calls is queued and
   every call answered, in turn (a self-test takes ~8 ms at the defaults; the input history
@@ -42,12 +44,22 @@ from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
 from rclpy.time import Time
-from std_msgs.msg import Float64, Header
+from std_msgs.msg import Float64, Float64MultiArray, Header, MultiArrayDimension
 from std_srvs.srv import Trigger
 
 from ..core.config import EstimatorConfig
+from ..core.multichannel import MIN_CHANNELS, JointEstimate
+from ..core.shapes import SHAPE_ROWS, phases_deg, signed_amplitudes
 from ..errors import StartupError
-from ..io.fields import check_component, check_input_type, component_getter, has_header, stamp_ns
+from ..io.fields import (
+    channels_getter,
+    channels_of,
+    check_component,
+    check_components,
+    check_input_type,
+    has_header,
+    stamp_ns,
+)
 from . import health as H
 from .parameters import (
     config_of,
@@ -57,7 +69,7 @@ from .parameters import (
     warn_unused_params_files,
 )
 from .runner import run
-from .stream import WARMUP_BUFFER, WARMUP_MESSAGE, EstimatorStream
+from .stream import WARMUP_BUFFER, WARMUP_MESSAGE, EstimatorStream, check_channels
 
 #: input history: sensor-data QoS (best effort) but 1000 deep instead of 5, so that a scheduling
 #: hiccup of up to 2 s at 500 Hz, or a player's burst after a stall, drops nothing
@@ -71,6 +83,8 @@ WARMUP_NOTICE = 1.0
 SERVICE_DEPTH = 1000
 #: the ROS parameters that configure the core, one per EstimatorConfig field
 CORE_NAMES = frozenset(EstimatorConfig.names())
+#: the ROS parameters that choose the fields of the input
+FIELD_NAMES = frozenset(('component', 'components'))
 #: the Float64 outputs of each estimate, in publication order: (topic under vibration/, field)
 FLOAT_OUTPUTS = (
     ('frequency', 'frequency_hz'),
@@ -106,6 +120,45 @@ class Outputs:
         ]
         self._reset = node.create_publisher(Header, 'vibration/reset', 10)
         self._modes = {}  # mode -> (frequency publisher, reset publisher)
+        self._shapes = {}  # mode -> shape publisher (several channels)
+        self._shape = Float64MultiArray()
+
+    def set_channels(self, channels, modes: int) -> None:
+        """The layout of the shapes of ``channels`` (several: publishers of modes 1..``modes``
+        made now, those of higher modes destroyed and made again on an estimate, as
+        :meth:`set_modes` does; one channel: none)."""
+        joint = len(channels) >= MIN_CHANNELS
+        keep = modes if joint else 0
+        for k in [k for k in self._shapes if k > keep]:
+            self._node.destroy_publisher(self._shapes.pop(k))
+        if not joint:
+            return
+        m = len(channels)
+        self._shape.layout.dim = [
+            MultiArrayDimension(
+                label=','.join(SHAPE_ROWS), size=len(SHAPE_ROWS), stride=len(SHAPE_ROWS) * m
+            ),
+            MultiArrayDimension(label=','.join(channels), size=m, stride=m),
+        ]
+        for k in range(1, modes + 1):
+            self._shape_publisher(k)
+
+    def _shape_publisher(self, k: int):
+        if k not in self._shapes:
+            self._shapes[k] = self._node.create_publisher(
+                Float64MultiArray, f'vibration/mode{k}/shape', 10
+            )
+        return self._shapes[k]
+
+    def publish_shape(self, joint: JointEstimate) -> None:
+        """``vibration/mode<k>/shape``: rows ``shape`` (each channel's signed amplitude),
+        ``shape_phase_deg`` (its phase) and ``shape_std`` (its uncertainty), one column per
+        channel (``layout.dim[0]``: the rows' names, ``dim[1]``: the channels', comma-joined;
+        row-major: the amplitudes first)."""
+        msg = self._shape
+        parts = (signed_amplitudes(joint.shape), phases_deg(joint.shape), joint.shape_std)
+        msg.data = [float(v) for part in parts for v in part]
+        self._shape_publisher(joint.estimate.mode).publish(msg)
 
     def set_modes(self, modes: int) -> None:
         """Publishers for modes 1..``modes``; those of higher modes are destroyed."""
@@ -148,11 +201,11 @@ class EstimatorNode(Node):
         #: warnings about params files that set nothing for this node (also logged)
         self.params_file_warnings = warn_unused_params_files(self, kwargs.get('cli_args'))
         try:
-            self._component = check_component(
-                self.get_parameter('component').value, self._input_type
+            self._channels = self._read_channels()
+            self._value = channels_getter(self._channels, self._input_type)
+            self._stream = EstimatorStream(
+                config_of(self), time.monotonic(), background=True, channels=self._channels
             )
-            self._value = component_getter(self._component, self._input_type)
-            self._stream = EstimatorStream(config_of(self), time.monotonic(), background=True)
         except ValueError as err:
             raise StartupError(str(err)) from None
         self._feed = self._stream.feed  # bound once (data path)
@@ -160,6 +213,7 @@ class EstimatorNode(Node):
         self._clock = self.get_clock()
         self._outputs = Outputs(self)
         self._outputs.set_modes(self._stream.config.modes)
+        self._outputs.set_channels(self._channels, self._stream.config.modes)
         # before the subscription: a node whose input is matched answers its services; a deep
         # request history, so that a burst of calls queues instead of being dropped
         service_qos = QoSProfile(depth=SERVICE_DEPTH, reliability=ReliabilityPolicy.RELIABLE)
@@ -187,19 +241,32 @@ class EstimatorNode(Node):
         self._warmup_logged = False
         self.get_logger().info(
             f'estimating on {self._subscription.topic_name} '
-            f'({self._input_type} [{self._component}]) with '
+            f'({self._input_type} [{", ".join(self._channels)}]) with '
             f'{self._stream.config}'
+        )
+
+    def _read_channels(self):
+        """The channels of the current ``component`` / ``components`` (ValueError if bad)."""
+        return channels_of(
+            self.get_parameter('component').value,
+            self.get_parameter('components').value,
+            self._input_type,
         )
 
     # ---- parameters ------------------------------------------------------------------------
     def _check_parameters(self, parameters) -> SetParametersResult:
         """Refuse, with the core's reason, a change that would make an invalid configuration."""
         changes = {p.name: config_value(p.value) for p in parameters if p.name in CORE_NAMES}
+        fields = {
+            'component': self.get_parameter('component').value,
+            'components': self.get_parameter('components').value,
+            **{p.name: p.value for p in parameters if p.name in FIELD_NAMES},
+        }
         try:
-            for p in parameters:
-                if p.name == 'component':
-                    check_component(p.value, self._input_type)
-            self._stream.config.replace(**changes)
+            check_component(fields['component'], self._input_type)
+            check_components(fields['components'] or (), self._input_type)
+            config = self._stream.config.replace(**changes)
+            check_channels(channels_of(**fields, input_type=self._input_type), config)
         except ValueError as err:
             return SetParametersResult(successful=False, reason=str(err))
         return SetParametersResult(successful=True)
@@ -207,19 +274,20 @@ class EstimatorNode(Node):
     def _apply_parameters(self, parameters) -> None:
         """Rebuild the estimator after an accepted change: a fresh segment, same time origin."""
         names = {p.name for p in parameters}
-        if not names & (CORE_NAMES | {'component'}):
+        if not names & (CORE_NAMES | FIELD_NAMES):
             return
-        self._component = self.get_parameter('component').value
-        self._value = component_getter(self._component, self._input_type)
-        self._stream.configure(config_of(self))
+        self._channels = self._read_channels()
+        self._value = channels_getter(self._channels, self._input_type)
+        self._stream.configure(config_of(self), self._channels)
         self._outputs.set_modes(self._stream.config.modes)
+        self._outputs.set_channels(self._channels, self._stream.config.modes)
         self._ready = self._stream.ready
         if not self._ready:
             self._warmup_logged = False
             self._warmup_timer.reset()
         self.get_logger().info(
             f'parameters {", ".join(sorted(names))} changed: estimator '
-            f'restarted on [{self._component}] with {self._stream.config}'
+            f'restarted on [{", ".join(self._channels)}] with {self._stream.config}'
         )
 
     # ---- data path -------------------------------------------------------------------------
@@ -254,8 +322,14 @@ class EstimatorNode(Node):
 
     def _publish(self, estimates, header: Header) -> None:
         """Publish the estimates of the sample of ``header`` (see :class:`Outputs`)."""
-        for estimate in estimates:
-            self._outputs.publish(estimate, header)
+        for item in estimates:
+            if isinstance(item, JointEstimate):  # several channels: the mode's shape too
+                estimate = item.estimate
+                self._outputs.publish(estimate, header)
+                self._outputs.publish_shape(item)
+            else:
+                estimate = item
+                self._outputs.publish(estimate, header)
             self._stream.published(estimate, time.monotonic())
 
     # ---- warm-up (the kernels compile in a thread; see .stream) -------------------------------
@@ -320,7 +394,7 @@ class EstimatorNode(Node):
         if self._stream.health.count('skipped_joint_missing') == 1:
             self.get_logger().warn(
                 f'{self._subscription.topic_name}: messages without the '
-                f'joint of [{self._component}] are skipped (counted in the '
+                f'joint of [{", ".join(self._channels)}] are skipped (counted in the '
                 'diagnostics)'
             )
 

@@ -81,8 +81,8 @@ class _Last:
 
 
 def format_value(value) -> str:
-    """A diagnostics value: integers exactly, floats to 9 significant digits."""
-    return str(value) if isinstance(value, int) else f'{value:.9g}'
+    """A diagnostics value: integers exactly, floats to 9 significant digits, text as it is."""
+    return str(value) if isinstance(value, (int, str)) else f'{value:.9g}'
 
 
 class Health:

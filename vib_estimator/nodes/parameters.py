@@ -92,8 +92,9 @@ def config_of(node: Node) -> EstimatorConfig:
 
 
 def declare_input(node: Node, default_topic: str = DEFAULT_INPUT_TOPIC):
-    """Declare ``input_type`` and ``input_topic`` (read-only) and ``component`` (its default
-    that of the type); return (the type's full name, the topic)."""
+    """Declare ``input_type`` and ``input_topic`` (read-only), ``component`` (its default that
+    of the type) and ``components`` (default ``[]``: ``component`` alone); return (the type's full
+    name, the topic)."""
     input_type = declare(
         node,
         'input_type',
@@ -116,6 +117,18 @@ def declare_input(node: Node, default_topic: str = DEFAULT_INPUT_TOPIC):
         DEFAULT_COMPONENT[input_type],
         descriptor(f'field of the input to estimate on: {describe_components(input_type)}'),
     )
+    declare(
+        node,
+        'components',
+        Parameter.Type.STRING_ARRAY,
+        descriptor(
+            'several fields of the input, one channel each, identified jointly with their mode '
+            'shapes (needs excitation ambient; [] = component alone): '
+            + describe_components(input_type)
+        ),
+    )
+    if node.get_parameter_or('components').type_ == Parameter.Type.NOT_SET:
+        node.set_parameters([Parameter('components', Parameter.Type.STRING_ARRAY, [])])
     return input_type, topic
 
 

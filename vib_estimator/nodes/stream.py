@@ -7,6 +7,10 @@ the stamp time base (``t = seconds_since(stamp, first stamp)``, exactly as the o
 ``vib-estimator analyze``), the estimator of the live configuration (``create_estimator``: one
 :class:`~vib_estimator.core.FrequencyEstimator`, or a mode tracker with ``modes`` >= 1; replaced
 on a change of configuration, its counters kept), and the :class:`~.health.Health` bookkeeping.
+With several ``channels`` (the node's ``components``) the estimator is the joint identifier
+(:class:`~vib_estimator.core.multichannel.JointAmbientEstimator`, ``excitation`` ambient only:
+:func:`check_channels`): each sample is a tuple of values, each estimate a
+:class:`~vib_estimator.core.multichannel.JointEstimate` (the estimate and its mode shape).
 
 Warm-up. A configuration whose kernels are not compiled in this process yet (the first start, or a
 change to a configuration that runs other kernels) is built in a background thread
@@ -23,11 +27,13 @@ import math
 import threading
 import time
 from collections import deque
-from typing import Any, Dict, Iterator, Optional, Sequence, Tuple
+from functools import partial
+from typing import Any, Callable, Dict, Iterator, Optional, Sequence, Tuple
 
 from ..core.config import EstimatorConfig
 from ..core.estimator import COUNTER_NAMES, Estimate
 from ..core.modes import create_estimator
+from ..core.multichannel import MIN_CHANNELS, JointAmbientEstimator
 from ..core.warmup import is_warm, warm
 from ..io.fields import seconds_since
 from .health import WARN, Health, Status
@@ -45,11 +51,31 @@ SELF_TEST_DIGITS = 3
 WARMUP_MESSAGE = 'compiling estimator kernels (first start)'
 
 
+def check_channels(channels: Sequence[str], config: EstimatorConfig) -> None:
+    """ValueError unless ``config`` can identify ``channels`` (names): several need
+    ``excitation`` ambient (the joint identification, :mod:`~vib_estimator.core.multichannel`)."""
+    if len(channels) >= MIN_CHANNELS and config.excitation != 'ambient':
+        raise ValueError(
+            f'{len(channels)} components ({", ".join(channels)}) need excitation ambient (the '
+            f'joint identification), got excitation {config.excitation}; free decays take one '
+            'component'
+        )
+
+
+def estimator_factory(channels: Sequence[str]) -> Callable[[EstimatorConfig], Any]:
+    """What builds the estimator of a configuration for ``channels``: one channel,
+    :func:`~vib_estimator.core.modes.create_estimator`; several, the joint identifier."""
+    if len(channels) < MIN_CHANNELS:
+        return create_estimator
+    return partial(JointAmbientEstimator, channels=tuple(channels))
+
+
 class _Build:
     """An estimator of ``config`` built in a daemon thread (its kernels compiled first)."""
 
-    def __init__(self, config: EstimatorConfig):
+    def __init__(self, config: EstimatorConfig, create: Callable[[EstimatorConfig], Any]):
         self.config = config
+        self._create = create
         self.started = time.monotonic()
         self.seconds = 0.0
         self.estimator = None
@@ -62,7 +88,7 @@ class _Build:
     def _run(self) -> None:
         try:
             warm(self.config)
-            self.estimator = create_estimator(self.config)
+            self.estimator = self._create(self.config)
         except Exception as err:  # reported by the node, never lost in a thread
             self.error = err
         self.seconds = time.monotonic() - self.started
@@ -76,11 +102,22 @@ class EstimatorStream:
     """Samples in, estimates out, with the node's counters and status (see the module doc).
 
     ``background``: build an estimator whose kernels are not compiled yet in a thread (the node);
-    False builds it at once (tests, tools).
+    False builds it at once (tests, tools). ``channels``: the names of the input's channels (the
+    node's components); one (or none given) is the single-channel estimator, bit for bit; several
+    feed :meth:`feed` a tuple of values a sample and give
+    :class:`~vib_estimator.core.multichannel.JointEstimate` s (``excitation`` ambient only).
     """
 
-    def __init__(self, config: EstimatorConfig, now: float, background: bool = False):
+    def __init__(
+        self,
+        config: EstimatorConfig,
+        now: float,
+        background: bool = False,
+        channels: Sequence[str] = (),
+    ):
         config.validate()
+        check_channels(channels, config)
+        self.channels: Tuple[str, ...] = tuple(channels)
         self.health = Health(now)
         self.origin = None  # first stamp, ns: t = 0
         self.last_t = None  # time of the last sample, s
@@ -104,18 +141,24 @@ class EstimatorStream:
         """False while a configuration's kernels compile (samples are held, not estimated)."""
         return self._build is None
 
-    def configure(self, config: EstimatorConfig) -> None:
-        """A fresh estimator of ``config`` (a new segment, same time origin, counters kept); built
-        in the background when its kernels are not compiled yet and ``background`` was asked."""
+    def configure(self, config: EstimatorConfig, channels: Optional[Sequence[str]] = None) -> None:
+        """A fresh estimator of ``config`` (a new segment, same time origin, counters kept) for
+        ``channels`` (default: the same); built in the background when its kernels are not
+        compiled yet and ``background`` was asked. ValueError if ``config`` cannot take the
+        channels (:func:`check_channels`)."""
+        channels = self.channels if channels is None else tuple(channels)
+        check_channels(channels, config)
+        self.channels = channels
+        create = estimator_factory(channels)
         if self.estimator is not None:
             self.health.absorb(self.estimator.counters)
             self.estimator = None
         self._config = config
         self.health.forget_modes(config.modes)
         if self._background and not is_warm(config):
-            self._build = _Build(config)
+            self._build = _Build(config, create)
         else:
-            self._install(create_estimator(config))
+            self._install(create(config))
 
     def _install(self, estimator) -> None:
         self.estimator = estimator
@@ -195,7 +238,10 @@ class EstimatorStream:
             }
             return Status(WARN, WARMUP_MESSAGE, values)
         config = self.config
-        return self.health.status(now, self.counters, self.last_t, config.band_hz, config.modes)
+        status = self.health.status(now, self.counters, self.last_t, config.band_hz, config.modes)
+        if len(self.channels) >= MIN_CHANNELS:  # a joint identification: which channels
+            status.values['channels'] = ','.join(self.channels)
+        return status
 
     def reset(self) -> Tuple[bool, str]:
         """Start a new segment at the last sample; counters kept. (False, why) during a warm-up."""
