@@ -55,12 +55,9 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.signal import sosfiltfilt
-
 from .ambient import (
     BLOCK_ROWS,
     COUNTER_NAMES,
-    DECIMATE_SOS,
     MATCH_TOL,
     MAX_STD_REL,
     MAX_TRACKS,
@@ -71,10 +68,12 @@ from .ambient import (
     ORDERS,
     ModeTrack,
     SlidingWindowIdentifier,
-    decimate,
+    decimation_level,
+    hankel_svd,
     estimate_columns,
     sdof_psd,
     stable_clusters,
+    state_matrices,
     whittle_std,
 )
 from .config import EstimatorConfig
@@ -140,15 +139,15 @@ def joint_poles(
     m = r.shape[1]
     idx = 1 + np.add.outer(np.arange(rows), np.arange(rows))
     hankel = r[idx].transpose(0, 2, 1, 3).reshape(rows * m, rows * m)
-    u, s, vt = np.linalg.svd(hankel)
+    u, s, vt = hankel_svd(hankel, max(orders), m)
     width = 3 + 3 * m
     out = []
-    for order in orders:
+    for order, a in zip(orders, state_matrices(u, s, m, orders)):
         root = np.sqrt(s[:order])
-        obs = u[:, :order] * root
-        up = obs[:-m]
+        obs = u[:m, :order] * root  # C, the first block row of O
         try:
-            a = np.linalg.lstsq(up, obs[m:], rcond=None)[0]
+            if a is None:
+                raise np.linalg.LinAlgError
             lam, vec = np.linalg.eig(a)
             g_modal = np.linalg.solve(vec, root[:, None] * vt[:order, :m])
         except np.linalg.LinAlgError:
@@ -201,13 +200,12 @@ def _cluster_shape(group: np.ndarray, m: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def joint_modes_at(
-    y: np.ndarray, fs: float, max_damping: float, band: tuple[float, float], counts: dict
+    r: np.ndarray, fs: float, max_damping: float, band: tuple[float, float], counts: dict
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The clustered modes of ``y`` (samples x channels) at ``fs``: (rows of frequency, damping,
-    each channel's variance; shapes; shape stds), close clusters merged when their shapes agree;
-    and the channels' variances ``R_0``."""
-    m = y.shape[1]
-    r = correlation_matrices(y, 2 * JOINT_BLOCK_ROWS)
+    """The clustered modes of correlation matrices ``r`` (:func:`correlation_matrices`, lags 0 ..
+    ``2 JOINT_BLOCK_ROWS``) at ``fs``: (rows of frequency, damping, each channel's variance;
+    shapes; shape stds), close clusters merged when their shapes agree."""
+    m = r.shape[1]
     clusters = stable_clusters(
         joint_poles(r, fs), fs, max_damping, (band[0], min(band[1], NU_MAX * fs)), counts
     )
@@ -269,7 +267,7 @@ def strong_joint(rows, shapes, stds, totals, fs, counts):
 
 
 def identify_joint(
-    y: np.ndarray,
+    cascade,
     fs: float,
     max_damping: float = 0.1,
     band: tuple[float, float] = (0.0, math.inf),
@@ -277,31 +275,33 @@ def identify_joint(
     top_hz: float = 0.0,
     search: bool = True,
 ) -> tuple[JointModes, float]:
-    """Modes of one window ``y`` (samples x channels) at ``fs``, the passes of
-    :func:`..ambient.identify` (a search from the full rate down, then the rate that puts the
-    highest mode at :data:`..ambient.TOP_NU`): (:class:`JointModes`, the summed variance)."""
+    """Modes of one window (its :class:`..ambient.CorrelationCascade` of lags 0 .. ``2
+    JOINT_BLOCK_ROWS``; ``fs`` the input rate), the passes of :func:`..ambient.identify` (a search
+    from the full rate down, then the rate that puts the highest mode at
+    :data:`..ambient.TOP_NU`): (:class:`JointModes`, the summed variance)."""
     counts = dict.fromkeys(COUNTER_NAMES, 0) if counts is None else counts
-    y = np.asarray(y, dtype=np.float64)
-    m = y.shape[1]
-    totals = np.var(y, axis=0)
+    m = cascade.channels
+    totals = np.diag(cascade.correlations(0)[0]).copy()  # R_0: each channel's variance
+
+    def modes_at(level):
+        r = cascade.correlations(level)
+        found = joint_modes_at(r, fs / 2**level, max_damping, band, counts)
+        return strong_joint(*found, totals, fs, counts)
+
     found = (np.empty((0, 2 + m)), np.empty((0, m), complex), np.empty((0, m)))
     strong = (*found, totals, np.empty(0, dtype=int))
     if search or top_hz <= 0:
-        yk, rate = y, fs
+        level = 0
         while True:
-            strong = strong_joint(
-                *joint_modes_at(yk, rate, max_damping, band, counts), totals, fs, counts
-            )
-            if len(strong[0]) or len(yk) // 2 < MIN_SAMPLES:
+            strong = modes_at(level)
+            if len(strong[0]) or cascade.samples(level + 1) < MIN_SAMPLES:
                 break
-            yk, rate = sosfiltfilt(DECIMATE_SOS, yk, axis=0)[::2], 0.5 * rate
+            level += 1
     top = max(float(np.max(strong[0][:, 0])) if len(strong[0]) else 0.0, top_hz)
     if top > 0:
-        yq, rate = decimate(y, fs, top)
-        if rate < fs or not (search or top_hz <= 0):  # (no search pass ran at fs)
-            strong = strong_joint(
-                *joint_modes_at(yq, rate, max_damping, band, counts), totals, fs, counts
-            )
+        level = decimation_level(cascade, fs, top)
+        if level > 0 or not (search or top_hz <= 0):  # (no search pass ran at fs)
+            strong = modes_at(level)
     rows, shapes, spread, noise, best = strong
     std = np.full((len(rows), 2), math.nan)
     for j, c in enumerate(best):
@@ -310,7 +310,7 @@ def identify_joint(
             (rows[:, 2 + c] > 0) & (np.abs(rows[:, 0] / rows[j, 0] - 1) <= NEIGHBOURS)
         )
         triples = [(rows[i, 0], rows[i, 1], rows[i, 2 + c]) for i in near]
-        cstd = np.array(whittle_std(triples, noise[c], fs, len(y))).reshape(-1, 2)
+        cstd = np.array(whittle_std(triples, noise[c], fs, cascade.samples(0))).reshape(-1, 2)
         std[j] = cstd[int(np.flatnonzero(near == j)[0])]
     modes = JointModes(rows[:, 0], rows[:, 1], rows[:, 2:], std[:, 0], std[:, 1], shapes, spread)
     weak = ~(modes.frequency_std <= MAX_STD_REL * modes.frequency)
@@ -365,7 +365,7 @@ class JointAmbientEstimator(SlidingWindowIdentifier):
                 f'got {len(channels)} (one channel: excitation ambient, one column)'
             )
         self._channels = channels
-        super().__init__(config, len(channels))
+        super().__init__(config, len(channels), 2 * JOINT_BLOCK_ROWS)
 
     @property
     def channels(self) -> tuple[str, ...]:
@@ -411,9 +411,9 @@ class JointAmbientEstimator(SlidingWindowIdentifier):
         window = self._next_window()
         if window is None:
             return []
-        ts, ys, fs, span, known, search = window
+        ts, cascade, fs, span, known, search = window
         modes, total = identify_joint(
-            ys, fs, self._config.max_damping, self._band, self._c, known, search
+            cascade, fs, self._config.max_damping, self._band, self._c, known, search
         )
         return self._track(modes, total, float(ts[-1]), span, len(ts))
 
