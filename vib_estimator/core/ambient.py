@@ -249,9 +249,11 @@ PRODUCT_BLOCK = 2048
 
 class LagProducts:
     """The lag products of a sliding window over a growing buffer of samples (one row of
-    ``channels`` values each), kept up to date exactly: a push adds the products of the new
-    samples with the window's earlier ones, a slide subtracts those of the samples that leave.
-    :meth:`correlations` gives what :func:`correlation_matrices` computes from the window."""
+    ``channels`` values each), kept exactly: when the correlations are read, the products of
+    the samples pushed since are added, those of the samples that left are subtracted (or, after
+    :data:`REFRESH_SLIDES` such slides or a slide longer than what stays, all recomputed from the
+    window). :meth:`correlations` gives what :func:`correlation_matrices` computes from the
+    window."""
 
     def __init__(self, lags: int, channels: int):
         self.lags, self.channels = lags, channels
@@ -259,8 +261,10 @@ class LagProducts:
         self.clear()
 
     def clear(self) -> None:
-        self._n = 0
-        self._start = 0
+        self._n = 0  # samples in the buffer
+        self._want = 0  # the window's first sample
+        self._start = 0  # the first sample of the stretch [start, done) the sums cover
+        self._done = 0
         self._offset = np.zeros(self.channels)
         self._sums = np.zeros((self.lags + 1, self.channels, self.channels))
         self._total = np.zeros(self.channels)
@@ -268,12 +272,12 @@ class LagProducts:
 
     def __len__(self) -> int:
         """The window's samples."""
-        return self._n - self._start
+        return self._n - self._want
 
     @property
     def window(self) -> np.ndarray:
         """The window's samples (a view)."""
-        return self._buf[self._start : self._n]
+        return self._buf[self._want : self._n]
 
     def push(self, x: np.ndarray) -> None:
         """Append samples ``x`` (rows) to the window."""
@@ -285,33 +289,40 @@ class LagProducts:
             size = max(len(self._buf), 1 << math.ceil(math.log2(2 * (keep + m))))
             buf = np.empty((size, self.channels)) if size > len(self._buf) else self._buf
             buf[:keep] = self._buf[self._start : self._n]
-            self._buf, self._n, self._start = buf, keep, 0
-        if self._n == self._start:
+            shift = self._start
+            self._buf, self._n = buf, keep
+            self._start, self._want, self._done = 0, self._want - shift, self._done - shift
+        if self._n == self._want:
             self._offset = np.array(x[0], dtype=np.float64)  # keeps the products' rounding small
+            self._restart()
         self._buf[self._n : self._n + m] = x
         self._n += m
-        self._add(self._n - m, self._n)
 
     def keep_last(self, count: int) -> None:
         """Slide the window's start so that it holds the last ``count`` samples."""
-        start = max(self._start, self._n - count)
-        if start == self._start:
-            return
-        if start - self._start >= self._n - start or self._slides >= REFRESH_SLIDES:
-            self._start = start
-            self._refresh()
-            return
-        self._sub(self._start, start)
-        self._start = start
-        self._slides += 1
+        self._want = max(self._want, self._n - count)
+        if self._want - self._start > self._n - self._want:
+            self._restart()  # (bounds the buffer of a level seldom read)
 
-    def _refresh(self) -> None:
-        """The sums afresh from the window."""
+    def _restart(self) -> None:
+        """Drop the sums: the next read recomputes them from the window."""
+        self._start = self._done = self._want
         self._sums[:] = 0.0
         self._total[:] = 0.0
         self._slides = 0
-        for a in range(self._start, self._n, PRODUCT_BLOCK):
-            self._add(a, min(self._n, a + PRODUCT_BLOCK))
+
+    def _sync(self) -> None:
+        """Bring the sums to the window."""
+        if self._want > self._start:
+            if self._want >= self._done or self._slides >= REFRESH_SLIDES:
+                self._restart()
+            else:
+                self._sub(self._start, self._want)
+                self._start = self._want
+                self._slides += 1
+        if self._done < self._n:
+            self._add(self._done, self._n)
+            self._done = self._n
 
     def _add(self, a: int, b: int) -> None:
         """Add the products ``y[t] y[t - k]^T`` of the samples a <= t < b with the window's."""
@@ -330,7 +341,7 @@ class LagProducts:
 
     def _sub(self, c: int, d: int) -> None:
         """Subtract the products ``y[u + k] y[u]^T`` of the samples c <= u < d leaving."""
-        lags, off, n = self.lags, self._offset, self._n
+        lags, off, n = self.lags, self._offset, self._done
         for c0 in range(c, d, PRODUCT_BLOCK):
             d0 = min(d, c0 + PRODUCT_BLOCK)
             hi = min(n, d0 + lags)
@@ -346,9 +357,12 @@ class LagProducts:
     def correlations(self) -> np.ndarray:
         """The window's unbiased correlation matrices of its mean-removed channels, ``R_k[a, b]
         = sum_t y_a,t+k y_b,t / (N - k)``, k = 0 .. ``lags``: (lags + 1, channels, channels)."""
+        self._sync()
         lags, n = self.lags, len(self)
         x = self.window
-        first = np.concatenate((np.zeros((1, self.channels)), np.cumsum(x[:lags] - self._offset, 0)))
+        first = np.concatenate(
+            (np.zeros((1, self.channels)), np.cumsum(x[:lags] - self._offset, 0))
+        )
         last = np.concatenate(
             (np.zeros((1, self.channels)), np.cumsum(x[: -lags - 1 : -1] - self._offset, 0))
         )
@@ -511,6 +525,11 @@ def ssi_poles(
     return out
 
 
+def order_support(group: np.ndarray) -> int:
+    """The model orders at which a cluster of :func:`stable_clusters` holds a pole."""
+    return len(set(group[:, -2].tolist()))
+
+
 def stable_clusters(
     poles: list[np.ndarray],
     fs: float,
@@ -551,7 +570,7 @@ def stable_clusters(
             continue
         group = allp[start:i]
         start = i
-        if len(np.unique(group[:, -2])) / n_orders < MIN_SUPPORT:
+        if order_support(group) / n_orders < MIN_SUPPORT:
             counts['rejected_unstable'] += 1
             continue
         clusters.append(group)
@@ -562,15 +581,10 @@ def cluster_modes(poles, fs, max_damping, band, counts) -> np.ndarray:
     """The physical modes of a stabilisation diagram ``poles`` (:func:`ssi_poles`): rows
     (frequency, damping, variance, support), ascending; counts the rejected poles/clusters
     (:func:`stable_clusters`)."""
-    modes = [
-        (
-            np.median(group[:, 0]),
-            np.median(group[:, 1]),
-            max(np.median(group[:, 2]), 0.0),
-            len(np.unique(group[:, -2])) / len(poles),
-        )
-        for group in stable_clusters(poles, fs, max_damping, band, counts)
-    ]
+    modes = []
+    for group in stable_clusters(poles, fs, max_damping, band, counts):
+        f, z, v = np.median(group[:, :3], axis=0)
+        modes.append((f, z, max(v, 0.0), order_support(group) / len(poles)))
     return np.array(modes).reshape(-1, 4)
 
 

@@ -16,8 +16,8 @@ are in), as the single-channel identifier (:mod:`..ambient`, whose stabilisation
 are reused) with matrices in place of scalars:
 
 1. **Joint SSI-cov**: the correlation matrices ``R_k = E[y_t+k y_t^T]`` (channels x channels,
-   k = 0 .. 2 p, by FFT, unbiased), their block Hankel matrix ``H = [R_{i+j+1}]`` (p =
-   :data:`JOINT_BLOCK_ROWS` block rows, every channel a reference), its SVD; at each model
+   k = 0 .. 2 p, unbiased), their block Hankel matrix ``H = [R_{i+j+1}]`` (p =
+   :func:`joint_rows` block rows, every channel a reference), its SVD; at each model
    order ``O = U_n S_n^1/2``, ``A = O_up^+ O_down``, ``C`` = the first block row of ``O``, ``G``
    = the first block column of ``S_n^1/2 V_n^T``. Each eigenvalue ``lambda`` (eigenvector
    ``v``) of ``A`` is a pole of every channel at once; its **shape** is ``phi = C v``, its share
@@ -55,6 +55,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+
 from .ambient import (
     BLOCK_ROWS,
     COUNTER_NAMES,
@@ -69,8 +70,9 @@ from .ambient import (
     ModeTrack,
     SlidingWindowIdentifier,
     decimation_level,
-    hankel_svd,
     estimate_columns,
+    hankel_svd,
+    order_support,
     sdof_psd,
     stable_clusters,
     state_matrices,
@@ -87,6 +89,10 @@ MAC_MATCH = 0.5
 #: ``rows x channels`` above the highest order; the SVD costs 8 times less; on the shear frame,
 #: two seeds, as accurate as 40 rows)
 JOINT_BLOCK_ROWS = BLOCK_ROWS // 2
+#: with many channels fewer block rows: ``rows x channels`` at most about this (the 5-storey
+#: frame's 100; the SVD's cost grows as its cube: 8 channels, 13 rows, 1.4x faster in all;
+#: the Heritage Court Tower's 6 channels, 17 rows: the same 6 modes, none > 2 % off)
+JOINT_HANKEL = 100
 #: a mode's Whittle bound counts the modes within this relative frequency of it (farther
 #: ones' skirts carry no information on it, and each bound then costs a few modes, not all)
 NEIGHBOURS = 0.2
@@ -110,6 +116,12 @@ def normalise_shape(phi: np.ndarray) -> np.ndarray:
 
 
 # ---- one window ---------------------------------------------------------------------------------
+def joint_rows(channels: int) -> int:
+    """Block rows of the joint Hankel matrix of ``channels`` channels: :data:`JOINT_BLOCK_ROWS`,
+    fewer when that would make it larger than :data:`JOINT_HANKEL`."""
+    return min(JOINT_BLOCK_ROWS, -(-JOINT_HANKEL // channels))
+
+
 def correlation_matrices(y: np.ndarray, lags: int) -> np.ndarray:
     """Unbiased correlation matrices ``R_k[a, b] = sum_t y_a,t+k y_b,t / (N - k)``, k = 0 ..
     ``lags``, of the mean-removed columns of ``y`` (samples x channels), by FFT: (lags + 1,
@@ -129,14 +141,12 @@ def correlation_matrices(y: np.ndarray, lags: int) -> np.ndarray:
     return r / np.arange(n, n - lags - 1, -1)[:, None, None]
 
 
-def joint_poles(
-    r: np.ndarray, fs: float, rows: int = JOINT_BLOCK_ROWS, orders: Sequence[int] = ORDERS
-) -> list[np.ndarray]:
-    """Joint SSI-cov poles of correlation matrices ``r`` (:func:`correlation_matrices`) at each
-    model order: per order an array with a row per complex pair (upper half plane): frequency Hz,
-    damping ratio, variance summed over channels, each channel's variance, the real then the
-    imaginary parts of the (unnormalised) shape."""
-    m = r.shape[1]
+def joint_poles(r: np.ndarray, fs: float, orders: Sequence[int] = ORDERS) -> list[np.ndarray]:
+    """Joint SSI-cov poles of correlation matrices ``r`` (:func:`correlation_matrices`, lags 0 ..
+    2 p: p block rows) at each model order: per order an array with a row per complex pair
+    (upper half plane): frequency Hz, damping ratio, variance summed over channels, each
+    channel's variance, the real then the imaginary parts of the (unnormalised) shape."""
+    m, rows = r.shape[1], (len(r) - 1) // 2
     idx = 1 + np.add.outer(np.arange(rows), np.arange(rows))
     hankel = r[idx].transpose(0, 2, 1, 3).reshape(rows * m, rows * m)
     u, s, vt = hankel_svd(hankel, max(orders), m)
@@ -190,9 +200,13 @@ class JointModes:
 def _cluster_shape(group: np.ndarray, m: int) -> tuple[np.ndarray, np.ndarray]:
     """The cluster's shape and its per-channel uncertainty (see the module doc, step 2)."""
     phis = group[:, 3 + m : 3 + 2 * m] + 1j * group[:, 3 + 2 * m : 3 + 3 * m]
-    phis = np.array([normalise_shape(p) for p in phis])
+    big = phis[np.arange(len(phis)), np.argmax(np.abs(phis), axis=1)]
+    size = np.abs(big)
+    unit = np.divide(big, size, out=np.ones_like(big), where=size > 0)
+    norm = np.where(size > 0, np.sqrt(np.sum(np.abs(phis) ** 2, axis=1)), 1.0)
+    phis = phis / (unit * norm)[:, None]  # each normalise_shape'd
     ref = phis[int(np.argmax(group[:, 2]))]
-    rot = np.array([np.vdot(p, ref) for p in phis])
+    rot = phis.conj() @ ref
     phis = phis * (rot / np.maximum(np.abs(rot), 1e-300))[:, None]
     mean = phis.mean(axis=0)
     spread = np.sqrt(np.mean(np.abs(phis - mean) ** 2, axis=0))
@@ -203,7 +217,7 @@ def joint_modes_at(
     r: np.ndarray, fs: float, max_damping: float, band: tuple[float, float], counts: dict
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The clustered modes of correlation matrices ``r`` (:func:`correlation_matrices`, lags 0 ..
-    ``2 JOINT_BLOCK_ROWS``) at ``fs``: (rows of frequency, damping, each channel's variance;
+    2 :func:`joint_rows`) at ``fs``: (rows of frequency, damping, each channel's variance;
     shapes; shape stds), close clusters merged when their shapes agree."""
     m = r.shape[1]
     clusters = stable_clusters(
@@ -214,11 +228,11 @@ def joint_modes_at(
         shape, spread = _cluster_shape(group, m)
         row = np.concatenate(
             (
-                [np.median(group[:, 0]), np.median(group[:, 1])],
+                np.median(group[:, :2], axis=0),
                 np.maximum(np.median(group[:, 3 : 3 + m], axis=0), 0.0),
             )
         )
-        sup = len(np.unique(group[:, -2]))
+        sup = order_support(group)
         if rows and row[0] <= rows[-1][0] * (1 + MERGE_TOL) and mac(shape, shapes[-1]) >= MAC_SAME:
             if sup > support[-1]:
                 rows[-1], shapes[-1], stds[-1], support[-1] = row, shape, spread, sup
@@ -275,8 +289,8 @@ def identify_joint(
     top_hz: float = 0.0,
     search: bool = True,
 ) -> tuple[JointModes, float]:
-    """Modes of one window (its :class:`..ambient.CorrelationCascade` of lags 0 .. ``2
-    JOINT_BLOCK_ROWS``; ``fs`` the input rate), the passes of :func:`..ambient.identify` (a search
+    """Modes of one window (its :class:`..ambient.CorrelationCascade` of lags 0 .. 2
+    :func:`joint_rows`; ``fs`` the input rate), the passes of :func:`..ambient.identify` (a search
     from the full rate down, then the rate that puts the highest mode at
     :data:`..ambient.TOP_NU`): (:class:`JointModes`, the summed variance)."""
     counts = dict.fromkeys(COUNTER_NAMES, 0) if counts is None else counts
@@ -365,7 +379,7 @@ class JointAmbientEstimator(SlidingWindowIdentifier):
                 f'got {len(channels)} (one channel: excitation ambient, one column)'
             )
         self._channels = channels
-        super().__init__(config, len(channels), 2 * JOINT_BLOCK_ROWS)
+        super().__init__(config, len(channels), 2 * joint_rows(len(channels)))
 
     @property
     def channels(self) -> tuple[str, ...]:

@@ -1,0 +1,91 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
+"""The identifiers' incremental window arithmetic equals the batch computation it replaces."""
+
+import math
+
+import numpy as np
+import pytest
+
+from vib_estimator.core.ambient import (
+    ORDERS,
+    CorrelationCascade,
+    correlations,
+    hankel_svd,
+    sdof_psd,
+    state_matrices,
+)
+from vib_estimator.core.multichannel import correlation_matrices
+
+
+@pytest.mark.parametrize('channels', [1, 3])
+def test_sliding_lag_products_equal_the_batch_correlations(channels):
+    # blocks of random length pushed, the window slid by random amounts (longer than what
+    # stays, too), levels read at random: every read equals the FFT of that level's window
+    rng = np.random.default_rng(channels)
+    y = rng.standard_normal((40000, channels)) + 7.0  # an offset: the centring is exercised
+    cascade = CorrelationCascade(40, channels)
+    pos, reads = 0, 0
+    for _ in range(120):
+        k = int(rng.integers(1, 1500))
+        cascade.push(y[pos : pos + k])
+        pos += k
+        cascade.keep_last(int(rng.integers(200, 7000)))
+        for level in cascade.levels:
+            if len(level) > 41 and rng.random() < 0.4:
+                ref = correlation_matrices(level.window, 40)
+                np.testing.assert_allclose(
+                    level.correlations(), ref, rtol=0, atol=1e-10 * np.abs(ref).max()
+                )
+                reads += 1
+    assert len(cascade.levels) >= 3 and reads > 50
+    one = CorrelationCascade.of(y[:5000, 0], 80)
+    np.testing.assert_allclose(one.correlations(0)[:, 0, 0], correlations(y[:5000, 0], 80))
+
+
+def test_cascade_levels_are_the_decimated_window():
+    # level j: every 2^j-th sample behind j anti-alias filters; a tone well inside every level's
+    # band keeps its variance, one above a level's band is removed there
+    fs, n = 500.0, 20000
+    t = np.arange(n) / fs
+    low = np.sin(2 * math.pi * 3.0 * t)
+    high = np.sin(2 * math.pi * 80.0 * t)  # above the band of the rate 125 Hz
+    cascade = CorrelationCascade.of(low + high, 8)
+    var = [float(cascade.correlations(j)[0, 0, 0]) for j in range(len(cascade.levels))]
+    assert len(var) >= 4
+    assert var[0] == pytest.approx(1.0, rel=0.01)  # both tones
+    assert var[1] == pytest.approx(1.0, rel=0.01)  # 80 Hz below 0.45 x 250 Hz (the cutoff)
+    for v in var[2:]:
+        assert v == pytest.approx(0.5, rel=0.02)  # the 3 Hz tone alone
+    assert [cascade.samples(j) for j in range(4)] == [n, n // 2, n // 4, n // 8]
+
+
+@pytest.mark.parametrize('m', [1, 6])
+def test_state_matrices_and_svd_equal_least_squares_and_lapack(m):
+    rng = np.random.default_rng(m)
+    size = 40 if m == 1 else 96
+    h = rng.standard_normal((size, size))
+    h = h @ np.diag(np.logspace(0, -3, size)) @ rng.standard_normal((size, size))
+    u, s, vt = hankel_svd(h, max(ORDERS), m)
+    u0, s0, vt0 = np.linalg.svd(h)
+    np.testing.assert_allclose(s, s0[: len(s)], rtol=1e-8)
+    sign = np.sign(np.sum(u * u0[:, : len(s)], axis=0))
+    np.testing.assert_allclose(u * sign, u0[:, : len(s)], atol=1e-7)
+    np.testing.assert_allclose(vt * sign[:, None], vt0[: len(s), :m], atol=1e-7)
+    for order, a in zip(ORDERS, state_matrices(u0, s0, m, ORDERS)):
+        obs = u0[:, :order] * np.sqrt(s0[:order])
+        ref = np.linalg.lstsq(obs[:-m], obs[m:], rcond=None)[0]
+        np.testing.assert_allclose(a, ref, atol=1e-10 * np.abs(ref).max())
+
+
+def test_sdof_density_in_real_arithmetic_is_the_complex_closed_form():
+    w = np.linspace(1e-3, math.pi, 2001)
+    for f, zeta, var, dt in ((5.0, 0.01, 1.0, 1 / 500), (23.0, 0.005, 0.2, 1 / 62.5)):
+        wn = 2 * math.pi * f * dt
+        root = math.sqrt(1 - zeta**2)
+        z = math.exp(-zeta * wn) * complex(math.cos(wn * root), math.sin(wn * root))
+        a = var * complex(1.0, -zeta / root)
+        e = np.exp(-1j * w)
+        total = a * (1 / (1 - z * e) + 1 / (1 - z / e) - 1)
+        total += a.conjugate() * (1 / (1 - z.conjugate() * e) + 1 / (1 - z.conjugate() / e) - 1)
+        np.testing.assert_allclose(sdof_psd(w, f, zeta, var, dt), 0.5 * total.real, rtol=1e-7)
