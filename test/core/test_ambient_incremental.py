@@ -6,58 +6,55 @@ import math
 
 import numpy as np
 import pytest
+from scipy.signal import sosfiltfilt
 
 from vib_estimator.core.ambient import (
+    DECIMATE_SOS,
     ORDERS,
     CorrelationCascade,
+    correlation_matrices,
     correlations,
+    halve,
     hankel_svd,
     sdof_psd,
     state_matrices,
 )
-from vib_estimator.core.multichannel import correlation_matrices
 
 
 @pytest.mark.parametrize('channels', [1, 3])
 def test_sliding_lag_products_equal_the_batch_correlations(channels):
     # blocks of random length pushed, the window slid by random amounts (longer than what
-    # stays, too), levels read at random: every read equals the FFT of that level's window
+    # stays, too), read at random: every read equals the FFT of the window
     rng = np.random.default_rng(channels)
     y = rng.standard_normal((40000, channels)) + 7.0  # an offset: the centring is exercised
     cascade = CorrelationCascade(40, channels)
     pos, reads = 0, 0
-    for _ in range(120):
+    for _ in range(150):
         k = int(rng.integers(1, 1500))
         cascade.push(y[pos : pos + k])
         pos += k
         cascade.keep_last(int(rng.integers(200, 7000)))
-        for level in cascade.levels:
-            if len(level) > 41 and rng.random() < 0.4:
-                ref = correlation_matrices(level.window, 40)
-                np.testing.assert_allclose(
-                    level.correlations(), ref, rtol=0, atol=1e-10 * np.abs(ref).max()
-                )
-                reads += 1
-    assert len(cascade.levels) >= 3 and reads > 50
+        if len(cascade.window(0)) > 41 and rng.random() < 0.4:
+            ref = correlation_matrices(cascade.window(0), 40)
+            got = cascade.correlations(0)
+            np.testing.assert_allclose(got, ref, rtol=0, atol=1e-10 * np.abs(ref).max())
+            reads += 1
+    assert reads > 30
     one = CorrelationCascade.of(y[:5000, 0], 80)
     np.testing.assert_allclose(one.correlations(0)[:, 0, 0], correlations(y[:5000, 0], 80))
 
 
-def test_cascade_levels_are_the_decimated_window():
-    # level j: every 2^j-th sample behind j anti-alias filters; a tone well inside every level's
-    # band keeps its variance, one above a level's band is removed there
-    fs, n = 500.0, 20000
-    t = np.arange(n) / fs
-    low = np.sin(2 * math.pi * 3.0 * t)
-    high = np.sin(2 * math.pi * 80.0 * t)  # above the band of the rate 125 Hz
-    cascade = CorrelationCascade.of(low + high, 8)
-    var = [float(cascade.correlations(j)[0, 0, 0]) for j in range(len(cascade.levels))]
-    assert len(var) >= 4
-    assert var[0] == pytest.approx(1.0, rel=0.01)  # both tones
-    assert var[1] == pytest.approx(1.0, rel=0.01)  # 80 Hz below 0.45 x 250 Hz (the cutoff)
-    for v in var[2:]:
-        assert v == pytest.approx(0.5, rel=0.02)  # the 3 Hz tone alone
-    assert [cascade.samples(j) for j in range(4)] == [n, n // 2, n // 4, n // 8]
+def test_halved_levels_are_the_zero_phase_decimation():
+    rng = np.random.default_rng(5)
+    y = rng.standard_normal((9001, 2))
+    assert np.array_equal(halve(y), sosfiltfilt(DECIMATE_SOS, y, axis=0)[::2])
+    assert np.array_equal(halve(y[:, 0]), sosfiltfilt(DECIMATE_SOS, y[:, 0])[::2])
+    cascade = CorrelationCascade.of(y, 10)
+    twice = sosfiltfilt(DECIMATE_SOS, sosfiltfilt(DECIMATE_SOS, y, axis=0)[::2], axis=0)[::2]
+    np.testing.assert_array_equal(cascade.window(2), twice)
+    np.testing.assert_allclose(cascade.correlations(2), correlation_matrices(twice, 10))
+    assert [cascade.samples(j) for j in range(4)] == [9001, 4501, 2251, 1126]
+    assert cascade.can_halve(2) and not cascade.can_halve(3)  # MIN_SAMPLES = 800
 
 
 @pytest.mark.parametrize('m', [1, 6])

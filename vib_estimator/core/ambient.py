@@ -234,17 +234,38 @@ def correlations(y: np.ndarray, lags: int) -> np.ndarray:
     return r / np.arange(n, n - lags - 1, -1)
 
 
-#: the anti-alias filter of each halving of a :class:`CorrelationCascade`: :data:`DECIMATE_SOS`
-#: twice, forwards (the magnitude of the zero-phase pass, ``|H|^4``; correlations do not see
-#: the phase)
-CASCADE_SOS = np.vstack((DECIMATE_SOS, DECIMATE_SOS))
-#: its steady state for a unit input (a level starts there, scaled by its first sample)
-CASCADE_ZI = sosfilt_zi(CASCADE_SOS)
+#: the steady state of :data:`DECIMATE_SOS` for a unit input, and the samples a zero-phase pass
+#: extends the signal by at each end (odd extension): those of ``scipy.signal.sosfiltfilt``
+DECIMATE_ZI = sosfilt_zi(DECIMATE_SOS)
+DECIMATE_PAD = 3 * (
+    2 * len(DECIMATE_SOS)
+    + 1
+    - min(int(np.sum(DECIMATE_SOS[:, 2] == 0)), int(np.sum(DECIMATE_SOS[:, 5] == 0)))
+)
 #: a :class:`LagProducts` recomputes its sums from its window after this many slides (bounds the
 #: rounding of the updates; the sums are otherwise exact)
 REFRESH_SLIDES = 64
 #: rows of a block of lag products computed at once
 PRODUCT_BLOCK = 2048
+
+
+def correlation_matrices(y: np.ndarray, lags: int) -> np.ndarray:
+    """Unbiased correlation matrices ``R_k[a, b] = sum_t y_a,t+k y_b,t / (N - k)``, k = 0 ..
+    ``lags``, of the mean-removed columns of ``y`` (samples x channels), by FFT: (lags + 1,
+    channels, channels)."""
+    n = len(y)
+    y = y - y.mean(axis=0)
+    size = 1 << math.ceil(math.log2(n + lags + 1))
+    spec = np.fft.rfft(y, size, axis=0).T  # channels x bins
+    m = y.shape[1]
+    a, b = np.triu_indices(m)
+    # one inverse transform per pair a <= b: its start holds R_k[a, b], its end R_k[b, a]
+    circ = np.fft.irfft(spec[a] * np.conj(spec[b]), size, axis=-1)
+    r = np.empty((lags + 1, m, m))
+    r[:, a, b] = circ[:, : lags + 1].T
+    r[0, b, a] = circ[:, 0]
+    r[1:, b, a] = circ[:, : -lags - 1 : -1].T
+    return r / np.arange(n, n - lags - 1, -1)[:, None, None]
 
 
 class LagProducts:
@@ -378,20 +399,31 @@ class LagProducts:
         return r / count[:, None, None]
 
 
+def halve(y: np.ndarray) -> np.ndarray:
+    """``y`` (samples, or samples x channels) at half its rate: every second sample of its
+    zero-phase (forwards and backwards) anti-alias filtering by :data:`DECIMATE_SOS` --
+    ``scipy.signal.sosfiltfilt(DECIMATE_SOS, y, axis=0)[::2]``, its initial conditions computed
+    once."""
+    pad = DECIMATE_PAD
+    ext = np.concatenate((2 * y[0] - y[pad:0:-1], y, 2 * y[-1] - y[-2 : -pad - 2 : -1]))
+    zi = DECIMATE_ZI.reshape(DECIMATE_ZI.shape + (1,) * (y.ndim - 1))
+    out = sosfilt(DECIMATE_SOS, ext, axis=0, zi=zi * ext[0])[0]
+    out = sosfilt(DECIMATE_SOS, out[::-1], axis=0, zi=zi * out[-1])[0]
+    return out[::-1][pad:-pad][::2]
+
+
 class CorrelationCascade:
     """A sliding window's correlations at the input rate and at that rate halved 1, 2, ...
-    times (level j: every 2^j-th sample behind j anti-alias filters :data:`CASCADE_SOS`, run
-    forwards over the stream): each level's :class:`LagProducts`, updated as samples arrive, so
-    that an analysis reads the correlations of any level without touching the window's samples.
-    A level is added once its parent's window holds ``2 * MIN_SAMPLES`` samples (the rates
-    :func:`decimation_level` may pick), from the parent's window."""
+    times (level j: :func:`halve` applied j times to the window). The input rate's are kept up to
+    date as samples arrive (:class:`LagProducts`: exact, without re-reading the window); a
+    halved rate's are computed from the window when first read after it moved (the zero-phase
+    filter depends on the window's ends), and the halved windows kept for the next level."""
 
     def __init__(self, lags: int, channels: int):
         self.lags, self.channels = lags, channels
         self.levels = [LagProducts(lags, channels)]
-        self._state: list[np.ndarray] = []  # each level's (from 1) filter state
-        self._parity: list[int] = []  # each level's parent samples filtered so far, mod 2
-        self.clear()
+        self._halved: list[np.ndarray] = []  # the window at levels 1, 2, ... (this analysis)
+        self._corr: dict[int, np.ndarray] = {}
 
     @classmethod
     def of(cls, y: np.ndarray, lags: int) -> 'CorrelationCascade':
@@ -402,55 +434,65 @@ class CorrelationCascade:
         return out
 
     def clear(self) -> None:
-        del self.levels[1:]
         self.levels[0].clear()
-        self._state, self._parity = [], []
+        self._moved()
+
+    def _moved(self) -> None:
+        self._halved, self._corr = [], {}
 
     def push(self, x: np.ndarray) -> None:
-        """Append samples ``x`` (rows) at the input rate, filter them down the levels."""
-        for j in range(len(self.levels)):
-            if j:
-                x = self._down(j, x)
-            if not len(x):
-                return
-            self.levels[j].push(x)
-        while len(self.levels[-1]) >= 2 * MIN_SAMPLES:
-            self._grow(self.levels[-1].window)
+        """Append samples ``x`` (rows) at the input rate."""
+        if len(x):
+            self.levels[0].push(x)
+            self._moved()
 
     def keep_last(self, count: int) -> None:
-        """Slide the windows: the input rate's holds its last ``count`` samples, level j its
-        last ``ceil(count / 2^j)``."""
-        for j, level in enumerate(self.levels):
-            level.keep_last(-(-count >> j))
+        """Slide the window: it holds the last ``count`` samples."""
+        if count < len(self.levels[0]):
+            self.levels[0].keep_last(count)
+            self._moved()
 
-    def _down(self, j: int, x: np.ndarray) -> np.ndarray:
-        """Level j's samples from its parent's new samples ``x``."""
-        y, self._state[j - 1] = sosfilt(CASCADE_SOS, x, axis=0, zi=self._state[j - 1])
-        first = self._parity[j - 1]
-        self._parity[j - 1] = (first + len(x)) % 2
-        return y[first::2]
-
-    def _grow(self, parent: np.ndarray) -> None:
-        """A new level from its parent's window ``parent``."""
-        self.levels.append(LagProducts(self.lags, self.channels))
-        self._state.append(CASCADE_ZI[:, :, None] * parent[0][None, None, :])
-        self._parity.append(0)
-        self.levels[-1].push(self._down(len(self.levels) - 1, parent))
+    def window(self, level: int) -> np.ndarray:
+        """The window at level ``level`` (samples x channels)."""
+        if level == 0:
+            return self.levels[0].window
+        while len(self._halved) < level:
+            self._halved.append(halve(self.window(len(self._halved))))
+        return self._halved[level - 1]
 
     def correlations(self, level: int) -> np.ndarray:
-        """Level ``level``'s correlation matrices (:meth:`LagProducts.correlations`)."""
-        return self.levels[level].correlations()
+        """Level ``level``'s correlation matrices (as :func:`correlation_matrices`)."""
+        if level not in self._corr:
+            if level == 0:
+                r = self.levels[0].correlations()
+            elif self.channels == 1:
+                r = correlations(self.window(level)[:, 0], self.lags)[:, None, None]
+            else:
+                r = correlation_matrices(self.window(level), self.lags)
+            self._corr[level] = r
+        return self._corr[level]
+
+    def variance(self) -> np.ndarray:
+        """Each channel's variance over the window (at the input rate)."""
+        return np.var(self.levels[0].window, axis=0)
 
     def samples(self, level: int) -> int:
-        """Level ``level``'s window samples (0 past the last level)."""
-        return len(self.levels[level]) if level < len(self.levels) else 0
+        """Level ``level``'s window samples."""
+        n = len(self.levels[0])
+        for _ in range(level):
+            n = (n + 1) // 2
+        return n
+
+    def can_halve(self, level: int) -> bool:
+        """Whether level ``level + 1`` keeps :data:`MIN_SAMPLES` in the window."""
+        return self.samples(level) // 2 >= MIN_SAMPLES
 
 
 def decimation_level(cascade: CorrelationCascade, fs: float, top_hz: float) -> int:
     """The level of the lowest rate fs / 2^j that keeps ``top_hz`` at or below :data:`TOP_NU`
     of it and :data:`MIN_SAMPLES` samples in the window."""
     j = 0
-    while top_hz <= 0.5 * TOP_NU * fs / 2**j and cascade.samples(j + 1) >= MIN_SAMPLES:
+    while top_hz <= 0.5 * TOP_NU * fs / 2**j and cascade.can_halve(j):
         j += 1
     return j
 
@@ -479,11 +521,19 @@ def state_matrices(u: np.ndarray, s: np.ndarray, m: int, orders: Sequence[int]) 
     for order in orders:
         w = u[-m:, :order]
         b = shift[:order, :order]
-        try:
-            b = b + w.T @ np.linalg.solve(eye - w @ w.T, w @ b)
-        except np.linalg.LinAlgError:
-            out.append(None)
-            continue
+        wb = w @ b
+        if m == 1:  # (a scalar: no LAPACK call)
+            gap = 1.0 - float(w[0] @ w[0])
+            if gap <= 0.0:
+                out.append(None)
+                continue
+            b = b + w.T @ (wb / gap)
+        else:
+            try:
+                b = b + w.T @ np.linalg.solve(eye - w @ w.T, wb)
+            except np.linalg.LinAlgError:
+                out.append(None)
+                continue
         root = np.sqrt(s[:order])
         out.append(b * (root[None, :] / root[:, None]))
     return out
@@ -649,7 +699,7 @@ def identify(
         return _strong(_modes_at(r, fs / 2**level, max_damping, band, counts), total, fs, counts)
 
     n = cascade.samples(0)
-    total = float(cascade.correlations(0)[0, 0, 0])  # R_0: the window's variance
+    total = float(cascade.variance()[0])
     modes, noise = np.empty((0, 4)), total
     if search or top_hz <= 0:
         # the search: from the full rate down by halvings until a level finds a mode (a low
@@ -657,7 +707,7 @@ def identify(
         level = 0
         while True:
             modes, noise = modes_at(level)
-            if len(modes) or cascade.samples(level + 1) < MIN_SAMPLES:
+            if len(modes) or not cascade.can_halve(level):
                 break
             level += 1
     top = max(float(np.max(modes[:, 0])) if len(modes) else 0.0, top_hz)

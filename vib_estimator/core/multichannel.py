@@ -64,7 +64,6 @@ from .ambient import (
     MAX_TRACKS,
     MERGE_TOL,
     MIN_PEAK_RATIO,
-    MIN_SAMPLES,
     NU_MAX,
     ORDERS,
     ModeTrack,
@@ -120,25 +119,6 @@ def joint_rows(channels: int) -> int:
     """Block rows of the joint Hankel matrix of ``channels`` channels: :data:`JOINT_BLOCK_ROWS`,
     fewer when that would make it larger than :data:`JOINT_HANKEL`."""
     return min(JOINT_BLOCK_ROWS, -(-JOINT_HANKEL // channels))
-
-
-def correlation_matrices(y: np.ndarray, lags: int) -> np.ndarray:
-    """Unbiased correlation matrices ``R_k[a, b] = sum_t y_a,t+k y_b,t / (N - k)``, k = 0 ..
-    ``lags``, of the mean-removed columns of ``y`` (samples x channels), by FFT: (lags + 1,
-    channels, channels)."""
-    n = len(y)
-    y = y - y.mean(axis=0)
-    size = 1 << math.ceil(math.log2(n + lags + 1))
-    spec = np.fft.rfft(y, size, axis=0).T  # channels x bins
-    m = y.shape[1]
-    a, b = np.triu_indices(m)
-    # one inverse transform per pair a <= b: its start holds R_k[a, b], its end R_k[b, a]
-    circ = np.fft.irfft(spec[a] * np.conj(spec[b]), size, axis=-1)
-    r = np.empty((lags + 1, m, m))
-    r[:, a, b] = circ[:, : lags + 1].T
-    r[0, b, a] = circ[:, 0]
-    r[1:, b, a] = circ[:, : -lags - 1 : -1].T
-    return r / np.arange(n, n - lags - 1, -1)[:, None, None]
 
 
 def joint_poles(r: np.ndarray, fs: float, orders: Sequence[int] = ORDERS) -> list[np.ndarray]:
@@ -295,7 +275,7 @@ def identify_joint(
     :data:`..ambient.TOP_NU`): (:class:`JointModes`, the summed variance)."""
     counts = dict.fromkeys(COUNTER_NAMES, 0) if counts is None else counts
     m = cascade.channels
-    totals = np.diag(cascade.correlations(0)[0]).copy()  # R_0: each channel's variance
+    totals = cascade.variance()
 
     def modes_at(level):
         r = cascade.correlations(level)
@@ -308,7 +288,7 @@ def identify_joint(
         level = 0
         while True:
             strong = modes_at(level)
-            if len(strong[0]) or cascade.samples(level + 1) < MIN_SAMPLES:
+            if len(strong[0]) or not cascade.can_halve(level):
                 break
             level += 1
     top = max(float(np.max(strong[0][:, 0])) if len(strong[0]) else 0.0, top_hz)
