@@ -17,7 +17,8 @@ noise-driven mode in white noise over the window's samples) and the RMS error ov
 (pyOMA2 SSI-cov on consecutive 20 s windows, decimated to >= 4x the highest true frequency,
 block rows 40, orders to 30, the pole nearest the true frequency at order 20:
 ``mpe(order_in=PEER_ORDER)`` -- told the frequencies, a generous peer) median error, share within
-2 %, damping median ratio; and the cost as multiples of real time (with ``--ref REV``, beside
+2 %, damping median ratio; and the cost as multiples of real time (record seconds per CPU
+second; with ``--ref REV``, beside
 that of revision REV's identifiers on the same records, same run: ``reference_cost``). Each driven
 record is run
 with ``excitation`` ambient and auto (a row each). Last, ``excitation = auto`` on the free-decay
@@ -111,10 +112,12 @@ def peer_ssi(t, y, fs, freqs):
 
 
 def ours(t, y, config):
+    """The estimates and the CPU seconds they took (the machine is shared: CPU time is the
+    steadier figure)."""
     est = create_estimator(config)
-    start = time.perf_counter()
+    start = time.process_time()
     e = est.process(t, y)
-    return e, time.perf_counter() - start
+    return e, time.process_time() - start
 
 
 def assign(freq, truth):

@@ -6,7 +6,7 @@ directory and timed in a subprocess (``--ref REV`` of ``bench_operation`` and ``
 
 The subprocess first runs a throwaway estimator over the record's first seconds (numba's kernels
 compile or load there, as they have in this process by then), then times ``process`` over the
-whole record with ``time.perf_counter``, as the benchmarks time this revision's.
+whole record in CPU seconds (``time.process_time``), as the benchmarks time this revision's.
 """
 
 from __future__ import annotations
@@ -39,9 +39,9 @@ else:
     make = lambda: JointAmbientEstimator(config, [f'c{i}' for i in range(y.shape[1])])
 make().process(t[:2000], y[:2000])
 est = make()
-start = time.perf_counter()
+start = time.process_time()
 est.process(t, y)
-print(time.perf_counter() - start)
+print(time.process_time() - start)
 """
 
 
@@ -54,8 +54,8 @@ class Reference:
         self.src = extract(rev, Path(self._dir.name))
 
     def seconds(self, t: np.ndarray, y: np.ndarray, **config) -> float:
-        """Seconds the revision's ``process`` takes over ``(t, y)`` (``y``: samples, or samples x
-        channels for the joint identifier) with ``EstimatorConfig(**config)``."""
+        """CPU seconds the revision's ``process`` takes over ``(t, y)`` (``y``: samples, or
+        samples x channels for the joint identifier) with ``EstimatorConfig(**config)``."""
         record = Path(self._dir.name) / 'record.npz'
         np.savez(record, t=t, y=y)
         env = dict(os.environ, PYTHONPATH=str(self.src))

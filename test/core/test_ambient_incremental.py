@@ -86,3 +86,27 @@ def test_sdof_density_in_real_arithmetic_is_the_complex_closed_form():
         total = a * (1 / (1 - z * e) + 1 / (1 - z / e) - 1)
         total += a.conjugate() * (1 / (1 - z.conjugate() * e) + 1 / (1 - z.conjugate() / e) - 1)
         np.testing.assert_allclose(sdof_psd(w, f, zeta, var, dt), 0.5 * total.real, rtol=1e-7)
+
+
+@pytest.mark.parametrize('channels', [1, 2])
+def test_halved_windows_kept_across_analyses_equal_the_whole_windows(channels):
+    # pushes of a second or so (odd counts too: the halved grids move), slides, reads of every
+    # level: each equals halve() applied to the window from scratch, to rounding
+    rng = np.random.default_rng(10 + channels)
+    y = rng.standard_normal((60000, channels)) + 3.0
+    cascade = CorrelationCascade(16, channels)
+    pos, reads = 0, 0
+    for step in range(60):
+        k = int(rng.integers(1, 700)) if step % 7 == 3 else 500
+        cascade.push(y[pos : pos + k])
+        pos += k
+        cascade.keep_last(12000)
+        ref = cascade.window(0)
+        for level in range(1, 5):
+            ref = halve(ref)
+            if rng.random() < 0.7:
+                np.testing.assert_allclose(
+                    cascade.window(level), ref, rtol=0, atol=1e-12 * np.abs(ref).max()
+                )
+                reads += 1
+    assert reads > 100

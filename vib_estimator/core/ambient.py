@@ -56,7 +56,7 @@ import math
 from collections.abc import Sequence
 
 import numpy as np
-from scipy.signal import butter, sosfilt, sosfilt_zi
+from scipy.signal import butter, sos2zpk, sosfilt, sosfilt_zi
 
 from .config import EstimatorConfig
 from .estimator import INPUT_COUNTERS, Estimate, EstimateArrays, as_series
@@ -399,31 +399,49 @@ class LagProducts:
         return r / count[:, None, None]
 
 
-def halve(y: np.ndarray) -> np.ndarray:
-    """``y`` (samples, or samples x channels) at half its rate: every second sample of its
-    zero-phase (forwards and backwards) anti-alias filtering by :data:`DECIMATE_SOS` --
-    ``scipy.signal.sosfiltfilt(DECIMATE_SOS, y, axis=0)[::2]``, its initial conditions computed
+def zero_phase(x: np.ndarray) -> np.ndarray:
+    """``scipy.signal.sosfiltfilt(DECIMATE_SOS, x, axis=0)``, its initial conditions computed
     once."""
     pad = DECIMATE_PAD
-    ext = np.concatenate((2 * y[0] - y[pad:0:-1], y, 2 * y[-1] - y[-2 : -pad - 2 : -1]))
-    zi = DECIMATE_ZI.reshape(DECIMATE_ZI.shape + (1,) * (y.ndim - 1))
+    ext = np.concatenate((2 * x[0] - x[pad:0:-1], x, 2 * x[-1] - x[-2 : -pad - 2 : -1]))
+    zi = DECIMATE_ZI.reshape(DECIMATE_ZI.shape + (1,) * (x.ndim - 1))
     out = sosfilt(DECIMATE_SOS, ext, axis=0, zi=zi * ext[0])[0]
     out = sosfilt(DECIMATE_SOS, out[::-1], axis=0, zi=zi * out[-1])[0]
-    return out[::-1][pad:-pad][::2]
+    return out[::-1][pad:-pad]
+
+
+def halve(y: np.ndarray) -> np.ndarray:
+    """``y`` (samples, or samples x channels) at half its rate: every second sample of its
+    zero-phase (forwards and backwards) anti-alias filtering by :data:`DECIMATE_SOS`
+    (:func:`zero_phase`)."""
+    return zero_phase(y)[::2]
+
+
+#: samples over which the anti-alias filter's response has decayed below 1e-20 of its start
+#: (its slowest pole's radius r: r^n < 1e-20), plus the zero-phase pass's extension
+SETTLE = (
+    math.ceil(-20.0 / math.log10(float(np.max(np.abs(sos2zpk(DECIMATE_SOS)[1]))))) + DECIMATE_PAD
+)
 
 
 class CorrelationCascade:
     """A sliding window's correlations at the input rate and at that rate halved 1, 2, ...
     times (level j: :func:`halve` applied j times to the window). The input rate's are kept up to
-    date as samples arrive (:class:`LagProducts`: exact, without re-reading the window); a
-    halved rate's are computed from the window when first read after it moved (the zero-phase
-    filter depends on the window's ends), and the halved windows kept for the next level."""
+    date as samples arrive (:class:`LagProducts`: exact, without re-reading the window). A
+    halved rate's window is made when first read after the window moved: the zero-phase
+    filtering of a window depends on its ends only within :data:`SETTLE` samples of them, so
+    its middle is kept from the previous analysis and only the stretches near the ends that
+    moved are filtered again (the same numbers, to rounding, as :func:`halve` of the whole
+    window: ``test/core/test_ambient_incremental.py``)."""
 
     def __init__(self, lags: int, channels: int):
         self.lags, self.channels = lags, channels
         self.levels = [LagProducts(lags, channels)]
-        self._halved: list[np.ndarray] = []  # the window at levels 1, 2, ... (this analysis)
-        self._corr: dict[int, np.ndarray] = {}
+        self._count = 0  # samples pushed since the last clear
+        #: level -> (its input's first sample's position, step, its zero-phase filtering,
+        #: the samples pushed by then)
+        self._filtered: dict[int, tuple] = {}
+        self._moved()
 
     @classmethod
     def of(cls, y: np.ndarray, lags: int) -> 'CorrelationCascade':
@@ -435,15 +453,21 @@ class CorrelationCascade:
 
     def clear(self) -> None:
         self.levels[0].clear()
+        self._count = 0
+        self._filtered = {}
         self._moved()
 
     def _moved(self) -> None:
-        self._halved, self._corr = [], {}
+        # per level from 1: the window, the position (input samples) of its first sample, and
+        # how many of its first and last samples may differ from the previous analysis's
+        self._halved: list[tuple[np.ndarray, int, int, int]] = []
+        self._corr: dict[int, np.ndarray] = {}
 
     def push(self, x: np.ndarray) -> None:
         """Append samples ``x`` (rows) at the input rate."""
         if len(x):
             self.levels[0].push(x)
+            self._count += len(x)
             self._moved()
 
     def keep_last(self, count: int) -> None:
@@ -452,13 +476,48 @@ class CorrelationCascade:
             self.levels[0].keep_last(count)
             self._moved()
 
+    def _level(self, level: int) -> tuple[np.ndarray, int, int, int]:
+        """Level ``level``'s (window, its first sample's position, samples at its start and at
+        its end that may differ from the previous analysis's)."""
+        if level == 0:
+            x = self.levels[0].window
+            prev = self._filtered.get(1)  # (the samples since level 1 was last made are new)
+            new = len(x) if prev is None else min(len(x), self._count - prev[3])
+            return x, self._count - len(x), 0, new
+        while len(self._halved) < level:
+            j = len(self._halved) + 1
+            x, start, head, tail = self._level(j - 1)
+            step = 1 << (j - 1)
+            z, head, tail = self._filter(j, x, start, step, head, tail)
+            self._halved.append((z[::2], start, (head + 1) // 2 + 1, (tail + 1) // 2 + 1))
+        return self._halved[level - 1]
+
+    def _filter(self, j, x, start, step, head, tail):
+        """:func:`zero_phase` of level j - 1's window ``x``, its middle kept from the previous
+        analysis where that is exact to rounding; with the counts of its first and last samples
+        that may differ from that analysis's."""
+        n, k = len(x), SETTLE
+        prev = self._filtered.get(j)
+        z = None
+        if prev is not None and prev[1] == step and (start - prev[0]) % step == 0:
+            shift = (start - prev[0]) // step
+            old = prev[2]
+            lo, hi = head + k, n - tail - k  # the middle [lo, hi) of x kept
+            if shift >= 0 and lo + 2 * k <= hi and hi + shift <= len(old) - k:
+                z = np.empty_like(x)
+                z[:lo] = zero_phase(x[: lo + 2 * k])[:lo]
+                z[lo:hi] = old[lo + shift : hi + shift]
+                z[hi:] = zero_phase(x[hi - 2 * k :])[2 * k :]
+                head, tail = lo, n - hi
+        if z is None:
+            z = zero_phase(x)
+            head, tail = n, n
+        self._filtered[j] = (start, step, z, self._count)
+        return z, head, tail
+
     def window(self, level: int) -> np.ndarray:
         """The window at level ``level`` (samples x channels)."""
-        if level == 0:
-            return self.levels[0].window
-        while len(self._halved) < level:
-            self._halved.append(halve(self.window(len(self._halved))))
-        return self._halved[level - 1]
+        return self._level(level)[0]
 
     def correlations(self, level: int) -> np.ndarray:
         """Level ``level``'s correlation matrices (as :func:`correlation_matrices`)."""
