@@ -13,8 +13,10 @@ node stream and ``analyze`` use): :class:`AmbientEstimator` ``.update(t, y) -> L
 Method, per analysis (every :data:`HOP_S` of input once ``ambient_window_s`` of samples are in):
 
 1. **Covariance-driven stochastic subspace identification** (SSI-cov; Peeters & De Roeck 1999) of
-   the last ``ambient_window_s`` seconds: the output correlations ``R_k`` (k = 0 .. 2 p, by FFT,
-   unbiased), their block Hankel matrix ``H = [R_{i+j+1}]`` (p = :data:`BLOCK_ROWS` rows), its
+   the last ``ambient_window_s`` seconds: the output correlations ``R_k`` (k = 0 .. 2 p,
+   unbiased; at the input rate kept up to date as samples arrive, at a halved rate from the
+   window's halving, whose unmoved middle is kept: :class:`CorrelationCascade`), their block
+   Hankel matrix ``H = [R_{i+j+1}]`` (p = :data:`BLOCK_ROWS` rows), its
    SVD ``H = U S V^T``; at each model order n = :data:`ORDERS` the observability matrix
    ``O = U_n S_n^1/2``, the state matrix ``A = O_up^+ O_down`` and the output/next-state
    covariance ``G`` (first column of ``S_n^1/2 V_n^T``). Each eigenvalue ``lambda`` of ``A`` gives
