@@ -4,7 +4,7 @@
 ``core.multichannel``) vs pyOMA2's multi-channel SSI-cov vs each channel alone.
 
     .venv/bin/python benchmarks/bench_channels.py [--seeds 3] [--no-peer]
-        [--real-data ../shared/real-data]
+        [--real-data ../shared/real-data] [--ref REV] [--cost-only]
 
 1. The 5-storey shear frame (``vib_estimator.sim.frame``: modes 0.89-6.00 Hz, zeta 2 %, one
    channel per storey, 20 dB, 50 Hz, 600 s; window 60 s): per mode the median and RMS relative
@@ -16,8 +16,12 @@
 2. A mode invisible on two of three channels (2.5 Hz on channel c only): found or not, and how far.
 3. The real Heritage Court Tower record (6 channels, 40 Hz, 327.7 s, window 120 s, band 0.5-6 Hz):
    published modes found (>= 10 estimates within 2 %), share of estimates > 2 % from every one.
-4. Cost: 8 channels at 500 Hz (4 modes 3-40 Hz, 120 s, window 30 s) as multiples of real time,
-   beside one channel of the same record through the single-channel identifier, same run.
+4. Cost: 8 channels at 500 Hz (4 modes 3-40 Hz, 120 s, window 30 s) as multiples of real time
+   (record seconds per CPU second) beside one channel of the same record through the
+   single-channel identifier, same run (with ``--ref REV``: beside revision REV's,
+   ``reference_cost``); and 6 channels at 1 kHz fed as a
+   node would, 1 s blocks (``process``) and sample by sample (``update``): multiples of real
+   time and the slowest block / sample (an analysis), CPU time.
 """
 
 from __future__ import annotations
@@ -178,23 +182,69 @@ def real_hct(real_data):
         )
 
 
-def cost():
-    fs, duration, channels = 500.0, 120.0, 8
-    modes = [(3.0, 0.02, 1.0), (9.0, 0.01, 0.5), (21.0, 0.01, 0.3), (40.0, 0.005, 0.2)]
+COST_MODES = [(3.0, 0.02, 1.0), (9.0, 0.01, 0.5), (21.0, 0.01, 0.3), (40.0, 0.005, 0.2)]
+
+
+def cost_record(fs, duration, channels):
     rng = np.random.default_rng(7)
-    shapes = rng.uniform(-1, 1, (channels, len(modes)))
-    t, y = modal_record(duration, fs, modes, shapes, 20.0, 8)
+    shapes = rng.uniform(-1, 1, (channels, len(COST_MODES)))
+    return modal_record(duration, fs, COST_MODES, shapes, 20.0, 8)
+
+
+def cost(ref=None):
+    fs, duration, channels = 500.0, 120.0, 8
+    t, y = cost_record(fs, duration, channels)
     config = EstimatorConfig(excitation='ambient', ambient_window_s=30.0)
-    start = time.perf_counter()
+    start = time.process_time()  # CPU seconds: the steadier figure on a shared machine
     r = JointAmbientEstimator(config, [f'c{i}' for i in range(channels)]).process(t, y)
-    joint = time.perf_counter() - start
-    start = time.perf_counter()
+    joint = time.process_time() - start
+    start = time.process_time()
     AmbientEstimator(config).process(t, y[:, 0])
-    one = time.perf_counter() - start
+    one = time.process_time() - start
     print(f'\n## Cost: {channels} channels at {fs:g} Hz, {duration:g} s, window 30 s (batch)')
     print(
         f'joint {duration / joint:.0f}x real time ({len(r)} estimates); one channel through the '
         f'single-channel identifier, same run: {duration / one:.0f}x real time'
+    )
+    if ref:
+        kw = {'excitation': 'ambient', 'ambient_window_s': 30.0}
+        print(
+            f'{ref.rev}, same records: joint {duration / ref.seconds(t, y, **kw):.0f}x, '
+            f'one channel {duration / ref.seconds(t, y[:, 0], **kw):.0f}x real time'
+        )
+    stream(config)
+
+
+def stream(config, fs=1000.0, duration=60.0, channels=6):
+    """6 channels at 1 kHz through the joint identifier as a node feeds it."""
+    t, y = cost_record(fs, duration, channels)
+    names = [f'c{i}' for i in range(channels)]
+    print(
+        f'\n## {channels} channels at {fs:g} Hz, {duration:g} s, window 30 s, as a node feeds them'
+    )
+    est = JointAmbientEstimator(config, names)
+    block = int(fs)
+    worst, total = 0.0, 0.0
+    for i in range(0, len(t), block):
+        start = time.process_time()
+        est.process(t[i : i + block], y[i : i + block])
+        dt = time.process_time() - start
+        worst, total = max(worst, dt), total + dt
+    print(
+        f'1 s blocks (process): {duration / total:.0f}x real time, '
+        f'slowest block {1e3 * worst:.1f} ms'
+    )
+    est = JointAmbientEstimator(config, names)
+    worst, total = 0.0, 0.0
+    rows = y.tolist()
+    for ti, yi in zip(t.tolist(), rows):
+        start = time.process_time()
+        est.update(ti, yi)
+        dt = time.process_time() - start
+        worst, total = max(worst, dt), total + dt
+    print(
+        f'sample by sample (update): {duration / total:.0f}x real time, '
+        f'slowest sample {1e3 * worst:.1f} ms'
     )
 
 
@@ -203,11 +253,21 @@ def main():
     parser.add_argument('--seeds', type=int, default=3)
     parser.add_argument('--no-peer', action='store_true')
     parser.add_argument('--real-data', default=str(REAL_DATA))
+    parser.add_argument(
+        '--ref', help="time this revision's identifiers beside (e.g. main; git archive)"
+    )
+    parser.add_argument('--cost-only', action='store_true', help='only the cost section')
     args = parser.parse_args()
-    frame(args.seeds, not args.no_peer)
-    invisible()
-    real_hct(args.real_data)
-    cost()
+    ref = None
+    if args.ref:
+        from reference_cost import Reference  # benchmarks/
+
+        ref = Reference(args.ref)
+    if not args.cost_only:
+        frame(args.seeds, not args.no_peer)
+        invisible()
+        real_hct(args.real_data)
+    cost(ref)
 
 
 if __name__ == '__main__':

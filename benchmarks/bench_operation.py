@@ -4,7 +4,7 @@
 vs the Whittle bound at the window used.
 
     .venv/bin/python benchmarks/bench_operation.py [--seeds 3] [--window 30] [--no-peer]
-        [--real-data ../shared/real-data] [--real-only] [--arm-only] [--free-only]
+        [--real-data ../shared/real-data] [--real-only] [--arm-only] [--free-only] [--ref REV]
 
 Synthetic records (``vib_estimator.sim.ambient``: white-noise-driven modes, 500 Hz, 180 s, the
 estimates of the whole record, i.e. from the first full window on) and the real Heritage Court
@@ -17,7 +17,10 @@ noise-driven mode in white noise over the window's samples) and the RMS error ov
 (pyOMA2 SSI-cov on consecutive 20 s windows, decimated to >= 4x the highest true frequency,
 block rows 40, orders to 30, the pole nearest the true frequency at order 20:
 ``mpe(order_in=PEER_ORDER)`` -- told the frequencies, a generous peer) median error, share within
-2 %, damping median ratio; and the cost as multiples of real time. Each driven record is run
+2 %, damping median ratio; and the cost as multiples of real time (record seconds per CPU
+second; with ``--ref REV``, beside
+that of revision REV's identifiers on the same records, same run: ``reference_cost``). Each driven
+record is run
 with ``excitation`` ambient and auto (a row each). Last, ``excitation = auto`` on the free-decay
 benchmarks' records (bench_precision, bench_modes, the real beams): the share of ``excitation =
 free``'s estimates it publishes unchanged, what it adds, and the seconds it judged driven
@@ -109,10 +112,12 @@ def peer_ssi(t, y, fs, freqs):
 
 
 def ours(t, y, config):
+    """The estimates and the CPU seconds they took (the machine is shared: CPU time is the
+    steadier figure)."""
     est = create_estimator(config)
-    start = time.perf_counter()
+    start = time.process_time()
     e = est.process(t, y)
-    return e, time.perf_counter() - start
+    return e, time.process_time() - start
 
 
 def assign(freq, truth):
@@ -121,15 +126,15 @@ def assign(freq, truth):
     return np.argmin(rel, axis=1), np.min(rel, axis=1)
 
 
-def synthetic(seeds, window, peer):
+def synthetic(seeds, window, peer, ref=None):
     n_window = int(window * FS) + 1
     print(f'## Synthetic records: {FS:g} Hz, {DURATION:g} s, {seeds} seeds, window {window:g} s')
     print(
         '| record | mode | Whittle bound | RMS err (x bound) | median err | within 2 % | > 5 % '
         '| damping med / true | RMS err/std | SSI-cov (pyOMA2) median / within 2 % / damping '
-        '| spurious | cost (x real time) |'
+        '| spurious | cost (x real time) |' + (f' cost of {ref.rev} |' if ref else '')
     )
-    print('|---|---|---|---|---|---|---|---|---|---|---|---|')
+    print('|---|---|---|---|---|---|---|---|---|---|---|---|' + ('---|' if ref else ''))
     for (name, (modes, snr)), excitation in itertools.product(CASES.items(), EXCITATIONS):
         config = EstimatorConfig(excitation=excitation, ambient_window_s=window)
         run_peer = peer and excitation == 'ambient'  # the peer does not change with ours
@@ -140,12 +145,14 @@ def synthetic(seeds, window, peer):
         peer_err = {k: [] for k in range(len(modes))}
         peer_z = {k: [] for k in range(len(modes))}
         spurious = total = 0
-        cost = 0.0
+        cost = ref_cost = 0.0
         noise_var = None
         for seed in range(seeds):
             t, y, noise_var = ambient_record(DURATION, FS, modes, snr, seed)
             e, elapsed = ours(t, y, config)
             cost += elapsed
+            if ref:
+                ref_cost += ref.seconds(t, y, excitation=excitation, ambient_window_s=window)
             idx, dist = assign(e.frequency_hz, truth)
             total += len(e)
             spurious += int(np.count_nonzero(dist > 0.10))
@@ -184,6 +191,7 @@ def synthetic(seeds, window, peer):
                 f'{peer_txt} | '
                 f'{(f"{100 * spurious / max(total, 1):.1f} % of {total}") if k == 0 else ""} | '
                 f'{(f"{seeds * DURATION / cost:.0f}") if k == 0 else ""} |'
+                + (f' {(f"{seeds * DURATION / ref_cost:.0f}") if k == 0 else ""} |' if ref else '')
             )
         sys.stdout.flush()
 
@@ -227,7 +235,7 @@ def arm(seeds, window):
         sys.stdout.flush()
 
 
-def real_hct(peer, real_data):
+def real_hct(peer, real_data, ref=None):
     hct = Path(real_data) / HCT_FILE
     if not hct.exists():
         print(f'\n(Heritage Court Tower record not found at {hct}: skipped)')
@@ -236,6 +244,10 @@ def real_hct(peer, real_data):
     t, y = data[:, 0], data[:, 2]  # ch2
     config = EstimatorConfig(excitation='ambient', ambient_window_s=120.0, band_hz=(0.5, 6.0))
     e, elapsed = ours(t, y, config)
+    ref_txt = ''
+    if ref:
+        sec = ref.seconds(t, y, excitation='ambient', ambient_window_s=120.0, band_hz=(0.5, 6.0))
+        ref_txt = f' ({ref.rev}: {t[-1] / sec:.0f}x)'
     idx, dist = assign(e.frequency_hz, HCT_MODES)
     found = sorted(
         {
@@ -248,7 +260,7 @@ def real_hct(peer, real_data):
     print(
         f'estimates {len(e)}; published modes found (>= 10 estimates within 2 %): {found}; '
         f'estimates > 2 % from every published mode: {100 * np.mean(dist > 0.02):.1f} %; '
-        f'cost {t[-1] / elapsed:.0f}x real time'
+        f'cost {t[-1] / elapsed:.0f}x real time{ref_txt}'
     )
     for k in sorted(set(e.mode)):
         m = e.mode == k
@@ -352,7 +364,15 @@ def main():
     parser.add_argument(
         '--free-only', action='store_true', help='only excitation auto on the free decays'
     )
+    parser.add_argument(
+        '--ref', help="time this revision's identifiers beside (e.g. main; git archive)"
+    )
     args = parser.parse_args()
+    ref = None
+    if args.ref:
+        from reference_cost import Reference  # benchmarks/
+
+        ref = Reference(args.ref)
     if args.free_only:
         free_decays(args.real_data)
         return
@@ -360,9 +380,9 @@ def main():
         arm(args.seeds, args.window)
         return
     if not args.real_only:
-        synthetic(args.seeds, args.window, not args.no_peer)
+        synthetic(args.seeds, args.window, not args.no_peer, ref)
         arm(args.seeds, args.window)
-    real_hct(not args.no_peer, args.real_data)
+    real_hct(not args.no_peer, args.real_data, ref)
     free_decays(args.real_data)
 
 

@@ -8,12 +8,8 @@ import numpy as np
 import pytest
 
 from vib_estimator.core import EstimatorConfig
-from vib_estimator.core.multichannel import (
-    JointAmbientEstimator,
-    correlation_matrices,
-    mac,
-    normalise_shape,
-)
+from vib_estimator.core.ambient import correlation_matrices
+from vib_estimator.core.multichannel import JointAmbientEstimator, mac, normalise_shape
 from vib_estimator.sim.frame import frame_record, modal_record, shear_frame
 
 #: 6 Hz at 0.3 of the rate: the frame's modes without decimation (a short test)

@@ -13,8 +13,10 @@ node stream and ``analyze`` use): :class:`AmbientEstimator` ``.update(t, y) -> L
 Method, per analysis (every :data:`HOP_S` of input once ``ambient_window_s`` of samples are in):
 
 1. **Covariance-driven stochastic subspace identification** (SSI-cov; Peeters & De Roeck 1999) of
-   the last ``ambient_window_s`` seconds: the output correlations ``R_k`` (k = 0 .. 2 p, by FFT,
-   unbiased), their block Hankel matrix ``H = [R_{i+j+1}]`` (p = :data:`BLOCK_ROWS` rows), its
+   the last ``ambient_window_s`` seconds: the output correlations ``R_k`` (k = 0 .. 2 p,
+   unbiased; at the input rate kept up to date as samples arrive, at a halved rate from the
+   window's halving, whose unmoved middle is kept: :class:`CorrelationCascade`), their block
+   Hankel matrix ``H = [R_{i+j+1}]`` (p = :data:`BLOCK_ROWS` rows), its
    SVD ``H = U S V^T``; at each model order n = :data:`ORDERS` the observability matrix
    ``O = U_n S_n^1/2``, the state matrix ``A = O_up^+ O_down`` and the output/next-state
    covariance ``G`` (first column of ``S_n^1/2 V_n^T``). Each eigenvalue ``lambda`` of ``A`` gives
@@ -56,7 +58,7 @@ import math
 from collections.abc import Sequence
 
 import numpy as np
-from scipy.signal import butter, sosfiltfilt
+from scipy.signal import butter, sos2zpk, sosfilt, sosfilt_zi
 
 from .config import EstimatorConfig
 from .estimator import INPUT_COUNTERS, Estimate, EstimateArrays, as_series
@@ -122,26 +124,23 @@ def sdof_psd(
     variance) of a white-noise-driven SDOF's response sampled every ``dt``: the DTFT of its
     autocovariance ``c_k = variance e^(-zeta wn |k| dt) (cos wd k dt + zeta / sqrt(1 - zeta^2)
     sin wd |k| dt)``, summed in closed form (``c_k = Re(a z^|k|)``, ``z = e^((-zeta wn + i wd)
-    dt)``)."""
-    return _sdof_psd(
-        np.exp(-1j * np.asarray(w, dtype=np.float64)), frequency_hz, zeta, variance, dt
-    )
+    dt)``: ``Re(a (1 - z^2) / (1 - 2 z cos w + z^2))``)."""
+    return _sdof_psd(np.cos(np.asarray(w, dtype=np.float64)), frequency_hz, zeta, variance, dt)
 
 
 def _sdof_psd(
-    e: np.ndarray, frequency_hz: float, zeta: float, variance: float, dt: float
+    c: np.ndarray, frequency_hz: float, zeta: float, variance: float, dt: float
 ) -> np.ndarray:
-    """:func:`sdof_psd` at ``e = exp(-i w)``."""
+    """:func:`sdof_psd` at ``c = cos w``, in real arithmetic."""
     wn = 2 * math.pi * frequency_hz * dt
     root = math.sqrt(max(1.0 - zeta * zeta, 1e-12))
     decay = math.exp(-zeta * wn)
     z = complex(decay * math.cos(wn * root), decay * math.sin(wn * root))
-    a = variance * complex(1.0, -zeta / root)
-    zc = z.conjugate()
-    total = a * (1.0 / (1.0 - z * e) + 1.0 / (1.0 - z / e) - 1.0) + a.conjugate() * (
-        1.0 / (1.0 - zc * e) + 1.0 / (1.0 - zc / e) - 1.0
-    )
-    return 0.5 * total.real
+    num = variance * complex(1.0, -zeta / root) * (1.0 - z * z)
+    zz = 1.0 + z * z
+    dr = zz.real - 2.0 * z.real * c
+    di = zz.imag - 2.0 * z.imag * c
+    return (num.real * dr + num.imag * di) / (dr * dr + di * di)
 
 
 def peak_ratio(
@@ -165,11 +164,11 @@ def _active_bins(modes, noise_var: float, dt: float, n: int) -> np.ndarray:
     return np.flatnonzero(keep)
 
 
-def _log_density_gradient(e: np.ndarray, modes, noise_var: float, dt: float):
-    """The model's density ``S`` at ``e = exp(-i w)`` and the gradient of ``ln S`` with respect
+def _log_density_gradient(c: np.ndarray, modes, noise_var: float, dt: float):
+    """The model's density ``S`` at ``c = cos w`` and the gradient of ``ln S`` with respect
     to (f, zeta, variance of each mode, the noise variance), one row each."""
     density = _sdof_psd
-    parts = [density(e, f, z, v, dt) for f, z, v in modes]
+    parts = [density(c, f, z, v, dt) for f, z, v in modes]
     total = noise_var + (np.sum(parts, axis=0) if parts else 0.0)
     grads = []
     for (f, z, v), part in zip(modes, parts):
@@ -179,9 +178,9 @@ def _log_density_gradient(e: np.ndarray, modes, noise_var: float, dt: float):
             lo = [f, z, v]
             hi[i] += h
             lo[i] -= h
-            grads.append((density(e, *hi, dt) - density(e, *lo, dt)) / (2 * h))
+            grads.append((density(c, *hi, dt) - density(c, *lo, dt)) / (2 * h))
         grads.append(part / v)
-    grads.append(np.ones(len(e)))
+    grads.append(np.ones(len(c)))
     return total, np.array(grads) / total
 
 
@@ -197,7 +196,7 @@ def whittle_fisher(
     precision) information on the noise level only, and are counted as such."""
     dt = 1.0 / fs
     bins = _active_bins(modes, noise_var, dt, n)
-    _, d = _log_density_gradient(np.exp(-2j * math.pi * bins / n), modes, noise_var, dt)
+    _, d = _log_density_gradient(np.cos(2 * math.pi * bins / n), modes, noise_var, dt)
     fisher = d @ d.T
     fisher[-1, -1] += ((n + 1) // 2 - 1 - len(bins)) / noise_var**2
     return fisher
@@ -237,21 +236,383 @@ def correlations(y: np.ndarray, lags: int) -> np.ndarray:
     return r / np.arange(n, n - lags - 1, -1)
 
 
+#: the steady state of :data:`DECIMATE_SOS` for a unit input, and the samples a zero-phase pass
+#: extends the signal by at each end (odd extension): those of ``scipy.signal.sosfiltfilt``
+DECIMATE_ZI = sosfilt_zi(DECIMATE_SOS)
+DECIMATE_PAD = 3 * (
+    2 * len(DECIMATE_SOS)
+    + 1
+    - min(int(np.sum(DECIMATE_SOS[:, 2] == 0)), int(np.sum(DECIMATE_SOS[:, 5] == 0)))
+)
+#: a :class:`LagProducts` recomputes its sums from its window after this many slides (bounds the
+#: rounding of the updates; the sums are otherwise exact)
+REFRESH_SLIDES = 64
+#: rows of a block of lag products computed at once
+PRODUCT_BLOCK = 2048
+
+
+def correlation_matrices(y: np.ndarray, lags: int) -> np.ndarray:
+    """Unbiased correlation matrices ``R_k[a, b] = sum_t y_a,t+k y_b,t / (N - k)``, k = 0 ..
+    ``lags``, of the mean-removed columns of ``y`` (samples x channels), by FFT: (lags + 1,
+    channels, channels)."""
+    n = len(y)
+    y = y - y.mean(axis=0)
+    size = 1 << math.ceil(math.log2(n + lags + 1))
+    spec = np.fft.rfft(y, size, axis=0).T  # channels x bins
+    m = y.shape[1]
+    a, b = np.triu_indices(m)
+    # one inverse transform per pair a <= b: its start holds R_k[a, b], its end R_k[b, a]
+    circ = np.fft.irfft(spec[a] * np.conj(spec[b]), size, axis=-1)
+    r = np.empty((lags + 1, m, m))
+    r[:, a, b] = circ[:, : lags + 1].T
+    r[0, b, a] = circ[:, 0]
+    r[1:, b, a] = circ[:, : -lags - 1 : -1].T
+    return r / np.arange(n, n - lags - 1, -1)[:, None, None]
+
+
+class LagProducts:
+    """The lag products of a sliding window over a growing buffer of samples (one row of
+    ``channels`` values each), kept exactly: when the correlations are read, the products of
+    the samples pushed since are added, those of the samples that left are subtracted (or, after
+    :data:`REFRESH_SLIDES` such slides or a slide longer than what stays, all recomputed from the
+    window). :meth:`correlations` gives what :func:`correlation_matrices` computes from the
+    window."""
+
+    def __init__(self, lags: int, channels: int):
+        self.lags, self.channels = lags, channels
+        self._buf = np.empty((1 << 12, channels))
+        self.clear()
+
+    def clear(self) -> None:
+        self._n = 0  # samples in the buffer
+        self._want = 0  # the window's first sample
+        self._start = 0  # the first sample of the stretch [start, done) the sums cover
+        self._done = 0
+        self._offset = np.zeros(self.channels)
+        self._sums = np.zeros((self.lags + 1, self.channels, self.channels))
+        self._total = np.zeros(self.channels)
+        self._slides = 0
+
+    def __len__(self) -> int:
+        """The window's samples."""
+        return self._n - self._want
+
+    @property
+    def window(self) -> np.ndarray:
+        """The window's samples (a view)."""
+        return self._buf[self._want : self._n]
+
+    def push(self, x: np.ndarray) -> None:
+        """Append samples ``x`` (rows) to the window."""
+        m = len(x)
+        if not m:
+            return
+        if self._n + m > len(self._buf):
+            keep = self._n - self._start
+            size = max(len(self._buf), 1 << math.ceil(math.log2(2 * (keep + m))))
+            buf = np.empty((size, self.channels)) if size > len(self._buf) else self._buf
+            buf[:keep] = self._buf[self._start : self._n]
+            shift = self._start
+            self._buf, self._n = buf, keep
+            self._start, self._want, self._done = 0, self._want - shift, self._done - shift
+        if self._n == self._want:
+            self._offset = np.array(x[0], dtype=np.float64)  # keeps the products' rounding small
+            self._restart()
+        self._buf[self._n : self._n + m] = x
+        self._n += m
+
+    def keep_last(self, count: int) -> None:
+        """Slide the window's start so that it holds the last ``count`` samples."""
+        self._want = max(self._want, self._n - count)
+        if self._want - self._start > self._n - self._want:
+            self._restart()  # (bounds the buffer of a level seldom read)
+
+    def _restart(self) -> None:
+        """Drop the sums: the next read recomputes them from the window."""
+        self._start = self._done = self._want
+        self._sums[:] = 0.0
+        self._total[:] = 0.0
+        self._slides = 0
+
+    def _sync(self) -> None:
+        """Bring the sums to the window."""
+        if self._want > self._start:
+            if self._want >= self._done or self._slides >= REFRESH_SLIDES:
+                self._restart()
+            else:
+                self._sub(self._start, self._want)
+                self._start = self._want
+                self._slides += 1
+        if self._done < self._n:
+            self._add(self._done, self._n)
+            self._done = self._n
+
+    def _add(self, a: int, b: int) -> None:
+        """Add the products ``y[t] y[t - k]^T`` of the samples a <= t < b with the window's."""
+        lags, off = self.lags, self._offset
+        for a0 in range(a, b, PRODUCT_BLOCK):
+            b0 = min(b, a0 + PRODUCT_BLOCK)
+            lo = max(self._start, a0 - lags)
+            ext = np.zeros((b0 - a0 + lags, self.channels))
+            ext[lags - (a0 - lo) :] = self._buf[lo:b0] - off
+            new = ext[lags:]
+            view = np.lib.stride_tricks.sliding_window_view(ext, lags + 1, axis=0)
+            # view[i, :, q] = ext[i + q] = y[a0 + i - (lags - q)]: lag k = lags - q
+            prod = np.tensordot(new, view, axes=(0, 0))  # (a, b, q)
+            self._sums += prod[:, :, ::-1].transpose(2, 0, 1)
+            self._total += new.sum(axis=0)
+
+    def _sub(self, c: int, d: int) -> None:
+        """Subtract the products ``y[u + k] y[u]^T`` of the samples c <= u < d leaving."""
+        lags, off, n = self.lags, self._offset, self._done
+        for c0 in range(c, d, PRODUCT_BLOCK):
+            d0 = min(d, c0 + PRODUCT_BLOCK)
+            hi = min(n, d0 + lags)
+            ext = np.zeros((d0 - c0 + lags, self.channels))
+            ext[: hi - c0] = self._buf[c0:hi] - off
+            old = ext[: d0 - c0]
+            view = np.lib.stride_tricks.sliding_window_view(ext, lags + 1, axis=0)[: d0 - c0]
+            # view[i, :, k] = y[c0 + i + k]
+            prod = np.tensordot(old, view, axes=(0, 0))  # (b, a, k)
+            self._sums -= prod.transpose(2, 1, 0)
+            self._total -= old.sum(axis=0)
+
+    def correlations(self) -> np.ndarray:
+        """The window's unbiased correlation matrices of its mean-removed channels, ``R_k[a, b]
+        = sum_t y_a,t+k y_b,t / (N - k)``, k = 0 .. ``lags``: (lags + 1, channels, channels)."""
+        self._sync()
+        lags, n = self.lags, len(self)
+        x = self.window
+        first = np.concatenate(
+            (np.zeros((1, self.channels)), np.cumsum(x[:lags] - self._offset, 0))
+        )
+        last = np.concatenate(
+            (np.zeros((1, self.channels)), np.cumsum(x[: -lags - 1 : -1] - self._offset, 0))
+        )
+        total = self._total
+        mean = total / n
+        count = np.arange(n, n - lags - 1, -1, dtype=np.float64)
+        r = (
+            self._sums
+            - (total - first)[:, :, None] * mean[None, None, :]
+            - mean[None, :, None] * (total - last)[:, None, :]
+            + count[:, None, None] * np.outer(mean, mean)[None]
+        )
+        return r / count[:, None, None]
+
+
+def zero_phase(x: np.ndarray) -> np.ndarray:
+    """``scipy.signal.sosfiltfilt(DECIMATE_SOS, x, axis=0)``, its initial conditions computed
+    once."""
+    pad = DECIMATE_PAD
+    ext = np.concatenate((2 * x[0] - x[pad:0:-1], x, 2 * x[-1] - x[-2 : -pad - 2 : -1]))
+    zi = DECIMATE_ZI.reshape(DECIMATE_ZI.shape + (1,) * (x.ndim - 1))
+    out = sosfilt(DECIMATE_SOS, ext, axis=0, zi=zi * ext[0])[0]
+    out = sosfilt(DECIMATE_SOS, out[::-1], axis=0, zi=zi * out[-1])[0]
+    return out[::-1][pad:-pad]
+
+
+def halve(y: np.ndarray) -> np.ndarray:
+    """``y`` (samples, or samples x channels) at half its rate: every second sample of its
+    zero-phase (forwards and backwards) anti-alias filtering by :data:`DECIMATE_SOS`
+    (:func:`zero_phase`)."""
+    return zero_phase(y)[::2]
+
+
+#: samples over which the anti-alias filter's response has decayed below 1e-20 of its start
+#: (its slowest pole's radius r: r^n < 1e-20), plus the zero-phase pass's extension
+SETTLE = (
+    math.ceil(-20.0 / math.log10(float(np.max(np.abs(sos2zpk(DECIMATE_SOS)[1]))))) + DECIMATE_PAD
+)
+
+
+class CorrelationCascade:
+    """A sliding window's correlations at the input rate and at that rate halved 1, 2, ...
+    times (level j: :func:`halve` applied j times to the window). The input rate's are kept up to
+    date as samples arrive (:class:`LagProducts`: exact, without re-reading the window). A
+    halved rate's window is made when first read after the window moved: the zero-phase
+    filtering of a window depends on its ends only within :data:`SETTLE` samples of them, so
+    its middle is kept from the previous analysis and only the stretches near the ends that
+    moved are filtered again (the same numbers, to rounding, as :func:`halve` of the whole
+    window: ``test/core/test_ambient_incremental.py``)."""
+
+    def __init__(self, lags: int, channels: int):
+        self.lags, self.channels = lags, channels
+        self.levels = [LagProducts(lags, channels)]
+        self._count = 0  # samples pushed since the last clear
+        #: level -> (its input's first sample's position, step, its zero-phase filtering,
+        #: the samples pushed by then)
+        self._filtered: dict[int, tuple] = {}
+        self._moved()
+
+    @classmethod
+    def of(cls, y: np.ndarray, lags: int) -> 'CorrelationCascade':
+        """The cascade of one window ``y`` (samples, or samples x channels)."""
+        y = np.asarray(y, dtype=np.float64)
+        out = cls(lags, 1 if y.ndim == 1 else y.shape[1])
+        out.push(y.reshape(len(y), -1))
+        return out
+
+    def clear(self) -> None:
+        self.levels[0].clear()
+        self._count = 0
+        self._filtered = {}
+        self._moved()
+
+    def _moved(self) -> None:
+        # per level from 1: the window, the position (input samples) of its first sample, and
+        # how many of its first and last samples may differ from the previous analysis's
+        self._halved: list[tuple[np.ndarray, int, int, int]] = []
+        self._corr: dict[int, np.ndarray] = {}
+
+    def push(self, x: np.ndarray) -> None:
+        """Append samples ``x`` (rows) at the input rate."""
+        if len(x):
+            self.levels[0].push(x)
+            self._count += len(x)
+            self._moved()
+
+    def keep_last(self, count: int) -> None:
+        """Slide the window: it holds the last ``count`` samples."""
+        if count < len(self.levels[0]):
+            self.levels[0].keep_last(count)
+            self._moved()
+
+    def _level(self, level: int) -> tuple[np.ndarray, int, int, int]:
+        """Level ``level``'s (window, its first sample's position, samples at its start and at
+        its end that may differ from the previous analysis's)."""
+        if level == 0:
+            x = self.levels[0].window
+            prev = self._filtered.get(1)  # (the samples since level 1 was last made are new)
+            new = len(x) if prev is None else min(len(x), self._count - prev[3])
+            return x, self._count - len(x), 0, new
+        while len(self._halved) < level:
+            j = len(self._halved) + 1
+            x, start, head, tail = self._level(j - 1)
+            step = 1 << (j - 1)
+            z, head, tail = self._filter(j, x, start, step, head, tail)
+            self._halved.append((z[::2], start, (head + 1) // 2 + 1, (tail + 1) // 2 + 1))
+        return self._halved[level - 1]
+
+    def _filter(self, j, x, start, step, head, tail):
+        """:func:`zero_phase` of level j - 1's window ``x``, its middle kept from the previous
+        analysis where that is exact to rounding; with the counts of its first and last samples
+        that may differ from that analysis's."""
+        n, k = len(x), SETTLE
+        prev = self._filtered.get(j)
+        z = None
+        if prev is not None and prev[1] == step and (start - prev[0]) % step == 0:
+            shift = (start - prev[0]) // step
+            old = prev[2]
+            lo, hi = head + k, n - tail - k  # the middle [lo, hi) of x kept
+            if shift >= 0 and lo + 2 * k <= hi and hi + shift <= len(old) - k:
+                z = np.empty_like(x)
+                z[:lo] = zero_phase(x[: lo + 2 * k])[:lo]
+                z[lo:hi] = old[lo + shift : hi + shift]
+                z[hi:] = zero_phase(x[hi - 2 * k :])[2 * k :]
+                head, tail = lo, n - hi
+        if z is None:
+            z = zero_phase(x)
+            head, tail = n, n
+        self._filtered[j] = (start, step, z, self._count)
+        return z, head, tail
+
+    def window(self, level: int) -> np.ndarray:
+        """The window at level ``level`` (samples x channels)."""
+        return self._level(level)[0]
+
+    def correlations(self, level: int) -> np.ndarray:
+        """Level ``level``'s correlation matrices (as :func:`correlation_matrices`)."""
+        if level not in self._corr:
+            if level == 0:
+                r = self.levels[0].correlations()
+            elif self.channels == 1:
+                r = correlations(self.window(level)[:, 0], self.lags)[:, None, None]
+            else:
+                r = correlation_matrices(self.window(level), self.lags)
+            self._corr[level] = r
+        return self._corr[level]
+
+    def variance(self) -> np.ndarray:
+        """Each channel's variance over the window (at the input rate)."""
+        return np.var(self.levels[0].window, axis=0)
+
+    def samples(self, level: int) -> int:
+        """Level ``level``'s window samples."""
+        n = len(self.levels[0])
+        for _ in range(level):
+            n = (n + 1) // 2
+        return n
+
+    def can_halve(self, level: int) -> bool:
+        """Whether level ``level + 1`` keeps :data:`MIN_SAMPLES` in the window."""
+        return self.samples(level) // 2 >= MIN_SAMPLES
+
+
+def decimation_level(cascade: CorrelationCascade, fs: float, top_hz: float) -> int:
+    """The level of the lowest rate fs / 2^j that keeps ``top_hz`` at or below :data:`TOP_NU`
+    of it and :data:`MIN_SAMPLES` samples in the window."""
+    j = 0
+    while top_hz <= 0.5 * TOP_NU * fs / 2**j and cascade.can_halve(j):
+        j += 1
+    return j
+
+
+def hankel_svd(h: np.ndarray, top: int, m: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The leading ``top`` singular values ``s`` of a (square) block Hankel matrix ``h``, their
+    left singular vectors ``u`` and the first ``m`` columns of the right ones ``vt``, from the
+    eigendecomposition of ``h h^T`` (a third of the cost of an SVD; the signal's singular values
+    lie decades above the rounding of the squares)."""
+    lam, vec = np.linalg.eigh(h @ h.T)
+    lam, u = lam[::-1][:top], vec[:, ::-1][:, :top]
+    s = np.sqrt(np.maximum(lam, 1e-30 * max(lam[0], 1e-300)))
+    return u, s, (u.T @ h[:, :m]) / s[:, None]
+
+
+def state_matrices(u: np.ndarray, s: np.ndarray, m: int, orders: Sequence[int]) -> list:
+    """The state matrices ``A = O_up^+ O_down`` of each model order from the SVD ``u``, ``s`` of
+    a block Hankel matrix of ``m`` rows a block (``O = U_n S_n^1/2``): with ``U``'s columns
+    orthonormal, ``O_up^T O_up = S^1/2 (I - W^T W) S^1/2`` (``W``: the last block row of
+    ``U_n``), so ``A = S^-1/2 (I + W^T (I - W W^T)^-1 W) U_up^T U_down S^1/2`` (Woodbury): one
+    ``m x m`` solve per order. None for an order where that is singular."""
+    top = max(orders)
+    shift = u[:-m, :top].T @ u[m:, :top]
+    eye = np.eye(m)
+    out = []
+    for order in orders:
+        w = u[-m:, :order]
+        b = shift[:order, :order]
+        wb = w @ b
+        if m == 1:  # (a scalar: no LAPACK call)
+            gap = 1.0 - float(w[0] @ w[0])
+            if gap <= 0.0:
+                out.append(None)
+                continue
+            b = b + w.T @ (wb / gap)
+        else:
+            try:
+                b = b + w.T @ np.linalg.solve(eye - w @ w.T, wb)
+            except np.linalg.LinAlgError:
+                out.append(None)
+                continue
+        root = np.sqrt(s[:order])
+        out.append(b * (root[None, :] / root[:, None]))
+    return out
+
+
 def ssi_poles(
     r: np.ndarray, fs: float, rows: int = BLOCK_ROWS, orders: Sequence[int] = ORDERS
 ) -> list[np.ndarray]:
     """SSI-cov poles of correlations ``r`` at each model order: one array per order with a row
     (frequency Hz, damping ratio, variance of the mode) per complex pair (upper half plane)."""
     hankel = r[1 + np.add.outer(np.arange(rows), np.arange(rows))]
-    u, s, vt = np.linalg.svd(hankel)
+    u, s, vt = hankel_svd(hankel, max(orders), 1)
     out = []
-    for order in orders:
+    for order, a in zip(orders, state_matrices(u, s, 1, orders)):
         root = np.sqrt(s[:order])
-        obs = u[:, :order] * root
-        ctrl = root[:, None] * vt[:order]
-        up = obs[:-1]
         try:
-            a = np.linalg.solve(up.T @ up, up.T @ obs[1:])
+            if a is None:
+                raise np.linalg.LinAlgError
             lam, vec = np.linalg.eig(a)
         except np.linalg.LinAlgError:
             out.append(np.empty((0, 3)))
@@ -260,9 +621,9 @@ def ssi_poles(
         if not np.any(keep):
             out.append(np.empty((0, 3)))
             continue
-        c_modal = obs[0] @ vec
+        c_modal = (u[0, :order] * root) @ vec
         try:
-            g_modal = np.linalg.solve(vec, ctrl[:, 0])
+            g_modal = np.linalg.solve(vec, root * vt[:order, 0])
         except np.linalg.LinAlgError:
             out.append(np.empty((0, 3)))
             continue
@@ -273,6 +634,11 @@ def ssi_poles(
         variance = 2.0 * (amp / lam_k).real  # the pair's share of R_0
         out.append(np.column_stack((freq, zeta, variance)))
     return out
+
+
+def order_support(group: np.ndarray) -> int:
+    """The model orders at which a cluster of :func:`stable_clusters` holds a pole."""
+    return len(set(group[:, -2].tolist()))
 
 
 def stable_clusters(
@@ -315,7 +681,7 @@ def stable_clusters(
             continue
         group = allp[start:i]
         start = i
-        if len(np.unique(group[:, -2])) / n_orders < MIN_SUPPORT:
+        if order_support(group) / n_orders < MIN_SUPPORT:
             counts['rejected_unstable'] += 1
             continue
         clusters.append(group)
@@ -326,36 +692,21 @@ def cluster_modes(poles, fs, max_damping, band, counts) -> np.ndarray:
     """The physical modes of a stabilisation diagram ``poles`` (:func:`ssi_poles`): rows
     (frequency, damping, variance, support), ascending; counts the rejected poles/clusters
     (:func:`stable_clusters`)."""
-    modes = [
-        (
-            np.median(group[:, 0]),
-            np.median(group[:, 1]),
-            max(np.median(group[:, 2]), 0.0),
-            len(np.unique(group[:, -2])) / len(poles),
-        )
-        for group in stable_clusters(poles, fs, max_damping, band, counts)
-    ]
+    modes = []
+    for group in stable_clusters(poles, fs, max_damping, band, counts):
+        f, z, v = np.median(group[:, :3], axis=0)
+        modes.append((f, z, max(v, 0.0), order_support(group) / len(poles)))
     return np.array(modes).reshape(-1, 4)
 
 
-def decimate(y: np.ndarray, fs: float, top_hz: float) -> tuple[np.ndarray, float]:
-    """``y`` at the lowest rate fs / 2^k that keeps ``top_hz`` at or below :data:`TOP_NU` of it
-    and :data:`MIN_SAMPLES` samples in the window (each halving behind the zero-phase anti-alias
-    filter :data:`DECIMATE_SOS`): ``(samples, rate)``; ``y`` may hold one channel a column."""
-    while top_hz <= 0.5 * TOP_NU * fs and len(y) // 2 >= MIN_SAMPLES:
-        y = sosfiltfilt(DECIMATE_SOS, y, axis=0)[::2]
-        fs *= 0.5
-    return y, fs
-
-
 def _modes_at(
-    y: np.ndarray, fs: float, max_damping: float, band: tuple[float, float], counts: dict[str, int]
+    r: np.ndarray, fs: float, max_damping: float, band: tuple[float, float], counts: dict[str, int]
 ) -> np.ndarray:
-    """The clustered modes (:func:`cluster_modes`) of ``y`` at ``fs``, poles up to
+    """The clustered modes (:func:`cluster_modes`) of correlations ``r`` at ``fs``, poles up to
     :data:`NU_MAX` fs in ``band``; clusters closer than :data:`MERGE_TOL` are one mode (the one
     with the larger support)."""
     modes = cluster_modes(
-        ssi_poles(correlations(y, 2 * BLOCK_ROWS), fs),
+        ssi_poles(r, fs),
         fs,
         max_damping,
         (band[0], min(band[1], NU_MAX * fs)),
@@ -379,8 +730,8 @@ def _strong(modes: np.ndarray, total: float, fs: float, counts: dict[str, int]):
     while True:
         noise = max(total - float(np.sum(modes[:, 2])), 1e-3 * total)
         w = 2 * math.pi * modes[:, 0] * dt
-        e = np.exp(-1j * w)
-        dens = np.array([_sdof_psd(e, f, z, max(v, 1e-300), dt) for f, z, v, _ in modes])
+        c = np.cos(w)
+        dens = np.array([_sdof_psd(c, f, z, max(v, 1e-300), dt) for f, z, v, _ in modes])
         own = np.diag(dens) if len(modes) else np.empty(0)
         ratio = own / (noise + dens.sum(axis=0) - own) if len(modes) else own
         weak = ratio < MIN_PEAK_RATIO
@@ -391,37 +742,42 @@ def _strong(modes: np.ndarray, total: float, fs: float, counts: dict[str, int]):
         modes = np.delete(modes, worst, axis=0)
 
 
-def identify(y, fs, max_damping=0.1, band=(0.0, math.inf), counts=None, top_hz=0.0, search=True):
-    """Modes of one window ``y`` sampled at ``fs``: (rows of frequency, damping, variance,
-    frequency std, damping std, ascending; the white noise variance left over; the window's
-    variance). A first pass at ``fs`` (or, if it finds none, at the first of the rates halved in
-    turn that does) finds the highest mode (or ``top_hz``, the highest mode
-    known, if higher; with ``search`` false and ``top_hz`` given, no first pass); when it lies
-    low enough, the modes come from a second pass at the rate
-    :func:`decimate` gives, over whose lags (``BLOCK_ROWS`` samples) close modes are resolved."""
+def identify(
+    cascade, fs, max_damping=0.1, band=(0.0, math.inf), counts=None, top_hz=0.0, search=True
+):
+    """Modes of one window (its :class:`CorrelationCascade`, one channel; ``fs`` the input
+    rate): (rows of frequency, damping, variance, frequency std, damping std, ascending; the
+    white noise variance left over; the window's variance). A first pass at ``fs`` (or, if it
+    finds none, at the first of the rates halved in turn that does) finds the highest mode (or
+    ``top_hz``, the highest mode known, if higher; with ``search`` false and ``top_hz`` given, no
+    first pass); when it lies low enough, the modes come from a second pass at the rate
+    :func:`decimation_level` gives, over whose lags (``BLOCK_ROWS`` samples) close modes are
+    resolved."""
     counts = dict.fromkeys(COUNTER_NAMES, 0) if counts is None else counts
-    total = float(np.var(y))
+
+    def modes_at(level):
+        r = cascade.correlations(level)[:, 0, 0]
+        return _strong(_modes_at(r, fs / 2**level, max_damping, band, counts), total, fs, counts)
+
+    n = cascade.samples(0)
+    total = float(cascade.variance()[0])
     modes, noise = np.empty((0, 4)), total
     if search or top_hz <= 0:
         # the search: from the full rate down by halvings until a level finds a mode (a low
         # mode spans too few periods of the full rate's lags to be stable there)
-        yk, rate = y, fs
+        level = 0
         while True:
-            modes, noise = _strong(
-                _modes_at(yk, rate, max_damping, band, counts), total, fs, counts
-            )
-            if len(modes) or len(yk) // 2 < MIN_SAMPLES:
+            modes, noise = modes_at(level)
+            if len(modes) or not cascade.can_halve(level):
                 break
-            yk, rate = sosfiltfilt(DECIMATE_SOS, yk)[::2], 0.5 * rate
+            level += 1
     top = max(float(np.max(modes[:, 0])) if len(modes) else 0.0, top_hz)
     if top > 0:
-        yq, rate = decimate(y, fs, top)
-        if rate < fs or not (search or top_hz <= 0):  # (no search pass ran at fs)
-            modes, noise = _strong(
-                _modes_at(yq, rate, max_damping, band, counts), total, fs, counts
-            )
+        level = decimation_level(cascade, fs, top)
+        if level > 0 or not (search or top_hz <= 0):  # (no search pass ran at fs)
+            modes, noise = modes_at(level)
     triples = [(f, z, v) for f, z, v, _ in modes]
-    stds = np.array(whittle_std(triples, noise, fs, len(y))).reshape(-1, 2)
+    stds = np.array(whittle_std(triples, noise, fs, n)).reshape(-1, 2)
     out = np.column_stack((modes[:, :3], stds)) if len(modes) else np.empty((0, 5))
     weak = ~(out[:, 3] <= MAX_STD_REL * out[:, 0])
     counts['rejected_uncertain'] += int(np.count_nonzero(weak))
@@ -469,7 +825,7 @@ class SlidingWindowIdentifier:
     clean samples of a batch, and the window each analysis reads. A subclass analyses a window
     (``_analyse``) and tracks its modes."""
 
-    def __init__(self, config: EstimatorConfig, channels: int = 0):
+    def __init__(self, config: EstimatorConfig, channels: int = 0, lags: int = 2 * BLOCK_ROWS):
         config.validate()
         self._config = config
         self._window = config.ambient_window_s
@@ -479,6 +835,7 @@ class SlidingWindowIdentifier:
         self._t = np.empty(1 << 14)
         self._y = np.empty((1 << 14, *self._row))
         self._tracks: list = []
+        self._cascade = CorrelationCascade(lags, max(channels, 1))
         self.restart()
 
     @property
@@ -503,6 +860,8 @@ class SlidingWindowIdentifier:
     def _clear(self) -> None:
         self._n = 0  # samples in the buffer
         self._start = 0  # first sample of the current window
+        self._fed = 0  # samples of the buffer in the cascade
+        self._cascade.clear()
         self._next = math.inf
 
     # ---- input --------------------------------------------------------------------------------
@@ -519,6 +878,7 @@ class SlidingWindowIdentifier:
             else:  # compact
                 self._t[:keep] = self._t[self._start : self._n]
                 self._y[:keep] = self._y[self._start : self._n]
+            self._fed -= self._start
             self._n, self._start = keep, 0
         self._t[self._n : self._n + m] = t
         self._y[self._n : self._n + m] = y
@@ -602,7 +962,8 @@ class SlidingWindowIdentifier:
         return ready, numbered
 
     def _next_window(self):
-        """Advance to the next analysis; ``(samples' times, values, rate, span, the highest
+        """Advance to the next analysis; ``(samples' times, their correlations (the
+        :class:`CorrelationCascade`, brought up to the last sample), rate, span, the highest
         published mode's frequency (0: none), whether to search the whole band)`` of the window
         it reads, or None when the window is too short."""
         t_end = self._t[self._n - 1]
@@ -613,14 +974,18 @@ class SlidingWindowIdentifier:
             np.searchsorted(self._t[self._start : self._n], t_end - self._window, 'left')
         )
         self._start = first
-        ts, ys = self._t[first : self._n], self._y[first : self._n]
+        ts = self._t[first : self._n]
+        new = self._y[self._fed : self._n]
+        self._cascade.push(new.reshape(len(new), -1))
+        self._fed = self._n
+        self._cascade.keep_last(len(ts))
         if len(ts) < 4 * BLOCK_ROWS + 2:
             return None
         span = float(ts[-1] - ts[0])
         self._c['analyses'] += 1
         known = max((tr.frequency for tr in self._tracks if tr.published), default=0.0)
         search = self._c['analyses'] % SEARCH_EVERY == 1
-        return ts, ys, (len(ts) - 1) / span, span, known, search
+        return ts, self._cascade, (len(ts) - 1) / span, span, known, search
 
 
 class AmbientEstimator(SlidingWindowIdentifier):
@@ -653,9 +1018,9 @@ class AmbientEstimator(SlidingWindowIdentifier):
         window = self._next_window()
         if window is None:
             return []
-        ts, ys, fs, span, known, search = window
+        ts, cascade, fs, span, known, search = window
         modes, _noise, total = identify(
-            ys, fs, self._config.max_damping, self._band, self._c, known, search
+            cascade, fs, self._config.max_damping, self._band, self._c, known, search
         )
         return self._track(modes, total, float(ts[-1]), span, len(ts))
 

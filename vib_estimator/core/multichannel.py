@@ -16,8 +16,8 @@ are in), as the single-channel identifier (:mod:`..ambient`, whose stabilisation
 are reused) with matrices in place of scalars:
 
 1. **Joint SSI-cov**: the correlation matrices ``R_k = E[y_t+k y_t^T]`` (channels x channels,
-   k = 0 .. 2 p, by FFT, unbiased), their block Hankel matrix ``H = [R_{i+j+1}]`` (p =
-   :data:`JOINT_BLOCK_ROWS` block rows, every channel a reference), its SVD; at each model
+   k = 0 .. 2 p, unbiased), their block Hankel matrix ``H = [R_{i+j+1}]`` (p =
+   :func:`joint_rows` block rows, every channel a reference), its SVD; at each model
    order ``O = U_n S_n^1/2``, ``A = O_up^+ O_down``, ``C`` = the first block row of ``O``, ``G``
    = the first block column of ``S_n^1/2 V_n^T``. Each eigenvalue ``lambda`` (eigenvector
    ``v``) of ``A`` is a pole of every channel at once; its **shape** is ``phi = C v``, its share
@@ -55,26 +55,26 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.signal import sosfiltfilt
 
 from .ambient import (
     BLOCK_ROWS,
     COUNTER_NAMES,
-    DECIMATE_SOS,
     MATCH_TOL,
     MAX_STD_REL,
     MAX_TRACKS,
     MERGE_TOL,
     MIN_PEAK_RATIO,
-    MIN_SAMPLES,
     NU_MAX,
     ORDERS,
     ModeTrack,
     SlidingWindowIdentifier,
-    decimate,
+    decimation_level,
     estimate_columns,
+    hankel_svd,
+    order_support,
     sdof_psd,
     stable_clusters,
+    state_matrices,
     whittle_std,
 )
 from .config import EstimatorConfig
@@ -88,6 +88,10 @@ MAC_MATCH = 0.5
 #: ``rows x channels`` above the highest order; the SVD costs 8 times less; on the shear frame,
 #: two seeds, as accurate as 40 rows)
 JOINT_BLOCK_ROWS = BLOCK_ROWS // 2
+#: with many channels fewer block rows: ``rows x channels`` at most about this (the 5-storey
+#: frame's 100; the SVD's cost grows as its cube: 8 channels, 13 rows, 1.4x faster in all;
+#: the Heritage Court Tower's 6 channels, 17 rows: the same 6 modes, none > 2 % off)
+JOINT_HANKEL = 100
 #: a mode's Whittle bound counts the modes within this relative frequency of it (farther
 #: ones' skirts carry no information on it, and each bound then costs a few modes, not all)
 NEIGHBOURS = 0.2
@@ -111,44 +115,29 @@ def normalise_shape(phi: np.ndarray) -> np.ndarray:
 
 
 # ---- one window ---------------------------------------------------------------------------------
-def correlation_matrices(y: np.ndarray, lags: int) -> np.ndarray:
-    """Unbiased correlation matrices ``R_k[a, b] = sum_t y_a,t+k y_b,t / (N - k)``, k = 0 ..
-    ``lags``, of the mean-removed columns of ``y`` (samples x channels), by FFT: (lags + 1,
-    channels, channels)."""
-    n = len(y)
-    y = y - y.mean(axis=0)
-    size = 1 << math.ceil(math.log2(n + lags + 1))
-    spec = np.fft.rfft(y, size, axis=0).T  # channels x bins
-    m = y.shape[1]
-    a, b = np.triu_indices(m)
-    # one inverse transform per pair a <= b: its start holds R_k[a, b], its end R_k[b, a]
-    circ = np.fft.irfft(spec[a] * np.conj(spec[b]), size, axis=-1)
-    r = np.empty((lags + 1, m, m))
-    r[:, a, b] = circ[:, : lags + 1].T
-    r[0, b, a] = circ[:, 0]
-    r[1:, b, a] = circ[:, : -lags - 1 : -1].T
-    return r / np.arange(n, n - lags - 1, -1)[:, None, None]
+def joint_rows(channels: int) -> int:
+    """Block rows of the joint Hankel matrix of ``channels`` channels: :data:`JOINT_BLOCK_ROWS`,
+    fewer when that would make it larger than :data:`JOINT_HANKEL`."""
+    return min(JOINT_BLOCK_ROWS, -(-JOINT_HANKEL // channels))
 
 
-def joint_poles(
-    r: np.ndarray, fs: float, rows: int = JOINT_BLOCK_ROWS, orders: Sequence[int] = ORDERS
-) -> list[np.ndarray]:
-    """Joint SSI-cov poles of correlation matrices ``r`` (:func:`correlation_matrices`) at each
-    model order: per order an array with a row per complex pair (upper half plane): frequency Hz,
-    damping ratio, variance summed over channels, each channel's variance, the real then the
-    imaginary parts of the (unnormalised) shape."""
-    m = r.shape[1]
+def joint_poles(r: np.ndarray, fs: float, orders: Sequence[int] = ORDERS) -> list[np.ndarray]:
+    """Joint SSI-cov poles of correlation matrices ``r`` (:func:`correlation_matrices`, lags 0 ..
+    2 p: p block rows) at each model order: per order an array with a row per complex pair
+    (upper half plane): frequency Hz, damping ratio, variance summed over channels, each
+    channel's variance, the real then the imaginary parts of the (unnormalised) shape."""
+    m, rows = r.shape[1], (len(r) - 1) // 2
     idx = 1 + np.add.outer(np.arange(rows), np.arange(rows))
     hankel = r[idx].transpose(0, 2, 1, 3).reshape(rows * m, rows * m)
-    u, s, vt = np.linalg.svd(hankel)
+    u, s, vt = hankel_svd(hankel, max(orders), m)
     width = 3 + 3 * m
     out = []
-    for order in orders:
+    for order, a in zip(orders, state_matrices(u, s, m, orders)):
         root = np.sqrt(s[:order])
-        obs = u[:, :order] * root
-        up = obs[:-m]
+        obs = u[:m, :order] * root  # C, the first block row of O
         try:
-            a = np.linalg.lstsq(up, obs[m:], rcond=None)[0]
+            if a is None:
+                raise np.linalg.LinAlgError
             lam, vec = np.linalg.eig(a)
             g_modal = np.linalg.solve(vec, root[:, None] * vt[:order, :m])
         except np.linalg.LinAlgError:
@@ -191,9 +180,13 @@ class JointModes:
 def _cluster_shape(group: np.ndarray, m: int) -> tuple[np.ndarray, np.ndarray]:
     """The cluster's shape and its per-channel uncertainty (see the module doc, step 2)."""
     phis = group[:, 3 + m : 3 + 2 * m] + 1j * group[:, 3 + 2 * m : 3 + 3 * m]
-    phis = np.array([normalise_shape(p) for p in phis])
+    big = phis[np.arange(len(phis)), np.argmax(np.abs(phis), axis=1)]
+    size = np.abs(big)
+    unit = np.divide(big, size, out=np.ones_like(big), where=size > 0)
+    norm = np.where(size > 0, np.sqrt(np.sum(np.abs(phis) ** 2, axis=1)), 1.0)
+    phis = phis / (unit * norm)[:, None]  # each normalise_shape'd
     ref = phis[int(np.argmax(group[:, 2]))]
-    rot = np.array([np.vdot(p, ref) for p in phis])
+    rot = phis.conj() @ ref
     phis = phis * (rot / np.maximum(np.abs(rot), 1e-300))[:, None]
     mean = phis.mean(axis=0)
     spread = np.sqrt(np.mean(np.abs(phis - mean) ** 2, axis=0))
@@ -201,13 +194,12 @@ def _cluster_shape(group: np.ndarray, m: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def joint_modes_at(
-    y: np.ndarray, fs: float, max_damping: float, band: tuple[float, float], counts: dict
+    r: np.ndarray, fs: float, max_damping: float, band: tuple[float, float], counts: dict
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The clustered modes of ``y`` (samples x channels) at ``fs``: (rows of frequency, damping,
-    each channel's variance; shapes; shape stds), close clusters merged when their shapes agree;
-    and the channels' variances ``R_0``."""
-    m = y.shape[1]
-    r = correlation_matrices(y, 2 * JOINT_BLOCK_ROWS)
+    """The clustered modes of correlation matrices ``r`` (:func:`correlation_matrices`, lags 0 ..
+    2 :func:`joint_rows`) at ``fs``: (rows of frequency, damping, each channel's variance;
+    shapes; shape stds), close clusters merged when their shapes agree."""
+    m = r.shape[1]
     clusters = stable_clusters(
         joint_poles(r, fs), fs, max_damping, (band[0], min(band[1], NU_MAX * fs)), counts
     )
@@ -216,11 +208,11 @@ def joint_modes_at(
         shape, spread = _cluster_shape(group, m)
         row = np.concatenate(
             (
-                [np.median(group[:, 0]), np.median(group[:, 1])],
+                np.median(group[:, :2], axis=0),
                 np.maximum(np.median(group[:, 3 : 3 + m], axis=0), 0.0),
             )
         )
-        sup = len(np.unique(group[:, -2]))
+        sup = order_support(group)
         if rows and row[0] <= rows[-1][0] * (1 + MERGE_TOL) and mac(shape, shapes[-1]) >= MAC_SAME:
             if sup > support[-1]:
                 rows[-1], shapes[-1], stds[-1], support[-1] = row, shape, spread, sup
@@ -269,7 +261,7 @@ def strong_joint(rows, shapes, stds, totals, fs, counts):
 
 
 def identify_joint(
-    y: np.ndarray,
+    cascade,
     fs: float,
     max_damping: float = 0.1,
     band: tuple[float, float] = (0.0, math.inf),
@@ -277,31 +269,33 @@ def identify_joint(
     top_hz: float = 0.0,
     search: bool = True,
 ) -> tuple[JointModes, float]:
-    """Modes of one window ``y`` (samples x channels) at ``fs``, the passes of
-    :func:`..ambient.identify` (a search from the full rate down, then the rate that puts the
-    highest mode at :data:`..ambient.TOP_NU`): (:class:`JointModes`, the summed variance)."""
+    """Modes of one window (its :class:`..ambient.CorrelationCascade` of lags 0 .. 2
+    :func:`joint_rows`; ``fs`` the input rate), the passes of :func:`..ambient.identify` (a search
+    from the full rate down, then the rate that puts the highest mode at
+    :data:`..ambient.TOP_NU`): (:class:`JointModes`, the summed variance)."""
     counts = dict.fromkeys(COUNTER_NAMES, 0) if counts is None else counts
-    y = np.asarray(y, dtype=np.float64)
-    m = y.shape[1]
-    totals = np.var(y, axis=0)
+    m = cascade.channels
+    totals = cascade.variance()
+
+    def modes_at(level):
+        r = cascade.correlations(level)
+        found = joint_modes_at(r, fs / 2**level, max_damping, band, counts)
+        return strong_joint(*found, totals, fs, counts)
+
     found = (np.empty((0, 2 + m)), np.empty((0, m), complex), np.empty((0, m)))
     strong = (*found, totals, np.empty(0, dtype=int))
     if search or top_hz <= 0:
-        yk, rate = y, fs
+        level = 0
         while True:
-            strong = strong_joint(
-                *joint_modes_at(yk, rate, max_damping, band, counts), totals, fs, counts
-            )
-            if len(strong[0]) or len(yk) // 2 < MIN_SAMPLES:
+            strong = modes_at(level)
+            if len(strong[0]) or not cascade.can_halve(level):
                 break
-            yk, rate = sosfiltfilt(DECIMATE_SOS, yk, axis=0)[::2], 0.5 * rate
+            level += 1
     top = max(float(np.max(strong[0][:, 0])) if len(strong[0]) else 0.0, top_hz)
     if top > 0:
-        yq, rate = decimate(y, fs, top)
-        if rate < fs or not (search or top_hz <= 0):  # (no search pass ran at fs)
-            strong = strong_joint(
-                *joint_modes_at(yq, rate, max_damping, band, counts), totals, fs, counts
-            )
+        level = decimation_level(cascade, fs, top)
+        if level > 0 or not (search or top_hz <= 0):  # (no search pass ran at fs)
+            strong = modes_at(level)
     rows, shapes, spread, noise, best = strong
     std = np.full((len(rows), 2), math.nan)
     for j, c in enumerate(best):
@@ -310,7 +304,7 @@ def identify_joint(
             (rows[:, 2 + c] > 0) & (np.abs(rows[:, 0] / rows[j, 0] - 1) <= NEIGHBOURS)
         )
         triples = [(rows[i, 0], rows[i, 1], rows[i, 2 + c]) for i in near]
-        cstd = np.array(whittle_std(triples, noise[c], fs, len(y))).reshape(-1, 2)
+        cstd = np.array(whittle_std(triples, noise[c], fs, cascade.samples(0))).reshape(-1, 2)
         std[j] = cstd[int(np.flatnonzero(near == j)[0])]
     modes = JointModes(rows[:, 0], rows[:, 1], rows[:, 2:], std[:, 0], std[:, 1], shapes, spread)
     weak = ~(modes.frequency_std <= MAX_STD_REL * modes.frequency)
@@ -365,7 +359,7 @@ class JointAmbientEstimator(SlidingWindowIdentifier):
                 f'got {len(channels)} (one channel: excitation ambient, one column)'
             )
         self._channels = channels
-        super().__init__(config, len(channels))
+        super().__init__(config, len(channels), 2 * joint_rows(len(channels)))
 
     @property
     def channels(self) -> tuple[str, ...]:
@@ -411,9 +405,9 @@ class JointAmbientEstimator(SlidingWindowIdentifier):
         window = self._next_window()
         if window is None:
             return []
-        ts, ys, fs, span, known, search = window
+        ts, cascade, fs, span, known, search = window
         modes, total = identify_joint(
-            ys, fs, self._config.max_damping, self._band, self._c, known, search
+            cascade, fs, self._config.max_damping, self._band, self._c, known, search
         )
         return self._track(modes, total, float(ts[-1]), span, len(ts))
 
