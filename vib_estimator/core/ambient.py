@@ -54,11 +54,12 @@ counted; a gap or a backward jump longer than ``max_gap`` starts a new window (`
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
-from scipy.signal import butter, sos2zpk, sosfilt, sosfilt_zi
 
 from .config import EstimatorConfig
 from .estimator import INPUT_COUNTERS, Estimate, EstimateArrays, as_series
@@ -101,8 +102,9 @@ MIN_SAMPLES = 20 * BLOCK_ROWS
 #: two clusters closer than this (relative) are one mode
 MERGE_TOL = 0.02
 #: anti-alias filter of each halving of the rate: 8th order Butterworth at 0.45 of the Nyquist
-#: frequency (run forwards and backwards: no phase, gain 0.96 at the owned band's top edge)
-DECIMATE_SOS = butter(8, 0.45, output='sos')
+#: frequency (run forwards and backwards: no phase, gain 0.96 at the owned band's top edge;
+#: :func:`decimation_filter`)
+DECIMATE_ORDER, DECIMATE_CUTOFF = 8, 0.45
 
 COUNTER_NAMES = INPUT_COUNTERS + (
     'analyses',
@@ -236,14 +238,35 @@ def correlations(y: np.ndarray, lags: int) -> np.ndarray:
     return r / np.arange(n, n - lags - 1, -1)
 
 
-#: the steady state of :data:`DECIMATE_SOS` for a unit input, and the samples a zero-phase pass
-#: extends the signal by at each end (odd extension): those of ``scipy.signal.sosfiltfilt``
-DECIMATE_ZI = sosfilt_zi(DECIMATE_SOS)
-DECIMATE_PAD = 3 * (
-    2 * len(DECIMATE_SOS)
-    + 1
-    - min(int(np.sum(DECIMATE_SOS[:, 2] == 0)), int(np.sum(DECIMATE_SOS[:, 5] == 0)))
-)
+@dataclass(frozen=True)
+class DecimationFilter:
+    """The anti-alias filter of each halving of the rate (:data:`DECIMATE_ORDER`,
+    :data:`DECIMATE_CUTOFF`) as second-order sections ``sos``; ``zi``: its steady state for a unit
+    input; ``pad``: the samples a zero-phase pass extends the signal by at each end (odd
+    extension), those of ``scipy.signal.sosfiltfilt``; ``settle``: the samples over which its
+    response has decayed below 1e-20 of its start (its slowest pole's radius r: r^n < 1e-20),
+    plus ``pad``."""
+
+    sos: np.ndarray
+    zi: np.ndarray
+    pad: int
+    settle: int
+
+
+@functools.lru_cache(maxsize=None)
+def decimation_filter() -> DecimationFilter:
+    """The :class:`DecimationFilter`, designed on first use: ``scipy.signal`` takes a second or
+    more to import, which a node or a command that never runs this identifier should not pay at
+    its start."""
+    from scipy.signal import butter, sos2zpk, sosfilt_zi
+
+    sos = butter(DECIMATE_ORDER, DECIMATE_CUTOFF, output='sos')
+    pad = 3 * (2 * len(sos) + 1 - min(int(np.sum(sos[:, 2] == 0)), int(np.sum(sos[:, 5] == 0))))
+    radius = float(np.max(np.abs(sos2zpk(sos)[1])))
+    settle = math.ceil(-20.0 / math.log10(radius)) + pad
+    return DecimationFilter(sos, sosfilt_zi(sos), pad, settle)
+
+
 #: a :class:`LagProducts` recomputes its sums from its window after this many slides (bounds the
 #: rounding of the updates; the sums are otherwise exact)
 REFRESH_SLIDES = 64
@@ -402,28 +425,24 @@ class LagProducts:
 
 
 def zero_phase(x: np.ndarray) -> np.ndarray:
-    """``scipy.signal.sosfiltfilt(DECIMATE_SOS, x, axis=0)``, its initial conditions computed
-    once."""
-    pad = DECIMATE_PAD
+    """``scipy.signal.sosfiltfilt(decimation_filter().sos, x, axis=0)``, its initial conditions
+    computed once."""
+    from scipy.signal import sosfilt
+
+    f = decimation_filter()
+    pad = f.pad
     ext = np.concatenate((2 * x[0] - x[pad:0:-1], x, 2 * x[-1] - x[-2 : -pad - 2 : -1]))
-    zi = DECIMATE_ZI.reshape(DECIMATE_ZI.shape + (1,) * (x.ndim - 1))
-    out = sosfilt(DECIMATE_SOS, ext, axis=0, zi=zi * ext[0])[0]
-    out = sosfilt(DECIMATE_SOS, out[::-1], axis=0, zi=zi * out[-1])[0]
+    zi = f.zi.reshape(f.zi.shape + (1,) * (x.ndim - 1))
+    out = sosfilt(f.sos, ext, axis=0, zi=zi * ext[0])[0]
+    out = sosfilt(f.sos, out[::-1], axis=0, zi=zi * out[-1])[0]
     return out[::-1][pad:-pad]
 
 
 def halve(y: np.ndarray) -> np.ndarray:
     """``y`` (samples, or samples x channels) at half its rate: every second sample of its
-    zero-phase (forwards and backwards) anti-alias filtering by :data:`DECIMATE_SOS`
+    zero-phase (forwards and backwards) anti-alias filtering by :func:`decimation_filter`
     (:func:`zero_phase`)."""
     return zero_phase(y)[::2]
-
-
-#: samples over which the anti-alias filter's response has decayed below 1e-20 of its start
-#: (its slowest pole's radius r: r^n < 1e-20), plus the zero-phase pass's extension
-SETTLE = (
-    math.ceil(-20.0 / math.log10(float(np.max(np.abs(sos2zpk(DECIMATE_SOS)[1]))))) + DECIMATE_PAD
-)
 
 
 class CorrelationCascade:
@@ -431,7 +450,8 @@ class CorrelationCascade:
     times (level j: :func:`halve` applied j times to the window). The input rate's are kept up to
     date as samples arrive (:class:`LagProducts`: exact, without re-reading the window). A
     halved rate's window is made when first read after the window moved: the zero-phase
-    filtering of a window depends on its ends only within :data:`SETTLE` samples of them, so
+    filtering of a window depends on its ends only within ``decimation_filter().settle``
+    samples of them, so
     its middle is kept from the previous analysis and only the stretches near the ends that
     moved are filtered again (the same numbers, to rounding, as :func:`halve` of the whole
     window: ``test/core/test_ambient_incremental.py``)."""
@@ -498,7 +518,7 @@ class CorrelationCascade:
         """:func:`zero_phase` of level j - 1's window ``x``, its middle kept from the previous
         analysis where that is exact to rounding; with the counts of its first and last samples
         that may differ from that analysis's."""
-        n, k = len(x), SETTLE
+        n, k = len(x), decimation_filter().settle
         prev = self._filtered.get(j)
         z = None
         if prev is not None and prev[1] == step and (start - prev[0]) % step == 0:
