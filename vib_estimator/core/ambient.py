@@ -464,6 +464,7 @@ class CorrelationCascade:
         #: the samples pushed by then)
         self._filtered: dict[int, tuple] = {}
         self._moved()
+        decimation_filter()  # scipy.signal imported now, not at the first analysis
 
     @classmethod
     def of(cls, y: np.ndarray, lags: int) -> 'CorrelationCascade':
