@@ -139,6 +139,23 @@ def test_the_free_decay_test_tells_a_decay_from_a_driven_mode():
         assert is_free_decay(t, y, F) is False
 
 
+def test_a_ringing_that_settles_into_a_limit_cycle_is_free():
+    """A ringing whose frequency rises 0.8 F -> F as its amplitude falls 3 -> 1 (2 s), then a
+    limit cycle (as the real arm's): not one decay over the test's 8 periods, but its last 2.5
+    periods are one within the noise."""
+    from vib_estimator.core.auto import RECENT_PERIODS, decay_misfit
+
+    rng = np.random.default_rng(4)
+    t = np.arange(int(3 * FS)) / FS
+    u = np.minimum(t / 2.0, 1.0)
+    phase = 2 * math.pi * np.cumsum(F * (0.8 + 0.2 * u)) / FS
+    y = (1 + 2 * (1 - u) ** 2) * np.sin(phase) + 0.001 * rng.standard_normal(len(t))
+    whole = decay_misfit(t, y, F)
+    assert whole is not None and whole[1] > 0.02  # the whole window: no single decay
+    assert decay_misfit(t, y, F, RECENT_PERIODS)[1] < 0.005
+    assert is_free_decay(t, y, F) is True
+
+
 @pytest.mark.parametrize('zeta', [0.01, 0.002])
 def test_a_driven_record_publishes_no_free_decay_estimate(zeta):
     """Driven from its first sample (a record that starts free for the envelope): the free-decay

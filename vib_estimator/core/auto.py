@@ -88,6 +88,10 @@ TEST_BLOCKS = 3
 #: (RMS): a driven mode's amplitude takes a random step each half period (~sqrt(2 pi zeta) of it)
 NOISE_RATIO = 4.0
 INNOVATION = 0.02
+#: ... or when its last RECENT_PERIODS alone are a decay within INNOVATION / CLEAN (a ringing that
+#: settled into a limit cycle, where the frequency moved with the amplitude: a real arm)
+RECENT_PERIODS = 2.5
+CLEAN = 4.0
 #: samples kept for the test (at 1 kHz: 8 periods down to 0.12 Hz)
 HISTORY = 1 << 16
 
@@ -130,14 +134,16 @@ def _blocks(t: np.ndarray, y: np.ndarray, f: float):
     return c, v
 
 
-def decay_misfit(t: np.ndarray, y: np.ndarray, f: float) -> Optional[Tuple[float, float]]:
+def decay_misfit(
+    t: np.ndarray, y: np.ndarray, f: float, periods: float = TEST_PERIODS
+) -> Optional[Tuple[float, float]]:
     """How far the signal ``(t, y)`` before a free estimate of ``f`` Hz (ending at its sample, the
     last :data:`TEST_PERIODS` periods) is from one damped sinusoid in white noise: the complex
     amplitudes ``c`` of its one-period blocks, half a period apart, after the last :data:`JUMP`
     (looked for one period further back), fitted by ``c[k+1] = r c[k]`` (a decay; the frequency
     refined twice from ``r``'s phase): the prediction error's mean square over the noise's and its
     RMS over the amplitude's. None when fewer than :data:`TEST_BLOCKS` blocks are left."""
-    lo = np.searchsorted(t, t[-1] - (TEST_PERIODS + 1) / f, 'left')
+    lo = np.searchsorted(t, t[-1] - (periods + 1) / f, 'left')
     t, y = t[lo:], y[lo:]
     for _ in range(3):
         got = _blocks(t, y, f) if f > 0 else None
@@ -146,13 +152,14 @@ def decay_misfit(t: np.ndarray, y: np.ndarray, f: float) -> Optional[Tuple[float
         c, v = got
         amp = np.abs(c)
         rises = np.flatnonzero(amp[:-1] * JUMP < amp[1:])
-        first = max(len(c) - 2 * TEST_PERIODS + 1, rises[-1] + 2 if len(rises) else 0)
+        first = max(len(c) - int(2 * periods) + 1, rises[-1] + 2 if len(rises) else 0)
         c, v = c[first:], v[first:]
         if len(c) < TEST_BLOCKS:
             return None
         x, z = c[:-1], c[1:]
         r = np.vdot(x, z) / np.vdot(x, x)
         f += float(np.angle(r)) * f / math.pi  # the phase per half period
+    x, z = c[:-1], c[1:]
     err = float(np.mean(np.abs(z - r * x) ** 2))
     noise = float(np.median(v)) * (1 + abs(r) ** 2)
     return err / noise, math.sqrt(err / float(np.mean(np.abs(x) ** 2)))
@@ -161,10 +168,14 @@ def decay_misfit(t: np.ndarray, y: np.ndarray, f: float) -> Optional[Tuple[float
 def is_free_decay(t: np.ndarray, y: np.ndarray, f: float) -> Optional[bool]:
     """Whether the signal before a free estimate of ``f`` Hz is a free decay
     (:func:`decay_misfit`): not when its prediction error exceeds :data:`NOISE_RATIO` x the
-    noise's and :data:`INNOVATION` of the amplitude (a driven mode's amplitude and phase wander);
-    None when too short to tell."""
+    noise's and :data:`INNOVATION` of the amplitude (a driven mode's amplitude and phase wander),
+    unless its last :data:`RECENT_PERIODS` are a decay within ``INNOVATION / CLEAN``; None when
+    too short to tell."""
     m = decay_misfit(t, y, f)
-    return None if m is None else not (m[0] > NOISE_RATIO and m[1] > INNOVATION)
+    if m is None or m[0] <= NOISE_RATIO or m[1] <= INNOVATION:
+        return None if m is None else True
+    recent = decay_misfit(t, y, f, RECENT_PERIODS)
+    return recent is not None and recent[1] <= INNOVATION / CLEAN
 
 
 def _is_onset(energies: Sequence[float], energy: float) -> bool:
