@@ -24,11 +24,13 @@ driven stretch stays driven (a driven response's energy also wanders down for a 
 onset, or until :data:`QUIET_BLOCKS` consecutive blocks are :data:`DROP` times below its median
 block: the structure rang down after the forcing stopped. A record starts free.
 
-A free-decay estimate publishes when its sample ends in a free stretch, an ambient estimate when
-it ends in a driven one: on a record that is a free decay throughout the output is the free
-estimator's (the identifier needs a whole window and confirmations before it publishes at all),
-on a driven one the identifier's, after the first blocks (which are free until the envelope has
-shown it is driven: a few seconds of free-decay estimates of a driven signal).
+A free-decay estimate publishes when its sample ends in a free stretch and (``modes`` = 0) it
+passes the free-decay test (:func:`is_free_decay`: the signal before it is one damped sinusoid in
+white noise, where a driven mode's amplitude and phase wander), an ambient estimate when it ends
+in a driven one: on a record that is a free decay throughout the output is the free estimator's
+(the identifier needs a whole window and confirmations before it publishes at all), on a driven
+one the identifier's (its first blocks are free until the envelope has shown it is driven, but
+their free-decay estimates fail the test).
 
 One ``mode`` scheme: every published estimate continues the mode within
 :data:`~.ambient.MATCH_TOL` of its frequency (else starts one), modes are numbered by ascending
