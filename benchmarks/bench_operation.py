@@ -331,7 +331,7 @@ def free_decays(real_data):
         n_free = same = added = 0
         driven = 0.0
         for t, y in recs:
-            free = create_estimator(cfg).process(t, y)
+            free = create_estimator(cfg.replace(excitation='free')).process(t, y)
             auto = create_estimator(cfg.replace(excitation='auto'))
             e = auto.process(t, y)
             key = lambda a: set(  # noqa: E731

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from vib_estimator.core import EstimatorConfig
-from vib_estimator.core.auto import AutoEstimator, is_driven
+from vib_estimator.core.auto import AutoEstimator, is_driven, is_free_decay
 from vib_estimator.core.modes import create_estimator
-from vib_estimator.sim.ambient import sdof_response
+from vib_estimator.sim.ambient import ambient_record, sdof_response
 
 FS, F, ZETA = 500.0, 5.0, 0.01
 AUTO = EstimatorConfig(excitation='auto')
@@ -121,3 +121,49 @@ def test_a_driven_stretch_ends_when_the_structure_rings_down():
     states = np.array(states)
     assert np.mean(states[(t > 15) & (t < 40)] == DRIVEN_STATE) == 1.0
     assert np.all(states[t > 60] == FREE_STATE) and env.changes['rang_down'] == 1
+
+
+def test_the_free_decay_test_tells_a_decay_from_a_driven_mode():
+    """A damped sinusoid in white noise (with an offset; 4 periods after a pluck from rest) is a
+    free decay, a white-noise-driven mode (zeta 1 % and 0.2 %) is not, 2 periods are too short."""
+    rng = np.random.default_rng(3)
+    t = np.arange(int(2 * FS)) / FS
+    y = 0.3 + 0.01 * rng.standard_normal(len(t))
+    y[t >= 0.5] += _decay(int(np.sum(t >= 0.5)), 2.0, 0.4)
+    end = int((0.5 + 4 / F) * FS)
+    assert is_free_decay(t[:end], y[:end], F) is True
+    assert is_free_decay(t, y, F * 1.02) is True  # the frequency refined from the blocks
+    assert is_free_decay(t[: int(2 / F * FS)], y[: int(2 / F * FS)], F) is None
+    for zeta in (0.01, 0.002):
+        y = sdof_response(len(t), FS, F, zeta, 1.0, rng) + 0.02 * rng.standard_normal(len(t))
+        assert is_free_decay(t, y, F) is False
+
+
+def test_a_ringing_that_settles_into_a_limit_cycle_is_free():
+    """A ringing whose frequency rises 0.8 F -> F as its amplitude falls 3 -> 1 (2 s), then a
+    limit cycle (as the real arm's): not one decay over the test's 8 periods, but its last 2.5
+    periods are one within the noise."""
+    from vib_estimator.core.auto import RECENT_PERIODS, decay_misfit
+
+    rng = np.random.default_rng(4)
+    t = np.arange(int(3 * FS)) / FS
+    u = np.minimum(t / 2.0, 1.0)
+    phase = 2 * math.pi * np.cumsum(F * (0.8 + 0.2 * u)) / FS
+    y = (1 + 2 * (1 - u) ** 2) * np.sin(phase) + 0.001 * rng.standard_normal(len(t))
+    whole = decay_misfit(t, y, F)
+    assert whole is not None and whole[1] > 0.02  # the whole window: no single decay
+    assert decay_misfit(t, y, F, RECENT_PERIODS)[1] < 0.005
+    assert is_free_decay(t, y, F) is True
+
+
+@pytest.mark.parametrize('zeta', [0.01, 0.002])
+def test_a_driven_record_publishes_no_free_decay_estimate(zeta):
+    """Driven from its first sample (a record that starts free for the envelope): the free-decay
+    estimates of its first seconds fail the test, so only the identifier's are published."""
+    t, y, _ = ambient_record(60.0, FS, [(F, zeta, 1.0)], 26.0, 5)
+    est = create_estimator(AUTO)
+    e = est.process(t, y)
+    assert len(e) >= 20 and est.counters['not_free_decay'] > 0
+    assert est.counters['estimates_free'] == 0
+    assert np.all(e.convergence_time >= 0.9 * AUTO.ambient_window_s)
+    assert np.all(np.abs(e.frequency_hz / F - 1) < 0.05)

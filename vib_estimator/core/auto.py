@@ -24,11 +24,13 @@ driven stretch stays driven (a driven response's energy also wanders down for a 
 onset, or until :data:`QUIET_BLOCKS` consecutive blocks are :data:`DROP` times below its median
 block: the structure rang down after the forcing stopped. A record starts free.
 
-A free-decay estimate publishes when its sample ends in a free stretch, an ambient estimate when
-it ends in a driven one: on a record that is a free decay throughout the output is the free
-estimator's (the identifier needs a whole window and confirmations before it publishes at all),
-on a driven one the identifier's, after the first blocks (which are free until the envelope has
-shown it is driven: a few seconds of free-decay estimates of a driven signal).
+A free-decay estimate publishes when its sample ends in a free stretch and (``modes`` = 0) it
+passes the free-decay test (:func:`is_free_decay`: the signal before it is one damped sinusoid in
+white noise, where a driven mode's amplitude and phase wander), an ambient estimate when it ends
+in a driven one: on a record that is a free decay throughout the output is the free estimator's
+(the identifier needs a whole window and confirmations before it publishes at all), on a driven
+one the identifier's (its first blocks are free until the envelope has shown it is driven, but
+their free-decay estimates fail the test).
 
 One ``mode`` scheme: every published estimate continues the mode within
 :data:`~.ambient.MATCH_TOL` of its frequency (else starts one), modes are numbered by ascending
@@ -40,7 +42,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from typing import Sequence
+from typing import Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -75,6 +77,25 @@ QUIET_BLOCKS = 6
 FLOOR = 1e-6
 #: the states of a stretch
 FREE, DRIVEN = 'free', 'driven'
+#: the free-decay test of each free estimate (``modes`` = 0): one-period blocks of the signal, half
+#: a period apart, over at most this many periods before the estimate's sample
+TEST_PERIODS = 8
+#: ... after the last block whose amplitude is more than this times the one before it (a pluck:
+#: the test starts one block after it)
+JUMP = 1.5
+#: ... at least this many blocks (fewer: the estimate is published untested)
+TEST_BLOCKS = 3
+#: not a free decay when the one-pole prediction of the blocks' complex amplitudes errs by more
+#: than NOISE_RATIO x the noise's share (mean square) and by more than INNOVATION of the amplitude
+#: (RMS): a driven mode's amplitude takes a random step each half period (~sqrt(2 pi zeta) of it)
+NOISE_RATIO = 4.0
+INNOVATION = 0.02
+#: ... or when its last RECENT_PERIODS alone are a decay within INNOVATION / CLEAN (a ringing that
+#: settled into a limit cycle, where the frequency moved with the amplitude: a real arm)
+RECENT_PERIODS = 2.5
+CLEAN = 4.0
+#: samples kept for the test (at 1 kHz: 8 periods down to 0.12 Hz)
+HISTORY = 1 << 16
 
 
 def is_driven(energies: Sequence[float]) -> bool:
@@ -93,6 +114,70 @@ def is_driven(energies: Sequence[float]) -> bool:
     return (
         len(before) > 1 and float(np.max(np.maximum.accumulate(before)[:-1] / before[1:])) > RISE
     )
+
+
+def _blocks(t: np.ndarray, y: np.ndarray, f: float):
+    """The complex amplitudes at ``f`` Hz of one-period blocks of ``(t, y)`` ending every half
+    period back from ``t[-1]`` (oldest first; each block's mean removed) and the noise variance of
+    each (4 x its residual's mean square / its samples); None if a block holds < 4 samples."""
+    w = 2 * math.pi * f
+    nb = int(math.floor((t[-1] - t[0]) * 2 * f)) - 1
+    ends = t[-1] - np.arange(nb)[::-1] / (2 * f)
+    a = np.searchsorted(t, ends - 1 / f, 'right')
+    b = np.searchsorted(t, ends, 'right')
+    if nb < 1 or np.any(b - a < 4):
+        return None
+    c, v = np.empty(nb, dtype=np.complex128), np.empty(nb)
+    for k, (i, j) in enumerate(zip(a.tolist(), b.tolist())):
+        yb = y[i:j] - np.mean(y[i:j])
+        e = np.exp(-1j * w * (t[i:j] - t[-1]))
+        c[k] = 2 * np.mean(yb * e)
+        v[k] = 4 * np.mean((yb - np.real(c[k] * np.conj(e))) ** 2) / (j - i)
+    return c, v
+
+
+def decay_misfit(
+    t: np.ndarray, y: np.ndarray, f: float, periods: float = TEST_PERIODS
+) -> Optional[Tuple[float, float]]:
+    """How far the signal ``(t, y)`` before a free estimate of ``f`` Hz (ending at its sample, the
+    last :data:`TEST_PERIODS` periods) is from one damped sinusoid in white noise: the complex
+    amplitudes ``c`` of its one-period blocks, half a period apart, after the last :data:`JUMP`
+    (looked for one period further back), fitted by ``c[k+1] = r c[k]`` (a decay; the frequency
+    refined twice from ``r``'s phase): the prediction error's mean square over the noise's and its
+    RMS over the amplitude's. None when fewer than :data:`TEST_BLOCKS` blocks are left."""
+    lo = np.searchsorted(t, t[-1] - (periods + 1) / f, 'left')
+    t, y = t[lo:], y[lo:]
+    for _ in range(3):
+        got = _blocks(t, y, f) if f > 0 else None
+        if got is None:
+            return None
+        c, v = got
+        amp = np.abs(c)
+        rises = np.flatnonzero(amp[:-1] * JUMP < amp[1:])
+        first = max(len(c) - int(2 * periods) + 1, rises[-1] + 2 if len(rises) else 0)
+        c, v = c[first:], v[first:]
+        if len(c) < TEST_BLOCKS:
+            return None
+        x, z = c[:-1], c[1:]
+        r = np.vdot(x, z) / np.vdot(x, x)
+        f += float(np.angle(r)) * f / math.pi  # the phase per half period
+    x, z = c[:-1], c[1:]
+    err = float(np.mean(np.abs(z - r * x) ** 2))
+    noise = float(np.median(v)) * (1 + abs(r) ** 2)
+    return err / noise, math.sqrt(err / float(np.mean(np.abs(x) ** 2)))
+
+
+def is_free_decay(t: np.ndarray, y: np.ndarray, f: float) -> Optional[bool]:
+    """Whether the signal before a free estimate of ``f`` Hz is a free decay
+    (:func:`decay_misfit`): not when its prediction error exceeds :data:`NOISE_RATIO` x the
+    noise's and :data:`INNOVATION` of the amplitude (a driven mode's amplitude and phase wander),
+    unless its last :data:`RECENT_PERIODS` are a decay within ``INNOVATION / CLEAN``; None when
+    too short to tell."""
+    m = decay_misfit(t, y, f)
+    if m is None or m[0] <= NOISE_RATIO or m[1] <= INNOVATION:
+        return None if m is None else True
+    recent = decay_misfit(t, y, f, RECENT_PERIODS)
+    return recent is not None and recent[1] <= INNOVATION / CLEAN
 
 
 def _is_onset(energies: Sequence[float], energy: float) -> bool:
@@ -188,6 +273,10 @@ class AutoEstimator:
         self._envelope = Envelope(max(MIN_BLOCK_S, config.ambient_window_s / BLOCKS_PER_WINDOW))
         self._modes: list[list[float]] = []  # [frequency, last t] of the known modes
         self._published = {FREE: 0, DRIVEN: 0}
+        self._test = config.modes == 0  # the free-decay test of each free estimate
+        self._not_free = 0  # free estimates the test held back
+        self._history = np.empty((2, 2 * HISTORY))  # the last HISTORY valid samples (t, y)
+        self._filled = 0
 
     @property
     def config(self) -> EstimatorConfig:
@@ -217,6 +306,7 @@ class AutoEstimator:
         c.update(self._envelope.changes)
         c['free_blocks'] = self._envelope.blocks[FREE]
         c['driven_blocks'] = self._envelope.blocks[DRIVEN]
+        c['not_free_decay'] = self._not_free
         c['estimates_free'] = self._published[FREE]
         c['estimates_driven'] = self._published[DRIVEN]
         c['estimates'] = self._published[FREE] + self._published[DRIVEN]
@@ -232,19 +322,42 @@ class AutoEstimator:
         self._ambient.restart()
         self._envelope.restart()
         self._modes = []
+        self._filled = 0
 
     def reset(self) -> None:
         self._free.reset()
         self._ambient.reset()
 
     # ---- streaming ----------------------------------------------------------------------------
+    def _remember(self, t: float, y: float) -> None:
+        """Keep a valid sample (the envelope's rule) for the free-decay test."""
+        if not (math.isfinite(t) and math.isfinite(y)) or (
+            self._filled and t <= self._history[0, self._filled - 1]
+        ):
+            return
+        if self._filled == self._history.shape[1]:
+            self._history[:, :HISTORY] = self._history[:, HISTORY:]
+            self._filled = HISTORY
+        self._history[:, self._filled] = t, y
+        self._filled += 1
+
+    def _passes(self, t: np.ndarray, y: np.ndarray, f: float) -> bool:
+        """The free-decay test of a free estimate of ``f`` Hz whose sample ends ``(t, y)`` (at
+        most :data:`HISTORY` valid samples); an untestable one passes."""
+        ok = not self._test or is_free_decay(t[-HISTORY:], y[-HISTORY:], f) is not False
+        self._not_free += not ok
+        return ok
+
     def update(self, t: float, y: float) -> list[Estimate]:
         """Feed one sample; the estimates it completes that belong to the current stretch."""
         self._envelope.update(float(t), float(y))
+        self._remember(float(t), float(y))
         free = self._free.update(t, y)
         ambient = self._ambient.update(t, y)
         if self._envelope.state == FREE:
             chosen = [] if free is None else (free if isinstance(free, list) else [free])
+            h = self._history[:, : self._filled]
+            chosen = [e for e in chosen if self._passes(h[0], h[1], e.frequency_hz)]
         else:
             chosen = ambient
         state = self._envelope.state
@@ -260,15 +373,31 @@ class AutoEstimator:
         # the state after each sample (a sample completes at most one block's decision)
         env = self._envelope
         states = np.empty(len(t), dtype=bool)
+        valid = np.zeros(len(t), dtype=bool)  # the samples the history keeps
+        last = self._history[0, self._filled - 1] if self._filled else -math.inf
         for i, (a, b) in enumerate(zip(t.tolist(), y.tolist())):
             env.update(a, b)
             states[i] = env.state == DRIVEN
+            if math.isfinite(a) and math.isfinite(b) and a > last:
+                valid[i], last = True, a
+        # the history before this call, then this call's valid samples
+        ht = np.concatenate((self._history[0, : self._filled], t[valid]))
+        hy = np.concatenate((self._history[1, : self._filled], y[valid]))
+        upto = self._filled + np.cumsum(valid)  # valid samples so far, after each sample
+        n_keep = min(HISTORY, len(ht))
+        self._history[:, :n_keep] = ht[len(ht) - n_keep :], hy[len(hy) - n_keep :]
+        self._filled = n_keep
         names = list(EstimateArrays.__dataclass_fields__)
         parts, driven = [], []
         for est, want in ((free, False), (ambient, True)):
             # an estimate's sample: the last one with its stamp (stamps increase where it counts)
             idx = np.clip(np.searchsorted(t, est.t, 'right') - 1, 0, max(len(t) - 1, 0))
             keep = states[idx] == want if len(t) else np.zeros(0, dtype=bool)
+            if not want:
+                for k in np.flatnonzero(keep).tolist():
+                    n = int(upto[idx[k]])
+                    lo = max(0, n - HISTORY)
+                    keep[k] = self._passes(ht[lo:n], hy[lo:n], float(est.frequency_hz[k]))
             parts.append(EstimateArrays(**{n: getattr(est, n)[keep] for n in names}))
             driven.append(np.full(int(np.sum(keep)), want))
         # by time, stable: at one stamp the free estimate first, an analysis's modes in order
