@@ -1139,8 +1139,8 @@ def run(p, s, c, seg, t, y, out, start, optional=None):
     :func:`step`).
 
     Returns (number of estimates written, index of the next sample to feed). Stops early when
-    ``out`` is full so the caller can grow it and continue. The arrays are used
-    :func:`core.jit.borrowed` (no reference counting per sample).
+    ``out`` is full so the caller can grow it and continue. The arrays are used through
+    :func:`core.jit.borrowed` views (no reference counting per sample).
     """
     p, s, c, seg = borrowed(p), borrowed(s), borrowed(c), borrowed(seg)
     t, y, out = borrowed(t), borrowed(y), borrowed(out)

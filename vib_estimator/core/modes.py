@@ -709,7 +709,8 @@ def _unpack(fs):
 def _run(fs, ic, qs, t, y, out, start):
     """Feed t[start:] until out may not hold another sample's estimates; returns the next index
     to feed (the batch path, and the streaming one over one sample: one compiled entry point).
-    The arrays are used :func:`core.jit.borrowed` (no reference counting per sample)."""
+    The arrays are used through :func:`core.jit.borrowed` views (no reference counting per
+    sample)."""
     fs, ic, qs, t, y, out = (
         borrowed(fs),
         borrowed(ic),
