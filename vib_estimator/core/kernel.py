@@ -319,7 +319,7 @@ def _newton_integrals(s, kmax, yoff, q):
         hp *= h
 
 
-@jit(inline='always')
+@jit
 def _interval_moments(s, kmax, a, h, npts):
     """Add to M_0..M_kmax the exact integral over the newest interval of s^k p(s).
 
