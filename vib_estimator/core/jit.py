@@ -14,11 +14,20 @@ function is compiled once per real signature.
 the right choice for a function called from one place: the caller's code is built and optimised
 once instead of once per level of the call tree (numba links each callee's code into its caller
 and optimises and emits the whole again).
+
+:func:`borrowed` takes reference counting out of the per-sample loops: numba increments and
+decrements the reference count of every array argument of every helper it inlines (numba #2345),
+and its pruning pass leaves those of a helper with branches or early returns. Each is an atomic
+operation behind an opaque call (LLVM then reloads the state from memory and spills its registers
+around it): the kernel's ``run`` had 191 calls, most of them these, on its per-sample path, and its
+batch rate went up 3.6x without them (docs/benchmarks.md, issue 24).
 """
 
 from __future__ import annotations
 
 from numba import njit, typeof, types
+from numba.core import cgutils
+from numba.extending import intrinsic
 
 
 def _plain(ty):
@@ -53,3 +62,21 @@ def entry(dispatcher, args):
     unboxes them. For a per-sample call with many array arguments that is a third of its cost.
     """
     return dispatcher.compile(tuple(typeof(a) for a in args))
+
+
+@intrinsic
+def borrowed(typingctx, array):
+    """``array`` without its reference count (a null meminfo): numba's increments and decrements
+    of it, and of every view of it, become a test of a null pointer.
+
+    For the compiled loops' own arguments only (:func:`core.kernel.run`, :func:`core.modes._run`):
+    the caller holds the arrays for the whole call, and no view of them outlives it.
+    """
+
+    def codegen(context, builder, signature, args):
+        view = context.make_array(signature.args[0])(context, builder, value=args[0])
+        view.meminfo = cgutils.get_null_value(view.meminfo.type)
+        view.parent = cgutils.get_null_value(view.parent.type)
+        return view._getvalue()
+
+    return array(array), codegen

@@ -60,7 +60,7 @@ from numba.core import types
 from numba.extending import overload
 
 from . import uncertainty as U
-from .jit import jit
+from .jit import borrowed, jit
 from .uncertainty import MODEL_BIASED, MODEL_DAMPED, MODEL_SINUSOID, TWO_PI
 
 # ---- parameter array layout (float64) -------------------------------------------------------
@@ -1139,8 +1139,11 @@ def run(p, s, c, seg, t, y, out, start, optional=None):
     :func:`step`).
 
     Returns (number of estimates written, index of the next sample to feed). Stops early when
-    ``out`` is full so the caller can grow it and continue.
+    ``out`` is full so the caller can grow it and continue. The arrays are used through
+    :func:`core.jit.borrowed` views (no reference counting per sample).
     """
+    p, s, c, seg = borrowed(p), borrowed(s), borrowed(c), borrowed(seg)
+    t, y, out = borrowed(t), borrowed(y), borrowed(out)
     n_out = 0
     i = start
     n = t.shape[0]

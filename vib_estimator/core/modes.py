@@ -71,7 +71,7 @@ from .ambient import AmbientEstimator
 from .auto import AutoEstimator
 from .config import EstimatorConfig
 from .estimator import COUNTER_NAMES, Estimate, EstimateArrays, FrequencyEstimator, as_series
-from .jit import jit
+from .jit import borrowed, jit
 from .kernel import BAND_DAMPING, advance, discretise
 from .subspace import N_R, R_AMP, R_ENERGY, R_NU, R_ZETA, analyse, init_subspace
 
@@ -708,7 +708,17 @@ def _unpack(fs):
 @jit
 def _run(fs, ic, qs, t, y, out, start):
     """Feed t[start:] until out may not hold another sample's estimates; returns the next index
-    to feed (the batch path, and the streaming one over one sample: one compiled entry point)."""
+    to feed (the batch path, and the streaming one over one sample: one compiled entry point).
+    The arrays are used through :func:`core.jit.borrowed` views (no reference counting per
+    sample)."""
+    fs, ic, qs, t, y, out = (
+        borrowed(fs),
+        borrowed(ic),
+        borrowed(qs),
+        borrowed(t),
+        borrowed(y),
+        borrowed(out),
+    )
     b, sl, pd, lams, pa = _unpack(fs)
     ic[I_NOUT] = 0
     i = start
