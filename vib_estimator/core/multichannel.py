@@ -251,7 +251,9 @@ def strong_joint(rows, shapes, stds, totals, fs, counts):
         dens = _densities(rows, fs)
         k = np.arange(len(rows))
         own = dens[k, k, :]  # modes x channels
-        ratio = own / (noise[None, :] + dens.sum(axis=1) - own)
+        rest = noise[None, :] + dens.sum(axis=1) - own
+        # a channel constant over the window (an IMU axis at rest) has no density: ratio 0
+        ratio = np.divide(own, rest, out=np.zeros_like(own), where=rest > 0)
         best = ratio.max(axis=1)
         if np.all(best >= MIN_PEAK_RATIO):
             return rows, shapes, stds, noise, np.argmax(ratio, axis=1)
