@@ -18,6 +18,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from vib_estimator import cli
+from vib_estimator.sim.ambient import ambient_record
 
 CELLS = st.one_of(
     st.floats(allow_nan=True, allow_infinity=True),
@@ -106,6 +107,31 @@ def test_no_estimate_says_why():
     why = [line for line in err.splitlines() if line.startswith('analyze: no estimate: ')]
     assert len(why) == 1 and 'never fired' in why[0] and 'damped-sinusoid' in why[0]
     assert 'open_segment_samples=4993' in err
+
+
+def test_a_constant_signal_in_operation_says_so():
+    """A constant column (an IMU axis at rest, an offset) through the output-only identifiers:
+    one channel, several, and a constant beside moving channels. The halvings of a constant
+    window hold only the filter's rounding: identified, it raised ZeroDivisionError (one
+    channel) or OverflowError (all channels), and one exactly-0 channel beside moving ones made
+    the joint identifier publish nothing."""
+    t, moving, _ = ambient_record(60, 100, [(3.0, 0.01, 1.0)], 25, 4)
+    table = np.column_stack([t, np.zeros_like(t), np.full_like(t, 9.81), moving, 0.5 * moving])
+    text = 't,zero,offset,a,b\n' + ''.join(
+        ','.join(repr(v) for v in row) + '\n' for row in table.tolist()
+    )
+    for columns in (['--column', 'offset'], ['--column', 'zero'], ['--columns', 'zero,offset']):
+        code, out, err = analyze(text.encode(), *columns, '--excitation', 'ambient')
+        assert code == 0 and out == '' and 'Traceback' not in err
+        assert 'flat_windows=' in err and 'estimates=0' in err
+        if columns[0] == '--column':
+            assert 'no estimate: the signal is constant' in err
+    code, out, err = analyze(
+        text.encode(), '--columns', 'zero,a,b', '--excitation', 'ambient', '--format', 'jsonl'
+    )
+    rows = [json.loads(line) for line in out.splitlines()]
+    assert code == 0 and len(rows) >= 10
+    assert all(abs(r['frequency_hz'] / 3 - 1) < 0.05 and r['shape_zero'] == 0 for r in rows)
 
 
 def test_gaps_are_counted_in_analyze_and_survey_rows(tmp_path):

@@ -233,6 +233,22 @@ def json_row(row: dict) -> dict:
 
 def explain_no_estimate(counters, open_samples: Optional[int], config: EstimatorConfig) -> str:
     """Why a run gave no estimate, from its counters, and what to try."""
+    if counters.get('used', 0) == 0:
+        return 'no sample was usable (see the skipped_* counters)'
+    analyses, flat = counters.get('analyses', 0), counters.get('flat_windows', 0)
+    if analyses and flat == analyses:
+        return f'the signal is constant (every window analysed was flat: flat_windows={flat})'
+    if config.excitation == 'ambient':
+        if not analyses:
+            return (
+                f'the record is shorter than one window (--ambient-window-s '
+                f'{config.ambient_window_s:g})'
+            )
+        return (
+            f'no mode stood out of the noise, stable over the model orders and in consecutive '
+            f'windows, in {analyses} analyses: try --band-hz around the modes of interest or a '
+            'longer --ambient-window-s'
+        )
     held = {k: v for k, v in counters.items() if v and k.startswith('rejected_')}
     if held:
         return (
@@ -241,8 +257,6 @@ def explain_no_estimate(counters, open_samples: Optional[int], config: Estimator
             + '): check --min-fit, '
             '--max-damping, --min-amplitude, or the model (--model)'
         )
-    if counters.get('used', 0) == 0:
-        return 'no sample was usable (see the skipped_* counters)'
     text = 'the convergence test (Eqs. 16-17) never fired'
     if open_samples:
         text += f' (the last segment ran {open_samples} samples without converging'

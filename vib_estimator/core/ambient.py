@@ -36,7 +36,9 @@ Method, per analysis (every :data:`HOP_S` of input once ``ambient_window_s`` of 
    factor the mode's own estimates from non-overlapping earlier windows show it to be too small
    (variance across windows: :meth:`_Track.calibration`). SSI-cov attains this
    bound within the measured factor of ``benchmarks/bench_operation.py``; a mode whose relative
-   frequency std exceeds :data:`MAX_STD_REL` is too weak to tell (``rejected_uncertain``).
+   frequency std exceeds :data:`MAX_STD_REL` is too weak to tell (``rejected_uncertain``). A
+   window constant to rounding (:meth:`CorrelationCascade.flat`) holds no vibration: it is not
+   identified (``flat_windows``); its halvings would hold only the filter's rounding.
 4. **Identity over time** (stability across windows): each mode is matched to the nearest tracked
    mode within :data:`MATCH_TOL`; a new one publishes once seen by :data:`CONFIRM` consecutive
    analyses (``modes_found``); one unseen for a window is lost (``modes_lost``). With
@@ -101,6 +103,9 @@ TOP_NU = 0.4
 MIN_SAMPLES = 20 * BLOCK_ROWS
 #: two clusters closer than this (relative) are one mode
 MERGE_TOL = 0.02
+#: a window whose RMS is at most this fraction of its mean's magnitude is constant to rounding
+#: (float64 sums and filters of it carry ~1e-13 relative; a 24-bit ADC resolves 6e-8)
+FLAT_RMS_REL = 1e-12
 #: anti-alias filter of each halving of the rate: 8th order Butterworth at 0.45 of the Nyquist
 #: frequency (run forwards and backwards: no phase, gain 0.96 at the owned band's top edge;
 #: :func:`decimation_filter`)
@@ -112,6 +117,7 @@ COUNTER_NAMES = INPUT_COUNTERS + (
     'rejected_unstable',
     'rejected_weak',
     'rejected_uncertain',
+    'flat_windows',
     'modes_found',
     'modes_lost',
     'estimates',
@@ -558,6 +564,12 @@ class CorrelationCascade:
         """Each channel's variance over the window (at the input rate)."""
         return np.var(self.levels[0].window, axis=0)
 
+    def flat(self) -> np.ndarray:
+        """Each channel's window is constant to rounding: its RMS at most :data:`FLAT_RMS_REL`
+        of its mean's magnitude (exactly constant if the mean is 0)."""
+        w = self.levels[0].window
+        return np.var(w, axis=0) <= (FLAT_RMS_REL * np.mean(w, axis=0)) ** 2
+
     def samples(self, level: int) -> int:
         """Level ``level``'s window samples."""
         n = len(self.levels[0])
@@ -782,6 +794,9 @@ def identify(
 
     n = cascade.samples(0)
     total = float(cascade.variance()[0])
+    if cascade.flat()[0]:
+        counts['flat_windows'] += 1
+        return np.empty((0, 5)), total, total
     modes, noise = np.empty((0, 4)), total
     if search or top_hz <= 0:
         # the search: from the full rate down by halvings until a level finds a mode (a low

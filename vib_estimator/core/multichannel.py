@@ -277,7 +277,8 @@ def identify_joint(
     :data:`..ambient.TOP_NU`): (:class:`JointModes`, the summed variance)."""
     counts = dict.fromkeys(COUNTER_NAMES, 0) if counts is None else counts
     m = cascade.channels
-    totals = cascade.variance()
+    flat = cascade.flat()  # constant channels: no density (their halvings: rounding only)
+    totals = np.where(flat, 0.0, cascade.variance())
 
     def modes_at(level):
         r = cascade.correlations(level)
@@ -286,7 +287,10 @@ def identify_joint(
 
     found = (np.empty((0, 2 + m)), np.empty((0, m), complex), np.empty((0, m)))
     strong = (*found, totals, np.empty(0, dtype=int))
-    if search or top_hz <= 0:
+    if np.all(flat):  # nothing to identify
+        counts['flat_windows'] += 1
+        search, top_hz = False, 0.0
+    elif search or top_hz <= 0:
         level = 0
         while True:
             strong = modes_at(level)
