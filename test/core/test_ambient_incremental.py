@@ -111,3 +111,48 @@ def test_halved_windows_kept_across_analyses_equal_the_whole_windows(channels):
                 )
                 reads += 1
     assert reads > 100
+
+
+def test_halved_lag_products_kept_across_analyses_equal_the_batch_correlations():
+    # several channels: the halved levels' lag products are updated at the moved ends only;
+    # every read equals the FFT of the level's window, to rounding
+    rng = np.random.default_rng(3)
+    y = rng.standard_normal((50000, 3)) + 3.0
+    cascade = CorrelationCascade(26, 3)
+    pos, reads = 0, 0
+    for step in range(60):
+        k = int(rng.integers(1, 700)) if step % 7 == 3 else 500
+        cascade.push(y[pos : pos + k])
+        pos += k
+        cascade.keep_last(15000)
+        for level in (1, 2, 3):
+            if rng.random() < 0.8:
+                ref = correlation_matrices(cascade.window(level), 26)
+                got = cascade.correlations(level)
+                np.testing.assert_allclose(got, ref, rtol=0, atol=1e-11 * np.abs(ref).max())
+                reads += 1
+    assert reads > 100
+
+
+def test_flat_channels_of_several_from_the_lag_products():
+    # a channel constant over the window after a step (far from the products' offset), one at
+    # 0, one of gravity plus rounding-sized noise, one moving: the window's own test
+    rng = np.random.default_rng(4)
+    n = 6000
+    y = np.column_stack(
+        (
+            np.r_[np.full(n, 100.0), np.full(n, 3.0)],
+            np.zeros(2 * n),
+            9.81 + 1e-14 * rng.standard_normal(2 * n),
+            rng.standard_normal(2 * n),
+        )
+    )
+    cascade = CorrelationCascade(10, 4)
+    for i in range(0, 2 * n, 500):
+        cascade.push(y[i : i + 500])
+        cascade.keep_last(4000)
+    w = cascade.window(0)
+    expect = np.var(w, axis=0) <= (1e-12 * np.mean(w, axis=0)) ** 2
+    assert expect.tolist() == [True, True, True, False]
+    assert cascade.flat().tolist() == expect.tolist()
+    np.testing.assert_allclose(cascade.variance(), np.var(w, axis=0), rtol=1e-9, atol=1e-20)
