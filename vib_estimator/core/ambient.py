@@ -196,6 +196,15 @@ def _log_density_gradient(c: np.ndarray, modes, noise_var: float, dt: float):
     return total, np.array(grads) / total
 
 
+@functools.lru_cache(maxsize=16)
+def fourier_cosines(n: int) -> np.ndarray:
+    """``cos w_k`` of the Fourier frequencies ``w_k = 2 pi k / n``, 0 <= k < (n + 1) / 2, of
+    ``n`` samples (the windows' counts repeat from one analysis to the next)."""
+    out = np.cos(2 * math.pi * np.arange((n + 1) // 2) / n)
+    out.flags.writeable = False
+    return out
+
+
 def whittle_fisher(
     modes: Sequence[tuple[float, float, float]], noise_var: float, fs: float, n: int
 ) -> np.ndarray:
@@ -208,7 +217,7 @@ def whittle_fisher(
     precision) information on the noise level only, and are counted as such."""
     dt = 1.0 / fs
     bins = _active_bins(modes, noise_var, dt, n)
-    _, d = _log_density_gradient(np.cos(2 * math.pi * bins / n), modes, noise_var, dt)
+    _, d = _log_density_gradient(fourier_cosines(n)[bins], modes, noise_var, dt)
     fisher = d @ d.T
     fisher[-1, -1] += ((n + 1) // 2 - 1 - len(bins)) / noise_var**2
     return fisher
