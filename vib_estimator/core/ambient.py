@@ -15,7 +15,8 @@ Method, per analysis (every :data:`HOP_S` of input once ``ambient_window_s`` of 
 1. **Covariance-driven stochastic subspace identification** (SSI-cov; Peeters & De Roeck 1999) of
    the last ``ambient_window_s`` seconds: the output correlations ``R_k`` (k = 0 .. 2 p,
    unbiased; at the input rate kept up to date as samples arrive, at a halved rate from the
-   window's halving, whose unmoved middle is kept: :class:`CorrelationCascade`), their block
+   window's halving, whose unmoved middle is kept, with several channels its lag products too:
+   :class:`CorrelationCascade`, :class:`EditedProducts`), their block
    Hankel matrix ``H = [R_{i+j+1}]`` (p = :data:`BLOCK_ROWS` rows), its
    SVD ``H = U S V^T``; at each model order n = :data:`ORDERS` the observability matrix
    ``O = U_n S_n^1/2``, the state matrix ``A = O_up^+ O_down`` and the output/next-state
@@ -579,7 +580,10 @@ class CorrelationCascade:
     samples of them, so
     its middle is kept from the previous analysis and only the stretches near the ends that
     moved are filtered again (the same numbers, to rounding, as :func:`halve` of the whole
-    window: ``test/core/test_ambient_incremental.py``)."""
+    window: ``test/core/test_ambient_incremental.py``). With several channels a halved window's
+    correlations come from its lag products, kept across analyses (:class:`EditedProducts`),
+    and the window's variance from the input rate's (``R_0``); with one, from the FFT of the
+    window and from the window (as before, bit for bit)."""
 
     def __init__(self, lags: int, channels: int):
         self.lags, self.channels = lags, channels
