@@ -141,37 +141,19 @@ def sdof_psd(
     return _sdof_psd(np.cos(np.asarray(w, dtype=np.float64)), frequency_hz, zeta, variance, dt)
 
 
-def _sdof_coefficients(frequency_hz: float, zeta: float, variance: float, dt: float):
-    """The scalars of :func:`_sdof_psd`'s closed form: ``(1 + z^2, 2 z, a (1 - z^2))`` as
-    (real, imaginary) pairs."""
+def _sdof_psd(
+    c: np.ndarray, frequency_hz: float, zeta: float, variance: float, dt: float
+) -> np.ndarray:
+    """:func:`sdof_psd` at ``c = cos w``, in real arithmetic."""
     wn = 2 * math.pi * frequency_hz * dt
     root = math.sqrt(max(1.0 - zeta * zeta, 1e-12))
     decay = math.exp(-zeta * wn)
     z = complex(decay * math.cos(wn * root), decay * math.sin(wn * root))
     num = variance * complex(1.0, -zeta / root) * (1.0 - z * z)
     zz = 1.0 + z * z
-    return zz.real, 2.0 * z.real, zz.imag, 2.0 * z.imag, num.real, num.imag
-
-
-def _sdof_psd(
-    c: np.ndarray, frequency_hz: float, zeta: float, variance: float, dt: float
-) -> np.ndarray:
-    """:func:`sdof_psd` at ``c = cos w``, in real arithmetic."""
-    zr, z2r, zi, z2i, nr, ni = _sdof_coefficients(frequency_hz, zeta, variance, dt)
-    dr = zr - z2r * c
-    di = zi - z2i * c
-    return (nr * dr + ni * di) / (dr * dr + di * di)
-
-
-def _sdof_psd_rows(c: np.ndarray, params, dt: float) -> np.ndarray:
-    """:func:`_sdof_psd` at ``c`` of each (frequency, damping, variance) of ``params``, a row
-    each, in one pass (the same numbers)."""
-    zr, z2r, zi, z2i, nr, ni = (
-        np.array(x)[:, None] for x in zip(*(_sdof_coefficients(*p, dt) for p in params))
-    )
-    dr = zr - z2r * c
-    di = zi - z2i * c
-    return (nr * dr + ni * di) / (dr * dr + di * di)
+    dr = zz.real - 2.0 * z.real * c
+    di = zz.imag - 2.0 * z.imag * c
+    return (num.real * dr + num.imag * di) / (dr * dr + di * di)
 
 
 def peak_ratio(
@@ -198,26 +180,21 @@ def _active_bins(modes, noise_var: float, dt: float, n: int) -> np.ndarray:
 def _log_density_gradient(c: np.ndarray, modes, noise_var: float, dt: float):
     """The model's density ``S`` at ``c = cos w`` and the gradient of ``ln S`` with respect
     to (f, zeta, variance of each mode, the noise variance), one row each."""
-    params = []
-    for f, z, v in modes:  # the mode, then f and zeta moved by -+ 1e-6 of themselves
-        params.append((f, z, v))
+    density = _sdof_psd
+    parts = [density(c, f, z, v, dt) for f, z, v in modes]
+    total = noise_var + (np.sum(parts, axis=0) if parts else 0.0)
+    grads = []
+    for (f, z, v), part in zip(modes, parts):
         for i, x in enumerate((f, z)):
             h = 1e-6 * x
-            for sign in (1, -1):
-                p = [f, z, v]
-                p[i] = x + h if sign > 0 else x - h
-                params.append(tuple(p))
-    dens = _sdof_psd_rows(c, params, dt) if modes else np.empty((0, len(c)))
-    parts = dens[::5]
-    total = noise_var + (np.sum(parts, axis=0) if len(modes) else 0.0)
-    grads = np.empty((3 * len(modes) + 1, len(c)))
-    for j, (f, z, v) in enumerate(modes):
-        for i, x in enumerate((f, z)):
-            h = 1e-6 * x
-            grads[3 * j + i] = (dens[5 * j + 1 + 2 * i] - dens[5 * j + 2 + 2 * i]) / (2 * h)
-        grads[3 * j + 2] = parts[j] / v
-    grads[-1] = 1.0
-    return total, grads / total
+            hi = [f, z, v]
+            lo = [f, z, v]
+            hi[i] += h
+            lo[i] -= h
+            grads.append((density(c, *hi, dt) - density(c, *lo, dt)) / (2 * h))
+        grads.append(part / v)
+    grads.append(np.ones(len(c)))
+    return total, np.array(grads) / total
 
 
 @functools.lru_cache(maxsize=16)
