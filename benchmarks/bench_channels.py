@@ -19,8 +19,9 @@
 4. Cost: 8 channels at 500 Hz (4 modes 3-40 Hz, 120 s, window 30 s) as multiples of real time
    (record seconds per CPU second, each identifier warmed up first) beside one channel of the
    same record through the single-channel identifier, same run (with ``--ref REV``: beside
-   revision REV's, ``reference_cost``); and 6 channels at 1 kHz fed as a node would, 1 s blocks (``process``) and sample by sample (``update``): multiples of real
-   time and the slowest block / sample (an analysis), CPU time.
+   revision REV's, ``reference_cost``); and 6 channels at 1 kHz fed as a node would, 1 s
+   blocks (``process``) and sample by sample (``update``): multiples of real time and the
+   slowest block / sample (an analysis), CPU time.
 """
 
 from __future__ import annotations
