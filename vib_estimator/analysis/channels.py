@@ -53,13 +53,14 @@ def component_names(args) -> list[str]:
     return names
 
 
-def read_channels(args, names, strict: bool = False):
-    """``(t, Y, names, signal)``: the channels of the input (CSV ``--columns``: ``signal`` None;
-    a bag's ``--components``: its :class:`..io.streaming.Signal`, read whole)."""
-    if is_csv(args.input):
-        t, y, names = read_csv_columns(args.input, ','.join(names))
+def read_channels(path, topic, names, strict: bool = False, info=None):
+    """``(t, Y, names, signal)``: the channels ``names`` of the recording ``path`` (CSV
+    columns: ``signal`` None; the fields of a bag's ``topic``: its
+    :class:`..io.streaming.Signal`, read whole; ``info``: the bag's metadata, if read)."""
+    if is_csv(path):
+        t, y, names = read_csv_columns(path, ','.join(names))
         return t, y, names, None
-    signal = open_signal(args.input, args.topic, strict=strict, components=names)
+    signal = open_signal(path, topic, strict=strict, components=names, info=info)
     blocks = [(t, y) for t, y in signal.blocks() if len(t)]
     if not blocks:
         raise ValueError(f'topic {signal.topic} of {signal.path} has no messages')
@@ -189,7 +190,9 @@ def run_joint(args, config: EstimatorConfig, names, json_row, prog: str, warn=No
     with their shapes on stdout, the counters and the summary on stderr, ``--plot``; ``warn``
     (signal, prog) says what a bag's read skipped. Bad input raises (CsvError, BagError,
     ValueError) before anything is printed."""
-    t, y, names, signal = read_channels(args, names, getattr(args, 'strict', False))
+    t, y, names, signal = read_channels(
+        args.input, args.topic, names, getattr(args, 'strict', False)
+    )
     estimator, result = joint_run(t, y, names, config)
     table = rows(result)
     extra = ''

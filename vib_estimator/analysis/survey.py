@@ -9,7 +9,11 @@ written per recording x topic x component (x mode with ``--modes``): first stamp
 duration, samples, estimates, the frequency and damping ratio with their 95 % intervals (by
 default the weighted mean of the estimates, the interval from their stds and their scatter,
 correlated estimates counted as such: :mod:`.interval`; ``--summary median``: the median and its
-distribution-free interval), the median amplitude, and the estimator's counters.
+distribution-free interval), the median amplitude, and the estimator's counters. Several
+channels (``--columns a,b,c|all`` of a CSV recording, ``--components x,y,z`` of a bag topic;
+``excitation ambient``): one joint identification per recording (:mod:`.channels`), its rows
+per mode with each channel's median shape, the median MAC and, against a baseline,
+``mac_to_baseline``.
 
 Health monitoring: against ``--baseline`` (a recording, whose rows are matched by topic,
 component and mode, or a frequency in Hz), a row is flagged (``alarm``) when the relative change
@@ -53,10 +57,13 @@ from typing import Dict, Iterable, List, Optional, Sequence, Tuple
 import numpy as np
 
 from ..core import COUNTER_NAMES, EstimatorConfig
+from ..core.multichannel import mac
 from ..errors import VibEstimatorError, report
+from ..io.csv_reader import column_names
 from ..io.fields import DEFAULT_COMPONENT, check_component
 from ..io.streaming import BagInfo, bag_info, is_csv, open_signal, supported_topics
-from .analyze import add_config_arguments, estimate_signal, make_config
+from .analyze import Run, add_config_arguments, estimate_signal, make_config
+from .channels import joint_run, mode_shapes, read_channels
 from .interval import combine
 from .outputs import check_output
 
@@ -122,6 +129,11 @@ class Options:
     strict: bool = False
     #: how a recording's estimates are summarised (:data:`SUMMARIES`)
     summary: str = SUMMARIES[0]
+    #: ``--columns``: a CSV recording's channels (names or indices, comma-separated, or
+    #: ``all``), identified jointly when two or more
+    columns: Optional[str] = None
+    #: ``--components``: two or more fields of a bag topic, identified jointly
+    joint_components: Tuple[str, ...] = ()
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -144,7 +156,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help='component to read (repeatable; each topic takes those valid for its '
         "type; default: the type's default)",
     )
+    parser.add_argument(
+        '--components',
+        help='several fields of each bag topic, comma-separated: one set of modes with their '
+        'shapes per recording (needs --excitation ambient; docs/survey.md)',
+    )
     parser.add_argument('--column', help='CSV signal column (default: the second)')
+    parser.add_argument(
+        '--columns',
+        help='several CSV signal columns, comma-separated names or indices, or all: one set of '
+        'modes with their shapes per recording (needs --excitation ambient; docs/survey.md)',
+    )
     add_config_arguments(parser, DEFAULT_MODEL)
     parser.add_argument(
         '--summary',
@@ -305,42 +327,81 @@ def summarise(est, take: np.ndarray, summary: str = SUMMARIES[0]) -> Dict:
     return fields
 
 
-def _stat_rows(recording: Path, signal, result, modes: int, summary: str) -> List[Dict]:
-    """The rows of one streamed signal: one, or one per mode."""
+def _stat_rows(
+    recording: Path, signal, result, modes: int, summary: str, joint=None, component=None
+) -> List[Dict]:
+    """The rows of one streamed signal: one, or one per mode. ``joint``: the
+    :class:`..core.multichannel.JointEstimates` of a joint run (``signal`` None for CSV
+    columns), whose rows gain the shape fields (:func:`mode_shape_fields`) and are named
+    ``component`` (the channels, comma-separated)."""
     est = result.estimates
-    start = signal.origin_ns * 1e-9 if signal.origin_ns is not None else result.first_t
+    origin = None if signal is None else signal.origin_ns
+    start = origin * 1e-9 if origin is not None else result.first_t
+    shapes = {} if joint is None else mode_shapes(joint)
     rows = []
     modes = modes or int(est.mode.max(initial=0))  # excitation ambient numbers its modes
     for mode in range(1, modes + 1) if modes else [0]:
         take = est.mode == mode
-        counters = (
-            result.estimator.mode_counters().get(mode, {}) if modes else result.estimator.counters
-        )
+        if not modes:
+            counters = result.estimator.counters
+        elif joint is None:
+            counters = result.estimator.mode_counters().get(mode, {})
+        else:
+            counters = {}  # as a one-channel ambient run's: the mode's estimates only
         rows.append(
             _row(
                 recording,
-                signal.topic,
-                signal.component or signal.label,
+                '' if signal is None else signal.topic,
+                component or signal.component or signal.label,
                 mode,
                 start_utc=_iso(start),
                 duration_s=result.last_t - result.first_t,
                 samples=result.estimator.counters['received'],
                 estimates=int(take.sum()),
-                messages_without_component=signal.skipped,
-                corrupt_records=signal.corrupt,
+                messages_without_component=0 if signal is None else signal.skipped,
+                corrupt_records=0 if signal is None else signal.corrupt,
                 **summarise(est, take, summary),
                 **{c: counters.get(c, 0) for c in _COUNTERS},
+                **({} if joint is None else mode_shape_fields(joint, take, shapes.get(mode))),
             )
         )
     return rows
 
 
-def _targets(
-    path: Path, options: Options
-) -> Tuple[List[Tuple[Optional[str], Optional[str]]], Optional[BagInfo]]:
-    """(topic, component) pairs to read from a recording, and the bag's metadata (read once)."""
+def mode_shape_fields(joint, take: np.ndarray, shape) -> Dict:
+    """A joint run's mode fields: per channel ``<name>``, ``shape_<name>`` and
+    ``shape_std_<name>`` (the medians over the mode's estimates ``take``, as ``analyze``'s
+    :func:`.channels.mode_shapes`), and ``mac``, the median MAC of consecutive estimates (NaN
+    for a mode without any, or estimated once)."""
+    amp, std = (np.full(len(joint.channels), math.nan),) * 2 if shape is None else shape[1:]
+    macs = joint.mac[take]
+    macs = macs[np.isfinite(macs)]
+    fields = {f'shape_{n}': float(a) for n, a in zip(joint.channels, amp)}
+    fields.update({f'shape_std_{n}': float(s) for n, s in zip(joint.channels, std)})
+    fields['mac'] = float(np.median(macs)) if macs.size else math.nan
+    return fields
+
+
+def row_shape(row: Dict) -> Optional[np.ndarray]:
+    """The median shape of a joint run's row (:func:`mode_shape_fields`), None for other rows."""
+    names = row['component'].split(',')
+    keys = [f'shape_{n}' for n in names]
+    if len(names) < 2 or not all(k in row for k in keys):
+        return None
+    shape = np.array([row[k] for k in keys], dtype=np.float64)
+    return shape if np.isfinite(shape).all() else None
+
+
+Target = Tuple[Optional[str], Optional[str], Tuple[str, ...]]
+
+
+def _targets(path: Path, options: Options) -> Tuple[List[Target], Optional[BagInfo]]:
+    """(topic, component, channels) to read from a recording (``channels``: two or more, read
+    jointly; a CSV file's one ``--columns`` column; else none), and the bag's metadata (read
+    once)."""
     if is_csv(path):
-        return [(None, None)], None
+        names = () if options.columns is None else tuple(column_names(path, options.columns))
+        return [(None, None, names)], None
     info = bag_info(path)
     topics = info.topics
     chosen = (
@@ -350,6 +411,8 @@ def _targets(
     )
     if not chosen:
         open_signal(path, info=info)  # raises the error naming the bag's topics
+    if options.joint_components:
+        return _joint_targets(path, chosen, options), info
     pairs = []
     for topic, kind in sorted(chosen.items()):
         valid = [c for c in options.components if _valid(c, kind)]
@@ -358,8 +421,25 @@ def _targets(
         for component in valid or [
             options.components[0] if options.components else DEFAULT_COMPONENT.get(kind)
         ]:
-            pairs.append((topic, component))
+            pairs.append((topic, component, ()))
     return pairs, info
+
+
+def _joint_targets(path: Path, chosen: Dict[str, str], options: Options) -> List[Target]:
+    """The topics whose type has every ``--components`` field (with ``--topic``: those
+    topics, an invalid field being their error row); ValueError if none has."""
+    names = options.joint_components
+    targets = [
+        (topic, None, names)
+        for topic, kind in sorted(chosen.items())
+        if options.topics or all(_valid(c, kind) for c in names)
+    ]
+    if not targets:
+        raise ValueError(
+            f'no topic of {path} has the fields {",".join(names)} (topics: '
+            f'{", ".join(f"{t} ({k})" for t, k in sorted(chosen.items()))})'
+        )
+    return targets
 
 
 def _valid(component: str, kind: str) -> bool:
@@ -420,9 +500,13 @@ def _recording_rows(path: Path, options: Options) -> List[Dict]:
     except Exception as err:  # noqa: BLE001 -- a bad recording is a row, not the end of the survey
         return [_error_row(path, '', '', err)]
     rows: List[Dict] = []
-    for topic, component in targets:
+    for topic, component, channels in targets:
         try:
-            signal = open_signal(path, topic, component, options.column, options.strict, info=info)
+            if len(channels) > 1:
+                rows.extend(_joint_recording_rows(path, topic, channels, options, info))
+                continue
+            column = channels[0] if channels else options.column
+            signal = open_signal(path, topic, component, column, options.strict, info=info)
             rows.extend(
                 _stat_rows(
                     path,
@@ -433,8 +517,19 @@ def _recording_rows(path: Path, options: Options) -> List[Dict]:
                 )
             )
         except Exception as err:  # noqa: BLE001 -- as above
-            rows.append(_error_row(path, topic or '', component or '', err))
+            rows.append(_error_row(path, topic or '', component or ','.join(channels), err))
     return rows
+
+
+def _joint_recording_rows(path, topic, names, options: Options, info) -> List[Dict]:
+    """The rows of a joint identification of the channels ``names`` of one recording."""
+    t, y, names, signal = read_channels(path, topic, names, options.strict, info)
+    if not len(t):
+        raise ValueError(f'{path} holds no samples')
+    estimator, joint = joint_run(t, y, names, options.config)
+    result = Run(estimator, joint.estimates, float(t[0]), float(t[-1]), None)
+    modes = options.config.modes
+    return _stat_rows(path, signal, result, modes, options.summary, joint, ','.join(names))
 
 
 def _error_row(path: Path, topic: str, component: str, err: BaseException) -> Dict:
@@ -526,9 +621,10 @@ def _key(row: Dict) -> Tuple[str, str, int]:
     return row['topic'], row['component'], row['mode']
 
 
-def baseline_rows(baseline: str, options: Options) -> Dict[Tuple, Tuple[float, float, float]]:
-    """{(topic, component, mode) or None: (median, lo, hi)} of ``--baseline``; a number is one
-    exact frequency for every row. ValueError if the baseline gives no frequency."""
+def baseline_rows(baseline: str, options: Options) -> Dict[Tuple, Tuple]:
+    """{(topic, component, mode) or None: (median, lo, hi, shape)} of ``--baseline`` (``shape``:
+    a joint run's median mode shape, :func:`row_shape`, else None); a number is one exact
+    frequency for every row. ValueError if the baseline gives no frequency."""
     try:
         hz = float(baseline)
     except ValueError:
@@ -536,7 +632,7 @@ def baseline_rows(baseline: str, options: Options) -> Dict[Tuple, Tuple[float, f
     if hz is not None:
         if not hz > 0:
             raise ValueError(f'--baseline frequency must be > 0 Hz, got {baseline}')
-        return {None: (hz, hz, hz)}
+        return {None: (hz, hz, hz, None)}
     if not Path(baseline).exists():
         raise ValueError(f'--baseline {baseline!r} is neither a frequency (Hz) nor a recording')
     rows = [
@@ -547,7 +643,8 @@ def baseline_rows(baseline: str, options: Options) -> Dict[Tuple, Tuple[float, f
     if not rows:
         raise ValueError(f'baseline {baseline} gives no frequency estimate')
     table = {
-        _key(r): (r['frequency_hz'], r['frequency_lo_hz'], r['frequency_hi_hz']) for r in rows
+        _key(r): (r['frequency_hz'], r['frequency_lo_hz'], r['frequency_hi_hz'], row_shape(r))
+        for r in rows
     }
     if len(rows) == 1:
         table[None] = next(iter(table.values()))
@@ -555,12 +652,17 @@ def baseline_rows(baseline: str, options: Options) -> Dict[Tuple, Tuple[float, f
 
 
 def flag(rows: List[Dict], base: Dict, alarm_rel: float) -> None:
-    """Set the change columns and ``alarm`` of every row against the baseline ``base``."""
+    """Set the change columns and ``alarm`` of every row against the baseline ``base``; a
+    joint run's row matched to a baseline row with a shape also ``mac_to_baseline`` (the MAC of
+    the two median shapes; no alarm)."""
     for row in rows:
         ref = base.get(_key(row), base.get(None))
         if ref is None or row['error']:
             continue
-        f0, lo0, hi0 = ref
+        f0, lo0, hi0, shape0 = ref
+        shape = row_shape(row)
+        if shape0 is not None and 'mac' in row and _key(row) in base:  # the same channels
+            row['mac_to_baseline'] = math.nan if shape is None else mac(shape, shape0)
         row['change_rel'] = row['frequency_hz'] / f0 - 1
         row['change_lo'] = row['frequency_lo_hz'] / hi0 - 1
         row['change_hi'] = row['frequency_hi_hz'] / lo0 - 1
@@ -577,6 +679,13 @@ def _plain(value):
     return value.item() if isinstance(value, np.generic) else value
 
 
+def row_columns(rows: List[Dict]) -> Tuple[str, ...]:
+    """:data:`COLUMNS`, then the fields only some rows have (a joint run's shapes, ``mac``,
+    ``mac_to_baseline``) in the order they first appear."""
+    extra = dict.fromkeys(k for row in rows for k in row if k not in COLUMNS)
+    return COLUMNS + tuple(extra)
+
+
 def write_rows(rows: List[Dict], fmt: str, out) -> None:
     """Rows as ``table``, ``csv`` or ``jsonl`` text on the stream ``out``."""
     if fmt == 'jsonl':
@@ -585,9 +694,11 @@ def write_rows(rows: List[Dict], fmt: str, out) -> None:
     elif fmt == 'csv':
         import csv
 
+        columns = row_columns(rows)
         writer = csv.writer(out, lineterminator='\n')
-        writer.writerow(COLUMNS)
+        writer.writerow(columns)
         for row in rows:
+            row = {**dict.fromkeys(columns, math.nan), **row}
             writer.writerow(
                 [
                     ''
@@ -595,7 +706,7 @@ def write_rows(rows: List[Dict], fmt: str, out) -> None:
                     else repr(_plain(row[k]))
                     if isinstance(row[k], float)
                     else row[k]
-                    for k in COLUMNS
+                    for k in columns
                 ]
             )
     else:
@@ -614,8 +725,18 @@ def write_rows(rows: List[Dict], fmt: str, out) -> None:
                 f'{r["samples"]:9d} {r["estimates"]:5d} {r["frequency_hz"]:10.5f} '
                 f'[{r["frequency_lo_hz"]:9.5f},{r["frequency_hi_hz"]:9.5f}] '
                 f'{r["damping"]:8.5f} {r["change_rel"]:+8.2%} '
-                f'{"ALARM" if r["alarm"] else ""}\n'
+                f'{"ALARM" if r["alarm"] else ""}{_shape_text(r)}\n'
             )
+
+
+def _shape_text(row: Dict) -> str:
+    """A joint run's row in the table: its median MAC (and to the baseline) and shape."""
+    if 'mac' not in row:
+        return ''
+    names = row['component'].split(',')
+    shape = ' '.join(f'{row[f"shape_{n}"]:+.2f}' for n in names)
+    base = f' base {row["mac_to_baseline"]:.3f}' if 'mac_to_baseline' in row else ''
+    return f' MAC {row["mac"]:.3f}{base} shape {shape}'
 
 
 def _short(name: str, width: int = 28) -> str:
@@ -629,7 +750,9 @@ def write_file(rows: List[Dict], path: Path) -> None:
         import pyarrow as pa
         import pyarrow.parquet as pq
 
-        pq.write_table(pa.Table.from_pylist(rows), path)
+        columns = row_columns(rows)
+        full = [{**dict.fromkeys(columns, math.nan), **row} for row in rows]
+        pq.write_table(pa.Table.from_pylist(full), path)
         return
     with path.open('w', newline='') as handle:
         write_rows(rows, 'csv' if path.suffix == '.csv' else 'jsonl', handle)
@@ -747,14 +870,52 @@ def _options(args: argparse.Namespace) -> Options:
     config = make_config(args)
     if args.model is None and not args.paper:
         config = config.replace(model=DEFAULT_MODEL)
+    column, columns = args.column, args.columns
+    if columns is not None:
+        if column is not None:
+            raise ValueError('give --column or --columns, not both')
+        items = _channel_list('--columns', columns)
+        if len(items) == 1 and items[0] != 'all':
+            column, columns = items[0], None  # one column: exactly --column
+        else:
+            _need_ambient(f'--columns {columns}', config)
+    components, joint = tuple(args.component), ()
+    if args.components is not None:
+        if components:
+            raise ValueError('give --component or --components, not both')
+        joint = _channel_list('--components', args.components)
+        if len(joint) == 1:
+            components, joint = joint, ()  # one component: exactly --component
+        else:
+            _need_ambient(f'{len(joint)} components', config)
     return Options(
         config,
         tuple(args.topic),
-        tuple(args.component),
-        args.column,
+        components,
+        column,
         args.strict,
         args.summary,
+        columns,
+        joint,
     )
+
+
+def _channel_list(option: str, text: str) -> Tuple[str, ...]:
+    """The comma-separated names of ``option`` (ValueError for an empty or repeated one)."""
+    names = tuple(n.strip() for n in text.split(','))
+    if not all(names):
+        raise ValueError(f'{option} {text!r} has an empty field')
+    if len(set(names)) < len(names):
+        raise ValueError(f'{option} {text!r} names a channel twice')
+    return names
+
+
+def _need_ambient(what: str, config: EstimatorConfig) -> None:
+    if config.excitation != 'ambient':
+        raise ValueError(
+            f'{what} need --excitation ambient (the joint identification); '
+            'free decays take one --column or --component'
+        )
 
 
 def run(args: argparse.Namespace) -> int:
