@@ -92,7 +92,8 @@ def test_sdof_density_in_real_arithmetic_is_the_complex_closed_form():
 @pytest.mark.parametrize('channels', [1, 2])
 def test_halved_windows_kept_across_analyses_equal_the_whole_windows(channels):
     # pushes of a second or so (odd counts too: the halved grids move), slides, reads of every
-    # level: each equals halve() applied to the window from scratch, to rounding
+    # level: each equals halve() applied to the window from scratch, to rounding, and so do its
+    # correlations (several channels: from the lag products updated at the moved ends)
     rng = np.random.default_rng(10 + channels)
     y = rng.standard_normal((60000, channels)) + 3.0
     cascade = CorrelationCascade(16, channels)
@@ -109,5 +110,33 @@ def test_halved_windows_kept_across_analyses_equal_the_whole_windows(channels):
                 np.testing.assert_allclose(
                     cascade.window(level), ref, rtol=0, atol=1e-12 * np.abs(ref).max()
                 )
+                r = correlation_matrices(ref, 16)
+                np.testing.assert_allclose(
+                    cascade.correlations(level), r, rtol=0, atol=1e-11 * np.abs(r).max()
+                )
                 reads += 1
     assert reads > 100
+
+
+def test_flat_channels_of_several_from_the_lag_products():
+    # a channel constant over the window after a step (far from the products' offset), one at
+    # 0, one of gravity plus rounding-sized noise, one moving: the window's own test
+    rng = np.random.default_rng(4)
+    n = 6000
+    y = np.column_stack(
+        (
+            np.r_[np.full(n, 100.0), np.full(n, 3.0)],
+            np.zeros(2 * n),
+            9.81 + 1e-14 * rng.standard_normal(2 * n),
+            rng.standard_normal(2 * n),
+        )
+    )
+    cascade = CorrelationCascade(10, 4)
+    for i in range(0, 2 * n, 500):
+        cascade.push(y[i : i + 500])
+        cascade.keep_last(4000)
+    w = cascade.window(0)
+    expect = np.var(w, axis=0) <= (1e-12 * np.mean(w, axis=0)) ** 2
+    assert expect.tolist() == [True, True, True, False]
+    assert cascade.flat().tolist() == expect.tolist()
+    np.testing.assert_allclose(cascade.variance(), np.var(w, axis=0), rtol=1e-9, atol=1e-20)

@@ -15,7 +15,8 @@ Method, per analysis (every :data:`HOP_S` of input once ``ambient_window_s`` of 
 1. **Covariance-driven stochastic subspace identification** (SSI-cov; Peeters & De Roeck 1999) of
    the last ``ambient_window_s`` seconds: the output correlations ``R_k`` (k = 0 .. 2 p,
    unbiased; at the input rate kept up to date as samples arrive, at a halved rate from the
-   window's halving, whose unmoved middle is kept: :class:`CorrelationCascade`), their block
+   window's halving, whose unmoved middle is kept, with several channels its lag products too:
+   :class:`CorrelationCascade`, :class:`EditedProducts`), their block
    Hankel matrix ``H = [R_{i+j+1}]`` (p = :data:`BLOCK_ROWS` rows), its
    SVD ``H = U S V^T``; at each model order n = :data:`ORDERS` the observability matrix
    ``O = U_n S_n^1/2``, the state matrix ``A = O_up^+ O_down`` and the output/next-state
@@ -110,6 +111,10 @@ FLAT_RMS_REL = 1e-12
 #: frequency (run forwards and backwards: no phase, gain 0.96 at the owned band's top edge;
 #: :func:`decimation_filter`)
 DECIMATE_ORDER, DECIMATE_CUTOFF = 8, 0.45
+#: a channel whose variance from the lag products is at most this fraction of its samples'
+#: squared distance from zero or the products' offset may be flat: its window is read
+#: (:meth:`CorrelationCascade.flat`; far above those products' rounding)
+FLAT_SUSPECT = 1e-6
 
 COUNTER_NAMES = INPUT_COUNTERS + (
     'analyses',
@@ -192,6 +197,15 @@ def _log_density_gradient(c: np.ndarray, modes, noise_var: float, dt: float):
     return total, np.array(grads) / total
 
 
+@functools.lru_cache(maxsize=16)
+def fourier_cosines(n: int) -> np.ndarray:
+    """``cos w_k`` of the Fourier frequencies ``w_k = 2 pi k / n``, 0 <= k < (n + 1) / 2, of
+    ``n`` samples (the windows' counts repeat from one analysis to the next)."""
+    out = np.cos(2 * math.pi * np.arange((n + 1) // 2) / n)
+    out.flags.writeable = False
+    return out
+
+
 def whittle_fisher(
     modes: Sequence[tuple[float, float, float]], noise_var: float, fs: float, n: int
 ) -> np.ndarray:
@@ -204,7 +218,7 @@ def whittle_fisher(
     precision) information on the noise level only, and are counted as such."""
     dt = 1.0 / fs
     bins = _active_bins(modes, noise_var, dt, n)
-    _, d = _log_density_gradient(np.cos(2 * math.pi * bins / n), modes, noise_var, dt)
+    _, d = _log_density_gradient(fourier_cosines(n)[bins], modes, noise_var, dt)
     fisher = d @ d.T
     fisher[-1, -1] += ((n + 1) // 2 - 1 - len(bins)) / noise_var**2
     return fisher
@@ -299,6 +313,67 @@ def correlation_matrices(y: np.ndarray, lags: int) -> np.ndarray:
     return r / np.arange(n, n - lags - 1, -1)[:, None, None]
 
 
+def later_products(y, a, b, lo, off, sums, total, subtract=False) -> None:
+    """Add to ``sums`` (lag k, channel a, channel b) the products ``x[t] x[t - k]^T`` of the
+    rows ``x = y - off`` for a <= t < b and lo <= t - k (k = 0 .. ``len(sums) - 1``), to
+    ``total`` the rows a <= t < b (both subtracted instead with ``subtract``)."""
+    lags, m = len(sums) - 1, y.shape[1]
+    for a0 in range(a, b, PRODUCT_BLOCK):
+        b0 = min(b, a0 + PRODUCT_BLOCK)
+        lo0 = max(lo, a0 - lags)
+        ext = np.zeros((b0 - a0 + lags, m))
+        ext[lags - (a0 - lo0) :] = y[lo0:b0] - off
+        new = ext[lags:]
+        view = np.lib.stride_tricks.sliding_window_view(ext, lags + 1, axis=0)
+        # view[i, :, q] = ext[i + q] = y[a0 + i - (lags - q)]: lag k = lags - q
+        prod = np.tensordot(new, view, axes=(0, 0))  # (a, b, q)
+        if subtract:
+            sums -= prod[:, :, ::-1].transpose(2, 0, 1)
+            total -= new.sum(axis=0)
+        else:
+            sums += prod[:, :, ::-1].transpose(2, 0, 1)
+            total += new.sum(axis=0)
+
+
+def earlier_products(y, c, d, hi, off, sums, total, subtract=False) -> None:
+    """Add to ``sums`` the products ``x[u + k] x[u]^T`` of the rows ``x = y - off`` for
+    c <= u < d and u + k < hi, to ``total`` the rows c <= u < d (subtracted with
+    ``subtract``)."""
+    lags, m = len(sums) - 1, y.shape[1]
+    for c0 in range(c, d, PRODUCT_BLOCK):
+        d0 = min(d, c0 + PRODUCT_BLOCK)
+        hi0 = min(hi, d0 + lags)
+        ext = np.zeros((d0 - c0 + lags, m))
+        ext[: hi0 - c0] = y[c0:hi0] - off
+        old = ext[: d0 - c0]
+        view = np.lib.stride_tricks.sliding_window_view(ext, lags + 1, axis=0)[: d0 - c0]
+        # view[i, :, k] = y[c0 + i + k]
+        prod = np.tensordot(old, view, axes=(0, 0))  # (b, a, k)
+        if subtract:
+            sums -= prod.transpose(2, 1, 0)
+            total -= old.sum(axis=0)
+        else:
+            sums += prod.transpose(2, 1, 0)
+            total += old.sum(axis=0)
+
+
+def centred_correlations(sums, total, x, off) -> np.ndarray:
+    """The unbiased correlation matrices of the mean-removed window ``x`` (rows) from its lag
+    products ``sums`` and sum ``total`` of ``x - off`` (:func:`later_products`)."""
+    lags, n, m = len(sums) - 1, len(x), x.shape[1]
+    first = np.concatenate((np.zeros((1, m)), np.cumsum(x[:lags] - off, 0)))
+    last = np.concatenate((np.zeros((1, m)), np.cumsum(x[: -lags - 1 : -1] - off, 0)))
+    mean = total / n
+    count = np.arange(n, n - lags - 1, -1, dtype=np.float64)
+    r = (
+        sums
+        - (total - first)[:, :, None] * mean[None, None, :]
+        - mean[None, :, None] * (total - last)[:, None, :]
+        + count[:, None, None] * np.outer(mean, mean)[None]
+    )
+    return r / count[:, None, None]
+
+
 class LagProducts:
     """The lag products of a sliding window over a growing buffer of samples (one row of
     ``channels`` values each), kept exactly: when the correlations are read, the products of
@@ -330,6 +405,16 @@ class LagProducts:
     def window(self) -> np.ndarray:
         """The window's samples (a view)."""
         return self._buf[self._want : self._n]
+
+    @property
+    def offset(self) -> np.ndarray:
+        """The value subtracted from the samples before their products are summed."""
+        return self._offset
+
+    def mean(self) -> np.ndarray:
+        """The window's mean, from the sums kept."""
+        self._sync()
+        return self._offset + self._total / len(self)
 
     def push(self, x: np.ndarray) -> None:
         """Append samples ``x`` (rows) to the window."""
@@ -378,56 +463,68 @@ class LagProducts:
 
     def _add(self, a: int, b: int) -> None:
         """Add the products ``y[t] y[t - k]^T`` of the samples a <= t < b with the window's."""
-        lags, off = self.lags, self._offset
-        for a0 in range(a, b, PRODUCT_BLOCK):
-            b0 = min(b, a0 + PRODUCT_BLOCK)
-            lo = max(self._start, a0 - lags)
-            ext = np.zeros((b0 - a0 + lags, self.channels))
-            ext[lags - (a0 - lo) :] = self._buf[lo:b0] - off
-            new = ext[lags:]
-            view = np.lib.stride_tricks.sliding_window_view(ext, lags + 1, axis=0)
-            # view[i, :, q] = ext[i + q] = y[a0 + i - (lags - q)]: lag k = lags - q
-            prod = np.tensordot(new, view, axes=(0, 0))  # (a, b, q)
-            self._sums += prod[:, :, ::-1].transpose(2, 0, 1)
-            self._total += new.sum(axis=0)
+        later_products(self._buf, a, b, self._start, self._offset, self._sums, self._total)
 
     def _sub(self, c: int, d: int) -> None:
         """Subtract the products ``y[u + k] y[u]^T`` of the samples c <= u < d leaving."""
-        lags, off, n = self.lags, self._offset, self._done
-        for c0 in range(c, d, PRODUCT_BLOCK):
-            d0 = min(d, c0 + PRODUCT_BLOCK)
-            hi = min(n, d0 + lags)
-            ext = np.zeros((d0 - c0 + lags, self.channels))
-            ext[: hi - c0] = self._buf[c0:hi] - off
-            old = ext[: d0 - c0]
-            view = np.lib.stride_tricks.sliding_window_view(ext, lags + 1, axis=0)[: d0 - c0]
-            # view[i, :, k] = y[c0 + i + k]
-            prod = np.tensordot(old, view, axes=(0, 0))  # (b, a, k)
-            self._sums -= prod.transpose(2, 1, 0)
-            self._total -= old.sum(axis=0)
+        earlier_products(
+            self._buf, c, d, self._done, self._offset, self._sums, self._total, subtract=True
+        )
 
     def correlations(self) -> np.ndarray:
         """The window's unbiased correlation matrices of its mean-removed channels, ``R_k[a, b]
         = sum_t y_a,t+k y_b,t / (N - k)``, k = 0 .. ``lags``: (lags + 1, channels, channels)."""
         self._sync()
-        lags, n = self.lags, len(self)
-        x = self.window
-        first = np.concatenate(
-            (np.zeros((1, self.channels)), np.cumsum(x[:lags] - self._offset, 0))
-        )
-        last = np.concatenate(
-            (np.zeros((1, self.channels)), np.cumsum(x[: -lags - 1 : -1] - self._offset, 0))
-        )
-        total = self._total
-        mean = total / n
-        count = np.arange(n, n - lags - 1, -1, dtype=np.float64)
-        r = (
-            self._sums
-            - (total - first)[:, :, None] * mean[None, None, :]
-            - mean[None, :, None] * (total - last)[:, None, :]
-            + count[:, None, None] * np.outer(mean, mean)[None]
-        )
-        return r / count[:, None, None]
+        return centred_correlations(self._sums, self._total, self.window, self._offset)
+
+
+class EditedProducts:
+    """The lag products of a halved window (:class:`CorrelationCascade`'s levels from 1), kept
+    across analyses: the window's middle is the previous window's (the same numbers, shifted),
+    only its first and last samples differ; the products of the pairs that involve them are
+    subtracted (the previous window's) and added (this one's) instead of all recomputed (all,
+    after :data:`REFRESH_SLIDES` such updates, or when the middle is not the previous one's).
+    :meth:`correlations` gives what :func:`correlation_matrices` computes from the window."""
+
+    def __init__(self, lags: int, channels: int):
+        self._sums = np.zeros((lags + 1, channels, channels))
+        self._total = np.zeros(channels)
+        self._x: np.ndarray | None = None  # the window the sums are of
+        self._pos = 0
+        self._off = np.zeros(channels)
+        self._updates = 0
+
+    def correlations(self, x: np.ndarray, pos: int, step: int, head: int, tail: int):
+        """The correlation matrices of window ``x`` (rows; its first sample at ``pos``, one
+        every ``step``, input samples) whose first ``head`` and last ``tail`` samples may
+        differ from the previous window's."""
+        old, n = self._x, len(x)
+        lo, hi = head, n - tail  # the middle of x, the previous window's
+        shift = (pos - self._pos) // step
+        if not (
+            old is not None
+            and self._updates < REFRESH_SLIDES
+            and (pos - self._pos) % step == 0
+            and 0 <= shift
+            and lo < hi
+            and hi + shift <= len(old)
+            and np.array_equal(x[lo:hi], old[lo + shift : hi + shift])
+        ):
+            self._off = np.array(x[0], dtype=np.float64)
+            self._sums[:] = 0.0
+            self._total[:] = 0.0
+            self._updates = 0
+            later_products(x, 0, n, 0, self._off, self._sums, self._total)
+        else:
+            # the pairs with a sample outside the middle: the previous window's out, x's in
+            sums, total, off, mid = self._sums, self._total, self._off, hi + shift
+            later_products(old, mid, len(old), 0, off, sums, total, subtract=True)
+            earlier_products(old, 0, lo + shift, mid, off, sums, total, subtract=True)
+            earlier_products(x, 0, lo, hi, off, sums, total)
+            later_products(x, hi, n, 0, off, sums, total)
+            self._updates += 1
+        self._x, self._pos = x, pos
+        return centred_correlations(self._sums, self._total, x, self._off)
 
 
 def zero_phase(x: np.ndarray) -> np.ndarray:
@@ -460,7 +557,10 @@ class CorrelationCascade:
     samples of them, so
     its middle is kept from the previous analysis and only the stretches near the ends that
     moved are filtered again (the same numbers, to rounding, as :func:`halve` of the whole
-    window: ``test/core/test_ambient_incremental.py``)."""
+    window: ``test/core/test_ambient_incremental.py``). With several channels a halved window's
+    correlations come from its lag products, kept across analyses (:class:`EditedProducts`),
+    and the window's variance from the input rate's (``R_0``); with one, from the FFT of the
+    window and from the window (as before, bit for bit)."""
 
     def __init__(self, lags: int, channels: int):
         self.lags, self.channels = lags, channels
@@ -469,6 +569,8 @@ class CorrelationCascade:
         #: level -> (its input's first sample's position, step, its zero-phase filtering,
         #: the samples pushed by then)
         self._filtered: dict[int, tuple] = {}
+        #: level (from 1, several channels) -> its window's lag products
+        self._products: dict[int, EditedProducts] = {}
         self._moved()
         decimation_filter()  # scipy.signal imported now, not at the first analysis
 
@@ -484,6 +586,7 @@ class CorrelationCascade:
         self.levels[0].clear()
         self._count = 0
         self._filtered = {}
+        self._products = {}
         self._moved()
 
     def _moved(self) -> None:
@@ -555,20 +658,39 @@ class CorrelationCascade:
                 r = self.levels[0].correlations()
             elif self.channels == 1:
                 r = correlations(self.window(level)[:, 0], self.lags)[:, None, None]
-            else:
-                r = correlation_matrices(self.window(level), self.lags)
+            else:  # (several channels: the lag products kept, not the FFT of the window)
+                x, start, head, tail = self._level(level)
+                products = self._products.setdefault(
+                    level, EditedProducts(self.lags, self.channels)
+                )
+                r = products.correlations(x, start, 1 << level, head, tail)
             self._corr[level] = r
         return self._corr[level]
 
     def variance(self) -> np.ndarray:
-        """Each channel's variance over the window (at the input rate)."""
-        return np.var(self.levels[0].window, axis=0)
+        """Each channel's variance over the window (at the input rate): with several channels,
+        from the lag products kept (``R_0``), not from the window."""
+        if self.channels == 1:
+            return np.var(self.levels[0].window, axis=0)
+        return np.diagonal(self.correlations(0)[0]).copy()
 
     def flat(self) -> np.ndarray:
         """Each channel's window is constant to rounding: its RMS at most :data:`FLAT_RMS_REL`
-        of its mean's magnitude (exactly constant if the mean is 0)."""
+        of its mean's magnitude (exactly constant if the mean is 0). With several channels, only
+        those whose variance from the lag products (:meth:`variance`, rounding about 1e-16 of
+        the square of the samples' distance from the products' offset) lies below
+        :data:`FLAT_SUSPECT` of that square are read over the window."""
         w = self.levels[0].window
-        return np.var(w, axis=0) <= (FLAT_RMS_REL * np.mean(w, axis=0)) ** 2
+        if self.channels == 1:
+            return np.var(w, axis=0) <= (FLAT_RMS_REL * np.mean(w, axis=0)) ** 2
+        var = self.variance()
+        mean, off = self.levels[0].mean(), self.levels[0].offset
+        out = np.zeros(self.channels, dtype=bool)
+        suspect = np.flatnonzero(var <= FLAT_SUSPECT * (mean**2 + (mean - off) ** 2))
+        if len(suspect):
+            x = w[:, suspect]
+            out[suspect] = np.var(x, axis=0) <= (FLAT_RMS_REL * np.mean(x, axis=0)) ** 2
+        return out
 
     def samples(self, level: int) -> int:
         """Level ``level``'s window samples."""
