@@ -47,10 +47,30 @@ def component_names(args) -> list[str]:
         raise BagError('--components reads bags only (a CSV file: --columns)')
     if args.component is not None:
         raise BagError('give --component or --components, not both')
-    names = [c.strip() for c in args.components.split(',')]
+    try:
+        return list(channel_list('--components', args.components))
+    except ValueError as err:
+        raise BagError(str(err)) from None
+
+
+def channel_list(option: str, text: str) -> tuple[str, ...]:
+    """The comma-separated names of ``option`` (ValueError for an empty or repeated one)."""
+    names = tuple(n.strip() for n in text.split(','))
     if not all(names):
-        raise BagError(f'--components {args.components!r} has an empty field')
+        raise ValueError(f'{option} {text!r} has an empty field')
+    if len(set(names)) < len(names):
+        raise ValueError(f'{option} {text!r} names a channel twice')
     return names
+
+
+def need_ambient(what: str, config: EstimatorConfig) -> None:
+    """ValueError unless ``config`` runs the joint identification (``excitation`` ambient):
+    ``what`` (several channels) needs it."""
+    if config.excitation != 'ambient':
+        raise ValueError(
+            f'{what} need --excitation ambient (the joint identification); '
+            'free decays take one --column or --component'
+        )
 
 
 def read_channels(path, topic, names, strict: bool = False, info=None):
@@ -71,11 +91,7 @@ def read_channels(path, topic, names, strict: bool = False, info=None):
 def joint_run(t: np.ndarray, y: np.ndarray, names, config: EstimatorConfig):
     """``(estimator, estimates)``: the joint identification of the channels (ValueError
     without ``excitation ambient``, for time not strictly increasing)."""
-    if config.excitation != 'ambient':
-        raise ValueError(
-            f'{len(names)} channels need --excitation ambient (the joint identification); '
-            'free decays take one --column'
-        )
+    need_ambient(f'{len(names)} channels', config)
     bad = np.flatnonzero(~(np.diff(t) > 0))
     if bad.size:
         raise ValueError(f'time is not strictly increasing at sample {int(bad[0]) + 1}')

@@ -63,7 +63,7 @@ from ..io.csv_reader import column_names
 from ..io.fields import DEFAULT_COMPONENT, check_component
 from ..io.streaming import BagInfo, bag_info, is_csv, open_signal, supported_topics
 from .analyze import Run, add_config_arguments, estimate_signal, make_config
-from .channels import joint_run, mode_shapes, read_channels
+from .channels import channel_list, joint_run, mode_shapes, need_ambient, read_channels
 from .interval import combine
 from .outputs import check_output
 
@@ -874,20 +874,20 @@ def _options(args: argparse.Namespace) -> Options:
     if columns is not None:
         if column is not None:
             raise ValueError('give --column or --columns, not both')
-        items = _channel_list('--columns', columns)
+        items = channel_list('--columns', columns)
         if len(items) == 1 and items[0] != 'all':
             column, columns = items[0], None  # one column: exactly --column
         else:
-            _need_ambient(f'--columns {columns}', config)
+            need_ambient(f'--columns {columns}', config)
     components, joint = tuple(args.component), ()
     if args.components is not None:
         if components:
             raise ValueError('give --component or --components, not both')
-        joint = _channel_list('--components', args.components)
+        joint = channel_list('--components', args.components)
         if len(joint) == 1:
             components, joint = joint, ()  # one component: exactly --component
         else:
-            _need_ambient(f'{len(joint)} components', config)
+            need_ambient(f'{len(joint)} components', config)
     return Options(
         config,
         tuple(args.topic),
@@ -898,24 +898,6 @@ def _options(args: argparse.Namespace) -> Options:
         columns,
         joint,
     )
-
-
-def _channel_list(option: str, text: str) -> Tuple[str, ...]:
-    """The comma-separated names of ``option`` (ValueError for an empty or repeated one)."""
-    names = tuple(n.strip() for n in text.split(','))
-    if not all(names):
-        raise ValueError(f'{option} {text!r} has an empty field')
-    if len(set(names)) < len(names):
-        raise ValueError(f'{option} {text!r} names a channel twice')
-    return names
-
-
-def _need_ambient(what: str, config: EstimatorConfig) -> None:
-    if config.excitation != 'ambient':
-        raise ValueError(
-            f'{what} need --excitation ambient (the joint identification); '
-            'free decays take one --column or --component'
-        )
 
 
 def run(args: argparse.Namespace) -> int:

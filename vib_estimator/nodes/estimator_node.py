@@ -323,13 +323,11 @@ class EstimatorNode(Node):
     def _publish(self, estimates, header: Header) -> None:
         """Publish the estimates of the sample of ``header`` (see :class:`Outputs`)."""
         for item in estimates:
-            if isinstance(item, JointEstimate):  # several channels: the mode's shape too
-                estimate = item.estimate
-                self._outputs.publish(estimate, header)
+            joint = isinstance(item, JointEstimate)  # several channels: the mode's shape too
+            estimate = item.estimate if joint else item
+            self._outputs.publish(estimate, header)
+            if joint:
                 self._outputs.publish_shape(item)
-            else:
-                estimate = item
-                self._outputs.publish(estimate, header)
             self._stream.published(estimate, time.monotonic())
 
     # ---- warm-up (the kernels compile in a thread; see .stream) -------------------------------
