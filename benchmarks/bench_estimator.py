@@ -13,8 +13,9 @@ Prints (one run, same machine, same signal: 2 M samples of a noisy 1.33 Hz sine 
   long windows (``min_periods`` = 5, 20; ``target_std_rel`` = 1e-4) and the band prefilter
   (``band_hz`` = [f/2, 2f]: its std is a sandwich over the prefilter's noise covariance) and the
   mode tracker (``modes`` = 3, over a quarter of the samples; goal >= 2 M samples/s);
-- streaming through the compiled entry (``core.jit.entry``, today's ``update``) beside the same
-  kernel called through numba's dispatcher (``update`` before), alternately;
+- streaming through the compiled entry (``core.jit.entry`` of ``core.kernel.feed``: two arrays
+  to unbox, today's ``update``) beside the same kernel called through numba's dispatcher with
+  seven array arguments (``update`` before issue 24), alternately;
 - the previous kernel (``PREVIOUS``, before the split into per-equation functions and before
   refinement; loaded at run time with ``git show`` into a temporary package, "skipped" without git)
   on the same signal, ``EstimatorConfig.paper(refine=0)`` (it also computes each estimate's std)
@@ -168,10 +169,12 @@ def compare_dispatch(t, y):
     from vib_estimator.core import kernel as K
 
     def dispatched(e):
+        t1, y1 = np.zeros(1), np.zeros(1)
+
         def update(a, b):
-            e._t1[0] = a
-            e._y1[0] = b
-            return K.run(e._p, e._s, e._c, e._seg, e._t1, e._y1, e._row, 0, e._optional)[0]
+            t1[0] = a
+            y1[0] = b
+            return K.run(e._p, e._s, e._c, e._seg, t1, y1, e._row, 0, e._optional)[0]
 
         return update
 

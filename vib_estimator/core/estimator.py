@@ -64,7 +64,7 @@ COUNTER_NAMES = INPUT_COUNTERS + (
 
 
 #: the attributes :meth:`FrequencyEstimator._bind` derives (not pickled: compiled code, views)
-_BOUND = ('_args', '_run', '_t1_view', '_y1_view')
+_BOUND = ('_feed', '_p', '_row', '_s', '_seg')
 
 
 def as_series(t: Sequence[float], y: Sequence[float]) -> Tuple[np.ndarray, np.ndarray]:
@@ -197,25 +197,19 @@ class FrequencyEstimator:
     def __init__(self, config: EstimatorConfig = EstimatorConfig()):
         config.validate()
         self._config = config
-        self._p = config.as_params()
-        self._s = np.zeros(K.N_STATE_FIXED + 2 * config.window + 1)
+        self._n_state = K.N_STATE_FIXED + 2 * config.window + 1
+        self._f = K.feed_buffer(config.as_params(), self._n_state, config.buffer_samples)
         self._c = np.zeros(K.N_COUNTERS, dtype=np.int64)
-        self._seg = np.zeros((2, config.buffer_samples))
-        self._row = np.zeros((1, K.N_OUT))
-        self._t1 = np.zeros(1)  # the streaming path's sample, fed to the batch kernel
-        self._y1 = np.zeros(1)
-        self._optional = K.optional_features(self._p)
+        self._optional = K.optional_features(self._f[: K.F_ROW])
         self._bind()
         self.restart()
 
     def _bind(self) -> None:
-        """The streaming path's fixed parts: run's arguments for one sample (``_t1``, ``_y1``
-        written through memoryviews: half the cost of numpy's item assignment) and its compiled
-        code, looked up at the first :meth:`update`."""
-        self._args = (self._p, self._s, self._c, self._seg, self._t1, self._y1, self._row, 0)
-        self._args += (self._optional,)
-        self._run = None
-        self._t1_view, self._y1_view = memoryview(self._t1), memoryview(self._y1)
+        """The parts derived from the buffer ``_f`` (not pickled): its views ``_p``, ``_row``,
+        ``_s``, ``_seg`` (:func:`core.kernel.feed_buffer`'s layout) and the streaming path's
+        compiled code, looked up at the first :meth:`update`."""
+        self._p, self._row, self._s, self._seg = K.feed_views.py_func(self._f, self._n_state)
+        self._feed = None
 
     def __getstate__(self) -> dict:
         return {k: v for k, v in self.__dict__.items() if k not in _BOUND}
@@ -261,17 +255,17 @@ class FrequencyEstimator:
     def update(self, t: float, y: float) -> Optional[Estimate]:
         """Feed one sample (time in s, any origin); return an estimate when one is published.
 
-        The batch kernel over one sample (one compiled entry point for both paths), called through
-        its compiled code for these argument types (:func:`core.jit.entry`): numba's dispatch
-        resolves the types of run's nine arguments at each call otherwise, about a third of the
-        cost of an update.
+        :func:`core.kernel.feed` (the step on one sample, as the batch kernel over a one-sample
+        array), called through its compiled code for these argument types
+        (:func:`core.jit.entry`): numba's dispatch resolves the types of its arguments at each
+        call otherwise.
         """
-        run = self._run
-        if run is None:
-            run = self._run = entry(K.run, self._args)
-        self._t1_view[0] = t
-        self._y1_view[0] = y
-        if run(*self._args)[0]:
+        feed = self._feed
+        if feed is None:
+            feed = self._feed = entry(
+                K.feed, (self._f, self._c, self._n_state, 0.0, 0.0, self._optional)
+            )
+        if feed(self._f, self._c, self._n_state, t, y, self._optional):
             return Estimate(
                 *(int(v) if i == K.O_SAMPLES else float(v) for i, v in enumerate(self._row[0]))
             )

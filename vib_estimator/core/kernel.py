@@ -1154,3 +1154,48 @@ def run(p, s, c, seg, t, y, out, start, optional=None):
             n_out += 1
         i += 1
     return n_out, i
+
+
+#: the streaming buffer's layout (:func:`feed`): the parameters, then the published row, the
+#: sample (t, y), the state and the segment buffer (its length is the rest)
+F_ROW = N_PARAMS
+F_SAMPLE = F_ROW + N_OUT
+F_STATE = F_SAMPLE + 2
+
+
+def feed_buffer(p, n_state, buffer_samples):
+    """One float64 buffer holding ``p``, the published row, a zeroed state of ``n_state`` and a
+    segment buffer of ``buffer_samples``: :func:`feed`'s argument (:func:`feed_views`)."""
+    f = np.zeros(F_STATE + n_state + 2 * buffer_samples)
+    f[:F_ROW] = p
+    return f
+
+
+@jit(inline='always')
+def feed_views(f, n_state):
+    """The views ``(p, row, s, seg)`` of :func:`feed_buffer`'s ``f``: :func:`run`'s arguments
+    (from Python: ``feed_views.py_func``)."""
+    n_buf = (f.shape[0] - F_STATE - n_state) // 2
+    return (
+        f[:F_ROW],
+        f[F_ROW:F_SAMPLE].reshape((1, N_OUT)),
+        f[F_STATE : F_STATE + n_state],
+        f[F_STATE + n_state :].reshape((2, n_buf)),
+    )
+
+
+@jit
+def feed(f, c, n_state, t, y, optional=None):
+    """Feed one sample ``t``, ``y`` to the estimator whose parameters, row, state and segment
+    live in ``f`` (:func:`feed_buffer`); return 1 when ``f``'s row holds a published estimate.
+
+    The streaming path: :func:`run` over the one-sample arrays of ``f``'s sample slots (the same
+    compiled code as the batch path: nothing more to compile), with two array arguments to unbox
+    from Python instead of seven (each costs about as much as a step).
+    """
+    f = borrowed(f)
+    p, row, s, seg = feed_views(f, n_state)
+    f[F_SAMPLE] = t
+    f[F_SAMPLE + 1] = y
+    sample_t, sample_y = f[F_SAMPLE : F_SAMPLE + 1], f[F_SAMPLE + 1 : F_STATE]
+    return run(p, s, borrowed(c), seg, sample_t, sample_y, row, 0, optional)[0]
