@@ -1164,8 +1164,9 @@ F_STATE = F_SAMPLE + 2
 
 
 def feed_buffer(p, n_state, buffer_samples):
-    """One float64 buffer holding ``p``, the published row, a zeroed state of ``n_state`` and a
-    segment buffer of ``buffer_samples``: :func:`feed`'s argument (:func:`feed_views`)."""
+    """One float64 buffer holding ``p``, the published row, the sample slots, a zeroed state of
+    ``n_state`` and a segment buffer of ``buffer_samples``: :func:`feed`'s argument (its views:
+    :func:`feed_views`)."""
     f = np.zeros(F_STATE + n_state + 2 * buffer_samples)
     f[:F_ROW] = p
     return f
@@ -1190,8 +1191,9 @@ def feed(f, c, n_state, t, y, optional=None):
     live in ``f`` (:func:`feed_buffer`); return 1 when ``f``'s row holds a published estimate.
 
     The streaming path: :func:`run` over the one-sample arrays of ``f``'s sample slots (the same
-    compiled code as the batch path: nothing more to compile), with two array arguments to unbox
-    from Python instead of seven (each costs about as much as a step).
+    compiled code as the batch path: only this wrapper is compiled on top, about 1 s cold), with
+    two array arguments to unbox from Python instead of seven (each costs about as much as a
+    step).
     """
     f = borrowed(f)
     p, row, s, seg = feed_views(f, n_state)
