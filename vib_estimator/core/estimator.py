@@ -200,8 +200,8 @@ class FrequencyEstimator:
         self._n_state = K.N_STATE_FIXED + 2 * config.window + 1
         self._f = K.feed_buffer(config.as_params(), self._n_state, config.buffer_samples)
         self._c = np.zeros(K.N_COUNTERS, dtype=np.int64)
-        self._optional = K.optional_features(self._f[: K.F_ROW])
         self._bind()
+        self._optional = K.optional_features(self._p)
         self.restart()
 
     def _bind(self) -> None:
