@@ -13,6 +13,7 @@ import pytest
 from vib_estimator.analysis import baselines
 from vib_estimator.analysis.baselines import SlidingDFT, hold_last, matrix_pencil
 from vib_estimator.analysis.bounds import crlb_frequency_std, fisher_frequency_std, window_crlb_std
+from vib_estimator.core.threads import blas_controller
 
 FS = 500.0
 ODE_TRACKERS = (baselines.ZiaraniKonrad, baselines.Hou, baselines.MojiriBakhshai)
@@ -138,9 +139,7 @@ def test_the_pencils_svd_runs_on_one_blas_thread(monkeypatch):
 
     def spy(*args, **kwargs):
         threads.extend(
-            lib['num_threads']
-            for lib in baselines.blas_controller().info()
-            if lib['user_api'] == 'blas'
+            lib['num_threads'] for lib in blas_controller().info() if lib['user_api'] == 'blas'
         )
         return svd(*args, **kwargs)
 

@@ -35,13 +35,13 @@ search band refined by two-bin interpolation.
 
 from __future__ import annotations
 
-import functools
 import math
 from typing import Optional, Sequence, Tuple
 
 import numpy as np
 from numba import njit
 
+from ..core.threads import one_blas_thread
 from ..core.uncertainty import TWO_PI
 
 ZIARANI, HOU, MOJIRI = 0, 1, 2
@@ -346,16 +346,6 @@ def hold_last(values: np.ndarray, initial: float = math.nan) -> np.ndarray:
     return np.where(idx >= 0, values[np.maximum(idx, 0)], initial)
 
 
-@functools.lru_cache(maxsize=None)
-def blas_controller():
-    """The BLAS libraries loaded (numpy's OpenBLAS). A pencil's SVD is small: with OpenBLAS's
-    threads it ran 20x slower on a 2-core machine busy with other work (88 s instead of 0.9 s for
-    one 10 s record), so it runs on one thread."""
-    from threadpoolctl import ThreadpoolController
-
-    return ThreadpoolController()
-
-
 def matrix_pencil(
     y: np.ndarray, ts: float, order: int = 2, max_pencil: int = 256
 ) -> Tuple[float, float]:
@@ -373,7 +363,7 @@ def matrix_pencil(
     if pencil < order + 1:
         return math.nan, math.nan
     hankel = np.lib.stride_tricks.sliding_window_view(y, pencil + 1)
-    with blas_controller().limit(limits=1, user_api='blas'):
+    with one_blas_thread():  # (a busy 2-core machine: 20x slower with OpenBLAS's threads)
         _, _, vt = np.linalg.svd(hankel, full_matrices=False)
         v = vt[:order].T
         poles = np.linalg.eigvals(np.linalg.pinv(v[:-1]) @ v[1:])

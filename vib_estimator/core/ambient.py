@@ -66,6 +66,7 @@ import numpy as np
 
 from .config import EstimatorConfig
 from .estimator import INPUT_COUNTERS, Estimate, EstimateArrays, as_series
+from .threads import single_blas_thread
 
 #: seconds of input between two analyses (the estimates' update period)
 HOP_S = 1.0
@@ -897,6 +898,7 @@ def _strong(modes: np.ndarray, total: float, fs: float, counts: dict[str, int]):
         modes = np.delete(modes, worst, axis=0)
 
 
+@single_blas_thread
 def identify(
     cascade, fs, max_damping=0.1, band=(0.0, math.inf), counts=None, top_hz=0.0, search=True
 ):
@@ -1067,6 +1069,7 @@ class SlidingWindowIdentifier:
         c['used'] += 1
         return True
 
+    @single_blas_thread
     def _feed(self, t: np.ndarray, y: np.ndarray, finite: np.ndarray) -> list:
         """Feed a batch (``finite``: per sample, its values are): each clean run (finite,
         increasing, no gap) at once up to the next analysis, any other sample through
@@ -1119,6 +1122,7 @@ class SlidingWindowIdentifier:
         numbered = sorted((tr for tr in tracks if tr.published), key=lambda tr: tr.frequency)
         return ready, numbered
 
+    @single_blas_thread
     def _next_window(self):
         """Advance to the next analysis; ``(samples' times, their correlations (the
         :class:`CorrelationCascade`, brought up to the last sample), rate, span, the highest

@@ -79,6 +79,7 @@ from .ambient import (
 )
 from .config import EstimatorConfig
 from .estimator import Estimate, EstimateArrays
+from .threads import single_blas_thread
 
 #: two clusters closer than ``MERGE_TOL`` are one mode only if their shapes' MAC is at least this
 MAC_SAME = 0.9
@@ -262,6 +263,7 @@ def strong_joint(rows, shapes, stds, totals, fs, counts):
         rows, shapes, stds = (np.delete(x, worst, axis=0) for x in (rows, shapes, stds))
 
 
+@single_blas_thread
 def identify_joint(
     cascade,
     fs: float,
