@@ -60,7 +60,7 @@ def test_one_column_is_exactly_column(record, capsys):
 @pytest.mark.parametrize(
     'options, message',
     [
-        (['--columns', 'a,b'], 'need --excitation ambient'),
+        (['--columns', 'a,b', '--excitation', 'auto'], 'need --excitation free or ambient'),
         (['--columns', 'a,x', *AMBIENT], "no column 'x'"),
         (['--columns', 'a,a', *AMBIENT], 'given twice'),
         (['--columns', 'a,b', '--column', 'c', *AMBIENT], 'not both'),
@@ -132,8 +132,8 @@ def test_one_component_is_exactly_component(bags, capsys):
     'options, message',
     [
         (
-            ['--components', ','.join(AXES[:2]), '--excitation', 'free'],
-            'need --excitation ambient',
+            ['--components', ','.join(AXES[:2]), '--excitation', 'auto'],
+            'need --excitation free or ambient',
         ),
         (['--components', 'linear_acceleration.x,torque.z', *AMBIENT], 'component of'),
         (['--components', 'linear_acceleration.x,,linear_acceleration.y', *AMBIENT], 'empty'),

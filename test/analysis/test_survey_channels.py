@@ -175,9 +175,12 @@ def test_components_of_a_bag_fleet(bag_fleet, capsys):
 @pytest.mark.parametrize(
     'options, message',
     [
-        (['--columns', 'a,b'], 'need --excitation ambient'),
-        (['--columns', 'all', '--excitation', 'free'], 'need --excitation ambient'),
-        (['--components', ','.join(AXES[:2])], 'need --excitation ambient'),
+        (['--columns', 'a,b', '--excitation', 'auto'], 'need --excitation free or ambient'),
+        (['--columns', 'all', '--excitation', 'auto'], 'need --excitation free or ambient'),
+        (
+            ['--components', ','.join(AXES[:2]), '--excitation', 'auto'],
+            'need --excitation free or ambient',
+        ),
         (['--columns', 'a,b', '--column', 'c', *AMBIENT], 'not both'),
         (['--components', ','.join(AXES), '--component', AXES[0], *AMBIENT], 'not both'),
         (['--columns', 'a,,b', *AMBIENT], 'empty'),

@@ -990,7 +990,7 @@ def test_several_joints_a_message_without_one_is_skipped_and_counted(make_probe)
 @pytest.mark.parametrize(
     'overrides, reason',
     [
-        ({'components': IMU_AXES}, 'need excitation ambient'),
+        ({'components': IMU_AXES, 'excitation': 'auto'}, 'need excitation free or ambient'),
         ({'components': ['linear_acceleration.x', 'torque.z'], **AMBIENT}, 'component of'),
         ({'components': ['linear_acceleration.x'] * 2, **AMBIENT}, 'given twice'),
     ],
@@ -1012,14 +1012,17 @@ def test_components_are_validated_at_run_time(ros_context):
     try:
         assert node.get_parameter('components').value == []
         assert node.describe_parameter('components').description.startswith('several fields')
-        refused = node.set_parameters([Parameter('components', value=IMU_AXES)])[0]
-        assert not refused.successful and 'need excitation ambient' in refused.reason
+        refused = node.set_parameters_atomically(
+            [Parameter('components', value=IMU_AXES), Parameter('excitation', value='auto')]
+        )
+        assert not refused.successful and 'need excitation free or ambient' in refused.reason
         both = node.set_parameters_atomically(
             [Parameter('components', value=IMU_AXES), Parameter('excitation', value='ambient')]
         )
         assert both.successful
-        refused = node.set_parameters([Parameter('excitation', value='free')])[0]
+        refused = node.set_parameters([Parameter('excitation', value='auto')])[0]
         assert not refused.successful and '3 components' in refused.reason
+        assert node.set_parameters([Parameter('excitation', value='free')])[0].successful
         empty = Parameter('components', Parameter.Type.STRING_ARRAY, [])
         assert node.set_parameters([empty])[0].successful
         assert node.set_parameters([Parameter('excitation', value='free')])[0].successful

@@ -153,8 +153,8 @@ def test_channels_one_is_the_single_channel_stream_several_the_joint_identifier(
 
     assert floats(one) == floats(plain)  # bit for bit
     names = ('a', 'b', 'c')
-    with pytest.raises(ValueError, match='3 components .* need excitation ambient'):
-        check_channels(names, EstimatorConfig())
+    with pytest.raises(ValueError, match='3 components .* need excitation free or ambient'):
+        check_channels(names, EstimatorConfig(excitation='auto'))
     config = EstimatorConfig(excitation='ambient', ambient_window_s=20.0)
     t, y = modal_record(60.0, 20.0, [(1.0, 0.02, 1.0)], np.array([[1.0], [0.5], [-0.3]]), 20.0)
     stamps = EPOCH_NS + np.round(t * 1e9).astype(np.int64)
@@ -166,7 +166,7 @@ def test_channels_one_is_the_single_channel_stream_several_the_joint_identifier(
     for e in got:
         stream.published(e.estimate, now=0.5)
     assert stream.status(now=1.0).values['channels'] == 'a,b,c'
-    with pytest.raises(ValueError, match='need excitation ambient'):
-        stream.configure(EstimatorConfig(), names)  # refused: the stream is unchanged
+    with pytest.raises(ValueError, match='need excitation free or ambient'):
+        stream.configure(EstimatorConfig(excitation='auto'), names)  # refused: unchanged
     stream.configure(config, ())  # back to one channel: counters kept, no channels key
     assert stream.counters['received'] == len(t) and 'channels' not in stream.status(2.0).values

@@ -78,7 +78,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         '--components',
         help='several fields of the bag topic, comma-separated (e.g. linear_acceleration.x,'
         'linear_acceleration.y,linear_acceleration.z): one set of modes with their shapes '
-        '(needs --excitation ambient; docs/channels.md)',
+        '(free decays or --excitation ambient; docs/channels.md)',
     )
     parser.add_argument(
         '--column',
@@ -87,7 +87,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         '--columns',
         help='several CSV signal columns, comma-separated names or indices, or all: one set of '
-        'modes with their shapes (needs --excitation ambient; docs/channels.md)',
+        'modes with their shapes (free decays or --excitation ambient; docs/channels.md)',
     )
     add_config_arguments(parser)
     parser.add_argument('--format', choices=('jsonl', 'csv', 'table'), default='jsonl')

@@ -4,8 +4,9 @@
 of one bag topic): several channels, one set of modes with their shapes.
 
 One column (``--columns b``) is exactly ``--column b``, one component exactly ``--component``.
-Two or more need ``--excitation ambient`` and go to the joint identifier
-(:mod:`..core.multichannel`). Each estimate row (JSONL, CSV, table) gains, per channel
+Two or more go to the joint estimator of the excitation: free decays
+(:mod:`..core.multichannel_free`) or ``--excitation ambient`` (:mod:`..core.multichannel`);
+``auto`` takes one channel. Each estimate row (JSONL, CSV, table) gains, per channel
 ``<name>``: ``shape_<name>`` (the signed amplitude, :func:`..core.shapes.signed_amplitudes`),
 ``shape_phase_deg_<name>`` (its phase, degrees, 0 or 180 for a real mode), ``shape_std_<name>``
 (its uncertainty) and ``mac`` (with the same mode's previous estimate; null at its first); a
@@ -21,7 +22,8 @@ import sys
 import numpy as np
 
 from ..core.config import EstimatorConfig
-from ..core.multichannel import JointAmbientEstimator, JointEstimates
+from ..core.multichannel import JointEstimates
+from ..core.multichannel_free import JOINT_EXCITATIONS, create_joint_estimator
 from ..core.shapes import SHAPE_ROWS, phases_deg, signed_amplitudes
 from ..errors import BagError, CsvError
 from ..io.csv_reader import column_names, read_csv_columns
@@ -63,13 +65,13 @@ def channel_list(option: str, text: str) -> tuple[str, ...]:
     return names
 
 
-def need_ambient(what: str, config: EstimatorConfig) -> None:
-    """ValueError unless ``config`` runs the joint identification (``excitation`` ambient):
-    ``what`` (several channels) needs it."""
-    if config.excitation != 'ambient':
+def need_joint(what: str, config: EstimatorConfig) -> None:
+    """ValueError unless ``config`` has a joint estimator (``excitation`` free or ambient):
+    ``what`` (several channels) needs one."""
+    if config.excitation not in JOINT_EXCITATIONS:
         raise ValueError(
-            f'{what} need --excitation ambient (the joint identification); '
-            'free decays take one --column or --component'
+            f'{what} need --excitation free or ambient (a joint estimation), got '
+            f'{config.excitation}: it takes one --column or --component'
         )
 
 
@@ -90,12 +92,12 @@ def read_channels(path, topic, names, strict: bool = False, info=None):
 
 def joint_run(t: np.ndarray, y: np.ndarray, names, config: EstimatorConfig):
     """``(estimator, estimates)``: the joint identification of the channels (ValueError
-    without ``excitation ambient``, for time not strictly increasing)."""
-    need_ambient(f'{len(names)} channels', config)
+    with ``excitation`` auto, for time not strictly increasing)."""
+    need_joint(f'{len(names)} channels', config)
     bad = np.flatnonzero(~(np.diff(t) > 0))
     if bad.size:
         raise ValueError(f'time is not strictly increasing at sample {int(bad[0]) + 1}')
-    estimator = JointAmbientEstimator(config, names)
+    estimator = create_joint_estimator(config, names)
     return estimator, estimator.process(t, y)
 
 

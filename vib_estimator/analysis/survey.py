@@ -11,7 +11,7 @@ default the weighted mean of the estimates, the interval from their stds and the
 correlated estimates counted as such: :mod:`.interval`; ``--summary median``: the median and its
 distribution-free interval), the median amplitude, and the estimator's counters. Several
 channels (``--columns a,b,c|all`` of a CSV recording, ``--components x,y,z`` of a bag topic;
-``excitation ambient``): one joint identification per recording (:mod:`.channels`), its rows
+``excitation`` free or ambient): one joint estimation per recording (:mod:`.channels`), its rows
 per mode with each channel's median shape, the median MAC and, against a baseline,
 ``mac_to_baseline``.
 
@@ -63,7 +63,7 @@ from ..io.csv_reader import column_names
 from ..io.fields import DEFAULT_COMPONENT, check_component
 from ..io.streaming import BagInfo, bag_info, is_csv, open_signal, supported_topics
 from .analyze import Run, add_config_arguments, estimate_signal, make_config
-from .channels import channel_list, joint_run, mode_shapes, need_ambient, read_channels
+from .channels import channel_list, joint_run, mode_shapes, need_joint, read_channels
 from .interval import combine
 from .outputs import check_output
 
@@ -159,13 +159,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         '--components',
         help='several fields of each bag topic, comma-separated: one set of modes with their '
-        'shapes per recording (needs --excitation ambient; docs/survey.md)',
+        'shapes per recording (free decays or --excitation ambient; docs/survey.md)',
     )
     parser.add_argument('--column', help='CSV signal column (default: the second)')
     parser.add_argument(
         '--columns',
         help='several CSV signal columns, comma-separated names or indices, or all: one set of '
-        'modes with their shapes per recording (needs --excitation ambient; docs/survey.md)',
+        'modes with their shapes per recording (free decays or --excitation ambient; '
+        'docs/survey.md)',
     )
     add_config_arguments(parser, DEFAULT_MODEL)
     parser.add_argument(
@@ -339,7 +340,7 @@ def _stat_rows(
     start = origin * 1e-9 if origin is not None else result.first_t
     shapes = {} if joint is None else mode_shapes(joint)
     rows = []
-    modes = modes or int(est.mode.max(initial=0))  # excitation ambient numbers its modes
+    modes = modes or int(est.mode.max(initial=0))  # a joint estimator numbers its modes
     for mode in range(1, modes + 1) if modes else [0]:
         take = est.mode == mode
         if not modes:
@@ -878,7 +879,7 @@ def _options(args: argparse.Namespace) -> Options:
         if len(items) == 1 and items[0] != 'all':
             column, columns = items[0], None  # one column: exactly --column
         else:
-            need_ambient(f'--columns {columns}', config)
+            need_joint(f'--columns {columns}', config)
     components, joint = tuple(args.component), ()
     if args.components is not None:
         if components:
@@ -887,7 +888,7 @@ def _options(args: argparse.Namespace) -> Options:
         if len(joint) == 1:
             components, joint = joint, ()  # one component: exactly --component
         else:
-            need_ambient(f'{len(joint)} components', config)
+            need_joint(f'{len(joint)} components', config)
     return Options(
         config,
         tuple(args.topic),

@@ -24,15 +24,17 @@ Method:
    cut at a gap longer than ``max_gap``): every channel is a damped sinusoid
    ``exp(-sigma u) (a_c sin(w u) + b_c cos(w u))`` (+ ``d_c`` for ``model`` biased-sinusoid) on
    the window's centred time ``u``, with the frequency and decay **shared** and the amplitudes
-   per channel. The decay is fitted whatever ``model`` says: a free decay decays, and the
+   per channel (and a cubic on the channels that carry a slower mode with less than a cycle
+   in the window). The decay is fitted whatever ``model`` says: a free decay decays, and the
    undamped model shared by several channels biased the joint estimate (a 5 Hz, 1 % decay on 3
    channels, 10 seeds: RMS error 0.57 % undamped, 0.40 % damped, the best channel alone 0.50 %),
    so the damping ratio is published with every joint estimate. With ``modes``, the other modes
-   any channel estimated within :data:`CONTEXT_S` (and at least :data:`MIN_SEPARATION` cycles
-   apart over the window) are further terms of the same fit, so they do not bias it. Variable
-   projection: the amplitudes are the least-squares solution at each (w, sigma); Gauss-Newton
-   steps on the shared parameters with the projected Jacobian ``J_c = (I - P) dmu_c/dtheta`` (P
-   the projection onto the model's columns), each channel weighted by its residual variance at
+   any channel estimated within :data:`CONTEXT_S` (with at least :data:`MIN_CONTEXT_CYCLES` in
+   the window, and :data:`MIN_SEPARATION` cycles apart from the others) are further terms of
+   the same fit, so they do not bias it. Variable projection: the amplitudes are the
+   least-squares solution at each (w, sigma); Gauss-Newton steps on the shared parameters with
+   the projected Jacobian ``J_c = (I - P_c) dmu_c/dtheta`` (P_c the projection onto channel c's
+   model columns), each channel weighted by its residual variance at
    the start; a step is kept only if it lowers the weighted residual (else halved, up to
    :data:`HALVINGS` times), at most :data:`ITERATIONS` steps.
 3. **Standard deviations: the exact Cramer-Rao bound** of the joint model over those samples,
@@ -86,6 +88,13 @@ from .threads import single_blas_thread
 CONTEXT_S = 2.0
 #: ... if at least this many cycles apart over the event's window (else not resolvable there)
 MIN_SEPARATION = 0.5
+#: ... and if the window holds at least this many of its cycles. A slower one is smooth there: a
+#: term for it cost a 17 Hz estimate over 48 samples twice the variance of the one channel that
+#: sees it (its amplitudes and decay poorly determined), and left out it bent the 17 Hz shape on
+#: the channels that carry it (median MAC 0.68); it is a polynomial of this degree on those (on
+#: all channels, the polynomial cost the clean channel's 17 Hz estimates their precision)
+MIN_CONTEXT_CYCLES = 1.0
+SLOW_DEGREE = 3
 #: Gauss-Newton steps of a joint fit at most, and the halvings of a step that does not help
 ITERATIONS = 8
 HALVINGS = 4
@@ -93,6 +102,8 @@ HALVINGS = 4
 STEP_TOL = 1e-3
 #: a joint fit further than this (relative) from its start is not published
 MAX_MOVE = 0.1
+#: the excitations with a joint estimator (``auto`` takes one channel)
+JOINT_EXCITATIONS = ('free', 'ambient')
 #: the joint identifier's own counters, after the input counters
 JOINT_COUNTERS = ('events', 'joint_fits', 'merged_events', 'rejected_joint', 'estimates')
 
@@ -112,30 +123,53 @@ class JointFit:
     fit: float
 
 
-def _basis(u: np.ndarray, omega: np.ndarray, sigma: np.ndarray, offset: bool):
-    """The model's columns (n x L: per term ``e sin``, ``e cos``; a column of ones last with
-    ``offset``) and each term's (``e sin``, ``e cos``) for the derivatives."""
+def _basis(u: np.ndarray, omega: np.ndarray, sigma: np.ndarray):
+    """The terms' columns (n x 2k: per term ``e sin``, ``e cos``) and each term's ``e sin``,
+    ``e cos`` (n x k) for the derivatives."""
     arg = np.outer(u, omega)
     env = np.exp(-np.outer(u, sigma))
     es, ec = env * np.sin(arg), env * np.cos(arg)
-    cols = [np.column_stack((es[:, j], ec[:, j])) for j in range(len(omega))]
-    if offset:
-        cols.append(np.ones((len(u), 1)))
-    return np.hstack(cols), es, ec
+    return np.stack((es, ec), axis=-1).reshape(len(u), -1), es, ec
 
 
-def _project(phi: np.ndarray, y: np.ndarray):
-    """``(q, amplitudes, residual)``: an orthonormal basis of ``phi``'s columns, the least-squares
-    amplitudes (L x channels) and the residual."""
-    q, r = np.linalg.qr(phi)
-    amp = np.linalg.solve(r, q.T @ y)
-    return q, amp, y - phi @ amp
+def _powers(u: np.ndarray, degree: int) -> np.ndarray:
+    """The powers 0 .. ``degree`` of ``u`` scaled to [-1, 1] (n x (degree + 1); none for -1)."""
+    half = float(np.max(np.abs(u))) or 1.0
+    return np.vander(u / half, degree + 1, increasing=True)
 
 
-def _jacobian(u, es, ec, amp, q) -> np.ndarray:
-    """The projected Jacobians ``(I - P) dmu_c / dtheta``: channels x n x parameters (theta =
+@dataclass
+class _Projection:
+    """The least-squares solution at one (omega, sigma): per group of channels with the same
+    polynomial degree its channels, orthonormal basis ``q`` and ``(Phi^T Phi)^-1``; the terms'
+    amplitudes (2k x channels) and the residual (n x channels)."""
+
+    groups: list
+    amp: np.ndarray
+    res: np.ndarray
+
+
+def _project(terms: np.ndarray, powers: dict, degrees: np.ndarray, y: np.ndarray) -> _Projection:
+    """Each channel's model: the terms' columns and its polynomial's (module doc, step 2)."""
+    amp = np.empty((terms.shape[1], y.shape[1]))
+    res = np.empty_like(y)
+    groups = []
+    for degree in np.unique(degrees):
+        ch = np.flatnonzero(degrees == degree)
+        phi = np.hstack((terms, powers[int(degree)]))
+        q, r = np.linalg.qr(phi)
+        a = np.linalg.solve(r, q.T @ y[:, ch])
+        amp[:, ch] = a[: terms.shape[1]]
+        res[:, ch] = y[:, ch] - phi @ a
+        r_inv = np.linalg.inv(r)
+        groups.append((ch, q, r_inv @ r_inv.T))
+    return _Projection(groups, amp, res)
+
+
+def _jacobian(u, es, ec, fit: _Projection) -> np.ndarray:
+    """The projected Jacobians ``(I - P_c) dmu_c / dtheta``: channels x n x parameters (theta =
     the terms' omegas, then their sigmas)."""
-    k = es.shape[1]
+    k, amp = es.shape[1], fit.amp
     cols = []
     for j in range(k):  # d/d omega_j of es a + ec b: u (ec a - es b)
         a, b = amp[2 * j], amp[2 * j + 1]
@@ -143,18 +177,25 @@ def _jacobian(u, es, ec, amp, q) -> np.ndarray:
     for j in range(k):  # d/d sigma_j: -u (es a + ec b)
         a, b = amp[2 * j], amp[2 * j + 1]
         cols.append(-u[:, None] * (es[:, j, None] * a + ec[:, j, None] * b))
-    d = np.stack(cols, axis=-1)  # n x channels x P
-    d = np.moveaxis(d, 1, 0)  # channels x n x P
-    return d - q[None] @ (q.T[None] @ d)
+    d = np.moveaxis(np.stack(cols, axis=-1), 1, 0)  # channels x n x P
+    for ch, q, _ in fit.groups:
+        d[ch] -= q[None] @ (q.T[None] @ d[ch])
+    return d
 
 
-def _weights(residual: np.ndarray, dof: int) -> np.ndarray:
+def _weights(residual: np.ndarray, dof: np.ndarray) -> np.ndarray:
     """Each channel's residual variance (a channel fitted exactly -- constant, or noiseless --
     gets the smallest of the others', or 1 if all are exact)."""
-    s2 = np.sum(residual**2, axis=0) / max(dof, 1)
+    s2 = np.sum(residual**2, axis=0) / np.maximum(dof, 1)
     positive = s2[s2 > 0]
     floor = float(np.min(positive)) if len(positive) else 1.0
     return np.maximum(s2, floor)
+
+
+def _scaled(u, es, ec, fit: _Projection, s2: np.ndarray) -> np.ndarray:
+    """The weighted projected Jacobian, all channels stacked ((channels n) x P)."""
+    jac = _jacobian(u, es, ec, fit) / np.sqrt(s2)[:, None, None]
+    return jac.reshape(-1, jac.shape[-1])
 
 
 def joint_fit(
@@ -162,59 +203,62 @@ def joint_fit(
     y: np.ndarray,
     omega: Sequence[float],
     sigma: Sequence[float],
-    offset: bool,
+    degrees: Sequence[int] | int = -1,
 ) -> JointFit | None:
     """The joint maximum-likelihood fit of the samples ``y`` (n x channels) at centred times
-    ``u`` from the terms' start values ``omega``, ``sigma`` (module doc, steps 2-4); None if it
+    ``u`` from the terms' start values ``omega``, ``sigma``, with a polynomial of ``degrees``
+    (per channel, or one for all; -1: none) on each channel (module doc, steps 2-4); None if it
     is not finite."""
     omega = np.array(omega, dtype=float)
     sigma = np.array(sigma, dtype=float)
     k, n = len(omega), len(u)
-    n_linear = 2 * k + offset
-    if n <= n_linear + 2 * k:
+    degrees = np.broadcast_to(np.asarray(degrees, dtype=int), (y.shape[1],))
+    dof = n - (2 * k + degrees + 1)
+    if np.any(dof <= 2 * k):
         return None
+    powers = {int(d): _powers(u, int(d)) for d in np.unique(degrees)}
 
     def evaluate(w, s):
-        phi, es, ec = _basis(u, w, s, offset)
-        q, amp, res = _project(phi, y)
-        return phi, es, ec, q, amp, res
+        terms, es, ec = _basis(u, w, s)
+        return es, ec, _project(terms, powers, degrees, y)
 
-    phi, es, ec, q, amp, res = evaluate(omega, sigma)
-    s2 = _weights(res, n - n_linear)
-    cost = float(np.sum(res**2 / s2))
+    es, ec, fit = evaluate(omega, sigma)
+    s2 = _weights(fit.res, dof)
+    cost = float(np.sum(fit.res**2 / s2))
     for _ in range(ITERATIONS):
-        jac = _jacobian(u, es, ec, amp, q) / np.sqrt(s2)[:, None, None]
-        jac = jac.reshape(-1, jac.shape[-1])
-        r = (res / np.sqrt(s2)).T.reshape(-1)
+        jac = _scaled(u, es, ec, fit, s2)
+        r = (fit.res / np.sqrt(s2)).T.reshape(-1)
         step, *_ = np.linalg.lstsq(jac, r, rcond=None)
         for _ in range(HALVINGS + 1):
             w, s = omega + step[:k], sigma + step[k:]
             trial = evaluate(w, s)
-            trial_cost = float(np.sum(trial[5] ** 2 / s2))
+            trial_cost = float(np.sum(trial[2].res ** 2 / s2))
             if np.isfinite(trial_cost) and trial_cost < cost:
                 break
             step = step / 2
         else:
             break
         omega, sigma, cost = w, s, trial_cost
-        phi, es, ec, q, amp, res = trial
+        es, ec, fit = trial
         fisher = jac.T @ jac
         if abs(step[0]) < STEP_TOL * math.sqrt(max(float(np.linalg.pinv(fisher)[0, 0]), 0.0)):
             break
-    s2 = _weights(res, n - n_linear)
-    jac = _jacobian(u, es, ec, amp, q) / np.sqrt(s2)[:, None, None]
-    jac = jac.reshape(-1, jac.shape[-1])
+    s2 = _weights(fit.res, dof)
+    jac = _scaled(u, es, ec, fit, s2)
     try:
         cov_all = np.linalg.inv(jac.T @ jac)
     except np.linalg.LinAlgError:
         return None
     cov = cov_all[np.ix_((0, k), (0, k))]
-    gram = np.linalg.inv(phi.T @ phi)
-    amp_std = np.sqrt(s2 * (gram[0, 0] + gram[1, 1]))
+    amp_var = np.empty(y.shape[1])
+    for ch, _, gram in fit.groups:
+        amp_var[ch] = gram[0, 0] + gram[1, 1]
+    amp_std = np.sqrt(s2 * amp_var)
     centred = y - np.mean(y, axis=0)
     total = float(np.sum(centred**2))
-    fit = 1.0 - float(np.sum(res**2)) / total if total > 0 else 0.0
-    out = JointFit(float(omega[0]), float(sigma[0]), cov, amp[1] - 1j * amp[0], amp_std, fit)
+    r2 = 1.0 - float(np.sum(fit.res**2)) / total if total > 0 else 0.0
+    amp = fit.amp
+    out = JointFit(float(omega[0]), float(sigma[0]), cov, amp[1] - 1j * amp[0], amp_std, r2)
     values = (out.omega, out.sigma, *out.cov.ravel(), *out.amplitudes.view(float), *amp_std)
     return out if np.all(np.isfinite(values)) else None
 
@@ -261,7 +305,6 @@ class JointFreeEstimator:
             )
         self._config = config
         self._channels = channels
-        self._offset = config.model == 'biased-sinusoid'
         self._create = create_estimator
         self._room = int(config.buffer_samples)
         self._c = dict.fromkeys(INPUT_COUNTERS + JOINT_COUNTERS, 0)
@@ -428,32 +471,41 @@ class JointFreeEstimator:
                 rows = rows[jumps[-1] + 1 :]
         return rows
 
-    def _terms(self, c: int, e: Estimate, span: float) -> tuple[list[float], list[float]]:
-        """The fit's start values: the event's mode first, then (``modes``) the others
-        estimated within ``CONTEXT_S`` that the window resolves."""
+    def _terms(self, c: int, e: Estimate, span: float):
+        """``(omega, sigma, degrees)``: the fit's start values, the event's mode first, then
+        (``modes``) the others estimated within ``CONTEXT_S`` that the window resolves; each
+        channel's polynomial degree (:data:`SLOW_DEGREE` where the channel's own estimator saw
+        a slower mode the window does not resolve, else 0 for biased-sinusoid, -1)."""
         omega = [e.omega * math.sqrt(max(1 - _zeta(e) ** 2, 0.0))]
         sigma = [e.omega * _zeta(e)]
         self._recent[(c, e.mode)] = (e.t, omega[0], sigma[0])
+        degrees = np.full(
+            len(self._channels), 0 if self._config.model == 'biased-sinusoid' else -1
+        )
         if self._config.modes:
-            for (_, _), (t, w, s) in sorted(self._recent.items()):
+            for (ch, _), (t, w, s) in sorted(self._recent.items()):
                 if e.t - t > CONTEXT_S:
                     continue
-                if all(abs(w - w0) * span / (2 * math.pi) >= MIN_SEPARATION for w0 in omega):
+                cycles = w * span / (2 * math.pi)
+                apart = all(abs(w - w0) * span / (2 * math.pi) >= MIN_SEPARATION for w0 in omega)
+                if cycles >= MIN_CONTEXT_CYCLES and apart:
                     omega.append(w)
                     sigma.append(s)
-        return omega, sigma
+                elif cycles < MIN_CONTEXT_CYCLES:
+                    degrees[ch] = SLOW_DEGREE
+        return omega, sigma, degrees
 
     def _event(self, index: int, c: int, e: Estimate) -> JointEstimate | None:
         rows = self._window(index, int(e.samples))
         t = rows[:, 0]
         span = float(t[-1] - t[0]) if len(t) > 1 else 0.0
-        omega, sigma = self._terms(c, e, span)
+        omega, sigma, degrees = self._terms(c, e, span)
         mode = self._nearest(e.frequency_hz)
         if mode is not None and e.t - mode.last_t < span / 2:
             self._c['merged_events'] += 1
             return None
         self._c['joint_fits'] += 1
-        fit = joint_fit(t - 0.5 * (t[0] + t[-1]), rows[:, 1:], omega, sigma, self._offset)
+        fit = joint_fit(t - 0.5 * (t[0] + t[-1]), rows[:, 1:], omega, sigma, degrees)
         if fit is None:
             self._c['rejected_joint'] += 1
             return None

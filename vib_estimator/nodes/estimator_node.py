@@ -10,7 +10,8 @@ and the diagnostics bookkeeping, all without rclpy) and publishes what comes bac
 * Input: ``coupling_torque`` (parameter ``input_topic``, read-only) of type ``input_type``
   (read-only; the types and components of :mod:`vib_estimator.io.fields`), best-effort sensor-data
   QoS with a deeper history (:data:`INPUT_DEPTH`); field ``component``, or with ``components``
-  several fields of each message, identified jointly (``excitation`` ambient: docs/channels.md).
+  several fields of each message, estimated jointly (free decays or ``excitation`` ambient:
+  docs/channels.md).
 * Output, on each estimate and in this order (:class:`Outputs`): ``vibration/frequency``,
   ``vibration/damping_ratio``, ``vibration/frequency_std``, ``vibration/amplitude``
   (std_msgs/Float64), then ``vibration/reset`` (std_msgs/Header: stamp and frame_id of the

@@ -123,7 +123,7 @@ def declare_input(node: Node, default_topic: str = DEFAULT_INPUT_TOPIC):
         Parameter.Type.STRING_ARRAY,
         descriptor(
             'several fields of the input, one channel each, identified jointly with their mode '
-            'shapes (needs excitation ambient; [] = component alone): '
+            'shapes (excitation free or ambient; [] = component alone): '
             + describe_components(input_type)
         ),
     )

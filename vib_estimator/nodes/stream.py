@@ -8,8 +8,8 @@ the stamp time base (``t = seconds_since(stamp, first stamp)``, exactly as the o
 :class:`~vib_estimator.core.FrequencyEstimator`, or a mode tracker with ``modes`` >= 1; replaced
 on a change of configuration, its counters kept), and the :class:`~.health.Health` bookkeeping.
 With several ``channels`` (the node's ``components``) the estimator is the joint identifier
-(:class:`~vib_estimator.core.multichannel.JointAmbientEstimator`, ``excitation`` ambient only:
-:func:`check_channels`): each sample is a tuple of values, each estimate a
+(:func:`~vib_estimator.core.multichannel_free.create_joint_estimator`: free decays or
+``excitation`` ambient, :func:`check_channels`): each sample is a tuple of values, each estimate a
 :class:`~vib_estimator.core.multichannel.JointEstimate` (the estimate and its mode shape).
 
 Warm-up. A configuration whose kernels are not compiled in this process yet (the first start, or a
@@ -33,7 +33,8 @@ from typing import Any, Callable, Dict, Iterator, Optional, Sequence, Tuple
 from ..core.config import EstimatorConfig
 from ..core.estimator import COUNTER_NAMES, Estimate
 from ..core.modes import create_estimator
-from ..core.multichannel import MIN_CHANNELS, JointAmbientEstimator
+from ..core.multichannel import MIN_CHANNELS
+from ..core.multichannel_free import JOINT_EXCITATIONS, create_joint_estimator
 from ..core.warmup import is_warm, warm
 from ..io.fields import seconds_since
 from .health import WARN, Health, Status
@@ -53,11 +54,12 @@ WARMUP_MESSAGE = 'compiling estimator kernels (first start)'
 
 def check_channels(channels: Sequence[str], config: EstimatorConfig) -> None:
     """ValueError unless ``config`` can identify ``channels`` (names): several need
-    ``excitation`` ambient (the joint identification, :mod:`~vib_estimator.core.multichannel`)."""
-    if len(channels) >= MIN_CHANNELS and config.excitation != 'ambient':
+    ``excitation`` free or ambient (a joint estimator,
+    :func:`~vib_estimator.core.multichannel_free.create_joint_estimator`)."""
+    if len(channels) >= MIN_CHANNELS and config.excitation not in JOINT_EXCITATIONS:
         raise ValueError(
-            f'{len(channels)} components ({", ".join(channels)}) need excitation ambient (the '
-            f'joint identification), got excitation {config.excitation}; free decays take one '
+            f'{len(channels)} components ({", ".join(channels)}) need excitation free or '
+            f'ambient (a joint estimation), got excitation {config.excitation}: it takes one '
             'component'
         )
 
@@ -67,7 +69,7 @@ def estimator_factory(channels: Sequence[str]) -> Callable[[EstimatorConfig], An
     :func:`~vib_estimator.core.modes.create_estimator`; several, the joint identifier."""
     if len(channels) < MIN_CHANNELS:
         return create_estimator
-    return partial(JointAmbientEstimator, channels=tuple(channels))
+    return partial(create_joint_estimator, channels=tuple(channels))
 
 
 class _Build:
@@ -105,7 +107,7 @@ class EstimatorStream:
     False builds it at once (tests, tools). ``channels``: the names of the input's channels (the
     node's components); one (or none given) is the single-channel estimator, bit for bit; several
     feed :meth:`feed` a tuple of values a sample and give
-    :class:`~vib_estimator.core.multichannel.JointEstimate` s (``excitation`` ambient only).
+    :class:`~vib_estimator.core.multichannel.JointEstimate` s (``excitation`` free or ambient).
     """
 
     def __init__(

@@ -1,0 +1,161 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
+"""Joint free-decay estimation of several channels (seeded, tolerant)."""
+
+import math
+
+import numpy as np
+import pytest
+
+from vib_estimator.core import EstimatorConfig
+from vib_estimator.core.modes import create_estimator
+from vib_estimator.core.multichannel import mac
+from vib_estimator.core.multichannel_free import (
+    JointFreeEstimator,
+    create_joint_estimator,
+    joint_fit,
+)
+
+FS = 500.0
+NAMES = ('a', 'b', 'c')
+SHAPE = np.array([1.0, -0.6, 0.2])
+
+
+def decay(f, zeta, seconds=6.0, phase=0.3):
+    t = np.arange(int(seconds * FS)) / FS
+    wn = 2 * math.pi * f
+    return t, np.exp(-zeta * wn * t) * np.sin(wn * math.sqrt(1 - zeta**2) * t + phase)
+
+
+def plucked(seed, noise=0.02, f=5.0, zeta=0.01):
+    """One mode of shape SHAPE on three channels, white noise of ``noise`` on each."""
+    t, y = decay(f, zeta)
+    rng = np.random.default_rng(seed)
+    return t, y[:, None] * SHAPE + noise * rng.standard_normal((len(t), len(SHAPE)))
+
+
+def rms(x):
+    return math.sqrt(float(np.mean(np.square(x))))
+
+
+def test_noiseless_fit_is_exact():
+    t, y = decay(5.0, 0.01, seconds=0.3)
+    u = t - t.mean()
+    fit = joint_fit(u, y[:, None] * SHAPE, [2 * math.pi * 5.1], [0.0])
+    wn = 2 * math.pi * 5.0
+    assert fit.omega == pytest.approx(wn * math.sqrt(1 - 1e-4), rel=1e-9)
+    assert fit.sigma == pytest.approx(0.01 * wn, rel=1e-6)
+    assert mac(fit.amplitudes, SHAPE) == pytest.approx(1.0, abs=1e-12)
+
+
+@pytest.mark.parametrize(
+    'config',
+    [EstimatorConfig(), EstimatorConfig(model='damped-sinusoid')],
+    ids=['default', 'damped'],
+)
+def test_joint_beats_the_best_channel_and_its_std_is_calibrated(config):
+    """Ten seeds: the joint RMS error is at most the best channel's alone (measured 0.40 against
+    0.50 % default, 0.39 against 0.44 % damped) and the CRB std is calibrated (1.09, 1.14)."""
+    joint, z, single = [], [], [[] for _ in NAMES]
+    for seed in range(10):
+        t, y = plucked(seed)
+        est = JointFreeEstimator(config, NAMES).process(t, y).estimates
+        joint += list(est.frequency_hz / 5.0 - 1)
+        z += list((est.frequency_hz - 5.0) / est.frequency_std_hz)
+        for c in range(len(NAMES)):
+            single[c] += list(create_estimator(config).process(t, y[:, c]).frequency_hz / 5.0 - 1)
+    assert len(joint) >= 150
+    assert rms(joint) <= min(rms(s) for s in single)
+    assert 0.8 <= rms(z) <= 1.4
+
+
+def test_shape_damping_and_mode_identity():
+    t, y = plucked(3)
+    result = JointFreeEstimator(EstimatorConfig(), NAMES).process(t, y)
+    est = result.estimates
+    assert len(result) > 10 and set(est.mode.tolist()) == {1}
+    assert np.all([mac(s, SHAPE) > 0.995 for s in result.shapes])
+    assert np.all(np.abs(result.shapes[:, 0].imag) < 1e-12) and np.all(
+        result.shapes[:, 0].real > 0
+    )
+    assert math.isnan(result.mac[0]) and np.all(result.mac[1:] > 0.99)
+    assert np.median(est.damping) == pytest.approx(0.01, rel=0.15)
+    assert np.all(result.shape_std > 0) and np.all(result.shape_std < 0.05)
+
+
+def test_a_mode_invisible_on_some_channels_is_found_on_the_others():
+    """5 Hz on channels a and b only, 17 Hz on c only: both modes, each with its true shape."""
+    t, low = decay(5.0, 0.01)
+    _, high = decay(17.0, 0.005, phase=1.0)
+    shapes = {5.0: np.array([1.0, 0.7, 0.0]), 17.0: np.array([0.0, 0.0, 1.0])}
+    y = low[:, None] * shapes[5.0] + 0.5 * high[:, None] * shapes[17.0]
+    y += 0.01 * np.random.default_rng(4).standard_normal(y.shape)
+    result = JointFreeEstimator(EstimatorConfig(modes=2), NAMES).process(t, y)
+    est = result.estimates
+    for f, shape in shapes.items():
+        near = np.abs(est.frequency_hz / f - 1) < 0.02
+        assert np.count_nonzero(near) >= 5
+        assert np.median(np.abs(est.frequency_hz[near] / f - 1)) < 0.005
+        assert np.median([mac(s, shape) for s in result.shapes[near]]) > 0.99
+    off = np.min(np.abs(est.frequency_hz[:, None] / np.array([5.0, 17.0]) - 1), axis=1) > 0.02
+    assert np.count_nonzero(off) <= 0.05 * len(est)
+
+
+@pytest.mark.parametrize(
+    'config', [EstimatorConfig(), EstimatorConfig(modes=1)], ids=['one', 'modes']
+)
+def test_streaming_and_chunks_equal_batch(config):
+    t, y = plucked(5)
+    batch = JointFreeEstimator(config, NAMES).process(t, y)
+    stream = JointFreeEstimator(config, NAMES)
+    got = [e for ti, yi in zip(t, y) for e in stream.update(ti, yi)]
+    chunked = JointFreeEstimator(config, NAMES)
+    parts = [chunked.process(t[i : i + 700], y[i : i + 700]) for i in range(0, len(t), 700)]
+    assert len(got) == len(batch) > 5
+    assert [e.estimate.frequency_hz for e in got] == batch.estimates.frequency_hz.tolist()
+    assert np.array_equal(np.array([e.shape for e in got]), batch.shapes)
+    assert np.concatenate([p.estimates.frequency_hz for p in parts]).tolist() == (
+        batch.estimates.frequency_hz.tolist()
+    )
+    assert stream.counters == batch_counters(config, t, y)
+
+
+def batch_counters(config, t, y):
+    est = JointFreeEstimator(config, NAMES)
+    est.process(t, y)
+    return est.counters
+
+
+def test_bad_rows_are_counted_and_change_nothing_else():
+    t, y = plucked(6)
+    clean = JointFreeEstimator(EstimatorConfig(), NAMES).process(t, y)
+    bad_t = np.insert(t, [100, 200, 300], [np.nan, t[199], t[250]])
+    bad_y = np.insert(
+        y, [100, 200, 300], [[1.0, 2.0, 3.0], [0.0, 0.0, 0.0], [5.0, 5.0, 5.0]], axis=0
+    )
+    bad_y[500, 1] = np.inf
+    est = JointFreeEstimator(EstimatorConfig(), NAMES)
+    got = est.process(bad_t, bad_y)
+    c = est.counters
+    assert (c['skipped_non_finite'], c['skipped_duplicate'], c['skipped_out_of_order']) == (
+        2,
+        1,
+        1,
+    )
+    assert c['received'] == len(bad_t) and c['used'] == len(bad_t) - 4
+    assert np.all(np.isfinite(got.estimates.frequency_hz)) and len(got) > 10
+    late = got.estimates.t > t[510]  # after the bad rows' windows, the same estimates
+    assert (
+        got.estimates.frequency_hz[late].tolist()
+        == clean.estimates.frequency_hz[clean.estimates.t > t[510]].tolist()
+    )
+
+
+def test_factory_and_refusals():
+    assert isinstance(create_joint_estimator(EstimatorConfig(), NAMES), JointFreeEstimator)
+    with pytest.raises(ValueError, match='free or ambient'):
+        create_joint_estimator(EstimatorConfig(excitation='auto'), NAMES)
+    with pytest.raises(ValueError, match='at least 2 channels'):
+        JointFreeEstimator(EstimatorConfig(), ('a',))
+    with pytest.raises(ValueError, match='expected 3 channel values'):
+        JointFreeEstimator(EstimatorConfig(), NAMES).update(0.0, [1.0, 2.0])
