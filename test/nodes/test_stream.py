@@ -170,3 +170,23 @@ def test_channels_one_is_the_single_channel_stream_several_the_joint_identifier(
         stream.configure(EstimatorConfig(excitation='auto'), names)  # refused: unchanged
     stream.configure(config, ())  # back to one channel: counters kept, no channels key
     assert stream.counters['received'] == len(t) and 'channels' not in stream.status(2.0).values
+
+
+def test_several_channels_of_free_decays_are_estimated_jointly():
+    """excitation free with three channels: the joint free-decay estimator's floats, shapes."""
+    from vib_estimator.core.multichannel import JointEstimate
+    from vib_estimator.core.multichannel_free import JointFreeEstimator
+
+    names = ('x', 'y', 'z')
+    stamps = EPOCH_NS + np.round(np.arange(3000) * 1e9 / 500.0).astype(np.int64)
+    t = (stamps - stamps[0]) * 1e-9
+    decay = np.exp(-0.3 * t) * np.sin(2 * np.pi * 5.0 * t + 0.3)
+    rng = np.random.default_rng(8)
+    y = decay[:, None] * np.array([0.2, 1.0, -0.5]) + 0.02 * rng.standard_normal((len(t), 3))
+    stream = EstimatorStream(EstimatorConfig(), now=0.0, channels=names)
+    got = [e for s, row in zip(stamps, y.tolist()) for e in stream.feed(int(s), tuple(row))]
+    expected = JointFreeEstimator(EstimatorConfig(), names).process(t, y)
+    assert all(isinstance(e, JointEstimate) for e in got) and len(got) == len(expected) > 10
+    assert [e.estimate.frequency_hz for e in got] == expected.estimates.frequency_hz.tolist()
+    assert np.array_equal([e.shape for e in got], expected.shapes)
+    assert stream.status(now=1.0).values['channels'] == 'x,y,z'
