@@ -166,10 +166,16 @@ def mode_shapes(result: JointEstimates) -> dict[int, tuple[float, np.ndarray, np
     }
 
 
-def plot_shapes(path: str, title: str, result: JointEstimates, unit: str = UNKNOWN_UNIT):
-    """``--plot`` of a joint run: the estimates' frequencies over time by mode (the
-    stabilisation over windows) and each mode's shape (bars of the channel amplitudes, error bars
-    their std); returns the Figure."""
+#: what the ``--plot`` title calls each excitation's joint estimation
+JOINT_METHODS = {'ambient': 'joint SSI-cov', 'free': 'joint free-decay fit'}
+
+
+def plot_shapes(
+    path: str, title: str, result: JointEstimates, unit: str = UNKNOWN_UNIT, excitation='ambient'
+):
+    """``--plot`` of a joint run: the estimates' frequencies over time by mode with their std
+    (the stabilisation over windows) and each mode's shape (bars of the channel amplitudes, error
+    bars their std); returns the Figure."""
     from .plotting import mode_colour, pyplot
 
     plt = pyplot()
@@ -181,10 +187,20 @@ def plot_shapes(path: str, title: str, result: JointEstimates, unit: str = UNKNO
     e = result.estimates
     for k in shapes:
         m = e.mode == k
-        ax.plot(e.t[m], e.frequency_hz[m], '.', ms=3, color=mode_colour(k), label=f'mode {k}')
+        ax.errorbar(
+            e.t[m],
+            e.frequency_hz[m],
+            yerr=e.frequency_std_hz[m],
+            fmt='.',
+            ms=3,
+            lw=0.5,
+            color=mode_colour(k),
+            label=f'mode {k}',
+        )
     ax.set_xlabel('time (s)')
     ax.set_ylabel('frequency (Hz)')
-    ax.set_title(f'{title}: joint SSI-cov over {len(result.channels)} channels')
+    method = JOINT_METHODS[excitation]
+    ax.set_title(f'{title}: {method} over {len(result.channels)} channels (error bars: 1 std)')
     if shapes:
         ax.legend(fontsize='small', loc='center left', bbox_to_anchor=(1.0, 0.5))
     x = np.arange(len(result.channels))
@@ -236,5 +252,5 @@ def run_joint(args, config: EstimatorConfig, names, json_row, prog: str, warn=No
         print(f'{prog}: mode {k} ({f:.3f} Hz) shape: {shape}', file=sys.stderr)
     if args.plot:
         unit = signal_unit(names[0]) if signal is not None else UNKNOWN_UNIT
-        plot_shapes(args.plot, str(args.input), result, unit)
+        plot_shapes(args.plot, str(args.input), result, unit, config.excitation)
     return 0
