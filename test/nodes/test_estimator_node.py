@@ -971,6 +971,30 @@ def test_three_axis_imu_gives_the_modes_with_their_shapes(make_probe):
     assert values_of(status)['channels'] == ','.join(IMU_AXES)
 
 
+def test_three_axis_imu_free_decay_is_estimated_jointly(make_probe):
+    """excitation free (the default) with three IMU axes: a pluck's joint free-decay estimates on
+    mode1/frequency and their shapes on mode1/shape, those of the core's joint estimator."""
+    from vib_estimator.core.multichannel_free import JointFreeEstimator
+
+    p = make_probe(1, input_type=fields.IMU, components=IMU_AXES)
+    t = np.arange(2000) / FS
+    decay = np.exp(-0.3 * t) * np.sin(2 * np.pi * 5.0 * t + 0.3)
+    true = np.array([0.2, 1.0, -0.5])
+    y = decay[:, None] * true + 0.02 * np.random.default_rng(9).standard_normal((len(t), 3))
+    stamps = sine_stamps(len(t))
+    p.publish([channels_message(fields.IMU, IMU_AXES, s, v) for s, v in zip(stamps, y)])
+    expected = JointFreeEstimator(config_of(p.node), IMU_AXES).process(
+        seconds_since(np.asarray(stamps, dtype=np.int64), stamps[0]), y
+    )
+    e = expected.estimates
+    assert len(e) > 5 and set(e.mode.tolist()) == {1}
+    assert spin_until(p.executor, lambda: len(p.shapes[1]) == len(e), 5.0)
+    assert p.values('mode1/frequency') == e.frequency_hz.tolist()
+    assert abs(np.median(e.frequency_hz) / 5.0 - 1) < 0.005
+    data = np.array([msg.data for msg in p.shapes[1]])
+    assert np.allclose(np.median(data[:, :3], axis=0), true / np.linalg.norm(true), atol=0.02)
+
+
 def test_several_joints_a_message_without_one_is_skipped_and_counted(make_probe):
     p = make_probe(2, input_type=fields.JOINT_STATE, components=EFFORTS, **AMBIENT)
     stamps, y = modal_samples(seed=5)
