@@ -12,7 +12,8 @@
    the peer: pyOMA2 SSI-cov on the consecutive non-overlapping 60 s windows of the same records
    (all channels, block rows 20, orders to 30, the pole nearest the true frequency at order 20:
    ``mpe(order_in=20)`` -- told the frequencies, a generous peer); each channel alone
-   (``excitation ambient``, the single-channel identifier): the best channel's RMS error per mode.
+   (``excitation ambient``, the single-channel identifier): the best channel's RMS error per mode;
+   and on the same windows: the joint estimate whose window is a peer window, beside the peer's.
 2. A mode invisible on two of three channels (2.5 Hz on channel c only): found or not, and how far.
 3. The real Heritage Court Tower record (6 channels, 40 Hz, 327.7 s, window 120 s, band 0.5-6 Hz):
    published modes found (>= 10 estimates within 2 %), share of estimates > 2 % from every one.
@@ -41,7 +42,7 @@ import numpy as np
 from bench_operation import HCT_FILE, HCT_MODES, REAL_DATA, ssi_cov_window  # benchmarks/
 
 from vib_estimator.core import EstimatorConfig
-from vib_estimator.core.ambient import AmbientEstimator
+from vib_estimator.core.ambient import HOP_S, AmbientEstimator
 from vib_estimator.core.modes import create_estimator
 from vib_estimator.core.multichannel import JOINT_BLOCK_ROWS, JointAmbientEstimator, mac
 from vib_estimator.core.multichannel_free import JointFreeEstimator
@@ -74,9 +75,10 @@ def rms(x):
 
 def peer(y, fs, freqs):
     """pyOMA2 multi-channel SSI-cov on consecutive :data:`WINDOW_S` windows: per mode the
-    relative errors and damping ratios."""
+    relative errors, damping ratios and the windows' last sample indices."""
     errs = [[] for _ in freqs]
     zetas = [[] for _ in freqs]
+    ends = [[] for _ in freqs]
     n = int(WINDOW_S * fs)
     for start in range(0, len(y) - n + 1, n):
         res = ssi_cov_window(y[start : start + n], fs, freqs, PEER_ROWS)
@@ -84,7 +86,27 @@ def peer(y, fs, freqs):
             if np.isfinite(fn) and abs(fn / f - 1) <= NEAR:
                 errs[j].append(fn / f - 1)
                 zetas[j].append(xi)
-    return [np.array(e) for e in errs], [np.array(z) for z in zetas]
+                ends[j].append(start + n - 1)
+    return [np.array(e) for e in errs], [np.array(z) for z in zetas], ends
+
+
+def same_windows(t, estimates, j, f, ends, hop):
+    """Pairs (joint error, index into the peer's list) of the joint estimates of mode ``j``
+    whose window is a peer window (its end within half a ``hop`` of the window's last sample)."""
+    e = estimates
+    out = []
+    for i, end in enumerate(ends):
+        close = np.flatnonzero(
+            (np.abs(e.t - t[end]) <= hop / 2) & (np.abs(e.frequency_hz / f - 1) <= NEAR)
+        )
+        if len(close):
+            k = (
+                close[np.argmin(np.abs(e.frequency_hz[close] / f - 1))]
+                if len(close) > 1
+                else close[0]
+            )
+            out.append((e.frequency_hz[k] / f - 1, i))
+    return out
 
 
 def frame(seeds, with_peer):
@@ -95,6 +117,7 @@ def frame(seeds, with_peer):
     )
     joint = {k: [] for k in ('err', 'zeta', 'mac')}
     peer_err, peer_zeta, single = None, None, None
+    paired = [[] for _ in range(5)]  # per mode: (joint error, peer error) on the same windows
     for seed in range(1, seeds + 1):
         t, y, freqs, shapes = frame_record(FRAME_S, FRAME_FS, ZETA, 20.0, seed)
         names = [f's{i}' for i in range(1, 6)]
@@ -118,10 +141,12 @@ def frame(seeds, with_peer):
             for j, x in enumerate(per_mode(s.frequency_hz, freqs)):
                 single[c][j].extend(x)
         if with_peer:
-            pe, pz = peer(y, FRAME_FS, freqs)
+            pe, pz, ends = peer(y, FRAME_FS, freqs)
             for j in range(len(freqs)):
                 peer_err[j].extend(pe[j])
                 peer_zeta[j].extend(pz[j])
+                pairs = same_windows(t, e, j, freqs[j], ends[j], HOP_S)
+                paired[j].extend((ours, pe[j][i]) for ours, i in pairs)
     print(
         '| mode | f (Hz) | joint: estimates | median err | RMS err | damping / true | MAC '
         '| pyOMA2 SSI-cov: windows | RMS err | damping / true | best single channel RMS err |'
@@ -141,6 +166,16 @@ def frame(seeds, with_peer):
             f'| {np.median(joint["mac"][j]):.4f} | {len(pe)} | {100 * rms(pe):.2f} % '
             f'| {np.median(pz) / ZETA if len(pz) else float("nan"):.2f} '
             f'| {100 * best[0]:.2f} % (s{best[1] + 1}, {best[2]} estimates) |'
+        )
+    if with_peer:
+        print(
+            "\nOn the same windows (the joint estimate whose 60 s window is the peer's, both "
+            'found): RMS error joint / pyOMA2 (windows): '
+            + ', '.join(
+                f'mode {j + 1} {100 * rms([p[0] for p in pr]):.2f} / '
+                f'{100 * rms([p[1] for p in pr]):.2f} % ({len(pr)})'
+                for j, pr in enumerate(paired)
+            )
         )
 
 
