@@ -273,18 +273,42 @@ def bad_bags(tmp_path):
     }
 
 
+def communicate_or_dump(proc, timeout):
+    """``proc.communicate`` within ``timeout``; past it, the process's threads' tracebacks
+    (faulthandler on SIGABRT) and its stderr in the failure, and the process gone."""
+    try:
+        return proc.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        proc.send_signal(signal.SIGABRT)
+        try:
+            out, err = proc.communicate(timeout=10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            out, err = proc.communicate()
+        pytest.fail(f'no exit within {timeout} s; stderr and tracebacks:\n{err}')
+
+
 def test_unplayable_bags_are_refused_with_one_line(bad_bags):
+    env = {**os.environ, 'PYTHONFAULTHANDLER': '1'}
     procs = {
         name: subprocess.Popen(
             REPLAYER + ['--ros-args'] + [a for p in params for a in ('-p', p)],
             stdout=subprocess.PIPE,
             stderr=subprocess.PIPE,
             text=True,
+            env=env,
         )
         for name, (params, _) in bad_bags.items()
     }
+    try:
+        results = {name: communicate_or_dump(proc, 120) for name, proc in procs.items()}
+    finally:
+        for proc in procs.values():
+            if proc.poll() is None:
+                proc.kill()
+                proc.communicate()
     for name, proc in procs.items():
-        _, err = proc.communicate(timeout=120)
+        err = results[name][1]
         assert proc.returncode == 2, (name, err)
         assert 'Traceback' not in err, (name, err)
         lines = [line for line in err.splitlines() if line.startswith('error: ')]
