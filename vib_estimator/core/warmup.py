@@ -32,8 +32,8 @@ SAMPLES = 1500
 
 #: the configurations ``make setup`` / ``vib-estimator warmup`` compile: the default, the paper's
 #: (Section 5.3: the demo, the reproductions), the damped model, the band-pass prefilter, the
-#: target-std rule and the mode tracker (the set-ups the README's quick start and the benchmarks
-#: use)
+#: target-std rule, the mode tracker and the ambient identifier (its zero-phase decimation filter;
+#: the set-ups the README's quick start and the benchmarks use)
 CONFIGURATIONS: Dict[str, EstimatorConfig] = {
     'default': EstimatorConfig(),
     'paper': EstimatorConfig.paper(),
@@ -41,6 +41,7 @@ CONFIGURATIONS: Dict[str, EstimatorConfig] = {
     'band_hz': EstimatorConfig(band_hz=(1.0, 20.0)),
     'target_std_rel': EstimatorConfig(target_std_rel=0.01),
     'modes: 3': EstimatorConfig(modes=3),
+    'excitation: ambient': EstimatorConfig(excitation='ambient'),
 }
 
 #: compile keys of the configurations warmed in this process (see :func:`compile_key`)
