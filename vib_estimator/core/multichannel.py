@@ -347,6 +347,30 @@ class JointEstimates:
     def __len__(self) -> int:
         return len(self.estimates)
 
+    @classmethod
+    def of(cls, out: Sequence[JointEstimate], channels: tuple[str, ...]) -> 'JointEstimates':
+        """The columns of the estimates ``out`` of ``channels``, in their order."""
+        m = len(channels)
+        return cls(
+            estimate_columns([e.estimate for e in out]),
+            np.array([e.shape for e in out], dtype=complex).reshape(-1, m),
+            np.array([e.shape_std for e in out]).reshape(-1, m),
+            np.array([e.mac for e in out]),
+            channels,
+        )
+
+
+def as_channels(t: Sequence[float], y: np.ndarray, channels: int) -> tuple[np.ndarray, np.ndarray]:
+    """``t``, ``y`` as contiguous float64 arrays, ``y`` samples x ``channels`` (ValueError
+    otherwise)."""
+    t = np.ascontiguousarray(t, dtype=np.float64)
+    y = np.ascontiguousarray(y, dtype=np.float64)
+    if t.ndim != 1 or y.shape != (len(t), channels):
+        raise ValueError(
+            f't must be 1-D and y samples x {channels} channels, got {t.shape}, {y.shape}'
+        )
+    return t, y
+
 
 class _ShapeTrack(ModeTrack):
     """A tracked mode with its last shape."""
@@ -389,24 +413,9 @@ class JointAmbientEstimator(SlidingWindowIdentifier):
     def process(self, t: Sequence[float], y: np.ndarray) -> JointEstimates:
         """Feed arrays (``y``: samples x channels; continuing the stream); the estimates by
         time."""
-        t = np.ascontiguousarray(t, dtype=np.float64)
-        y = np.ascontiguousarray(y, dtype=np.float64)
-        if t.ndim != 1 or y.shape != (len(t), len(self._channels)):
-            raise ValueError(
-                f't must be 1-D and y samples x {len(self._channels)} channels, '
-                f'got {t.shape}, {y.shape}'
-            )
-        return self._columns(self._feed(t, y, np.isfinite(y).all(axis=1) & np.isfinite(t)))
-
-    def _columns(self, out: list[JointEstimate]) -> JointEstimates:
-        m = len(self._channels)
-        return JointEstimates(
-            estimate_columns([e.estimate for e in out]),
-            np.array([e.shape for e in out], dtype=complex).reshape(-1, m),
-            np.array([e.shape_std for e in out]).reshape(-1, m),
-            np.array([e.mac for e in out]),
-            self._channels,
-        )
+        t, y = as_channels(t, y, len(self._channels))
+        out = self._feed(t, y, np.isfinite(y).all(axis=1) & np.isfinite(t))
+        return JointEstimates.of(out, self._channels)
 
     # ---- analysis -----------------------------------------------------------------------------
     def _analyse(self) -> list[JointEstimate]:

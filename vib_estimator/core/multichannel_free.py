@@ -70,7 +70,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .ambient import MATCH_TOL, MAX_TRACKS, estimate_columns
+from .ambient import MATCH_TOL, MAX_TRACKS
 from .config import EstimatorConfig
 from .estimator import INPUT_COUNTERS, Estimate
 from .multichannel import (
@@ -79,6 +79,7 @@ from .multichannel import (
     JointAmbientEstimator,
     JointEstimate,
     JointEstimates,
+    as_channels,
     mac,
     normalise_shape,
 )
@@ -418,13 +419,7 @@ class JointFreeEstimator:
     def process(self, t: Sequence[float], y: np.ndarray) -> JointEstimates:
         """Feed arrays (``y``: samples x channels; continuing the stream); the estimates by
         time."""
-        t = np.ascontiguousarray(t, dtype=np.float64)
-        y = np.ascontiguousarray(y, dtype=np.float64)
-        m = len(self._channels)
-        if t.ndim != 1 or y.shape != (len(t), m):
-            raise ValueError(
-                f't must be 1-D and y samples x {m} channels, got {t.shape}, {y.shape}'
-            )
+        t, y = as_channels(t, y, len(self._channels))
         keep = self._keep(t, y)
         t, y = t[keep], y[keep]
         out: list[JointEstimate] = []
@@ -439,13 +434,7 @@ class JointFreeEstimator:
                 events += [(int(i), c, e) for i, e in zip(index, cols.to_list())]
             events.sort(key=lambda ev: ev[0])  # stable: by time, then channel, then order
             out += self._events(events)
-        return JointEstimates(
-            estimate_columns([e.estimate for e in out]),
-            np.array([e.shape for e in out], dtype=complex).reshape(-1, m),
-            np.array([e.shape_std for e in out]).reshape(-1, m),
-            np.array([e.mac for e in out]),
-            self._channels,
-        )
+        return JointEstimates.of(out, self._channels)
 
     # ---- events ---------------------------------------------------------------------------------
     @single_blas_thread
