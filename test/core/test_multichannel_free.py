@@ -159,3 +159,18 @@ def test_factory_and_refusals():
         JointFreeEstimator(EstimatorConfig(), ('a',))
     with pytest.raises(ValueError, match='expected 3 channel values'):
         JointFreeEstimator(EstimatorConfig(), NAMES).update(0.0, [1.0, 2.0])
+
+
+def test_restart_forgets_the_modes_and_keeps_the_counters():
+    t, y = plucked(7)
+    est = JointFreeEstimator(EstimatorConfig(), NAMES)
+    first = est.process(t, y)
+    before = est.counters
+    est.restart()
+    assert est.counters == before  # kept, the channels' estimators' included
+    again = est.process(t + t[-1] + 1.0, y)  # the same pluck later: the same estimates
+    assert again.estimates.frequency_hz == pytest.approx(first.estimates.frequency_hz, rel=1e-9)
+    assert again.estimates.mode.tolist() == first.estimates.mode.tolist()
+    assert np.isnan(again.mac[0])  # a new first estimate: the modes were forgotten
+    assert est.counters['estimates'] == 2 * before['estimates']
+    assert est.counters['rejected_fit'] == 2 * before['rejected_fit']

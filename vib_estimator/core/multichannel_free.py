@@ -73,6 +73,7 @@ import numpy as np
 from .ambient import MATCH_TOL, MAX_TRACKS
 from .config import EstimatorConfig
 from .estimator import INPUT_COUNTERS, Estimate
+from .modes import create_estimator
 from .multichannel import (
     MAC_MATCH,
     MIN_CHANNELS,
@@ -294,8 +295,6 @@ class JointFreeEstimator:
     ``channels``: the channel names (their count is the number of columns fed)."""
 
     def __init__(self, config: EstimatorConfig, channels: Sequence[str]):
-        from .modes import create_estimator  # (.modes builds the single-channel estimators)
-
         config.validate()
         if config.excitation != 'free':
             raise ValueError(f'JointFreeEstimator needs excitation free, got {config.excitation}')
@@ -306,10 +305,10 @@ class JointFreeEstimator:
             )
         self._config = config
         self._channels = channels
-        self._create = create_estimator
         self._room = int(config.buffer_samples)
         self._c = dict.fromkeys(INPUT_COUNTERS + JOINT_COUNTERS, 0)
-        self._retired: dict[str, int] = {}  # the channels' counters of estimators restarted
+        self._retired: dict[str, int] = {}  # the counters of the channels' estimators restarted
+        self._estimators: list = []
         self.restart()
 
     @property
@@ -324,23 +323,25 @@ class JointFreeEstimator:
     def counters(self) -> dict[str, int]:
         """The input and joint counters, and the channels' estimators' others summed."""
         total = dict(self._c)
+        for name, value in self._channel_counters().items():
+            total[name] = total.get(name, 0) + value
+        return total
+
+    def _channel_counters(self) -> dict[str, int]:
+        """The channels' estimators' counters summed, those restarted included (their input
+        counters and estimates left out: the joint identifier counts its own)."""
+        total = dict(self._retired)
         for est in self._estimators:
             for name, value in est.counters.items():
                 if name not in INPUT_COUNTERS and name != 'estimates':
                     total[name] = total.get(name, 0) + int(value)
-        for name, value in self._retired.items():
-            total[name] = total.get(name, 0) + value
         return total
 
     def restart(self) -> None:
         """Forget the signal and the known modes; counters are kept."""
-        if hasattr(self, '_estimators'):
-            for est in self._estimators:
-                for name, value in est.counters.items():
-                    if name not in INPUT_COUNTERS and name != 'estimates':
-                        self._retired[name] = self._retired.get(name, 0) + int(value)
+        self._retired = self._channel_counters()
         m = len(self._channels)
-        self._estimators = [self._create(self._config) for _ in range(m)]
+        self._estimators = [create_estimator(self._config) for _ in range(m)]
         self._rows = np.empty((2 * self._room, 1 + m))  # t, channels: the last rows kept
         self._n = 0
         self._last = -math.inf
