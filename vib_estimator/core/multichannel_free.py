@@ -355,24 +355,28 @@ class JointFreeEstimator:
 
     # ---- input --------------------------------------------------------------------------------
     def _keep(self, t: np.ndarray, y: np.ndarray) -> np.ndarray:
-        """The rows to keep (finite, after the last kept stamp, increasing), counted."""
-        c = self._c
-        c['received'] += len(t)
+        """The rows to keep (finite, after the last kept stamp), counted (:meth:`_accept`)."""
         finite = np.isfinite(t) & np.all(np.isfinite(y), axis=1)
-        c['skipped_non_finite'] += int(np.count_nonzero(~finite))
-        keep = np.zeros(len(t), dtype=bool)
-        last = self._last
-        for i in np.flatnonzero(finite):  # stamps are checked in order (a running maximum)
-            ti = t[i]
-            if ti > last:
-                keep[i], last = True, ti
-            elif ti == last:
-                c['skipped_duplicate'] += 1
-            else:
-                c['skipped_out_of_order'] += 1
-        self._last = last
-        c['used'] += int(np.count_nonzero(keep))
-        return keep
+        return np.array(
+            [self._accept(ti, ok) for ti, ok in zip(t.tolist(), finite.tolist())], bool
+        )
+
+    def _accept(self, t: float, finite: bool) -> bool:
+        """Whether a row of stamp ``t`` (its values all finite or not) is kept, counted: finite
+        and after the last kept stamp."""
+        c = self._c
+        c['received'] += 1
+        if not finite:
+            c['skipped_non_finite'] += 1
+        elif t == self._last:
+            c['skipped_duplicate'] += 1
+        elif t < self._last:
+            c['skipped_out_of_order'] += 1
+        else:
+            self._last = t
+            c['used'] += 1
+            return True
+        return False
 
     def _row_of(self, times: np.ndarray) -> np.ndarray:
         """The store index of the row nearest each of ``times`` (an estimate's stamp is its
@@ -403,19 +407,19 @@ class JointFreeEstimator:
     # ---- streaming and batch ------------------------------------------------------------------
     def update(self, t: float, y: Sequence[float]) -> list[JointEstimate]:
         """Feed one sample (one value per channel); the estimates it completes."""
-        y = np.asarray(y, dtype=np.float64).reshape(1, -1)
-        if y.shape[1] != len(self._channels):
-            raise ValueError(f'expected {len(self._channels)} channel values, got {y.shape[1]}')
-        t = np.array((float(t),))
-        if not self._keep(t, y)[0]:
+        values = [float(v) for v in y]
+        if len(values) != len(self._channels):
+            raise ValueError(f'expected {len(self._channels)} channel values, got {len(values)}')
+        t = float(t)
+        if not self._accept(t, math.isfinite(t) and all(map(math.isfinite, values))):
             return []
-        self._append(t, y)
+        self._append(np.array((t,)), np.array((values,)))
         events = []
         for c, est in enumerate(self._estimators):
-            out = est.update(float(t[0]), float(y[0, c]))
+            out = est.update(t, values[c])
             for e in [out] if isinstance(out, Estimate) else out or ():
                 events.append((int(self._row_of(np.array((e.t,)))[0]), c, e))
-        return self._events(events)
+        return self._events(events) if events else []  # (no BLAS-thread switch per sample)
 
     def process(self, t: Sequence[float], y: np.ndarray) -> JointEstimates:
         """Feed arrays (``y``: samples x channels; continuing the stream); the estimates by
