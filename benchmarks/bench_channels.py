@@ -100,11 +100,7 @@ def same_windows(t, estimates, j, f, ends, hop):
             (np.abs(e.t - t[end]) <= hop / 2) & (np.abs(e.frequency_hz / f - 1) <= NEAR)
         )
         if len(close):
-            k = (
-                close[np.argmin(np.abs(e.frequency_hz[close] / f - 1))]
-                if len(close) > 1
-                else close[0]
-            )
+            k = close[np.argmin(np.abs(e.frequency_hz[close] / f - 1))]
             out.append((e.frequency_hz[k] / f - 1, i))
     return out
 

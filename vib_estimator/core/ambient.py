@@ -924,7 +924,6 @@ def _strong(modes: np.ndarray, total: float, fs: float, counts: dict[str, int]):
         modes = np.delete(modes, worst, axis=0)
 
 
-@single_blas_thread
 def identify(
     cascade, fs, max_damping=0.1, band=(0.0, math.inf), counts=None, top_hz=0.0, search=True
 ):
@@ -1096,6 +1095,12 @@ class SlidingWindowIdentifier:
         return True
 
     @single_blas_thread
+    def _analysis(self) -> list:
+        """:meth:`_analyse` on one BLAS thread (:mod:`.threads`), for a sample fed alone; a
+        batch (:meth:`_feed`) is on one thread throughout."""
+        return self._analyse()
+
+    @single_blas_thread
     def _feed(self, t: np.ndarray, y: np.ndarray, finite: np.ndarray) -> list:
         """Feed a batch (``finite``: per sample, its values are): each clean run (finite,
         increasing, no gap) at once up to the next analysis, any other sample through
@@ -1148,7 +1153,6 @@ class SlidingWindowIdentifier:
         numbered = sorted((tr for tr in tracks if tr.published), key=lambda tr: tr.frequency)
         return ready, numbered
 
-    @single_blas_thread
     def _next_window(self):
         """Advance to the next analysis; ``(samples' times, their correlations (the
         :class:`CorrelationCascade`, brought up to the last sample), rate, span, the highest
@@ -1193,7 +1197,7 @@ class AmbientEstimator(SlidingWindowIdentifier):
             return []
         self._append(np.array((t,)), np.array((y,)))
         if t >= self._next:
-            return self._analyse()
+            return self._analysis()
         return []
 
     def process(self, t: Sequence[float], y: Sequence[float]) -> EstimateArrays:

@@ -79,7 +79,6 @@ from .ambient import (
 )
 from .config import EstimatorConfig
 from .estimator import Estimate, EstimateArrays
-from .threads import single_blas_thread
 
 #: two clusters closer than ``MERGE_TOL`` are one mode only if their shapes' MAC is at least this
 MAC_SAME = 0.9
@@ -106,6 +105,14 @@ def mac(a: np.ndarray, b: np.ndarray) -> float:
     a, b = np.asarray(a), np.asarray(b)
     den = float(np.vdot(a, a).real * np.vdot(b, b).real)
     return float(abs(np.vdot(a, b)) ** 2 / den) if den > 0 else 0.0
+
+
+def continues(f: float, shape: np.ndarray, frequency: float, last_shape: np.ndarray):
+    """The relative frequency distance of a mode (``f``, ``shape``) from a tracked one
+    (``frequency``, ``last_shape``) if it continues it -- within :data:`..ambient.MATCH_TOL` and
+    with a MAC of at least :data:`MAC_MATCH` --, else None."""
+    dist = abs(f / frequency - 1)
+    return dist if dist <= MATCH_TOL and mac(shape, last_shape) >= MAC_MATCH else None
 
 
 def normalise_shape(phi: np.ndarray) -> np.ndarray:
@@ -263,7 +270,6 @@ def strong_joint(rows, shapes, stds, totals, fs, counts):
         rows, shapes, stds = (np.delete(x, worst, axis=0) for x in (rows, shapes, stds))
 
 
-@single_blas_thread
 def identify_joint(
     cascade,
     fs: float,
@@ -407,7 +413,7 @@ class JointAmbientEstimator(SlidingWindowIdentifier):
             return []
         self._append(np.array((t,)), y[None, :])
         if t >= self._next:
-            return self._analyse()
+            return self._analysis()
         return []
 
     def process(self, t: Sequence[float], y: np.ndarray) -> JointEstimates:
@@ -435,8 +441,8 @@ class JointAmbientEstimator(SlidingWindowIdentifier):
         pairs = []
         for i in range(len(modes)):
             for j, tr in enumerate(tracks):
-                dist = abs(modes.frequency[i] / tr.frequency - 1)
-                if dist <= MATCH_TOL and mac(modes.shapes[i], tr.shape) >= MAC_MATCH:
+                dist = continues(modes.frequency[i], modes.shapes[i], tr.frequency, tr.shape)
+                if dist is not None:
                     pairs.append((not tr.published, dist, i, j))
         match: dict[int, int] = {}
         used = set()

@@ -75,12 +75,12 @@ from .config import EstimatorConfig
 from .estimator import INPUT_COUNTERS, Estimate
 from .modes import create_estimator
 from .multichannel import (
-    MAC_MATCH,
     MIN_CHANNELS,
     JointAmbientEstimator,
     JointEstimate,
     JointEstimates,
     as_channels,
+    continues,
     mac,
     normalise_shape,
 )
@@ -466,13 +466,13 @@ class JointFreeEstimator:
         return rows
 
     def _terms(self, c: int, e: Estimate, span: float):
-        """``(omega, sigma, degrees)``: the fit's start values, the event's mode first, then
+        """``(omega, sigma, degrees)``: the fit's start values, the event's mode first (its
+        estimate, recorded by :meth:`_event`), then
         (``modes``) the others estimated within ``CONTEXT_S`` that the window resolves; each
         channel's polynomial degree (:data:`SLOW_DEGREE` where the channel's own estimator saw
         a slower mode the window does not resolve, else 0 for biased-sinusoid, -1)."""
-        omega = [e.omega * math.sqrt(max(1 - _zeta(e) ** 2, 0.0))]
-        sigma = [e.omega * _zeta(e)]
-        self._recent[(c, e.mode)] = (e.t, omega[0], sigma[0])
+        omega = [self._recent[(c, e.mode)][1]]
+        sigma = [self._recent[(c, e.mode)][2]]
         degrees = np.full(
             len(self._channels), 0 if self._config.model == 'biased-sinusoid' else -1
         )
@@ -493,11 +493,13 @@ class JointFreeEstimator:
         rows = self._window(index, int(e.samples))
         t = rows[:, 0]
         span = float(t[-1] - t[0]) if len(t) > 1 else 0.0
-        omega, sigma, degrees = self._terms(c, e, span)
+        zeta = _zeta(e)  # the channel's estimate: a start value of its mode's later events
+        self._recent[(c, e.mode)] = (e.t, e.omega * math.sqrt(1 - zeta**2), e.omega * zeta)
         mode = self._nearest(e.frequency_hz)
         if mode is not None and e.t - mode.last_t < span / 2:
             self._c['merged_events'] += 1
             return None
+        omega, sigma, degrees = self._terms(c, e, span)
         self._c['joint_fits'] += 1
         fit = joint_fit(t - 0.5 * (t[0] + t[-1]), rows[:, 1:], omega, sigma, degrees)
         if fit is None:
@@ -522,13 +524,10 @@ class JointFreeEstimator:
     def _identify(self, f: float, shape: np.ndarray, t: float) -> tuple[float, int]:
         """``(MAC with the mode's last shape or NaN, mode number)``: the known mode this
         estimate continues (module doc, step 5), updated, or a new one."""
-        near = [
-            m
-            for m in self._modes
-            if abs(f / m.frequency - 1) <= MATCH_TOL and mac(shape, m.shape) >= MAC_MATCH
-        ]
+        dists = [(continues(f, shape, m.frequency, m.shape), m) for m in self._modes]
+        near = [(d, m) for d, m in dists if d is not None]
         if near:
-            mode = min(near, key=lambda m: abs(f / m.frequency - 1))
+            mode = min(near, key=lambda pair: pair[0])[1]
             similarity = mac(shape, mode.shape)
             mode.frequency, mode.shape, mode.last_t = f, shape, t
         else:
