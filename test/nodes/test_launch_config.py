@@ -17,6 +17,7 @@ import yaml
 
 from vib_estimator.core import EstimatorConfig
 from vib_estimator.core.config import PAPER
+from vib_estimator.io.align import ALIGN_TOLERANCE_S
 from vib_estimator.io.fields import DEFAULT_COMPONENT, INPUT_TYPES, WRENCH_STAMPED
 from vib_estimator.nodes.estimator_node import EstimatorNode
 from vib_estimator.nodes.parameters import config_of
@@ -32,6 +33,8 @@ def test_params_file_holds_the_defaults():
     assert params.pop('input_topic') == 'coupling_torque'
     assert params.pop('component') == DEFAULT_COMPONENT[WRENCH_STAMPED]
     assert params.pop('components') == []
+    assert params.pop('input_topics') == []
+    assert params.pop('sync_tolerance_s') == ALIGN_TOLERANCE_S
     defaults = EstimatorConfig()
     assert set(params) == set(EstimatorConfig.names())
     for name, value in params.items():

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import re
 from operator import attrgetter
-from typing import Callable, Dict, Optional, Tuple
+from typing import Callable, Dict, Optional, Sequence, Tuple
 
 WRENCH_STAMPED = 'geometry_msgs/msg/WrenchStamped'
 #: the topic estimator_node reads by default (and ``analyze`` picks in a bag of several inputs)
@@ -148,6 +148,14 @@ def channels_of(component: str, components, input_type: str = WRENCH_STAMPED) ->
     if components:
         return check_components(components, input_type)
     return (check_component(component, input_type),)
+
+
+def topic_channels(topics: Sequence[str], fields: Tuple[str, ...]) -> Tuple[str, ...]:
+    """The channel names of ``fields`` read from each of ``topics``: the fields themselves for one
+    topic, ``topic:field`` for each topic and field (topic by topic) for several."""
+    if len(topics) < 2:
+        return tuple(fields)
+    return tuple(f'{topic}:{field}' for topic in topics for field in fields)
 
 
 def channels_getter(

@@ -11,7 +11,11 @@ and the diagnostics bookkeeping, all without rclpy) and publishes what comes bac
   (read-only; the types and components of :mod:`vib_estimator.io.fields`), best-effort sensor-data
   QoS with a deeper history (:data:`INPUT_DEPTH`); field ``component``, or with ``components``
   several fields of each message, estimated jointly (free decays or ``excitation`` ambient:
-  docs/channels.md).
+  docs/channels.md); with ``input_topics`` (read-only, two or more topics of ``input_type``, which
+  must have a header) the fields of each topic, the topics' samples aligned by header stamp
+  within ``sync_tolerance_s`` (:mod:`vib_estimator.io.align`: the first topic is the time base; a
+  message lost on one topic costs that joint sample; a stalled topic makes the status WARN and the
+  others wait, bounded), channels named ``topic:field``.
 * Output, on each estimate and in this order (:class:`Outputs`): ``vibration/frequency``,
   ``vibration/damping_ratio``, ``vibration/frequency_std``, ``vibration/amplitude``
   (std_msgs/Float64), then ``vibration/reset`` (std_msgs/Header: stamp and frame_id of the
@@ -37,6 +41,7 @@ from __future__ import annotations
 import importlib
 import sys
 import time
+from functools import partial
 from typing import Optional
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
@@ -52,6 +57,7 @@ from ..core.config import EstimatorConfig
 from ..core.multichannel import MIN_CHANNELS, JointEstimate
 from ..core.shapes import SHAPE_ROWS, phases_deg, signed_amplitudes
 from ..errors import StartupError
+from ..io.align import StampAligner
 from ..io.fields import (
     channels_getter,
     channels_of,
@@ -60,6 +66,7 @@ from ..io.fields import (
     check_input_type,
     has_header,
     stamp_ns,
+    topic_channels,
 )
 from . import health as H
 from .parameters import (
@@ -197,18 +204,32 @@ class EstimatorNode(Node):
 
     def __init__(self, **kwargs):
         super().__init__('estimator_node', **kwargs)
-        self._input_type, topic = declare_input(self)
+        self._input_type, topics, tolerance = declare_input(self)
+        #: the input topics (several: resolved, their channels are named after them)
+        self._topics = topics if len(topics) < 2 else tuple(map(self.resolve_topic_name, topics))
         declare_config(self)
         #: warnings about params files that set nothing for this node (also logged)
         self.params_file_warnings = warn_unused_params_files(self, kwargs.get('cli_args'))
         try:
-            self._channels = self._read_channels()
-            self._value = channels_getter(self._channels, self._input_type)
+            self._fields = self._read_fields()
+            self._channels = topic_channels(self._topics, self._fields)
+            self._value = channels_getter(self._fields, self._input_type)
             self._stream = EstimatorStream(
                 config_of(self), time.monotonic(), background=True, channels=self._channels
             )
         except ValueError as err:
             raise StartupError(str(err)) from None
+        #: several input topics: their samples aligned by stamp (io.align), counted in the
+        #: node's counters
+        self._aligner = None
+        if len(self._topics) > 1:
+            self._aligner = StampAligner(
+                len(self._topics),
+                round(tolerance * 1e9),
+                counters=self._stream.health.node_counters,
+                jump_ns=round(self._stream.config.max_gap * 1e9),
+            )
+        self._align_tick: dict = {}
         self._feed = self._stream.feed  # bound once (data path)
         self._ready = self._stream.ready
         self._clock = self.get_clock()
@@ -225,12 +246,15 @@ class EstimatorNode(Node):
             reliability=qos_profile_sensor_data.reliability,
             durability=qos_profile_sensor_data.durability,
         )
-        self._subscription = self.create_subscription(
-            message_class(self._input_type),
-            topic,
-            self._on_stamped if has_header(self._input_type) else self._on_unstamped,
-            qos,
-        )
+        if self._aligner is None:
+            callbacks = [self._on_stamped if has_header(self._input_type) else self._on_unstamped]
+        else:
+            callbacks = [partial(self._on_topic, i) for i in range(len(self._topics))]
+        self._subscriptions_in = [
+            self.create_subscription(message_class(self._input_type), topic, callback, qos)
+            for topic, callback in zip(self._topics, callbacks)
+        ]
+        self._input_names = ','.join(sub.topic_name for sub in self._subscriptions_in)
         self.add_on_set_parameters_callback(self._check_parameters)
         self.add_post_set_parameters_callback(self._apply_parameters)
         self._diagnostics_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
@@ -241,13 +265,13 @@ class EstimatorNode(Node):
         self._warmup_timer = self.create_timer(WARMUP_POLL, self._poll_warmup, clock=steady)
         self._warmup_logged = False
         self.get_logger().info(
-            f'estimating on {self._subscription.topic_name} '
+            f'estimating on {self._input_names} '
             f'({self._input_type} [{", ".join(self._channels)}]) with '
             f'{self._stream.config}'
         )
 
-    def _read_channels(self):
-        """The channels of the current ``component`` / ``components`` (ValueError if bad)."""
+    def _read_fields(self):
+        """The fields of the current ``component`` / ``components`` (ValueError if bad)."""
         return channels_of(
             self.get_parameter('component').value,
             self.get_parameter('components').value,
@@ -267,7 +291,10 @@ class EstimatorNode(Node):
             check_component(fields['component'], self._input_type)
             check_components(fields['components'] or (), self._input_type)
             config = self._stream.config.replace(**changes)
-            check_channels(channels_of(**fields, input_type=self._input_type), config)
+            check_channels(
+                topic_channels(self._topics, channels_of(**fields, input_type=self._input_type)),
+                config,
+            )
         except ValueError as err:
             return SetParametersResult(successful=False, reason=str(err))
         return SetParametersResult(successful=True)
@@ -277,8 +304,12 @@ class EstimatorNode(Node):
         names = {p.name for p in parameters}
         if not names & (CORE_NAMES | FIELD_NAMES):
             return
-        self._channels = self._read_channels()
-        self._value = channels_getter(self._channels, self._input_type)
+        self._fields = self._read_fields()
+        self._channels = topic_channels(self._topics, self._fields)
+        self._value = channels_getter(self._fields, self._input_type)
+        if self._aligner is not None:  # the queued samples may carry other fields
+            self._aligner.clear()
+            self._aligner.jump_ns = round(config_of(self).max_gap * 1e9)
         self._stream.configure(config_of(self), self._channels)
         self._outputs.set_modes(self._stream.config.modes)
         self._outputs.set_channels(self._channels, self._stream.config.modes)
@@ -321,6 +352,25 @@ class EstimatorNode(Node):
         if estimates:
             self._publish(estimates, Header(stamp=Time(nanoseconds=now).to_msg()))
 
+    def _on_topic(self, index: int, msg) -> None:
+        """A message of input topic ``index`` (several ``input_topics``): its values wait in the
+        aligner until every topic has a sample of the same stamp (:mod:`..io.align`)."""
+        value = self._value(msg)
+        if value is None:
+            self._skip_joint_missing()
+            return
+        header = msg.header
+        if header.stamp.sec == 0 and header.stamp.nanosec == 0:
+            self._replace_zero_stamp(header)
+        values = value if isinstance(value, tuple) else (value,)
+        for stamp, joint, first in self._aligner.push(index, stamp_ns(header), values, header):
+            if not self._ready:
+                self._hold(stamp, joint, first)
+                continue
+            estimates = self._feed(stamp, joint)
+            if estimates:
+                self._publish(estimates, first)
+
     def _publish(self, estimates, header: Header) -> None:
         """Publish the estimates of the sample of ``header`` (see :class:`Outputs`)."""
         for item in estimates:
@@ -336,7 +386,7 @@ class EstimatorNode(Node):
         """Keep a sample until the kernels are ready (the first drop is logged once)."""
         if self._stream.hold(stamp, value, header):
             self.get_logger().warn(
-                f'{self._subscription.topic_name}: more than {WARMUP_BUFFER} samples arrived '
+                f'{self._input_names}: more than {WARMUP_BUFFER} samples arrived '
                 'while the estimator kernels compiled: the oldest are dropped (counted as '
                 'dropped_warmup; `vib-estimator warmup` compiles them ahead of a start)'
             )
@@ -384,7 +434,7 @@ class EstimatorNode(Node):
         if self._stream.health.count('zero_stamps_replaced') == 1:  # warn once (rclpy's once=True
             # costs ~0.15 ms a call)
             self.get_logger().warn(
-                f'{self._subscription.topic_name}: zero header stamps are '
+                f'{self._input_names}: zero header stamps are '
                 'replaced by the receipt time (counted in the diagnostics)'
             )
 
@@ -392,7 +442,7 @@ class EstimatorNode(Node):
         """Count (and the first time, log) a JointState message without the configured joint."""
         if self._stream.health.count('skipped_joint_missing') == 1:
             self.get_logger().warn(
-                f'{self._subscription.topic_name}: messages without the '
+                f'{self._input_names}: messages without the '
                 f'joint of [{", ".join(self._channels)}] are skipped (counted in the '
                 'diagnostics)'
             )
@@ -425,6 +475,17 @@ class EstimatorNode(Node):
         """Publish the status; log the last estimate every 10 s (rclpy's throttled logging costs
         ~0.15 ms a call, too much for the data path)."""
         status = self._stream.status(time.monotonic())
+        if self._aligner is not None:
+            counters = self._stream.health.node_counters
+            lagging = self._aligner.lagging(round(H.STALE_AFTER * 1e9))
+            status = H.alignment_status(
+                status,
+                [self._subscriptions_in[i].topic_name for i in lagging],
+                self._aligner.pending,
+                counters,
+                self._align_tick,
+            )
+            self._align_tick = {name: counters[name] for name in H.ALIGN_PROBLEMS}
         if status.log:
             self.get_logger().warn(status.log)
         array = DiagnosticArray(
@@ -433,7 +494,7 @@ class EstimatorNode(Node):
                     level=LEVELS[status.level],
                     name=self.get_fully_qualified_name(),
                     message=status.message,
-                    hardware_id=self._subscription.topic_name,
+                    hardware_id=self._input_names,
                     values=[
                         KeyValue(key=key, value=H.format_value(value))
                         for key, value in status.values.items()

@@ -16,7 +16,7 @@ is the time base of the estimator (seconds since the first stamp).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Dict, Mapping, Optional, Sequence
 
 #: levels, equal to ``diagnostic_msgs/DiagnosticStatus``'s
@@ -78,6 +78,44 @@ class _Last:
 
     estimate: object
     at: float
+
+
+#: the aligner's counters whose growth since the previous status is a problem (see
+#: :func:`alignment_status`)
+ALIGN_PROBLEMS = ('dropped_unaligned', 'dropped_stalled')
+
+
+def alignment_status(
+    status: Status,
+    lagging: Sequence[str],
+    pending: int,
+    counters: Mapping[str, int],
+    before: Mapping[str, int],
+) -> Status:
+    """``status`` of a node reading several input topics (``io.align.StampAligner``): with the
+    samples ``pending`` (waiting for a partner) and the ``lagging`` topics (behind the others by
+    more than :data:`STALE_AFTER` s of stamps) among its values; WARN (or, STALE, the reason) when
+    a topic lags or the :data:`ALIGN_PROBLEMS` counters grew since ``before``."""
+    values = {**status.values, 'pending_aligned': pending, 'lagging_topics': ','.join(lagging)}
+    problems = []
+    if lagging:
+        problems.append(
+            f'{", ".join(lagging)} behind the other input topics by more than {STALE_AFTER:g} s: '
+            'no joint sample until they resume (the others wait, then their oldest are dropped)'
+        )
+    grown = {name: counters.get(name, 0) - before.get(name, 0) for name in ALIGN_PROBLEMS}
+    if grown['dropped_unaligned']:
+        problems.append(
+            f'{grown["dropped_unaligned"]} samples without a partner within sync_tolerance_s on '
+            'every input topic dropped'
+        )
+    if grown['dropped_stalled']:
+        problems.append(f'{grown["dropped_stalled"]} samples dropped waiting for a stalled topic')
+    if not problems:
+        return replace(status, values=values)
+    text = '; '.join(problems)
+    message = text if status.level == OK else f'{status.message}; {text}'
+    return replace(status, level=max(status.level, WARN), message=message, values=values)
 
 
 def format_value(value) -> str:

@@ -17,6 +17,7 @@ from rclpy.parameter import Parameter
 
 from ..core.config import EstimatorConfig
 from ..errors import StartupError
+from ..io.align import ALIGN_TOLERANCE_S
 from ..io.fields import (
     DEFAULT_COMPONENT,
     DEFAULT_INPUT_TOPIC,
@@ -24,6 +25,7 @@ from ..io.fields import (
     WRENCH_STAMPED,
     check_input_type,
     describe_components,
+    has_header,
 )
 
 
@@ -92,9 +94,10 @@ def config_of(node: Node) -> EstimatorConfig:
 
 
 def declare_input(node: Node, default_topic: str = DEFAULT_INPUT_TOPIC):
-    """Declare ``input_type`` and ``input_topic`` (read-only), ``component`` (its default that
-    of the type) and ``components`` (default ``[]``: ``component`` alone); return (the type's full
-    name, the topic)."""
+    """Declare ``input_type``, ``input_topic``, ``input_topics`` and ``sync_tolerance_s``
+    (read-only), ``component`` (its default that of the type) and ``components`` (default ``[]``:
+    ``component`` alone); return (the type's full name, the topics: ``input_topics`` when it names
+    two or more, else ``(input_topic,)``, the stamp tolerance in s)."""
     input_type = declare(
         node,
         'input_type',
@@ -111,25 +114,61 @@ def declare_input(node: Node, default_topic: str = DEFAULT_INPUT_TOPIC):
         default_topic,
         descriptor('input topic, of type input_type', read_only=True),
     )
+    topics = declare_array(
+        node,
+        'input_topics',
+        descriptor(
+            "several input topics of type input_type, aligned by header stamp: each topic's "
+            'component (or components) are its channels, named topic:field, identified jointly '
+            '([] = input_topic alone)',
+            read_only=True,
+        ),
+    )
+    tolerance = declare(
+        node,
+        'sync_tolerance_s',
+        ALIGN_TOLERANCE_S,
+        descriptor(
+            'with input_topics: the samples of the topics whose stamps lie within this of each '
+            'other are one joint sample, s',
+            (0.0, 1.0),
+            read_only=True,
+        ),
+    )
+    if len(set(topics)) != len(topics) or any(not t for t in topics):
+        raise StartupError(f'input_topics must name distinct topics, got {list(topics)}')
+    if len(topics) >= 2 and not has_header(input_type):
+        raise StartupError(
+            f'input_topics needs a stamped input_type (its samples are aligned by header '
+            f'stamp): {input_type} has no header'
+        )
     declare(
         node,
         'component',
         DEFAULT_COMPONENT[input_type],
         descriptor(f'field of the input to estimate on: {describe_components(input_type)}'),
     )
-    declare(
+    declare_array(
         node,
         'components',
-        Parameter.Type.STRING_ARRAY,
         descriptor(
             'several fields of the input, one channel each, identified jointly with their mode '
             'shapes (excitation free or ambient; [] = component alone): '
             + describe_components(input_type)
         ),
     )
-    if node.get_parameter_or('components').type_ == Parameter.Type.NOT_SET:
-        node.set_parameters([Parameter('components', Parameter.Type.STRING_ARRAY, [])])
-    return input_type, topic
+    return input_type, (tuple(topics) if len(topics) >= 2 else (topic,)), tolerance
+
+
+def declare_array(node: Node, name: str, desc: ParameterDescriptor) -> Tuple[str, ...]:
+    """Declare a string-array parameter whose default is ``[]``; return its value (a writable
+    one left unset is set to ``[]``, so that it reads as an array)."""
+    declare(node, name, Parameter.Type.STRING_ARRAY, desc)
+    if node.get_parameter_or(name).type_ == Parameter.Type.NOT_SET:
+        if desc.read_only:
+            return ()
+        node.set_parameters([Parameter(name, Parameter.Type.STRING_ARRAY, [])])
+    return tuple(node.get_parameter(name).value)
 
 
 def params_files(args: Optional[Sequence[str]]) -> List[str]:
