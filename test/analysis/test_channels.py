@@ -150,3 +150,66 @@ def test_bad_components_are_one_error_line(bags, capsys, options, message):
 def test_components_of_a_csv_file_are_refused(record, capsys):
     assert main(['analyze', str(record), '--components', 'a,b', *AMBIENT]) == 2
     assert '--components reads bags only' in capsys.readouterr().err
+
+
+TOPICS = ['/joint1/wrench', '/joint2/wrench', '/joint3/wrench']
+
+
+@pytest.fixture(scope='module')
+def topic_bag(tmp_path_factory):
+    """The channels of ``bags`` on three WrenchStamped topics of one bag (torque.z), a message of
+    the second topic lost now and then, and a CSV file of the samples every topic has."""
+    from vib_estimator.io.bags import BagWriter, channels_message
+    from vib_estimator.io.fields import WRENCH_STAMPED
+
+    t, y = modal_record(80.0, 20.0, MODES, SHAPES, snr_db=20.0, seed=4)
+    stamps = EPOCH_NS + np.round(t * 1e9).astype(np.int64)
+    lost = set(range(100, len(t), 97))
+    folder = tmp_path_factory.mktemp('topic_bags')
+    with BagWriter(folder / 'wrench') as bag:
+        conns = [bag.add_topic(topic, WRENCH_STAMPED) for topic in TOPICS]
+        for k, stamp in enumerate(stamps.tolist()):
+            for i, conn in enumerate(conns):
+                if not (i == 1 and k in lost):
+                    msg = channels_message(WRENCH_STAMPED, stamp, '', ['torque.z'], [y[k, i]])
+                    bag.write_message(conn, stamp, msg)
+    keep = np.array([k not in lost for k in range(len(t))])
+    csv = folder / 'kept.csv'
+    kept = stamps[keep]
+    lines = [
+        f'{s!r},{a!r},{b!r},{c!r}'
+        for s, (a, b, c) in zip(seconds_since(kept, kept[0]).tolist(), y[keep].tolist())
+    ]
+    csv.write_text('time,a,b,c\n' + '\n'.join(lines) + '\n')
+    return folder, len(lost)
+
+
+def test_several_topics_of_a_bag_are_aligned_by_stamp(topic_bag, capsys):
+    """``--topics``: the fields of three topics joined by stamp give the rows of the CSV file of
+    the samples every topic has; each lost message costs its stamp (counted)."""
+    folder, lost = topic_bag
+    csv, _ = joint_rows(capsys, folder / 'kept.csv', '--columns', 'all')
+    assert len(csv) > 20
+    rows, err = joint_rows(
+        capsys, folder / 'wrench', '--topics', ','.join(TOPICS), '--component', 'torque.z'
+    )
+    names = [f'{topic}:torque.z' for topic in TOPICS]
+    assert f'channels={",".join(names)}' in err
+    assert f'dropped_unaligned={2 * lost}' in err and 'dropped_stalled=0' in err
+    assert [r.pop('stamp_ns') for r in rows] == [EPOCH_NS + round(r['t'] * 1e9) for r in rows]
+    assert [renamed(r, names) for r in rows] == csv
+
+
+@pytest.mark.parametrize(
+    'options, message',
+    [
+        (['--topics', ','.join(TOPICS), '--topic', TOPICS[0]], 'not both'),
+        (['--topics', f'{TOPICS[0]},{TOPICS[0]}'], 'twice'),
+        (['--topics', f'{TOPICS[0]},/nope'], "no topic '/nope'"),
+        (['--topics', ','.join(TOPICS), '--excitation', 'auto'], 'need --excitation free'),
+    ],
+)
+def test_bad_topics_are_one_error_line(topic_bag, capsys, options, message):
+    assert main(['analyze', str(topic_bag[0] / 'wrench'), *options]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and 'error:' in err[0] and message in err[0], err

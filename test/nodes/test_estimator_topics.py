@@ -52,7 +52,10 @@ class TopicsProbe:
         self.frequencies, self.shapes, self.diagnostics = [], [], []
         subs = [
             self.probe.create_subscription(
-                Float64, 'vibration/mode1/frequency', lambda m: self.frequencies.append(m.data), 100
+                Float64,
+                'vibration/mode1/frequency',
+                lambda m: self.frequencies.append(m.data),
+                100,
             ),
             self.probe.create_subscription(
                 Float64MultiArray, 'vibration/mode1/shape', self.shapes.append, 100
@@ -65,8 +68,10 @@ class TopicsProbe:
         executor.add_node(self.probe)
         assert spin_until(
             executor,
-            lambda: all(p.get_subscription_count() >= 1 for p in self.pubs)
-            and all(s.get_publisher_count() >= 1 for s in subs),
+            lambda: (
+                all(p.get_subscription_count() >= 1 for p in self.pubs)
+                and all(s.get_publisher_count() >= 1 for s in subs)
+            ),
             10.0,
         )
         self.sent = 0

@@ -32,9 +32,10 @@ from ..core import MODELS, EstimateArrays, EstimatorConfig
 from ..core.config import EXCITATIONS, PAPER
 from ..core.modes import create_estimator
 from ..errors import VibEstimatorError, report
+from ..io.align import ALIGN_TOLERANCE_S
 from ..io.fields import INPUT_TYPES, signal_unit
 from ..io.streaming import Signal, open_signal
-from .channels import channel_names, component_names, run_joint
+from .channels import channel_names, component_names, need_joint, run_joint, topic_list
 from .outputs import check_output
 from .summary import summarise_modes, summary_lines
 
@@ -73,6 +74,19 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="field of the messages, as the node's component "
         "parameter (default: the type's, e.g. torque.z of a WrenchStamped, "
         'linear_acceleration.z of an Imu)',
+    )
+    parser.add_argument(
+        '--topics',
+        help='several topics of a bag, comma-separated: the --component (or --components) of '
+        "each, their samples aligned by header stamp as the node's input_topics, one set of "
+        'modes with their shapes (channels topic:field; docs/channels.md)',
+    )
+    parser.add_argument(
+        '--sync-tolerance-s',
+        type=float,
+        default=ALIGN_TOLERANCE_S,
+        help='--topics: samples whose stamps lie within this of each other are one joint sample '
+        f"(default {ALIGN_TOLERANCE_S:g} s, as the node's sync_tolerance_s)",
     )
     parser.add_argument(
         '--components',
@@ -325,6 +339,13 @@ def run(args: argparse.Namespace) -> int:
             if len(names) > 1:
                 return run_joint(args, config, names, json_row, 'analyze')
             args.column = names[0]  # one column: exactly --column
+        if getattr(args, 'topics', None) is not None:
+            args.topics_list = topic_list(args)
+            if len(args.topics_list) > 1:
+                names = component_names(args) if args.components is not None else []
+                need_joint(f'{len(args.topics_list)} topics', config)
+                return run_joint(args, config, names, json_row, 'analyze', damage_warning)
+            args.topic = args.topics_list[0]  # one topic: exactly --topic
         if getattr(args, 'components', None) is not None:
             names = component_names(args)
             if len(names) > 1:

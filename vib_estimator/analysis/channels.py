@@ -1,7 +1,10 @@
 # Copyright 2026 vib_estimator developers
 # SPDX-License-Identifier: Apache-2.0
-"""``analyze --columns a,b,c|all`` (CSV) and ``analyze BAG --components a,b,c`` (several fields
-of one bag topic): several channels, one set of modes with their shapes.
+"""``analyze --columns a,b,c|all`` (CSV), ``analyze BAG --components a,b,c`` (several fields
+of one bag topic) and ``analyze BAG --topics /a,/b,/c`` (the ``--component`` or
+``--components`` of several topics, their samples aligned by header stamp as the node's
+``input_topics``: :mod:`..io.align`; channels ``topic:field``): several channels, one set of
+modes with their shapes.
 
 One column (``--columns b``) is exactly ``--column b``, one component exactly ``--component``.
 Two or more go to the joint estimator of the excitation: free decays
@@ -27,8 +30,8 @@ from ..core.multichannel_free import JOINT_EXCITATIONS, create_joint_estimator
 from ..core.shapes import SHAPE_ROWS, phases_deg, signed_amplitudes
 from ..errors import BagError, CsvError
 from ..io.csv_reader import column_names, read_csv_columns
-from ..io.fields import UNKNOWN_UNIT, signal_unit
-from ..io.streaming import is_csv, open_signal
+from ..io.fields import UNKNOWN_UNIT, seconds_since, signal_unit
+from ..io.streaming import is_csv, open_signal, read_topics
 from .summary import summarise_modes, summary_lines
 
 
@@ -88,6 +91,46 @@ def read_channels(path, topic, names, strict: bool = False, info=None):
         raise ValueError(f'topic {signal.topic} of {signal.path} has no messages')
     t, y = (np.concatenate(part) for part in zip(*blocks))
     return t, y, list(signal.components), signal
+
+
+def topic_list(args) -> tuple[str, ...]:
+    """The ``--topics`` of the bag input (BagError for a CSV file, with ``--topic`` too, or an
+    empty or repeated name)."""
+    if is_csv(args.input):
+        raise BagError('--topics reads bags only')
+    if args.topic is not None:
+        raise BagError('give --topic or --topics, not both')
+    try:
+        return channel_list('--topics', args.topics)
+    except ValueError as err:
+        raise BagError(str(err)) from None
+
+
+def read_joint(args, names):
+    """``(t, Y, channel names, the bags' signals (none for CSV), the first stamp in ns, the
+    alignment's counters)`` of ``analyze``'s several channels: CSV ``--columns``, a bag topic's
+    ``--components`` or the fields of several ``--topics`` aligned by stamp
+    (:func:`..io.streaming.read_topics`)."""
+    strict = getattr(args, 'strict', False)
+    topics = getattr(args, 'topics_list', ())
+    if len(topics) < 2:
+        t, y, names, signal = read_channels(args.input, args.topic, names, strict)
+        if signal is None:
+            return t, y, names, (), 0, {}
+        return t, y, names, (signal,), signal.origin_ns, {}
+    aligned = read_topics(
+        args.input,
+        topics,
+        args.component,
+        names or None,
+        round(args.sync_tolerance_s * 1e9),
+        strict,
+    )
+    if not len(aligned.stamps):
+        raise ValueError(f'the topics {", ".join(topics)} of {args.input} have no joint sample')
+    origin = int(aligned.stamps[0])
+    t = seconds_since(aligned.stamps, origin)
+    return t, aligned.values, list(aligned.channels), aligned.signals, origin, aligned.counters
 
 
 def joint_run(t: np.ndarray, y: np.ndarray, names, config: EstimatorConfig):
@@ -224,19 +267,20 @@ def run_joint(args, config: EstimatorConfig, names, json_row, prog: str, warn=No
     with their shapes on stdout, the counters and the summary on stderr, ``--plot``; ``warn``
     (signal, prog) says what a bag's read skipped. Bad input raises (CsvError, BagError,
     ValueError) before anything is printed."""
-    t, y, names, signal = read_channels(
-        args.input, args.topic, names, getattr(args, 'strict', False)
-    )
+    t, y, names, signals, origin, counters = read_joint(args, names)
     estimator, result = joint_run(t, y, names, config)
     table = rows(result)
     extra = ''
-    if signal is not None:
+    if signals:
         if warn is not None:
-            warn(signal, prog)
+            for signal in signals:
+                warn(signal, prog)
         for row in table:
-            row['stamp_ns'] = signal.origin_ns + round(row['t'] * 1e9)
-        extra = f', messages_without_component={signal.skipped}' if signal.skipped else ''
-        extra += f', corrupt_records={signal.corrupt}'
+            row['stamp_ns'] = origin + round(row['t'] * 1e9)
+        skipped = sum(signal.skipped for signal in signals)
+        extra = f', messages_without_component={skipped}' if skipped else ''
+        extra += f', corrupt_records={sum(signal.corrupt for signal in signals)}'
+        extra += ''.join(f', {k}={v}' for k, v in counters.items())
     print_rows(table, args.format, json_row)
     print(
         f'{prog}: channels={",".join(names)}, '
@@ -251,6 +295,6 @@ def run_joint(args, config: EstimatorConfig, names, json_row, prog: str, warn=No
         shape = ', '.join(f'{n} {a:+.2f}' for n, a in zip(names, amp))
         print(f'{prog}: mode {k} ({f:.3f} Hz) shape: {shape}', file=sys.stderr)
     if args.plot:
-        unit = signal_unit(names[0]) if signal is not None else UNKNOWN_UNIT
+        unit = signal_unit(names[0].rsplit(':', 1)[-1]) if signals else UNKNOWN_UNIT
         plot_shapes(args.plot, str(args.input), result, unit, config.excitation)
     return 0

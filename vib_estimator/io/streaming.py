@@ -41,6 +41,7 @@ from rosbags.rosbag2 import Reader
 
 from ..errors import BagError, CdrLayoutError, DamageCount, McapFormatError, as_bag_error
 from . import cdr, mcap
+from .align import StampAligner
 from .bags import TYPESTORE, check_bag_path, only_topic
 from .csv_reader import csv_blocks, csv_layout
 from .fields import (
@@ -54,6 +55,7 @@ from .fields import (
     normalise_type,
     seconds_since,
     stamp_ns,
+    topic_channels,
 )
 
 #: samples per block handed to the estimator (bags: chunks are grouped up to this size)
@@ -93,12 +95,16 @@ class Signal(DamageCount):
         if not self.topic:
             yield from self._source()
             return
-        for stamps, values in self._source():
-            if len(stamps) == 0:
-                continue
+        for stamps, values in self.stamped():
             if self.origin_ns is None:
                 self.origin_ns = int(stamps[0])
             yield seconds_since(stamps, self.origin_ns), values
+
+    def stamped(self) -> Iterator[Block]:
+        """A bag topic's non-empty blocks as ``(stamps in ns, values)``."""
+        for stamps, values in self._source():
+            if len(stamps):
+                yield stamps, values
 
 
 def is_csv(path) -> bool:
@@ -224,6 +230,63 @@ def bag_signal(
     signal = Signal(path, label, topic, msgtype, component, fields, strict=strict)
     signal._source = lambda: _counted(signal, _bag_blocks(signal, files), expected)
     return signal
+
+
+@dataclass(frozen=True)
+class AlignedTopics:
+    """Several topics of a bag read whole and aligned by header stamp (:func:`read_topics`):
+    the joint samples' ``stamps`` (ns, the first topic's) and ``values`` (a column per channel,
+    topic by topic), the channels' names (``topic:field``), each topic's :class:`Signal` (its
+    skipped and damaged records) and the aligner's counters (:data:`.align.ALIGN_COUNTERS`)."""
+
+    stamps: np.ndarray
+    values: np.ndarray
+    channels: Tuple[str, ...]
+    signals: Tuple[Signal, ...]
+    counters: Dict[str, int]
+
+
+def read_topics(
+    path,
+    topics: Sequence[str],
+    component: Optional[str],
+    components: Optional[Sequence[str]],
+    tolerance_ns: int,
+    strict: bool = False,
+    info: Optional[BagInfo] = None,
+) -> AlignedTopics:
+    """The fields (``components``, else ``component``, else each type's default) of each of the
+    bag's ``topics``, their samples aligned by stamp as the node aligns its ``input_topics``
+    (:class:`.align.StampAligner`, fed in stamp order; raises BagError or ValueError)."""
+    path = Path(path)
+    info = info or bag_info(path)
+    signals = tuple(bag_signal(path, t, component, strict, components, info) for t in topics)
+    fields = signals[0].components or (signals[0].component,)
+    if any((s.components or (s.component,)) != fields for s in signals):
+        raise ValueError(
+            f'the topics {", ".join(topics)} default to different fields: give --component(s)'
+        )
+    stamps, values, source = [], [], []
+    for i, signal in enumerate(signals):
+        for st, v in signal.stamped():
+            stamps.append(st.astype(np.int64))
+            values.append(np.asarray(v, dtype=np.float64).reshape(len(st), -1))
+            source.append(np.full(len(st), i))
+    m = len(fields)
+    if not stamps:
+        return AlignedTopics(
+            np.empty(0, np.int64), np.empty((0, m * len(topics))), (), signals, {}
+        )
+    st, v, src = np.concatenate(stamps), np.concatenate(values), np.concatenate(source)
+    order = np.lexsort((src, st))  # by stamp, the topics in their order at equal stamps
+    aligner = StampAligner(len(topics), tolerance_ns, depth=len(st))
+    out = []
+    for k in order.tolist():
+        out.extend(aligner.push(int(src[k]), int(st[k]), v[k]))
+    joint_stamps = np.array([o[0] for o in out], dtype=np.int64)
+    joint = np.array([o[1] for o in out], dtype=np.float64).reshape(len(out), m * len(topics))
+    names = topic_channels([s.topic for s in signals], fields)
+    return AlignedTopics(joint_stamps, joint, names, signals, dict(aligner.counters))
 
 
 def _storage_files(reader, path: Path) -> List[Path]:
