@@ -88,10 +88,18 @@ MAC_MATCH = 0.5
 #: ``rows x channels`` above the highest order; the SVD costs 8 times less; on the shear frame,
 #: two seeds, as accurate as 40 rows)
 JOINT_BLOCK_ROWS = BLOCK_ROWS // 2
-#: with many channels fewer block rows: ``rows x channels`` at most about this (the 5-storey
-#: frame's 100; the SVD's cost grows as its cube: 8 channels, 13 rows, 1.4x faster in all;
-#: the Heritage Court Tower's 6 channels, 17 rows: the same 6 modes, none > 2 % off)
-JOINT_HANKEL = 100
+#: with many channels fewer block rows: ``rows x channels`` at most about this (above the
+#: highest model order, ``ORDERS``' 28). Measured on the 5-storey frame (5 channels, 10 seeds,
+#: RMS frequency error of every estimate, modes 1-5; benchmarks/bench_channels.py): 100 (20
+#: rows) 0.94/0.63/0.52/0.47/0.41 %, 60 (12) 0.93/0.60/0.48/0.41/0.41, 40 (8)
+#: 0.84/0.58/0.45/0.39/0.39; 150 (30) and 200 (40) worse than 100: a shorter Hankel matrix
+#: averages more of the window's correlation estimates per entry. The SVD's cost grows as its
+#: cube.
+JOINT_HANKEL = 40
+#: ... but never fewer block rows than this: the Heritage Court Tower's 6 channels with 7 rows lose
+#: its 3.85 Hz mode (5 of 6 published modes, 1.7 % of estimates off), with 8, 9, 10 or 17 rows
+#: find all 6 (none off)
+JOINT_MIN_ROWS = 8
 #: a mode's Whittle bound counts the modes within this relative frequency of it (farther
 #: ones' skirts carry no information on it, and each bound then costs a few modes, not all)
 NEIGHBOURS = 0.2
@@ -125,8 +133,9 @@ def normalise_shape(phi: np.ndarray) -> np.ndarray:
 # ---- one window ---------------------------------------------------------------------------------
 def joint_rows(channels: int) -> int:
     """Block rows of the joint Hankel matrix of ``channels`` channels: :data:`JOINT_BLOCK_ROWS`,
-    fewer when that would make it larger than :data:`JOINT_HANKEL`."""
-    return min(JOINT_BLOCK_ROWS, -(-JOINT_HANKEL // channels))
+    fewer when that would make it larger than :data:`JOINT_HANKEL` (at least
+    :data:`JOINT_MIN_ROWS`)."""
+    return max(JOINT_MIN_ROWS, min(JOINT_BLOCK_ROWS, -(-JOINT_HANKEL // channels)))
 
 
 def joint_poles(r: np.ndarray, fs: float, orders: Sequence[int] = ORDERS) -> list[np.ndarray]:
@@ -311,6 +320,11 @@ def identify_joint(
         if level > 0 or not (search or top_hz <= 0):  # (no search pass ran at fs)
             strong = modes_at(level)
     rows, shapes, spread, noise, best = strong
+    if np.any(flat) and len(shapes):
+        # a constant channel does not move: its entries are the eigenvectors' rounding (1e-12)
+        shapes = shapes.copy()
+        shapes[:, flat] = 0.0
+        shapes = np.array([normalise_shape(phi) for phi in shapes]).reshape(shapes.shape)
     std = np.full((len(rows), 2), math.nan)
     for j, c in enumerate(best):
         # the bound on the mode's best channel, with the modes there within NEIGHBOURS of it
