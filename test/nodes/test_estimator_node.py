@@ -37,7 +37,7 @@ from vib_estimator.io.fields import seconds_since
 from vib_estimator.nodes import stream
 from vib_estimator.nodes.estimator_node import EstimatorNode, message_class
 from vib_estimator.nodes.parameters import config_of
-from vib_estimator.nodes.runner import StartupError, spin_until
+from vib_estimator.nodes.runner import StartupError, spin_until, spin_until_arrival
 from vib_estimator.sim.frame import modal_record
 
 EPOCH_NS = 1_000_000_000 * 1_000_000_000  # synthetic stamps start in 2001, far from "now"
@@ -182,15 +182,10 @@ class Probe:
 
     def wait_status(self, predicate, timeout=5.0) -> DiagnosticStatus:
         """Spin until a /diagnostics status satisfies ``predicate``; return it."""
-        start = len(self.diagnostics)
-
-        def found():
-            return any(predicate(a.status[0]) for a in self.diagnostics[start:])
-
-        assert spin_until(self.executor, found, timeout), [
-            (a.status[0].level, a.status[0].message) for a in self.diagnostics[start:]
-        ]
-        return next(a.status[0] for a in self.diagnostics[start:] if predicate(a.status[0]))
+        array = spin_until_arrival(
+            self.executor, self.diagnostics, lambda a: predicate(a.status[0]), timeout
+        )
+        return array.status[0]
 
     def status_age(self, status: DiagnosticStatus, since: float) -> float:
         """Seconds from ``since`` (wall clock, before the samples were sent) to the stamp of the

@@ -325,17 +325,28 @@ class EstimatorNode(Node):
     # ---- data path -------------------------------------------------------------------------
     def _on_stamped(self, msg) -> None:
         """A message with a header: its stamp is the sample's time."""
+        value = self._stamped_value(msg)
+        if value is not None:
+            self._take(stamp_ns(msg.header), value, msg.header)
+
+    def _stamped_value(self, msg):
+        """The channels' value(s) of a message with a header (its zero stamp replaced by the
+        receipt time); None, counted, for a JointState without the configured joints."""
         value = self._value(msg)
         if value is None:
             self._skip_joint_missing()
-            return
+            return None
         header = msg.header
         if header.stamp.sec == 0 and header.stamp.nanosec == 0:
             self._replace_zero_stamp(header)
+        return value
+
+    def _take(self, stamp: int, value, header: Header) -> None:
+        """One sample: held during a warm-up, else estimated on and its estimates published."""
         if not self._ready:
-            self._hold(stamp_ns(header), value, header)
+            self._hold(stamp, value, header)
             return
-        estimates = self._feed(stamp_ns(header), value)
+        estimates = self._feed(stamp, value)
         if estimates:
             self._publish(estimates, header)
 
@@ -355,21 +366,14 @@ class EstimatorNode(Node):
     def _on_topic(self, index: int, msg) -> None:
         """A message of input topic ``index`` (several ``input_topics``): its values wait in the
         aligner until every topic has a sample of the same stamp (:mod:`..io.align`)."""
-        value = self._value(msg)
+        value = self._stamped_value(msg)
         if value is None:
-            self._skip_joint_missing()
             return
-        header = msg.header
-        if header.stamp.sec == 0 and header.stamp.nanosec == 0:
-            self._replace_zero_stamp(header)
         values = value if isinstance(value, tuple) else (value,)
-        for stamp, joint, first in self._aligner.push(index, stamp_ns(header), values, header):
-            if not self._ready:
-                self._hold(stamp, joint, first)
-                continue
-            estimates = self._feed(stamp, joint)
-            if estimates:
-                self._publish(estimates, first)
+        for stamp, joint, first in self._aligner.push(
+            index, stamp_ns(msg.header), values, msg.header
+        ):
+            self._take(stamp, joint, first)
 
     def _publish(self, estimates, header: Header) -> None:
         """Publish the estimates of the sample of ``header`` (see :class:`Outputs`)."""

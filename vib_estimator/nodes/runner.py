@@ -102,6 +102,18 @@ def spin_until(executor, predicate: Callable[[], bool], timeout: float) -> bool:
     return predicate()
 
 
+def spin_until_arrival(executor, arrived: list, predicate: Callable, timeout: float):
+    """Spin ``executor`` until an item appended to ``arrived`` (a subscription's list) after this
+    call satisfies ``predicate``; return it (AssertionError listing what arrived, on time-out)."""
+    start = len(arrived)
+
+    def found():
+        return any(predicate(item) for item in arrived[start:])
+
+    assert spin_until(executor, found, timeout), arrived[start:]
+    return next(item for item in arrived[start:] if predicate(item))
+
+
 def run(
     factory: Callable[[], Node],
     args: Optional[Sequence[str]] = None,
