@@ -83,7 +83,7 @@ class TopicsProbe:
             + c['dropped_unaligned']
             + c['dropped_stalled']
             + c['skipped_stream_order']
-            + self.node._aligner.pending  # noqa: SLF001 -- what the node still waits for
+            + self.node.pending_aligned
         )
 
     def publish(self, samples):

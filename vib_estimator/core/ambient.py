@@ -979,10 +979,10 @@ def whittle_frequencies(
     dt = 1.0 / fs
     out = modes[:, 0].copy()
     for k, (f, zeta, variance) in enumerate(modes[:, :3]):
-        others = np.delete(modes[:, 0], k)
-        gap = float(np.min(np.abs(others - f))) if len(others) else math.inf
         if zeta * f * n / fs < WHITTLE_MIN_BINS or zeta > WHITTLE_MAX_DAMPING:
             continue  # a peak narrower than the bins (their leakage shapes it), or a wide one
+        others = np.delete(modes[:, 0], k)
+        gap = float(np.min(np.abs(others - f))) if len(others) else math.inf
         half = max(min(WHITTLE_SPAN * zeta * f, WHITTLE_GAP * gap), 2 * fs / n)
         near = np.abs(hz - f) <= half
         reach = min(half / 2, WHITTLE_REACH * float(stds[k]))

@@ -470,6 +470,11 @@ class EstimatorNode(Node):
 
     # ---- diagnostics -----------------------------------------------------------------------
     @property
+    def pending_aligned(self) -> int:
+        """With several ``input_topics``: the samples waiting for the other topics (0 else)."""
+        return 0 if self._aligner is None else self._aligner.pending
+
+    @property
     def counters(self):
         """The core counters since start (across parameter changes) and the node's own
         (:data:`~vib_estimator.nodes.health.NODE_COUNTERS`)."""
@@ -485,7 +490,7 @@ class EstimatorNode(Node):
             status = H.alignment_status(
                 status,
                 [self._subscriptions_in[i].topic_name for i in lagging],
-                self._aligner.pending,
+                self.pending_aligned,
                 counters,
                 self._align_tick,
             )
