@@ -196,3 +196,26 @@ def test_gaps_and_outliers_warn_and_are_logged_once_per_episode():
         4.0,
     )
     assert s.level == H.OK and s.values['gaps'] == 3 and s.values['samples_lost'] == 150
+
+
+def test_alignment_status_names_a_lagging_topic_and_new_drops():
+    """Several input topics: the status carries what waits and which topic lags; it turns WARN
+    for a lagging topic or for drops since the previous status, and keeps STALE (with the
+    reason) when nothing came through."""
+    ok = H.Status(H.OK, 'estimating', {'received': 10})
+    counters = {'dropped_unaligned': 0, 'dropped_stalled': 0}
+    calm = H.alignment_status(ok, [], 0, counters, counters)
+    assert calm.level == H.OK and calm.message == 'estimating'
+    assert calm.values == {'received': 10, 'pending_aligned': 0, 'lagging_topics': ''}
+    lag = H.alignment_status(ok, ['/joint3/torque'], 2000, counters, counters)
+    assert lag.level == H.WARN and lag.message.startswith('/joint3/torque behind')
+    assert (
+        lag.values['lagging_topics'] == '/joint3/torque' and lag.values['pending_aligned'] == 2000
+    )
+    grown = {'dropped_unaligned': 7, 'dropped_stalled': 3}
+    drops = H.alignment_status(ok, [], 0, grown, counters)
+    assert drops.level == H.WARN
+    assert '7 samples without a partner' in drops.message and '3 samples dropped' in drops.message
+    assert H.alignment_status(ok, [], 0, grown, grown).level == H.OK  # nothing new
+    stale = H.alignment_status(H.Status(H.STALE, 'no input', {}), ['/b'], 5, counters, counters)
+    assert stale.level == H.STALE and stale.message.startswith('no input; /b behind')

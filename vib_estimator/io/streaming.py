@@ -273,9 +273,10 @@ def read_topics(
             values.append(np.asarray(v, dtype=np.float64).reshape(len(st), -1))
             source.append(np.full(len(st), i))
     m = len(fields)
+    names = topic_channels([s.topic for s in signals], fields)
     if not stamps:
         return AlignedTopics(
-            np.empty(0, np.int64), np.empty((0, m * len(topics))), (), signals, {}
+            np.empty(0, np.int64), np.empty((0, m * len(topics))), names, signals, {}
         )
     st, v, src = np.concatenate(stamps), np.concatenate(values), np.concatenate(source)
     order = np.lexsort((src, st))  # by stamp, the topics in their order at equal stamps
@@ -285,7 +286,6 @@ def read_topics(
         out.extend(aligner.push(int(src[k]), int(st[k]), v[k]))
     joint_stamps = np.array([o[0] for o in out], dtype=np.int64)
     joint = np.array([o[1] for o in out], dtype=np.float64).reshape(len(out), m * len(topics))
-    names = topic_channels([s.topic for s in signals], fields)
     return AlignedTopics(joint_stamps, joint, names, signals, dict(aligner.counters))
 
 
