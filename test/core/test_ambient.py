@@ -200,3 +200,41 @@ def test_a_record_too_slow_to_decimate_is_identified_at_every_analysis():
         near = np.abs(est.frequency_hz / f - 1) < 0.03
         assert near.sum() >= 0.8 * analyses, (f, near.sum(), analyses)
         assert abs(np.median(est.frequency_hz[near]) / f - 1) < 0.01
+
+
+def test_publication_rule_scripted(monkeypatch):
+    """The identity rule alone (ambient.identify scripted per analysis): the first mode publishes
+    after CONFIRM analyses; a published one missing from one analysis publishes again as soon as
+    it is seen; a pole beside a published mode publishes only after CONFIRM_BESIDE analyses
+    running (shorter runs: a coloured excitation's statistical poles never publish)."""
+    from vib_estimator.core import ambient
+
+    beside = ambient.CONFIRM_BESIDE
+    short = range(10, 10 + beside - 1)  # one analysis too few
+    long = range(30, 30 + beside + 4)
+    calls = []
+
+    def scripted(cascade, fs, *args):
+        k = len(calls) + 1  # the analysis' number
+        calls.append(k)
+        rows = [] if k == 6 else [(5.0, 0.01, 1.0, 0.01, 0.001)]
+        rows += [(7.0, 0.01, 0.1, 0.01, 0.001)] if k in short else []
+        rows += [(9.0, 0.01, 0.1, 0.01, 0.001)] if k in long else []
+        return np.array(rows).reshape(-1, 5), 0.01, 1.5
+
+    monkeypatch.setattr(ambient, 'identify', scripted)
+    fs = 100.0
+    t = np.arange(0, 70, 1 / fs)
+    est = AmbientEstimator(AMBIENT).process(t, np.random.default_rng(0).standard_normal(len(t)))
+    n = len(calls)
+    assert n >= 45
+    # the analysis of each estimate, from its stamp (one a second; the first estimate's is the
+    # CONFIRM-th)
+    k = ambient.CONFIRM + np.round((est.t - est.t[0]) / ambient.HOP_S).astype(int)
+    by_f = {f: k[est.frequency_hz == f].tolist() for f in (5.0, 7.0, 9.0)}
+    assert by_f[5.0] == [j for j in range(ambient.CONFIRM, n + 1) if j != 6]
+    assert by_f[7.0] == []
+    assert by_f[9.0] == list(range(long[0] + beside - 1, long[-1] + 1))
+    # numbered by frequency among the published: the 9 Hz mode is 2 while both publish
+    assert set(est.mode[est.frequency_hz == 9.0]) == {2}
+    assert set(est.mode[est.frequency_hz == 5.0]) == {1}

@@ -45,7 +45,8 @@ Method, per analysis (every :data:`HOP_S` of input once ``ambient_window_s`` of 
    identified (``flat_windows``); its halvings would hold only the filter's rounding.
 4. **Identity over time** (stability across windows): each mode is matched to the nearest tracked
    mode within :data:`MATCH_TOL`; a new one publishes once seen by :data:`CONFIRM` consecutive
-   analyses (``modes_found``); one unseen for a window is lost (``modes_lost``). With
+   analyses (:data:`CONFIRM_BESIDE` beside published modes; ``modes_found``), a published one
+   whenever seen; one unseen for a window is lost (``modes_lost``). With
    ``modes`` >= 1 at most that many (the strongest) publish. Published modes are numbered by
    ascending frequency, 1 = the lowest, as the mode tracker's ``mode`` key.
 
@@ -94,8 +95,11 @@ MATCH_TOL = 0.03
 SEARCH_EVERY = 5
 #: a mode's estimates over this many windows calibrate its stds (:meth:`_Track.calibration`)
 HISTORY_WINDOWS = 4
-#: consecutive analyses that must see a new mode before it publishes
+#: consecutive analyses that must see a new mode before it publishes, while none is published
 CONFIRM = 3
+#: ... and beside published modes: a coloured excitation's continuum (a randomly commanded arm's)
+#: gives statistical poles beside a strong mode that last 1-8 analyses; a mode persists
+CONFIRM_BESIDE = 8
 #: most modes tracked at once
 MAX_TRACKS = 8
 #: a frequency bin counts in the Fisher information of the modes where their density exceeds this
@@ -1225,7 +1229,8 @@ class SlidingWindowIdentifier:
     def _confirm(self, seen: dict, t: float) -> tuple[list, list]:
         """After an analysis at ``t`` (``seen``: the tracks it saw, by id): forget the unseen
         unpublished tracks and the published ones unseen for a window, publish those seen
-        ``CONFIRM`` analyses running (the ``modes`` strongest if set); ``(the tracks to publish
+        ``CONFIRM`` analyses running (``CONFIRM_BESIDE`` once a mode is published) and the
+        published ones seen again (the ``modes`` strongest if set); ``(the tracks to publish
         now, every published track by ascending frequency: the mode numbers)``."""
         tracks = self._tracks
         for tr in list(tracks):
@@ -1234,7 +1239,8 @@ class SlidingWindowIdentifier:
                 if not tr.published or t - tr.last_t > self._window:
                     tracks.remove(tr)
                     self._c['modes_lost'] += tr.published
-        ready = [tr for tr in tracks if id(tr) in seen and tr.seen >= CONFIRM]
+        need = CONFIRM_BESIDE if any(tr.published for tr in tracks) else CONFIRM
+        ready = [tr for tr in tracks if id(tr) in seen and (tr.published or tr.seen >= need)]
         if self._config.modes:
             ready = sorted(ready, key=lambda tr: -tr.amplitude)[: self._config.modes]
         for tr in ready:
