@@ -167,3 +167,45 @@ def test_a_driven_record_publishes_no_free_decay_estimate(zeta):
     assert est.counters['estimates_free'] == 0
     assert np.all(e.convergence_time >= 0.9 * AUTO.ambient_window_s)
     assert np.all(np.abs(e.frequency_hz / F - 1) < 0.05)
+
+
+def test_envelope_feed_equals_sample_by_sample():
+    """Envelope.feed (block by block, what a batch uses) gives exactly the states and counts of
+    update (sample by sample, what a node uses), in chunks that split blocks, across a pluck, a
+    driven stretch, a ring-down, NaNs, duplicate and out-of-order stamps and a gap."""
+    from vib_estimator.core.auto import Envelope
+
+    rng = np.random.default_rng(5)
+    fs = 200.0
+    t = np.arange(0, 120, 1 / fs)
+    y = 0.01 * rng.standard_normal(len(t))
+    pluck = (t >= 10) & (t < 40)
+    y[pluck] += np.exp(-0.3 * (t[pluck] - 10)) * np.sin(2 * np.pi * 3 * t[pluck])
+    driven = (t >= 50) & (t < 90)
+    y[driven] += np.convolve(rng.standard_normal(int(driven.sum())), np.ones(20) / 20, 'same')
+    y[rng.choice(len(t), 200, replace=False)] = np.nan
+    t = t.copy()
+    dup = rng.choice(len(t) - 1, 100, replace=False)
+    t[dup + 1] = t[dup]  # duplicates
+    back = rng.choice(len(t) - 1, 50, replace=False)
+    t[back + 1] -= 0.5 / fs  # out of order
+    t[t > 100] += 3.0  # a gap
+    one, chunked = Envelope(1.0), Envelope(1.0)
+    states = []
+    for a, b in zip(t.tolist(), y.tolist()):
+        one.update(a, b)
+        states.append(one.state == 'driven')
+    valid, driven_out = [], []
+    for lo in range(0, len(t), 777):
+        v, d = chunked.feed(t[lo : lo + 777], y[lo : lo + 777])
+        valid.append(v)
+        driven_out.append(d)
+    np.testing.assert_array_equal(np.concatenate(driven_out), states)
+    assert one.blocks == chunked.blocks and one.changes == chunked.changes
+    assert one.changes['became_driven'] >= 1 and one.changes['onsets'] >= 1
+    kept, last = [], -math.inf  # the rule: finite and later than the last kept
+    for a, b in zip(t.tolist(), y.tolist()):
+        kept.append(math.isfinite(b) and a > last)
+        last = a if kept[-1] else last
+    np.testing.assert_array_equal(np.concatenate(valid), kept)
+    assert not all(kept)

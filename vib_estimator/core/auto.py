@@ -227,6 +227,47 @@ class Envelope:
         self._s1 += y
         self._s2 += y * y
 
+    def feed(self, t: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`update` for arrays, block by block: ``(valid, driven)`` per sample (kept by
+        the envelope's rule; the state after it). The same states as sample by sample: each
+        block's sums are sequential (``cumsum``, from the sums carried in), as ``update``'s."""
+        n = len(t)
+        finite = np.isfinite(t) & np.isfinite(y)
+        # valid: finite and later than every finite stamp before it (the valid ones increase)
+        seen = np.maximum.accumulate(np.where(finite, t, -math.inf)) if n else t
+        before = np.concatenate(([self._last], np.maximum(seen[:-1], self._last))) if n else t
+        valid = finite & (t > before)
+        driven = np.zeros(n, dtype=bool)
+        idx = np.flatnonzero(valid)
+        if not len(idx):
+            driven[:] = self.state == DRIVEN
+            return valid, driven
+        tv, yv = t[idx], y[idx]
+        if self._t0 is None:
+            self._t0 = float(tv[0])
+        self._last = float(tv[-1])
+        k = ((tv - self._t0) // self.block_s).astype(np.int64)
+        # the first valid sample of each new block closes the one before
+        starts = np.flatnonzero(np.diff(np.concatenate(([self._k], k))) != 0)
+        ends = np.concatenate((starts, [len(k)]))
+        changes = [(0, self.state == DRIVEN)]
+        lo = 0
+        for j, hi in zip(starts.tolist() + [None], ends.tolist()):
+            part = yv[lo:hi]
+            if len(part):
+                self._n += len(part)
+                self._s1 = float(np.cumsum(np.concatenate(([self._s1], part)))[-1])
+                self._s2 = float(np.cumsum(np.concatenate(([self._s2], part * part)))[-1])
+            if j is None:
+                break
+            self._close()
+            self._k = int(k[j])
+            changes.append((int(idx[j]), self.state == DRIVEN))
+            lo = j
+        for (a, state), (b, _) in zip(changes, changes[1:] + [(n, None)]):
+            driven[a:b] = state
+        return valid, driven
+
     def _close(self) -> None:
         n = self._n
         if n < 2:  # an empty block (a gap): nothing to add
@@ -370,16 +411,9 @@ class AutoEstimator:
         t, y = as_series(t, y)
         free = self._free.process(t, y)
         ambient = self._ambient.process(t, y)
-        # the state after each sample (a sample completes at most one block's decision)
-        env = self._envelope
-        states = np.empty(len(t), dtype=bool)
-        valid = np.zeros(len(t), dtype=bool)  # the samples the history keeps
-        last = self._history[0, self._filled - 1] if self._filled else -math.inf
-        for i, (a, b) in enumerate(zip(t.tolist(), y.tolist())):
-            env.update(a, b)
-            states[i] = env.state == DRIVEN
-            if math.isfinite(a) and math.isfinite(b) and a > last:
-                valid[i], last = True, a
+        # the state after each sample (a sample completes at most one block's decision) and the
+        # samples the history keeps (the envelope's rule)
+        valid, states = self._envelope.feed(t, y)
         # the history before this call, then this call's valid samples
         ht = np.concatenate((self._history[0, : self._filled], t[valid]))
         hy = np.concatenate((self._history[1, : self._filled], y[valid]))
