@@ -234,9 +234,8 @@ class Envelope:
         n = len(t)
         finite = np.isfinite(t) & np.isfinite(y)
         # valid: finite and later than every finite stamp before it (the valid ones increase)
-        seen = np.maximum.accumulate(np.where(finite, t, -math.inf)) if n else t
-        before = np.concatenate(([self._last], np.maximum(seen[:-1], self._last))) if n else t
-        valid = finite & (t > before)
+        stamps = np.concatenate(([self._last], np.where(finite, t, -math.inf)))
+        valid = finite & (t > np.maximum.accumulate(stamps)[:-1])
         driven = np.zeros(n, dtype=bool)
         idx = np.flatnonzero(valid)
         if not len(idx):

@@ -110,7 +110,8 @@ def spin_until_arrival(executor, arrived: list, predicate: Callable, timeout: fl
     def found():
         return any(predicate(item) for item in arrived[start:])
 
-    assert spin_until(executor, found, timeout), arrived[start:]
+    if not spin_until(executor, found, timeout):
+        raise AssertionError(arrived[start:])
     return next(item for item in arrived[start:] if predicate(item))
 
 
