@@ -24,7 +24,8 @@ record is run
 with ``excitation`` ambient and auto (a row each). Last, ``excitation = auto`` on the free-decay
 benchmarks' records (bench_precision, bench_modes, the real beams): the share of ``excitation =
 free``'s estimates it publishes unchanged, what it adds, and the seconds it judged driven
-(``--free-only``: that section alone).
+(``--free-only``: that section alone); with the paper's reproductions (``vib-estimator compare``'s
+records) and the simulated arm moved every 10 s.
 """
 
 from __future__ import annotations
@@ -297,6 +298,7 @@ def free_decays(real_data):
     from bench_precision import CASES as PRECISION_CASES
     from real_data import REFERENCE
 
+    from vib_estimator.analysis.compare import CASES as COMPARE_CASES
     from vib_estimator.io.csv_reader import read_csv_series
     from vib_estimator.sim.arm_model import Move, simulate
 
@@ -317,6 +319,17 @@ def free_decays(real_data):
         sched = (Move(0.0, 1.0, 1.0, 0.030), Move(12.0, 0.0, 1.0, 0.06117))
         rec = simulate(24.0, sched)
         yield 'bench_modes tip-mass change (arm)', MODE_CONFIG, [(rec.t, rec.torque)]
+        # the paper's reproductions (vib-estimator compare: Fig. 1's sine, Sections 5.3 and 5.5's
+        # arm) and the arm moved every 10 s, from rest and while it rings (1.15-1.64 Hz: several
+        # periods to an envelope block)
+        moves = (Move(0.0, 1.0, 1.0), Move(10.0, 0.0, 1.0), Move(20.0, 0.5, 0.5), Move(30.0, 1.2))
+        for case in COMPARE_CASES:
+            recs = [case.record(seed)[:2] for seed in range(3)]
+            for name, cfg in (('paper', EstimatorConfig.paper()), ('defaults', EstimatorConfig())):
+                yield f'compare {case.key} ({case.title}), {name}', cfg, recs
+        recs = [(r.t, r.torque) for r in (simulate(40.0, moves, seed=s) for s in range(3))]
+        for name, cfg in (('paper', EstimatorConfig.paper()), ('defaults', EstimatorConfig())):
+            yield f'arm moved every 10 s, {name}', cfg, recs
         folder = Path(real_data) / 'aluminium_cantilever_adxl357'
         if folder.is_dir():
             for length in REFERENCE:
@@ -341,7 +354,7 @@ def free_decays(real_data):
             n_free += len(kf)
             same += len(kf & ka)
             added += len(ka - kf)
-            driven += auto.counters['driven_blocks'] * auto.block_s
+            driven += auto.driven_s
         print(
             f'| {label} ({len(recs)}) | {n_free} | {100 * same / max(n_free, 1):.1f} % | '
             f'{added} | {driven:.0f} |'

@@ -149,6 +149,7 @@ FLAT_SUSPECT = 1e-6
 
 COUNTER_NAMES = INPUT_COUNTERS + (
     'analyses',
+    'analyses_idle',
     'rejected_damping',
     'rejected_unstable',
     'rejected_weak',
@@ -1116,6 +1117,10 @@ class SlidingWindowIdentifier:
         self._y = np.empty((1 << 14, *self._row))
         self._tracks: list = []
         self._cascade = CorrelationCascade(lags, max(channels, 1))
+        #: while True, a window that is due only slides (counted ``analyses_idle``): nothing is
+        #: identified or published, the tracked modes wait (``excitation = auto`` in a free
+        #: stretch, where the identifier's estimates would not publish)
+        self.idle = False
         self.restart()
 
     @property
@@ -1189,11 +1194,19 @@ class SlidingWindowIdentifier:
         c['used'] += 1
         return True
 
+    def _due(self) -> list:
+        """The analysis due now (:meth:`_analyse`), or, :attr:`idle`, only the window's slide."""
+        if not self.idle:
+            return self._analyse()
+        self._slide()
+        self._c['analyses_idle'] += 1
+        return []
+
     @single_blas_thread
     def _analysis(self) -> list:
-        """:meth:`_analyse` on one BLAS thread (:mod:`.threads`), for a sample fed alone; a
-        batch (:meth:`_feed`) is on one thread throughout."""
-        return self._analyse()
+        """:meth:`_due` on one BLAS thread (:mod:`.threads`), for a sample fed alone; a batch
+        (:meth:`_feed`) is on one thread throughout."""
+        return self._due()
 
     @single_blas_thread
     def _feed(self, t: np.ndarray, y: np.ndarray, finite: np.ndarray) -> list:
@@ -1223,7 +1236,7 @@ class SlidingWindowIdentifier:
                 self._last = float(t[k - 1])
                 i = k
                 if self._last >= self._next:
-                    out.extend(self._analyse())
+                    out.extend(self._due())
         return out
 
     def _confirm(self, seen: dict, t: float) -> tuple[list, list]:
@@ -1255,6 +1268,18 @@ class SlidingWindowIdentifier:
         :class:`CorrelationCascade`, brought up to the last sample), rate, span, the highest
         published mode's frequency (0: none), whether to search the whole band)`` of the window
         it reads, or None when the window is too short."""
+        ts = self._slide()
+        if len(ts) < 4 * BLOCK_ROWS + 2:
+            return None
+        span = float(ts[-1] - ts[0])
+        self._c['analyses'] += 1
+        known = max((tr.frequency for tr in self._tracks if tr.published), default=0.0)
+        search = self._c['analyses'] % SEARCH_EVERY == 1
+        return ts, self._cascade, (len(ts) - 1) / span, span, known, search
+
+    def _slide(self) -> np.ndarray:
+        """Schedule the next analysis and slide the window (and the cascade) to end at the last
+        sample; its samples' times."""
         t_end = self._t[self._n - 1]
         self._next += HOP_S
         if self._next <= t_end:
@@ -1268,13 +1293,7 @@ class SlidingWindowIdentifier:
         self._cascade.push(new.reshape(len(new), -1))
         self._fed = self._n
         self._cascade.keep_last(len(ts))
-        if len(ts) < 4 * BLOCK_ROWS + 2:
-            return None
-        span = float(ts[-1] - ts[0])
-        self._c['analyses'] += 1
-        known = max((tr.frequency for tr in self._tracks if tr.published), default=0.0)
-        search = self._c['analyses'] % SEARCH_EVERY == 1
-        return ts, self._cascade, (len(ts) - 1) / span, span, known, search
+        return ts
 
 
 class AmbientEstimator(SlidingWindowIdentifier):

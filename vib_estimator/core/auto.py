@@ -14,15 +14,21 @@ consecutive blocks of ``ambient_window_s / BLOCKS_PER_WINDOW`` s (at least :data
   modes' random amplitudes.
 
 An **onset** is a block more than :data:`ONSET` times as energetic as the one before (a pluck, a
-move from rest), or more than :data:`RISE` times and sudden against the blocks before it
-(:data:`SHARP`: a move while the structure still rings). A free stretch becomes **driven** when,
-over the blocks since the last onset (at most the last :data:`HORIZON_BLOCKS`), the energy rises
-by more than :data:`RISE` after the most energetic block, or falls by more than it before, or the
-peak comes three or more blocks after the onset still rising by more than :data:`RISE` over its
-last two blocks; fewer than :data:`MIN_BLOCKS` blocks since an onset, or a decay, stay free. A
-driven stretch stays driven (a driven response's energy also wanders down for a while) until an
-onset, or until :data:`QUIET_BLOCKS` consecutive blocks are :data:`DROP` times below its median
-block: the structure rang down after the forcing stopped. A record starts free.
+move from rest; in a free stretch also over the two before, both rises above :data:`RISE`: a
+pluck straddling two blocks), or more than :data:`RISE` times and sudden against the blocks
+before it (:data:`SHARP`: a move while the structure still rings), or, in a free stretch one of
+whose free estimates passed the free-decay test, any rise above :data:`RISE` after blocks that
+rang down (:data:`SETTLE`). While a stretch is free the block lengthens to hold
+:data:`BLOCK_PERIODS` periods of its free estimates' frequency (:meth:`Envelope.follow`). A
+free stretch becomes **driven** when, over the blocks since the last onset (at most the last
+:data:`HORIZON_BLOCKS`), the energy rises by more than :data:`RISE` after the most energetic
+block, or falls by more than it before, or the peak comes three or more blocks after the onset
+still rising by more than :data:`RISE` over its last two blocks, or two blocks running each rose
+by more than :data:`RISE` to the peak; fewer than :data:`MIN_BLOCKS` blocks since an onset, or a
+decay, stay free. A driven stretch stays driven (a driven response's energy also wanders down
+for a while) until an onset, or until :data:`QUIET_BLOCKS` consecutive blocks are :data:`DROP`
+times below its median block: the structure rang down after the forcing stopped. A record
+starts free.
 
 A free-decay estimate publishes when its sample ends in a free stretch and (``modes`` = 0) it
 passes the free-decay test (:func:`is_free_decay`: the signal before it is one damped sinusoid in
@@ -54,6 +60,15 @@ from .estimator import Estimate, EstimateArrays, as_series
 BLOCKS_PER_WINDOW = 30
 #: shortest envelope block, s
 MIN_BLOCK_S = 0.25
+#: the block holds at least this many periods of the latest free estimate's frequency while the
+#: stretch is free: a shorter block's variance depends on the phase it starts at (a 1 s block of a
+#: 1.15 Hz decay jitters by more than RISE, read as driven)
+BLOCK_PERIODS = 3.0
+#: ... grown (or shrunk, when it holds more than twice the periods needed) to this many times the
+#: block needed, so that the next estimates' scatter leaves it, and at most the ambient window
+#: over this (the envelope decides within MIN_BLOCKS of them)
+BLOCK_MARGIN = 1.25
+MAX_BLOCK_FRACTION = 3
 #: most blocks (since the last onset) the envelope test looks back over
 HORIZON_BLOCKS = 10
 #: fewest blocks since an onset before a stretch can be called driven
@@ -66,6 +81,12 @@ ONSET = 10.0
 #: consecutive blocks before it since the last onset (at least MIN_BLOCKS of them): sudden against
 #: a smooth decay (a move while the structure still rings), not a driven response's wandering
 SHARP = 6.0
+#: in a free stretch one of whose free estimates passed the free-decay test, a block more than
+#: RISE times as energetic as the one before, after at least MIN_BLOCKS blocks since the last
+#: onset that rang down from their peak (none more than this times the one before), is an onset:
+#: a move while the structure still rings (a driven response's energy also falls for a few
+#: blocks and rises again, but its free estimates fail the test)
+SETTLE = 1.1
 #: a driven stretch ends (back to free) when QUIET_BLOCKS consecutive blocks are this many times
 #: less energetic than the median block of the driven stretch (its last BLOCKS_PER_WINDOW blocks):
 #: the structure rang down after the forcing stopped
@@ -80,9 +101,13 @@ FREE, DRIVEN = 'free', 'driven'
 #: the free-decay test of each free estimate (``modes`` = 0): one-period blocks of the signal, half
 #: a period apart, over at most this many periods before the estimate's sample
 TEST_PERIODS = 8
-#: ... after the last block whose amplitude is more than this times the one before it (a pluck:
-#: the test starts one block after it)
+#: ... after the last block whose amplitude is more than this times every block before it (a
+#: pluck: the test starts one block after it; a driven mode's amplitude also jumps by this much
+#: between blocks, seldom above all of the last periods)
 JUMP = 1.5
+#: ... and one block after the blocks that follow it each more than this many times as large as
+#: the one before: the vibration still building up (a move's ramp)
+BUILD_UP = 1.2
 #: ... at least this many blocks (fewer: the estimate is published untested)
 TEST_BLOCKS = 3
 #: not a free decay when the one-pole prediction of the blocks' complex amplitudes errs by more
@@ -94,6 +119,11 @@ INNOVATION = 0.02
 #: settled into a limit cycle, where the frequency moved with the amplitude: a real arm)
 RECENT_PERIODS = 2.5
 CLEAN = 4.0
+#: the test also fits (per block) the strongest other component of the signal at least one
+#: frequency (and a main lobe) above the estimate's, when its periodogram peak is this many times
+#: the periodogram's median (a white noise's ordinates: ~exponential, 30 x median ~ exp(-21)): a
+#: second mode, ringing or driven, is then neither noise nor misfit
+PEAK = 30.0
 #: samples kept for the test (at 1 kHz: 8 periods down to 0.12 Hz)
 HISTORY = 1 << 16
 
@@ -107,6 +137,8 @@ def is_driven(energies: Sequence[float]) -> bool:
     p = int(np.argmax(e))
     if p >= 3 and e[p] > RISE * e[p - 2]:  # still rising 3 blocks after an onset: no pluck
         return True
+    if p >= 2 and e[p] > RISE * e[p - 1] and e[p - 1] > RISE * e[p - 2]:  # two rises running
+        return True
     after = e[p + 1 :]
     if len(after) > 1 and float(np.max(after[1:] / np.minimum.accumulate(after)[:-1])) > RISE:
         return True
@@ -116,24 +148,75 @@ def is_driven(energies: Sequence[float]) -> bool:
     )
 
 
-def _blocks(t: np.ndarray, y: np.ndarray, f: float):
+def other_frequency(t: np.ndarray, y: np.ndarray, f: float) -> Optional[float]:
+    """The frequency of the strongest component of ``(t, y)`` at least an octave (and its main
+    lobe) above ``f`` Hz and below 0.45 x the rate: another mode, ringing or driven. The peak of
+    the Hann-windowed periodogram (zero-padded to at least 4 x), None unless it is :data:`PEAK`
+    times the periodogram's median there."""
+    n = len(t)
+    if n < 8:
+        return None
+    fs = (n - 1) / float(t[-1] - t[0])
+    m = 1 << (4 * n - 1).bit_length()  # a power of two, at least 4 n
+    spec = np.abs(np.fft.rfft((y - np.mean(y)) * np.hanning(n), m))
+    freq = np.fft.rfftfreq(m, 1 / fs)
+    allowed = (freq - f >= max(f, 2 * fs / n)) & (freq <= 0.45 * fs)  # beyond f's main lobe
+    if not allowed.any():
+        return None
+    power = np.where(allowed, spec**2, 0.0)
+    k = int(np.argmax(power))
+    return float(freq[k]) if power[k] > PEAK * np.median(power[allowed]) else None
+
+
+def _blocks(t: np.ndarray, y: np.ndarray, f: float, other: Optional[float] = None):
     """The complex amplitudes at ``f`` Hz of one-period blocks of ``(t, y)`` ending every half
-    period back from ``t[-1]`` (oldest first; each block's mean removed) and the noise variance of
-    each (4 x its residual's mean square / its samples); None if a block holds < 4 samples."""
-    w = 2 * math.pi * f
+    period back from ``t[-1]`` (oldest first) and the noise variance of each (4 x its residual's
+    mean square / its samples): each block's mean removed and its projection on the sinusoid at
+    ``f``, or (``other``) its least-squares fit of a constant and the sinusoids at ``f`` and at
+    ``other`` Hz (the residual's mean square over its degrees of freedom); None if a block holds
+    fewer than 4 samples (beyond the fit's parameters)."""
     nb = int(math.floor((t[-1] - t[0]) * 2 * f)) - 1
     ends = t[-1] - np.arange(nb)[::-1] / (2 * f)
     a = np.searchsorted(t, ends - 1 / f, 'right')
     b = np.searchsorted(t, ends, 'right')
-    if nb < 1 or np.any(b - a < 4):
+    p = 0 if other is None else 5
+    if nb < 1 or np.any(b - a < 4 + p):
         return None
-    c, v = np.empty(nb, dtype=np.complex128), np.empty(nb)
-    for k, (i, j) in enumerate(zip(a.tolist(), b.tolist())):
-        yb = y[i:j] - np.mean(y[i:j])
-        e = np.exp(-1j * w * (t[i:j] - t[-1]))
-        c[k] = 2 * np.mean(yb * e)
-        v[k] = 4 * np.mean((yb - np.real(c[k] * np.conj(e))) ** 2) / (j - i)
-    return c, v
+    n = b - a
+    idx = a[:, None] + np.arange(int(n.max()))[None, :]
+    inside = idx < b[:, None]
+    idx = np.minimum(idx, len(t) - 1)
+    tau = t[idx] - t[-1]
+    e = np.exp(-2j * math.pi * f * tau) * inside
+    yb = (y[idx] - (np.sum(y[idx] * inside, axis=1) / n)[:, None]) * inside
+    if other is None:
+        c = 2 * np.sum(yb * e, axis=1) / n
+        res = (yb - np.real(c[:, None] * np.conj(e))) * inside
+        return c, 4 * np.sum(res**2, axis=1) / (n * n)
+    cols = [inside.astype(np.float64), e.real, e.imag]
+    w2 = 2 * math.pi * other
+    cols += [np.cos(w2 * tau) * inside, np.sin(w2 * tau) * inside]
+    x = np.stack(cols, axis=-1)
+    gram = np.einsum('kni,knj->kij', x, x)
+    beta = np.linalg.solve(gram, np.einsum('kni,kn->ki', x, yb)[..., None])[..., 0]
+    res = yb - np.einsum('kni,ki->kn', x, beta)
+    # y - m = A cos(w tau) - B sin(w tau) + ... = Re(c exp(i w tau)): c = A + iB
+    return beta[:, 1] + 1j * beta[:, 2], 4 * np.sum(res**2, axis=1) / ((n - p) * n)
+
+
+def _first_block(c: np.ndarray, periods: float) -> int:
+    """The first block the test uses: of the last ``periods`` periods, one block after the last
+    :data:`JUMP` (a pluck: a block that many times as large as every block before it) and one
+    after the rise that runs on from there, if any (:data:`BUILD_UP`: the excitation still on, a
+    move's ramp building the vibration up over a period or more)."""
+    amp = np.abs(c)
+    rises = np.flatnonzero(np.maximum.accumulate(amp)[:-1] * JUMP < amp[1:])
+    first = max(len(c) - int(2 * periods) + 1, rises[-1] + 2 if len(rises) else 0)
+    ends = np.flatnonzero(amp[first + 1 :] <= BUILD_UP * amp[first:-1])  # the rise's end
+    if not len(ends):
+        return len(c)
+    run = int(ends[0])  # blocks rising from `first` to the run's peak
+    return first + run + (run > 0)
 
 
 def decay_misfit(
@@ -145,16 +228,24 @@ def decay_misfit(
     (looked for one period further back), fitted by ``c[k+1] = r c[k]`` (a decay; the frequency
     refined twice from ``r``'s phase): the prediction error's mean square over the noise's and its
     RMS over the amplitude's. None when fewer than :data:`TEST_BLOCKS` blocks are left."""
+    if not f > 0:
+        return None
     lo = np.searchsorted(t, t[-1] - (periods + 1) / f, 'left')
     t, y = t[lo:], y[lo:]
-    for _ in range(3):
-        got = _blocks(t, y, f) if f > 0 else None
+    other = None
+    for step in range(3):
+        got = (other is not None and _blocks(t, y, f, other)) or _blocks(t, y, f)
         if got is None:
             return None
         c, v = got
-        amp = np.abs(c)
-        rises = np.flatnonzero(amp[:-1] * JUMP < amp[1:])
-        first = max(len(c) - int(2 * periods) + 1, rises[-1] + 2 if len(rises) else 0)
+        first = _first_block(c, periods)
+        if step == 0:  # the other component over the blocks used, from the start of the first
+            start = np.searchsorted(t, t[-1] - (len(c) - first + 1) / (2 * f), 'left')
+            other = other_frequency(t[start:], y[start:], f)
+            got = _blocks(t, y, f, other) if other is not None else None
+            if got:
+                c, v = got
+                first = _first_block(c, periods)
         c, v = c[first:], v[first:]
         if len(c) < TEST_BLOCKS:
             return None
@@ -180,28 +271,65 @@ def is_free_decay(t: np.ndarray, y: np.ndarray, f: float) -> Optional[bool]:
     return recent is not None and recent[1] <= INNOVATION / CLEAN
 
 
-def _is_onset(energies: Sequence[float], energy: float) -> bool:
+def _is_onset(
+    energies: Sequence[float], energy: float, free: bool = False, ringing: bool = False
+) -> bool:
     """Whether a block of ``energy`` after the blocks ``energies`` (since the last onset) is an
-    onset (see :data:`ONSET`, :data:`SHARP`)."""
+    onset (see :data:`ONSET`, :data:`SHARP`); ``free``: in a free stretch, whose blocks up to the
+    most energetic are its excitation (a move from rest builds up over blocks), a rise sudden
+    against the blocks since that one; ``ringing``: a free estimate of the stretch passed the
+    free-decay test, and then any rise by more than :data:`RISE` after a ring-down (:data:`SETTLE`)
+    is an onset too (a driven response's energy also falls for a few blocks, then rises again: its
+    free estimates fail the test)."""
     e = np.asarray(energies, dtype=np.float64)
     e = np.maximum(e, FLOOR * float(e.max()) + 1e-300)
     rise = energy / e[-1]
     if rise > ONSET:
+        return True  # a pluck
+    if free and len(e) > 1 and energy > ONSET * e[-2] and rise > RISE and e[-1] > RISE * e[-2]:
+        return True  # a pluck straddling two blocks (a long one: the stretch's low frequency)
+    if ringing and len(e) >= MIN_BLOCKS and _rises_after_ring_down(e, energy):
         return True
     if rise <= RISE or len(e) < MIN_BLOCKS + 1:
         return False
+    if free:
+        e = e[int(np.argmax(e)) :]
+        if len(e) < 2:
+            return False
     return math.log(rise) > SHARP * float(np.max(np.abs(np.diff(np.log(e)))))
 
 
-class Envelope:
-    """Block energies of the stream and the free/driven state after each completed block."""
+def _rises_after_ring_down(e: np.ndarray, energy: float) -> bool:
+    """Whether a block of ``energy`` rises by more than :data:`RISE` over the block before it, or
+    over the one before that through a rising block (a move that straddles two blocks), after
+    blocks that rang down from their peak (each at most :data:`SETTLE` x the one before)."""
+    for lead in (1, 2):
+        base = e[: len(e) - lead + 1]  # up to the block before the rise
+        if len(base) < 2 or energy <= RISE * base[-1] or e[-1] < base[-1]:
+            continue
+        tail = base[int(np.argmax(base)) :]
+        if len(tail) >= 2 and np.all(tail[1:] <= SETTLE * tail[:-1]):
+            return True
+    return False
 
-    def __init__(self, block_s: float):
-        self.block_s = block_s
+
+class Envelope:
+    """Block energies of the stream and the free/driven state after each completed block.
+
+    The block is ``block_s`` s, lengthened to :data:`BLOCK_PERIODS` periods of a lower frequency
+    the stream is found to ring at (:meth:`follow`), up to ``max_block_s``."""
+
+    def __init__(self, block_s: float, max_block_s: float = math.inf):
+        self.base_s = block_s
+        self.max_block_s = max(block_s, max_block_s)
         self.restart()
 
     def restart(self) -> None:
+        self.block_s = self.base_s
+        self.seconds = {FREE: 0.0, DRIVEN: 0.0}  # the blocks closed in each state, s
         self.state = FREE
+        #: a free estimate of this stretch (since its last onset) passed the free-decay test
+        self.ringing = False
         self._t0 = None
         self._last = -math.inf
         self._k = 0
@@ -211,6 +339,25 @@ class Envelope:
         self._quiet = 0  # consecutive blocks DROP below the driven stretch's median
         self.blocks = {FREE: 0, DRIVEN: 0}  # blocks closed in each state
         self.changes = {'onsets': 0, 'rang_down': 0, 'became_driven': 0}
+
+    def fitted_block(self, f: float) -> float:
+        """The block for a free estimate of ``f`` Hz: :data:`BLOCK_PERIODS` of its periods at the
+        least, :data:`BLOCK_MARGIN` x that when it changes (within the base and the maximum)."""
+        need = BLOCK_PERIODS / f if f > 0 and math.isfinite(f) else 0.0
+        if need <= self.block_s and (2 * need >= self.block_s or self.block_s == self.base_s):
+            return self.block_s
+        return min(max(self.base_s, BLOCK_MARGIN * need), self.max_block_s)
+
+    def follow(self, f: float) -> None:
+        """Fit the block to a free estimate of ``f`` Hz (:meth:`fitted_block`): the block under
+        way goes on with the new length."""
+        new = self.fitted_block(f)
+        if new == self.block_s:
+            return
+        if self._t0 is not None:
+            self._t0 += self._k * self.block_s
+            self._k = 0
+        self.block_s = new
 
     def update(self, t: float, y: float) -> None:
         """One sample (skipped unless finite and later than the last)."""
@@ -227,15 +374,19 @@ class Envelope:
         self._s1 += y
         self._s2 += y * y
 
+    def valid(self, t: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """The samples of arrays ``(t, y)`` that :meth:`update` keeps: finite and later than every
+        finite stamp before them (the state unchanged)."""
+        finite = np.isfinite(t) & np.isfinite(y)
+        stamps = np.concatenate(([self._last], np.where(finite, t, -math.inf)))
+        return finite & (t > np.maximum.accumulate(stamps)[:-1])
+
     def feed(self, t: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`update` for arrays, block by block: ``(valid, driven)`` per sample (kept by
         the envelope's rule; the state after it). The same states as sample by sample: each
         block's sums are sequential (``cumsum``, from the sums carried in), as ``update``'s."""
         n = len(t)
-        finite = np.isfinite(t) & np.isfinite(y)
-        # valid: finite and later than every finite stamp before it (the valid ones increase)
-        stamps = np.concatenate(([self._last], np.where(finite, t, -math.inf)))
-        valid = finite & (t > np.maximum.accumulate(stamps)[:-1])
+        valid = self.valid(t, y)
         driven = np.zeros(n, dtype=bool)
         idx = np.flatnonzero(valid)
         if not len(idx):
@@ -276,8 +427,9 @@ class Envelope:
         energy = max(0.0, self._s2 / n - m * m)
         self._n, self._s1, self._s2 = 0, 0.0, 0.0
         e = self._energies
-        onset = bool(e) and _is_onset(e, energy)
+        onset = bool(e) and _is_onset(e, energy, self.state == FREE, self.ringing)
         if onset:
+            self.ringing = False
             e.clear()
             self.changes['onsets'] += 1
         e.append(energy)
@@ -294,9 +446,11 @@ class Envelope:
                 self._driven = (self._driven + [energy])[-BLOCKS_PER_WINDOW:]
         elif is_driven(e):
             self.state = DRIVEN
+            self.ringing = False
             self.changes['became_driven'] += 1
             self._driven, self._quiet = list(e), 0
         self.blocks[self.state] += 1
+        self.seconds[self.state] += self.block_s
 
 
 class AutoEstimator:
@@ -310,7 +464,10 @@ class AutoEstimator:
         self._config = config
         self._free = free
         self._ambient = AmbientEstimator(config.replace(excitation='ambient'))
-        self._envelope = Envelope(max(MIN_BLOCK_S, config.ambient_window_s / BLOCKS_PER_WINDOW))
+        self._envelope = Envelope(
+            max(MIN_BLOCK_S, config.ambient_window_s / BLOCKS_PER_WINDOW),
+            config.ambient_window_s / MAX_BLOCK_FRACTION,
+        )
         self._modes: list[list[float]] = []  # [frequency, last t] of the known modes
         self._published = {FREE: 0, DRIVEN: 0}
         self._test = config.modes == 0  # the free-decay test of each free estimate
@@ -324,8 +481,13 @@ class AutoEstimator:
 
     @property
     def block_s(self) -> float:
-        """The envelope's block, s."""
+        """The envelope's block, s (now)."""
         return self._envelope.block_s
+
+    @property
+    def driven_s(self) -> float:
+        """The seconds of signal the envelope has read as driven (its closed blocks)."""
+        return self._envelope.seconds[DRIVEN]
 
     @property
     def state(self) -> str:
@@ -383,21 +545,27 @@ class AutoEstimator:
 
     def _passes(self, t: np.ndarray, y: np.ndarray, f: float) -> bool:
         """The free-decay test of a free estimate of ``f`` Hz whose sample ends ``(t, y)`` (at
-        most :data:`HISTORY` valid samples); an untestable one passes."""
-        ok = not self._test or is_free_decay(t[-HISTORY:], y[-HISTORY:], f) is not False
-        self._not_free += not ok
-        return ok
+        most :data:`HISTORY` valid samples); an untestable one passes. One that passes tells the
+        envelope its stretch rings freely (``ringing``), as any does with the test off
+        (``modes`` >= 1: the envelope alone decides)."""
+        verdict = is_free_decay(t[-HISTORY:], y[-HISTORY:], f) if self._test else None
+        self._envelope.ringing |= verdict is True or not self._test
+        self._not_free += verdict is False
+        return verdict is not False
 
     def update(self, t: float, y: float) -> list[Estimate]:
         """Feed one sample; the estimates it completes that belong to the current stretch."""
         self._envelope.update(float(t), float(y))
         self._remember(float(t), float(y))
         free = self._free.update(t, y)
+        free = [] if free is None else (free if isinstance(free, list) else [free])
+        self._ambient.idle = self._envelope.state == FREE
         ambient = self._ambient.update(t, y)
         if self._envelope.state == FREE:
-            chosen = [] if free is None else (free if isinstance(free, list) else [free])
+            for e in free:
+                self._envelope.follow(e.frequency_hz)
             h = self._history[:, : self._filled]
-            chosen = [e for e in chosen if self._passes(h[0], h[1], e.frequency_hz)]
+            chosen = [e for e in free if self._passes(h[0], h[1], e.frequency_hz)]
         else:
             chosen = ambient
         state = self._envelope.state
@@ -409,28 +577,25 @@ class AutoEstimator:
         """Feed arrays (continuing the stream); the same estimates as :meth:`update`, by time."""
         t, y = as_series(t, y)
         free = self._free.process(t, y)
-        ambient = self._ambient.process(t, y)
-        # the state after each sample (a sample completes at most one block's decision) and the
-        # samples the history keeps (the envelope's rule)
-        valid, states = self._envelope.feed(t, y)
-        # the history before this call, then this call's valid samples
+        # the history before this call, then this call's valid samples (the envelope's rule)
+        valid = self._envelope.valid(t, y)
         ht = np.concatenate((self._history[0, : self._filled], t[valid]))
         hy = np.concatenate((self._history[1, : self._filled], y[valid]))
         upto = self._filled + np.cumsum(valid)  # valid samples so far, after each sample
+        # the state after each sample (a sample completes at most one block's decision) and the
+        # free estimates that pass
+        states, passed = self._feed_envelope(t, y, free, (ht, hy, upto))
+        ambient = self._identify(t, y, states)
         n_keep = min(HISTORY, len(ht))
         self._history[:, :n_keep] = ht[len(ht) - n_keep :], hy[len(hy) - n_keep :]
         self._filled = n_keep
         names = list(EstimateArrays.__dataclass_fields__)
         parts, driven = [], []
         for est, want in ((free, False), (ambient, True)):
-            # an estimate's sample: the last one with its stamp (stamps increase where it counts)
-            idx = np.clip(np.searchsorted(t, est.t, 'right') - 1, 0, max(len(t) - 1, 0))
-            keep = states[idx] == want if len(t) else np.zeros(0, dtype=bool)
             if not want:
-                for k in np.flatnonzero(keep).tolist():
-                    n = int(upto[idx[k]])
-                    lo = max(0, n - HISTORY)
-                    keep[k] = self._passes(ht[lo:n], hy[lo:n], float(est.frequency_hz[k]))
+                keep = passed
+            else:
+                keep = states[self._samples(t, est.t)] if len(t) else np.zeros(0, dtype=bool)
             parts.append(EstimateArrays(**{n: getattr(est, n)[keep] for n in names}))
             driven.append(np.full(int(np.sum(keep)), want))
         # by time, stable: at one stamp the free estimate first, an analysis's modes in order
@@ -443,6 +608,47 @@ class AutoEstimator:
             for f, s, k in zip(out.frequency_hz.tolist(), out.t.tolist(), kind.tolist())
         ]
         return out
+
+    @staticmethod
+    def _samples(t: np.ndarray, stamps: np.ndarray) -> np.ndarray:
+        """Each estimate's sample: the last one with its stamp (where it counts, they increase)."""
+        return np.clip(np.searchsorted(t, stamps, 'right') - 1, 0, max(len(t) - 1, 0))
+
+    def _feed_envelope(
+        self, t: np.ndarray, y: np.ndarray, free: EstimateArrays, history
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`Envelope.feed` of a batch, in pieces that end at its ``free`` estimates' samples,
+        each of them, where the stretch is free, followed and tested (``history``: the valid
+        samples ``(t, y)`` and how many end each sample of the batch), as :meth:`update` has it:
+        the state after each sample and whether each free estimate publishes."""
+        env = self._envelope
+        ht, hy, upto = history
+        passed = np.zeros(len(free), dtype=bool)
+        lo, parts = 0, []
+        for j, (k, f) in enumerate(
+            zip(self._samples(t, free.t).tolist(), free.frequency_hz.tolist())
+        ):
+            parts.append(env.feed(t[lo : k + 1], y[lo : k + 1])[1])
+            lo = k + 1
+            if env.state == FREE:
+                env.follow(f)
+                n = int(upto[k])
+                passed[j] = self._passes(
+                    ht[max(0, n - HISTORY) : n], hy[max(0, n - HISTORY) : n], f
+                )
+        parts.append(env.feed(t[lo:], y[lo:])[1])
+        return np.concatenate(parts), passed
+
+    def _identify(self, t: np.ndarray, y: np.ndarray, driven: np.ndarray) -> EstimateArrays:
+        """The identifier's estimates of a batch whose samples end ``driven`` stretches (else
+        free): it runs idle over each run of free samples, as :meth:`update` has it."""
+        edges = [0, *(np.flatnonzero(np.diff(driven)) + 1).tolist(), len(t)]
+        parts = []
+        for a, b in zip(edges[:-1], edges[1:]):
+            if b > a:
+                self._ambient.idle = not driven[a]
+                parts.append(self._ambient.process(t[a:b], y[a:b]))
+        return EstimateArrays.concatenate(parts)
 
     def _rank(self, f: float, t: float, kind: str) -> int:
         """The mode number, in the shared scheme, of a ``kind`` estimate of ``f`` Hz at ``t``."""
