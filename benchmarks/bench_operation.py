@@ -323,13 +323,18 @@ def free_decays(real_data):
         # arm) and the arm moved every 10 s, from rest and while it rings (1.15-1.64 Hz: several
         # periods to an envelope block)
         moves = (Move(0.0, 1.0, 1.0), Move(10.0, 0.0, 1.0), Move(20.0, 0.5, 0.5), Move(30.0, 1.2))
-        for case in COMPARE_CASES:
-            recs = [case.record(seed)[:2] for seed in range(3)]
-            for name, cfg in (('paper', EstimatorConfig.paper()), ('defaults', EstimatorConfig())):
-                yield f'compare {case.key} ({case.title}), {name}', cfg, recs
-        recs = [(r.t, r.torque) for r in (simulate(40.0, moves, seed=s) for s in range(3))]
-        for name, cfg in (('paper', EstimatorConfig.paper()), ('defaults', EstimatorConfig())):
-            yield f'arm moved every 10 s, {name}', cfg, recs
+
+        def moved(seed):
+            rec = simulate(40.0, moves, seed=seed)
+            return rec.t, rec.torque
+
+        configs = (('paper', EstimatorConfig.paper()), ('defaults', EstimatorConfig()))
+        arm_records = [(f'compare {c.key} ({c.title})', c.record) for c in COMPARE_CASES]
+        arm_records.append(('arm moved every 10 s', moved))
+        for label, record in arm_records:
+            recs = [record(seed)[:2] for seed in range(3)]
+            for name, cfg in configs:
+                yield f'{label}, {name}', cfg, recs
         folder = Path(real_data) / 'aluminium_cantilever_adxl357'
         if folder.is_dir():
             for length in REFERENCE:

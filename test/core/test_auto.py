@@ -328,7 +328,7 @@ def test_the_test_starts_after_a_build_up():
         assert m[0] > 10 * auto.NOISE_RATIO and m[1] > 2 * auto.INNOVATION
 
 
-def _replucked(amp2, at, lead=0.0):
+def _replucked(amp2, at):
     """A 5 Hz decay (amplitude 1, its block energy x 0.8 per 1 s block), plucked again in phase
     at ``at`` s (the amplitude then ``amp2`` x), with white noise."""
     rng = np.random.default_rng(7)
