@@ -108,3 +108,46 @@ def test_sensitivity_command(capsys, tmp_path):
     assert float(zv_row[1]) == 0.5 and float(zv_row[4]) == pytest.approx(7.85, abs=0.01)
     assert (tmp_path / 's.png').stat().st_size > 10_000
     assert sensitivity_main(['--damping', '2']) == 2
+
+
+def test_sped_up_demo_holds_the_simulator_at_each_event():
+    """Sped up, the driver acts at each event's simulated time, whatever its own lag: the
+    simulator holds there (``pause_at``) until the event is done and the next one's time is set;
+    the last releases it. (The CI failure this answers: a listener 0.6 s behind made the last
+    shaped move too late to measure.)"""
+    from types import SimpleNamespace
+
+    from vib_estimator.demo.shaping import drive
+
+    events = shaping_events(6.0, 'zvd', 0.5)
+    calls = []
+
+    class Driver:
+        heard = 0.0
+
+        def now(self):
+            return self.heard
+
+        def set_shaper(self, name):
+            calls.append(('shaper', self.heard, name))
+
+        def move(self, reference):
+            calls.append(('move', self.heard, reference))
+
+        def pause_sim_at(self, t):
+            calls.append(('pause_at', self.heard, t))
+            self.heard = t or 99.0  # the simulator runs on to the hold (or to its end)
+
+    def spin_until(predicate, timeout):
+        return predicate()
+
+    args = SimpleNamespace(seconds_per_mass=6.0, shaper='zvd', step=0.5, speed=10.0)
+    sim = SimpleNamespace(poll=lambda: None)
+    driver = Driver()
+    driver.heard = events[0][0]  # sim_node started with pause_at at the first event
+    moves = drive(SimpleNamespace(spin_until=spin_until), driver, sim, args, held=True)
+    acted = [c for c in calls if c[0] != 'pause_at']
+    assert [(kind, t, value) for t, kind, value in events] == acted  # each at its own time
+    holds = [c[2] for c in calls if c[0] == 'pause_at']
+    assert holds == [t for t, _, _ in events[1:]] + [0.0]
+    assert [m.t for m in moves] == [t for t, kind, _ in events if kind == 'move']

@@ -357,6 +357,45 @@ def test_lockstep_waits_for_the_commander(ros_context, executor):
             node.destroy_node()
 
 
+def test_pause_at_holds_the_arm_until_raised(ros_context, executor):
+    """pause_at (simulated time, settable): the arm publishes up to the first sample at or after
+    it and holds there, however long, until it is raised; 0 releases it; the samples stay
+    evenly spaced through the holds; refused without simulated time."""
+    with pytest.raises(StartupError, match='pause_at needs simulated time'):
+        sim_node(ros_context, pause_at=1.0)
+    real = sim_node(ros_context, namespace='real_pause')
+    refused = real.set_parameters([Parameter('pause_at', value=1.0)])[0]
+    real.destroy_node()
+    assert not refused.successful and 'simulated time' in refused.reason
+    sim = sim_node(
+        ros_context, namespace='pause', speed=20.0, pause_at=0.503, wait_for_subscribers=1
+    )
+    probe = Node('pause_probe', context=ros_context)
+    stamps = []
+    probe.create_subscription(
+        WrenchStamped,
+        '/pause/coupling_torque',
+        lambda m: stamps.append(m.header.stamp.sec * 10**9 + m.header.stamp.nanosec),
+        QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE),
+    )
+    for node in (sim, probe):
+        executor.add_node(node)
+    try:
+        for pause_at, held_at in ((0.503, 0.504), (1.0, 1.0)):
+            assert spin_until(executor, lambda: sim_seconds(stamps) >= pause_at, 30.0)
+            spin_until(executor, lambda: False, 0.3)  # 6 simulated seconds at 20x
+            assert sim_seconds(stamps) == pytest.approx(held_at, abs=1e-9)
+            assert len(stamps) == round(held_at * 500) + 1
+            assert sim.set_parameters([Parameter('pause_at', value=1.0)])[0].successful
+        assert sim.set_parameters([Parameter('pause_at', value=0.0)])[0].successful
+        assert spin_until(executor, lambda: sim_seconds(stamps) > 2.0, 30.0)
+        assert set(np.diff(stamps)) == {2_000_000}
+    finally:
+        for node in (sim, probe):
+            executor.remove_node(node)
+            node.destroy_node()
+
+
 def test_realism_parameters_reach_the_published_torque(ros_context, executor):
     """offset, quantum and limit_cycle_voltage (issue 25): coupling_torque is the model's with
     them, sample for sample, on the quantum's grid."""

@@ -6,7 +6,9 @@ Per tip mass of Section 5.5 a move unshaped, then, once ``estimator_node`` has e
 free vibration since, the same move back shaped by ``shaper_node`` for that estimate
 (:func:`shaping_events`, played by :class:`ShapingDriver`); the vibration each move adds to the
 mode still ringing is measured from the recorded torque (:func:`measure_moves`) and each shaped
-move must cut it by the shaper's :data:`MIN_REDUCTION` (:func:`summarise_shaping`).
+move must cut it by the shaper's :data:`MIN_REDUCTION` (:func:`summarise_shaping`). Sped up,
+``sim_node`` runs in lockstep with ``shaper_node`` and holds at each event's time until the
+driver has acted (:func:`drive`).
 """
 
 from __future__ import annotations
@@ -76,7 +78,8 @@ def shaping_events(
 
 
 class ShapingDriver:
-    """Publishes the ``reference`` and switches ``shaper_node``'s ``shaper`` parameter."""
+    """Publishes the ``reference``, switches ``shaper_node``'s ``shaper`` parameter and, sped
+    up, holds ``sim_node`` at each event's time (its ``pause_at``) until the event is done."""
 
     def __init__(self, session: Session):
         from rclpy.parameter_client import AsyncParameterClient
@@ -86,22 +89,30 @@ class ShapingDriver:
         self._msg = Float64
         node = session.listener.node
         self.reference_pub = node.create_publisher(Float64, 'reference', 10)
-        self._params = AsyncParameterClient(node, 'shaper_node')
+        self._shaper = AsyncParameterClient(node, 'shaper_node')
+        self._sim = AsyncParameterClient(node, 'sim_node')
 
     def now(self) -> float:
         """The simulated time of the last sample heard, s."""
         t = self._session.listener.record.t
         return t[-1] if t else 0.0
 
-    def set_shaper(self, name: str) -> None:
+    def _set(self, client, node: str, name: str, value) -> None:
         from rclpy.parameter import Parameter
 
-        future = self._params.set_parameters([Parameter('shaper', value=name)])
+        future = client.set_parameters([Parameter(name, value=value)])
         if not self._session.spin_until(future.done, 10.0):
-            raise RuntimeError('shaper_node did not answer a parameter request')
+            raise RuntimeError(f'{node} did not answer a parameter request')
         result = future.result().results[0]
         if not result.successful:
-            raise RuntimeError(f'shaper_node refused shaper {name}: {result.reason}')
+            raise RuntimeError(f'{node} refused {name} {value}: {result.reason}')
+
+    def set_shaper(self, name: str) -> None:
+        self._set(self._shaper, 'shaper_node', 'shaper', name)
+
+    def pause_sim_at(self, t: float) -> None:
+        """Hold sim_node once it has simulated ``t`` s (0: no hold)."""
+        self._set(self._sim, 'sim_node', 'pause_at', float(t))
 
     def move(self, reference: float) -> None:
         self.reference_pub.publish(self._msg(data=float(reference)))
@@ -113,12 +124,15 @@ def design_estimate(rec: Record, t: float) -> float:
     return float(np.median(last)) if last else float('nan')
 
 
-def _drive(session: Session, driver: ShapingDriver, sim, args) -> List[ShapedMove]:
+def drive(session: Session, driver: ShapingDriver, sim, args, held: bool) -> List[ShapedMove]:
     """Play the events as the simulated time reaches them; return the moves made (``t``: the
-    time heard when commanded; the arm sees it later, see :func:`measure_moves`)."""
+    time heard when commanded; the arm sees it later, see :func:`measure_moves`). ``held``: the
+    simulator holds at each event's time (its ``pause_at``, started at the first event) until the
+    event is done and the next one's time is set, so a loaded machine cannot make a move late."""
     moves: List[ShapedMove] = []
     name = 'none'
-    for t, kind, value in shaping_events(args.seconds_per_mass, args.shaper, args.step):
+    events = shaping_events(args.seconds_per_mass, args.shaper, args.step)
+    for i, (t, kind, value) in enumerate(events):
         session.spin_until(
             lambda: sim.poll() is not None or driver.now() >= t,
             STARTUP_TIMEOUT + 3 * args.seconds_per_mass / args.speed,
@@ -128,10 +142,14 @@ def _drive(session: Session, driver: ShapingDriver, sim, args) -> List[ShapedMov
         if kind == 'shaper':
             driver.set_shaper(value)
             name = value
-            continue
-        moves.append(ShapedMove(int(t // args.seconds_per_mass), driver.now(), value, shaper=name))
-        driver.move(value)
-        print(f'[{moves[-1].t:6.2f} s] move to {value:g} rad, {name}', flush=True)
+        else:
+            moves.append(
+                ShapedMove(int(t // args.seconds_per_mass), driver.now(), value, shaper=name)
+            )
+            driver.move(value)
+            print(f'[{moves[-1].t:6.2f} s] move to {value:g} rad, {name}', flush=True)
+        if held:
+            driver.pause_sim_at(events[i + 1][0] if i + 1 < len(events) else 0.0)
     return moves
 
 
@@ -252,11 +270,13 @@ def run_shaping(session: Session, args: argparse.Namespace, wall_start: float) -
     masses = [Move(i * p, 0.0, 1.0, m) for i, m in enumerate(MASSES_5_5)]
     lockstep = args.speed != 1  # in real time the arm takes the commands as they come
     sim_start = time.monotonic()
+    first_event = shaping_events(p, args.shaper, args.step)[0][0]
     sim = session.start_sim(
         sim_params(args.speed, 3 * p, schedule_to_array(masses), 2)
         + ['wait_for_command:=true', f'lockstep:={str(lockstep).lower()}']
+        + ([f'pause_at:={float(first_event)}'] if lockstep else [])
     )
-    moves = _drive(session, driver, sim, args)
+    moves = drive(session, driver, sim, args, held=lockstep)
     session.finish_sim(sim, 3 * p, args.speed)
     sim_wall = time.monotonic() - sim_start
     rows = measure_moves(listener.record, moves, p)

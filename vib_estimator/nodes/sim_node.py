@@ -30,7 +30,9 @@ Section 5.5. ``duration`` makes the node exit 0 after that much simulated time, 
 ``wait_for_subscribers`` holds the start until the consumers are matched (the demo and the tests
 use both); ``wait_for_command`` until the first command. ``lockstep`` (simulated time) makes each
 batch wait for a command answering the previous ``/clock``, so a closed loop through other nodes
-behaves the same at any speed and load.
+behaves the same at any speed and load; ``pause_at`` (simulated time, settable) holds the arm at
+a simulated time until it is raised, so a commander outside that loop (the shaping demo's moves)
+acts at the times it planned, however far behind it is.
 """
 
 from __future__ import annotations
@@ -78,6 +80,7 @@ SIM_TIME_ORIGIN_NS = 1_000_000_000  # stamp of the first sample in simulated tim
 # the command answering the previous batch's /clock
 LOCKSTEP_BATCH_SECONDS = 0.02
 LOCKSTEP_TIMEOUT = 1.0
+PAUSE_NEEDS_SIM_TIME = 'pause_at needs simulated time: speed other than 1 or publish_clock'
 #: physical range of the tip mass, kg (Table 1's bar: 45.55 g; 10 kg gives f0 = 0.09 Hz)
 TIP_MASS_RANGE_KG = (0.001, 10.0)
 SCHEDULE_FIELDS = 4  # start, final_angle, slope, tip_mass_kg (0 = unchanged)
@@ -264,6 +267,17 @@ PARAMETERS = {
             read_only=True,
         ),
     ),
+    'pause_at': (
+        0.0,
+        descriptor(
+            'simulated time only: once it has published the sample at (or just after) this '
+            'simulated time, s, the arm holds (no sample, no /clock) until the parameter is '
+            'raised or set to 0 (= never); settable: a commander sets it to its next event, '
+            'acts there and raises it, so it acts at the times it planned however loaded the '
+            'machine',
+            (0.0, 1e9),
+        ),
+    ),
     'output_type': (
         WRENCH_STAMPED,
         descriptor(
@@ -363,6 +377,10 @@ class SimNode(Node):
             raise StartupError(
                 'lockstep needs simulated time: speed other than 1 or publish_clock'
             )
+        if p['pause_at'] > 0 and not self._sim_time:
+            raise StartupError(PAUSE_NEEDS_SIM_TIME)
+        self._pause_at = p['pause_at']
+        self._paused_since = None  # monotonic time the arm began holding at pause_at
         self._answered = True  # a command arrived since the last /clock (lockstep)
         self._clock_at = 0.0  # monotonic time of the last batch's /clock
         self.lockstep_timeouts = 0
@@ -462,6 +480,27 @@ class SimNode(Node):
         )
         return False
 
+    def _samples_until_pause(self) -> int:
+        """Samples still to publish before holding at ``pause_at``: up to the first at or after
+        it."""
+        last = math.ceil(self._pause_at * self._rate - 1e-9)
+        return last + 1 - round(self._sim.t * self._rate)
+
+    def _holding(self) -> bool:
+        """Whether the arm holds at ``pause_at``; on leaving a hold the wall-clock start moves by
+        its length, so the run goes on at ``speed`` instead of catching up (and the lockstep's
+        wait for an answer restarts)."""
+        if self._pause_at > 0 and self._samples_until_pause() <= 0:
+            if self._paused_since is None:
+                self._paused_since = time.monotonic()
+            return True
+        if self._paused_since is not None:
+            held = time.monotonic() - self._paused_since
+            self._wall_start += held
+            self._clock_at += held
+            self._paused_since = None
+        return False
+
     # ---- parameters ------------------------------------------------------------------------
     def _validate(self, params: List[Parameter]) -> SetParametersResult:
         """Checks beyond the descriptors' ranges and read-only flags; a refused value is kept out.
@@ -470,6 +509,8 @@ class SimNode(Node):
         :data:`MIN_SAMPLES_PER_PERIOD` samples per period.
         """
         for param in params:
+            if param.name == 'pause_at' and param.value > 0 and not self._sim_time:
+                return SetParametersResult(successful=False, reason=PAUSE_NEEDS_SIM_TIME)
             if param.name == 'tip_mass_kg':
                 lo, hi = TIP_MASS_RANGE_KG
                 if not lo <= param.value <= hi:  # the schedule's masses have no descriptor
@@ -498,6 +539,8 @@ class SimNode(Node):
                 )
             elif param.name == 'noise_std':
                 self._sim.noise_std = float(param.value)
+            elif param.name == 'pause_at':
+                self._pause_at = float(param.value)
 
     def _sync_mass_parameter(self) -> None:
         """Show a tip mass set by the schedule in the ``tip_mass_kg`` parameter."""
@@ -526,7 +569,7 @@ class SimNode(Node):
                 self._publish_clock(self._origin_ns)
                 return
             self._wall_start = time.monotonic()
-        if self._lockstep_wait():
+        if self._holding() or self._lockstep_wait():
             return
         due_t = (time.monotonic() - self._wall_start) * self._speed
         if self._duration > 0:
@@ -534,6 +577,8 @@ class SimNode(Node):
         due = int(due_t * self._rate) + 1 - round(self._sim.t * self._rate)
         if self._lockstep:
             due = min(due, max(1, int(LOCKSTEP_BATCH_SECONDS * self._rate)))
+        if self._pause_at > 0:
+            due = min(due, self._samples_until_pause())
         limit = int(max(MAX_BATCH_SECONDS, BATCH_TICKS * self._speed / TICK_HZ) * self._rate)
         if due > limit:
             self.get_logger().warning(
