@@ -80,7 +80,8 @@ SIM_TIME_ORIGIN_NS = 1_000_000_000  # stamp of the first sample in simulated tim
 # the command answering the previous batch's /clock
 LOCKSTEP_BATCH_SECONDS = 0.02
 LOCKSTEP_TIMEOUT = 1.0
-PAUSE_NEEDS_SIM_TIME = 'pause_at needs simulated time: speed other than 1 or publish_clock'
+#: why lockstep and pause_at are refused in real time
+NEEDS_SIM_TIME = 'needs simulated time: speed other than 1 or publish_clock'
 #: physical range of the tip mass, kg (Table 1's bar: 45.55 g; 10 kg gives f0 = 0.09 Hz)
 TIP_MASS_RANGE_KG = (0.001, 10.0)
 SCHEDULE_FIELDS = 4  # start, final_angle, slope, tip_mass_kg (0 = unchanged)
@@ -374,11 +375,9 @@ class SimNode(Node):
         self._wait_for_command = p['wait_for_command']
         self._lockstep = p['lockstep']
         if self._lockstep and not self._sim_time:
-            raise StartupError(
-                'lockstep needs simulated time: speed other than 1 or publish_clock'
-            )
+            raise StartupError(f'lockstep {NEEDS_SIM_TIME}')
         if p['pause_at'] > 0 and not self._sim_time:
-            raise StartupError(PAUSE_NEEDS_SIM_TIME)
+            raise StartupError(f'pause_at {NEEDS_SIM_TIME}')
         self._pause_at = p['pause_at']
         self._paused_since = None  # monotonic time the arm began holding at pause_at
         self._answered = True  # a command arrived since the last /clock (lockstep)
@@ -510,7 +509,7 @@ class SimNode(Node):
         """
         for param in params:
             if param.name == 'pause_at' and param.value > 0 and not self._sim_time:
-                return SetParametersResult(successful=False, reason=PAUSE_NEEDS_SIM_TIME)
+                return SetParametersResult(successful=False, reason=f'pause_at {NEEDS_SIM_TIME}')
             if param.name == 'tip_mass_kg':
                 lo, hi = TIP_MASS_RANGE_KG
                 if not lo <= param.value <= hi:  # the schedule's masses have no descriptor
