@@ -145,7 +145,7 @@ def test_sped_up_demo_holds_the_simulator_at_each_event():
     sim = SimpleNamespace(poll=lambda: None)
     driver = Driver()
     driver.heard = events[0][0]  # sim_node started with pause_at at the first event
-    moves = drive(SimpleNamespace(spin_until=spin_until), driver, sim, args, held=True)
+    moves = drive(SimpleNamespace(spin_until=spin_until), driver, sim, events, args, held=True)
     acted = [c for c in calls if c[0] != 'pause_at']
     assert [(kind, t, value) for t, kind, value in events] == acted  # each at its own time
     holds = [c[2] for c in calls if c[0] == 'pause_at']

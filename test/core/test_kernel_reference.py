@@ -198,15 +198,14 @@ def _assert_same(name, col, got, want) -> None:
     """Exactly equal (NaN = NaN); the mode tracker's floats to ``MODES_RTOL``, the others' to
     ``HOST_RTOL`` (see the module)."""
     got = np.asarray(got, dtype=np.float64)
-    rtol = MODES_RTOL if name.startswith('modes') else HOST_RTOL
+    modes = name.startswith('modes')
+    rtol = MODES_RTOL if modes else HOST_RTOL
     if rtol and col not in ('t', 'samples', 'mode'):
         np.testing.assert_array_equal(np.isnan(got), np.isnan(want), err_msg=col)
         ok = ~np.isnan(want)
         # relative to each value, or to the column's scale for values near 0 (a damping ratio
         # is a difference: 1e-5 of 1e-2 carries the ulps of the 1e-2)
-        atol = (
-            0.0 if name.startswith('modes') else rtol * float(np.max(np.abs(want[ok]), initial=0))
-        )
+        atol = 0.0 if modes else rtol * float(np.max(np.abs(want[ok]), initial=0))
         np.testing.assert_allclose(got[ok], want[ok], rtol=rtol, atol=atol, err_msg=col)
     else:
         np.testing.assert_array_equal(got, want, err_msg=col)

@@ -54,7 +54,7 @@ import numpy as np
 
 from .ambient import MATCH_TOL, AmbientEstimator
 from .config import EstimatorConfig
-from .estimator import Estimate, EstimateArrays, as_series
+from .estimator import Estimate, EstimateArrays, as_estimates, as_series
 
 #: envelope blocks per ambient window
 BLOCKS_PER_WINDOW = 30
@@ -219,6 +219,14 @@ def _first_block(c: np.ndarray, periods: float) -> int:
     return first + run + (run > 0)
 
 
+def _tested_blocks(t: np.ndarray, y: np.ndarray, f: float, periods: float, other=None):
+    """:func:`_blocks` at ``f`` Hz, fitting the ``other`` component too when given and the blocks
+    hold enough samples for it, and the first block the test uses (:func:`_first_block`):
+    ``(c, v, first)``, or None when the blocks are too short."""
+    got = (other is not None and _blocks(t, y, f, other)) or _blocks(t, y, f)
+    return None if got is None else (*got, _first_block(got[0], periods))
+
+
 def decay_misfit(
     t: np.ndarray, y: np.ndarray, f: float, periods: float = TEST_PERIODS
 ) -> Optional[Tuple[float, float]]:
@@ -234,18 +242,15 @@ def decay_misfit(
     t, y = t[lo:], y[lo:]
     other = None
     for step in range(3):
-        got = (other is not None and _blocks(t, y, f, other)) or _blocks(t, y, f)
+        got = _tested_blocks(t, y, f, periods, other)
         if got is None:
             return None
-        c, v = got
-        first = _first_block(c, periods)
+        c, v, first = got
         if step == 0:  # the other component over the blocks used, from the start of the first
             start = np.searchsorted(t, t[-1] - (len(c) - first + 1) / (2 * f), 'left')
             other = other_frequency(t[start:], y[start:], f)
-            got = _blocks(t, y, f, other) if other is not None else None
-            if got:
-                c, v = got
-                first = _first_block(c, periods)
+            if other is not None:
+                c, v, first = _tested_blocks(t, y, f, periods, other)
         c, v = c[first:], v[first:]
         if len(c) < TEST_BLOCKS:
             return None
@@ -557,8 +562,7 @@ class AutoEstimator:
         """Feed one sample; the estimates it completes that belong to the current stretch."""
         self._envelope.update(float(t), float(y))
         self._remember(float(t), float(y))
-        free = self._free.update(t, y)
-        free = [] if free is None else (free if isinstance(free, list) else [free])
+        free = as_estimates(self._free.update(t, y))
         self._ambient.idle = self._envelope.state == FREE
         ambient = self._ambient.update(t, y)
         if self._envelope.state == FREE:
@@ -632,10 +636,8 @@ class AutoEstimator:
             lo = k + 1
             if env.state == FREE:
                 env.follow(f)
-                n = int(upto[k])
-                passed[j] = self._passes(
-                    ht[max(0, n - HISTORY) : n], hy[max(0, n - HISTORY) : n], f
-                )
+                kept = slice(max(0, int(upto[k]) - HISTORY), int(upto[k]))  # its history
+                passed[j] = self._passes(ht[kept], hy[kept], f)
         parts.append(env.feed(t[lo:], y[lo:])[1])
         return np.concatenate(parts), passed
 

@@ -125,6 +125,14 @@ class Estimate:
         }
 
 
+def as_estimates(result) -> Sequence[Estimate]:
+    """An estimator's ``update`` result as a sequence: none (``None`` or an empty list), the one
+    :class:`Estimate` of the free-decay estimator, or the list of the others."""
+    if not result:
+        return ()
+    return result if isinstance(result, list) else (result,)
+
+
 @dataclass
 class EstimateArrays:
     """Estimates of a batch run as columns (same fields as :class:`Estimate`)."""

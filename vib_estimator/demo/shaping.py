@@ -124,14 +124,16 @@ def design_estimate(rec: Record, t: float) -> float:
     return float(np.median(last)) if last else float('nan')
 
 
-def drive(session: Session, driver: ShapingDriver, sim, args, held: bool) -> List[ShapedMove]:
-    """Play the events as the simulated time reaches them; return the moves made (``t``: the
-    time heard when commanded; the arm sees it later, see :func:`measure_moves`). ``held``: the
-    simulator holds at each event's time (its ``pause_at``, started at the first event) until the
-    event is done and the next one's time is set, so a loaded machine cannot make a move late."""
+def drive(
+    session: Session, driver: ShapingDriver, sim, events, args, held: bool
+) -> List[ShapedMove]:
+    """Play the ``events`` (:func:`shaping_events`) as the simulated time reaches them; return
+    the moves made (``t``: the time heard when commanded; the arm sees it later, see
+    :func:`measure_moves`). ``held``: the simulator holds at each event's time (its ``pause_at``,
+    started at the first event) until the event is done and the next one's time is set, so a
+    loaded machine cannot make a move late."""
     moves: List[ShapedMove] = []
     name = 'none'
-    events = shaping_events(args.seconds_per_mass, args.shaper, args.step)
     for i, (t, kind, value) in enumerate(events):
         session.spin_until(
             lambda: sim.poll() is not None or driver.now() >= t,
@@ -270,13 +272,13 @@ def run_shaping(session: Session, args: argparse.Namespace, wall_start: float) -
     masses = [Move(i * p, 0.0, 1.0, m) for i, m in enumerate(MASSES_5_5)]
     lockstep = args.speed != 1  # in real time the arm takes the commands as they come
     sim_start = time.monotonic()
-    first_event = shaping_events(p, args.shaper, args.step)[0][0]
+    events = shaping_events(p, args.shaper, args.step)
     sim = session.start_sim(
         sim_params(args.speed, 3 * p, schedule_to_array(masses), 2)
         + ['wait_for_command:=true', f'lockstep:={str(lockstep).lower()}']
-        + ([f'pause_at:={float(first_event)}'] if lockstep else [])
+        + ([f'pause_at:={float(events[0][0])}'] if lockstep else [])
     )
-    moves = drive(session, driver, sim, args, held=lockstep)
+    moves = drive(session, driver, sim, events, args, held=lockstep)
     session.finish_sim(sim, 3 * p, args.speed)
     sim_wall = time.monotonic() - sim_start
     rows = measure_moves(listener.record, moves, p)

@@ -31,7 +31,7 @@ from functools import partial
 from typing import Any, Callable, Dict, Iterator, Optional, Sequence, Tuple
 
 from ..core.config import EstimatorConfig
-from ..core.estimator import COUNTER_NAMES, Estimate
+from ..core.estimator import COUNTER_NAMES, Estimate, as_estimates
 from ..core.modes import create_estimator
 from ..core.multichannel import MIN_CHANNELS
 from ..core.multichannel_free import JOINT_EXCITATIONS, create_joint_estimator
@@ -40,7 +40,6 @@ from ..io.fields import seconds_since
 from .health import WARN, Health, Status
 from .self_test import self_test
 
-_NONE: Tuple[Estimate, ...] = ()
 #: the core counters while no estimator runs (a warm-up): nothing received yet
 _IDLE_COUNTERS = dict.fromkeys(COUNTER_NAMES, 0)
 #: samples held while the kernels compile: a minute at 1 kHz (a cold compile takes seconds)
@@ -173,10 +172,7 @@ class EstimatorStream:
         if self.origin is None:
             self.origin = stamp_ns
         self.last_t = t = seconds_since(stamp_ns, self.origin)
-        result = self._update(t, value)
-        if not result:  # None, or an empty list (modes >= 1)
-            return _NONE
-        return result if isinstance(result, list) else (result,)
+        return as_estimates(self._update(t, value))
 
     @property
     def held_samples(self) -> int:
