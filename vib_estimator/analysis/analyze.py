@@ -33,8 +33,9 @@ from ..core.config import EXCITATIONS, PAPER
 from ..core.modes import create_estimator
 from ..errors import VibEstimatorError, report
 from ..io.align import ALIGN_TOLERANCE_S
+from ..io.csv_reader import csv_layout
 from ..io.fields import INPUT_TYPES, signal_unit
-from ..io.streaming import Signal, open_signal
+from ..io.streaming import Signal, is_csv, open_signal
 from .channels import channel_names, component_names, need_joint, run_joint, topic_list
 from .outputs import check_output
 from .summary import summarise_modes, summary_lines
@@ -320,6 +321,14 @@ def _print(estimates, origin, fmt, modes: int = 0) -> None:
             )
 
 
+def default_column(args) -> Optional[list[str]]:
+    """For a CSV input read without ``--column``: the file's signal columns, the one read (the
+    first after the time) first; else None."""
+    if args.column is not None or not is_csv(args.input):
+        return None
+    return list(csv_layout(args.input).names[1:])
+
+
 def damage_warning(signal: Signal, prog: str) -> None:
     """The one ``warning:`` line on stderr for the damaged records a read skipped, if any."""
     if signal.corrupt:
@@ -358,10 +367,19 @@ def run(args: argparse.Namespace) -> int:
             args.column,
             strict=getattr(args, 'strict', False),
         )
+        columns = default_column(args)
         result = estimate_signal(signal, config, bool(args.plot))
     except (VibEstimatorError, ValueError) as err:
         return report(err, 'vib-estimator analyze')
     damage_warning(signal, 'vib-estimator analyze')
+    others = columns[1:] if columns else []
+    if columns:
+        print(
+            f'analyze: column {columns[0]} (the first after the time, the default'
+            + (f'; the others: {", ".join(others)}: --column NAME' if others else '')
+            + ')',
+            file=sys.stderr,
+        )
     estimates = result.estimates
     _print(estimates, signal.origin_ns, args.format, config.modes or config.excitation != 'free')
     counters = result.estimator.counters
@@ -373,13 +391,22 @@ def run(args: argparse.Namespace) -> int:
     print(
         'analyze: ' + ', '.join(f'{k}={v}' for k, v in counters.items()) + extra, file=sys.stderr
     )
-    mode = estimates.mode if config.modes else None
+    mode = estimates.mode if config.modes or config.excitation != 'free' else None
     if len(estimates) == 0:
         print(
             'analyze: no estimate: ' + explain_no_estimate(counters, open_samples, config),
             file=sys.stderr,
         )
-    for line in summary_lines(summarise_modes(estimates.frequency_hz, estimates.damping, mode)):
+        if others:
+            print(
+                f"analyze: column {signal.label} gave no estimate; the file's other columns: "
+                + ', '.join(others)
+                + ' (--column NAME, or --columns all for a joint estimation)',
+                file=sys.stderr,
+            )
+    for line in summary_lines(
+        summarise_modes(estimates.frequency_hz, estimates.damping, mode, estimates.t)
+    ):
         print('analyze: ' + line, file=sys.stderr)
     if args.plot:
         plot_run(args.plot, args.input, signal, result, mode)

@@ -289,7 +289,7 @@ def run_joint(args, config: EstimatorConfig, names, json_row, prog: str, warn=No
         file=sys.stderr,
     )
     e = result.estimates
-    for line in summary_lines(summarise_modes(e.frequency_hz, e.damping, e.mode)):
+    for line in summary_lines(summarise_modes(e.frequency_hz, e.damping, e.mode, e.t)):
         print(f'{prog}: ' + line, file=sys.stderr)
     for k, (f, amp, _) in mode_shapes(result).items():
         shape = ', '.join(f'{n} {a:+.2f}' for n, a in zip(names, amp))
