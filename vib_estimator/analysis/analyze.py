@@ -37,6 +37,7 @@ from ..io.csv_reader import csv_layout
 from ..io.fields import INPUT_TYPES, signal_unit
 from ..io.streaming import Signal, is_csv, open_signal
 from .channels import channel_names, component_names, need_joint, run_joint, topic_list
+from .choosing import decided_blocks, decides, window_given
 from .outputs import check_output
 from .summary import summarise_modes, summary_lines
 
@@ -206,8 +207,11 @@ class Run:
     samples: Optional[Tuple[np.ndarray, np.ndarray]]
 
 
-def estimate_signal(signal: Signal, config: EstimatorConfig, keep_samples: bool = False) -> Run:
-    """Stream ``signal`` through a fresh estimator of ``config``, block by block.
+def estimate_signal(
+    signal: Signal, config: EstimatorConfig, keep_samples: bool = False, blocks=None
+) -> Run:
+    """Stream ``signal`` (or its ``blocks``, when some were read ahead) through a fresh estimator
+    of ``config``, block by block.
 
     Raises ValueError (no samples, time not increasing, band above Nyquist) and the readers'
     CsvError/BagError.
@@ -215,7 +219,7 @@ def estimate_signal(signal: Signal, config: EstimatorConfig, keep_samples: bool 
     estimator = create_estimator(config)
     parts, kept = [], []
     count, previous, first_t, nyquist_checked = 0, 0.0, None, False
-    for t, y in signal.blocks():
+    for t, y in signal.blocks() if blocks is None else blocks:
         if len(t) == 0:
             continue
         _check_times(t, previous, count, str(signal.path))
@@ -368,10 +372,17 @@ def run(args: argparse.Namespace) -> int:
             strict=getattr(args, 'strict', False),
         )
         columns = default_column(args)
-        result = estimate_signal(signal, config, bool(args.plot))
+        blocks, decided = None, ''
+        if decides(args):
+            config, blocks, decided = decided_blocks(
+                config, signal.blocks(), 'analyze', window_given(args)
+            )
+        result = estimate_signal(signal, config, bool(args.plot), blocks)
     except (VibEstimatorError, ValueError) as err:
         return report(err, 'vib-estimator analyze')
     damage_warning(signal, 'vib-estimator analyze')
+    if decided:
+        print(decided, file=sys.stderr)
     others = columns[1:] if columns else []
     if columns:
         print(

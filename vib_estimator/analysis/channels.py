@@ -32,6 +32,7 @@ from ..errors import BagError, CsvError
 from ..io.csv_reader import column_names, read_csv_columns
 from ..io.fields import UNKNOWN_UNIT, seconds_since, signal_unit
 from ..io.streaming import is_csv, open_signal, read_topics
+from .choosing import decided_config, decides, window_given
 from .summary import summarise_modes, summary_lines
 
 
@@ -268,6 +269,9 @@ def run_joint(args, config: EstimatorConfig, names, json_row, prog: str, warn=No
     (signal, prog) says what a bag's read skipped. Bad input raises (CsvError, BagError,
     ValueError) before anything is printed."""
     t, y, names, signals, origin, counters = read_joint(args, names)
+    decided = ''
+    if decides(args):
+        config, decided = decided_config(config, t, y, len(names), prog, window_given(args))
     estimator, result = joint_run(t, y, names, config)
     table = rows(result)
     extra = ''
@@ -282,6 +286,8 @@ def run_joint(args, config: EstimatorConfig, names, json_row, prog: str, warn=No
         extra += f', corrupt_records={sum(signal.corrupt for signal in signals)}'
         extra += ''.join(f', {k}={v}' for k, v in counters.items())
     print_rows(table, args.format, json_row)
+    if decided:
+        print(decided, file=sys.stderr)
     print(
         f'{prog}: channels={",".join(names)}, '
         + ', '.join(f'{k}={v}' for k, v in estimator.counters.items())
