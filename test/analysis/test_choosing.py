@@ -10,6 +10,7 @@ import json
 import numpy as np
 import pytest
 
+from vib_estimator.analysis.choosing import window_advice
 from vib_estimator.cli import main
 from vib_estimator.sim.ambient import ambient_record
 from vib_estimator.sim.frame import frame_record
@@ -88,3 +89,40 @@ def test_survey_decides_each_recording(capsys, tmp_path, free_decay, driven):
         by.setdefault(r['recording'].rsplit('/', 1)[-1], []).append(r)
     assert [r['mode'] for r in by['decay.csv']] == [0]
     assert sorted(r['mode'] for r in by['driven.csv']) == [1, 2]
+
+
+def test_a_forced_excitation_the_record_contradicts_is_warned_about(capsys, free_decay, driven):
+    _, err = analyze(capsys, driven, '--excitation', 'free')
+    assert 'warning: the record looks driven throughout' in err
+    _, err = analyze(capsys, free_decay, '--excitation', 'ambient')
+    assert 'warning: the record looks like free decays' in err
+    for args in ((free_decay, '--excitation', 'free'), (driven, '--excitation', 'ambient')):
+        assert 'warning' not in analyze(capsys, *args)[1]
+    assert 'warning' not in analyze(capsys, driven, '--paper')[1]  # the paper's, as printed
+
+
+def test_no_mode_from_a_short_window_says_which_window_helps(capsys, tmp_path):
+    from vib_estimator.core import EstimatorConfig
+    from vib_estimator.core.choice import decide
+
+    # a 0.5 Hz mode: 20 s hold 1.3 correlation times at zeta 2 %, 6 s at 20 Hz too few samples
+    t, y, _ = ambient_record(200, 20, [(0.5, 0.02, 1.0)], 20, 5)
+    d = decide(t, y)
+    short = EstimatorConfig(excitation='ambient', ambient_window_s=20)
+    assert window_advice(short, d) == (
+        'the 20 s window holds 1.3 correlation times of the 0.5 Hz peak (at zeta 2 %): '
+        '--ambient-window-s 240'
+    )
+    assert window_advice(short.replace(ambient_window_s=300), d) == ''
+    path = write(tmp_path / 'slow.csv', t, y)
+    rows, err = analyze(capsys, path, '--excitation', 'ambient', '--ambient-window-s', '6')
+    assert not rows
+    assert 'a 6 s window holds 120 samples at 20 Hz, fewer than the identifier needs' in err
+    assert '--ambient-window-s 9' in err
+    rows, err = analyze(capsys, path, '--excitation', 'ambient', '--ambient-window-s', '300')
+    assert 'the record is shorter than one window (--ambient-window-s 300; it spans 200 s' in err
+    # the default sizes the window itself and finds the mode
+    rows, err = analyze(capsys, path)
+    assert 'window 140 s' in err and len(rows) > 40
+    err = np.abs(np.array([r['frequency_hz'] for r in rows]) / 0.5 - 1)
+    assert np.mean(err <= 0.02) >= 0.9 and np.all(err <= 0.05)  # issue 37's driven goals

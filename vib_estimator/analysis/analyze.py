@@ -37,7 +37,7 @@ from ..io.csv_reader import csv_layout
 from ..io.fields import INPUT_TYPES, signal_unit
 from ..io.streaming import Signal, is_csv, open_signal
 from .channels import channel_names, component_names, need_joint, run_joint, topic_list
-from .choosing import decided_blocks, decides, window_given
+from .choosing import explain_no_estimate, prepare, read_ahead
 from .outputs import check_output
 from .summary import summarise_modes, summary_lines
 
@@ -250,50 +250,6 @@ def json_row(row: dict) -> dict:
     }
 
 
-def explain_no_estimate(counters, open_samples: Optional[int], config: EstimatorConfig) -> str:
-    """Why a run gave no estimate, from its counters, and what to try."""
-    if counters.get('used', 0) == 0:
-        return 'no sample was usable (see the skipped_* counters)'
-    analyses, flat = counters.get('analyses', 0), counters.get('flat_windows', 0)
-    if analyses and flat == analyses:
-        return f'the signal is constant (every window analysed was flat: flat_windows={flat})'
-    if config.excitation == 'ambient':
-        if not analyses:
-            return (
-                f'the record is shorter than one window (--ambient-window-s '
-                f'{config.ambient_window_s:g})'
-            )
-        return (
-            f'no mode stood out of the noise, stable over the model orders and in consecutive '
-            f'windows, in {analyses} analyses: try --band-hz around the modes of interest or a '
-            'longer --ambient-window-s'
-        )
-    held = {k: v for k, v in counters.items() if v and k.startswith('rejected_')}
-    if held:
-        return (
-            'every converged estimate was held back by the quality gate ('
-            + ', '.join(f'{k}={v}' for k, v in held.items())
-            + '): check --min-fit, '
-            '--max-damping, --min-amplitude, or the model (--model)'
-        )
-    text = 'the convergence test (Eqs. 16-17) never fired'
-    if open_samples:
-        text += f' (the last segment ran {open_samples} samples without converging'
-        text += (
-            ', '
-            + (
-                'max_window automatic: 10 s'
-                if not config.max_window
-                else f'max_window {config.max_window:g} s'
-            )
-            + ')'
-        )
-    return (
-        text + f': the signal may not follow --model {config.model} (a decay: try '
-        '--model damped-sinusoid), or try a larger --tolerance or a longer recording'
-    )
-
-
 def _print(estimates, origin, fmt, modes: int = 0) -> None:
     rows = []
     for e in estimates.to_list():
@@ -372,17 +328,16 @@ def run(args: argparse.Namespace) -> int:
             strict=getattr(args, 'strict', False),
         )
         columns = default_column(args)
-        blocks, decided = None, ''
-        if decides(args):
-            config, blocks, decided = decided_blocks(
-                config, signal.blocks(), 'analyze', window_given(args)
-            )
+        ahead, blocks = read_ahead(signal.blocks())
+        decision, notes = None, []
+        if ahead is not None:
+            config, decision, notes = prepare(args, config, *ahead, 1, 'analyze')
         result = estimate_signal(signal, config, bool(args.plot), blocks)
     except (VibEstimatorError, ValueError) as err:
         return report(err, 'vib-estimator analyze')
     damage_warning(signal, 'vib-estimator analyze')
-    if decided:
-        print(decided, file=sys.stderr)
+    for line in notes:
+        print(line, file=sys.stderr)
     others = columns[1:] if columns else []
     if columns:
         print(
@@ -405,7 +360,8 @@ def run(args: argparse.Namespace) -> int:
     mode = estimates.mode if config.modes or config.excitation != 'free' else None
     if len(estimates) == 0:
         print(
-            'analyze: no estimate: ' + explain_no_estimate(counters, open_samples, config),
+            'analyze: no estimate: '
+            + explain_no_estimate(counters, open_samples, config, decision),
             file=sys.stderr,
         )
         if others:

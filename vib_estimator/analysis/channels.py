@@ -32,7 +32,7 @@ from ..errors import BagError, CsvError
 from ..io.csv_reader import column_names, read_csv_columns
 from ..io.fields import UNKNOWN_UNIT, seconds_since, signal_unit
 from ..io.streaming import is_csv, open_signal, read_topics
-from .choosing import decided_config, decides, window_given
+from .choosing import explain_no_estimate, prepare
 from .summary import summarise_modes, summary_lines
 
 
@@ -269,9 +269,7 @@ def run_joint(args, config: EstimatorConfig, names, json_row, prog: str, warn=No
     (signal, prog) says what a bag's read skipped. Bad input raises (CsvError, BagError,
     ValueError) before anything is printed."""
     t, y, names, signals, origin, counters = read_joint(args, names)
-    decided = ''
-    if decides(args):
-        config, decided = decided_config(config, t, y, len(names), prog, window_given(args))
+    config, decision, notes = prepare(args, config, t, y, len(names), prog)
     estimator, result = joint_run(t, y, names, config)
     table = rows(result)
     extra = ''
@@ -286,8 +284,8 @@ def run_joint(args, config: EstimatorConfig, names, json_row, prog: str, warn=No
         extra += f', corrupt_records={sum(signal.corrupt for signal in signals)}'
         extra += ''.join(f', {k}={v}' for k, v in counters.items())
     print_rows(table, args.format, json_row)
-    if decided:
-        print(decided, file=sys.stderr)
+    for line in notes:
+        print(line, file=sys.stderr)
     print(
         f'{prog}: channels={",".join(names)}, '
         + ', '.join(f'{k}={v}' for k, v in estimator.counters.items())
@@ -295,6 +293,9 @@ def run_joint(args, config: EstimatorConfig, names, json_row, prog: str, warn=No
         file=sys.stderr,
     )
     e = result.estimates
+    if not len(e):
+        why = explain_no_estimate(estimator.counters, None, config, decision)
+        print(f'{prog}: no estimate: {why}', file=sys.stderr)
     for line in summary_lines(summarise_modes(e.frequency_hz, e.damping, e.mode, e.t)):
         print(f'{prog}: ' + line, file=sys.stderr)
     for k, (f, amp, _) in mode_shapes(result).items():

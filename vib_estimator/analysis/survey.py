@@ -57,6 +57,7 @@ from typing import Dict, Iterable, List, Optional, Sequence, Tuple
 import numpy as np
 
 from ..core import COUNTER_NAMES, EstimatorConfig
+from ..core.choice import decide
 from ..core.multichannel import mac
 from ..errors import VibEstimatorError, report
 from ..io.csv_reader import column_names
@@ -64,7 +65,7 @@ from ..io.fields import DEFAULT_COMPONENT, check_component
 from ..io.streaming import BagInfo, bag_info, is_csv, open_signal, supported_topics
 from .analyze import Run, add_config_arguments, estimate_signal, make_config
 from .channels import channel_list, joint_run, mode_shapes, need_joint, read_channels
-from .choosing import decided_blocks, decided_config, decides, window_given
+from .choosing import decided_config, decides, read_ahead, window_given
 from .interval import combine
 from .outputs import check_output
 
@@ -515,9 +516,10 @@ def _recording_rows(path: Path, options: Options) -> List[Dict]:
             signal = open_signal(path, topic, component, column, options.strict, info=info)
             config, blocks = options.config, None
             if options.decide:
-                config, blocks, _ = decided_blocks(
-                    config, signal.blocks(), 'survey', options.keep_window
-                )
+                ahead, blocks = read_ahead(signal.blocks())
+                if ahead is not None:
+                    d = decide(*ahead, 1, config.ambient_window_s)
+                    config = decided_config(config, d, 'survey', options.keep_window)[0]
             rows.extend(
                 _stat_rows(
                     path,
@@ -539,7 +541,8 @@ def _joint_recording_rows(path, topic, names, options: Options, info) -> List[Di
         raise ValueError(f'{path} holds no samples')
     config = options.config
     if options.decide:
-        config, _ = decided_config(config, t, y, len(names), 'survey', options.keep_window)
+        d = decide(t, y, len(names), config.ambient_window_s)
+        config = decided_config(config, d, 'survey', options.keep_window)[0]
     estimator, joint = joint_run(t, y, names, config)
     result = Run(estimator, joint.estimates, float(t[0]), float(t[-1]), None)
     modes = options.config.modes

@@ -77,6 +77,9 @@ class Decision:
     fundamental_hz: float
     peaks_hz: tuple = field(default=())
     reason: str = ''
+    #: the seconds and the mean sampling rate of what was read
+    span_s: float = math.nan
+    rate_hz: float = math.nan
 
 
 def principal_component(y: np.ndarray) -> np.ndarray:
@@ -166,4 +169,7 @@ def decide(t, y, channels: int = 1, window_s: float = 30.0) -> Decision:
         seen += (
             f'; window {window:.0f} s ({window * fundamental:.0f} periods of {fundamental:.3g} Hz)'
         )
-    return Decision(excitation, window, share, dominant, fundamental, tuple(peaks), seen)
+    rate = (len(t) - 1) / span
+    return Decision(
+        excitation, window, share, dominant, fundamental, tuple(peaks), seen, span, rate
+    )
