@@ -133,23 +133,16 @@ def summarise_modes(frequency_hz, damping, mode=None, t=None) -> List[ModeSummar
             continue
         key = float(np.median(frequency_hz[sel]))
         if times is None:
-            groups.append((key, [_summary(k, frequency_hz[sel], damping[sel], None)]))
-            continue
-        sel = sel[np.argsort(times[sel], kind='stable')]
-        parts = stretches(frequency_hz[sel])
-        groups.append(
-            (
-                key,
-                [
-                    dataclasses.replace(
-                        _summary(k, frequency_hz[sel[p]], damping[sel[p]], times[sel[p]]),
-                        stretch=j,
-                        stretches=len(parts),
-                    )
-                    for j, p in enumerate(parts, 1)
-                ],
-            )
-        )
+            parts = [np.arange(len(sel))]
+        else:
+            sel = sel[np.argsort(times[sel], kind='stable')]
+            parts = stretches(frequency_hz[sel])
+        summaries = []
+        for j, part in enumerate(parts, 1):
+            idx = sel[part]
+            m = _summary(k, frequency_hz[idx], damping[idx], None if times is None else times[idx])
+            summaries.append(dataclasses.replace(m, stretch=j, stretches=len(parts)))
+        groups.append((key, summaries))
     return [m for _, ms in sorted(groups, key=lambda g: g[0]) for m in ms]
 
 
