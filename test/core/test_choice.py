@@ -155,3 +155,37 @@ def test_the_constants_are_pinned_from_both_sides(monkeypatch, name, factor):
     assert right()
     monkeypatch.setattr(choice, name, getattr(choice, name) * factor)
     assert not right()
+
+
+def watch(t, y, step=100):
+    """DrivenWatch over ``(t, y)``, asked every ``step`` samples: the answers."""
+    from vib_estimator.core.choice import DrivenWatch
+
+    w = DrivenWatch()
+    out = []
+    for k in range(0, len(t), step):
+        for a, b in zip(t[k : k + step].tolist(), y[k : k + step].tolist()):
+            w.update(a, b)
+        out.append(w.driven())
+    return out
+
+
+@pytest.mark.parametrize('factor', [1e-3, 1e3])
+@pytest.mark.parametrize('name', ['WATCH_S', 'LIVE_LEVEL'])
+def test_the_stream_watch_tells_a_driven_input_and_its_constants_are_pinned(
+    monkeypatch, name, factor
+):
+    """Driven throughout: said once half the watched span (60 s) is in, not before; a decay
+    ringing down into noise: never. Each constant at 0.001x and 1000x breaks one of them."""
+    t, y, _ = ambient_record(300, 100, [(1.2, 0.015, 1.0)], 20, 1)
+    ring_t = np.arange(0, 300, 0.01)
+    ring = np.exp(-0.01 * 2 * np.pi * 2 * ring_t) * np.sin(2 * np.pi * 2 * ring_t)
+    ring += 0.01 * np.random.default_rng(0).standard_normal(len(ring_t))
+
+    def right():
+        said = [s is not None for s in watch(t, y)]  # one answer a second
+        return not any(said[:59]) and sum(said[200:]) >= 90 and not any(watch(ring_t, ring))
+
+    assert right()
+    monkeypatch.setattr(choice, name, getattr(choice, name) * factor)
+    assert not right()

@@ -28,16 +28,23 @@ first :data:`DECIDE_S` seconds of the record (all channels):
    :data:`MAX_WINDOW_S`, and no longer than the record allows :data:`MIN_ANALYSES` analyses of.
 
 Each decision carries its reasons in words (:attr:`Decision.reason`), which ``analyze`` prints.
+
+A stream cannot be seen ahead: :class:`DrivenWatch` keeps the same envelope over
+``estimator_node``'s input and tells, over the last :data:`WATCH_S` s, when a free-decay
+estimator is fed a response driven throughout (its ``/diagnostics`` then say so, and which
+``excitation`` helps).
 """
 
 from __future__ import annotations
 
 import math
+from collections import deque
 from dataclasses import dataclass, field
+from typing import Optional
 
 import numpy as np
 
-from .auto import BLOCK_MARGIN, BLOCK_PERIODS, MIN_BLOCK_S, Envelope
+from .auto import BLOCK_MARGIN, BLOCK_PERIODS, DRIVEN, FREE, MIN_BLOCK_S, Envelope
 
 #: the first seconds of a record the decision reads
 DECIDE_S = 600.0
@@ -173,3 +180,50 @@ def decide(t, y, channels: int = 1, window_s: float = 30.0) -> Decision:
     return Decision(
         excitation, window, share, dominant, fundamental, tuple(peaks), seen, span, rate
     )
+
+
+#: the seconds of a stream :class:`DrivenWatch` judges
+WATCH_S = 120.0
+#: ... and the least mean variance they must hold, relative to the stream's largest block's
+LIVE_LEVEL = 1e-2
+
+
+class DrivenWatch:
+    """Whether a stream's last :data:`WATCH_S` s look driven throughout: the share of their energy
+    in the blocks auto's envelope (:class:`.auto.Envelope`, its block following the free
+    estimates' frequency) read as driven above :data:`DRIVEN_ABOVE`, their mean level at least
+    :data:`LIVE_LEVEL` of the largest block's (not the noise a decay rang down into) and the
+    envelope driven now. Fed sample by sample (:meth:`update`), asked at most once a second
+    (:meth:`driven`)."""
+
+    def __init__(self):
+        self._envelope = Envelope(4 * MIN_BLOCK_S, MAX_WINDOW_S / 10)
+        self._marks: deque = deque()  # (stream time, free energy, driven energy)
+        self._last_t = math.nan
+
+    def update(self, t: float, y: float) -> None:
+        self._envelope.update(t, y)
+        self._last_t = t
+
+    def follow(self, f: float) -> None:
+        """A free estimate of ``f`` Hz: the block holds a few of its periods."""
+        self._envelope.follow(f)
+
+    def driven(self) -> Optional[float]:
+        """The driven share of the last :data:`WATCH_S` s' energy when they look driven
+        throughout (see the class doc), else None. Marks the stream's energies now."""
+        env = self._envelope
+        now = (self._last_t, env.energy[FREE], env.energy[DRIVEN])
+        marks = self._marks
+        if not math.isfinite(now[0]):
+            return None
+        marks.append(now)
+        while len(marks) > 2 and now[0] - marks[1][0] >= WATCH_S:
+            marks.popleft()
+        span = now[0] - marks[0][0]
+        free, driven = now[1] - marks[0][1], now[2] - marks[0][2]
+        if span < WATCH_S / 2 or env.state != DRIVEN or not free + driven > 0:
+            return None
+        share = driven / (free + driven)
+        live = (free + driven) / span >= LIVE_LEVEL * env.peak
+        return share if share > DRIVEN_ABOVE and live else None
