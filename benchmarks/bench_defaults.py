@@ -59,6 +59,18 @@ def records(folder: Path, real: Path | None):
     y = np.exp(-0.01 * 2 * np.pi * 5 * t) * np.sin(2 * np.pi * 5 * t)
     y += 0.01 * rng.standard_normal(len(t))
     out.append(('decay 5 Hz', 'free', write_csv(folder, 'decay5', t, y), [], [5.0], ['--paper']))
+    for name, modes in (
+        ('decay 10 / 13 Hz, 1:0.5', ((10.0, 1.0, 0.003), (13.0, 0.5, 0.003))),
+        ('decay 8 / 21 / 55 Hz', ((8.0, 1.0, 0.003), (21.0, 0.3, 0.002), (55.0, 0.05, 0.002))),
+    ):
+        t = np.arange(0, 11, 0.001)
+        tau = np.maximum(t - 1.0, 0)
+        y = sum(
+            a * np.exp(-z * 2 * np.pi * f * tau) * np.sin(2 * np.pi * f * tau) for f, a, z in modes
+        )
+        y += 0.05 / np.sqrt(2) * 10 ** (-1.5) * rng.standard_normal(len(t))
+        path = write_csv(folder, name.split(',')[0].replace(' ', '').replace('/', '_'), t, y)
+        out.append((name, 'free', path, [], [m[0] for m in modes], ['--modes', '3']))
     rec = arm_model.experiment_5_3(0)
     path = write_csv(folder, 'arm53', rec.t, rec.torque)
     out.append(('arm 5.3 (sim)', 'free', path, [], [1.3306], ['--paper']))

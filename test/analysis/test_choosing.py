@@ -126,3 +126,24 @@ def test_no_mode_from_a_short_window_says_which_window_helps(capsys, tmp_path):
     assert 'window 140 s' in err and len(rows) > 40
     err = np.abs(np.array([r['frequency_hz'] for r in rows]) / 0.5 - 1)
     assert np.mean(err <= 0.02) >= 0.9 and np.all(err <= 0.05)  # issue 37's driven goals
+
+
+def test_a_free_decay_of_two_modes_reports_both(capsys, tmp_path):
+    t = np.arange(0, 10, 0.001)
+    tau = np.maximum(t - 0.5, 0)
+    y = sum(
+        a * np.exp(-0.003 * 2 * np.pi * f * tau) * np.sin(2 * np.pi * f * tau)
+        for f, a in ((10.0, 1.0), (13.0, 0.5))
+    )
+    y += 1e-3 * np.random.default_rng(3).standard_normal(len(t))
+    rows, err = analyze(capsys, write(tmp_path / 'two.csv', t, y))
+    assert 'separate modes (10, 13 Hz): the mode tracker, modes 3' in err
+    f = np.array([r['frequency_hz'] for r in rows])
+    for true in (10.0, 13.0):
+        near = np.abs(f / true - 1) <= 0.02
+        assert near.sum() > 20
+    err_rel = np.min(np.abs(f[:, None] / [10.0, 13.0] - 1), axis=1)
+    assert np.mean(err_rel <= 0.02) >= 0.9
+    # --modes keeps the user's count
+    _, err = analyze(capsys, write(tmp_path / 'two.csv', t, y), '--modes', '2')
+    assert 'separate modes' in err

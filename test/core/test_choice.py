@@ -189,3 +189,52 @@ def test_the_stream_watch_tells_a_driven_input_and_its_constants_are_pinned(
     assert right()
     monkeypatch.setattr(choice, name, getattr(choice, name) * factor)
     assert not right()
+
+
+def several(freqs, amps, zetas, seconds=10.0, fs=1000.0, clip=None, seed=0):
+    """A free decay of several modes from t = 0.5 s, maybe clipped (its harmonics)."""
+    t = np.arange(0, seconds, 1 / fs)
+    tau = np.maximum(t - 0.5, 0)
+    y = sum(
+        a * np.exp(-z * 2 * np.pi * f * tau) * np.sin(2 * np.pi * f * tau)
+        for f, a, z in zip(freqs, amps, zetas)
+    )
+    if clip is not None:
+        y = np.clip(y, -clip, clip)
+    return t, y + 1e-3 * np.random.default_rng(seed).standard_normal(len(t))
+
+
+@pytest.mark.parametrize('factor', [1e-3, 1e3])
+@pytest.mark.parametrize('name', ['MODE_SHARE', 'MODE_GAP', 'HARMONIC_TOL', 'TRACKED_MODES'])
+def test_a_free_decay_of_several_modes_goes_to_the_mode_tracker(monkeypatch, name, factor):
+    """Two modes 30 % apart and 8/21 Hz at 1:0.3: the tracker; one mode, a heavily clipped one
+    (harmonics) and the simulated arm's three tip masses (a mode that moved, and its moves'
+    peaks): one estimator. Each constant at 0.001x and 1000x breaks one of them."""
+    from vib_estimator.sim import arm_model
+
+    pair = several((10.0, 13.0), (1.0, 0.5), (0.003, 0.003))
+    wide = several((8.0, 21.0), (1.0, 0.3), (0.003, 0.002))
+    one = several((12.03,), (1.0,), (0.003,))
+    clipped = several((12.03,), (1.0,), (0.003,), clip=0.2)
+    arm = arm_model.experiment_5_5(0)
+
+    def right():
+        try:
+            return (
+                decide(*pair).modes == decide(*wide).modes == 3
+                and decide(*one).modes == decide(*clipped).modes == 0
+                and decide(arm.t, arm.torque).modes == 0
+                and 'separate modes (10, 13 Hz)' in decide(*pair).reason
+            )
+        except (TypeError, ValueError):
+            return False
+
+    assert right()
+    monkeypatch.setattr(choice, name, getattr(choice, name) * factor)
+    if name == 'TRACKED_MODES':  # a count of modes the configuration refuses
+        from vib_estimator.core import EstimatorConfig
+
+        with pytest.raises(ValueError):
+            EstimatorConfig(modes=decide(*pair).modes).validate()
+        return
+    assert not right()

@@ -45,18 +45,20 @@ def window_given(args) -> bool:
 def decided_config(
     config: EstimatorConfig, d: Decision, prog: str, keep_window: bool = False
 ) -> Tuple[EstimatorConfig, str]:
-    """``config`` with the excitation and (unless ``keep_window``: ``--ambient-window-s`` was
-    given) the ambient window of the decision ``d``, and the line that says so."""
+    """``config`` with the excitation, (unless ``keep_window``: ``--ambient-window-s`` was
+    given) the ambient window and (unless ``config.modes`` is set) the modes to track of the
+    decision ``d``, and the line that says so."""
     window = config.ambient_window_s
     if not keep_window and d.excitation != 'free':
         window = d.window_s
+    modes = config.modes or d.modes
     line = (
         f'{prog}: excitation {d.excitation} (the default decides from the record: {d.reason}; '
         '--excitation free, ambient or auto overrides'
         + ('' if d.excitation == 'free' else ', --ambient-window-s the window')
         + ')'
     )
-    return config.replace(excitation=d.excitation, ambient_window_s=window), line
+    return config.replace(excitation=d.excitation, ambient_window_s=window, modes=modes), line
 
 
 def contradiction(config: EstimatorConfig, d: Decision, prog: str) -> str:

@@ -21,7 +21,9 @@ first :data:`DECIDE_S` seconds of the record (all channels):
    above :data:`DRIVEN_ABOVE`: ``ambient`` (output-only identification); between, one channel:
    ``auto`` (per stretch), several: the larger share's (the joint estimators take free or
    ambient).
-3. **The window** of a driven record: :data:`WINDOW_PERIODS` periods of the fundamental
+3. **Several modes** in a free decay: peaks that are modes of their own (:func:`separate_modes`)
+   send it to the mode tracker (``modes`` :data:`TRACKED_MODES`), each mode numbered.
+4. **The window** of a driven record: :data:`WINDOW_PERIODS` periods of the fundamental
    (about 15 correlation times ``1 / (2 pi zeta f)`` of a mode at zeta = 2 %: the frequency of a
    lightly damped mode scatters by more than 2 % across windows of a few correlation times, and
    the identifier drops it), at least the configured ``ambient_window_s`` and at most
@@ -64,6 +66,18 @@ FREE_BELOW = 0.1
 #: ... and one read driven for more than this share is driven throughout (the envelope's first
 #: blocks of a driven record read free: 80-98 % measured, a 1.2 Hz mode's 3 s blocks the least)
 DRIVEN_ABOVE = 0.7
+#: a free decay whose spectrum holds several separate modes (:func:`separate_modes`) goes to the
+#: mode tracker with this many modes (on bench_modes' records, modes 3 has every mode within 2 %
+#: from 0.7-2 periods, where the one estimator reports the strongest alone, or a mixture)
+TRACKED_MODES = 3
+#: ... a separate mode: a peak holding at least this share of the strongest's power (the
+#: simulated arm's moves leave peaks of 1-3 %, a second mode at 30 % amplitude 4-16 %)
+MODE_SHARE = 0.02
+#: ... at least this far (relative) from every stronger mode (the arm's three tip masses'
+#: 1.33 / 1.56 Hz, 17 %, are one mode that moved)
+MODE_GAP = 0.25
+#: ... and not within this of a harmonic (2-7 x) of one
+HARMONIC_TOL = 0.02
 #: a driven record's window, in periods of its fundamental (~15 correlation times at zeta 2 %)
 WINDOW_PERIODS = 120.0
 #: the longest window the decision chooses, s
@@ -87,6 +101,8 @@ class Decision:
     #: the seconds and the mean sampling rate of what was read
     span_s: float = math.nan
     rate_hz: float = math.nan
+    #: a free decay of several separate modes: the modes to track (0: one estimator)
+    modes: int = 0
 
 
 def principal_component(y: np.ndarray) -> np.ndarray:
@@ -153,7 +169,7 @@ def decide(t, y, channels: int = 1, window_s: float = 30.0) -> Decision:
         t, y = t[:n], y[:n]
     if len(t) < 64 or not t[-1] > t[0]:
         return Decision('free', window_s, 0.0, math.nan, math.nan, (), 'too short to tell: free')
-    peaks, _ = spectral_peaks(t, y)
+    peaks, powers = spectral_peaks(t, y)
     dominant = float(peaks[0]) if len(peaks) else math.nan
     fundamental = float(np.min(peaks)) if len(peaks) else math.nan
     share = driven_share(t, principal_component(y), dominant if len(peaks) else 0.0)
@@ -176,10 +192,34 @@ def decide(t, y, channels: int = 1, window_s: float = 30.0) -> Decision:
         seen += (
             f'; window {window:.0f} s ({window * fundamental:.0f} periods of {fundamental:.3g} Hz)'
         )
+    modes = 0
+    separate = separate_modes(peaks, powers)
+    if excitation == 'free' and len(separate) > 1:
+        modes = TRACKED_MODES
+        seen += (
+            f'; {len(separate)} separate modes ('
+            + ', '.join(f'{f:.3g}' for f in sorted(separate))
+            + f' Hz): the mode tracker, modes {modes}'
+        )
     rate = (len(t) - 1) / span
     return Decision(
-        excitation, window, share, dominant, fundamental, tuple(peaks), seen, span, rate
+        excitation, window, share, dominant, fundamental, tuple(peaks), seen, span, rate, modes
     )
+
+
+def separate_modes(peaks: np.ndarray, powers: np.ndarray) -> list[float]:
+    """The spectral peaks (strongest first) that are modes of their own: at least
+    :data:`MODE_SHARE` of the strongest's power, :data:`MODE_GAP` (relative) from every stronger
+    one kept, and no harmonic (within :data:`HARMONIC_TOL`) of one (a clipped or non-sinusoidal
+    response)."""
+    kept: list[float] = []
+    for f, p in zip(peaks.tolist(), powers.tolist()):
+        if p < MODE_SHARE * powers[0] or any(abs(f / k - 1) < MODE_GAP for k in kept):
+            continue
+        if any(abs(f / (k * n) - 1) < HARMONIC_TOL for k in kept for n in range(2, 8)):
+            continue
+        kept.append(f)
+    return kept
 
 
 #: the seconds of a stream :class:`DrivenWatch` judges
