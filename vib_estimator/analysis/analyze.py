@@ -107,6 +107,19 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--format', choices=('jsonl', 'csv', 'table'), default='jsonl')
     parser.add_argument('--plot', metavar='FILE.png', help='write a Fig. 5-like figure')
     parser.add_argument(
+        '--report',
+        metavar='DIR',
+        help='write DIR/index.html, a self-contained page (images beside it): the modes, '
+        'spectrum, stabilisation diagram, estimates over time, mode shapes, MAC, shaper '
+        '(docs/report.md)',
+    )
+    parser.add_argument(
+        '--geometry',
+        metavar='FILE.yaml',
+        help="--report: draw each mode's shape on the structure (points, channels, lines: "
+        'docs/geometry.md; examples in config/geometry/)',
+    )
+    parser.add_argument(
         '--strict',
         action='store_true',
         help='a damaged bag record is an error (exit 2) instead of a counted skip',
@@ -334,22 +347,27 @@ def run(args: argparse.Namespace) -> int:
     try:
         config = make_config(args)
         check_output(args.plot, '--plot')
+        geometry = args.loaded_geometry = report_geometry(args)
         if getattr(args, 'columns', None) is not None:
             names = channel_names(args)
             if len(names) > 1:
-                return run_joint(args, config, names, json_row, 'analyze')
+                return run_joint(args, config, names, json_row, 'analyze', why=explain_no_estimate)
             args.column = names[0]  # one column: exactly --column
         if getattr(args, 'topics', None) is not None:
             args.topics_list = topic_list(args)
             if len(args.topics_list) > 1:
                 names = component_names(args) if args.components is not None else []
                 need_joint(f'{len(args.topics_list)} topics', config)
-                return run_joint(args, config, names, json_row, 'analyze', damage_warning)
+                return run_joint(
+                    args, config, names, json_row, 'analyze', damage_warning, explain_no_estimate
+                )
             args.topic = args.topics_list[0]  # one topic: exactly --topic
         if getattr(args, 'components', None) is not None:
             names = component_names(args)
             if len(names) > 1:
-                return run_joint(args, config, names, json_row, 'analyze', damage_warning)
+                return run_joint(
+                    args, config, names, json_row, 'analyze', damage_warning, explain_no_estimate
+                )
             args.component = names[0]  # one component: exactly --component
         signal = open_signal(
             args.input,
@@ -358,7 +376,9 @@ def run(args: argparse.Namespace) -> int:
             args.column,
             strict=getattr(args, 'strict', False),
         )
-        result = estimate_signal(signal, config, bool(args.plot))
+        result = estimate_signal(signal, config, bool(args.plot or args.report))
+        if geometry is not None:
+            geometry.check_channels((signal.component or signal.label,))
     except (VibEstimatorError, ValueError) as err:
         return report(err, 'vib-estimator analyze')
     damage_warning(signal, 'vib-estimator analyze')
@@ -383,7 +403,45 @@ def run(args: argparse.Namespace) -> int:
         print('analyze: ' + line, file=sys.stderr)
     if args.plot:
         plot_run(args.plot, args.input, signal, result, mode)
+    if getattr(args, 'report', None):
+        why = '' if len(estimates) else explain_no_estimate(counters, open_samples, config)
+        write_run_report(args, config, signal, result, geometry, why)
     return 0
+
+
+def report_geometry(args):
+    """Check ``--report`` (a writable folder) and load ``--geometry`` (GeometryError, ValueError
+    if bad; --geometry without --report is a ValueError)."""
+    report_dir, path = getattr(args, 'report', None), getattr(args, 'geometry', None)
+    check_output(report_dir, '--report', directory=True)
+    if path and not report_dir:
+        raise ValueError('--geometry draws the shapes of --report DIR: give --report too')
+    if not path:
+        return None
+    from ..io.geometry import load_geometry
+
+    return load_geometry(path)
+
+
+def write_run_report(args, config, signal: Signal, run: Run, geometry, why: str) -> None:
+    """``--report`` of a one-channel run (its samples kept)."""
+    from .report import Record, command_line, write_report
+
+    name = signal.component or signal.label
+    record = Record(
+        str(args.input),
+        command_line(args),
+        (name,),
+        run.samples[0],
+        run.samples[1],
+        run.estimates,
+        config,
+        dict(run.estimator.counters),
+        unit=signal_unit(name),
+        why=why,
+    )
+    path = write_report(args.report, record, geometry)
+    print(f'analyze: report written to {path}', file=sys.stderr)
 
 
 def plot_run(path: str, name: str, signal: Signal, run: Run, mode=None):

@@ -262,12 +262,18 @@ def plot_shapes(
     return fig
 
 
-def run_joint(args, config: EstimatorConfig, names, json_row, prog: str, warn=None) -> int:
+def run_joint(
+    args, config: EstimatorConfig, names, json_row, prog: str, warn=None, why=None
+) -> int:
     """``analyze --columns`` or ``--components`` with two or more channels ``names``: estimates
-    with their shapes on stdout, the counters and the summary on stderr, ``--plot``; ``warn``
-    (signal, prog) says what a bag's read skipped. Bad input raises (CsvError, BagError,
-    ValueError) before anything is printed."""
+    with their shapes on stdout, the counters and the summary on stderr, ``--plot``, ``--report``
+    (``why``: (counters, None, config) -> why nothing was estimated); ``warn`` (signal, prog)
+    says what a bag's read skipped. Bad input raises (CsvError, BagError, ValueError,
+    GeometryError) before anything is printed."""
     t, y, names, signals, origin, counters = read_joint(args, names)
+    geometry = getattr(args, 'loaded_geometry', None)
+    if geometry is not None:
+        geometry.check_channels(names)
     estimator, result = joint_run(t, y, names, config)
     table = rows(result)
     extra = ''
@@ -294,7 +300,32 @@ def run_joint(args, config: EstimatorConfig, names, json_row, prog: str, warn=No
     for k, (f, amp, _) in mode_shapes(result).items():
         shape = ', '.join(f'{n} {a:+.2f}' for n, a in zip(names, amp))
         print(f'{prog}: mode {k} ({f:.3f} Hz) shape: {shape}', file=sys.stderr)
+    unit = signal_unit(names[0].rsplit(':', 1)[-1]) if signals else UNKNOWN_UNIT
     if args.plot:
-        unit = signal_unit(names[0].rsplit(':', 1)[-1]) if signals else UNKNOWN_UNIT
         plot_shapes(args.plot, str(args.input), result, unit, config.excitation)
+    if getattr(args, 'report', None):
+        report_joint(args, config, (t, y, unit), result, estimator.counters, why)
     return 0
+
+
+def report_joint(args, config, samples, result: JointEstimates, counters, why) -> None:
+    """``--report`` of a joint run of the channels' ``samples`` (t, Y, their unit)."""
+    from .report import Record, command_line, write_report
+
+    t, y, unit = samples
+    reason = '' if len(result) or why is None else why(dict(counters), None, config)
+    record = Record(
+        str(args.input),
+        command_line(args),
+        tuple(result.channels),
+        t,
+        y,
+        result.estimates,
+        config,
+        dict(counters),
+        shapes=result.shapes,
+        unit=unit,
+        why=reason,
+    )
+    path = write_report(args.report, record, getattr(args, 'loaded_geometry', None))
+    print(f'analyze: report written to {path}', file=sys.stderr)
