@@ -49,7 +49,7 @@ def test_markers_are_deleteall_then_each_modes_with_stable_ids():
     assert [(s.ns, s.id) for s in specs[1:]] == [
         (ns, k) for k in (1, 2) for ns in ('undeformed', 'deformed', 'sensors', 'label')
     ]
-    assert specs[4].text == 'mode 1: 1 Hz, ζ not estimated'
+    assert specs[4].text == 'mode 1\n1 Hz, ζ not estimated'
     sensors = specs[3].points - (g.points[[1, 2, 3]] + m.origin(1))  # p1, p2, p3
     # at t = 0 the largest deflection, 0.1 of the structure's extent, along x
     assert np.allclose(sensors[:, 0], 0.1 * g.size * np.array([0.2, 0.6, 1.0]))
@@ -142,7 +142,7 @@ def check_markers(arrays, shapes, geometry, node):
             size = float(np.abs(moved).max())
             if size > best[k][0]:
                 best[k] = (size, moved)
-            assert by['label', k].text.startswith(f'mode {k}: ')
+            assert by['label', k].text.startswith(f'mode {k}\n')
     pairs = geometry.lines.reshape(-1)
     for k, shape in shapes.items():
         expected = geometry.displacements(shape, node.get_parameter('components').value)[pairs]

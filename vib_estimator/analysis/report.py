@@ -402,14 +402,14 @@ def shape_animation(path: Path, geometry, record, mode: ModeSummary, shape: np.n
         for k in range(GIF_FRAMES)
     ]
     view = view_axes(base, disp)
-    fig = plt.figure(figsize=(9.0, 4.6))
+    fig = plt.figure(figsize=(6.8, 3.6))
     (lines3, dots3), (lines2, dots2) = _shape_axes(
         fig, geometry, frames, mode_colour(mode.mode), view
     )
     fig.suptitle(
-        f'{mode_name(mode)}: {mode.frequency_hz:.4g} Hz, ζ = {_zeta(mode.damping)} -- '
-        f'{geometry.name} (deflection exaggerated)',
-        fontsize=9,
+        f'{mode_name(mode)}: {mode.frequency_hz:.4g} Hz, ζ = {_zeta(mode.damping)}; '
+        f'{geometry.name}\n(deflection exaggerated)',
+        fontsize=7,
     )
     sensors = sorted({p for pts in geometry.channel_points for p in pts})
     images = []
@@ -526,7 +526,7 @@ STYLE = (
     'table{border-collapse:collapse;margin:0.5em 0}td,th{border:1px solid #ccc;padding:3px 8px;'
     'text-align:left;font-size:0.92em}th{background:#f0f0f0}pre{background:#f6f6f6;padding:0.6em;'
     'white-space:pre-wrap;word-break:break-all}figure{margin:0.8em 0;display:inline-block;'
-    'vertical-align:top}img{max-width:100%}figcaption{font-size:0.85em;color:#555;max-width:820px}'
+    'vertical-align:top}img{max-width:100%}figcaption{font-size:0.85em;color:#555;max-width:540px}'
     '.note{font-size:0.85em;color:#555}'
     '.why{background:#fff4e0;border-left:4px solid #e90;padding:0.5em 1em}'
 )
@@ -602,7 +602,8 @@ def shapes_html(directory: Path, record: Record, geometry, shapes) -> str:
         parts.append(
             _figure(
                 'mac.png',
-                'MAC between the modes: distinct modes near 0, a mode against itself 1',
+                "MAC between the modes' shapes: 1 on the diagonal; distinct modes near 0 (with "
+                'few channels two modes may look alike: their frequencies tell them apart)',
                 'MAC matrix',
             )
         )

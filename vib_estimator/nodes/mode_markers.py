@@ -11,7 +11,7 @@ per mode k (ids = k in every namespace, so a marker is replaced, not accumulated
 * ``deformed``: the wireframe displaced by the mode's shape at the animation's phase
   ``2 pi t / period_s``, each vertex coloured by its amplitude (blue: still, red: the largest);
 * ``sensors``: the channels' points, displaced (``SPHERE_LIST``);
-* ``label``: ``mode k: f Hz, zeta`` above it (``TEXT_VIEW_FACING``).
+* ``label``: ``mode k`` and ``f Hz, ζ`` (two lines) above it (``TEXT_VIEW_FACING``).
 
 Mode k is drawn beside mode 1, shifted along x by (k - 1) x :data:`SPACING` x the structure's
 extent, its largest displacement ``scale`` x that extent. A shape moves each channel's points
@@ -37,12 +37,12 @@ DEFAULTS = {
     'mode_shapes_period_s': 2.0,
 }
 #: modes side by side: mode k's origin is (k - 1) x this x the structure's extent along x
-SPACING = 1.3
+SPACING = 2.0
 #: line width and sensor size, fractions of the structure's extent
 LINE_WIDTH = 0.006
 SENSOR_SIZE = 0.02
 #: the label's height, a fraction of the extent, and its place above the structure
-TEXT_SIZE = 0.05
+TEXT_SIZE = 0.04
 GREY = (0.6, 0.6, 0.6, 0.8)
 WHITE = (1.0, 1.0, 1.0, 1.0)
 
@@ -118,7 +118,7 @@ class ModeShapeMarkers:
             rest = g.points + self.origin(k)
             width = (LINE_WIDTH * size,) * 3
             sensors = sorted({p for pts in g.channel_points for p in pts})
-            zeta_text = f'ζ = {zeta:.4f}' if math.isfinite(zeta) else 'ζ not estimated'
+            zeta_text = f'ζ {zeta:.4f}' if math.isfinite(zeta) else 'ζ not estimated'
             top = rest.max(axis=0) if len(rest) else np.zeros(3)
             out += [
                 MarkerSpec('undeformed', k, 'line_list', rest[pairs], colour=GREY, scale=width),
@@ -142,7 +142,7 @@ class ModeShapeMarkers:
                     'label',
                     k,
                     'text',
-                    text=f'mode {k}: {f:.4g} Hz, {zeta_text}',
+                    text=f'mode {k}\n{f:.4g} Hz, {zeta_text}',
                     scale=(0.0, 0.0, TEXT_SIZE * size),
                     position=(
                         float(rest[:, 0].mean()),
