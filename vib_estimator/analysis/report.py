@@ -662,12 +662,12 @@ def write_report(directory, record: Record, geometry=None) -> Path:
     body = [f'<h1>{html.escape(title)}</h1>', record_html(record, geometry), '<h2>Modes</h2>']
     if record.modes:
         body.append(modes_table(record, shapes if len(record.channels) > 1 else None))
-        lines = summary_lines(record.modes)
         body.append(
-            '<h3>Recommended input shaper</h3><pre>'
-            + html.escape('\n'.join(lines[len(record.modes) + 1 :]))
-            + '</pre>'
+            '<p class="note">Frequency: the median of the mode\'s estimates ± their robust '
+            "standard deviation; damping ratio: the median ± the median of its estimates' "
+            'stds.</p>'
         )
+        body.append(shaper_html(record.modes))
     else:
         body.append(f'<p class="why"><b>No estimate.</b> Why: {html.escape(record.why)}</p>')
     body.append('<h2>Spectrum and estimates</h2>' + figures_html(directory, record))
