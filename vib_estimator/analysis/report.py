@@ -270,11 +270,15 @@ def stabilisation_figure(path: Path, record: Record) -> None:
 
 
 def tracks_figure(path: Path, record: Record) -> None:
-    """Frequency (one mode: Hz; several: relative to each mode's median, %) and damping ratio
-    over time by mode, error bars 1 std (at most :data:`MAX_BARS` a mode)."""
+    """Frequency (one mode: Hz; several: relative to each mode's median, %) and, when the model
+    estimates it, damping ratio over time by mode, error bars 1 std (at most :data:`MAX_BARS` a
+    mode)."""
     plt = pyplot()
-    fig, axes = plt.subplots(2, 1, figsize=(9, 5.6), sharex=True)
     e = record.estimates
+    damped = bool(np.any(np.isfinite(e.damping)))
+    fig, axes = plt.subplots(2 if damped else 1, 1, figsize=(9, 5.6 if damped else 3.4),
+                             sharex=True, squeeze=False)  # fmt: skip
+    axes = axes[:, 0]
     several = len(record.modes) > 1
     for m in record.modes:
         sel = e.mode == m.mode
@@ -282,7 +286,8 @@ def tracks_figure(path: Path, record: Record) -> None:
         fstd = (
             100 * e.frequency_std_hz[sel] / m.frequency_hz if several else e.frequency_std_hz[sel]
         )
-        for ax, value, std in ((axes[0], f, fstd), (axes[1], e.damping[sel], e.damping_std[sel])):
+        series = ((f, fstd), (e.damping[sel], e.damping_std[sel]))
+        for ax, (value, std) in zip(axes, series):
             ax.errorbar(
                 e.t[sel],
                 value,
@@ -295,18 +300,14 @@ def tracks_figure(path: Path, record: Record) -> None:
                 label=f'{mode_name(m)}: {m.frequency_hz:.4g} Hz',
             )
     axes[0].set_ylabel('frequency - median (%)' if several else 'frequency (Hz)')
-    axes[1].set_ylabel('damping ratio ζ')
-    axes[1].set_xlabel('time (s)')
-    axes[0].set_title('estimates over time (error bars: 1 std)')
-    if not np.any(np.isfinite(e.damping)):
-        axes[1].text(
-            0.5,
-            0.5,
-            'damping not estimated by this model (--model damped-sinusoid)',
-            transform=axes[1].transAxes,
-            ha='center',
-            va='center',
-        )
+    axes[-1].set_xlabel('time (s)')
+    axes[0].set_title(
+        'estimates over time (error bars: 1 std)'
+        + ('' if damped else '; damping not estimated by this model (--model damped-sinusoid)'),
+        fontsize=None if damped else 10,
+    )
+    if damped:
+        axes[1].set_ylabel('damping ratio ζ')
     if record.modes:
         axes[0].legend(fontsize='small', loc='upper left', bbox_to_anchor=(1.0, 1.0))
     save_figure(fig, axes, str(path))
