@@ -684,3 +684,81 @@ def write_report(directory, record: Record, geometry=None) -> Path:
     path = directory / 'index.html'
     path.write_text(page, encoding='utf-8')
     return path
+
+
+# ---- survey --report ----------------------------------------------------------------------------
+#: the survey rows' columns the page shows: (heading, row key, format)
+SURVEY_COLUMNS = (
+    ('recording', 'recording', '{}'),
+    ('start (UTC)', 'start_utc', '{}'),
+    ('topic', 'topic', '{}'),
+    ('component', 'component', '{}'),
+    ('mode', 'mode', '{}'),
+    ('frequency (Hz)', 'frequency_hz', '{:.5f}'),
+    ('95 % interval (Hz)', ('frequency_lo_hz', 'frequency_hi_hz'), '{:.5f} – {:.5f}'),
+    ('damping ratio', 'damping', '{:.4f}'),
+    ('estimates', 'estimates', '{}'),
+    ('change vs baseline', 'change_rel', '{:+.3%}'),
+    ('alarm', 'alarm', '{}'),
+    ('error', 'error', '{}'),
+)
+
+
+def _cell(row: dict, key, fmt: str) -> str:
+    keys = key if isinstance(key, tuple) else (key,)
+    values = [row.get(k) for k in keys]
+    if any(v is None or (isinstance(v, float) and not math.isfinite(v)) for v in values):
+        return ''
+    if key == 'alarm':
+        return 'ALARM' if values[0] else ''
+    return fmt.format(*values)
+
+
+def write_survey_report(directory, rows, command: str, baseline, trend: bool) -> Path:
+    """``survey --report DIR``: ``DIR/index.html`` with the command line, the counts, the trend
+    (``trend.png``, drawn by the caller when ``trend``) and one table row per survey row (alarms
+    and errors highlighted); returns the page's path."""
+    directory = Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    recordings = len({r['recording'] for r in rows})
+    alarms = sum(bool(r['alarm']) for r in rows)
+    errors = sum(bool(r['error']) for r in rows)
+    head = ''.join(f'<th>{html.escape(h)}</th>' for h, _, _ in SURVEY_COLUMNS)
+    body = []
+    for r in rows:
+        cls = ' class="alarm"' if r['alarm'] else ' class="error"' if r['error'] else ''
+        cells = ''.join(
+            f'<td>{html.escape(_cell(r, key, fmt))}</td>' for _, key, fmt in SURVEY_COLUMNS
+        )
+        body.append(f'<tr{cls}>{cells}</tr>')
+    parts = [
+        '<h1>vib_estimator survey report</h1>',
+        f'<p>Command line:</p><pre>{html.escape(command)}</pre>',
+        f'<p>{recordings} recording(s), {len(rows)} row(s): <b>{alarms} alarm(s)</b>, '
+        f'{errors} error(s). Baseline: {html.escape(baseline or "none (--baseline)")}.</p>',
+    ]
+    if trend:
+        parts.append(
+            _figure(
+                'trend.png',
+                'Frequency (and damping) of each recording with its 95 % interval; dashed: the '
+                'baseline, shaded: the no-alarm band; crosses: alarms.',
+                'frequency trend',
+            )
+        )
+    else:
+        parts.append('<p class="why">No recording gave a frequency: see the error column.</p>')
+    parts.append(f'<h2>Recordings</h2><table><tr>{head}</tr>{"".join(body)}</table>')
+    style = (
+        STYLE
+        + 'tr.alarm td{background:#fde0e0}tr.error td{background:#fff4e0}td{white-space:nowrap}'
+    )
+    page = (
+        '<!DOCTYPE html><html lang="en"><head><meta charset="utf-8">'
+        f'<title>vib_estimator survey report</title><style>{style}</style></head><body>'
+        + '\n'.join(parts)
+        + '</body></html>\n'
+    )
+    path = directory / 'index.html'
+    path.write_text(page, encoding='utf-8')
+    return path
