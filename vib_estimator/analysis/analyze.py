@@ -401,10 +401,10 @@ def run(args: argparse.Namespace) -> int:
         )
     for line in summary_lines(summarise_modes(estimates.frequency_hz, estimates.damping, mode)):
         print('analyze: ' + line, file=sys.stderr)
+    why = '' if len(estimates) else explain_no_estimate(counters, open_samples, config)
     if args.plot:
-        plot_run(args.plot, args.input, signal, result, mode)
+        plot_run(args.plot, args.input, signal, result, mode, config, why)
     if getattr(args, 'report', None):
-        why = '' if len(estimates) else explain_no_estimate(counters, open_samples, config)
         write_run_report(args, config, signal, result, geometry, why)
     return 0
 
@@ -444,13 +444,27 @@ def write_run_report(args, config, signal: Signal, run: Run, geometry, why: str)
     print(f'analyze: report written to {path}', file=sys.stderr)
 
 
-def plot_run(path: str, name: str, signal: Signal, run: Run, mode=None):
+#: what ``--plot`` calls the estimates of each excitation
+ESTIMATE_LABELS = {
+    'free': 'algebraic estimates',
+    'ambient': 'SSI-cov estimates (ambient)',
+    'auto': 'estimates (decays: algebraic; driven: SSI-cov)',
+}
+
+
+def plot_run(path: str, name: str, signal: Signal, run: Run, mode=None, config=None, why=''):
     """``--plot``: the estimates and spectrum figure of a run (``keep_samples``) of ``signal``,
     its signal axis in the unit of the component or column (:func:`..io.fields.signal_unit`);
-    returns the Figure."""
+    the estimates labelled by what made them (``config``'s excitation; ambient: coloured by
+    mode, the third panel their frequency std: every estimate spans the same window); ``why``
+    written on the empty panels of a run without an estimate; returns the Figure."""
     from .plotting import plot_estimates
 
     e = run.estimates
+    excitation = config.excitation if config is not None else 'free'
+    ambient = excitation == 'ambient'
+    if ambient and mode is None:
+        mode = e.mode
     return plot_estimates(
         path,
         *run.samples,
@@ -461,4 +475,7 @@ def plot_run(path: str, name: str, signal: Signal, run: Run, mode=None):
         ylabel=signal.label,
         mode=mode,
         unit=signal_unit(signal.component or signal.label),
+        label=ESTIMATE_LABELS.get(excitation, 'estimates'),
+        panel3=('frequency std (Hz)', e.frequency_std_hz) if ambient else None,
+        note=why,
     )
