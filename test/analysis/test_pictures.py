@@ -303,3 +303,19 @@ def test_a_schedule_of_three_frequencies_marks_each_segments_median(tmp_path):
     )
     marks = [x for x in legend_texts(fig.axes[3]) if x.startswith('f = ')]
     assert marks == ['f = 1.6 Hz', 'f = 1.3 Hz', 'f = 1.1 Hz']  # one per mass, in time order
+
+
+def test_joint_plot_gives_each_mode_its_own_strip_so_close_modes_do_not_overlap(tmp_path):
+    from vib_estimator.analysis.channels import joint_run, plot_shapes
+    from vib_estimator.sim.frame import modal_record
+
+    modes = [(1.24, 0.01, 1.0), (1.29, 0.01, 1.0)]  # the Heritage Court Tower's close pair
+    shapes = np.array([[1.0, 0.2], [0.2, 1.0], [0.7, -0.7]])
+    t, y = modal_record(200.0, 10.0, modes, shapes, snr_db=25.0, seed=3)
+    config = EstimatorConfig(excitation='ambient', ambient_window_s=80.0)
+    _, result = joint_run(t, y, ['a', 'b', 'c'], config)
+    fig = plot_shapes(str(tmp_path / 's.png'), 'pair', result)
+    strips = fig.axes[:2]
+    assert [s.get_ylabel().split('\n')[0] for s in strips] == ['mode 1', 'mode 2']
+    (lo1, hi1), (lo2, hi2) = (s.get_ylim() for s in strips)
+    assert hi1 < 1.29 * 0.995 and lo2 > 1.24 * 1.005  # each strip holds its own mode only
