@@ -65,7 +65,7 @@ from ..io.streaming import BagInfo, bag_info, is_csv, open_signal, supported_top
 from .analyze import Run, add_config_arguments, estimate_signal, make_config
 from .channels import channel_list, joint_run, mode_shapes, need_joint, read_channels
 from .interval import combine
-from .outputs import check_output
+from .outputs import check_output, progress
 
 _STATS = (
     'start_utc',
@@ -548,10 +548,7 @@ def _error_row(path: Path, topic: str, component: str, err: BaseException) -> Di
 
 
 def _progress(total: int):
-    from tqdm import tqdm
-
-    on_terminal = sys.stdout.isatty() and sys.stderr.isatty()
-    return tqdm(total=total, unit='recording', disable=not on_terminal, file=sys.stderr)
+    return progress(total, 'recording')
 
 
 def survey(
