@@ -838,7 +838,9 @@ def plot_trend(
     if damped:
         axes[1, 0].set_ylabel('damping ratio')
     axes[-1, 0].set_xlabel('recording start (UTC)')
-    unique = dict(zip(*reversed(ax_f.get_legend_handles_labels())))  # (a label once)
+    unique: Dict[str, object] = {}
+    for handle, text in zip(*ax_f.get_legend_handles_labels()):
+        unique.setdefault(text, handle)  # a label once: its first line
     ax_f.legend(
         unique.values(), unique.keys(), fontsize=8, loc='upper left', bbox_to_anchor=(1.01, 1.0)
     )  # beside the axes: the alarms stay visible
