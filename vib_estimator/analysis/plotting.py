@@ -148,6 +148,13 @@ def welch_psd(t: np.ndarray, y: np.ndarray, lowest_hz: float = math.nan):
     return welch(y - np.mean(y), fs=fs, nperseg=nperseg)
 
 
+def mark_modes(ax, modes, label) -> None:
+    """A dashed vertical line at each of ``modes``' frequency, in its colour, labelled
+    ``label(mode)``."""
+    for m in modes:
+        ax.axvline(m.frequency_hz, color=mode_colour(m.mode), ls='--', lw=1.0, label=label(m))
+
+
 def plot_spectrum(ax, t: np.ndarray, y: np.ndarray, modes, unit: str = UNKNOWN_UNIT) -> None:
     """The Welch PSD of the signal on ``ax`` (log scale), each of ``modes``
     (:class:`.summary.ModeSummary`) marked at its median frequency, labelled "f = ... Hz"."""
@@ -156,14 +163,11 @@ def plot_spectrum(ax, t: np.ndarray, y: np.ndarray, modes, unit: str = UNKNOWN_U
         return
     f, psd = welch_psd(t, y, min((m.frequency_hz for m in modes), default=math.nan))
     ax.semilogy(f[1:], psd[1:], lw=0.8, color='0.3', label='Welch PSD')
-    for m in modes:
-        ax.axvline(
-            m.frequency_hz,
-            color=mode_colour(m.mode),
-            ls='--',
-            lw=1.0,
-            label=f'f = {m.frequency_hz:.5g} Hz' + (f' (mode {m.mode})' if m.mode else ''),
-        )
+    mark_modes(
+        ax,
+        modes,
+        lambda m: f'f = {m.frequency_hz:.5g} Hz' + (f' (mode {m.mode})' if m.mode else ''),
+    )
     if modes:
         ax.set_xlim(0, min(f[-1], PSD_SPAN * max(m.frequency_hz for m in modes)))
     ax.set_xlabel('frequency (Hz)')

@@ -31,7 +31,7 @@ from ..core.estimator import EstimateArrays
 from ..core.multichannel import mac
 from ..core.shapes import phases_deg, signed_amplitudes
 from ..io.fields import UNKNOWN_UNIT
-from .plotting import PSD_RESOLUTION, mode_colour, pyplot, save_figure, welch_psd
+from .plotting import PSD_RESOLUTION, mark_modes, mode_colour, pyplot, save_figure, welch_psd
 from .summary import ModeSummary, summarise_modes, summary_lines
 
 #: frames of a mode shape's animation (one period) and their rate, frames/s
@@ -120,14 +120,7 @@ def _mark_band(ax, config: EstimatorConfig, hi: float) -> None:
 
 
 def _mark_modes(ax, modes) -> None:
-    for m in modes:
-        ax.axvline(
-            m.frequency_hz,
-            color=mode_colour(m.mode),
-            ls='--',
-            lw=1.0,
-            label=f'{mode_name(m)}: {m.frequency_hz:.4g} Hz',
-        )
+    mark_modes(ax, modes, lambda m: f'{mode_name(m)}: {m.frequency_hz:.4g} Hz')
 
 
 def resolution_hz(modes) -> float:
@@ -675,9 +668,15 @@ def write_report(directory, record: Record, geometry=None) -> Path:
     if record.modes:
         body.append('<h2>Mode shapes</h2>' + shapes_html(directory, record, geometry, shapes))
     body.append(counters_html(record))
+    return write_page(directory, title, STYLE, body)
+
+
+def write_page(directory: Path, title: str, style: str, body: Sequence[str]) -> Path:
+    """``directory/index.html``: an HTML page of ``title``, inline CSS ``style`` and the
+    ``body`` parts; returns its path."""
     page = (
         '<!DOCTYPE html><html lang="en"><head><meta charset="utf-8">'
-        f'<title>{html.escape(title)}</title><style>{STYLE}</style></head><body>'
+        f'<title>{html.escape(title)}</title><style>{style}</style></head><body>'
         + '\n'.join(body)
         + '</body></html>\n'
     )
@@ -753,12 +752,4 @@ def write_survey_report(directory, rows, command: str, baseline, trend: bool) ->
         STYLE
         + 'tr.alarm td{background:#fde0e0}tr.error td{background:#fff4e0}td{white-space:nowrap}'
     )
-    page = (
-        '<!DOCTYPE html><html lang="en"><head><meta charset="utf-8">'
-        f'<title>vib_estimator survey report</title><style>{style}</style></head><body>'
-        + '\n'.join(parts)
-        + '</body></html>\n'
-    )
-    path = directory / 'index.html'
-    path.write_text(page, encoding='utf-8')
-    return path
+    return write_page(directory, 'vib_estimator survey report', style, parts)
