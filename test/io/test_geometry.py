@@ -81,3 +81,17 @@ def test_unreadable_or_not_yaml_files(tmp_path):
     bad.write_text('points: {a: [0, 0, 0]\nchannels: [')
     with pytest.raises(GeometryError, match='not valid YAML at line'):
         load_geometry(bad)
+
+
+def test_numbered_points_and_channels_are_names_as_text():
+    """pyOMA2-style numbering: points 1, 2, channels 1, 2 (YAML integers) work as names."""
+    g = parse_geometry(
+        {
+            'points': {1: [0, 0, 0], 2: [0, 0, 1]},
+            'channels': {1: {'point': 2, 'direction': 'X'}, 2: {'point': [2], 'direction': '+y'}},
+            'lines': [[1, 2]],
+            'fixed': [1],
+        }
+    )
+    assert g.channels == ('1', '2') and g.fixed == (0,) and g.lines.tolist() == [[0, 1]]
+    assert np.allclose(g.displacements([1.0, 2.0], ('1', '2')), [[0, 0, 0], [1.0, 2.0, 0]])

@@ -164,3 +164,17 @@ def test_a_geometry_that_does_not_place_a_channel_stops_the_start(ros_context, t
             context=ros_context,
             parameter_overrides=[Parameter(k, value=v) for k, v in overrides.items()],
         )
+
+
+def test_channels_changed_to_ones_the_geometry_does_not_place_stop_the_drawing(
+    ros_context, node_with_geometry
+):
+    node, _ = node_with_geometry
+    shapes = node._mode_shapes
+    shapes.update(type('E', (), {'mode': 1, 'frequency_hz': 1.0, 'damping': 0.02})(), np.ones(3))
+    assert shapes.markers.modes
+    result = node.set_parameters([Parameter('components', value=['angular_velocity.x', AXES[1]])])
+    assert result[0].successful
+    assert not shapes.active and not shapes.markers.modes  # nothing stale is drawn
+    result = node.set_parameters([Parameter('components', value=AXES[:2])])
+    assert result[0].successful and shapes.active and shapes.markers.channels == tuple(AXES[:2])

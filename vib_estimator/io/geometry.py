@@ -118,11 +118,13 @@ def _direction(path, name: str, value) -> np.ndarray:
 
 
 def _point_refs(path, what: str, value, index: dict) -> tuple[int, ...]:
-    """The indices of one point name or a list of them."""
-    names = [value] if isinstance(value, str) else value
-    if not isinstance(names, list) or not names:
+    """The indices of one point name or a list of them (names compared as text: ``1`` and
+    ``'1'`` are one point)."""
+    names = value if isinstance(value, list) else [value]
+    if not names or any(isinstance(n, (list, dict)) or n is None for n in names):
         raise GeometryError(_where(path, f'{what} must be a point name or a list of them'))
-    unknown = [str(n) for n in names if n not in index]
+    names = [str(n) for n in names]
+    unknown = [n for n in names if n not in index]
     if unknown:
         raise GeometryError(
             _where(path, f'{what} names unknown point(s) {", ".join(unknown)} (not under points:)')
@@ -176,7 +178,7 @@ def parse_geometry(data, path: str = '<geometry>') -> Geometry:
     raw = _mapping(path, data, 'points')
     names = tuple(str(n) for n in raw)
     points = np.array([_vector(path, f'point {n}', raw[n]) for n in raw]).reshape(-1, 3)
-    index = {n: i for i, n in enumerate(raw)}
+    index = {str(n): i for i, n in enumerate(raw)}
     channels, channel_points, directions = _channels(path, data, index)
     fixed = data.get('fixed') or []
     fixed = _point_refs(path, 'fixed', fixed, index) if fixed else ()
