@@ -377,7 +377,13 @@ def _shape_axes(fig, geometry, frames, colour, view):
     dots3 = ax3.plot([], [], [], 'o', color=colour, ms=4)[0]
     dots2 = ax2.plot([], [], 'o', color=colour, ms=4)[0]
     ax2.grid(alpha=0.3)
-    fig.subplots_adjust(left=0.02, right=0.97, wspace=0.35)
+    flat = np.ptp(base, axis=0) == 0
+    for setter, value, is_flat in zip(
+        (ax3.set_xticks, ax3.set_yticks, ax3.set_zticks), base[0], flat
+    ):
+        if is_flat:  # a planar structure: one tick on the axis it does not extend along
+            setter([value])
+    fig.subplots_adjust(left=0.02, right=0.97, bottom=0.15, top=0.86, wspace=0.35)
     return (lines3, dots3), (lines2, dots2)
 
 
