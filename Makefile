@@ -44,6 +44,7 @@ bench-all: bench
 	$(VENV)/bin/python benchmarks/bench_survey_accuracy.py
 	$(VENV)/bin/python benchmarks/real_data.py
 	$(VENV)/bin/python benchmarks/bench_channels.py
+	$(VENV)/bin/python benchmarks/bench_defaults.py
 
 reproduce: setup
 	$(VENV)/bin/vib-estimator reproduce fig1 --out out/fig1.png

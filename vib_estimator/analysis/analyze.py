@@ -33,9 +33,11 @@ from ..core.config import EXCITATIONS, PAPER
 from ..core.modes import create_estimator
 from ..errors import VibEstimatorError, report
 from ..io.align import ALIGN_TOLERANCE_S
+from ..io.csv_reader import csv_layout
 from ..io.fields import INPUT_TYPES, signal_unit
-from ..io.streaming import Signal, open_signal
+from ..io.streaming import Signal, is_csv, open_signal
 from .channels import channel_names, component_names, need_joint, run_joint, topic_list
+from .choosing import explain_no_estimate, prepare, read_ahead
 from .outputs import check_output
 from .summary import summarise_modes, summary_lines
 
@@ -218,8 +220,11 @@ class Run:
     samples: Optional[Tuple[np.ndarray, np.ndarray]]
 
 
-def estimate_signal(signal: Signal, config: EstimatorConfig, keep_samples: bool = False) -> Run:
-    """Stream ``signal`` through a fresh estimator of ``config``, block by block.
+def estimate_signal(
+    signal: Signal, config: EstimatorConfig, keep_samples: bool = False, blocks=None
+) -> Run:
+    """Stream ``signal`` (or its ``blocks``, when some were read ahead) through a fresh estimator
+    of ``config``, block by block.
 
     Raises ValueError (no samples, time not increasing, band above Nyquist) and the readers'
     CsvError/BagError.
@@ -227,7 +232,7 @@ def estimate_signal(signal: Signal, config: EstimatorConfig, keep_samples: bool 
     estimator = create_estimator(config)
     parts, kept = [], []
     count, previous, first_t, nyquist_checked = 0, 0.0, None, False
-    for t, y in signal.blocks():
+    for t, y in signal.blocks() if blocks is None else blocks:
         if len(t) == 0:
             continue
         _check_times(t, previous, count, str(signal.path))
@@ -256,50 +261,6 @@ def json_row(row: dict) -> dict:
     return {
         k: None if isinstance(v, float) and not math.isfinite(v) else v for k, v in row.items()
     }
-
-
-def explain_no_estimate(counters, open_samples: Optional[int], config: EstimatorConfig) -> str:
-    """Why a run gave no estimate, from its counters, and what to try."""
-    if counters.get('used', 0) == 0:
-        return 'no sample was usable (see the skipped_* counters)'
-    analyses, flat = counters.get('analyses', 0), counters.get('flat_windows', 0)
-    if analyses and flat == analyses:
-        return f'the signal is constant (every window analysed was flat: flat_windows={flat})'
-    if config.excitation == 'ambient':
-        if not analyses:
-            return (
-                f'the record is shorter than one window (--ambient-window-s '
-                f'{config.ambient_window_s:g})'
-            )
-        return (
-            f'no mode stood out of the noise, stable over the model orders and in consecutive '
-            f'windows, in {analyses} analyses: try --band-hz around the modes of interest or a '
-            'longer --ambient-window-s'
-        )
-    held = {k: v for k, v in counters.items() if v and k.startswith('rejected_')}
-    if held:
-        return (
-            'every converged estimate was held back by the quality gate ('
-            + ', '.join(f'{k}={v}' for k, v in held.items())
-            + '): check --min-fit, '
-            '--max-damping, --min-amplitude, or the model (--model)'
-        )
-    text = 'the convergence test (Eqs. 16-17) never fired'
-    if open_samples:
-        text += f' (the last segment ran {open_samples} samples without converging'
-        text += (
-            ', '
-            + (
-                'max_window automatic: 10 s'
-                if not config.max_window
-                else f'max_window {config.max_window:g} s'
-            )
-            + ')'
-        )
-    return (
-        text + f': the signal may not follow --model {config.model} (a decay: try '
-        '--model damped-sinusoid), or try a larger --tolerance or a longer recording'
-    )
 
 
 def _print(estimates, origin, fmt, modes: int = 0) -> None:
@@ -333,6 +294,14 @@ def _print(estimates, origin, fmt, modes: int = 0) -> None:
             )
 
 
+def default_column(args) -> Optional[list[str]]:
+    """For a CSV input read without ``--column``: the file's signal columns, the one read (the
+    first after the time) first; else None."""
+    if args.column is not None or not is_csv(args.input):
+        return None
+    return list(csv_layout(args.input).names[1:])
+
+
 def damage_warning(signal: Signal, prog: str) -> None:
     """The one ``warning:`` line on stderr for the damaged records a read skipped, if any."""
     if signal.corrupt:
@@ -351,23 +320,19 @@ def run(args: argparse.Namespace) -> int:
         if getattr(args, 'columns', None) is not None:
             names = channel_names(args)
             if len(names) > 1:
-                return run_joint(args, config, names, json_row, 'analyze', why=explain_no_estimate)
+                return run_joint(args, config, names, json_row, 'analyze')
             args.column = names[0]  # one column: exactly --column
         if getattr(args, 'topics', None) is not None:
             args.topics_list = topic_list(args)
             if len(args.topics_list) > 1:
                 names = component_names(args) if args.components is not None else []
                 need_joint(f'{len(args.topics_list)} topics', config)
-                return run_joint(
-                    args, config, names, json_row, 'analyze', damage_warning, explain_no_estimate
-                )
+                return run_joint(args, config, names, json_row, 'analyze', damage_warning)
             args.topic = args.topics_list[0]  # one topic: exactly --topic
         if getattr(args, 'components', None) is not None:
             names = component_names(args)
             if len(names) > 1:
-                return run_joint(
-                    args, config, names, json_row, 'analyze', damage_warning, explain_no_estimate
-                )
+                return run_joint(args, config, names, json_row, 'analyze', damage_warning)
             args.component = names[0]  # one component: exactly --component
         signal = open_signal(
             args.input,
@@ -376,12 +341,27 @@ def run(args: argparse.Namespace) -> int:
             args.column,
             strict=getattr(args, 'strict', False),
         )
-        result = estimate_signal(signal, config, bool(args.plot or args.report))
         if geometry is not None:
             geometry.check_channels((signal.component or signal.label,))
+        columns = default_column(args)
+        ahead, blocks = read_ahead(signal.blocks())
+        decision, notes = None, []
+        if ahead is not None:
+            config, decision, notes = prepare(args, config, *ahead, 1, 'analyze')
+        result = estimate_signal(signal, config, bool(args.plot or args.report), blocks)
     except (VibEstimatorError, ValueError) as err:
         return report(err, 'vib-estimator analyze')
     damage_warning(signal, 'vib-estimator analyze')
+    for line in notes:
+        print(line, file=sys.stderr)
+    others = columns[1:] if columns else []
+    if columns:
+        print(
+            f'analyze: column {columns[0]} (the first after the time, the default'
+            + (f'; the others: {", ".join(others)}: --column NAME' if others else '')
+            + ')',
+            file=sys.stderr,
+        )
     estimates = result.estimates
     _print(estimates, signal.origin_ns, args.format, config.modes or config.excitation != 'free')
     counters = result.estimator.counters
@@ -393,20 +373,31 @@ def run(args: argparse.Namespace) -> int:
     print(
         'analyze: ' + ', '.join(f'{k}={v}' for k, v in counters.items()) + extra, file=sys.stderr
     )
-    mode = estimates.mode if config.modes else None
+    mode = estimates.mode if config.modes or config.excitation != 'free' else None
+    why = '' if len(estimates) else explain_no_estimate(counters, open_samples, config, decision)
     if len(estimates) == 0:
-        print(
-            'analyze: no estimate: ' + explain_no_estimate(counters, open_samples, config),
-            file=sys.stderr,
-        )
-    for line in summary_lines(summarise_modes(estimates.frequency_hz, estimates.damping, mode)):
+        print('analyze: no estimate: ' + why, file=sys.stderr)
+        if others:
+            print(
+                f"analyze: column {signal.label} gave no estimate; the file's other columns: "
+                + ', '.join(others)
+                + ' (--column NAME, or --columns all for a joint estimation)',
+                file=sys.stderr,
+            )
+    for line in summary_lines(
+        summarise_modes(estimates.frequency_hz, estimates.damping, mode, estimates.t)
+    ):
         print('analyze: ' + line, file=sys.stderr)
-    why = '' if len(estimates) else explain_no_estimate(counters, open_samples, config)
-    if args.plot:
-        plot_run(args.plot, args.input, signal, result, mode, config, why)
-    if getattr(args, 'report', None):
-        write_run_report(args, config, signal, result, geometry, why)
+    pictures(args, config, signal, result, mode, geometry, why)
     return 0
+
+
+def pictures(args, config, signal: Signal, run: Run, mode, geometry, why: str) -> None:
+    """``--plot`` and ``--report`` of a one-channel run (its samples kept)."""
+    if args.plot:
+        plot_run(args.plot, args.input, signal, run, mode, config, why)
+    if getattr(args, 'report', None):
+        write_run_report(args, config, signal, run, geometry, why)
 
 
 def report_geometry(args):

@@ -32,6 +32,7 @@ from ..errors import BagError, CsvError
 from ..io.csv_reader import column_names, read_csv_columns
 from ..io.fields import UNKNOWN_UNIT, seconds_since, signal_unit
 from ..io.streaming import is_csv, open_signal, read_topics
+from .choosing import explain_no_estimate, prepare
 from .summary import summarise_modes, summary_lines
 
 
@@ -267,18 +268,16 @@ def plot_shapes(
     return fig
 
 
-def run_joint(
-    args, config: EstimatorConfig, names, json_row, prog: str, warn=None, why=None
-) -> int:
+def run_joint(args, config: EstimatorConfig, names, json_row, prog: str, warn=None) -> int:
     """``analyze --columns`` or ``--components`` with two or more channels ``names``: estimates
-    with their shapes on stdout, the counters and the summary on stderr, ``--plot``, ``--report``
-    (``why``: (counters, None, config) -> why nothing was estimated); ``warn`` (signal, prog)
-    says what a bag's read skipped. Bad input raises (CsvError, BagError, ValueError,
-    GeometryError) before anything is printed."""
+    with their shapes on stdout, the counters and the summary on stderr, ``--plot``,
+    ``--report``; ``warn`` (signal, prog) says what a bag's read skipped. Bad input raises
+    (CsvError, BagError, ValueError, GeometryError) before anything is printed."""
     t, y, names, signals, origin, counters = read_joint(args, names)
     geometry = getattr(args, 'loaded_geometry', None)
     if geometry is not None:
         geometry.check_channels(names)
+    config, decision, notes = prepare(args, config, t, y, len(names), prog)
     estimator, result = joint_run(t, y, names, config)
     table = rows(result)
     extra = ''
@@ -293,6 +292,8 @@ def run_joint(
         extra += f', corrupt_records={sum(signal.corrupt for signal in signals)}'
         extra += ''.join(f', {k}={v}' for k, v in counters.items())
     print_rows(table, args.format, json_row)
+    for line in notes:
+        print(line, file=sys.stderr)
     print(
         f'{prog}: channels={",".join(names)}, '
         + ', '.join(f'{k}={v}' for k, v in estimator.counters.items())
@@ -300,7 +301,10 @@ def run_joint(
         file=sys.stderr,
     )
     e = result.estimates
-    for line in summary_lines(summarise_modes(e.frequency_hz, e.damping, e.mode)):
+    why = '' if len(e) else explain_no_estimate(estimator.counters, None, config, decision)
+    if why:
+        print(f'{prog}: no estimate: {why}', file=sys.stderr)
+    for line in summary_lines(summarise_modes(e.frequency_hz, e.damping, e.mode, e.t)):
         print(f'{prog}: ' + line, file=sys.stderr)
     for k, (f, amp, _) in mode_shapes(result).items():
         shape = ', '.join(f'{n} {a:+.2f}' for n, a in zip(names, amp))
@@ -314,11 +318,11 @@ def run_joint(
 
 
 def report_joint(args, config, samples, result: JointEstimates, counters, why) -> None:
-    """``--report`` of a joint run of the channels' ``samples`` (t, Y, their unit)."""
+    """``--report`` of a joint run of the channels' ``samples`` (t, Y, their unit); ``why``:
+    why nothing was estimated ('' if something was)."""
     from .report import Record, command_line, write_report
 
     t, y, unit = samples
-    reason = '' if len(result) or why is None else why(dict(counters), None, config)
     record = Record(
         str(args.input),
         command_line(args),
@@ -330,7 +334,7 @@ def report_joint(args, config, samples, result: JointEstimates, counters, why) -
         dict(counters),
         shapes=result.shapes,
         unit=unit,
-        why=reason,
+        why=why,
     )
     path = write_report(args.report, record, getattr(args, 'loaded_geometry', None))
     print(f'analyze: report written to {path}', file=sys.stderr)

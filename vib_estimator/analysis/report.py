@@ -508,7 +508,10 @@ def modes_table(record: Record, shapes) -> str:
             f'<td class="mode" data-mode="{m.mode}">{m.mode or "-"}</td>',
             f'<td>{m.frequency_hz:.4f} {_std(m.frequency_std_hz)}</td>',
             f'<td>{_zeta(m.damping)} {_std(damping_std(record, m))}</td>',
-            f'<td>{m.count}' + (f' ({m.outliers} outliers)' if m.outliers else '') + '</td>',
+            f'<td>{m.count}'
+            + (f' ({m.outliers} outliers)' if m.outliers else '')
+            + (' (tentative: too few to shape for)' if m.tentative else '')
+            + '</td>',
         ]
         if shape is not None:
             amp = signed_amplitudes(shape)
@@ -554,12 +557,20 @@ def record_html(record: Record, geometry) -> str:
     )
 
 
-def shaper_html(modes) -> str:
-    """The recommended input shaper (:func:`.summary.summary_lines`): why, and the command."""
-    lines = summary_lines(modes)[len(modes) + 1 :]
+def shaper_html(record: Record) -> str:
+    """The recommended input shaper as ``analyze`` gives it (:func:`.summary.summary_lines` of
+    the estimates by mode and stretch): why, and the ``shaper_node`` command -- or why none."""
+    e = record.estimates
+    lines = summary_lines(summarise_modes(e.frequency_hz, e.damping, e.mode, e.t))
+    start = next(
+        (i for i, line in enumerate(lines) if line.startswith(('recommended', 'no input shaper'))),
+        len(lines),
+    )
+    text, command = lines[start : start + 1], lines[start + 1 : start + 2]
     return (
-        f'<h3>Recommended input shaper</h3><p>{html.escape(lines[0].rstrip(":"))}:</p>'
-        f'<pre>{html.escape(lines[1].strip())}</pre>'
+        '<h3>Recommended input shaper</h3>'
+        + ''.join(f'<p>{html.escape(t.rstrip(":"))}{":" if command else ""}</p>' for t in text)
+        + ''.join(f'<pre>{html.escape(c.strip())}</pre>' for c in command)
     )
 
 
@@ -667,7 +678,7 @@ def write_report(directory, record: Record, geometry=None) -> Path:
             "standard deviation; damping ratio: the median ± the median of its estimates' "
             'stds.</p>'
         )
-        body.append(shaper_html(record.modes))
+        body.append(shaper_html(record))
     else:
         body.append(f'<p class="why"><b>No estimate.</b> Why: {html.escape(record.why)}</p>')
     body.append('<h2>Spectrum and estimates</h2>' + figures_html(directory, record))

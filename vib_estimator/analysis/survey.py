@@ -57,6 +57,7 @@ from typing import Dict, Iterable, List, Optional, Sequence, Tuple
 import numpy as np
 
 from ..core import COUNTER_NAMES, EstimatorConfig
+from ..core.choice import decide
 from ..core.multichannel import mac
 from ..errors import VibEstimatorError, report
 from ..io.csv_reader import column_names
@@ -64,6 +65,7 @@ from ..io.fields import DEFAULT_COMPONENT, check_component
 from ..io.streaming import BagInfo, bag_info, is_csv, open_signal, supported_topics
 from .analyze import Run, add_config_arguments, estimate_signal, make_config
 from .channels import channel_list, joint_run, mode_shapes, need_joint, read_channels
+from .choosing import decided_config, decides, read_ahead, window_given
 from .interval import combine
 from .outputs import check_output, progress
 
@@ -134,6 +136,10 @@ class Options:
     columns: Optional[str] = None
     #: ``--components``: two or more fields of a bag topic, identified jointly
     joint_components: Tuple[str, ...] = ()
+    #: no ``--excitation``: each recording's excitation (and ambient window, unless
+    #: ``keep_window``) is decided from it (:mod:`.choosing`)
+    decide: bool = False
+    keep_window: bool = False
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -514,12 +520,18 @@ def _recording_rows(path: Path, options: Options) -> List[Dict]:
                 continue
             column = channels[0] if channels else options.column
             signal = open_signal(path, topic, component, column, options.strict, info=info)
+            config, blocks = options.config, None
+            if options.decide:
+                ahead, blocks = read_ahead(signal.blocks())
+                if ahead is not None:
+                    d = decide(*ahead, 1, config.ambient_window_s)
+                    config = decided_config(config, d, 'survey', options.keep_window)[0]
             rows.extend(
                 _stat_rows(
                     path,
                     signal,
-                    estimate_signal(signal, options.config),
-                    options.config.modes,
+                    estimate_signal(signal, config, blocks=blocks),
+                    config.modes,
                     options.summary,
                 )
             )
@@ -533,7 +545,11 @@ def _joint_recording_rows(path, topic, names, options: Options, info) -> List[Di
     t, y, names, signal = read_channels(path, topic, names, options.strict, info)
     if not len(t):
         raise ValueError(f'{path} holds no samples')
-    estimator, joint = joint_run(t, y, names, options.config)
+    config = options.config
+    if options.decide:
+        d = decide(t, y, len(names), config.ambient_window_s)
+        config = decided_config(config, d, 'survey', options.keep_window)[0]
+    estimator, joint = joint_run(t, y, names, config)
     result = Run(estimator, joint.estimates, float(t[0]), float(t[-1]), None)
     modes = options.config.modes
     return _stat_rows(path, signal, result, modes, options.summary, joint, ','.join(names))
@@ -932,6 +948,8 @@ def _options(args: argparse.Namespace) -> Options:
         args.summary,
         columns,
         joint,
+        decides(args),
+        window_given(args),
     )
 
 

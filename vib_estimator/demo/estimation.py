@@ -83,7 +83,9 @@ def run_estimation(session: Session, args: argparse.Namespace, wall_start: float
         + (
             ' on a realistic rig (' + ', '.join(REAL_ARM_SIM_PARAMS) + '), estimator defaults'
             if real
-            else ''
+            else "; estimator_node in the paper's configuration (config/paper.yaml: "
+            + ', '.join(PAPER_PARAMS)
+            + '), not the defaults: --real-arm runs the defaults on a realistic rig'
         ),
         flush=True,
     )
