@@ -217,3 +217,31 @@ def test_the_probe_sees_a_broken_image(report, tmp_path):
     bad.write_text(f'<html><body><img src="missing.png">{PROBE}</body></html>')
     out = chromium(tmp_path, '--virtual-time-budget=5000', '--dump-dom', bad.as_uri()).stdout
     assert 'images=1 broken=missing.png;' in out
+
+
+def test_a_mode_whose_frequency_moved_is_listed_and_marked_per_stretch(tmp_path):
+    """Three tip masses (1.64, 1.33, 1.15 Hz) of one mode: three rows and three marks, never one
+    median across them."""
+    from vib_estimator.analysis.report import Record, write_report
+    from vib_estimator.core import EstimatorConfig
+    from vib_estimator.core.ambient import estimate_columns
+    from vib_estimator.core.estimator import Estimate
+
+    truth = [(0.0, 1.64), (10.0, 1.33), (20.0, 1.15)]
+    est = [
+        Estimate(t0 + k, f * (1 + 1e-3 * (k % 2)), 1.0, 500, 0.99, 1.0)
+        for t0, f in truth
+        for k in range(1, 6)
+    ]
+    t = np.arange(0, 30, 0.002)
+    y = np.sin(2 * np.pi * 1.3 * t)
+    record = Record('x.csv', 'vib-estimator analyze x.csv', ('y',), t, y,
+                    estimate_columns(est), EstimatorConfig(), {})  # fmt: skip
+    page = write_report(tmp_path, record).read_text()
+    rows = re.findall(r'\(t ([\d.]+)–([\d.]+) s\)</td><td>([\d.]+) ', page)
+    assert len(rows) == 3
+    for (t0, f), (first, last, shown) in zip(truth, rows):
+        assert (float(first), float(last)) == (t0 + 1, t0 + 5)
+        assert abs(float(shown) / f - 1) < 2e-3
+    assert page.count('data-mode="0"') == 3
+    assert 'for the last stretch, from t = 21 s' in page  # the shaper: the last mass's

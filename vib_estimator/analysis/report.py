@@ -67,11 +67,14 @@ class Record:
     unit: str = UNKNOWN_UNIT
     why: str = ''
     modes: list = field(default_factory=list)
+    #: per mode, per stretch of its estimates when its frequency moved (:mod:`.summary`)
+    stretches: list = field(default_factory=list)
 
     def __post_init__(self):
         self.y = np.asarray(self.y, dtype=float).reshape(len(self.t), -1)
         e = self.estimates
         self.modes = summarise_modes(e.frequency_hz, e.damping, e.mode)
+        self.stretches = summarise_modes(e.frequency_hz, e.damping, e.mode, e.t)
 
 
 def command_line(args) -> str:
@@ -120,7 +123,14 @@ def _mark_band(ax, config: EstimatorConfig, hi: float) -> None:
 
 
 def _mark_modes(ax, modes) -> None:
-    mark_modes(ax, modes, lambda m: f'{mode_name(m)}: {m.frequency_hz:.4g} Hz')
+    mark_modes(
+        ax,
+        modes,
+        lambda m: (
+            f'{mode_name(m)}: {m.frequency_hz:.4g} Hz'
+            + (f' (t {m.t_first:.3g}–{m.t_last:.3g} s)' if m.stretches > 1 else '')
+        ),
+    )
 
 
 def resolution_hz(modes) -> float:
@@ -164,7 +174,7 @@ def spectrum_figure(path: Path, record: Record) -> None:
     """The PSD (one channel) or the singular values of the spectral matrix, modes marked."""
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(9, 4.2))
-    lowest = resolution_hz(record.modes)
+    lowest = resolution_hz(record.stretches)
     t, y, unit = record.t, record.y, record.unit
     if len(t) < 4 or not np.any(np.ptp(y, axis=0) > 0):
         text = 'too few samples for a spectrum' if len(t) < 4 else 'constant signal: no spectrum'
@@ -187,7 +197,7 @@ def spectrum_figure(path: Path, record: Record) -> None:
             f'singular values of the spectral matrix ({y.shape[1]} channels), modes marked'
         )
     if ax.lines:
-        _mark_modes(ax, record.modes)
+        _mark_modes(ax, record.stretches)
         top = max((m.frequency_hz for m in record.modes), default=0.0)
         hi = min(f[-1], SPAN * top) if top > 0 else f[-1]
         _mark_band(ax, record.config, hi)
@@ -247,7 +257,7 @@ def stabilisation_figure(path: Path, record: Record) -> None:
             ms=5,
         )
     ax.plot([], [], 'o', mfc='none', color='k', label='stable pole (a cluster over the orders)')
-    _mark_modes(ax, record.modes)
+    _mark_modes(ax, record.stretches)
     top = max((m.frequency_hz for m in record.modes), default=0.45 * rate)
     hi = min(0.5 * rate, SPAN * top)
     _mark_band(ax, record.config, hi)
@@ -503,9 +513,12 @@ def modes_table(record: Record, shapes) -> str:
         + '</tr>'
     )
     rows = []
-    for m, shape in zip(record.modes, shapes or [None] * len(record.modes)):
+    shape_of = dict(zip((m.mode for m in record.modes), shapes or [None] * len(record.modes)))
+    for m in record.stretches:
+        shape = shape_of.get(m.mode)
+        when = f' (t {m.t_first:.4g}–{m.t_last:.4g} s)' if m.stretches > 1 else ''
         cells = [
-            f'<td class="mode" data-mode="{m.mode}">{m.mode or "-"}</td>',
+            f'<td class="mode" data-mode="{m.mode}">{m.mode or "-"}{when}</td>',
             f'<td>{m.frequency_hz:.4f} {_std(m.frequency_std_hz)}</td>',
             f'<td>{_zeta(m.damping)} {_std(damping_std(record, m))}</td>',
             f'<td>{m.count}'
@@ -676,7 +689,8 @@ def write_report(directory, record: Record, geometry=None) -> Path:
         body.append(
             '<p class="note">Frequency: the median of the mode\'s estimates ± their robust '
             "standard deviation; damping ratio: the median ± the median of its estimates' "
-            'stds.</p>'
+            'stds. A mode whose frequency moved during the record (a changed load) is listed per '
+            'stretch, with its times.</p>'
         )
         body.append(shaper_html(record))
     else:
