@@ -109,6 +109,19 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--format', choices=('jsonl', 'csv', 'table'), default='jsonl')
     parser.add_argument('--plot', metavar='FILE.png', help='write a Fig. 5-like figure')
     parser.add_argument(
+        '--report',
+        metavar='DIR',
+        help='write DIR/index.html, a self-contained page (images beside it): the modes, '
+        'spectrum, stabilisation diagram, estimates over time, mode shapes, MAC, shaper '
+        '(docs/report.md)',
+    )
+    parser.add_argument(
+        '--geometry',
+        metavar='FILE.yaml',
+        help="--report: draw each mode's shape on the structure (points, channels, lines: "
+        'docs/geometry.md; examples in config/geometry/)',
+    )
+    parser.add_argument(
         '--strict',
         action='store_true',
         help='a damaged bag record is an error (exit 2) instead of a counted skip',
@@ -303,6 +316,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         config = make_config(args)
         check_output(args.plot, '--plot')
+        geometry = args.loaded_geometry = report_geometry(args)
         if getattr(args, 'columns', None) is not None:
             names = channel_names(args)
             if len(names) > 1:
@@ -327,12 +341,14 @@ def run(args: argparse.Namespace) -> int:
             args.column,
             strict=getattr(args, 'strict', False),
         )
+        if geometry is not None:
+            geometry.check_channels((signal.component or signal.label,))
         columns = default_column(args)
         ahead, blocks = read_ahead(signal.blocks())
         decision, notes = None, []
         if ahead is not None:
             config, decision, notes = prepare(args, config, *ahead, 1, 'analyze')
-        result = estimate_signal(signal, config, bool(args.plot), blocks)
+        result = estimate_signal(signal, config, bool(args.plot or args.report), blocks)
     except (VibEstimatorError, ValueError) as err:
         return report(err, 'vib-estimator analyze')
     damage_warning(signal, 'vib-estimator analyze')
@@ -358,12 +374,9 @@ def run(args: argparse.Namespace) -> int:
         'analyze: ' + ', '.join(f'{k}={v}' for k, v in counters.items()) + extra, file=sys.stderr
     )
     mode = estimates.mode if config.modes or config.excitation != 'free' else None
+    why = '' if len(estimates) else explain_no_estimate(counters, open_samples, config, decision)
     if len(estimates) == 0:
-        print(
-            'analyze: no estimate: '
-            + explain_no_estimate(counters, open_samples, config, decision),
-            file=sys.stderr,
-        )
+        print('analyze: no estimate: ' + why, file=sys.stderr)
         if others:
             print(
                 f"analyze: column {signal.label} gave no estimate; the file's other columns: "
@@ -375,18 +388,74 @@ def run(args: argparse.Namespace) -> int:
         summarise_modes(estimates.frequency_hz, estimates.damping, mode, estimates.t)
     ):
         print('analyze: ' + line, file=sys.stderr)
-    if args.plot:
-        plot_run(args.plot, args.input, signal, result, mode)
+    pictures(args, config, signal, result, mode, geometry, why)
     return 0
 
 
-def plot_run(path: str, name: str, signal: Signal, run: Run, mode=None):
+def pictures(args, config, signal: Signal, run: Run, mode, geometry, why: str) -> None:
+    """``--plot`` and ``--report`` of a one-channel run (its samples kept)."""
+    if args.plot:
+        plot_run(args.plot, args.input, signal, run, mode, config, why)
+    if getattr(args, 'report', None):
+        write_run_report(args, config, signal, run, geometry, why)
+
+
+def report_geometry(args):
+    """Check ``--report`` (a writable folder) and load ``--geometry`` (GeometryError, ValueError
+    if bad; --geometry without --report is a ValueError)."""
+    report_dir, path = getattr(args, 'report', None), getattr(args, 'geometry', None)
+    check_output(report_dir, '--report', directory=True)
+    if path and not report_dir:
+        raise ValueError('--geometry draws the shapes of --report DIR: give --report too')
+    if not path:
+        return None
+    from ..io.geometry import load_geometry
+
+    return load_geometry(path)
+
+
+def write_run_report(args, config, signal: Signal, run: Run, geometry, why: str) -> None:
+    """``--report`` of a one-channel run (its samples kept)."""
+    from .report import Record, command_line, write_report
+
+    name = signal.component or signal.label
+    record = Record(
+        str(args.input),
+        command_line(args),
+        (name,),
+        run.samples[0],
+        run.samples[1],
+        run.estimates,
+        config,
+        dict(run.estimator.counters),
+        unit=signal_unit(name),
+        why=why,
+    )
+    path = write_report(args.report, record, geometry)
+    print(f'analyze: report written to {path}', file=sys.stderr)
+
+
+#: what ``--plot`` calls the estimates of each excitation
+ESTIMATE_LABELS = {
+    'free': 'algebraic estimates',
+    'ambient': 'SSI-cov estimates (ambient)',
+    'auto': 'estimates (decays: algebraic; driven: SSI-cov)',
+}
+
+
+def plot_run(path: str, name: str, signal: Signal, run: Run, mode=None, config=None, why=''):
     """``--plot``: the estimates and spectrum figure of a run (``keep_samples``) of ``signal``,
     its signal axis in the unit of the component or column (:func:`..io.fields.signal_unit`);
-    returns the Figure."""
+    the estimates labelled by what made them (``config``'s excitation; ambient: coloured by
+    mode, the third panel their frequency std: every estimate spans the same window); ``why``
+    written on the empty panels of a run without an estimate; returns the Figure."""
     from .plotting import plot_estimates
 
     e = run.estimates
+    excitation = config.excitation if config is not None else 'free'
+    ambient = excitation == 'ambient'
+    if ambient and mode is None:
+        mode = e.mode
     return plot_estimates(
         path,
         *run.samples,
@@ -397,4 +466,7 @@ def plot_run(path: str, name: str, signal: Signal, run: Run, mode=None):
         ylabel=signal.label,
         mode=mode,
         unit=signal_unit(signal.component or signal.label),
+        label=ESTIMATE_LABELS.get(excitation, 'estimates'),
+        panel3=('frequency std (Hz)', e.frequency_std_hz) if ambient else None,
+        note=why,
     )

@@ -67,7 +67,7 @@ from .analyze import Run, add_config_arguments, estimate_signal, make_config
 from .channels import channel_list, joint_run, mode_shapes, need_joint, read_channels
 from .choosing import decided_config, decides, read_ahead, window_given
 from .interval import combine
-from .outputs import check_output
+from .outputs import check_output, progress
 
 _STATS = (
     'start_utc',
@@ -189,6 +189,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         '--plot', metavar='FILE.png', help='frequency and damping vs recording time'
+    )
+    parser.add_argument(
+        '--report',
+        metavar='DIR',
+        help='write DIR/index.html: the trend with the baseline and the alarm band, one row per '
+        'recording (docs/report.md)',
     )
     parser.add_argument('--baseline', help='a recording, or a frequency in Hz, to compare against')
     parser.add_argument(
@@ -558,10 +564,7 @@ def _error_row(path: Path, topic: str, component: str, err: BaseException) -> Di
 
 
 def _progress(total: int):
-    from tqdm import tqdm
-
-    on_terminal = sys.stdout.isatty() and sys.stderr.isatty()
-    return tqdm(total=total, unit='recording', disable=not on_terminal, file=sys.stderr)
+    return progress(total, 'recording')
 
 
 def survey(
@@ -781,6 +784,16 @@ def alarm_band(ref: Tuple[float, float, float], alarm_rel: float) -> Tuple[float
     return ref[1] * (1 - alarm_rel), ref[2] * (1 + alarm_rel)
 
 
+def with_gaps(good: List[Dict], key) -> List[Dict]:
+    """The rows of ``key`` (topic, component, mode) over every recording of ``good``, by start
+    time: a recording where that mode was not found gets a row of NaNs, so that its line breaks
+    there instead of joining the recordings either side."""
+    start = {r['recording']: r['start_utc'] for r in good}
+    mine = {r['recording']: r for r in good if _key(r) == key}
+    order = sorted(start, key=lambda rec: (start[rec], rec))
+    return [mine.get(rec) or _row(Path(rec), *key, start_utc=start[rec]) for rec in order]
+
+
 def _bars(ax, x, line: List[Dict], name: str, colour: str, label: str) -> np.ndarray:
     """Plot the rows' ``name`` (frequency or damping) with their 95 % intervals as bars."""
     value = np.array([r[name + '_hz' if name == 'frequency' else name] for r in line])
@@ -805,12 +818,12 @@ def plot_trend(
     good = [r for r in rows if not r['error'] and np.isfinite(r['frequency_hz'])]
     damped = any(np.isfinite(r['damping']) for r in good)
     fig, axes = plt.subplots(
-        2 if damped else 1, 1, sharex=True, figsize=(9, 6 if damped else 4), squeeze=False
+        2 if damped else 1, 1, sharex=True, figsize=(12, 6 if damped else 4), squeeze=False
     )
     ax_f = axes[0, 0]
     for n, key in enumerate(sorted({_key(r) for r in good})):
         colour = f'C{n % 10}'
-        line = [r for r in good if _key(r) == key]
+        line = with_gaps(good, key)
         x = [
             datetime.fromisoformat(r['start_utc'].replace('Z', '+00:00')) if r['start_utc'] else i
             for i, r in enumerate(line)
@@ -841,7 +854,12 @@ def plot_trend(
     if damped:
         axes[1, 0].set_ylabel('damping ratio')
     axes[-1, 0].set_xlabel('recording start (UTC)')
-    ax_f.legend(fontsize=8, loc='best')
+    unique: Dict[str, object] = {}
+    for handle, text in zip(*ax_f.get_legend_handles_labels()):
+        unique.setdefault(text, handle)  # a label once: its first line
+    ax_f.legend(
+        unique.values(), unique.keys(), fontsize=8, loc='upper left', bbox_to_anchor=(1.01, 1.0)
+    )  # beside the axes: the alarms stay visible
     for ax in axes[:, 0]:
         ax.grid(alpha=0.3)
     fig.autofmt_xdate()
@@ -850,6 +868,21 @@ def plot_trend(
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return fig
+
+
+def write_survey_page(args: argparse.Namespace, rows: List[Dict], base) -> None:
+    """``--report DIR``: the trend (:func:`plot_trend`) and a page with a row per recording."""
+    from .report import command_line, write_survey_report
+
+    folder = Path(args.report)
+    good = [r for r in rows if not r['error'] and np.isfinite(r['frequency_hz'])]
+    if good:
+        plot_trend(rows, folder / 'trend.png', base, args.alarm_rel)
+    baseline = None
+    if base is not None:
+        baseline = f'{args.baseline}, alarm beyond ±{100 * args.alarm_rel:g} % (--alarm-rel)'
+    path = write_survey_report(folder, rows, command_line(args), baseline, bool(good))
+    print(f'vib-estimator survey: report written to {path}', file=sys.stderr)
 
 
 def report_entries(rows: List[Dict], ignored: Sequence[Path], out) -> None:
@@ -880,6 +913,7 @@ def _options(args: argparse.Namespace) -> Options:
         raise ValueError(f'--out must end in {", ".join(_OUT_SUFFIXES)}, got {args.out}')
     check_output(args.out, '--out')
     check_output(args.plot, '--plot')
+    check_output(getattr(args, 'report', None), '--report', directory=True)
     if args.jobs < 1:
         raise ValueError(f'--jobs must be >= 1, got {args.jobs}')
     if not args.alarm_rel >= 0:
@@ -935,6 +969,8 @@ def run(args: argparse.Namespace) -> int:
         write_file(rows, Path(args.out))
     if args.plot:
         plot_trend(rows, Path(args.plot), base, args.alarm_rel)
+    if getattr(args, 'report', None):
+        write_survey_page(args, rows, base)
     if args.fail_on_alarm and any(r['alarm'] for r in rows):
         return 3
     return 1 if args.strict and any(r['error'] for r in rows) else 0

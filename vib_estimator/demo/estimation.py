@@ -98,7 +98,7 @@ def run_estimation(session: Session, args: argparse.Namespace, wall_start: float
     rec = listener.record
     rows, ok = summarise(rec)
     print('\n' + '\n'.join(rows))
-    out = Path(args.out or 'out/demo.png')
+    out = Path(args.out or ('out/demo_real_arm.png' if real else 'out/demo.png'))
     out.parent.mkdir(parents=True, exist_ok=True)
     plot_estimation(str(out), rec, args.speed)
     print(

@@ -69,6 +69,7 @@ from ..io.fields import (
     topic_channels,
 )
 from . import health as H
+from .mode_shapes import ModeShapesPublisher
 from .parameters import (
     config_of,
     config_value,
@@ -208,6 +209,7 @@ class EstimatorNode(Node):
         #: the input topics (several: resolved, their channels are named after them)
         self._topics = topics if len(topics) < 2 else tuple(map(self.resolve_topic_name, topics))
         declare_config(self)
+        mode_shapes = ModeShapesPublisher.declare(self)
         #: warnings about params files that set nothing for this node (also logged)
         self.params_file_warnings = warn_unused_params_files(self, kwargs.get('cli_args'))
         try:
@@ -236,6 +238,8 @@ class EstimatorNode(Node):
         self._outputs = Outputs(self)
         self._outputs.set_modes(self._stream.config.modes)
         self._outputs.set_channels(self._channels, self._stream.config.modes)
+        #: with a geometry_file: vibration/mode_shapes, the modes' shapes for RViz
+        self._mode_shapes = ModeShapesPublisher.create(self, mode_shapes, self._channels)
         # before the subscription: a node whose input is matched answers its services; a deep
         # request history, so that a burst of calls queues instead of being dropped
         service_qos = QoSProfile(depth=SERVICE_DEPTH, reliability=ReliabilityPolicy.RELIABLE)
@@ -313,6 +317,8 @@ class EstimatorNode(Node):
         self._stream.configure(config_of(self), self._channels)
         self._outputs.set_modes(self._stream.config.modes)
         self._outputs.set_channels(self._channels, self._stream.config.modes)
+        if self._mode_shapes is not None:
+            self._mode_shapes.set_channels(self._channels)
         self._ready = self._stream.ready
         if not self._ready:
             self._warmup_logged = False
@@ -383,6 +389,8 @@ class EstimatorNode(Node):
             self._outputs.publish(estimate, header)
             if joint:
                 self._outputs.publish_shape(item)
+            if self._mode_shapes is not None:
+                self._mode_shapes.update(estimate, item.shape if joint else None)
             self._stream.published(estimate, time.monotonic())
 
     # ---- warm-up (the kernels compile in a thread; see .stream) -------------------------------
