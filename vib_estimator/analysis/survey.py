@@ -56,13 +56,14 @@ from typing import Dict, Iterable, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from ..core import COUNTER_NAMES, EstimatorConfig
+from ..core import COUNTER_NAMES, EstimatorConfig, health_model
 from ..core.choice import decide
 from ..core.multichannel import mac
 from ..errors import VibEstimatorError, report
 from ..io.csv_reader import column_names
 from ..io.fields import DEFAULT_COMPONENT, check_component
 from ..io.streaming import BagInfo, bag_info, is_csv, open_signal, supported_topics
+from . import health
 from .analyze import Run, add_config_arguments, estimate_signal, make_config
 from .channels import channel_list, joint_run, mode_shapes, need_joint, read_channels
 from .choosing import decided_config, decides, read_ahead, window_given
@@ -140,6 +141,8 @@ class Options:
     #: ``keep_window``) is decided from it (:mod:`.choosing`)
     decide: bool = False
     keep_window: bool = False
+    #: ``--covariates``: each recording's mean of these (:mod:`..io.covariates`) in its rows
+    covariates: Tuple[str, ...] = ()
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -196,7 +199,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help='write DIR/index.html: the trend with the baseline and the alarm band, one row per '
         'recording (docs/report.md)',
     )
-    parser.add_argument('--baseline', help='a recording, or a frequency in Hz, to compare against')
+    parser.add_argument(
+        '--baseline',
+        help='a recording, or a frequency in Hz, to compare against; or a saved learned '
+        'baseline (FILE.yaml, --save-baseline)',
+    )
     parser.add_argument(
         '--alarm-rel',
         type=float,
@@ -206,6 +213,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         '--fail-on-alarm', action='store_true', help='exit 3 if any row is flagged'
     )
+    health.add_arguments(parser)
     parser.add_argument(
         '--strict',
         action='store_true',
@@ -504,7 +512,10 @@ def streaming_malloc():
 def survey_recording(path: Path, options: Options) -> List[Dict]:
     """The rows of one recording; any failure is one row with ``error`` set (never raises)."""
     with streaming_malloc():
-        return _recording_rows(path, options)
+        rows = _recording_rows(path, options)
+    if options.covariates:
+        health.add_covariates(path, rows, options.covariates)
+    return rows
 
 
 def _recording_rows(path: Path, options: Options) -> List[Dict]:
@@ -930,6 +941,7 @@ def _options(args: argparse.Namespace) -> Options:
             column, columns = items[0], None  # one column: exactly --column
         else:
             need_joint(f'--columns {columns}', config)
+    covariates, _ = health.check_arguments(args)
     components, joint = tuple(args.component), ()
     if args.components is not None:
         if components:
@@ -950,13 +962,15 @@ def _options(args: argparse.Namespace) -> Options:
         joint,
         decides(args),
         window_given(args),
+        covariates,
     )
 
 
 def run(args: argparse.Namespace) -> int:
     try:
         options = _options(args)
-        base = baseline_rows(args.baseline, options) if args.baseline else None
+        learned = health.check_arguments(args)[1]
+        base = baseline_rows(args.baseline, options) if args.baseline and not learned else None
     except (ValueError, VibEstimatorError) as err:
         return report(err, 'vib-estimator survey')
     ignored: List[Path] = []
@@ -964,10 +978,28 @@ def run(args: argparse.Namespace) -> int:
     report_entries(rows, ignored, sys.stderr)
     if base is not None:
         flag(rows, base, args.alarm_rel)
+    if args.baseline_records is not None or args.baseline_until is not None:
+        try:
+            learned = health.learn_rows(
+                rows,
+                options.covariates,
+                args.baseline_records,
+                args.baseline_until,
+                row_shape,
+                args.false_alarm,
+            )
+        except ValueError as err:
+            return report(err, 'vib-estimator survey')
+    if learned is not None:
+        health.flag_learned(rows, learned, row_shape, args.false_alarm, args.cusum)
+        if args.save_baseline:
+            health_model.save(learned, Path(args.save_baseline))
     write_rows(rows, args.format, sys.stdout)
     if args.out:
         write_file(rows, Path(args.out))
-    if args.plot:
+    if args.plot and learned is not None:
+        health.plot_health(rows, Path(args.plot), learned)
+    elif args.plot:
         plot_trend(rows, Path(args.plot), base, args.alarm_rel)
     if getattr(args, 'report', None):
         write_survey_page(args, rows, base)

@@ -1,0 +1,464 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
+"""A learned health baseline (pure numpy/scipy, no rclpy): what a structure's modes normally do
+as the weather changes, and when they do something else.
+
+Per mode, a linear regression of the frequency on the covariates (temperature, load, ...), fitted
+by ordinary least squares with an intercept over a training period of ``n`` recordings::
+
+    f = b0 + b . (x - x_mean) + e,     e ~ N(0, s^2)
+
+``s`` is the residual standard deviation (``n - p - 1`` degrees of freedom, ``p`` covariates).
+A new recording with covariates ``x0`` is predicted ``f_hat = b0 + b . (x0 - x_mean)`` and its
+prediction error ``r = f - f_hat`` has the standard deviation ``se = s sqrt(1 + h)``,
+``h = u' (U'U)^-1 u`` (``u = [1, x0 - x_mean]``: the leverage, the parameters' own uncertainty,
+growing as ``x0`` leaves the training range). For Gaussian errors ``z = r / se`` follows Student's
+t with ``n - p - 1`` degrees of freedom exactly, so the alarm ``|z| > t_(1 - P/2)`` has the false
+alarm probability ``P`` per recording per mode (:data:`DEFAULT_FALSE_ALARM`). The compensated
+change is ``f / f_hat - 1`` and its 95 % interval ``(r -+ t_0.975 se) / f_hat``.
+
+Optionally a sequential test accumulates small persistent shifts: the two-sided CUSUM of the
+standardised residuals, ``S+ = max(0, S+ + z - k)``, ``S- = max(0, S- - z - k)``, alarm when either
+exceeds ``h`` (reference value :data:`CUSUM_K` = 0.5, i.e. tuned to a shift of one ``se``;
+threshold :data:`CUSUM_H` = 5). Its in-control average run length (Siegmund's approximation,
+:func:`cusum_arl`) is ~930 recordings per side, ~465 for the two-sided test: one false alarm in
+~465 recordings of an undamaged mode; a shift of 1 ``se`` is found after ~10 recordings, of 2
+after ~4.
+
+Modes are matched across recordings by frequency (relative distance below :data:`MATCH_REL` of
+the frequency the baseline predicts) and, with several channels, by the MAC of the shapes (at
+least :data:`MATCH_MAC`). The baseline is saved as plain YAML (:func:`save`, :data:`VERSION`).
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Dict, List, Optional, Sequence, Tuple
+
+import numpy as np
+
+from .multichannel import mac
+
+#: version of the saved baseline's layout (``version:`` in the YAML file)
+VERSION = 1
+#: false-alarm probability of the per-recording test, per recording per mode
+DEFAULT_FALSE_ALARM = 0.001
+#: confidence of the compensated change's interval
+CHANGE_CONFIDENCE = 0.95
+#: CUSUM reference value (allowance), in prediction standard deviations
+CUSUM_K = 0.5
+#: CUSUM decision threshold, in prediction standard deviations
+CUSUM_H = 5.0
+#: a recording's mode is a baseline mode when its frequency is within this relative distance of
+#: the frequency the baseline predicts (and training rows within it of each other form a mode)
+MATCH_REL = 0.05
+#: ... and, with shapes on both sides, their MAC is at least this
+MATCH_MAC = 0.8
+#: a training cluster is a mode when at least this share of the training recordings has it
+MODE_PRESENCE = 0.5
+
+
+@functools.lru_cache(maxsize=256)
+def student_quantile(q: float, dof: int) -> float:
+    """Student's t quantile ``q`` at ``dof`` degrees of freedom (cached: asked per estimate)."""
+    from scipy.stats import t as student
+
+    return float(student.ppf(q, dof))
+
+
+def cusum_arl(shift: float = 0.0, k: float = CUSUM_K, h: float = CUSUM_H) -> float:
+    """Average run length of a one-sided CUSUM of unit-variance normal data with mean ``shift``
+    (Siegmund's approximation, ``h + 1.166``): ~930 in control with the defaults."""
+    d = shift - k
+    b = h + 1.166
+    if abs(d) < 1e-9:
+        return b * b
+    return (math.exp(-2 * d * b) + 2 * d * b - 1) / (2 * d * d)
+
+
+@dataclass
+class ModeBaseline:
+    """One mode's learned normal behaviour (see the module doc); fields as saved."""
+
+    topic: str
+    component: str
+    #: 1, 2, ... by ascending frequency within (topic, component)
+    mode: int
+    #: the mode's mean training frequency, Hz
+    frequency_hz: float
+    #: regression coefficients ``[b0, b_1 ... b_p]`` (Hz; Hz per covariate unit)
+    coef: List[float]
+    #: covariate means of the training period (the regression's centre)
+    x_mean: List[float]
+    #: ``(U'U)^-1`` of the centred design (p+1 x p+1)
+    xtx_inv: List[List[float]]
+    #: residual standard deviation, Hz, and its degrees of freedom (n - p - 1)
+    residual_std_hz: float
+    dof: int
+    #: training recordings
+    n: int
+    #: each covariate's training range [min, max]
+    x_range: List[List[float]] = field(default_factory=list)
+    #: the mean training shape (several channels), else empty
+    shape: List[float] = field(default_factory=list)
+
+    def predict(self, x: Sequence[float]) -> Tuple[float, float]:
+        """``(f_hat, se)``: the predicted frequency at covariates ``x`` and the standard deviation
+        of a new recording's prediction error (parameter uncertainty included)."""
+        u = np.concatenate(([1.0], np.asarray(x, dtype=float) - np.asarray(self.x_mean)))
+        f_hat = float(np.dot(self.coef, u))
+        h = float(u @ np.asarray(self.xtx_inv) @ u)
+        return f_hat, self.residual_std_hz * math.sqrt(1.0 + h)
+
+    def extrapolated(self, x: Sequence[float]) -> bool:
+        """Whether a covariate lies outside its training range."""
+        return any(not lo <= v <= hi for v, (lo, hi) in zip(x, self.x_range))
+
+    def to_dict(self) -> Dict:
+        return {
+            'topic': self.topic,
+            'component': self.component,
+            'mode': self.mode,
+            'frequency_hz': float(self.frequency_hz),
+            'coef': [float(c) for c in self.coef],
+            'x_mean': [float(c) for c in self.x_mean],
+            'xtx_inv': [[float(c) for c in row] for row in self.xtx_inv],
+            'residual_std_hz': float(self.residual_std_hz),
+            'dof': int(self.dof),
+            'n': int(self.n),
+            'x_range': [[float(a), float(b)] for a, b in self.x_range],
+            'shape': [float(c) for c in self.shape],
+        }
+
+
+@dataclass
+class Change:
+    """A recording's mode against its baseline."""
+
+    predicted_hz: float
+    change_rel: float
+    change_lo: float
+    change_hi: float
+    #: standardised residual r / se
+    z: float
+    #: the relative change beyond which the recording alarms, at the false-alarm probability
+    limit_rel: float
+    alarm: bool
+    extrapolated: bool
+
+
+@dataclass
+class Baseline:
+    """Every mode's :class:`ModeBaseline`, the covariates' names, the false-alarm probability."""
+
+    covariates: List[str]
+    modes: List[ModeBaseline]
+    false_alarm: float = DEFAULT_FALSE_ALARM
+    #: what the baseline was learned from (free text: recordings, dates)
+    trained_on: str = ''
+
+    def threshold(self, mode: ModeBaseline, false_alarm: Optional[float] = None) -> float:
+        """``t_(1 - P/2)`` at the mode's degrees of freedom."""
+        p = self.false_alarm if false_alarm is None else false_alarm
+        return student_quantile(1 - p / 2, mode.dof)
+
+    def change(
+        self,
+        mode: ModeBaseline,
+        frequency_hz: float,
+        x: Sequence[float],
+        false_alarm: Optional[float] = None,
+    ) -> Change:
+        """The compensated change of ``frequency_hz`` at covariates ``x`` (module doc)."""
+        f_hat, se = mode.predict(x)
+        r = frequency_hz - f_hat
+        q95 = student_quantile(0.5 + CHANGE_CONFIDENCE / 2, mode.dof)
+        q = self.threshold(mode, false_alarm)
+        z = r / se if se > 0 else math.copysign(math.inf, r) if r else 0.0
+        return Change(
+            f_hat,
+            r / f_hat,
+            (r - q95 * se) / f_hat,
+            (r + q95 * se) / f_hat,
+            z,
+            q * se / f_hat,
+            bool(abs(z) > q),
+            mode.extrapolated(x),
+        )
+
+    def match(
+        self,
+        topic: str,
+        component: str,
+        frequency_hz: float,
+        x: Sequence[float],
+        shape: Optional[np.ndarray] = None,
+    ) -> Optional[ModeBaseline]:
+        """The baseline mode of (topic, component) nearest ``frequency_hz`` (relative to its
+        prediction at ``x``) within :data:`MATCH_REL`, with a MAC of at least :data:`MATCH_MAC`
+        where both have shapes; None if none."""
+        best, best_d = None, MATCH_REL
+        for m in self.modes:
+            if (m.topic, m.component) != (topic, component):
+                continue
+            if (
+                shape is not None
+                and len(m.shape) == len(shape)
+                and mac(shape, m.shape) < MATCH_MAC
+            ):
+                continue
+            d = abs(math.log(frequency_hz / m.predict(x)[0]))
+            if d < best_d:
+                best, best_d = m, d
+        return best
+
+    def to_dict(self) -> Dict:
+        return {
+            'version': VERSION,
+            'kind': 'vib_estimator health baseline',
+            'covariates': list(self.covariates),
+            'false_alarm': float(self.false_alarm),
+            'trained_on': self.trained_on,
+            'modes': [m.to_dict() for m in self.modes],
+        }
+
+
+def fit_mode(
+    topic: str,
+    component: str,
+    mode: int,
+    frequency_hz: Sequence[float],
+    x: np.ndarray,
+    shape: Sequence[float] = (),
+) -> ModeBaseline:
+    """Ordinary least squares of ``frequency_hz`` (n) on ``x`` (n x p) with an intercept;
+    ValueError if fewer than p + 3 recordings (two residual degrees of freedom) or a covariate
+    that does not vary."""
+    f = np.asarray(frequency_hz, dtype=float)
+    x = np.asarray(x, dtype=float).reshape(len(f), -1)
+    n, p = x.shape
+    if n < p + 3:
+        raise ValueError(
+            f'mode {mode} of {topic or "the recordings"} {component}: {n} training recording(s), '
+            f'need at least {p + 3} to learn a baseline of {p} covariate(s)'
+        )
+    x_mean = x.mean(axis=0)
+    u = np.column_stack([np.ones(n), x - x_mean])
+    if np.linalg.matrix_rank(u) < p + 1:
+        raise ValueError(
+            f'mode {mode} of {topic or "the recordings"} {component}: a covariate does not vary '
+            'over the training recordings (or two move together); a baseline cannot separate them'
+        )
+    xtx_inv = np.linalg.inv(u.T @ u)
+    coef = xtx_inv @ u.T @ f
+    resid = f - u @ coef
+    dof = n - p - 1
+    s = math.sqrt(float(resid @ resid) / dof)
+    return ModeBaseline(
+        topic,
+        component,
+        mode,
+        float(f.mean()),
+        coef.tolist(),
+        x_mean.tolist(),
+        xtx_inv.tolist(),
+        s,
+        dof,
+        n,
+        [[float(a), float(b)] for a, b in zip(x.min(axis=0), x.max(axis=0))],
+        [float(v) for v in shape],
+    )
+
+
+def group_modes(frequencies: Sequence[float], recordings: Sequence[int]) -> List[List[int]]:
+    """Indices of training rows grouped into modes: sorted by frequency and split where the gap
+    between neighbours exceeds :data:`MATCH_REL` (relative); a group is kept when at least
+    :data:`MODE_PRESENCE` of the recordings have a row in it, one row per recording (the nearest
+    the group's median). Groups in ascending frequency."""
+    f = np.asarray(frequencies, dtype=float)
+    rec = np.asarray(recordings)
+    order = np.argsort(f)
+    groups, current = [], [int(order[0])] if len(order) else []
+    for a, b in zip(order[:-1], order[1:]):
+        if math.log(f[b] / f[a]) > MATCH_REL:
+            groups.append(current)
+            current = []
+        current.append(int(b))
+    if current:
+        groups.append(current)
+    total = len(set(rec.tolist()))
+    kept = []
+    for g in groups:
+        median = float(np.median(f[g]))
+        best: Dict[int, int] = {}
+        for i in g:
+            r = int(rec[i])
+            if r not in best or abs(f[i] - median) < abs(f[best[r]] - median):
+                best[r] = i
+        if len(best) >= MODE_PRESENCE * total:
+            kept.append(sorted(best.values()))
+    return kept
+
+
+def learn(
+    rows: Sequence[Dict],
+    covariates: Sequence[str],
+    x_of,
+    shape_of=lambda row: None,
+    false_alarm: float = DEFAULT_FALSE_ALARM,
+    trained_on: str = '',
+) -> Baseline:
+    """A :class:`Baseline` from training rows (dicts with ``recording``, ``topic``,
+    ``component``, ``frequency_hz``): per (topic, component), the rows grouped into modes
+    (:func:`group_modes`), each mode fitted (:func:`fit_mode`) on ``x_of(row)`` (the row's
+    covariate values); ``shape_of(row)``: its mode shape or None. ValueError if no mode."""
+    usable = [
+        r
+        for r in rows
+        if np.isfinite(r['frequency_hz'])
+        and r['frequency_hz'] > 0
+        and np.all(np.isfinite(x_of(r)))
+    ]
+    modes: List[ModeBaseline] = []
+    for topic, component in sorted({(r['topic'], r['component']) for r in usable}):
+        mine = [r for r in usable if (r['topic'], r['component']) == (topic, component)]
+        names = sorted({r['recording'] for r in mine})
+        groups = group_modes(
+            [r['frequency_hz'] for r in mine], [names.index(r['recording']) for r in mine]
+        )
+        for k, g in enumerate(groups, 1):
+            shapes = [shape_of(mine[i]) for i in g]
+            shape = _mean_shape([s for s in shapes if s is not None])
+            modes.append(
+                fit_mode(
+                    topic,
+                    component,
+                    k,
+                    [mine[i]['frequency_hz'] for i in g],
+                    np.array([x_of(mine[i]) for i in g], dtype=float).reshape(len(g), -1),
+                    shape,
+                )
+            )
+    if not modes:
+        raise ValueError(
+            'no mode to learn a baseline from: no training recording gave a frequency (and every '
+            'covariate)'
+        )
+    return Baseline(list(covariates), modes, false_alarm, trained_on)
+
+
+def _mean_shape(shapes: List[np.ndarray]) -> List[float]:
+    """The mean of unit shapes, each signed as the first (shapes' sign is arbitrary)."""
+    if not shapes:
+        return []
+    ref = np.asarray(shapes[0], dtype=float)
+    acc = np.zeros_like(ref)
+    for s in shapes:
+        s = np.asarray(s, dtype=float)
+        s = s / (np.linalg.norm(s) or 1.0)
+        acc += s if np.dot(s, ref) >= 0 else -s
+    return (acc / (np.linalg.norm(acc) or 1.0)).tolist()
+
+
+class Cusum:
+    """Two-sided CUSUM of standardised residuals (module doc): :meth:`update` with each ``z``."""
+
+    def __init__(self, k: float = CUSUM_K, h: float = CUSUM_H) -> None:
+        self.k, self.h = k, h
+        self.high = self.low = 0.0
+        #: index of the update after which each side was last zero (the change-point estimate)
+        self.high_start = self.low_start = 0
+        self.count = 0
+
+    def update(self, z: float) -> bool:
+        """Add one standardised residual; True while either side is above ``h``."""
+        if not math.isfinite(z):
+            return self.alarm
+        self.count += 1
+        self.high = max(0.0, self.high + z - self.k)
+        self.low = max(0.0, self.low - z - self.k)
+        if self.high == 0.0:
+            self.high_start = self.count
+        if self.low == 0.0:
+            self.low_start = self.count
+        return self.alarm
+
+    @property
+    def alarm(self) -> bool:
+        return self.high > self.h or self.low > self.h
+
+    @property
+    def value(self) -> float:
+        """The larger side, signed (negative: the frequency fell)."""
+        return self.high if self.high >= self.low else -self.low
+
+    @property
+    def start(self) -> int:
+        """0-based index of the first update of the alarmed side's current excursion."""
+        return self.high_start if self.high >= self.low else self.low_start
+
+
+# ------------------------------------------------------------------------------ the YAML file
+
+
+def from_dict(data: Dict) -> Baseline:
+    """A :class:`Baseline` from its :meth:`Baseline.to_dict` (ValueError naming what is wrong)."""
+    if not isinstance(data, dict) or 'version' not in data:
+        raise ValueError('not a health baseline (no version:)')
+    if data['version'] != VERSION:
+        raise ValueError(
+            f'health baseline version {data["version"]}, this program reads {VERSION}'
+        )
+    try:
+        modes = [ModeBaseline(**m) for m in data['modes']]
+        baseline = Baseline(
+            [str(c) for c in data['covariates']],
+            modes,
+            float(data.get('false_alarm', DEFAULT_FALSE_ALARM)),
+            str(data.get('trained_on', '')),
+        )
+    except (KeyError, TypeError) as err:
+        raise ValueError(f'health baseline: bad or missing field ({err})') from None
+    p = len(baseline.covariates)
+    for m in modes:
+        if len(m.coef) != p + 1 or len(m.x_mean) != p or np.shape(m.xtx_inv) != (p + 1, p + 1):
+            raise ValueError(f'health baseline: mode {m.mode} does not have {p} covariate(s)')
+        if not (m.residual_std_hz >= 0 and m.dof >= 1):
+            raise ValueError(f'health baseline: mode {m.mode} has no residual spread')
+    if not 0 < baseline.false_alarm < 1:
+        raise ValueError(
+            f'health baseline: false_alarm must be in (0, 1), got {baseline.false_alarm}'
+        )
+    return baseline
+
+
+def save(baseline: Baseline, path) -> None:
+    """Write ``baseline`` as plain YAML (``version: 1``; fields: docs/health.md)."""
+    import yaml
+
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(yaml.safe_dump(baseline.to_dict(), sort_keys=False))
+
+
+def load(path) -> Baseline:
+    """Read a baseline written by :func:`save` (ValueError if it is not one)."""
+    import yaml
+
+    try:
+        data = yaml.safe_load(Path(path).read_text())
+    except (OSError, yaml.YAMLError) as err:
+        raise ValueError(f'cannot read health baseline {path}: {err}') from None
+    try:
+        return from_dict(data)
+    except ValueError as err:
+        raise ValueError(f'{path}: {err}') from None
+
+
+def is_baseline_file(path) -> bool:
+    """Whether ``path`` is a file named ``*.yaml``/``*.yml`` (a saved baseline, not a bag)."""
+    path = Path(path)
+    return path.is_file() and path.suffix.lower() in ('.yaml', '.yml')
