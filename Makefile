@@ -4,7 +4,7 @@ VENV    := .venv
 STAMP   := $(VENV)/.installed
 export ROS_AUTOMATIC_DISCOVERY_RANGE := LOCALHOST
 
-.PHONY: setup demo shaping test bench bench-all reproduce compare bags survey survey-ambient clean
+.PHONY: setup demo shaping test bench bench-all reproduce compare bags survey survey-ambient survey-temperature clean
 
 setup: $(STAMP)
 
@@ -68,6 +68,15 @@ survey-ambient: setup
 	$(VENV)/bin/vib-estimator survey out/fleet_ambient --excitation ambient \
 		--baseline out/fleet_ambient/day_00 --alarm-rel 0.0025 \
 		--out out/fleet_ambient_survey.csv --plot out/fleet_ambient_trend.png
+
+# 160 ambient days of a two-mode structure whose frequencies follow the temperature (-0.2 %/degC,
+# +-10 degC), stiffness 1 % lower from day 130; baseline learned from the first 80 (docs/health.md)
+survey-temperature: setup
+	$(VENV)/bin/python scripts/make_fleet.py --temperature --out out/fleet_temperature
+	$(VENV)/bin/vib-estimator survey out/fleet_temperature --topic /accel --excitation ambient \
+		--covariates /temperature:temperature --baseline-records 80 \
+		--save-baseline out/fleet_temperature_baseline.yaml \
+		--out out/fleet_temperature_survey.jsonl --plot out/fleet_temperature_health.png
 
 clean:
 	rm -rf $(VENV) build install log out *.egg-info

@@ -122,10 +122,14 @@ def test_match_by_frequency_pinned_from_both_sides():
     base = hm.learn(_rows(np.random.default_rng(5)), ['x'], lambda r: [r['x']])
     # a 1 % damage is still mode 1 (MATCH_REL at 0.001x would lose it)
     assert base.match('/accel', 'z', 8.0 * 0.99, [0.0]).mode == 1
-    # 13 Hz is no mode (MATCH_REL at 1000x would call it mode 1 or 2)
+    # 13 Hz is no mode (MATCH_REL or MATCH_FAR at 1000x would call it mode 1 or 2)
     assert base.match('/accel', 'z', 13.0, [0.0]) is None
     assert base.match('/other', 'z', 8.0, [0.0]) is None
-    assert hm.MATCH_REL == 0.05
+    # a 15 % change is still its mode (MATCH_FAR at 0.001x would lose it); 25 %: too far
+    assert base.match('/accel', 'z', 8.0 * 0.85, [0.0]).mode == 1
+    assert base.match('/accel', 'z', 21.0 * 1.15, [0.0]).mode == 2
+    assert base.match('/accel', 'z', 21.0 * 1.25, [0.0]) is None
+    assert (hm.MATCH_REL, hm.MATCH_FAR) == (0.05, 0.2)
 
 
 def test_match_by_shape():

@@ -55,6 +55,9 @@ CUSUM_H = 5.0
 #: a recording's mode is a baseline mode when its frequency is within this relative distance of
 #: the frequency the baseline predicts (and training rows within it of each other form a mode)
 MATCH_REL = 0.05
+#: farther than MATCH_REL, a recording's mode is still its nearest baseline mode if it is within
+#: half the distance to the next baseline mode and this relative distance
+MATCH_FAR = 0.2
 #: ... and, with shapes on both sides, their MAC is at least this
 MATCH_MAC = 0.8
 #: a training cluster is a mode when at least this share of the training recordings has it
@@ -191,18 +194,21 @@ class Baseline:
 
     def match(
         self,
-        topic: str,
-        component: str,
+        topic: Optional[str],
+        component: Optional[str],
         frequency_hz: float,
         x: Sequence[float],
         shape: Optional[np.ndarray] = None,
     ) -> Optional[ModeBaseline]:
         """The baseline mode of (topic, component) nearest ``frequency_hz`` (relative to its
-        prediction at ``x``) within :data:`MATCH_REL`, with a MAC of at least :data:`MATCH_MAC`
-        where both have shapes; None if none."""
-        best, best_d = None, MATCH_REL
+        prediction at ``x``): within :data:`MATCH_REL`, or farther (a large change must not go
+        unmatched) up to half the distance to the next baseline mode's prediction and at most
+        :data:`MATCH_FAR`; with a MAC of at least :data:`MATCH_MAC` where both have shapes; None
+        if none. ``topic`` None: any mode (the node's topic may be named otherwise than the bags
+        the baseline was learned from)."""
+        near = []
         for m in self.modes:
-            if (m.topic, m.component) != (topic, component):
+            if topic is not None and (m.topic, m.component) != (topic, component):
                 continue
             if (
                 shape is not None
@@ -210,10 +216,16 @@ class Baseline:
                 and mac(shape, m.shape) < MATCH_MAC
             ):
                 continue
-            d = abs(math.log(frequency_hz / m.predict(x)[0]))
-            if d < best_d:
-                best, best_d = m, d
-        return best
+            near.append((abs(math.log(frequency_hz / m.predict(x)[0])), m))
+        if not near:
+            return None
+        near.sort(key=lambda item: item[0])
+        d, best = near[0]
+        if d < MATCH_REL:
+            return best
+        f_best = best.predict(x)[0]
+        gaps = [abs(math.log(m.predict(x)[0] / f_best)) for _, m in near[1:]]
+        return best if d < min([MATCH_FAR] + [g / 2 for g in gaps]) else None
 
     def to_dict(self) -> Dict:
         return {
@@ -399,6 +411,170 @@ class Cusum:
     def start(self) -> int:
         """0-based index of the first update of the alarmed side's current excursion."""
         return self.high_start if self.high >= self.low else self.low_start
+
+
+# ------------------------------------------------------------------------------ live (the node)
+
+
+@dataclass
+class WindowResult:
+    """A closed window's verdict for one baseline mode."""
+
+    mode: int
+    frequency_hz: float
+    change: Change
+    alarm: bool
+    #: stream time (s) of the start of the window the current alarm began in (NaN: no alarm)
+    since: float
+
+
+class LiveHealth:
+    """The node's side of a baseline (no rclpy). Estimates are summarised over windows of stream
+    time ``[k window_s, (k + 1) window_s)``, each standing for one recording of the training
+    (``window_s``: the recordings' length); the covariates are averaged over the same window
+    (by their stamps). At each window's end every matched baseline mode gets the change and
+    alarm :meth:`Baseline.change` gives ``survey`` (optionally the CUSUM), and since when. While
+    learning, closed windows are kept and :meth:`learned` fits a new baseline from them.
+    ``summarise(values, stds, t, spans)``: a window's frequency (default: the mean)."""
+
+    def __init__(
+        self,
+        baseline: Optional[Baseline],
+        covariates: Sequence[str],
+        window_s: float,
+        cusum: bool = False,
+        summarise=None,
+    ) -> None:
+        self.baseline = baseline
+        self.covariates = list(covariates)
+        self.window_s = window_s
+        self.cusum = cusum
+        self.summarise = summarise or (lambda f, s, t, span: float(np.mean(f)))
+        self.learning = False
+        self.windows: List[Dict] = []  # closed windows kept while learning
+        self._cusums: Dict[int, Cusum] = {}
+        self._since: Dict[int, float] = {}
+        self.last: List[WindowResult] = []
+        self._start: Optional[float] = None
+        self._new_window(None)
+
+    def _new_window(self, start: Optional[float]) -> None:
+        self._start = start
+        self._est: Dict[int, List[Tuple[float, float, float, float]]] = {}
+        ahead = getattr(self, '_ahead', {})
+        self._cov = ahead.pop(start, None) or [[0.0, 0] for _ in self.covariates]
+        #: covariate samples stamped in later windows, by window start
+        self._ahead = {k: v for k, v in ahead.items() if start is None or k > start}
+
+    def covariate(self, index: int, value: float, t: Optional[float] = None) -> None:
+        """A covariate sample, averaged over the window of its stream time ``t`` (None: the
+        current window): one stamped after the current window waits for its own."""
+        if not math.isfinite(value):
+            return
+        acc = self._cov
+        if t is not None and self._start is not None:
+            start = math.floor(t / self.window_s) * self.window_s
+            if start > self._start:
+                acc = self._ahead.setdefault(start, [[0.0, 0] for _ in self.covariates])
+        acc[index][0] += value
+        acc[index][1] += 1
+
+    def x(self) -> List[float]:
+        """The current window's covariate means (NaN for one not yet received)."""
+        return [a / n if n else math.nan for a, n in self._cov]
+
+    def estimate(
+        self, t: float, mode: int, frequency_hz: float, std: float = math.nan, span: float = 0.0
+    ) -> Optional[List[WindowResult]]:
+        """Add a mode's estimate at stream time ``t``; at a window's end (this estimate opens
+        the next one) the closed window's results, else None."""
+        closed = None
+        start = math.floor(t / self.window_s) * self.window_s  # windows on the stream's grid
+        if self._start is None:
+            self._start = start
+        elif start > self._start:
+            closed = self.close()
+            self._new_window(start)
+        self._est.setdefault(mode, []).append((frequency_hz, std, t, span))
+        return closed
+
+    def running_change(self, mode: int) -> Optional[Tuple[int, float]]:
+        """``(baseline mode, change)`` of the current window's estimates of ``mode`` so far."""
+        window = self._summary()
+        if self.baseline is None or mode not in window:
+            return None
+        x = self.x()
+        if not all(math.isfinite(v) for v in x):
+            return None
+        m = self.baseline.match(None, None, window[mode], x)
+        if m is None:
+            return None
+        return m.mode, self.baseline.change(m, window[mode], x).change_rel
+
+    def _summary(self) -> Dict[int, float]:
+        out = {}
+        for mode, items in self._est.items():
+            f, s, t, span = (np.array(v, dtype=float) for v in zip(*items))
+            out[mode] = self.summarise(f, s, t, span)
+        return out
+
+    def close(self, restart: bool = False) -> List[WindowResult]:
+        """Close the current window: its results (and, learning, keep it); ``restart``: the next
+        estimate opens a new one."""
+        window, x = self._summary(), self.x()
+        if restart:
+            self._new_window(None)
+        if self.learning and window and all(math.isfinite(v) for v in x):
+            self.windows.extend(
+                {
+                    'recording': f'window {len(self.windows)}',
+                    'topic': '',
+                    'component': '',
+                    'frequency_hz': f,
+                    'x': x,
+                }
+                for f in window.values()
+            )
+        results: List[WindowResult] = []
+        if self.baseline is None or not all(math.isfinite(v) for v in x):
+            self.last = results
+            return results
+        chosen: Dict[int, Tuple[float, ModeBaseline, float]] = {}
+        for f in window.values():
+            m = self.baseline.match(None, None, f, x)
+            if m is None:
+                continue
+            d = abs(math.log(f / m.predict(x)[0]))
+            if m.mode not in chosen or d < chosen[m.mode][0]:
+                chosen[m.mode] = (d, m, f)
+        for k, (_, m, f) in sorted(chosen.items()):
+            change = self.baseline.change(m, f, x)
+            alarm = change.alarm
+            if self.cusum:
+                c = self._cusums.setdefault(k, Cusum())
+                alarm = c.update(change.z) or alarm
+            if alarm:
+                self._since.setdefault(k, self._start)
+            else:
+                self._since.pop(k, None)
+            results.append(WindowResult(k, f, change, alarm, self._since.get(k, math.nan)))
+        self.last = results
+        return results
+
+    def start_learning(self) -> None:
+        self.learning, self.windows = True, []
+
+    def learned(self, false_alarm: float = DEFAULT_FALSE_ALARM) -> Baseline:
+        """Stop learning; the baseline of the kept windows (ValueError if too few)."""
+        self.learning = False
+        rows = [dict(r, recording=r['recording']) for r in self.windows]
+        return learn(
+            rows,
+            self.covariates,
+            lambda r: r['x'],
+            false_alarm=false_alarm,
+            trained_on=f'{len({r["recording"] for r in rows})} windows on line',
+        )
 
 
 # ------------------------------------------------------------------------------ the YAML file

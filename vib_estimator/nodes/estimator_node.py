@@ -70,6 +70,7 @@ from ..io.fields import (
 )
 from . import health as H
 from .mode_shapes import ModeShapesPublisher
+from .baseline_monitor import BaselineMonitor
 from .parameters import (
     config_of,
     config_value,
@@ -240,6 +241,8 @@ class EstimatorNode(Node):
         self._outputs.set_channels(self._channels, self._stream.config.modes)
         #: with a geometry_file: vibration/mode_shapes, the modes' shapes for RViz
         self._mode_shapes = ModeShapesPublisher.create(self, mode_shapes, self._channels)
+        #: health monitoring against a learned baseline (baseline_file; docs/health.md)
+        self.baseline_monitor = BaselineMonitor(self, lambda: self._stream.origin)
         # before the subscription: a node whose input is matched answers its services; a deep
         # request history, so that a burst of calls queues instead of being dropped
         service_qos = QoSProfile(depth=SERVICE_DEPTH, reliability=ReliabilityPolicy.RELIABLE)
@@ -391,6 +394,8 @@ class EstimatorNode(Node):
                 self._outputs.publish_shape(item)
             if self._mode_shapes is not None:
                 self._mode_shapes.update(estimate, item.shape if joint else None)
+            if self.baseline_monitor.active:
+                self.baseline_monitor.estimate(estimate)
             self._stream.published(estimate, time.monotonic())
 
     # ---- warm-up (the kernels compile in a thread; see .stream) -------------------------------
@@ -503,6 +508,8 @@ class EstimatorNode(Node):
                 self._align_tick,
             )
             self._align_tick = {name: counters[name] for name in H.ALIGN_PROBLEMS}
+        if self.baseline_monitor.active:
+            status = self.baseline_monitor.status(status)
         if status.log:
             self.get_logger().warn(status.log)
         array = DiagnosticArray(
