@@ -150,3 +150,42 @@ def test_a_missing_covariate_is_an_error_row(fleet, capsys):
     assert code == 0
     assert rows[0]['error'].startswith('covariate:') and 'humidity' in rows[0]['error']
     assert np.isfinite(rows[0]['frequency_hz'])
+
+
+def test_csv_covariate_columns(tmp_path, capsys):
+    """CSV recordings: the covariate is a column by name; Unix time gives the start."""
+    rng = np.random.default_rng(1)
+    t = np.arange(0, 6, 0.004)
+    for day in range(7):
+        celsius = rng.uniform(-10, 10)
+        f = 2.0 * (1 - 0.002 * celsius) * (0.99 if day == 6 else 1.0)
+        y = np.sin(2 * np.pi * f * t) + 0.003 * rng.standard_normal(len(t))
+        temp = celsius + 0.01 * rng.standard_normal(len(t))
+        np.savetxt(
+            tmp_path / f'day{day}.csv',
+            np.column_stack([EPOCH / 1e9 + day * 86400 + t, y, temp]),
+            delimiter=',',
+            header='t,accel,temperature',
+            comments='',
+        )
+    code = main(
+        [
+            'survey',
+            str(tmp_path),
+            '--column',
+            'accel',
+            '--covariates',
+            'temperature',
+            '--baseline-records',
+            '6',
+            '--format',
+            'jsonl',
+            '--jobs',
+            '1',
+        ]
+    )
+    rows = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    assert code == 0
+    assert [r['alarm'] for r in rows] == [False] * 6 + [True]
+    assert rows[-1]['start_utc'] == '2026-01-07T00:00:00Z' == rows[-1]['alarm_since']
+    assert all(np.isfinite(r['covariate_temperature']) for r in rows)
