@@ -135,6 +135,7 @@ def test_cusum_and_plot(fleet, capsys, tmp_path):
         (['--baseline-records', '5', '--false-alarm', '2'], 'must be in'),
         (['--covariates', ':x'], 'neither TOPIC:FIELD'),
         (['--baseline-until', 'soon', '--covariates', 'a'], 'ISO 8601'),
+        (['--baseline-records', '5'], 'only 1 recording(s)'),
     ],
 )
 def test_bad_arguments(fleet, capsys, args, message):

@@ -164,6 +164,10 @@ def training(rows: Sequence[Dict], records: Optional[int], until: Optional[str])
     starting up to ``until``), errors left out."""
     order = in_time_order([r for r in rows if not r['error']])
     if records is not None:
+        if records > len(order):
+            raise ValueError(
+                f'--baseline-records {records}: only {len(order)} recording(s) gave rows'
+            )
         chosen = set(order[:records])
     else:
         end = until_time(until)
