@@ -190,3 +190,46 @@ def test_csv_covariate_columns(tmp_path, capsys):
     assert [r['alarm'] for r in rows] == [False] * 6 + [True]
     assert rows[-1]['start_utc'] == '2026-01-07T00:00:00Z' == rows[-1]['alarm_since']
     assert all(np.isfinite(r['covariate_temperature']) for r in rows)
+
+
+def test_the_node_side_judges_a_recording_as_survey(fleet, capsys, tmp_path):
+    """A day's estimates and temperatures through LiveHealth (the node's core, the day one
+    window, summarised as the node does) give survey's compensated change and alarm."""
+    from vib_estimator.analysis.analyze import estimate_signal
+    from vib_estimator.analysis.survey import DEFAULT_MODEL
+    from vib_estimator.core import EstimatorConfig
+    from vib_estimator.io.covariates import covariate_means
+    from vib_estimator.io.streaming import open_signal
+    from vib_estimator.nodes.baseline_monitor import window_frequency
+
+    root, _ = fleet
+    saved = tmp_path / 'base.yaml'
+    code, rows, _ = _survey(
+        capsys,
+        root,
+        '--covariates',
+        '/temperature:temperature',
+        '--baseline-records',
+        10,
+        '--save-baseline',
+        saved,
+    )
+    assert code == 0
+    baseline = hm.load(saved)
+    config = EstimatorConfig(model=DEFAULT_MODEL)
+    for day in (3, DAMAGED + 1):
+        path = root / f'day_{day:02d}'
+        est = estimate_signal(open_signal(path, '/accel'), config).estimates
+        live = hm.LiveHealth(baseline, baseline.covariates, 1e6, summarise=window_frequency)
+        live.covariate(0, covariate_means(path, baseline.covariates)[0])
+        for k in range(len(est.t)):
+            live.estimate(
+                est.t[k],
+                1,
+                est.frequency_hz[k],
+                est.frequency_std_hz[k],
+                est.convergence_time[k],
+            )
+        (result,) = live.close()
+        assert result.change.change_rel == pytest.approx(rows[day]['change_rel'], abs=1e-12)
+        assert result.alarm == rows[day]['alarm'] == (day >= DAMAGED)
