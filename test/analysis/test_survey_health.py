@@ -108,7 +108,6 @@ def test_cusum_and_plot(fleet, capsys, tmp_path):
         '/temperature:temperature',
         '--baseline-until',
         '2026-01-10',
-        '--cusum',
         '--false-alarm',
         '0.01',
         '--plot',
@@ -116,7 +115,7 @@ def test_cusum_and_plot(fleet, capsys, tmp_path):
     )
     assert code == 0
     assert all('cusum' in r for r in rows)
-    assert rows[-1]['cusum'] < -hm.CUSUM_H and rows[-1]['alarm']
+    assert rows[-1]['cusum'] < -hm.cusum_threshold(0.01) and rows[-1]['alarm']
     assert png.is_file()
     baseline = hm.learn(
         [r for r in rows[:10]], ['/temperature:temperature'], lambda r: [r[COLUMN]]

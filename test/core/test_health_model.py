@@ -142,26 +142,59 @@ def test_match_by_shape():
     assert hm.MATCH_MAC == 0.8
 
 
-def test_cusum_in_control_run_length_and_detection():
-    """In control the two-sided CUSUM alarms about once in ARL/2 ~ 470 recordings; a shift of
-    one std is found within ~10."""
-    assert hm.cusum_arl() == pytest.approx(938, rel=0.01)
-    assert hm.cusum_arl(1.0) == pytest.approx(10.3, rel=0.05)
+def test_cusum_threshold_from_the_false_alarm_probability():
+    """h is set so that the two-sided in-control run length is 1/P: measured on 300 seeded runs
+    at P = 0.01 (~100 recordings); a shift of 2 std is found within ~4."""
+    h = hm.cusum_threshold(0.001)
+    assert h == pytest.approx(5.75, abs=0.01)
+    assert hm.cusum_arl(h) == pytest.approx(2000, rel=1e-6)
+    assert hm.cusum_arl(h, 2.0) == pytest.approx(4.4, rel=0.05)
     rng = np.random.default_rng(7)
+    h = hm.cusum_threshold(0.01)
     runs = []
-    for _ in range(200):
-        c, n = hm.Cusum(), 0
+    for _ in range(300):
+        c, n = hm.Cusum(h), 0
         while not c.update(float(rng.standard_normal())):
             n += 1
         runs.append(n + 1)
-    # the ARL of the two-sided test: ~470 (exponential-like run lengths, mean of 200: +-7 %)
-    assert 330 < np.mean(runs) < 650, np.mean(runs)
-    c = hm.Cusum()
+    # Siegmund's approximation is within ~10 % here; the mean of 300 runs within ~6 %
+    assert 75 < np.mean(runs) < 130, np.mean(runs)
+    c = hm.Cusum(hm.cusum_threshold(0.001))
     for n in range(1, 40):
-        if c.update(float(rng.standard_normal()) - 1.0):
+        if c.update(float(rng.standard_normal()) - 2.0):
             break
-    assert n <= 25 and c.value < 0
-    assert (hm.CUSUM_K, hm.CUSUM_H) == (0.5, 5.0)
+    assert n <= 10 and c.value < 0
+    assert hm.CUSUM_K == 0.5
+
+
+def _cusum_run(mode, truth, x, n, shared=True, seed=10):
+    """Recordings at covariate ``x`` of true frequency ``truth`` (noise 0.004 Hz): the first
+    one the CUSUM alarms on (None if none of ``n``)."""
+    rng = np.random.default_rng(seed)
+    base = hm.Baseline(['t'], [mode])
+    c = hm.Cusum(base.cusum_h())
+    for i in range(n):
+        change = base.change(mode, truth + 0.004 * rng.standard_normal(), [x])
+        if c.update(change.z, change.shared if shared else 0.0):
+            return i
+    return None
+
+
+def test_cusum_does_not_accumulate_the_regressions_own_error():
+    """An unlucky training (its slope 2 of its stds off) extrapolated to +10 degC: the prediction
+    errs by ~1.4 se on every later recording. The per-recording test allows for it; the CUSUM
+    must too (CUSUM_SHARED at 0.001x alarms within ~10 recordings), yet find a shift of 2 se
+    inside the training range (at 1000x it would never)."""
+    rng = np.random.default_rng(9)
+    x = np.linspace(-10, 0, 30)
+    tilt = 2 * 0.004 / np.sqrt(np.sum((x - x.mean()) ** 2))  # 2 stds of the slope
+    f = 8 - 0.016 * x + tilt * (x - x.mean()) + 0.004 * rng.standard_normal(30)
+    mode = hm.fit_mode('/a', 'z', 1, f, x)
+    assert _cusum_run(mode, 8 - 0.016 * 10, 10.0, 60) is None
+    assert _cusum_run(mode, 8 - 0.016 * 10, 10.0, 60, shared=False) is not None
+    inside = 8 - 0.016 * -5 - 2 * mode.predict([-5.0])[1]
+    assert _cusum_run(mode, inside, -5.0, 60) < 10
+    assert hm.CUSUM_SHARED == 2.0
 
 
 def test_save_load_round_trip(tmp_path):

@@ -7,10 +7,10 @@ docs/health.md).
 Options: ``--covariates TOPIC:FIELD[,...]`` (each recording's mean of each, column
 ``covariate_<spec>``), ``--baseline-records N`` or ``--baseline-until DATE`` (learn from the first
 N recordings by start time, or those starting up to DATE), ``--baseline FILE.yaml`` (a saved one),
-``--save-baseline FILE.yaml``, ``--false-alarm P``, ``--cusum``. Every row of a baseline mode gains
-``baseline_mode``, ``predicted_hz``, ``residual_z``, ``alarm_limit_rel``, ``extrapolated``,
-``alarm_since`` (and ``cusum``), and its ``change_rel``/``change_lo``/``change_hi``/``alarm`` are
-the compensated ones.
+``--save-baseline FILE.yaml``, ``--false-alarm P``, ``--sequential cusum|none``. Every row of a
+baseline mode gains ``baseline_mode``, ``predicted_hz``, ``residual_z``, ``alarm_limit_rel``,
+``extrapolated``, ``alarm_since`` (and ``cusum``), and its ``change_rel``/``change_lo``/
+``change_hi``/``alarm`` are the compensated ones.
 """
 
 from __future__ import annotations
@@ -27,6 +27,8 @@ from ..core import health_model as hm
 from ..core.multichannel import mac
 from ..io.covariates import covariate_means, parse_covariates
 
+#: ``--sequential``: the sequential test beside the per-recording one (default first)
+SEQUENTIAL = ('cusum', 'none')
 #: a row's covariate column is this prefix and the covariate's spec
 COVARIATE_PREFIX = 'covariate_'
 #: fields a row of a baseline mode gains (after ``change_*`` and ``alarm``)
@@ -76,11 +78,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         f"(default {hm.DEFAULT_FALSE_ALARM}, or the saved baseline's)",
     )
     parser.add_argument(
-        '--cusum',
-        action='store_true',
-        help='with a learned baseline: also alarm on a two-sided CUSUM of the standardised '
-        f'changes (k {hm.CUSUM_K}, h {hm.CUSUM_H}: one false alarm in ~'
-        f'{hm.cusum_arl() / 2:.0f} recordings per mode)',
+        '--sequential',
+        choices=SEQUENTIAL,
+        default=SEQUENTIAL[0],
+        help='with a learned baseline: cusum (default) also alarms while a two-sided CUSUM of the '
+        f'standardised changes (k {hm.CUSUM_K}) is beyond the threshold whose in-control run '
+        'length is 1/P recordings; none: the per-recording test alone',
     )
 
 
@@ -113,8 +116,6 @@ def check_arguments(args: argparse.Namespace) -> Tuple[Tuple[str, ...], Optional
             raise ValueError(f'--false-alarm must be in (0, 1), got {args.false_alarm}')
         if not (learning or saved):
             raise ValueError('--false-alarm needs a learned baseline (--baseline-records, ...)')
-    if args.cusum and not (learning or saved):
-        raise ValueError('--cusum needs a learned baseline (--baseline-records, ...)')
     return covariates, saved
 
 
@@ -205,11 +206,12 @@ def flag_learned(
     baseline: hm.Baseline,
     shape_of: Callable,
     false_alarm: Optional[float] = None,
-    cusum: bool = False,
+    cusum: bool = True,
 ) -> None:
     """Match each row to a baseline mode (:meth:`~..core.health_model.Baseline.match`; one row
     per mode and recording, the nearest) and set its compensated change, alarm and since when
-    (in recording time order; ``cusum``: also the CUSUM's alarm, since its change point)."""
+    (in recording time order; ``cusum``: also while the CUSUM is beyond its threshold). Since
+    when: the first recording of the current run of alarmed recordings."""
     if false_alarm is not None:
         baseline.false_alarm = false_alarm
 
@@ -238,19 +240,16 @@ def flag_learned(
             (row for (_, i), (_, row) in chosen.items() if i == index),
             key=lambda r: order[r['recording']],
         )
-        sequential = hm.Cusum() if cusum else None
+        sequential = hm.Cusum(baseline.cusum_h()) if cusum else None
         since = ''
-        for n, row in enumerate(mine):
+        for row in mine:
             change = baseline.change(mode, row['frequency_hz'], x_of(row))
             alarm = change.alarm
             if sequential is not None:
-                sequential.update(change.z)
+                sequential.update(change.z, change.shared)
                 row['cusum'] = sequential.value
+            alarm = alarm or (sequential is not None and sequential.alarm)
             since = (since or row['start_utc'] or row['recording']) if alarm else ''
-            if sequential is not None and sequential.alarm:
-                first = mine[min(sequential.start, n)]
-                since = since if alarm and since < first['start_utc'] else first['start_utc']
-                alarm = True
             row.update(
                 baseline_mode=mode.mode,
                 predicted_hz=change.predicted_hz,

@@ -991,7 +991,7 @@ def run(args: argparse.Namespace) -> int:
         except ValueError as err:
             return report(err, 'vib-estimator survey')
     if learned is not None:
-        health.flag_learned(rows, learned, row_shape, args.false_alarm, args.cusum)
+        health.flag_learned(rows, learned, row_shape, args.false_alarm, args.sequential == 'cusum')
         if args.save_baseline:
             health_model.save(learned, Path(args.save_baseline))
     write_rows(rows, args.format, sys.stdout)

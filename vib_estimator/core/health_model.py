@@ -17,13 +17,14 @@ t with ``n - p - 1`` degrees of freedom exactly, so the alarm ``|z| > t_(1 - P/2
 alarm probability ``P`` per recording per mode (:data:`DEFAULT_FALSE_ALARM`). The compensated
 change is ``f / f_hat - 1`` and its 95 % interval ``(r -+ t_0.975 se) / f_hat``.
 
-Optionally a sequential test accumulates small persistent shifts: the two-sided CUSUM of the
-standardised residuals, ``S+ = max(0, S+ + z - k)``, ``S- = max(0, S- - z - k)``, alarm when either
-exceeds ``h`` (reference value :data:`CUSUM_K` = 0.5, i.e. tuned to a shift of one ``se``;
-threshold :data:`CUSUM_H` = 5). Its in-control average run length (Siegmund's approximation,
-:func:`cusum_arl`) is ~930 recordings per side, ~465 for the two-sided test: one false alarm in
-~465 recordings of an undamaged mode; a shift of 1 ``se`` is found after ~10 recordings, of 2
-after ~4.
+A sequential test (by default on beside it) accumulates persistent shifts, and keeps the alarm
+on while a shift lasts: the two-sided CUSUM of the standardised residuals in recording order,
+``S+ = max(0, S+ + z - k)``, ``S- = max(0, S- - z - k)``, alarm while either exceeds ``h``. The
+reference value :data:`CUSUM_K` = 0.5 tunes it to a shift of one ``se``; the threshold ``h`` is
+set by the same ``P`` (:func:`cusum_threshold`): an in-control average run length (Siegmund's
+approximation, :func:`cusum_arl`) of ``2/P`` recordings per side, ``1/P`` for the two-sided test
+-- one false excursion in ``1/P`` recordings of an undamaged mode on average (P = 0.001:
+h = 5.75; a shift of 1 ``se`` is found after ~12 recordings, of 2 after ~4, of 5 after ~2).
 
 Modes are matched across recordings by frequency (relative distance below :data:`MATCH_REL` of
 the frequency the baseline predicts) and, with several channels, by the MAC of the shapes (at
@@ -50,8 +51,8 @@ DEFAULT_FALSE_ALARM = 0.001
 CHANGE_CONFIDENCE = 0.95
 #: CUSUM reference value (allowance), in prediction standard deviations
 CUSUM_K = 0.5
-#: CUSUM decision threshold, in prediction standard deviations
-CUSUM_H = 5.0
+#: the CUSUM's allowance grows by this many of the regression's own share of the std of z
+CUSUM_SHARED = 2.0
 #: a recording's mode is a baseline mode when its frequency is within this relative distance of
 #: the frequency the baseline predicts (and training rows within it of each other form a mode)
 MATCH_REL = 0.05
@@ -72,14 +73,24 @@ def student_quantile(q: float, dof: int) -> float:
     return float(student.ppf(q, dof))
 
 
-def cusum_arl(shift: float = 0.0, k: float = CUSUM_K, h: float = CUSUM_H) -> float:
-    """Average run length of a one-sided CUSUM of unit-variance normal data with mean ``shift``
-    (Siegmund's approximation, ``h + 1.166``): ~930 in control with the defaults."""
+def cusum_arl(h: float, shift: float = 0.0, k: float = CUSUM_K) -> float:
+    """Average run length of a one-sided CUSUM of threshold ``h`` on unit-variance normal data of
+    mean ``shift`` (Siegmund's approximation, ``h + 1.166``)."""
     d = shift - k
     b = h + 1.166
     if abs(d) < 1e-9:
         return b * b
     return (math.exp(-2 * d * b) + 2 * d * b - 1) / (2 * d * d)
+
+
+def cusum_threshold(false_alarm: float, k: float = CUSUM_K) -> float:
+    """The threshold ``h`` whose one-sided in-control run length is ``2 / false_alarm`` (the
+    two-sided test's ``1 / false_alarm``), by bisection of :func:`cusum_arl`."""
+    target, lo, hi = 2.0 / false_alarm, 0.0, 50.0
+    for _ in range(100):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if cusum_arl(mid, 0.0, k) < target else (lo, mid)
+    return 0.5 * (lo + hi)
 
 
 @dataclass
@@ -113,8 +124,12 @@ class ModeBaseline:
         of a new recording's prediction error (parameter uncertainty included)."""
         u = np.concatenate(([1.0], np.asarray(x, dtype=float) - np.asarray(self.x_mean)))
         f_hat = float(np.dot(self.coef, u))
-        h = float(u @ np.asarray(self.xtx_inv) @ u)
-        return f_hat, self.residual_std_hz * math.sqrt(1.0 + h)
+        return f_hat, self.residual_std_hz * math.sqrt(1.0 + self.leverage(x))
+
+    def leverage(self, x: Sequence[float]) -> float:
+        """``h = u' (U'U)^-1 u`` at covariates ``x`` (module doc)."""
+        u = np.concatenate(([1.0], np.asarray(x, dtype=float) - np.asarray(self.x_mean)))
+        return float(u @ np.asarray(self.xtx_inv) @ u)
 
     def extrapolated(self, x: Sequence[float]) -> bool:
         """Whether a covariate lies outside its training range."""
@@ -151,6 +166,9 @@ class Change:
     limit_rel: float
     alarm: bool
     extrapolated: bool
+    #: the std of ``z`` due to the regression's own error, ``sqrt(h / (1 + h))``: shared by the
+    #: recordings near these covariates, so the CUSUM must not accumulate it (:class:`Cusum`)
+    shared: float = 0.0
 
 
 @dataclass
@@ -162,6 +180,10 @@ class Baseline:
     false_alarm: float = DEFAULT_FALSE_ALARM
     #: what the baseline was learned from (free text: recordings, dates)
     trained_on: str = ''
+
+    def cusum_h(self) -> float:
+        """The CUSUM threshold of the false-alarm probability (:func:`cusum_threshold`)."""
+        return cusum_threshold(self.false_alarm)
 
     def threshold(self, mode: ModeBaseline, false_alarm: Optional[float] = None) -> float:
         """``t_(1 - P/2)`` at the mode's degrees of freedom."""
@@ -190,6 +212,7 @@ class Baseline:
             q * se / f_hat,
             bool(abs(z) > q),
             mode.extrapolated(x),
+            math.sqrt(mode.leverage(x) / (1.0 + mode.leverage(x))),
         )
 
     def match(
@@ -378,24 +401,21 @@ def _mean_shape(shapes: List[np.ndarray]) -> List[float]:
 class Cusum:
     """Two-sided CUSUM of standardised residuals (module doc): :meth:`update` with each ``z``."""
 
-    def __init__(self, k: float = CUSUM_K, h: float = CUSUM_H) -> None:
+    def __init__(self, h: float, k: float = CUSUM_K) -> None:
         self.k, self.h = k, h
         self.high = self.low = 0.0
-        #: index of the update after which each side was last zero (the change-point estimate)
-        self.high_start = self.low_start = 0
-        self.count = 0
 
-    def update(self, z: float) -> bool:
-        """Add one standardised residual; True while either side is above ``h``."""
+    def update(self, z: float, shared: float = 0.0) -> bool:
+        """Add one standardised residual; True while either side is above ``h``. ``shared``: the
+        part of ``z``'s std that is the regression's own error (:attr:`Change.shared`), common to
+        neighbouring recordings: the allowance grows by :data:`CUSUM_SHARED` of it, so that an
+        error of the fitted relation (larger where it extrapolates) is not accumulated as a
+        shift."""
         if not math.isfinite(z):
             return self.alarm
-        self.count += 1
-        self.high = max(0.0, self.high + z - self.k)
-        self.low = max(0.0, self.low - z - self.k)
-        if self.high == 0.0:
-            self.high_start = self.count
-        if self.low == 0.0:
-            self.low_start = self.count
+        k = self.k + CUSUM_SHARED * shared
+        self.high = max(0.0, self.high + z - k)
+        self.low = max(0.0, self.low - z - k)
         return self.alarm
 
     @property
@@ -406,11 +426,6 @@ class Cusum:
     def value(self) -> float:
         """The larger side, signed (negative: the frequency fell)."""
         return self.high if self.high >= self.low else -self.low
-
-    @property
-    def start(self) -> int:
-        """0-based index of the first update of the alarmed side's current excursion."""
-        return self.high_start if self.high >= self.low else self.low_start
 
 
 # ------------------------------------------------------------------------------ live (the node)
@@ -442,7 +457,7 @@ class LiveHealth:
         baseline: Optional[Baseline],
         covariates: Sequence[str],
         window_s: float,
-        cusum: bool = False,
+        cusum: bool = True,
         summarise=None,
     ) -> None:
         self.baseline = baseline
@@ -551,8 +566,8 @@ class LiveHealth:
             change = self.baseline.change(m, f, x)
             alarm = change.alarm
             if self.cusum:
-                c = self._cusums.setdefault(k, Cusum())
-                alarm = c.update(change.z) or alarm
+                c = self._cusums.setdefault(k, Cusum(self.baseline.cusum_h()))
+                alarm = c.update(change.z, change.shared) or alarm
             if alarm:
                 self._since.setdefault(k, self._start)
             else:
