@@ -292,7 +292,7 @@ def plot_health(rows: List[Dict], path: Path, baseline: hm.Baseline):
         change = 100 * np.array([r['change_rel'] for r in mine])
         limit = 100 * np.array([r['alarm_limit_rel'] for r in mine])
         alarmed = np.array([bool(r['alarm']) for r in mine], dtype=bool)
-        title = f'{mode.topic} {mode.component} mode {mode.mode} ({mode.frequency_hz:.4g} Hz)'
+        title = f'mode {mode.mode} ({mode.frequency_hz:.4g} Hz)'
         ax = ax_row[0]
         ax.plot(x, f, 'o', ms=3, label='measured')
         ax.plot(x, pred, '-', lw=1, label='baseline prediction (covariates)')
@@ -329,6 +329,11 @@ def plot_health(rows: List[Dict], path: Path, baseline: hm.Baseline):
         for a in ax_row:
             a.grid(alpha=0.3)
             a.legend(fontsize=7, loc='best')
+    fig.suptitle(
+        f'{", ".join(sorted({f"{m.topic} {m.component}".strip() for m in modes}))}: learned '
+        f'baseline of {baseline.trained_on}, P = {baseline.false_alarm:g} per recording per mode',
+        fontsize=10,
+    )
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=100)
     plt.close(fig)
