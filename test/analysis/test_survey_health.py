@@ -30,11 +30,11 @@ def _make_fleet():
 
 @pytest.fixture(scope='module')
 def fleet(tmp_path_factory):
-    """16 days of a 6 s sine (2 Hz at 0 degC, -0.2 %/degC) and a /temperature topic."""
+    """16 days of a 4 s sine (2 Hz at 0 degC, -0.2 %/degC) and a /temperature topic."""
     root = tmp_path_factory.mktemp('fleet')
     writer = _make_fleet().write_temperature_day
     rng = np.random.default_rng(0)
-    t = np.arange(0, 6, 0.004)
+    t = np.arange(0, 4, 0.005)
     truth = []
     for day in range(16):
         celsius = rng.uniform(-10, 10)
@@ -42,7 +42,7 @@ def fleet(tmp_path_factory):
         f *= 0.99 if day >= DAMAGED else 1.0
         y = 0.3 * np.sin(2 * np.pi * f * t + day) + 0.003 * rng.standard_normal(len(t))
         stamps = EPOCH + day * DAY + np.round(t * 1e9).astype(np.int64)
-        writer(root / f'day_{day:02d}', stamps, y, celsius + 0.01 * rng.standard_normal(6))
+        writer(root / f'day_{day:02d}', stamps, y, celsius + 0.01 * rng.standard_normal(4))
         truth.append(celsius)
     return root, np.array(truth)
 
