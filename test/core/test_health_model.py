@@ -139,6 +139,8 @@ def test_match_by_shape():
     base = hm.Baseline(['t'], [mode])
     assert base.match('/a', 'x,y', 8.0, [-5.0], np.array([0.9, 0.1])) is mode
     assert base.match('/a', 'x,y', 8.0, [-5.0], np.array([0.0, 1.0])) is None
+    # MAC 0.5: another mode at the same frequency (MATCH_MAC at 0.001x would take it)
+    assert base.match('/a', 'x,y', 8.0, [-5.0], np.array([1.0, 1.0])) is None
     assert hm.MATCH_MAC == 0.8
 
 
