@@ -3,7 +3,9 @@
 """``survey`` with a learned baseline: covariates in the rows, compensated changes, alarms on the
 damaged days only, since when, the saved baseline read back, the plot, bad arguments."""
 
+import contextlib
 import importlib.util
+import io
 import json
 from pathlib import Path
 
@@ -55,20 +57,37 @@ def _survey(capsys, *args):
     return code, [json.loads(line) for line in out.out.splitlines()], out.err
 
 
-def test_learned_baseline_alarms_on_the_damaged_days_only(fleet, capsys, tmp_path):
+@pytest.fixture(scope='module')
+def learned(fleet, tmp_path_factory):
+    """The fleet's rows against a baseline learned from its first 10 days, and the saved
+    baseline."""
+    root, _ = fleet
+    saved = tmp_path_factory.mktemp('baseline') / 'base.yaml'
+    out, err = io.StringIO(), io.StringIO()
+    args = ['--covariates', '/temperature:temperature', '--baseline-records', '10']
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = main(
+            [
+                'survey',
+                str(root),
+                '--topic',
+                '/accel',
+                '--format',
+                'jsonl',
+                '--jobs',
+                '1',
+                *args,
+                '--save-baseline',
+                str(saved),
+            ]
+        )
+    assert code == 0, err.getvalue()
+    return [json.loads(line) for line in out.getvalue().splitlines()], saved
+
+
+def test_learned_baseline_alarms_on_the_damaged_days_only(fleet, learned, capsys):
     root, celsius = fleet
-    saved = tmp_path / 'base.yaml'
-    code, rows, err = _survey(
-        capsys,
-        root,
-        '--covariates',
-        '/temperature:temperature',
-        '--baseline-records',
-        10,
-        '--save-baseline',
-        saved,
-    )
-    assert code == 0, err
+    rows, saved = learned
     assert len(rows) == 16
     assert np.allclose([r[COLUMN] for r in rows], celsius, atol=0.02)
     assert [r['baseline_mode'] for r in rows] == [1] * 16
@@ -191,7 +210,7 @@ def test_csv_covariate_columns(tmp_path, capsys):
     assert all(np.isfinite(r['covariate_temperature']) for r in rows)
 
 
-def test_the_node_side_judges_a_recording_as_survey(fleet, capsys, tmp_path):
+def test_the_node_side_judges_a_recording_as_survey(fleet, learned):
     """A day's estimates and temperatures through LiveHealth (the node's core, the day one
     window, summarised as the node does) give survey's compensated change and alarm."""
     from vib_estimator.analysis.analyze import estimate_signal
@@ -202,18 +221,7 @@ def test_the_node_side_judges_a_recording_as_survey(fleet, capsys, tmp_path):
     from vib_estimator.nodes.baseline_monitor import window_frequency
 
     root, _ = fleet
-    saved = tmp_path / 'base.yaml'
-    code, rows, _ = _survey(
-        capsys,
-        root,
-        '--covariates',
-        '/temperature:temperature',
-        '--baseline-records',
-        10,
-        '--save-baseline',
-        saved,
-    )
-    assert code == 0
+    rows, saved = learned
     baseline = hm.load(saved)
     config = EstimatorConfig(model=DEFAULT_MODEL)
     for day in (3, DAMAGED + 1):
