@@ -201,6 +201,34 @@ def learn_rows(
     )
 
 
+def judge(
+    rows: List[Dict],
+    args: argparse.Namespace,
+    covariates: Sequence[str],
+    saved: Optional[hm.Baseline],
+    shape_of: Callable,
+) -> Optional[hm.Baseline]:
+    """``survey``'s health step: the baseline learned from ``rows`` (``--baseline-records``,
+    ``--baseline-until``) or ``saved``, every row judged against it (:func:`flag_learned`), and
+    saved (``--save-baseline``); None without one. ValueError if it cannot be learned."""
+    baseline = saved
+    if args.baseline_records is not None or args.baseline_until is not None:
+        baseline = learn_rows(
+            rows,
+            covariates,
+            args.baseline_records,
+            args.baseline_until,
+            shape_of,
+            args.false_alarm,
+        )
+    if baseline is None:
+        return None
+    flag_learned(rows, baseline, shape_of, args.false_alarm, args.sequential == SEQUENTIAL[0])
+    if args.save_baseline:
+        hm.save(baseline, Path(args.save_baseline))
+    return baseline
+
+
 def flag_learned(
     rows: List[Dict],
     baseline: hm.Baseline,

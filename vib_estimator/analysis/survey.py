@@ -56,7 +56,7 @@ from typing import Dict, Iterable, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from ..core import COUNTER_NAMES, EstimatorConfig, health_model
+from ..core import COUNTER_NAMES, EstimatorConfig
 from ..core.choice import decide
 from ..core.multichannel import mac
 from ..errors import VibEstimatorError, report
@@ -978,22 +978,10 @@ def run(args: argparse.Namespace) -> int:
     report_entries(rows, ignored, sys.stderr)
     if base is not None:
         flag(rows, base, args.alarm_rel)
-    if args.baseline_records is not None or args.baseline_until is not None:
-        try:
-            learned = health.learn_rows(
-                rows,
-                options.covariates,
-                args.baseline_records,
-                args.baseline_until,
-                row_shape,
-                args.false_alarm,
-            )
-        except ValueError as err:
-            return report(err, 'vib-estimator survey')
-    if learned is not None:
-        health.flag_learned(rows, learned, row_shape, args.false_alarm, args.sequential == 'cusum')
-        if args.save_baseline:
-            health_model.save(learned, Path(args.save_baseline))
+    try:
+        learned = health.judge(rows, args, options.covariates, learned, row_shape)
+    except ValueError as err:
+        return report(err, 'vib-estimator survey')
     write_rows(rows, args.format, sys.stdout)
     if args.out:
         write_file(rows, Path(args.out))
