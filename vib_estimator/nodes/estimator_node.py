@@ -69,8 +69,8 @@ from ..io.fields import (
     topic_channels,
 )
 from . import health as H
-from .mode_shapes import ModeShapesPublisher
 from .baseline_monitor import BaselineMonitor
+from .mode_shapes import ModeShapesPublisher
 from .parameters import (
     config_of,
     config_value,
