@@ -31,9 +31,10 @@ relative ``HOST_RTOL`` (of the column's largest value near 0); the stamps and co
 
 The same holds across numba versions: another numba is another LLVM, which schedules and contracts
 the same arithmetic differently. Under Ubuntu 24.04's numba 0.59 (LLVM 14; make test-jazzy), on the
-same AVX-512 host, every case kept its stamps, counts and counters, its floats 1-9 ulp apart
-(7.5e-14 of the column's largest at most: a damping ratio near 0; 4 Dec 2026). Bit identity is therefore asserted only where the platform is pinned:
-requirements.txt's numba on a host with AVX-512; everywhere else ``HOST_RTOL``.
+same AVX-512 host, every case kept its stamps, counts and counters, its floats apart by 7.5e-14
+of their column's largest at most (a damping ratio near 0; 4 Dec 2026). Bit identity is therefore
+asserted only where the platform is pinned: requirements.txt's numba on a host with AVX-512;
+everywhere else to ``HOST_RTOL``.
 """
 
 from __future__ import annotations
