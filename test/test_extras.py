@@ -27,8 +27,8 @@ def test_a_missing_or_broken_extra_is_none_after_one_warning_line(
     ]
 
 
-def test_an_extra_that_loads_is_returned_silently(capsys):
-    forget()
+def test_an_extra_that_loads_is_returned_silently(break_extra, capsys):
+    forget()  # imported afresh (break_extra's teardown restores what the run found)
     module = optional('tqdm')
     assert module is not None and module.__name__ == 'tqdm' and optional('tqdm') is module
     assert capsys.readouterr().err == ''

@@ -30,6 +30,8 @@ FALLBACKS = {
     'pyoma2': "the benchmarks leave out pyOMA2's SSI-cov peer",
 }
 
+#: how the warning line of an unavailable extra begins
+WARNING = 'vib_estimator: warning: optional package'
 #: the packages already reported unavailable in this process
 _reported: Set[str] = set()
 
@@ -49,7 +51,7 @@ def optional(name: str) -> Optional[ModuleType]:
             _reported.add(package)
             why = (str(err).strip().splitlines() or [''])[0]
             sys.stderr.write(
-                f'vib_estimator: warning: optional package {package} unavailable '
+                f'{WARNING} {package} unavailable '
                 f'({type(err).__name__}: {why}): {FALLBACKS[package]}\n'
             )
         return None
