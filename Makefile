@@ -4,7 +4,7 @@ VENV    := .venv
 STAMP   := $(VENV)/.installed
 export ROS_AUTOMATIC_DISCOVERY_RANGE := LOCALHOST
 
-.PHONY: setup demo shaping test bench bench-all reproduce compare bags survey survey-ambient survey-temperature clean
+.PHONY: setup setup-jazzy test-jazzy demo shaping test bench bench-all reproduce compare bags survey survey-ambient survey-temperature clean
 
 setup: $(STAMP)
 
@@ -19,6 +19,27 @@ $(STAMP): requirements.txt setup.py setup.cfg package.xml
 	@# a second instead of half a minute)
 	$(VENV)/bin/vib-estimator warmup
 	touch $(STAMP)
+
+# The Jazzy floor: the suite on what a real ROS 2 Jazzy machine (Ubuntu 24.04) has, numpy 1.26,
+# scipy 1.11, numba 0.59, matplotlib 3.6 (requirements-jazzy.txt), in its own venv. Its numba keeps
+# its kernels in its own cache: two numba versions on the caches beside the sources
+# (__pycache__) would each find the other's index there and recompile everything.
+JAZZY       := .venv-jazzy
+JAZZY_STAMP := $(JAZZY)/.installed
+JAZZY_ENV   := NUMBA_CACHE_DIR=$(CURDIR)/$(JAZZY)/numba-cache
+
+setup-jazzy: $(JAZZY_STAMP)
+
+$(JAZZY_STAMP): requirements-jazzy.txt setup.py setup.cfg package.xml
+	test -x $(JAZZY)/bin/python || $(PY) -m venv $(JAZZY)
+	$(JAZZY)/bin/pip install --quiet --disable-pip-version-check -r requirements-jazzy.txt
+	$(JAZZY)/bin/pip install --quiet --disable-pip-version-check --no-deps --no-build-isolation -e .
+	for exe in $(JAZZY)/lib/vib_estimator/*; do ln -sf ../lib/vib_estimator/$$(basename $$exe) $(JAZZY)/bin/; done
+	$(JAZZY_ENV) $(JAZZY)/lib/vib_estimator/vib-estimator warmup
+	touch $(JAZZY_STAMP)
+
+test-jazzy: setup-jazzy
+	$(JAZZY_ENV) $(JAZZY)/bin/python -m pytest -q test
 
 demo: setup
 	$(VENV)/bin/vib-estimator demo
@@ -79,4 +100,4 @@ survey-temperature: setup
 		--out out/fleet_temperature_survey.jsonl --plot out/fleet_temperature_health.png
 
 clean:
-	rm -rf $(VENV) build install log out *.egg-info
+	rm -rf $(VENV) $(JAZZY) build install log out *.egg-info

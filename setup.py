@@ -23,7 +23,16 @@ setup(
         ('share/' + PACKAGE + '/launch', glob('launch/*.py')),
     ]
     + [('share/' + PACKAGE + '/' + d, glob(d + '/*.*')) for d in BAG_DIRS],
-    install_requires=['setuptools'],
+    # floors: Ubuntu 24.04's versions (ROS 2 Jazzy's platform), tested by make test-jazzy
+    install_requires=[
+        'setuptools',
+        'numpy>=1.26.4',
+        'scipy>=1.11.4',
+        'numba>=0.59.0',
+        'matplotlib>=3.6.3',
+        'PyYAML>=6.0.1',
+        'rosbags>=0.11.9',
+    ],
     zip_safe=True,
     maintainer='vib_estimator developers',
     maintainer_email='vib-estimator@example.com',
@@ -34,6 +43,7 @@ setup(
     entry_points={
         'console_scripts': [
             'vib-estimator = vib_estimator.cli:main',
+            'warmup = vib_estimator.analysis.warm:main',
             'estimator_node = vib_estimator.nodes.estimator_node:main',
             'sim_node = vib_estimator.nodes.sim_node:main',
             'shaper_node = vib_estimator.nodes.shaper_node:main',

@@ -46,6 +46,7 @@ from vib_estimator.core.ambient import HOP_S, AmbientEstimator
 from vib_estimator.core.modes import create_estimator
 from vib_estimator.core.multichannel import JOINT_BLOCK_ROWS, JointAmbientEstimator, mac
 from vib_estimator.core.multichannel_free import JointFreeEstimator
+from vib_estimator.extras import optional
 from vib_estimator.sim.frame import frame_record, modal_record
 
 warnings.filterwarnings('ignore', category=RuntimeWarning)
@@ -361,6 +362,8 @@ def main():
     parser.add_argument('--cost-only', action='store_true', help='only the cost section')
     parser.add_argument('--free-only', action='store_true', help='only the free-decay section')
     args = parser.parse_args()
+    # without pyOMA2 (left out on a Jazzy machine, or not loading) no peer column: one warning line
+    args.no_peer = args.no_peer or optional('pyoma2') is None
     if args.free_only:
         free_decays()
         return

@@ -45,6 +45,7 @@ import numpy as np
 from vib_estimator.core import EstimatorConfig
 from vib_estimator.core.ambient import whittle_std
 from vib_estimator.core.modes import create_estimator
+from vib_estimator.extras import optional
 from vib_estimator.sim.ambient import ambient_record
 
 warnings.filterwarnings('ignore', category=RuntimeWarning)  # pyOMA2's np.cov on one channel
@@ -386,6 +387,8 @@ def main():
         '--ref', help="time this revision's identifiers beside (e.g. main; git archive)"
     )
     args = parser.parse_args()
+    # without pyOMA2 (left out on a Jazzy machine, or not loading) no peer column: one warning line
+    args.no_peer = args.no_peer or optional('pyoma2') is None
     ref = None
     if args.ref:
         from reference_cost import Reference  # benchmarks/

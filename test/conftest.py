@@ -4,7 +4,10 @@
 
 from __future__ import annotations
 
+import contextlib
+import io
 import os
+import sys
 
 import pytest
 from hypothesis import settings
@@ -43,3 +46,51 @@ def executor(ros_context):
     ex.shutdown()
     for node in nodes:
         node.destroy_node()  # idempotent: a test may have destroyed it already
+
+
+#: the optional extras the library imports on its in-process paths (CSV, --out, progress, BLAS)
+EXTRAS_USED = ('pyarrow.csv', 'pyarrow.parquet', 'tqdm', 'threadpoolctl')
+
+
+def _load_extras() -> None:
+    """Import them once, now: one that is unavailable (pyarrow 26 beside numpy 1.26) writes its
+    warning line at the start of the run, not into the captured stderr of whichever test happens
+    to read a CSV first."""
+    from vib_estimator.extras import optional
+
+    for name in EXTRAS_USED:
+        optional(name)
+
+
+_load_extras()
+
+
+@pytest.fixture
+def break_extra(monkeypatch):
+    """``break_extra(package, error)``: from now on importing the optional extra ``package`` or a
+    submodule of it raises ``error`` (a missing package: ``ImportError``; one that fails as it
+    loads: anything), as if it were not installed or broken; restored after the test."""
+    from vib_estimator.extras import forget
+
+    def breaker(package: str, error: BaseException = ImportError('not installed')) -> None:
+        def hit(name):
+            return name == package or name.startswith(package + '.')
+
+        for name in [n for n in sys.modules if hit(n)]:
+            monkeypatch.delitem(sys.modules, name)
+
+        class Broken:
+            @staticmethod
+            def find_spec(name, path=None, target=None):
+                if hit(name):
+                    raise error
+                return None
+
+        monkeypatch.setattr(sys, 'meta_path', [Broken(), *sys.meta_path])
+        forget()
+
+    yield breaker
+    monkeypatch.undo()
+    forget()
+    with contextlib.redirect_stderr(io.StringIO()):  # said at the start of the run already
+        _load_extras()

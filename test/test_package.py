@@ -15,7 +15,14 @@ import pytest
 from vib_estimator.io.bags import read_wrench_series
 
 ROOT = Path(__file__).resolve().parents[1]
-EXECUTABLES = ['vib-estimator', 'estimator_node', 'sim_node', 'bag_replayer', 'bag_recorder']
+EXECUTABLES = [
+    'vib-estimator',
+    'estimator_node',
+    'sim_node',
+    'bag_replayer',
+    'bag_recorder',
+    'warmup',
+]
 #: ROS packages the code may import, by the name package.xml must declare
 ROS_PACKAGES = {
     'rclpy',
@@ -93,6 +100,16 @@ def test_colcon_build_installs_the_executables_where_ros2_run_looks(tmp_path):
         timeout=60,
     )
     assert run.returncode == 0 and 'analyze' in run.stdout
+    # `ros2 run vib_estimator warmup`: the compile ahead, from the installed tree
+    run = subprocess.run(
+        [str(prefix / 'lib/vib_estimator/warmup'), '--only', 'default', '--ros-args'],
+        env={**os.environ, 'PYTHONPATH': str(site), 'NUMBA_CACHE_DIR': str(tmp_path / 'cache')},
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert run.returncode == 0 and 'warmup: default:' in run.stdout, run.stdout + run.stderr
+    assert any((tmp_path / 'cache').rglob('*.nbc'))  # compiled code kept for the node's start
 
 
 #: rosdep key of each PyPI requirement that has one (ros/rosdistro rosdep/python.yaml)
@@ -154,3 +171,43 @@ def test_every_requirement_has_a_rosdep_key_or_a_readme_line():
             problems.append(f'{name}: package.xml lacks {key}')
     unknown = (exec_keys | test_keys) - set(ROSDEP_KEYS.values()) - ROS_PACKAGES
     assert not problems and not unknown, (problems, f'keys not known to be in rosdep: {unknown}')
+
+
+#: Ubuntu 24.04's versions of the rosdep keys (what `rosdep install` gives on a Jazzy machine)
+JAZZY_FLOOR = {
+    'numpy': '1.26.4',
+    'scipy': '1.11.4',
+    'numba': '0.59.0',
+    'llvmlite': '0.42.0',
+    'matplotlib': '3.6.3',
+    'pyyaml': '6.0.1',
+}
+#: left out of the floor set: the benchmarks' peer, which needs numpy 2 (its fallback: no peer)
+JAZZY_LEFT_OUT = {'pyoma-2'}
+
+
+def _pins(name):
+    pins = {}
+    for line in (ROOT / name).read_text().splitlines():
+        line = line.split('#')[0].strip()
+        if line:
+            package, _, version = line.partition('==')
+            pins[re.split(r'[\[ ]', package)[0].lower()] = version
+    return pins
+
+
+def test_the_jazzy_set_is_the_floor_and_every_other_pin_unchanged():
+    """requirements-jazzy.txt (make test-jazzy) = requirements.txt with the floor's versions, less
+    what is left out; and the floors declared to pip (setup.py) and rosdep (package.xml) are the
+    versions tested there."""
+    newest, jazzy = _pins('requirements.txt'), _pins('requirements-jazzy.txt')
+    expected = {n: v for n, v in newest.items() if n not in JAZZY_LEFT_OUT}
+    expected.update(JAZZY_FLOOR)
+    assert jazzy == expected
+    setup = (ROOT / 'setup.py').read_text()
+    root = ET.parse(ROOT / 'package.xml').getroot()
+    gte = {e.text: e.get('version_gte') for e in root if e.tag in ('exec_depend', 'test_depend')}
+    for name, version in JAZZY_FLOOR.items():
+        if name in newest:  # llvmlite comes with numba
+            assert f"'{name}>={version}'" in setup.lower(), name
+            assert gte[ROSDEP_KEYS[name]] == version, name

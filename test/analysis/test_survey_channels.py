@@ -11,6 +11,7 @@ import pytest
 from vib_estimator.analysis import survey as S
 from vib_estimator.cli import main
 from vib_estimator.core import EstimatorConfig
+from vib_estimator.extras import WARNING
 from vib_estimator.io.bags import WrenchSeries, write_channels, write_wrench_series
 from vib_estimator.io.fields import IMU
 from vib_estimator.sim.frame import modal_record
@@ -80,7 +81,8 @@ def test_columns_all_gives_the_modes_with_their_shapes_and_the_changed_day_alarm
     code, rows, err = survey_rows(
         capsys, same, changed, moved, '--columns', 'all', '--baseline', base, *AMBIENT, *ALARM
     )
-    assert code == 0 and not err
+    # nothing on stderr but, without pyarrow (Ubuntu 24.04's numpy 1.26), its one warning line
+    assert code == 0 and [ln for ln in err.splitlines() if not ln.startswith(WARNING)] == []
     assert {r['component'] for r in rows} == {'a,b,c'} and {r['topic'] for r in rows} == {''}
     by_day = {n: [r for r in rows if r['recording'] == str(n)] for n in (same, changed, moved)}
     check_modes(by_day[same], 'abc', 1.0)

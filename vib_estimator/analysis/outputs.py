@@ -9,16 +9,29 @@ import os
 from pathlib import Path
 from typing import Optional
 
+from ..extras import optional
+
+
+class _NoBar:
+    """The progress bar without tqdm (an optional extra: :mod:`..extras`)."""
+
+    def update(self, n: int = 1) -> None:
+        pass
+
+    def close(self) -> None:
+        pass
+
 
 def progress(total: int, unit: str, desc: str = ''):
     """A tqdm progress bar on stderr (``total`` ``unit``s), shown only when stdout and stderr
-    are a terminal (a pipe or a log gets no bar characters)."""
+    are a terminal (a pipe or a log gets no bar characters); none without tqdm."""
     import sys
 
-    from tqdm import tqdm
-
+    tqdm = optional('tqdm')
+    if tqdm is None:
+        return _NoBar()
     on_terminal = sys.stdout.isatty() and sys.stderr.isatty()
-    return tqdm(
+    return tqdm.tqdm(
         total=total, unit=unit, desc=desc or None, disable=not on_terminal, file=sys.stderr
     )
 

@@ -60,6 +60,7 @@ from ..core import COUNTER_NAMES, EstimatorConfig
 from ..core.choice import decide
 from ..core.multichannel import mac
 from ..errors import VibEstimatorError, report
+from ..extras import optional
 from ..io.csv_reader import column_names
 from ..io.fields import DEFAULT_COMPONENT, check_component
 from ..io.streaming import BagInfo, bag_info, is_csv, open_signal, supported_topics
@@ -616,10 +617,9 @@ def local_pool(jobs: int, fresh: bool = False) -> ProcessPoolExecutor:
 
 def _on_executor(recordings, options, jobs, scheduler, bar) -> List[List[Dict]]:
     client = None
-    if scheduler is not None:
-        from distributed import Client
-
-        client = Client(scheduler)
+    distributed = None if scheduler is None else optional('distributed')
+    if distributed is not None:
+        client = distributed.Client(scheduler)
         executor = client.get_executor(pure=False)
     else:
         executor = local_pool(jobs)
@@ -775,16 +775,16 @@ def _short(name: str, width: int = 28) -> str:
 
 
 def write_file(rows: List[Dict], path: Path) -> None:
-    """``--out``: the rows as .csv, .jsonl, or .parquet (pyarrow)."""
+    """``--out``: the rows as .csv, .jsonl, or .parquet (pyarrow; without it, the .csv beside)."""
     path.parent.mkdir(parents=True, exist_ok=True)
     if path.suffix == '.parquet':
-        import pyarrow as pa
-        import pyarrow.parquet as pq
-
-        columns = row_columns(rows)
-        full = [{**dict.fromkeys(columns, math.nan), **row} for row in rows]
-        pq.write_table(pa.Table.from_pylist(full), path)
-        return
+        pa, pq = optional('pyarrow'), optional('pyarrow.parquet')
+        if pa is not None and pq is not None:
+            columns = row_columns(rows)
+            full = [{**dict.fromkeys(columns, math.nan), **row} for row in rows]
+            pq.write_table(pa.Table.from_pylist(full), path)
+            return
+        path = path.with_suffix('.csv')  # without pyarrow (its warning line says so)
     with path.open('w', newline='') as handle:
         write_rows(rows, 'csv' if path.suffix == '.csv' else 'jsonl', handle)
 

@@ -138,23 +138,28 @@ def sensitivity(shaper: Shaper, frequency_ratio, damping: Optional[float] = None
     )
 
 
-def _ei_equations(x: np.ndarray, frequency_hz: float, damping: float, vtol: float) -> np.ndarray:
-    """EI conditions on ``x = [A1, A2, t2, t3, rl, rh]`` (A3 = 1 - A1 - A2, frequencies as ratios
-    to the design): V(1) = Vtol, dV/dr(1) = 0, and the residual phasor zero at rl and rh."""
+#: largest step in sigma = zeta / sqrt(1 - zeta^2) between two solves of the EI continuation
+EI_SIGMA_STEP = 0.05
+
+
+def _ei_equations(x: np.ndarray, sigma: float, vtol: float) -> np.ndarray:
+    """EI conditions on ``x = [A1, A2, t2, t3, rl, rh]`` (A3 = 1 - A1 - A2, times in damped
+    periods, frequencies as ratios to the design): V(1) = Vtol, dV/dr(1) = 0, and the residual
+    phasor zero at rl and rh.
+
+    In these units the mode enters only through ``sigma = zeta / sqrt(1 - zeta^2)``: the residual
+    phasor is ``P(r) = sum A_i exp(2 pi r (sigma + i) (t_i - t3))`` and ``V = |P|``, so
+    ``dV/dr = Re(conj(P) P') / V``, in closed form (no finite difference)."""
     a1, a2, t2, t3, rl, rh = x
-    times = np.array([0.0, t2, t3])
+    lag = np.array([-t3, t2 - t3, 0.0])
     amps = np.array([a1, a2, 1.0 - a1 - a2])
-
-    def phasor(r):
-        w = 2 * np.pi * frequency_hz * r
-        return np.sum(
-            amps * np.exp((damping * w + 1j * w * math.sqrt(1 - damping**2)) * (times - t3))
-        )
-
-    h = 1e-6
-    v = residual_vibration(times, amps, frequency_hz * np.array([1 - h, 1.0, 1 + h]), damping)
-    zl, zh = phasor(rl), phasor(rh)
-    return np.array([v[1] - vtol, (v[2] - v[0]) / (2 * h), zl.real, zl.imag, zh.real, zh.imag])
+    s = 2 * np.pi * (sigma + 1j)
+    p1 = np.sum(amps * np.exp(s * lag))
+    dp1 = np.sum(amps * s * lag * np.exp(s * lag))
+    zl, zh = np.sum(amps * np.exp(s * rl * lag)), np.sum(amps * np.exp(s * rh * lag))
+    return np.array(
+        [abs(p1) - vtol, (p1.conjugate() * dp1).real, zl.real, zl.imag, zh.real, zh.imag]
+    )
 
 
 def ei(frequency_hz: float, damping: float = 0.0, vtol: float = EI_VTOL) -> Shaper:
@@ -162,7 +167,10 @@ def ei(frequency_hz: float, damping: float = 0.0, vtol: float = EI_VTOL) -> Shap
     zero at two frequencies around it (Singhose, Seering & Singer).
 
     Undamped it is the closed form ``A = [(1+V)/4, (1-V)/2, (1+V)/4]`` at ``[0, T/2, T]``; damped,
-    the six conditions are solved by Newton's method (scipy) from the undamped solution.
+    the six conditions (dimensionless: :func:`_ei_equations`) are solved by Powell's hybrid method
+    (scipy's ``fsolve``) along a continuation in damping from the undamped solution, each step at
+    most :data:`EI_SIGMA_STEP`: a single solve from the undamped solution diverged beyond zeta
+    ~0.18 (and at other dampings under each scipy version), each short step converges to 1e-15.
     """
     from scipy.optimize import fsolve
 
@@ -180,15 +188,22 @@ def ei(frequency_hz: float, damping: float = 0.0, vtol: float = EI_VTOL) -> Shap
             0.0,
         )
     zero = math.acos(-(1 - vtol) / (1 + vtol)) / math.pi  # undamped zeros at r and 2 - r
-    x0 = np.array([a, (1 - vtol) / 2, period / 2, period, zero, 2 - zero])
-    x, _, ok, msg = fsolve(
-        _ei_equations, x0, args=(frequency_hz, damping, vtol), full_output=True, xtol=1e-12
-    )
-    if ok != 1 or np.max(np.abs(_ei_equations(x, frequency_hz, damping, vtol))) > 1e-8:
+    x = np.array([a, (1 - vtol) / 2, 0.5, 1.0, zero, 2 - zero])
+    sigma = damping / math.sqrt(1 - damping**2)
+    steps = math.ceil(sigma / EI_SIGMA_STEP)
+    for k in range(1, steps + 1):
+        x, _, _, msg = fsolve(
+            _ei_equations, x, args=(sigma * k / steps, vtol), full_output=True, xtol=1e-13
+        )
+    a1, a2, t2, t3, rl, rh = x
+    if not (0 < t2 < t3 and rl < 1 < rh) or np.max(np.abs(_ei_equations(x, sigma, vtol))) > 1e-12:
         raise ValueError(f'EI design for zeta {damping} did not converge: {msg}')
-    a1, a2, t2, t3 = x[:4]
     return Shaper(
-        'ei', np.array([0.0, t2, t3]), np.array([a1, a2, 1 - a1 - a2]), frequency_hz, damping
+        'ei',
+        np.array([0.0, t2, t3]) * period,
+        np.array([a1, a2, 1 - a1 - a2]),
+        frequency_hz,
+        damping,
     )
 
 

@@ -9,8 +9,8 @@ waits; ``excitation: ambient`` cost 180-214x real time per 500 Hz channel with t
 400-480x with one, the same wall time), and on a machine busy with other work it made a sliding
 matrix pencil 20x slower (88 s instead of 0.9 s for one 10 s record). Inside
 :func:`one_blas_thread` every BLAS library loaded runs on one thread; the caller's setting is
-restored after. Without threadpoolctl (it is in requirements.txt; a system install may lack it)
-nothing is limited.
+restored after. Without threadpoolctl (it is in requirements.txt; a system install may lack it, or
+have one that does not load) nothing is limited (:func:`..extras.optional`).
 """
 
 from __future__ import annotations
@@ -18,25 +18,26 @@ from __future__ import annotations
 import contextlib
 import functools
 
+from ..extras import optional
+
 
 @functools.lru_cache(maxsize=None)
 def blas_controller():
     """threadpoolctl's controller of numpy's and scipy's BLAS libraries (each wheel bundles its
     own OpenBLAS), or None without threadpoolctl. It knows only the libraries loaded when it is
     made, so scipy's is loaded first."""
-    try:
-        from threadpoolctl import ThreadpoolController
-    except ImportError:  # pragma: no cover - requirements.txt pins it
+    threadpoolctl = optional('threadpoolctl')
+    if threadpoolctl is None:
         return None
     import scipy.linalg  # noqa: F401 -- loads scipy's OpenBLAS before the controller looks
 
-    return ThreadpoolController()
+    return threadpoolctl.ThreadpoolController()
 
 
 def one_blas_thread():
     """A context in which BLAS calls run on one thread (about 4 µs to enter and leave)."""
     controller = blas_controller()
-    if controller is None:  # pragma: no cover
+    if controller is None:
         return contextlib.nullcontext()
     return controller.limit(limits=1, user_api='blas')
 

@@ -28,6 +28,7 @@ from typing import Iterator, List, Optional, Tuple
 import numpy as np
 
 from ..errors import CsvError
+from ..extras import optional
 
 #: bytes of CSV text per parsed block (512 kB: ~20 k rows). Arrow's streaming reader reads up to
 #: 32 blocks ahead on its I/O thread, so this sets the reader's memory (~16 MB in flight; 2 MB
@@ -191,11 +192,9 @@ def csv_column_blocks(
 ) -> Iterator[Tuple[np.ndarray, np.ndarray]]:
     """``(t, Y)`` blocks of the file, ``Y[:, k]`` its ``layout.columns[k]``, by pyarrow; on a file
     it refuses, the rest by the exact rules (``block_rows`` rows per block); all of it by the exact
-    rules where pyarrow is not installed (rosdep alone does not bring it)."""
-    try:
-        import pyarrow as pa
-        import pyarrow.csv as pacsv
-    except ImportError:
+    rules where pyarrow is missing or does not load (:func:`..extras.optional`)."""
+    pa, pacsv = optional('pyarrow'), optional('pyarrow.csv')
+    if pa is None or pacsv is None:
         yield from _exact_blocks(layout, 0, block_rows)
         return
 
