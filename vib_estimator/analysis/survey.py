@@ -179,6 +179,29 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         'docs/survey.md)',
     )
     add_config_arguments(parser, DEFAULT_MODEL)
+    _add_output_arguments(parser)
+    health.add_arguments(parser)
+    parser.add_argument(
+        '--strict',
+        action='store_true',
+        help='a damaged bag record fails its recording; exit 1 if any recording failed',
+    )
+    parser.add_argument(
+        '--jobs',
+        type=int,
+        default=os.cpu_count() or 1,
+        help='local worker processes (default: the number of cores)',
+    )
+    parser.add_argument(
+        '--scheduler',
+        metavar='ADDRESS',
+        help='run on this Dask distributed scheduler (e.g. tcp://host:8786)',
+    )
+
+
+def _add_output_arguments(parser: argparse.ArgumentParser) -> None:
+    """The options of what survey writes: the rows' summary and format, files, the baseline and
+    the alarm."""
     parser.add_argument(
         '--summary',
         choices=SUMMARIES,
@@ -213,23 +236,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         '--fail-on-alarm', action='store_true', help='exit 3 if any row is flagged'
-    )
-    health.add_arguments(parser)
-    parser.add_argument(
-        '--strict',
-        action='store_true',
-        help='a damaged bag record fails its recording; exit 1 if any recording failed',
-    )
-    parser.add_argument(
-        '--jobs',
-        type=int,
-        default=os.cpu_count() or 1,
-        help='local worker processes (default: the number of cores)',
-    )
-    parser.add_argument(
-        '--scheduler',
-        metavar='ADDRESS',
-        help='run on this Dask distributed scheduler (e.g. tcp://host:8786)',
     )
 
 
