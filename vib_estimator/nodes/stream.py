@@ -241,6 +241,12 @@ class EstimatorStream:
             status.values['channels'] = ','.join(self.channels)
         return status
 
+    def restart(self) -> None:
+        """Forget the signal (a jump of the stamps): the next sample starts afresh, uncompared
+        with the last; counters kept. Nothing during a warm-up (the held samples go on)."""
+        if self.ready:
+            self.estimator.restart()
+
     def reset(self) -> Tuple[bool, str]:
         """Start a new segment at the last sample; counters kept. (False, why) during a warm-up."""
         if not self.ready:
