@@ -135,6 +135,26 @@ def test_a_step_back_is_followed_and_a_small_one_ignored():
     assert c['samples_missing'] == 0 and c['stamp_jumps'] == 0 and c['cadence_gaps'] == 0
 
 
+def test_the_watchdog_recreates_a_silent_subscription_once_then_backs_off():
+    w = C.Watchdog()
+    assert not w.check(10.0, 0.0, 1, float('nan'))  # never received: not armed
+    assert not w.check(10.0, 9.0, 1, 1e-4)  # data 1 s ago
+    assert not w.check(11.9, 9.0, 1, 1e-4)
+    assert w.check(12.1, 9.0, 1, 1e-4) and w.episode == 1  # 3 s of silence, publisher matched
+    assert not w.check(17.9, 9.0, 1, 1e-4)
+    assert w.check(18.2, 9.0, 1, 1e-4) and w.episode == 2  # then after 6 s, 12 s, ... 60 s
+    assert not w.check(100.0, 9.0, 0, 1e-4)  # nobody publishes: nothing to recover
+    assert w.check(101.0, 100.5, 1, 1e-4) is False and w.episode == 0  # data again: episode over
+    assert w.check(103.6, 100.5, 1, 1e-4) and w.episode == 1
+
+
+def test_the_watchdog_waits_for_many_expected_periods():
+    w = C.Watchdog()
+    period = 0.01  # 100 Hz: 1000 periods = 10 s
+    assert not w.check(9.0, 1.0, 1, period)
+    assert w.check(11.5, 1.0, 1, period)
+
+
 @pytest.mark.parametrize(
     'name, factor, test',
     [
@@ -146,9 +166,22 @@ def test_a_step_back_is_followed_and_a_small_one_ignored():
         ('DECIDE_AFTER_S', 1e3, test_a_gap_when_the_stream_stops_is_counted_at_the_next_flush),
         ('DECIDE_AFTER_S', 1e-3, test_a_gap_when_the_stream_stops_is_counted_at_the_next_flush),
         ('RATE_WINDOW_S', 1e3, test_a_stall_that_overflows_the_queue_is_lost_in_the_queue),
+        (
+            'WATCHDOG_MIN_S',
+            1e3,
+            test_the_watchdog_recreates_a_silent_subscription_once_then_backs_off,
+        ),
+        (
+            'WATCHDOG_MIN_S',
+            1e-3,
+            test_the_watchdog_recreates_a_silent_subscription_once_then_backs_off,
+        ),
+        ('WATCHDOG_PERIODS', 1e3, test_the_watchdog_waits_for_many_expected_periods),
+        ('WATCHDOG_PERIODS', 1e-3, test_the_watchdog_waits_for_many_expected_periods),
     ],
 )
 def test_the_constants_are_pinned(monkeypatch, name, factor, test):
+    """Set to 0.001x or 1000x, each constant fails a test."""
     monkeypatch.setattr(C, name, getattr(C, name) * factor)
     with pytest.raises(AssertionError):
         test(10.0) if 'speed' in test.__code__.co_varnames else test()

@@ -98,3 +98,34 @@ def test_a_gap_before_a_stop_is_counted_by_the_diagnostics(make_probe):
     status = p.wait_status(lambda s: counters_of(s).get('samples_missing') == 5)
     assert status.level == DiagnosticStatus.WARN
     assert '1 gaps in the stamps (5 samples missing' in status.message
+
+
+def test_a_subscription_that_stops_delivering_is_recreated_with_one_warn(make_probe, monkeypatch):
+    """Never deaf: the middleware stops delivering (stubbed: the subscription's messages are
+    dropped before the node's callback) while a publisher stays matched; the watchdog re-creates
+    the subscription, input flows again, one WARN."""
+    from vib_estimator.nodes import cadence
+
+    monkeypatch.setattr(cadence, 'WATCHDOG_MIN_S', 1.5)
+    p = make_probe()
+    stamps = sine_stamps(500)
+    p.feed(stamps, sine(stamps))
+    (sub,) = p.node._subscriptions_in
+    sub.callback = lambda msg: None  # deaf
+    warnings = []
+    logger = p.node.get_logger()
+    monkeypatch.setattr(logger, 'warn', lambda text, **kw: warnings.append(text))
+    sent = 500
+
+    def keep_publishing():
+        nonlocal sent
+        for stamp in sine_stamps(1, EPOCH_NS + sent * STEP):  # one a turn, as long as it takes
+            p.pub.publish(message(p.input_type, 'torque.z', stamp, sine([stamp])[0]))
+            sent += 1
+        return p.node.counters['input_resubscribed'] >= 1 and p.node.counters['received'] > 600
+
+    assert spin_until(p.executor, keep_publishing, 20.0), (p.node.counters, warnings)
+    assert p.node._subscriptions_in[0] is not sub
+    assert p.node.counters['input_resubscribed'] == 1
+    resubscribed = [w for w in warnings if 'subscription is re-created' in w]
+    assert len(resubscribed) == 1 and '1 publisher(s) matched' in resubscribed[0]

@@ -36,13 +36,15 @@ from __future__ import annotations
 import math
 from typing import Dict, Optional
 
-#: what :class:`Cadence` counts (the node's diagnostics carry them)
+#: what :class:`Cadence` counts (the node's diagnostics carry them), and the re-creations of an
+#: input subscription by the :class:`Watchdog`
 CADENCE_COUNTERS = (
     'cadence_gaps',
     'samples_missing',
     'lost_in_queue',
     'missing_in_gaps',
     'stamp_jumps',
+    'input_resubscribed',
 )
 #: a step longer than this many periods misses at least one sample (``round(step / period) - 1``)
 GAP_FACTOR = 1.5
@@ -122,6 +124,19 @@ class Cadence:
         self._window = None
         return False
 
+    @property
+    def last_at(self) -> float:
+        """Steady time of the last message taken (0 before the first)."""
+        return self._last_at
+
+    @property
+    def period_s(self) -> float:
+        """The expected steady time between messages: the period over the live rate (NaN until
+        both are known)."""
+        if self.period <= 0.0 or not self.rate > 0.0:
+            return math.nan
+        return self.period * 1e-9 / self.rate
+
     def flush(self, now: float) -> None:
         """Decide a gap that waited :data:`DECIDE_AFTER_S` s (the stream stopped after it)."""
         if self._gap is not None and now - self._gap[2] > DECIDE_AFTER_S:
@@ -155,3 +170,47 @@ class Cadence:
         known = self.rate == self.rate
         self.rate = self.rate + RATE_WEIGHT * (rate - self.rate) if known else rate
         self._window = (now, stamp)
+
+
+#: the watchdog: silence for this many expected periods of the input (or at least
+#: :data:`WATCHDOG_MIN_S`) with a publisher matched re-creates the subscription
+WATCHDOG_PERIODS = 1000
+#: the shortest silence that re-creates the subscription, steady s (beyond the STALE status, 2 s)
+WATCHDOG_MIN_S = 3.0
+#: the longest wait between two re-creations while the silence lasts, steady s
+WATCHDOG_MAX_S = 60.0
+
+
+class Watchdog:
+    """Never deaf: when a publisher is matched but no message was taken for
+    :data:`WATCHDOG_PERIODS` expected periods (at least :data:`WATCHDOG_MIN_S` s) after input
+    once flowed, :meth:`check` says to re-create the subscription; while the silence lasts it says
+    so again after twice as long each time (up to :data:`WATCHDOG_MAX_S` s: a publisher that is
+    only paused costs a few cheap re-creations); a message taken ends the episode."""
+
+    def __init__(self):
+        self._taken_at = 0.0  # steady s of the last message seen taken (0: none yet)
+        self._since = 0.0  # steady s of that message, or of the last re-creation
+        self._wait = WATCHDOG_MIN_S
+        #: re-creations in the current silence (0: data flows)
+        self.episode = 0
+
+    def check(self, now: float, taken_at: float, matched: int, period_s: float) -> bool:
+        """True when the subscription should be re-created now: the last message was taken at
+        ``taken_at`` (steady s; 0: none yet), ``matched`` publishers, input expected every
+        ``period_s`` steady s (NaN: unknown)."""
+        if taken_at > self._taken_at:  # data flows: a new episode may start
+            self._taken_at = self._since = taken_at
+            self._wait = WATCHDOG_MIN_S
+            self.episode = 0
+        if self._taken_at <= 0.0 or matched <= 0:
+            return False
+        wait = self._wait
+        if self.episode == 0 and period_s == period_s:
+            wait = max(wait, WATCHDOG_PERIODS * period_s)
+        if now - self._since < wait:
+            return False
+        self.episode += 1
+        self._since = now
+        self._wait = min(2 * wait, WATCHDOG_MAX_S)
+        return True

@@ -71,7 +71,7 @@ from ..io.fields import (
     topic_channels,
 )
 from . import health as H
-from .cadence import Cadence
+from .cadence import Cadence, Watchdog
 from .parameters import (
     config_of,
     config_value,
@@ -265,14 +265,11 @@ class EstimatorNode(Node):
             callbacks = [self._on_stamped if has_header(self._input_type) else self._on_unstamped]
         else:
             callbacks = [partial(self._on_topic, i) for i in range(len(self._topics))]
-        # the middleware's own count of the samples it lost before the queue
-        events = SubscriptionEventCallbacks(message_lost=self._on_message_lost)
-        self._subscriptions_in = [
-            self.create_subscription(
-                message_class(self._input_type), topic, callback, qos, event_callbacks=events
-            )
-            for topic, callback in zip(self._topics, callbacks)
-        ]
+        self._input_qos = qos
+        self._input_callbacks = callbacks
+        self._subscriptions_in = [self._subscribe(i) for i in range(len(self._topics))]
+        #: each input subscription's watchdog (never deaf: .cadence.Watchdog)
+        self._watchdogs = [Watchdog() for _ in self._topics]
         self._input_names = ','.join(sub.topic_name for sub in self._subscriptions_in)
         self.add_on_set_parameters_callback(self._check_parameters)
         self.add_post_set_parameters_callback(self._apply_parameters)
@@ -288,6 +285,38 @@ class EstimatorNode(Node):
             f'({self._input_type} [{", ".join(self._channels)}]) with '
             f'{self._stream.config}'
         )
+
+    def _subscribe(self, index: int):
+        """The subscription to input topic ``index`` (with the middleware's own count of the
+        samples it lost before the queue)."""
+        return self.create_subscription(
+            message_class(self._input_type),
+            self._topics[index],
+            self._input_callbacks[index],
+            self._input_qos,
+            event_callbacks=SubscriptionEventCallbacks(message_lost=self._on_message_lost),
+        )
+
+    def _watch_inputs(self, now: float) -> None:
+        """Re-create an input subscription whose publishers are matched but from which nothing
+        was taken for long (:class:`.cadence.Watchdog`), with one WARN per silence."""
+        stamped = has_header(self._input_type)
+        for i, watchdog in enumerate(self._watchdogs):
+            sub, cadence = self._subscriptions_in[i], self._cadences[i]
+            taken_at = cadence.last_at if stamped else self._stream.health.input_at
+            matched = sub.get_publisher_count()
+            if not watchdog.check(now, taken_at, matched, cadence.period_s):
+                continue
+            topic = sub.topic_name
+            self.destroy_subscription(sub)
+            self._subscriptions_in[i] = self._subscribe(i)
+            self._stream.health.count('input_resubscribed')
+            if watchdog.episode == 1:
+                self.get_logger().warn(
+                    f'{topic}: {matched} publisher(s) matched but no message taken for '
+                    f'{now - taken_at:.1f} s: the subscription is re-created (counted in '
+                    'input_resubscribed; again, without a log, while the silence lasts)'
+                )
 
     def _read_fields(self):
         """The fields of the current ``component`` / ``components`` (ValueError if bad)."""
@@ -526,6 +555,7 @@ class EstimatorNode(Node):
         for cadence in self._cadences:
             cadence.flush(now)
         status = self._stream.status(now)
+        self._watch_inputs(now)
         if self._aligner is not None:
             counters = self._stream.health.node_counters
             lagging = self._aligner.lagging(round(H.STALE_AFTER * 1e9))

@@ -180,6 +180,11 @@ class Health:
         totals.update(self.node_counters)
         return totals
 
+    @property
+    def input_at(self) -> float:
+        """The monotonic time of the status that first saw the last input (0 before any)."""
+        return self._input_at or 0.0
+
     # ---- estimates ---------------------------------------------------------------------------
     def record(self, estimate, now: float, totals: Mapping[str, int]) -> None:
         """An estimate was published at ``now``: mode 0 or 1 is the one of ``vibration/frequency``;
