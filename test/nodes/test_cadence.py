@@ -135,24 +135,34 @@ def test_a_step_back_is_followed_and_a_small_one_ignored():
     assert c['samples_missing'] == 0 and c['stamp_jumps'] == 0 and c['cadence_gaps'] == 0
 
 
+def fired(w, start, stop, taken_at, matched=1, period=1e-4, step=1.0):
+    """The times a watchdog checked every ``step`` s from ``start`` to ``stop`` said to
+    re-create."""
+    times = np.arange(start, stop, step)
+    return [float(t) for t in times if w.check(float(t), taken_at, matched, period)]
+
+
 def test_the_watchdog_recreates_a_silent_subscription_once_then_backs_off():
     w = C.Watchdog()
-    assert not w.check(10.0, 0.0, 1, float('nan'))  # never received: not armed
-    assert not w.check(10.0, 9.0, 1, 1e-4)  # data 1 s ago
-    assert not w.check(11.9, 9.0, 1, 1e-4)
-    assert w.check(12.1, 9.0, 1, 1e-4) and w.episode == 1  # 3 s of silence, publisher matched
-    assert not w.check(17.9, 9.0, 1, 1e-4)
-    assert w.check(18.2, 9.0, 1, 1e-4) and w.episode == 2  # then after 6 s, 12 s, ... 60 s
-    assert not w.check(100.0, 9.0, 0, 1e-4)  # nobody publishes: nothing to recover
-    assert w.check(101.0, 100.5, 1, 1e-4) is False and w.episode == 0  # data again: episode over
-    assert w.check(103.6, 100.5, 1, 1e-4) and w.episode == 1
+    assert fired(w, 0.0, 10.0, 0.0) == []  # nothing ever received: not armed
+    assert fired(w, 10.0, 100.0, 9.5) == [13.0, 19.0, 31.0, 55.0]  # 3 s, then 6, 12, 24 ...
+    assert w.episode == 4
+    assert fired(w, 100.0, 200.0, 9.5, matched=0) == []  # nobody publishes: nothing to recover
+    assert fired(w, 200.0, 205.0, 200.5) == [204.0] and w.episode == 1  # data again: new episode
 
 
 def test_the_watchdog_waits_for_many_expected_periods():
     w = C.Watchdog()
-    period = 0.01  # 100 Hz: 1000 periods = 10 s
-    assert not w.check(9.0, 1.0, 1, period)
-    assert w.check(11.5, 1.0, 1, period)
+    assert fired(w, 1.0, 12.0, 1.0, period=0.01) == [11.0]  # 100 Hz: 1000 periods = 10 s
+
+
+def test_the_watchdog_does_not_count_the_time_the_node_itself_was_held():
+    """A SIGSTOP of the node: no check for 3 s, then no data yet -- not a silence of the input
+    (the soak saw one re-creation after a stop of the node); a real silence after it still is."""
+    w = C.Watchdog()
+    assert fired(w, 10.0, 11.0, 9.9) == []
+    assert fired(w, 14.0, 16.0, 9.9) == []  # held from 10 to 14
+    assert fired(w, 16.0, 20.0, 9.9) == [17.0]  # 3 s after the node ran again
 
 
 @pytest.mark.parametrize(
@@ -178,6 +188,16 @@ def test_the_watchdog_waits_for_many_expected_periods():
         ),
         ('WATCHDOG_PERIODS', 1e3, test_the_watchdog_waits_for_many_expected_periods),
         ('WATCHDOG_PERIODS', 1e-3, test_the_watchdog_waits_for_many_expected_periods),
+        (
+            'WATCHDOG_HELD_S',
+            1e3,
+            test_the_watchdog_does_not_count_the_time_the_node_itself_was_held,
+        ),
+        (
+            'WATCHDOG_HELD_S',
+            1e-3,
+            test_the_watchdog_recreates_a_silent_subscription_once_then_backs_off,
+        ),
     ],
 )
 def test_the_constants_are_pinned(monkeypatch, name, factor, test):

@@ -13,8 +13,9 @@ the order taken, with the steady time of its arrival:
   gaps). Each gap is then told apart by how the node took the :data:`DRAIN_SAMPLES` messages after
   it: faster than :data:`DRAIN_RATIO` times the live rate of the stamps (stamp seconds per steady
   second, learnt over :data:`RATE_WINDOW_S` windows without a gap) means the node was draining a
-  backlog -- its input queue had overflowed (keep-last history: the oldest were replaced) and its
-  samples are ``lost_in_queue``; otherwise the messages came at the live pace after the gap: the
+  backlog -- the queue in front of it had overflowed (the keep-last history replacing the oldest,
+  or the transport's buffers while the process was stopped) and its samples are
+  ``lost_in_queue``; otherwise the messages came at the live pace after the gap: the
   samples never reached the queue (not sent, or lost on the way) and are ``missing_in_gaps``. So
   ``samples_missing == lost_in_queue + missing_in_gaps`` at every moment (a gap is counted once it
   is told apart: after :data:`DRAIN_SAMPLES` messages, or :data:`DECIDE_AFTER_S` s, whichever
@@ -179,6 +180,9 @@ WATCHDOG_PERIODS = 1000
 WATCHDOG_MIN_S = 3.0
 #: the longest wait between two re-creations while the silence lasts, steady s
 WATCHDOG_MAX_S = 60.0
+#: checks further apart than this (steady s; the node checks every second) mean the node itself
+#: was held (a SIGSTOP, a starved CPU): the silence is measured again from then
+WATCHDOG_HELD_S = 2.0
 
 
 class Watchdog:
@@ -192,6 +196,7 @@ class Watchdog:
         self._taken_at = 0.0  # steady s of the last message seen taken (0: none yet)
         self._since = 0.0  # steady s of that message, or of the last re-creation
         self._wait = WATCHDOG_MIN_S
+        self._checked = math.inf  # steady s of the previous check
         #: re-creations in the current silence (0: data flows)
         self.episode = 0
 
@@ -199,6 +204,9 @@ class Watchdog:
         """True when the subscription should be re-created now: the last message was taken at
         ``taken_at`` (steady s; 0: none yet), ``matched`` publishers, input expected every
         ``period_s`` steady s (NaN: unknown)."""
+        held, self._checked = now - self._checked > WATCHDOG_HELD_S, now
+        if held:  # the node itself was held (stopped, starved): no silence measured across it
+            self._since = max(self._since, now)
         if taken_at > self._taken_at:  # data flows: a new episode may start
             self._taken_at = self._since = taken_at
             self._wait = WATCHDOG_MIN_S

@@ -66,6 +66,28 @@ NODE_COUNTERS = (
 )
 
 
+#: what each sample the core received became
+RECEIVED_AS = (
+    'used',
+    'skipped_non_finite',
+    'skipped_duplicate',
+    'skipped_out_of_order',
+    'skipped_outlier',
+)
+
+
+def identities(counters: Mapping[str, int]) -> Dict[str, bool]:
+    """The identities the counters satisfy (docs/nodes.md#what-the-counters-count), by name:
+    whether each holds."""
+    c = counters
+    return {
+        'received = used + skipped': c.get('received', 0)
+        == sum(c.get(name, 0) for name in RECEIVED_AS),
+        'samples_missing = lost_in_queue + missing_in_gaps': c.get('samples_missing', 0)
+        == c.get('lost_in_queue', 0) + c.get('missing_in_gaps', 0),
+    }
+
+
 @dataclass(frozen=True)
 class Status:
     """One diagnostics status: level (:data:`OK` ...), message, ordered key/values, and a
