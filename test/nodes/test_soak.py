@@ -4,7 +4,7 @@
 estimator_node as processes, four faults on a seeded schedule (a restart with time going back, a
 parameter storm with invalid values, a 2-s SIGSTOP, a 5000-message burst); every fault recovered,
 every call answered, every burst message received or counted, the counters' identities, no
-traceback, SIGINT exit 0 (issue 40)."""
+traceback, SIGINT exit 0 within 2 s (issue 40)."""
 
 from __future__ import annotations
 
@@ -26,11 +26,9 @@ def test_a_minute_of_faults(tmp_path):
         timeout=180,
     )
     fig = json.loads(out.read_text())
-    assert run.returncode in (0, 1), run.stdout + run.stderr
-    # the 2-s exit is the benchmark's goal; on a loaded CI machine an analysis in progress can hold
-    # the node's one thread a little longer (measured 0.5-2.3 s here): at most 5 s
-    assert all(code == 0 and seconds <= 5.0 for code, seconds in fig['exits'].values())
-    assert [p for p in fig['problems'] if 'of SIGINT' not in p] == [], run.stdout
+    assert run.returncode == 0 and fig['problems'] == [], run.stdout + run.stderr
+    # (the interpreter's teardown after the estimator's kernels took 1-2.6 s of the exit: now 0.03)
+    assert all(code == 0 and seconds <= 2.0 for code, seconds in fig['exits'].values())
     kinds = [f['kind'] for f in fig['faults']]
     assert kinds[:3] == ['restart', 'storm', 'stop'], kinds
     assert all(f['recovered'] is not False for f in fig['faults']), fig['faults']
