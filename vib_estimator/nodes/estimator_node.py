@@ -596,7 +596,7 @@ class EstimatorNode(Node):
 
 def main(args=None):
     """Entry point of ``ros2 run vib_estimator estimator_node``."""
-    sys.exit(run(EstimatorNode, args, exit_on_signal=True))
+    sys.exit(run(EstimatorNode, args))
 
 
 if __name__ == '__main__':

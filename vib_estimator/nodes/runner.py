@@ -119,7 +119,6 @@ def run(
     factory: Callable[[], Node],
     args: Optional[Sequence[str]] = None,
     done: Optional[Callable[[Node], bool]] = None,
-    exit_on_signal: bool = False,
 ) -> int:
     """Initialise rclpy, build the node with ``factory`` and spin it until shutdown.
 
@@ -129,13 +128,6 @@ def run(
     ``--params-file``, an invalid name given to a node: one ``error:`` line), else the node's
     ``exit_code`` read after it was destroyed (so an error while closing, e.g. a bag that cannot
     be finished at SIGINT, still fails the process).
-
-    ``exit_on_signal``: when SIGINT or SIGTERM ended the spin, end the process right there (after
-    the node is destroyed, rclpy shut down and stdout/stderr flushed) instead of returning: the
-    interpreter's own finalization after a node with the estimator kernels loaded took 1-2.6 s
-    (the LLVM and DDS libraries' teardown; the node's work ended 10-40 ms after the signal),
-    beyond the 2 s an operator's SIGINT is given. Only for a node whose resources are all closed
-    by its ``destroy_node`` (no buffered file of its own).
     """
     error = init_or_error(args)
     if error is not None:
@@ -163,8 +155,4 @@ def run(
             node.destroy_node()
             code = code or getattr(node, 'exit_code', 0)
         rclpy.try_shutdown()
-    if exit_on_signal and stop.requested:
-        sys.stdout.flush()
-        sys.stderr.flush()
-        os._exit(code)
     return code
