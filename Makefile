@@ -4,7 +4,7 @@ VENV    := .venv
 STAMP   := $(VENV)/.installed
 export ROS_AUTOMATIC_DISCOVERY_RANGE := LOCALHOST
 
-.PHONY: setup demo shaping test bench bench-all soak reproduce compare bags survey survey-ambient clean
+.PHONY: setup demo shaping test bench bench-all soak reproduce compare bags survey survey-ambient survey-temperature clean
 
 setup: $(STAMP)
 
@@ -44,6 +44,7 @@ bench-all: bench
 	$(VENV)/bin/python benchmarks/bench_survey_accuracy.py
 	$(VENV)/bin/python benchmarks/real_data.py
 	$(VENV)/bin/python benchmarks/bench_channels.py
+	$(VENV)/bin/python benchmarks/bench_defaults.py
 
 # the nodes for 6 minutes at speed 10 with a fault every 24 s (docs/soak.md); SOAK_ARGS=--minutes 480
 soak: setup
@@ -71,6 +72,15 @@ survey-ambient: setup
 	$(VENV)/bin/vib-estimator survey out/fleet_ambient --excitation ambient \
 		--baseline out/fleet_ambient/day_00 --alarm-rel 0.0025 \
 		--out out/fleet_ambient_survey.csv --plot out/fleet_ambient_trend.png
+
+# 160 ambient days of a two-mode structure whose frequencies follow the temperature (-0.2 %/degC,
+# +-10 degC), stiffness 1 % lower from day 130; baseline learned from the first 80 (docs/health.md)
+survey-temperature: setup
+	$(VENV)/bin/python scripts/make_fleet.py --temperature --out out/fleet_temperature
+	$(VENV)/bin/vib-estimator survey out/fleet_temperature --topic /accel --excitation ambient \
+		--covariates /temperature:temperature --baseline-records 80 \
+		--save-baseline out/fleet_temperature_baseline.yaml \
+		--out out/fleet_temperature_survey.jsonl --plot out/fleet_temperature_health.png
 
 clean:
 	rm -rf $(VENV) build install log out *.egg-info

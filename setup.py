@@ -18,7 +18,8 @@ setup(
     data_files=[
         ('share/ament_index/resource_index/packages', ['resource/' + PACKAGE]),
         ('share/' + PACKAGE, ['package.xml']),
-        ('share/' + PACKAGE + '/config', glob('config/*.yaml')),
+        ('share/' + PACKAGE + '/config', glob('config/*.yaml') + glob('config/*.rviz')),
+        ('share/' + PACKAGE + '/config/geometry', glob('config/geometry/*.yaml')),
         ('share/' + PACKAGE + '/launch', glob('launch/*.py')),
     ]
     + [('share/' + PACKAGE + '/' + d, glob(d + '/*.*')) for d in BAG_DIRS],

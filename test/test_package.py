@@ -78,6 +78,8 @@ def test_colcon_build_installs_the_executables_where_ros2_run_looks(tmp_path):
     share = prefix / 'share' / 'vib_estimator'
     assert (share / 'package.xml').is_file()
     assert list((share / 'config').glob('*.yaml')) and list((share / 'launch').glob('*.py'))
+    geometries = sorted(p.name for p in (ROOT / 'config' / 'geometry').glob('*.yaml'))
+    assert geometries == sorted(p.name for p in (share / 'config' / 'geometry').glob('*.yaml'))
     shipped = sorted(p.name for p in (ROOT / 'bags').iterdir() if p.is_dir())
     assert shipped and shipped == sorted(p.name for p in (share / 'bags').iterdir() if p.is_dir())
     for name in shipped:  # each bag stays a readable rosbag2 directory

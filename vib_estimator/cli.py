@@ -67,6 +67,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
             modules[name] = importlib.import_module(module)
             modules[name].add_arguments(p)
     args = parser.parse_args(argv)
+    #: the command line as given (a report quotes it)
+    args.argv = ['vib-estimator', *(argv if argv is not None else sys.argv[1:])]
     try:
         return modules[args.command].run(args)
     except VibEstimatorError as err:

@@ -17,6 +17,7 @@ Hierarchy::
     +-- McapFormatError          -- an MCAP file the indexed fast path cannot take (internal:
     |   +-- McapCut              --   the caller reads it another way); a record cut short
     +-- CdrLayoutError           -- payloads the vectorised CDR decoder cannot take (internal)
+    +-- GeometryError            -- a geometry file (sensor layout) that cannot be read
 
 ``ValueError`` (a bad option value, e.g. an unknown component) also maps to exit code 2.
 """
@@ -63,6 +64,11 @@ class McapCut(McapFormatError):
 
 class CdrLayoutError(VibEstimatorError):
     """A batch the vectorised decoder cannot take (not little-endian CDR, or too short)."""
+
+
+class GeometryError(VibEstimatorError):
+    """A geometry file (points, channels, lines: :mod:`vib_estimator.io.geometry`) that cannot be
+    read or does not fit the record's channels; one sentence naming the file."""
 
 
 class StartupError(VibEstimatorError):

@@ -118,3 +118,26 @@ def test_amplitude_tuned_gains_come_from_the_grid_and_help_on_scoring_seeds():
     assert math.isfinite(tuned.tracked) and math.isnan(paper.tracked)
     truth = seg[2]
     assert np.mean(np.square(tuned.values - truth)) < np.mean(np.square(paper.values - truth))
+
+
+def test_compare_shows_a_progress_bar_on_a_terminal(monkeypatch, capsys):
+    """``make compare`` runs minutes: on a terminal a bar counts the records (a pipe gets none)."""
+    import sys
+
+    from vib_estimator.analysis import outputs
+
+    bars = []
+
+    def counted(total, unit, desc=''):
+        bar = real(total, unit, desc)
+        bars.append((total, unit, bar))
+        return bar
+
+    real = outputs.progress
+    monkeypatch.setattr(compare, 'progress', counted)
+    monkeypatch.setattr(sys.stdout, 'isatty', lambda: True, raising=False)
+    monkeypatch.setattr(sys.stderr, 'isatty', lambda: True, raising=False)
+    compare.compare(1, compare.CASES[:1])
+    ((total, unit, bar),) = bars
+    assert (total, unit) == (1, 'record') and bar.n == 1
+    assert '1/1' in capsys.readouterr().err  # drawn: the terminal gets the bar

@@ -259,3 +259,63 @@ def test_sensitivity_plot_none_line_clears_the_frame(tmp_path):
     assert top > 100 + 0.05 * (top - bottom)  # visible, not on the top spine
     for line in ax.get_lines():
         assert np.max(line.get_ydata()) < top
+
+
+def test_ambient_plot_names_the_method_and_shows_the_std_not_a_flat_window(tmp_path):
+    from vib_estimator.sim.frame import modal_record
+
+    t, y = modal_record(120.0, 20.0, [(1.0, 0.02, 1.0)], np.ones((1, 1)), snr_db=20.0, seed=2)
+    path = tmp_path / 'amb.csv'
+    np.savetxt(path, np.column_stack([t, y[:, 0]]), delimiter=',', header='t,y', comments='')
+    signal = open_signal(path)
+    config = EstimatorConfig(excitation='ambient', ambient_window_s=40.0)
+    run = estimate_signal(signal, config, keep_samples=True)
+    fig = plot_run(str(tmp_path / 'c.png'), 'amb.csv', signal, run, None, config)
+    est_ax, third = fig.axes[1], fig.axes[2]
+    assert len(run.estimates) and 'algebraic estimates' not in legend_texts(est_ax)
+    assert third.get_ylabel() == 'frequency std (Hz)'
+    shown = np.concatenate([line.get_ydata() for line in third.get_lines()])
+    assert np.allclose(np.sort(shown), np.sort(run.estimates.frequency_std_hz))
+
+
+def test_a_record_without_estimate_says_why_on_its_panels(tmp_path):
+    path = tmp_path / 'noise.csv'
+    t = np.arange(3000) / 100
+    noise = np.random.default_rng(0).standard_normal(3000)
+    np.savetxt(path, np.column_stack([t, noise]), delimiter=',', header='t,y', comments='')
+    signal = open_signal(path)
+    run = estimate_signal(signal, EstimatorConfig(), keep_samples=True)
+    assert len(run.estimates) == 0
+    fig = plot_run(str(tmp_path / 'd.png'), 'noise.csv', signal, run, None, None, 'the reason')
+    texts = [x.get_text() for x in fig.axes[1].texts]
+    assert texts == ['no estimate: the reason'] and not legend_texts(fig.axes[1])
+
+
+def test_a_schedule_of_three_frequencies_marks_each_segments_median(tmp_path):
+    from vib_estimator.analysis.plotting import plot_estimates
+
+    t = np.arange(0, 30, 0.01)
+    est_t = np.arange(1, 30, 1.0)
+    est_f = np.where(est_t < 10, 1.6, np.where(est_t < 20, 1.3, 1.1))
+    truth = [(0, 10, 1.6), (10, 20, 1.3), (20, 30, 1.1)]
+    fig = plot_estimates(
+        str(tmp_path / 'e.png'), t, np.sin(t), est_t, est_f, np.ones_like(est_t), truth
+    )
+    marks = [x for x in legend_texts(fig.axes[3]) if x.startswith('f = ')]
+    assert marks == ['f = 1.6 Hz', 'f = 1.3 Hz', 'f = 1.1 Hz']  # one per mass, in time order
+
+
+def test_joint_plot_gives_each_mode_its_own_strip_so_close_modes_do_not_overlap(tmp_path):
+    from vib_estimator.analysis.channels import joint_run, plot_shapes
+    from vib_estimator.sim.frame import modal_record
+
+    modes = [(1.24, 0.01, 1.0), (1.29, 0.01, 1.0)]  # the Heritage Court Tower's close pair
+    shapes = np.array([[1.0, 0.2], [0.2, 1.0], [0.7, -0.7]])
+    t, y = modal_record(200.0, 10.0, modes, shapes, snr_db=25.0, seed=3)
+    config = EstimatorConfig(excitation='ambient', ambient_window_s=80.0)
+    _, result = joint_run(t, y, ['a', 'b', 'c'], config)
+    fig = plot_shapes(str(tmp_path / 's.png'), 'pair', result)
+    strips = fig.axes[:2]
+    assert [s.get_ylabel().split('\n')[0] for s in strips] == ['mode 1', 'mode 2']
+    (lo1, hi1), (lo2, hi2) = (s.get_ylim() for s in strips)
+    assert hi1 < 1.29 * 0.995 and lo2 > 1.24 * 1.005  # each strip holds its own mode only

@@ -378,3 +378,55 @@ def test_used_counts_the_samples_used_under_every_excitation(tmp_path, capsys):
         assert row['mode'] == 1 and (row['estimates'] > 0 or excitation == 'free'), excitation
         assert row['samples'] == len(t) and row['skipped_non_finite'] == 1, excitation
         assert row['used'] == len(t) - 1, excitation
+
+
+def test_trend_legend_is_beside_the_axes_each_entry_once_and_lines_break_at_gaps(tmp_path):
+    """Two modes, one missing on a day: no line across that day; 'alarm' listed once."""
+    rows = []
+    for day in range(4):
+        for mode, f in ((1, 1.3), (2, 3.1)):
+            if mode == 2 and day == 2:
+                continue  # not found that day
+            drift = 0.95 if day == 3 else 1.0
+            rows.append(
+                S._row(
+                    Path(f'day_{day}'),
+                    '/t',
+                    'torque.z',
+                    mode,
+                    start_utc=f'2026-01-0{day + 1}T00:00:00Z',
+                    frequency_hz=f * drift,
+                    frequency_lo_hz=f * drift * 0.999,
+                    frequency_hi_hz=f * drift * 1.001,
+                    alarm=day == 3,
+                )  # fmt: skip
+            )
+    fig = S.plot_trend(rows, tmp_path / 'trend.png', {None: (1.3, 1.29, 1.31)}, 0.02)
+    ax = fig.axes[0]
+    labels = legend_texts(ax)
+    assert len(labels) == len(set(labels)) and labels.count('alarm') == 1
+    assert ax.get_legend().get_bbox_to_anchor().x0 > ax.get_window_extent().x1 - 1
+    ys = [
+        np.asarray(line.get_ydata(), float)
+        for line in ax.get_lines()
+        if len(line.get_ydata()) == 4
+    ]
+    assert any(np.isnan(y[2]) and np.isfinite(y[[0, 1, 3]]).all() for y in ys), ys
+
+
+def test_survey_report_page(tmp_path, capsys):
+    days = fleet(tmp_path / 'drift', [1.3] * 3 + [1.3 * 0.95] * 2)
+    folder = tmp_path / 'page'
+    args = [*survey_args(tmp_path / 'drift', days[0]), '--report', str(folder)]
+    assert main(args) == 3
+    out = capsys.readouterr()
+    rows = jsonl(out.out)
+    page = (folder / 'index.html').read_text()
+    assert f'report written to {folder / "index.html"}' in out.err
+    assert page.count('<tr class="alarm">') == sum(r['alarm'] for r in rows) == 2
+    assert all(f'{r["frequency_hz"]:.5f}' in page for r in rows)
+    assert '<img src="trend.png"' in page and (folder / 'trend.png').stat().st_size > 10_000
+    from PIL import Image
+
+    with Image.open(folder / 'trend.png') as im:
+        im.load()

@@ -19,7 +19,9 @@ from vib_estimator.core import EstimatorConfig
 from vib_estimator.core.config import PAPER
 from vib_estimator.io.align import ALIGN_TOLERANCE_S
 from vib_estimator.io.fields import DEFAULT_COMPONENT, INPUT_TYPES, WRENCH_STAMPED
+from vib_estimator.nodes.baseline_monitor import DEFAULT_WINDOW_S
 from vib_estimator.nodes.estimator_node import EstimatorNode
+from vib_estimator.nodes.mode_markers import DEFAULTS as MODE_SHAPES
 from vib_estimator.nodes.parameters import config_of
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -35,6 +37,10 @@ def test_params_file_holds_the_defaults():
     assert params.pop('components') == []
     assert params.pop('input_topics') == []
     assert params.pop('sync_tolerance_s') == ALIGN_TOLERANCE_S
+    for name, default in MODE_SHAPES.items():  # vibration/mode_shapes (nodes/mode_shapes.py)
+        assert params.pop(name) == default, name
+    assert params.pop('baseline_file') == params.pop('covariate_topics') == ''
+    assert params.pop('health_window_s') == DEFAULT_WINDOW_S
     defaults = EstimatorConfig()
     assert set(params) == set(EstimatorConfig.names())
     for name, value in params.items():

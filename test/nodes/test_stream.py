@@ -190,3 +190,35 @@ def test_several_channels_of_free_decays_are_estimated_jointly():
     assert [e.estimate.frequency_hz for e in got] == expected.estimates.frequency_hz.tolist()
     assert np.array_equal([e.shape for e in got], expected.shapes)
     assert stream.status(now=1.0).values['channels'] == 'x,y,z'
+
+
+def test_a_driven_input_to_the_free_estimator_is_said_in_the_status_once_logged():
+    """The node cannot see its input ahead: when the free-decay estimator is fed a response that
+    looks driven throughout (core.choice.DrivenWatch), /diagnostics say so and which excitation
+    helps; not for a free decay ringing down into noise, nor under excitation ambient."""
+    from vib_estimator.sim.ambient import ambient_record
+
+    def run(config, t, y):
+        stream = EstimatorStream(config, now=0.0)
+        stamps = EPOCH_NS + np.round(t * 1e9).astype(np.int64)
+        statuses = []
+        for k in range(0, len(t), 100):  # a status a second of the 100 Hz input
+            feed(stream, stamps[k : k + 100], y[k : k + 100])
+            statuses.append(stream.status(now=1.0 + k / 100))
+        return statuses
+
+    t, y, _ = ambient_record(240, 100, [(1.2, 0.015, 1.0)], 20, 1)
+    statuses = run(EstimatorConfig(), t, y)
+    said = [s for s in statuses if 'the input looks driven' in s.message]
+    assert said and all(s.level == H.WARN for s in said)
+    assert 'excitation:=ambient' in said[-1].message
+    assert statuses[-1] in said  # still said at the end
+    logged = [s.log for s in statuses if s.log and 'looks driven' in s.log]
+    assert len(logged) == 1  # logged when it starts, not every second
+    assert not any(
+        'looks driven' in s.message for s in run(EstimatorConfig(excitation='ambient'), t, y)
+    )
+    t = np.arange(0, 240, 0.01)
+    y = np.exp(-0.01 * 2 * np.pi * 2 * t) * np.sin(2 * np.pi * 2 * t)
+    y += 0.002 * np.random.default_rng(0).standard_normal(len(t))
+    assert not any('looks driven' in s.message for s in run(EstimatorConfig(), t, y))

@@ -33,9 +33,11 @@ from ..core.config import EXCITATIONS, PAPER
 from ..core.modes import create_estimator
 from ..errors import VibEstimatorError, report
 from ..io.align import ALIGN_TOLERANCE_S
+from ..io.csv_reader import csv_layout
 from ..io.fields import INPUT_TYPES, signal_unit
-from ..io.streaming import Signal, open_signal
+from ..io.streaming import Signal, is_csv, open_signal
 from .channels import channel_names, component_names, need_joint, run_joint, topic_list
+from .choosing import explain_no_estimate, prepare, read_ahead
 from .outputs import check_output
 from .summary import summarise_modes, summary_lines
 
@@ -106,6 +108,19 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_config_arguments(parser)
     parser.add_argument('--format', choices=('jsonl', 'csv', 'table'), default='jsonl')
     parser.add_argument('--plot', metavar='FILE.png', help='write a Fig. 5-like figure')
+    parser.add_argument(
+        '--report',
+        metavar='DIR',
+        help='write DIR/index.html, a self-contained page (images beside it): the modes, '
+        'spectrum, stabilisation diagram, estimates over time, mode shapes, MAC, shaper '
+        '(docs/report.md)',
+    )
+    parser.add_argument(
+        '--geometry',
+        metavar='FILE.yaml',
+        help="--report: draw each mode's shape on the structure (points, channels, lines: "
+        'docs/geometry.md; examples in config/geometry/)',
+    )
     parser.add_argument(
         '--strict',
         action='store_true',
@@ -205,8 +220,11 @@ class Run:
     samples: Optional[Tuple[np.ndarray, np.ndarray]]
 
 
-def estimate_signal(signal: Signal, config: EstimatorConfig, keep_samples: bool = False) -> Run:
-    """Stream ``signal`` through a fresh estimator of ``config``, block by block.
+def estimate_signal(
+    signal: Signal, config: EstimatorConfig, keep_samples: bool = False, blocks=None
+) -> Run:
+    """Stream ``signal`` (or its ``blocks``, when some were read ahead) through a fresh estimator
+    of ``config``, block by block.
 
     Raises ValueError (no samples, time not increasing, band above Nyquist) and the readers'
     CsvError/BagError.
@@ -214,7 +232,7 @@ def estimate_signal(signal: Signal, config: EstimatorConfig, keep_samples: bool 
     estimator = create_estimator(config)
     parts, kept = [], []
     count, previous, first_t, nyquist_checked = 0, 0.0, None, False
-    for t, y in signal.blocks():
+    for t, y in signal.blocks() if blocks is None else blocks:
         if len(t) == 0:
             continue
         _check_times(t, previous, count, str(signal.path))
@@ -243,50 +261,6 @@ def json_row(row: dict) -> dict:
     return {
         k: None if isinstance(v, float) and not math.isfinite(v) else v for k, v in row.items()
     }
-
-
-def explain_no_estimate(counters, open_samples: Optional[int], config: EstimatorConfig) -> str:
-    """Why a run gave no estimate, from its counters, and what to try."""
-    if counters.get('used', 0) == 0:
-        return 'no sample was usable (see the skipped_* counters)'
-    analyses, flat = counters.get('analyses', 0), counters.get('flat_windows', 0)
-    if analyses and flat == analyses:
-        return f'the signal is constant (every window analysed was flat: flat_windows={flat})'
-    if config.excitation == 'ambient':
-        if not analyses:
-            return (
-                f'the record is shorter than one window (--ambient-window-s '
-                f'{config.ambient_window_s:g})'
-            )
-        return (
-            f'no mode stood out of the noise, stable over the model orders and in consecutive '
-            f'windows, in {analyses} analyses: try --band-hz around the modes of interest or a '
-            'longer --ambient-window-s'
-        )
-    held = {k: v for k, v in counters.items() if v and k.startswith('rejected_')}
-    if held:
-        return (
-            'every converged estimate was held back by the quality gate ('
-            + ', '.join(f'{k}={v}' for k, v in held.items())
-            + '): check --min-fit, '
-            '--max-damping, --min-amplitude, or the model (--model)'
-        )
-    text = 'the convergence test (Eqs. 16-17) never fired'
-    if open_samples:
-        text += f' (the last segment ran {open_samples} samples without converging'
-        text += (
-            ', '
-            + (
-                'max_window automatic: 10 s'
-                if not config.max_window
-                else f'max_window {config.max_window:g} s'
-            )
-            + ')'
-        )
-    return (
-        text + f': the signal may not follow --model {config.model} (a decay: try '
-        '--model damped-sinusoid), or try a larger --tolerance or a longer recording'
-    )
 
 
 def _print(estimates, origin, fmt, modes: int = 0) -> None:
@@ -320,6 +294,14 @@ def _print(estimates, origin, fmt, modes: int = 0) -> None:
             )
 
 
+def default_column(args) -> Optional[list[str]]:
+    """For a CSV input read without ``--column``: the file's signal columns, the one read (the
+    first after the time) first; else None."""
+    if args.column is not None or not is_csv(args.input):
+        return None
+    return list(csv_layout(args.input).names[1:])
+
+
 def damage_warning(signal: Signal, prog: str) -> None:
     """The one ``warning:`` line on stderr for the damaged records a read skipped, if any."""
     if signal.corrupt:
@@ -334,6 +316,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         config = make_config(args)
         check_output(args.plot, '--plot')
+        geometry = args.loaded_geometry = report_geometry(args)
         if getattr(args, 'columns', None) is not None:
             names = channel_names(args)
             if len(names) > 1:
@@ -358,10 +341,27 @@ def run(args: argparse.Namespace) -> int:
             args.column,
             strict=getattr(args, 'strict', False),
         )
-        result = estimate_signal(signal, config, bool(args.plot))
+        if geometry is not None:
+            geometry.check_channels((signal.component or signal.label,))
+        columns = default_column(args)
+        ahead, blocks = read_ahead(signal.blocks())
+        decision, notes = None, []
+        if ahead is not None:
+            config, decision, notes = prepare(args, config, *ahead, 1, 'analyze')
+        result = estimate_signal(signal, config, bool(args.plot or args.report), blocks)
     except (VibEstimatorError, ValueError) as err:
         return report(err, 'vib-estimator analyze')
     damage_warning(signal, 'vib-estimator analyze')
+    for line in notes:
+        print(line, file=sys.stderr)
+    others = columns[1:] if columns else []
+    if columns:
+        print(
+            f'analyze: column {columns[0]} (the first after the time, the default'
+            + (f'; the others: {", ".join(others)}: --column NAME' if others else '')
+            + ')',
+            file=sys.stderr,
+        )
     estimates = result.estimates
     _print(estimates, signal.origin_ns, args.format, config.modes or config.excitation != 'free')
     counters = result.estimator.counters
@@ -373,26 +373,89 @@ def run(args: argparse.Namespace) -> int:
     print(
         'analyze: ' + ', '.join(f'{k}={v}' for k, v in counters.items()) + extra, file=sys.stderr
     )
-    mode = estimates.mode if config.modes else None
+    mode = estimates.mode if config.modes or config.excitation != 'free' else None
+    why = '' if len(estimates) else explain_no_estimate(counters, open_samples, config, decision)
     if len(estimates) == 0:
-        print(
-            'analyze: no estimate: ' + explain_no_estimate(counters, open_samples, config),
-            file=sys.stderr,
-        )
-    for line in summary_lines(summarise_modes(estimates.frequency_hz, estimates.damping, mode)):
+        print('analyze: no estimate: ' + why, file=sys.stderr)
+        if others:
+            print(
+                f"analyze: column {signal.label} gave no estimate; the file's other columns: "
+                + ', '.join(others)
+                + ' (--column NAME, or --columns all for a joint estimation)',
+                file=sys.stderr,
+            )
+    for line in summary_lines(
+        summarise_modes(estimates.frequency_hz, estimates.damping, mode, estimates.t)
+    ):
         print('analyze: ' + line, file=sys.stderr)
-    if args.plot:
-        plot_run(args.plot, args.input, signal, result, mode)
+    pictures(args, config, signal, result, mode, geometry, why)
     return 0
 
 
-def plot_run(path: str, name: str, signal: Signal, run: Run, mode=None):
+def pictures(args, config, signal: Signal, run: Run, mode, geometry, why: str) -> None:
+    """``--plot`` and ``--report`` of a one-channel run (its samples kept)."""
+    if args.plot:
+        plot_run(args.plot, args.input, signal, run, mode, config, why)
+    if getattr(args, 'report', None):
+        write_run_report(args, config, signal, run, geometry, why)
+
+
+def report_geometry(args):
+    """Check ``--report`` (a writable folder) and load ``--geometry`` (GeometryError, ValueError
+    if bad; --geometry without --report is a ValueError)."""
+    report_dir, path = getattr(args, 'report', None), getattr(args, 'geometry', None)
+    check_output(report_dir, '--report', directory=True)
+    if path and not report_dir:
+        raise ValueError('--geometry draws the shapes of --report DIR: give --report too')
+    if not path:
+        return None
+    from ..io.geometry import load_geometry
+
+    return load_geometry(path)
+
+
+def write_run_report(args, config, signal: Signal, run: Run, geometry, why: str) -> None:
+    """``--report`` of a one-channel run (its samples kept)."""
+    from .report import Record, command_line, write_report
+
+    name = signal.component or signal.label
+    record = Record(
+        str(args.input),
+        command_line(args),
+        (name,),
+        run.samples[0],
+        run.samples[1],
+        run.estimates,
+        config,
+        dict(run.estimator.counters),
+        unit=signal_unit(name),
+        why=why,
+    )
+    path = write_report(args.report, record, geometry)
+    print(f'analyze: report written to {path}', file=sys.stderr)
+
+
+#: what ``--plot`` calls the estimates of each excitation
+ESTIMATE_LABELS = {
+    'free': 'algebraic estimates',
+    'ambient': 'SSI-cov estimates (ambient)',
+    'auto': 'estimates (decays: algebraic; driven: SSI-cov)',
+}
+
+
+def plot_run(path: str, name: str, signal: Signal, run: Run, mode=None, config=None, why=''):
     """``--plot``: the estimates and spectrum figure of a run (``keep_samples``) of ``signal``,
     its signal axis in the unit of the component or column (:func:`..io.fields.signal_unit`);
-    returns the Figure."""
+    the estimates labelled by what made them (``config``'s excitation; ambient: coloured by
+    mode, the third panel their frequency std: every estimate spans the same window); ``why``
+    written on the empty panels of a run without an estimate; returns the Figure."""
     from .plotting import plot_estimates
 
     e = run.estimates
+    excitation = config.excitation if config is not None else 'free'
+    ambient = excitation == 'ambient'
+    if ambient and mode is None:
+        mode = e.mode
     return plot_estimates(
         path,
         *run.samples,
@@ -403,4 +466,7 @@ def plot_run(path: str, name: str, signal: Signal, run: Run, mode=None):
         ylabel=signal.label,
         mode=mode,
         unit=signal_unit(signal.component or signal.label),
+        label=ESTIMATE_LABELS.get(excitation, 'estimates'),
+        panel3=('frequency std (Hz)', e.frequency_std_hz) if ambient else None,
+        note=why,
     )

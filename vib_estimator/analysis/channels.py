@@ -32,6 +32,7 @@ from ..errors import BagError, CsvError
 from ..io.csv_reader import column_names, read_csv_columns
 from ..io.fields import UNKNOWN_UNIT, seconds_since, signal_unit
 from ..io.streaming import is_csv, open_signal, read_topics
+from .choosing import explain_no_estimate, prepare
 from .summary import summarise_modes, summary_lines
 
 
@@ -216,39 +217,44 @@ JOINT_METHODS = {'ambient': 'joint SSI-cov', 'free': 'joint free-decay fit'}
 def plot_shapes(
     path: str, title: str, result: JointEstimates, unit: str = UNKNOWN_UNIT, excitation='ambient'
 ):
-    """``--plot`` of a joint run: the estimates' frequencies over time by mode with their std
-    (the stabilisation over windows) and each mode's shape (bars of the channel amplitudes, error
-    bars their std); returns the Figure."""
+    """``--plot`` of a joint run: each mode's frequency over time with its std (the stabilisation
+    over windows), one strip a mode with its own scale (close modes, 1.24 and 1.29 Hz, do not
+    overlap), and each mode's shape (bars of the channel amplitudes, error bars their std);
+    returns the Figure. Without an estimate: one panel saying so."""
     from .plotting import mode_colour, pyplot
 
     plt = pyplot()
     shapes = mode_shapes(result)
-    cols = max(1, len(shapes))
-    fig = plt.figure(figsize=(max(8.0, 2.4 * cols), 7.0))
-    grid = fig.add_gridspec(2, cols, height_ratios=(1.2, 1.0))
-    ax = fig.add_subplot(grid[0, :])
+    cols, rows = max(1, len(shapes)), max(1, len(shapes))
+    fig = plt.figure(figsize=(max(8.0, 2.4 * cols), 3.8 + 0.75 * rows))
+    outer = fig.add_gridspec(2, 1, height_ratios=(0.75 * rows, 3.2), hspace=0.28)
+    top = outer[0].subgridspec(rows, 1, hspace=0.12)
+    bottom = outer[1].subgridspec(1, cols, wspace=0.35)
+    strips = [fig.add_subplot(top[0])]
+    strips += [fig.add_subplot(top[i], sharex=strips[0]) for i in range(1, rows)]
     e = result.estimates
-    for k in shapes:
+    for ax, (k, (f, _, _)) in zip(strips, shapes.items()):
         m = e.mode == k
-        ax.errorbar(
-            e.t[m],
-            e.frequency_hz[m],
-            yerr=e.frequency_std_hz[m],
-            fmt='.',
-            ms=3,
-            lw=0.5,
-            color=mode_colour(k),
-            label=f'mode {k}',
-        )
-    ax.set_xlabel('time (s)')
-    ax.set_ylabel('frequency (Hz)')
+        ax.errorbar(e.t[m], e.frequency_hz[m], yerr=e.frequency_std_hz[m], fmt='.', ms=3,
+                    lw=0.5, color=mode_colour(k))  # fmt: skip
+        ax.set_ylabel(f'mode {k}\n{f:.3f} Hz', fontsize='small', rotation=0, ha='right',
+                      va='center')  # fmt: skip
+        ax.tick_params(labelsize='x-small')
+        ax.grid(alpha=0.3)
+    for ax in strips[:-1]:
+        ax.tick_params(labelbottom=False)
+    strips[-1].set_xlabel('time (s)', fontsize='small')
     method = JOINT_METHODS[excitation]
-    ax.set_title(f'{title}: {method} over {len(result.channels)} channels (error bars: 1 std)')
-    if shapes:
-        ax.legend(fontsize='small', loc='center left', bbox_to_anchor=(1.0, 0.5))
+    strips[0].set_title(
+        f'{title}: {method} over {len(result.channels)} channels: frequency (Hz) over time, '
+        'one strip a mode (error bars: 1 std)',
+        fontsize='small',
+    )
+    if not shapes:
+        strips[0].text(0.5, 0.5, 'no estimate', transform=strips[0].transAxes, ha='center')
     x = np.arange(len(result.channels))
     for col, (k, (f, amp, std)) in enumerate(shapes.items()):
-        sub = fig.add_subplot(grid[1, col])
+        sub = fig.add_subplot(bottom[col])
         sub.bar(x, amp, yerr=std, color=mode_colour(k), capsize=2)
         sub.axhline(0.0, color='k', lw=0.5)
         sub.set_xticks(x, result.channels, rotation=60, fontsize='small')
@@ -256,7 +262,7 @@ def plot_shapes(
         sub.set_title(f'mode {k}: {f:.3f} Hz', fontsize='small')
         if col == 0:
             sub.set_ylabel(f'shape ({unit}, normalised)')
-    fig.tight_layout()
+    fig.subplots_adjust(left=0.1, right=0.98, top=0.95, bottom=0.1)
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return fig
@@ -264,10 +270,14 @@ def plot_shapes(
 
 def run_joint(args, config: EstimatorConfig, names, json_row, prog: str, warn=None) -> int:
     """``analyze --columns`` or ``--components`` with two or more channels ``names``: estimates
-    with their shapes on stdout, the counters and the summary on stderr, ``--plot``; ``warn``
-    (signal, prog) says what a bag's read skipped. Bad input raises (CsvError, BagError,
-    ValueError) before anything is printed."""
+    with their shapes on stdout, the counters and the summary on stderr, ``--plot``,
+    ``--report``; ``warn`` (signal, prog) says what a bag's read skipped. Bad input raises
+    (CsvError, BagError, ValueError, GeometryError) before anything is printed."""
     t, y, names, signals, origin, counters = read_joint(args, names)
+    geometry = getattr(args, 'loaded_geometry', None)
+    if geometry is not None:
+        geometry.check_channels(names)
+    config, decision, notes = prepare(args, config, t, y, len(names), prog)
     estimator, result = joint_run(t, y, names, config)
     table = rows(result)
     extra = ''
@@ -282,6 +292,8 @@ def run_joint(args, config: EstimatorConfig, names, json_row, prog: str, warn=No
         extra += f', corrupt_records={sum(signal.corrupt for signal in signals)}'
         extra += ''.join(f', {k}={v}' for k, v in counters.items())
     print_rows(table, args.format, json_row)
+    for line in notes:
+        print(line, file=sys.stderr)
     print(
         f'{prog}: channels={",".join(names)}, '
         + ', '.join(f'{k}={v}' for k, v in estimator.counters.items())
@@ -289,12 +301,40 @@ def run_joint(args, config: EstimatorConfig, names, json_row, prog: str, warn=No
         file=sys.stderr,
     )
     e = result.estimates
-    for line in summary_lines(summarise_modes(e.frequency_hz, e.damping, e.mode)):
+    why = '' if len(e) else explain_no_estimate(estimator.counters, None, config, decision)
+    if why:
+        print(f'{prog}: no estimate: {why}', file=sys.stderr)
+    for line in summary_lines(summarise_modes(e.frequency_hz, e.damping, e.mode, e.t)):
         print(f'{prog}: ' + line, file=sys.stderr)
     for k, (f, amp, _) in mode_shapes(result).items():
         shape = ', '.join(f'{n} {a:+.2f}' for n, a in zip(names, amp))
         print(f'{prog}: mode {k} ({f:.3f} Hz) shape: {shape}', file=sys.stderr)
+    unit = signal_unit(names[0].rsplit(':', 1)[-1]) if signals else UNKNOWN_UNIT
     if args.plot:
-        unit = signal_unit(names[0].rsplit(':', 1)[-1]) if signals else UNKNOWN_UNIT
         plot_shapes(args.plot, str(args.input), result, unit, config.excitation)
+    if getattr(args, 'report', None):
+        report_joint(args, config, (t, y, unit), result, estimator.counters, why)
     return 0
+
+
+def report_joint(args, config, samples, result: JointEstimates, counters, why) -> None:
+    """``--report`` of a joint run of the channels' ``samples`` (t, Y, their unit); ``why``:
+    why nothing was estimated ('' if something was)."""
+    from .report import Record, command_line, write_report
+
+    t, y, unit = samples
+    record = Record(
+        str(args.input),
+        command_line(args),
+        tuple(result.channels),
+        t,
+        y,
+        result.estimates,
+        config,
+        dict(counters),
+        shapes=result.shapes,
+        unit=unit,
+        why=why,
+    )
+    path = write_report(args.report, record, getattr(args, 'loaded_geometry', None))
+    print(f'analyze: report written to {path}', file=sys.stderr)

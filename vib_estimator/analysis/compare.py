@@ -67,7 +67,7 @@ from .baselines import (
     hold_last,
 )
 from .bounds import window_crlb_std
-from .outputs import check_output
+from .outputs import check_output, progress
 
 TOLERANCE = 0.02
 OUTLIER = 0.05
@@ -325,6 +325,7 @@ def compare(
     for name in METHODS:  # compile and warm up before timing
         run_method(name, *CASES[-1].record(0)[:2])
     rows = []
+    bar = progress(len(cases) * seeds, 'record', f'{len(METHODS)} methods')
     for case in cases:
         acc: Dict[Tuple[str, int], List[SegmentResult]] = {}
         seconds = dict.fromkeys(METHODS, 0.0)
@@ -344,6 +345,7 @@ def compare(
                     acc.setdefault((name, k), []).append(
                         evaluate(run, t, y, seg, case.noise_std, name in ALGEBRAIC_CONFIGS)
                     )
+            bar.update()
         for name in METHODS:
             for k, (_, _, f) in enumerate(segs):
                 res = acc[(name, k)]
@@ -374,6 +376,7 @@ def compare(
                         1e6 * seconds[name] / samples,
                     )
                 )
+    bar.close()
     return rows
 
 

@@ -10,6 +10,19 @@ from pathlib import Path
 from typing import Optional
 
 
+def progress(total: int, unit: str, desc: str = ''):
+    """A tqdm progress bar on stderr (``total`` ``unit``s), shown only when stdout and stderr
+    are a terminal (a pipe or a log gets no bar characters)."""
+    import sys
+
+    from tqdm import tqdm
+
+    on_terminal = sys.stdout.isatty() and sys.stderr.isatty()
+    return tqdm(
+        total=total, unit=unit, desc=desc or None, disable=not on_terminal, file=sys.stderr
+    )
+
+
 def check_output(path: Optional[str], option: str, directory: bool = False) -> None:
     """ValueError naming ``option`` unless ``path`` (a file, or a ``directory``) can be written.
 

@@ -10,6 +10,7 @@ for it and no display is needed.
 from __future__ import annotations
 
 import math
+import textwrap
 from typing import Optional, Sequence, Tuple
 
 import numpy as np
@@ -62,6 +63,9 @@ def plot_estimates(
     ylabel: str = 'signal',
     mode: Optional[np.ndarray] = None,
     unit: str = UNKNOWN_UNIT,
+    label: str = 'algebraic estimates',
+    panel3: Optional[Tuple[str, np.ndarray]] = None,
+    note: str = '',
 ):
     """Write a four-panel PNG: the three panels of Fig. 5 and the signal's spectrum; return the
     Figure (closed: for inspection, not display).
@@ -70,7 +74,11 @@ def plot_estimates(
     ``mode`` (the estimates' mode column, ``modes`` >= 1) colours the estimates by mode, with a
     legend "mode k"; without it (or all 0) they are one series. ``unit`` labels the signal axis
     (and the PSD's). The spectrum (:func:`welch_psd`) marks each mode's median estimate with a
-    vertical line labelled "f = ... Hz".
+    vertical line labelled "f = ... Hz" -- with ``truth``, each segment's median (a schedule's
+    segments are different frequencies: one median across them would be none of them).
+    ``label``: the single series' legend (what estimated them); ``panel3``: (y label, values) to
+    draw instead of the convergence times (ambient: the window is the same for every estimate);
+    ``note``: written on the empty estimate panels when there is no estimate (why).
     """
     plt = pyplot()
     fig = plt.figure(figsize=(9, 10))
@@ -84,9 +92,10 @@ def plot_estimates(
     mode = np.zeros(len(est_t), dtype=int) if mode is None else np.asarray(mode)
     for k in np.unique(mode) if len(mode) else [0]:
         sel = mode == k
-        label = 'algebraic estimates' if k == 0 else f'mode {k}'
-        axes[1].plot(est_t[sel], est_f[sel], '*', color=mode_colour(k), label=label)
-        axes[2].plot(est_t[sel], est_conv[sel], 'o', mfc='none', color=mode_colour(k))
+        name = label if k == 0 else f'mode {k}'
+        third = est_conv if panel3 is None else np.asarray(panel3[1])
+        axes[1].plot(est_t[sel], est_f[sel], '*', color=mode_colour(k), label=name)
+        axes[2].plot(est_t[sel], third[sel], 'o', mfc='none', color=mode_colour(k))
     for i, (t0, t1, f) in enumerate(truth or []):
         axes[1].hlines(
             f, t0, t1, colors='k', linestyles='--', label='true frequency' if i == 0 else None
@@ -98,14 +107,32 @@ def plot_estimates(
         lo, hi = np.percentile(est_f, [2, 98])
         pad = max(0.05 * (hi - lo), 0.02 * hi)
         axes[1].set_ylim(lo - pad, hi + pad)
-    axes[1].legend(loc='best')
-    axes[2].set_ylabel('convergence time (s)')
+    if len(est_t) == 0:
+        text = textwrap.fill('no estimate' + (f': {note}' if note else ''), 90)
+        for ax, words in zip(axes[1:], (text, 'no estimate')):
+            ax.text(0.5, 0.5, words, transform=ax.transAxes, ha='center', va='center', fontsize=9)
+    else:
+        axes[1].legend(loc='best')
+    axes[2].set_ylabel('convergence time (s)' if panel3 is None else panel3[0])
     axes[2].set_xlabel('time (s)')
     if title:
         axes[0].set_title(title)
     modes = summarise_modes(est_f, np.full(len(est_f), np.nan), mode)
+    if truth:
+        modes = segment_medians(est_t, est_f, truth)
     plot_spectrum(ax_psd, t, y, modes, unit)
     return save_figure(fig, (*axes, ax_psd), path)
+
+
+def segment_medians(est_t, est_f, truth) -> list:
+    """One :class:`.summary.ModeSummary` per ``truth`` segment (t0, t1, f) that holds estimates:
+    their median."""
+    out = []
+    for t0, t1, _ in truth:
+        sel = (est_t >= t0) & (est_t < t1) & np.isfinite(est_f)
+        if sel.any():
+            out += summarise_modes(est_f[sel], np.full(int(sel.sum()), np.nan))
+    return out
 
 
 def welch_psd(t: np.ndarray, y: np.ndarray, lowest_hz: float = math.nan):
@@ -121,6 +148,13 @@ def welch_psd(t: np.ndarray, y: np.ndarray, lowest_hz: float = math.nan):
     return welch(y - np.mean(y), fs=fs, nperseg=nperseg)
 
 
+def mark_modes(ax, modes, label) -> None:
+    """A dashed vertical line at each of ``modes``' frequency, in its colour, labelled
+    ``label(mode)``."""
+    for m in modes:
+        ax.axvline(m.frequency_hz, color=mode_colour(m.mode), ls='--', lw=1.0, label=label(m))
+
+
 def plot_spectrum(ax, t: np.ndarray, y: np.ndarray, modes, unit: str = UNKNOWN_UNIT) -> None:
     """The Welch PSD of the signal on ``ax`` (log scale), each of ``modes``
     (:class:`.summary.ModeSummary`) marked at its median frequency, labelled "f = ... Hz"."""
@@ -129,14 +163,11 @@ def plot_spectrum(ax, t: np.ndarray, y: np.ndarray, modes, unit: str = UNKNOWN_U
         return
     f, psd = welch_psd(t, y, min((m.frequency_hz for m in modes), default=math.nan))
     ax.semilogy(f[1:], psd[1:], lw=0.8, color='0.3', label='Welch PSD')
-    for m in modes:
-        ax.axvline(
-            m.frequency_hz,
-            color=mode_colour(m.mode),
-            ls='--',
-            lw=1.0,
-            label=f'f = {m.frequency_hz:.5g} Hz' + (f' (mode {m.mode})' if m.mode else ''),
-        )
+    mark_modes(
+        ax,
+        modes,
+        lambda m: f'f = {m.frequency_hz:.5g} Hz' + (f' (mode {m.mode})' if m.mode else ''),
+    )
     if modes:
         ax.set_xlim(0, min(f[-1], PSD_SPAN * max(m.frequency_hz for m in modes)))
     ax.set_xlabel('frequency (Hz)')

@@ -14,10 +14,22 @@ leave ZVD more residual vibration than EI's tolerance: with ``s`` = 2 robust std
 (:func:`..control.shaping.sensitivity`, at the mode's damping) above ``EI_VTOL`` (5 %) recommends
 EI, which stays within ``EI_VTOL`` over a wider band. ``shaper_node`` shapes one
 mode: the recommendation is for the lowest one.
+
+Never a confident wrong answer:
+
+- **A frequency that moved** (a tip mass changed, a structure stiffened): with the estimates'
+  times, each mode's estimates are cut into *stretches* (:func:`stretches`: a new one starts where
+  :data:`STRETCH_RUN` estimates running lie more than :data:`STRETCH_REL` from the stretch's
+  median); a mode of several stretches is summarised per stretch, said to have moved, and the
+  shaper is designed for its last stretch (the structure as it is now).
+- **A mode on too few estimates** (fewer than :data:`MIN_ESTIMATES`) is listed as tentative and no
+  shaper is designed for it: the lowest mode that is not tentative gets the recommendation, or the
+  summary says why there is none.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from typing import List, Optional
@@ -32,6 +44,14 @@ MAD_TO_STD = 1.4826
 OUTLIER_STDS = 5.0
 #: the spread of a mode's estimates, in robust stds each side of the median (~95 %)
 SPREAD_STDS = 2.0
+#: a new stretch of a mode starts where its estimates move by more than this, relative, from the
+#: stretch's median (a mode's estimates scatter by 0.1-1 %; the tracker's and the identifier's
+#: own match tolerance is 3 %: a smaller move is the same structure)
+STRETCH_REL = 0.05
+#: ... for this many estimates running (one estimate off is an outlier, not a move)
+STRETCH_RUN = 2
+#: a mode with fewer estimates than this is tentative: listed, but no shaper is designed for it
+MIN_ESTIMATES = 3
 
 
 @dataclass(frozen=True)
@@ -48,35 +68,82 @@ class ModeSummary:
     spread_rel: float
     damping: float
     outliers: int = 0
+    #: the times of the stretch's first and last estimates (NaN without times)
+    t_first: float = math.nan
+    t_last: float = math.nan
+    #: the stretch's number within its mode (1 = the first) and how many the mode has
+    stretch: int = 1
+    stretches: int = 1
+
+    @property
+    def tentative(self) -> bool:
+        """Fewer than :data:`MIN_ESTIMATES` estimates: listed, never shaped for."""
+        return self.count < MIN_ESTIMATES
 
 
-def summarise_modes(frequency_hz, damping, mode=None) -> List[ModeSummary]:
-    """Per mode (lowest frequency first), the statistics of its finite estimates."""
+def stretches(f: np.ndarray) -> List[np.ndarray]:
+    """The stretches of one mode's estimates ``f`` (in time order) as index arrays: a new one
+    starts at the first of :data:`STRETCH_RUN` estimates running that lie more than
+    :data:`STRETCH_REL` from the median of the stretch so far."""
+    bounds, start = [0], 0
+    i = 1
+    while i + STRETCH_RUN <= len(f):
+        centre = float(np.median(f[start:i]))
+        run = f[i : i + STRETCH_RUN]
+        if np.all(np.abs(run / centre - 1) > STRETCH_REL) and (
+            np.all(run > centre) or np.all(run < centre)
+        ):
+            bounds.append(i)
+            start = i
+            i += STRETCH_RUN
+        else:
+            i += 1
+    bounds.append(len(f))
+    return [np.arange(a, b) for a, b in zip(bounds[:-1], bounds[1:])]
+
+
+def _summary(k: int, f: np.ndarray, zeta: np.ndarray, t: Optional[np.ndarray]) -> ModeSummary:
+    median = float(np.median(f))
+    std = MAD_TO_STD * float(np.median(np.abs(f - median)))
+    zeta = zeta[np.isfinite(zeta)]
+    return ModeSummary(
+        int(k),
+        len(f),
+        median,
+        std,
+        SPREAD_STDS * std / median,
+        float(np.median(zeta)) if len(zeta) else math.nan,
+        int(np.sum(np.abs(f - median) > OUTLIER_STDS * std)) if std else 0,
+        float(t[0]) if t is not None else math.nan,
+        float(t[-1]) if t is not None else math.nan,
+    )
+
+
+def summarise_modes(frequency_hz, damping, mode=None, t=None) -> List[ModeSummary]:
+    """Per mode (lowest frequency first), the statistics of its finite estimates; with their
+    times ``t``, per stretch of each mode (:func:`stretches`; in time order within a mode)."""
     frequency_hz = np.asarray(frequency_hz, dtype=float)
     damping = np.asarray(damping, dtype=float)
     mode = np.zeros(len(frequency_hz), dtype=int) if mode is None else np.asarray(mode)
-    out = []
+    times = None if t is None else np.asarray(t, dtype=float)
+    groups = []  # per mode: (the median of its estimates, its summaries in time order)
     for k in np.unique(mode):
-        sel = (mode == k) & np.isfinite(frequency_hz)
-        if not sel.any():
+        sel = np.flatnonzero((mode == k) & np.isfinite(frequency_hz))
+        if not len(sel):
             continue
-        f = frequency_hz[sel]
-        median = float(np.median(f))
-        std = MAD_TO_STD * float(np.median(np.abs(f - median)))
-        zeta = damping[sel]
-        zeta = zeta[np.isfinite(zeta)]
-        out.append(
-            ModeSummary(
-                int(k),
-                int(sel.sum()),
-                median,
-                std,
-                SPREAD_STDS * std / median,
-                float(np.median(zeta)) if len(zeta) else math.nan,
-                int(np.sum(np.abs(f - median) > OUTLIER_STDS * std)) if std else 0,
-            )
-        )
-    return sorted(out, key=lambda m: m.frequency_hz)
+        key = float(np.median(frequency_hz[sel]))
+        if times is None:
+            parts = [np.arange(len(sel))]
+        else:
+            sel = sel[np.argsort(times[sel], kind='stable')]
+            parts = stretches(frequency_hz[sel])
+        summaries = []
+        for j, part in enumerate(parts, 1):
+            idx = sel[part]
+            m = _summary(k, frequency_hz[idx], damping[idx], None if times is None else times[idx])
+            summaries.append(dataclasses.replace(m, stretch=j, stretches=len(parts)))
+        groups.append((key, summaries))
+    return [m for _, ms in sorted(groups, key=lambda g: g[0]) for m in ms]
 
 
 def recommend_shaper(mode: ModeSummary) -> str:
@@ -105,24 +172,55 @@ def shaper_command(mode: ModeSummary, shaper: Optional[str] = None) -> str:
     )
 
 
+def _mode_line(m: ModeSummary) -> str:
+    zeta = (
+        'damping not estimated (--model damped-sinusoid estimates it)'
+        if not math.isfinite(m.damping)
+        else f'damping ratio {m.damping:.4f}'
+    )
+    odd = f', {m.outliers} outlier(s) beyond {OUTLIER_STDS:g} std' if m.outliers else ''
+    when = f't {m.t_first:.4g}-{m.t_last:.4g} s: ' if m.stretches > 1 else ''
+    weak = (
+        f'; tentative: {m.count} estimate{"s" if m.count > 1 else ""}, fewer than {MIN_ESTIMATES}'
+        if m.tentative
+        else ''
+    )
+    return (
+        f'{when}f = {m.frequency_hz:.4f} ± {m.frequency_std_hz:.2g} Hz '
+        f'(robust std of {m.count} estimates{odd}{weak}), ' + zeta
+    )
+
+
+def shaped_mode(modes: List[ModeSummary]) -> Optional[ModeSummary]:
+    """The summary a shaper is designed for: the last stretch of the lowest mode whose last
+    stretch is not tentative; None if every mode is."""
+    last = {}
+    for m in modes:  # per mode in ascending frequency, its stretches in time order
+        last[m.mode] = m
+    return next((m for m in last.values() if not m.tentative), None)
+
+
 def summary_lines(modes: List[ModeSummary]) -> List[str]:
-    """The lines of the summary: one per mode, then the recommended shaper and its command."""
+    """The lines of the summary: one per mode (per stretch of a mode whose frequency moved), then
+    the recommended shaper and its command, or why there is none."""
     if not modes:
         return []
     lines = ['modes found:']
     for m in modes:
         name = f'mode {m.mode}' if m.mode else 'mode'
-        zeta = (
-            'damping not estimated (--model damped-sinusoid estimates it)'
-            if not math.isfinite(m.damping)
-            else f'damping ratio {m.damping:.4f}'
-        )
-        odd = f', {m.outliers} outlier(s) beyond {OUTLIER_STDS:g} std' if m.outliers else ''
+        if m.stretches > 1 and m.stretch == 1:
+            lines.append(
+                f'  {name}: the frequency moved during the record ({m.stretches} stretches, each '
+                f'more than {100 * STRETCH_REL:g} % from the one before): summarised per stretch'
+            )
+        lines.append(f'  {"  " if m.stretches > 1 else name + ": "}{_mode_line(m)}')
+    low = shaped_mode(modes)
+    if low is None:
         lines.append(
-            f'  {name}: f = {m.frequency_hz:.4f} ± {m.frequency_std_hz:.2g} Hz '
-            f'(robust std of {m.count} estimates{odd}), ' + zeta
+            f'no input shaper recommended: every mode rests on fewer than {MIN_ESTIMATES} '
+            'estimates (a longer record, or the options the lines above suggest, give more)'
         )
-    low = modes[0]
+        return lines
     shaper = recommend_shaper(low)
     spread = f'±{SPREAD_STDS:g} std = ±{100 * low.spread_rel:.2g} %'
     why = (
@@ -132,9 +230,16 @@ def summary_lines(modes: List[ModeSummary]) -> List[str]:
         else f'ZVD leaves under {100 * EI_VTOL:g} % residual vibration over the '
         f"estimates' spread, {spread}"
     )
+    notes = []
+    if low.stretches > 1:
+        notes.append(f'for the last stretch, from t = {low.t_first:.4g} s')
+    if low.mode != modes[0].mode:
+        notes.append('the modes below it are tentative; shaper_node shapes one mode')
+    elif len({m.mode for m in modes}) > 1:
+        notes.append('shaper_node shapes one mode: the lowest')
     lines.append(
         f'recommended input shaper: {shaper.upper()} for {low.frequency_hz:.4g} Hz '
-        f'({why}' + ('; shaper_node shapes one mode: the lowest' if len(modes) > 1 else '') + '):'
+        f'({why}' + ''.join('; ' + n for n in notes) + '):'
     )
     lines.append('  ' + shaper_command(low, shaper))
     return lines

@@ -57,16 +57,19 @@ from typing import Dict, Iterable, List, Optional, Sequence, Tuple
 import numpy as np
 
 from ..core import COUNTER_NAMES, EstimatorConfig
+from ..core.choice import decide
 from ..core.estimator import INPUT_COUNTERS
 from ..core.multichannel import mac
 from ..errors import VibEstimatorError, report
 from ..io.csv_reader import column_names
 from ..io.fields import DEFAULT_COMPONENT, check_component
 from ..io.streaming import BagInfo, bag_info, is_csv, open_signal, supported_topics
+from . import health
 from .analyze import Run, add_config_arguments, estimate_signal, make_config
 from .channels import channel_list, joint_run, mode_shapes, need_joint, read_channels
+from .choosing import decided_config, decides, read_ahead, window_given
 from .interval import combine
-from .outputs import check_output
+from .outputs import check_output, progress
 
 _STATS = (
     'start_utc',
@@ -141,6 +144,12 @@ class Options:
     columns: Optional[str] = None
     #: ``--components``: two or more fields of a bag topic, identified jointly
     joint_components: Tuple[str, ...] = ()
+    #: no ``--excitation``: each recording's excitation (and ambient window, unless
+    #: ``keep_window``) is decided from it (:mod:`.choosing`)
+    decide: bool = False
+    keep_window: bool = False
+    #: ``--covariates``: each recording's mean of these (:mod:`..io.covariates`) in its rows
+    covariates: Tuple[str, ...] = ()
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -191,7 +200,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         '--plot', metavar='FILE.png', help='frequency and damping vs recording time'
     )
-    parser.add_argument('--baseline', help='a recording, or a frequency in Hz, to compare against')
+    parser.add_argument(
+        '--report',
+        metavar='DIR',
+        help='write DIR/index.html: the trend with the baseline and the alarm band, one row per '
+        'recording (docs/report.md)',
+    )
+    parser.add_argument(
+        '--baseline',
+        help='a recording, or a frequency in Hz, to compare against; or a saved learned '
+        'baseline (FILE.yaml, --save-baseline)',
+    )
     parser.add_argument(
         '--alarm-rel',
         type=float,
@@ -201,6 +220,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         '--fail-on-alarm', action='store_true', help='exit 3 if any row is flagged'
     )
+    health.add_arguments(parser)
     parser.add_argument(
         '--strict',
         action='store_true',
@@ -516,7 +536,10 @@ def streaming_malloc():
 def survey_recording(path: Path, options: Options) -> List[Dict]:
     """The rows of one recording; any failure is one row with ``error`` set (never raises)."""
     with streaming_malloc():
-        return _recording_rows(path, options)
+        rows = _recording_rows(path, options)
+    if options.covariates:
+        health.add_covariates(path, rows, options.covariates)
+    return rows
 
 
 def _recording_rows(path: Path, options: Options) -> List[Dict]:
@@ -532,12 +555,18 @@ def _recording_rows(path: Path, options: Options) -> List[Dict]:
                 continue
             column = channels[0] if channels else options.column
             signal = open_signal(path, topic, component, column, options.strict, info=info)
+            config, blocks = options.config, None
+            if options.decide:
+                ahead, blocks = read_ahead(signal.blocks())
+                if ahead is not None:
+                    d = decide(*ahead, 1, config.ambient_window_s)
+                    config = decided_config(config, d, 'survey', options.keep_window)[0]
             rows.extend(
                 _stat_rows(
                     path,
                     signal,
-                    estimate_signal(signal, options.config),
-                    options.config.modes,
+                    estimate_signal(signal, config, blocks=blocks),
+                    config.modes,
                     options.summary,
                 )
             )
@@ -551,7 +580,11 @@ def _joint_recording_rows(path, topic, names, options: Options, info) -> List[Di
     t, y, names, signal = read_channels(path, topic, names, options.strict, info)
     if not len(t):
         raise ValueError(f'{path} holds no samples')
-    estimator, joint = joint_run(t, y, names, options.config)
+    config = options.config
+    if options.decide:
+        d = decide(t, y, len(names), config.ambient_window_s)
+        config = decided_config(config, d, 'survey', options.keep_window)[0]
+    estimator, joint = joint_run(t, y, names, config)
     result = Run(estimator, joint.estimates, float(t[0]), float(t[-1]), None)
     modes = options.config.modes
     return _stat_rows(path, signal, result, modes, options.summary, joint, ','.join(names))
@@ -566,10 +599,7 @@ def _error_row(path: Path, topic: str, component: str, err: BaseException) -> Di
 
 
 def _progress(total: int):
-    from tqdm import tqdm
-
-    on_terminal = sys.stdout.isatty() and sys.stderr.isatty()
-    return tqdm(total=total, unit='recording', disable=not on_terminal, file=sys.stderr)
+    return progress(total, 'recording')
 
 
 def survey(
@@ -789,6 +819,16 @@ def alarm_band(ref: Tuple[float, float, float], alarm_rel: float) -> Tuple[float
     return ref[1] * (1 - alarm_rel), ref[2] * (1 + alarm_rel)
 
 
+def with_gaps(good: List[Dict], key) -> List[Dict]:
+    """The rows of ``key`` (topic, component, mode) over every recording of ``good``, by start
+    time: a recording where that mode was not found gets a row of NaNs, so that its line breaks
+    there instead of joining the recordings either side."""
+    start = {r['recording']: r['start_utc'] for r in good}
+    mine = {r['recording']: r for r in good if _key(r) == key}
+    order = sorted(start, key=lambda rec: (start[rec], rec))
+    return [mine.get(rec) or _row(Path(rec), *key, start_utc=start[rec]) for rec in order]
+
+
 def _bars(ax, x, line: List[Dict], name: str, colour: str, label: str) -> np.ndarray:
     """Plot the rows' ``name`` (frequency or damping) with their 95 % intervals as bars."""
     value = np.array([r[name + '_hz' if name == 'frequency' else name] for r in line])
@@ -813,12 +853,12 @@ def plot_trend(
     good = [r for r in rows if not r['error'] and np.isfinite(r['frequency_hz'])]
     damped = any(np.isfinite(r['damping']) for r in good)
     fig, axes = plt.subplots(
-        2 if damped else 1, 1, sharex=True, figsize=(9, 6 if damped else 4), squeeze=False
+        2 if damped else 1, 1, sharex=True, figsize=(12, 6 if damped else 4), squeeze=False
     )
     ax_f = axes[0, 0]
     for n, key in enumerate(sorted({_key(r) for r in good})):
         colour = f'C{n % 10}'
-        line = [r for r in good if _key(r) == key]
+        line = with_gaps(good, key)
         x = [
             datetime.fromisoformat(r['start_utc'].replace('Z', '+00:00')) if r['start_utc'] else i
             for i, r in enumerate(line)
@@ -849,7 +889,12 @@ def plot_trend(
     if damped:
         axes[1, 0].set_ylabel('damping ratio')
     axes[-1, 0].set_xlabel('recording start (UTC)')
-    ax_f.legend(fontsize=8, loc='best')
+    unique: Dict[str, object] = {}
+    for handle, text in zip(*ax_f.get_legend_handles_labels()):
+        unique.setdefault(text, handle)  # a label once: its first line
+    ax_f.legend(
+        unique.values(), unique.keys(), fontsize=8, loc='upper left', bbox_to_anchor=(1.01, 1.0)
+    )  # beside the axes: the alarms stay visible
     for ax in axes[:, 0]:
         ax.grid(alpha=0.3)
     fig.autofmt_xdate()
@@ -858,6 +903,21 @@ def plot_trend(
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return fig
+
+
+def write_survey_page(args: argparse.Namespace, rows: List[Dict], base) -> None:
+    """``--report DIR``: the trend (:func:`plot_trend`) and a page with a row per recording."""
+    from .report import command_line, write_survey_report
+
+    folder = Path(args.report)
+    good = [r for r in rows if not r['error'] and np.isfinite(r['frequency_hz'])]
+    if good:
+        plot_trend(rows, folder / 'trend.png', base, args.alarm_rel)
+    baseline = None
+    if base is not None:
+        baseline = f'{args.baseline}, alarm beyond ±{100 * args.alarm_rel:g} % (--alarm-rel)'
+    path = write_survey_report(folder, rows, command_line(args), baseline, bool(good))
+    print(f'vib-estimator survey: report written to {path}', file=sys.stderr)
 
 
 def report_entries(rows: List[Dict], ignored: Sequence[Path], out) -> None:
@@ -888,6 +948,7 @@ def _options(args: argparse.Namespace) -> Options:
         raise ValueError(f'--out must end in {", ".join(_OUT_SUFFIXES)}, got {args.out}')
     check_output(args.out, '--out')
     check_output(args.plot, '--plot')
+    check_output(getattr(args, 'report', None), '--report', directory=True)
     if args.jobs < 1:
         raise ValueError(f'--jobs must be >= 1, got {args.jobs}')
     if not args.alarm_rel >= 0:
@@ -904,6 +965,7 @@ def _options(args: argparse.Namespace) -> Options:
             column, columns = items[0], None  # one column: exactly --column
         else:
             need_joint(f'--columns {columns}', config)
+    covariates, _ = health.check_arguments(args)
     components, joint = tuple(args.component), ()
     if args.components is not None:
         if components:
@@ -922,13 +984,17 @@ def _options(args: argparse.Namespace) -> Options:
         args.summary,
         columns,
         joint,
+        decides(args),
+        window_given(args),
+        covariates,
     )
 
 
 def run(args: argparse.Namespace) -> int:
     try:
         options = _options(args)
-        base = baseline_rows(args.baseline, options) if args.baseline else None
+        learned = health.check_arguments(args)[1]
+        base = baseline_rows(args.baseline, options) if args.baseline and not learned else None
     except (ValueError, VibEstimatorError) as err:
         return report(err, 'vib-estimator survey')
     ignored: List[Path] = []
@@ -952,11 +1018,19 @@ def run(args: argparse.Namespace) -> int:
     report_entries(rows, ignored, sys.stderr)
     if base is not None:
         flag(rows, base, args.alarm_rel)
+    try:
+        learned = health.judge(rows, args, options.covariates, learned, row_shape)
+    except ValueError as err:
+        return report(err, 'vib-estimator survey')
     write_rows(rows, args.format, sys.stdout)
     if args.out:
         write_file(rows, Path(args.out))
-    if args.plot:
+    if args.plot and learned is not None:
+        health.plot_health(rows, Path(args.plot), learned)
+    elif args.plot:
         plot_trend(rows, Path(args.plot), base, args.alarm_rel)
+    if getattr(args, 'report', None):
+        write_survey_page(args, rows, base)
     if args.fail_on_alarm and any(r['alarm'] for r in rows):
         return 3
     return 1 if args.strict and any(r['error'] for r in rows) else 0

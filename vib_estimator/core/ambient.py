@@ -77,6 +77,8 @@ from .threads import single_blas_thread
 HOP_S = 1.0
 #: block rows p of the correlation Hankel matrix (lags 1 .. 2p)
 BLOCK_ROWS = 40
+#: fewest samples a window must hold to be analysed (twice the lags, and two)
+MIN_WINDOW_SAMPLES = 4 * BLOCK_ROWS + 2
 #: model orders of the stabilisation diagram
 ORDERS = tuple(range(4, 31, 4))
 #: neighbouring poles within this relative frequency join one cluster
@@ -1269,7 +1271,7 @@ class SlidingWindowIdentifier:
         published mode's frequency (0: none), whether to search the whole band)`` of the window
         it reads, or None when the window is too short."""
         ts = self._slide()
-        if len(ts) < 4 * BLOCK_ROWS + 2:
+        if len(ts) < MIN_WINDOW_SAMPLES:
             return None
         span = float(ts[-1] - ts[0])
         self._c['analyses'] += 1

@@ -332,6 +332,10 @@ class Envelope:
     def restart(self) -> None:
         self.block_s = self.base_s
         self.seconds = {FREE: 0.0, DRIVEN: 0.0}  # the blocks closed in each state, s
+        #: the energy of the blocks closed in each state (their variance x their seconds) and the
+        #: largest block variance
+        self.energy = {FREE: 0.0, DRIVEN: 0.0}
+        self.peak = 0.0
         self.state = FREE
         #: a free estimate of this stretch (since its last onset) passed the free-decay test
         self.ringing = False
@@ -456,6 +460,8 @@ class Envelope:
             self._driven, self._quiet = list(e), 0
         self.blocks[self.state] += 1
         self.seconds[self.state] += self.block_s
+        self.energy[self.state] += energy * self.block_s
+        self.peak = max(self.peak, energy)
 
 
 class AutoEstimator:

@@ -84,7 +84,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         '--out',
         default=None,
-        help='figure path (default out/demo.png, with --shaping out/shaping.png)',
+        help='figure path (default out/demo.png, with --shaping out/shaping.png, with --real-arm '
+        'out/demo_real_arm.png)',
     )
     parser.add_argument(
         '--domain-id',

@@ -83,7 +83,9 @@ def run_estimation(session: Session, args: argparse.Namespace, wall_start: float
         + (
             ' on a realistic rig (' + ', '.join(REAL_ARM_SIM_PARAMS) + '), estimator defaults'
             if real
-            else ''
+            else "; estimator_node in the paper's configuration (config/paper.yaml: "
+            + ', '.join(PAPER_PARAMS)
+            + '), not the defaults: --real-arm runs the defaults on a realistic rig'
         ),
         flush=True,
     )
@@ -96,7 +98,7 @@ def run_estimation(session: Session, args: argparse.Namespace, wall_start: float
     rec = listener.record
     rows, ok = summarise(rec)
     print('\n' + '\n'.join(rows))
-    out = Path(args.out or 'out/demo.png')
+    out = Path(args.out or ('out/demo_real_arm.png' if real else 'out/demo.png'))
     out.parent.mkdir(parents=True, exist_ok=True)
     plot_estimation(str(out), rec, args.speed)
     print(

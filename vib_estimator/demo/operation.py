@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import argparse
 import time
+from pathlib import Path
+from typing import Optional
 
 import numpy as np
 
@@ -54,6 +56,20 @@ def summarise_operation(est_f, f0: float) -> tuple[list[str], bool]:
     return rows, within >= MIN_WITHIN and len(f) >= MIN_ESTIMATES
 
 
+def arm_geometry() -> Optional[str]:
+    """config/geometry/arm.yaml of the source tree or of the installed package
+    (share/vib_estimator); None if neither has it (the demo then publishes no mode_shapes)."""
+    candidates = [Path(__file__).resolve().parents[2] / 'config' / 'geometry' / 'arm.yaml']
+    try:
+        from ament_index_python import packages
+
+        share = packages.get_package_share_directory('vib_estimator')
+        candidates.append(Path(share) / 'config' / 'geometry' / 'arm.yaml')
+    except (ImportError, LookupError, OSError, ValueError):
+        pass
+    return next((str(p) for p in candidates if p.is_file()), None)
+
+
 def run_operation(session: Session, args: argparse.Namespace, wall_start: float) -> int:
     """The operation demo: the driven arm, every estimate against Eq. 23."""
     from ..nodes.sim_node import schedule_to_array
@@ -67,7 +83,17 @@ def run_operation(session: Session, args: argparse.Namespace, wall_start: float)
         f'{args.excitation} (window {WINDOW_S:g} s: the first estimates after it)',
         flush=True,
     )
-    session.start_estimator([f'excitation:={args.excitation}', f'ambient_window_s:={WINDOW_S}'])
+    geometry = arm_geometry()
+    session.start_estimator(
+        [f'excitation:={args.excitation}', f'ambient_window_s:={WINDOW_S}']
+        + ([f'geometry_file:={geometry}'] if geometry else [])
+    )
+    if geometry:
+        print(
+            "demo --operation: vibration/mode_shapes draws the arm's mode in RViz: rviz2 -d "
+            f'{Path(geometry).parents[1] / "mode_shapes.rviz"} (frame world)',
+            flush=True,
+        )
     schedule = schedule_to_array([Move(0.0, 0.0, 1.0, OPERATION_MASS_KG)])
     sim = session.start_sim(
         sim_params(args.speed, duration, schedule, 2) + [f'excitation:={args.sim_excitation}']

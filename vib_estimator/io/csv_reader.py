@@ -4,6 +4,9 @@
 
 Format: optional ``#`` comment lines, an optional header row, then rows whose first column is the
 time in seconds. The signal is a named column (header) or a column index; by default the second.
+Without a header row, the last comment line before the data names the columns when it lists one
+name per column (``# time_s,accel_g  (notes)``: names separated by commas, up to two spaces or a
+parenthesis; :func:`comment_names`).
 Empty cells and ``nan`` are kept as NaN (the estimator skips and counts them).
 
 This module holds the rules (:func:`csv_layout` finds the header, the column and where the data
@@ -17,6 +20,7 @@ read by the exact rules instead, so the result and the error messages are those 
 from __future__ import annotations
 
 import csv
+import re
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Iterator, List, Optional, Tuple
@@ -56,6 +60,8 @@ class CsvLayout:
     has_header: bool
     data_offset: int
     indices: Tuple[int, ...] = ()
+    #: every column's name: the header's, a comment line's (:func:`comment_names`) or its index
+    names: Tuple[str, ...] = ()
 
     @property
     def columns(self) -> Tuple[int, ...]:
@@ -103,9 +109,31 @@ def csv_layout(path, column: Optional[str] = None) -> CsvLayout:
     except (OSError, UnicodeDecodeError, csv.Error) as err:
         raise CsvError(f'cannot read {path} as CSV: {err}') from None
     width = len(data[2])
-    names = header or [str(i) for i in range(width)]
+    names = header or comment_names(path, data[1], width) or [str(i) for i in range(width)]
     index = _column_index(path, column, names, width)
-    return CsvLayout(path, index, names[index], width, header is not None, data[1])
+    return CsvLayout(
+        path, index, names[index], width, header is not None, data[1], names=tuple(names)
+    )
+
+
+#: a column name in a comment header: a letter or underscore, then word characters and . - / [ ]
+_NAME = re.compile(r'[A-Za-z_][\w.\-/\[\]]*')
+
+
+def comment_names(path: Path, data_offset: int, width: int) -> Optional[List[str]]:
+    """The column names of the last ``#`` comment line before the data (at byte
+    ``data_offset``), when it lists ``width`` distinct names separated by commas (text after two
+    spaces or a parenthesis is a note); None otherwise."""
+    with path.open('rb') as handle:
+        head = handle.read(data_offset).decode(errors='replace').splitlines()
+    comments = [line.strip() for line in head if line.strip().startswith('#')]
+    if not comments:
+        return None
+    text = re.split(r'\s{2,}|\s*\(', comments[-1].lstrip('#').strip())[0]
+    cells = [cell.strip() for cell in text.split(',')]
+    if len(cells) != width or len(set(cells)) != width:
+        return None
+    return cells if all(_NAME.fullmatch(cell) for cell in cells) else None
 
 
 def _column_index(path: Path, column: Optional[str], names: List[str], width: int) -> int:
@@ -243,7 +271,7 @@ def column_names(path, columns: str) -> List[str]:
     comma-separated list of header names or 0-based indices (as text). Raises :class:`CsvError`
     for an unknown or repeated column."""
     layout = csv_layout(path)
-    names = _names(layout)
+    names = list(layout.names)
     if columns.strip() == 'all':
         return names[1:]
     out = []
@@ -255,20 +283,12 @@ def column_names(path, columns: str) -> List[str]:
     return out
 
 
-def _names(layout: CsvLayout) -> List[str]:
-    """The header's names of ``layout``'s file (or the indices, as text, without a header)."""
-    if not layout.has_header:
-        return [str(i) for i in range(layout.width)]
-    with layout.path.open('rb') as handle:
-        return [name.strip() for name in next(_rows(handle))[2]]
-
-
 def read_csv_columns(path, columns: str) -> Tuple[np.ndarray, np.ndarray, List[str]]:
     """``(t, Y, names)``: time and the ``columns`` (:func:`column_names`) as the columns of
     ``Y``, read in one pass by :func:`read_csv_series`'s rules."""
     names = column_names(path, columns)
     layout = csv_layout(path, names[0])
-    every = _names(layout)
+    every = list(layout.names)
     layout = replace(layout, indices=tuple(every.index(name) for name in names))
     parts = list(csv_column_blocks(layout)) or [(np.empty(0), np.empty((0, len(names))))]
     t, y = (np.concatenate(p) for p in zip(*parts))

@@ -71,7 +71,9 @@ from ..io.fields import (
     topic_channels,
 )
 from . import health as H
+from .baseline_monitor import BaselineMonitor
 from .cadence import Cadence, Watchdog
+from .mode_shapes import ModeShapesPublisher
 from .parameters import (
     config_of,
     config_value,
@@ -217,6 +219,7 @@ class EstimatorNode(Node):
         #: the input topics (several: resolved, their channels are named after them)
         self._topics = topics if len(topics) < 2 else tuple(map(self.resolve_topic_name, topics))
         declare_config(self)
+        mode_shapes = ModeShapesPublisher.declare(self)
         #: warnings about params files that set nothing for this node (also logged)
         self.params_file_warnings = warn_unused_params_files(self, kwargs.get('cli_args'))
         try:
@@ -251,6 +254,10 @@ class EstimatorNode(Node):
         self._outputs = Outputs(self)
         self._outputs.set_modes(self._stream.config.modes)
         self._outputs.set_channels(self._channels, self._stream.config.modes)
+        #: with a geometry_file: vibration/mode_shapes, the modes' shapes for RViz
+        self._mode_shapes = ModeShapesPublisher.create(self, mode_shapes, self._channels)
+        #: health monitoring against a learned baseline (baseline_file; docs/health.md)
+        self.baseline_monitor = BaselineMonitor(self, lambda: self._stream.origin)
         # before the subscription: a node whose input is matched answers its services; a deep
         # request history, so that a burst of calls queues instead of being dropped
         service_qos = QoSProfile(depth=SERVICE_DEPTH, reliability=ReliabilityPolicy.RELIABLE)
@@ -363,6 +370,8 @@ class EstimatorNode(Node):
         self._stream.configure(config_of(self), self._channels)
         self._outputs.set_modes(self._stream.config.modes)
         self._outputs.set_channels(self._channels, self._stream.config.modes)
+        if self._mode_shapes is not None:
+            self._mode_shapes.set_channels(self._channels)
         self._ready = self._stream.ready
         if not self._ready:
             self._warmup_logged = False
@@ -451,6 +460,10 @@ class EstimatorNode(Node):
             self._outputs.publish(estimate, header)
             if joint:
                 self._outputs.publish_shape(item)
+            if self._mode_shapes is not None:
+                self._mode_shapes.update(estimate, item.shape if joint else None)
+            if self.baseline_monitor.active:
+                self.baseline_monitor.estimate(estimate)
             self._stream.published(estimate, time.monotonic())
 
     # ---- warm-up (the kernels compile in a thread; see .stream) -------------------------------
@@ -567,6 +580,8 @@ class EstimatorNode(Node):
                 self._align_tick,
             )
             self._align_tick = {name: counters[name] for name in H.ALIGN_PROBLEMS}
+        if self.baseline_monitor.active:
+            status = self.baseline_monitor.status(status)
         if status.log:
             self.get_logger().warn(status.log)
         array = DiagnosticArray(

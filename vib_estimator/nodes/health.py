@@ -181,6 +181,7 @@ class Health:
         self._input_at: Optional[float] = None
         self._band_warned: Optional[tuple] = None
         self._bad_warned = False
+        self._hinted: Optional[str] = None
 
     # ---- counters ----------------------------------------------------------------------------
     def count(self, name: str, n: int = 1) -> int:
@@ -236,12 +237,14 @@ class Health:
         last_t: Optional[float],
         band_hz: Optional[Sequence[float]] = None,
         modes: int = 0,
+        hint: Optional[str] = None,
     ) -> Status:
         """The status at ``now``; updates the rates and the ``band_above_nyquist`` counter.
 
         STALE without input for :attr:`stale_after` s; WARN when a :data:`HELD_BACK` counter grew
-        since the last estimate, when JointState messages lacked the joint since the last call, or
-        when ``band_hz`` reaches the Nyquist frequency of the input; OK otherwise.
+        since the last estimate, when JointState messages lacked the joint since the last call,
+        when ``band_hz`` reaches the Nyquist frequency of the input, or with a ``hint`` (what the
+        input shows that the configuration does not fit; logged when it starts); OK otherwise.
         """
         tick = self._tick
         messages = totals.get('received', 0) + totals['skipped_joint_missing']
@@ -265,7 +268,11 @@ class Health:
         bad, bad_log = self._check_bad_input(totals)
         if bad:
             problems.append(bad)
-        log = '; '.join(text for text in (log, bad_log) if text) or None
+        hint_log = hint if hint and not self._hinted else None  # logged when it starts
+        self._hinted = hint
+        if hint:
+            problems.append(hint)
+        log = '; '.join(text for text in (log, bad_log, hint_log) if text) or None
         if self._input_at is None or now - self._input_at > self.stale_after:
             level, message = STALE, 'no input'
         elif problems:

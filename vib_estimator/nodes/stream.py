@@ -30,6 +30,7 @@ from collections import deque
 from functools import partial
 from typing import Any, Callable, Dict, Iterator, Optional, Sequence, Tuple
 
+from ..core.choice import WATCH_S, DrivenWatch
 from ..core.config import EstimatorConfig
 from ..core.estimator import COUNTER_NAMES, Estimate, as_estimates
 from ..core.modes import create_estimator
@@ -130,6 +131,8 @@ class EstimatorStream:
         self._self_test: Tuple[Any, Tuple[bool, str]] = (None, (False, ''))
         #: seconds the last warm-up took (None before one ended)
         self.warmup_seconds: Optional[float] = None
+        #: whether the input looks driven throughout (a hint when the estimator is free's)
+        self._watch = DrivenWatch()
         self.configure(config)
 
     @property
@@ -172,7 +175,11 @@ class EstimatorStream:
         if self.origin is None:
             self.origin = stamp_ns
         self.last_t = t = seconds_since(stamp_ns, self.origin)
-        return as_estimates(self._update(t, value))
+        self._watch.update(t, value if isinstance(value, float) else value[0])
+        estimates = as_estimates(self._update(t, value))
+        for e in estimates:
+            self._watch.follow(getattr(e, 'estimate', e).frequency_hz)
+        return estimates
 
     @property
     def held_samples(self) -> int:
@@ -236,7 +243,9 @@ class EstimatorStream:
             }
             return Status(WARN, WARMUP_MESSAGE, values)
         config = self.config
-        status = self.health.status(now, self.counters, self.last_t, config.band_hz, config.modes)
+        status = self.health.status(
+            now, self.counters, self.last_t, config.band_hz, config.modes, self._driven_hint()
+        )
         if len(self.channels) >= MIN_CHANNELS:  # a joint identification: which channels
             status.values['channels'] = ','.join(self.channels)
         return status
@@ -246,6 +255,18 @@ class EstimatorStream:
         with the last; counters kept. Nothing during a warm-up (the held samples go on)."""
         if self.ready:
             self.estimator.restart()
+
+    def _driven_hint(self) -> Optional[str]:
+        """With the free-decay estimator, what to say when the input looks driven throughout
+        (:class:`~vib_estimator.core.choice.DrivenWatch`); else None."""
+        share = self._watch.driven()
+        if share is None or self.config.excitation != 'free':
+            return None
+        return (
+            f'the input looks driven ({100 * share:.0f} % of the energy of the last '
+            f'{WATCH_S:g} s): free-decay estimates of a driven structure scatter; '
+            'excitation:=ambient identifies its modes (auto: both, per stretch)'
+        )
 
     def reset(self) -> Tuple[bool, str]:
         """Start a new segment at the last sample; counters kept. (False, why) during a warm-up."""

@@ -1,0 +1,149 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
+"""With no option, ``analyze`` and ``survey`` decide each record's excitation and window from
+the record (analysis.choosing over core.choice): a free decay gives exactly ``--excitation
+free``'s output, a driven record the identifier's modes; ``--paper`` and ``--excitation`` are
+never overridden."""
+
+import json
+
+import numpy as np
+import pytest
+
+from vib_estimator.analysis.choosing import window_advice
+from vib_estimator.cli import main
+from vib_estimator.sim.ambient import ambient_record
+from vib_estimator.sim.frame import frame_record
+
+
+def write(path, t, y, names=None):
+    y = np.asarray(y).reshape(len(t), -1)
+    names = names or [f'ch{i + 1}' for i in range(y.shape[1])]
+    np.savetxt(
+        path, np.column_stack([t, y]), delimiter=',', header=','.join(['t', *names]), comments=''
+    )
+    return path
+
+
+def analyze(capsys, *args):
+    assert main(['analyze', *map(str, args)]) == 0
+    out, err = capsys.readouterr()
+    return [json.loads(line) for line in out.splitlines()], err
+
+
+@pytest.fixture
+def free_decay(tmp_path):
+    t = np.arange(0, 10, 0.002)
+    y = np.exp(-0.01 * 2 * np.pi * 5 * t) * np.sin(2 * np.pi * 5 * t)
+    y += 0.01 * np.random.default_rng(0).standard_normal(len(t))
+    return write(tmp_path / 'decay.csv', t, y)
+
+
+@pytest.fixture
+def driven(tmp_path):
+    t, y, _ = ambient_record(120, 200, [(2.0, 0.01, 1.0), (7.0, 0.01, 0.5)], 20, 1)
+    return write(tmp_path / 'driven.csv', t, y)
+
+
+def test_a_free_decay_gives_exactly_the_free_estimator_s_output(capsys, free_decay):
+    rows, err = analyze(capsys, free_decay)
+    assert 'analyze: excitation free (the default decides from the record' in err
+    free, err_free = analyze(capsys, free_decay, '--excitation', 'free')
+    assert rows == free and len(rows) > 10
+    assert 'decides from the record' not in err_free
+
+
+def test_a_driven_record_gets_the_identifier_and_its_modes(capsys, driven):
+    rows, err = analyze(capsys, driven)
+    assert 'analyze: excitation ambient (the default decides from the record' in err
+    assert 'window 60 s (120 periods of 2 Hz)' in err
+    f = np.array([r['frequency_hz'] for r in rows])
+    for true in (2.0, 7.0):
+        near = np.abs(f / true - 1) <= 0.02
+        assert near.sum() > 20
+    assert np.all(np.min(np.abs(f[:, None] / [2.0, 7.0] - 1), axis=1) <= 0.05)
+    # the summary is per mode; the window option keeps its value
+    assert 'mode 1: f = 2.0' in err and 'mode 2: f = 7.0' in err
+    _, err = analyze(capsys, driven, '--ambient-window-s', '40')
+    assert 'excitation ambient' in err
+    rows_free, err = analyze(capsys, driven, '--excitation', 'free')
+    assert 'decides' not in err and all(r['mode'] == 0 for r in rows_free)
+    _, err = analyze(capsys, driven, '--paper')
+    assert 'decides' not in err
+
+
+def test_several_channels_of_a_driven_frame_get_the_joint_identifier(capsys, tmp_path):
+    t, y, freqs, _ = frame_record(240, 40, seed=2)
+    rows, err = analyze(capsys, write(tmp_path / 'frame.csv', t, y), '--columns', 'all')
+    assert 'excitation ambient' in err and 'shape_ch5' in rows[0]
+    f = np.array([r['frequency_hz'] for r in rows])
+    found = [np.any(np.abs(f / true - 1) <= 0.01) for true in freqs]
+    assert sum(found) >= 4
+
+
+def test_survey_decides_each_recording(capsys, tmp_path, free_decay, driven):
+    assert main(['survey', str(free_decay), str(driven), '--format', 'jsonl']) == 0
+    rows = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    by = {}
+    for r in rows:
+        by.setdefault(r['recording'].rsplit('/', 1)[-1], []).append(r)
+    assert [r['mode'] for r in by['decay.csv']] == [0]
+    assert sorted(r['mode'] for r in by['driven.csv']) == [1, 2]
+
+
+def test_a_forced_excitation_the_record_contradicts_is_warned_about(capsys, free_decay, driven):
+    _, err = analyze(capsys, driven, '--excitation', 'free')
+    assert 'warning: the record looks driven throughout' in err
+    _, err = analyze(capsys, free_decay, '--excitation', 'ambient')
+    assert 'warning: the record looks like free decays' in err
+    for args in ((free_decay, '--excitation', 'free'), (driven, '--excitation', 'ambient')):
+        assert 'warning' not in analyze(capsys, *args)[1]
+    assert 'warning' not in analyze(capsys, driven, '--paper')[1]  # the paper's, as printed
+
+
+def test_no_mode_from_a_short_window_says_which_window_helps(capsys, tmp_path):
+    from vib_estimator.core import EstimatorConfig
+    from vib_estimator.core.choice import decide
+
+    # a 0.5 Hz mode: 20 s hold 1.3 correlation times at zeta 2 %, 6 s at 20 Hz too few samples
+    t, y, _ = ambient_record(200, 20, [(0.5, 0.02, 1.0)], 20, 5)
+    d = decide(t, y)
+    short = EstimatorConfig(excitation='ambient', ambient_window_s=20)
+    assert window_advice(short, d) == (
+        'the 20 s window holds 1.3 correlation times of the 0.5 Hz peak (at zeta 2 %): '
+        '--ambient-window-s 240'
+    )
+    assert window_advice(short.replace(ambient_window_s=300), d) == ''
+    path = write(tmp_path / 'slow.csv', t, y)
+    rows, err = analyze(capsys, path, '--excitation', 'ambient', '--ambient-window-s', '6')
+    assert not rows
+    assert 'a 6 s window holds 120 samples at 20 Hz, fewer than the identifier needs' in err
+    assert '--ambient-window-s 9' in err
+    rows, err = analyze(capsys, path, '--excitation', 'ambient', '--ambient-window-s', '300')
+    assert 'the record is shorter than one window (--ambient-window-s 300; it spans 200 s' in err
+    # the default sizes the window itself and finds the mode
+    rows, err = analyze(capsys, path)
+    assert 'window 140 s' in err and len(rows) > 40
+    err = np.abs(np.array([r['frequency_hz'] for r in rows]) / 0.5 - 1)
+    assert np.mean(err <= 0.02) >= 0.9 and np.all(err <= 0.05)  # issue 37's driven goals
+
+
+def test_a_free_decay_of_two_modes_reports_both(capsys, tmp_path):
+    t = np.arange(0, 10, 0.001)
+    tau = np.maximum(t - 0.5, 0)
+    y = sum(
+        a * np.exp(-0.003 * 2 * np.pi * f * tau) * np.sin(2 * np.pi * f * tau)
+        for f, a in ((10.0, 1.0), (13.0, 0.5))
+    )
+    y += 1e-3 * np.random.default_rng(3).standard_normal(len(t))
+    rows, err = analyze(capsys, write(tmp_path / 'two.csv', t, y))
+    assert 'separate modes (10, 13 Hz): the mode tracker, modes 3' in err
+    f = np.array([r['frequency_hz'] for r in rows])
+    for true in (10.0, 13.0):
+        near = np.abs(f / true - 1) <= 0.02
+        assert near.sum() > 20
+    err_rel = np.min(np.abs(f[:, None] / [10.0, 13.0] - 1), axis=1)
+    assert np.mean(err_rel <= 0.02) >= 0.9
+    # --modes keeps the user's count
+    _, err = analyze(capsys, write(tmp_path / 'two.csv', t, y), '--modes', '2')
+    assert 'separate modes' in err

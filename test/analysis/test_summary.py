@@ -1,0 +1,134 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
+"""``analyze``'s summary never gives a confident wrong answer: a frequency that moved is
+summarised per stretch and shaped for the last one; a mode on too few estimates is tentative;
+the modes of an identifier are never pooled; the default CSV column is named."""
+
+import re
+from pathlib import Path
+
+import numpy as np
+
+from vib_estimator.analysis.summary import (
+    MIN_ESTIMATES,
+    STRETCH_REL,
+    shaped_mode,
+    stretches,
+    summarise_modes,
+    summary_lines,
+)
+from vib_estimator.cli import main
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def steps(levels, each, scatter, seed=0):
+    """Estimates in time order: ``each`` at each frequency of ``levels``, relative ``scatter``."""
+    rng = np.random.default_rng(seed)
+    f = np.repeat(levels, each) * (1 + scatter * rng.standard_normal(len(levels) * each))
+    return f, np.arange(len(f), dtype=float)
+
+
+def test_a_steady_mode_is_one_stretch_and_a_moved_one_three():
+    # a steady mode scattering by 1 % (several times the scatter of a real mode's estimates)
+    f, _ = steps([5.0], 60, 0.01)
+    assert len(stretches(f)) == 1
+    # one estimate 20 % off is an outlier, not a move
+    f[30] *= 1.2
+    assert len(stretches(f)) == 1
+    # three tip masses (Section 5.5: 1.64, 1.33, 1.15 Hz; 19 % and 14 % apart)
+    f, _ = steps([1.6395, 1.3306, 1.1482], 4, 0.001)
+    parts = stretches(f)
+    assert [len(p) for p in parts] == [4, 4, 4]
+    # a move of twice the threshold is found, one of half of it is not
+    for move, found in ((2 * STRETCH_REL, 2), (0.5 * STRETCH_REL, 1)):
+        f, _ = steps([2.0, 2.0 * (1 + move)], 6, 0.001)
+        assert len(stretches(f)) == found
+
+
+def test_the_summary_of_a_moved_mode_is_per_stretch_and_shapes_the_last():
+    f, t = steps([1.6395, 1.3306, 1.1482], 4, 0.001)
+    modes = summarise_modes(f, np.full(len(f), np.nan), None, t)
+    assert [m.stretch for m in modes] == [1, 2, 3] and {m.stretches for m in modes} == {3}
+    assert [round(m.frequency_hz, 2) for m in modes] == [1.64, 1.33, 1.15]
+    assert (modes[2].t_first, modes[2].t_last) == (8.0, 11.0)
+    assert shaped_mode(modes) is modes[2]
+    text = '\n'.join(summary_lines(modes))
+    assert 'the frequency moved' in text
+    # the shaper is designed for the last stretch, its spread that of the stretch alone
+    command = text.splitlines()[-1]
+    assert re.search(r'initial_frequency_hz:=1\.14[0-9]*', command)
+    assert 'shaper:=zvd' in command
+    # without the times the modes are pooled as before (one summary)
+    (pooled,) = summarise_modes(f, np.full(len(f), np.nan))
+    assert pooled.stretches == 1 and pooled.spread_rel > 0.1
+
+
+def test_a_mode_on_too_few_estimates_is_tentative_and_not_shaped():
+    few = MIN_ESTIMATES - 1
+    f = np.concatenate([np.full(few, 1.37), np.full(MIN_ESTIMATES, 3.85)])
+    mode = np.concatenate([np.full(few, 1), np.full(MIN_ESTIMATES, 2)])
+    t = np.arange(len(f), dtype=float)
+    modes = summarise_modes(f, np.full(len(f), 0.01), mode, t)
+    assert [m.tentative for m in modes] == [True, False]
+    lines = summary_lines(modes)
+    assert 'tentative' in lines[1]
+    assert 'initial_frequency_hz:=3.85' in lines[-1]  # the lowest mode that is not tentative
+    assert 'below it are tentative' in lines[-2]
+    # nothing but tentative modes: no shaper, and why
+    lines = summary_lines(summarise_modes(f[:few], np.full(few, 0.01), mode[:few], t[:few]))
+    assert shaped_mode(summarise_modes(f[:few], np.full(few, 0.01))) is None
+    assert lines[-1].startswith('no input shaper recommended')
+    assert not any('ros2 run' in line for line in lines)
+
+
+def test_analyze_summarises_a_bag_whose_frequency_moved_per_stretch(capsys):
+    assert main(['analyze', str(ROOT / 'bags' / 'arm_5_5'), '--format', 'csv']) == 0
+    err = capsys.readouterr().err
+    assert 'the frequency moved during the record (3 stretches' in err
+    # each stretch within 0.5 % of its tip mass's true frequency (Eq. 23)
+    found = [float(x) for x in re.findall(r's: f = ([0-9.]+) ', err)]
+    assert len(found) == 3
+    assert np.allclose(found, [1.6395, 1.3306, 1.1482], rtol=5e-3)
+    command = err.strip().splitlines()[-1]
+    assert (
+        abs(float(re.search(r'initial_frequency_hz:=([0-9.]+)', command)[1]) / 1.1482 - 1) < 5e-3
+    )
+
+
+def test_an_identifier_s_modes_are_summarised_apart(tmp_path, capsys):
+    from vib_estimator.sim.ambient import ambient_record
+
+    t, y, _ = ambient_record(90, 200, [(2.0, 0.01, 1.0), (7.0, 0.01, 0.6)], 25, 3)
+    path = tmp_path / 'driven.csv'
+    np.savetxt(path, np.column_stack([t, y]), delimiter=',', header='t,y', comments='')
+    assert main(['analyze', str(path), '--excitation', 'ambient', '--format', 'csv']) == 0
+    err = capsys.readouterr().err
+    found = [float(x) for x in re.findall(r'mode \d: f = ([0-9.]+) ', err)]
+    assert len(found) == 2 and np.allclose(found, [2.0, 7.0], rtol=0.02)
+    command = err.strip().splitlines()[-1]
+    assert abs(float(re.search(r'initial_frequency_hz:=([0-9.]+)', command)[1]) / 2.0 - 1) < 0.01
+
+
+def test_the_default_column_is_named_and_the_others_listed_when_it_gives_nothing(tmp_path, capsys):
+    t = np.arange(0, 6, 0.002)
+    ring = 0.2 * np.exp(-0.05 * t) * np.sin(2 * np.pi * 1.8 * t)
+    path = tmp_path / 'rig.csv'
+    np.savetxt(
+        path,
+        np.column_stack([t, np.zeros_like(t), ring]),
+        delimiter=',',
+        header='time_s,hub,tip',
+        comments='',
+    )
+    assert main(['analyze', str(path)]) == 0
+    err = capsys.readouterr().err
+    assert 'analyze: column hub (the first after the time, the default; the others: tip' in err
+    assert "column hub gave no estimate; the file's other columns: tip" in err
+    # a comment line naming the columns names them (no header row)
+    path.write_text(
+        '# time_s,tip_g  (a note, with a comma)\n' + '\n'.join(f'{a},{b}' for a, b in zip(t, ring))
+    )
+    assert main(['analyze', str(path), '--column', 'tip_g', '--format', 'csv']) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert len(out) > 2 and abs(float(out[1].split(',')[1]) / 1.8 - 1) < 0.01

@@ -1,0 +1,240 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
+"""The default's decision from the record (core.choice): free decays stay free, driven records go
+to the identifier with a window sized to their fundamental; each constant pinned from both
+sides."""
+
+import numpy as np
+import pytest
+
+from vib_estimator.core import choice
+from vib_estimator.core.choice import decide, principal_component, spectral_peaks
+from vib_estimator.sim.ambient import ambient_record
+from vib_estimator.sim.frame import frame_record
+
+
+def decay(f, zeta, seconds, fs=500.0, noise=0.002, seed=0, plucks=(0.0,)):
+    t = np.arange(0, seconds, 1 / fs)
+    y = np.zeros_like(t)
+    for p in plucks:
+        on = t >= p
+        tau = t[on] - p
+        y[on] += np.exp(-zeta * 2 * np.pi * f * tau) * np.sin(2 * np.pi * f * tau)
+    return t, y + noise * np.random.default_rng(seed).standard_normal(len(t))
+
+
+@pytest.mark.parametrize(
+    'record',
+    [
+        decay(5.0, 0.01, 10),
+        decay(0.8, 0.02, 20),  # a low decay: the block holds 3.75 periods, not 1 s
+        decay(16.4, 0.003, 20, fs=1000),
+        decay(1.33, 0.004, 18, plucks=(0, 6, 12)),  # three plucks
+    ],
+)
+def test_free_decays_stay_free(record):
+    d = decide(*record)
+    assert d.excitation == 'free' and d.driven_share < choice.FREE_BELOW
+    assert d.window_s == 30.0  # the configured window, untouched
+
+
+@pytest.mark.parametrize(
+    'modes, fundamental',
+    [
+        ([(5.0, 0.01, 1.0)], 5.0),
+        ([(3.0, 0.02, 1.0), (11.0, 0.01, 0.5), (23.0, 0.005, 0.2)], 3.0),
+        ([(1.2, 0.015, 1.0), (4.0, 0.01, 0.3)], 1.2),
+    ],
+)
+def test_driven_records_go_to_the_identifier_with_a_window_for_their_fundamental(
+    modes, fundamental
+):
+    t, y, _ = ambient_record(240, 100, modes, 20, 1)
+    d = decide(t, y)
+    assert d.excitation == 'ambient' and d.driven_share > choice.DRIVEN_ABOVE
+    assert abs(d.fundamental_hz / fundamental - 1) < 0.03
+    want = min(max(30.0, choice.WINDOW_PERIODS / fundamental), choice.MAX_WINDOW_S)
+    assert d.window_s == pytest.approx(min(want, 240 - choice.MIN_ANALYSES), rel=0.03)
+    assert 'read driven' in d.reason and 'window' in d.reason
+
+
+def test_the_window_is_bounded_by_the_record_and_the_maximum():
+    t, y, _ = ambient_record(150, 50, [(0.3, 0.02, 1.0)], 20, 2)  # 400 s wanted
+    d = decide(t, y)
+    assert d.excitation == 'ambient'
+    assert d.window_s == pytest.approx(150 - choice.MIN_ANALYSES, abs=0.1)
+    t, y, _ = ambient_record(900, 20, [(0.3, 0.02, 1.0)], 20, 2)
+    assert decide(t, y).window_s == choice.MAX_WINDOW_S
+
+
+def test_several_channels_decide_on_their_principal_component():
+    t, y, freqs, _ = frame_record(300, 40, seed=3)
+    d = decide(t, y, channels=y.shape[1])
+    assert d.excitation == 'ambient'
+    assert abs(d.fundamental_hz / freqs[0] - 1) < 0.03
+    # the principal component carries the channels' strongest common motion
+    pc = principal_component(y)
+    assert pc.shape == (len(t),) and np.var(pc) >= np.max(np.var(y, axis=0))
+
+
+def test_a_mixed_record_goes_to_auto_and_a_short_one_stays_free():
+    t1, y1 = decay(2.0, 0.005, 60, fs=200)
+    t2, y2, _ = ambient_record(60, 200, [(2.0, 0.01, 0.1)], 30, 4)
+    t = np.concatenate([t1, t2 + 60])
+    y = np.concatenate([y1, y2])
+    d = decide(t, y)
+    assert choice.FREE_BELOW < d.driven_share < choice.DRIVEN_ABOVE and d.excitation == 'auto'
+    # several channels take the joint estimator of the larger share
+    assert decide(t, np.column_stack([y, y]), channels=2).excitation in ('free', 'ambient')
+    assert decide(t[:50], y[:50]).excitation == 'free'
+
+
+def test_spectral_peaks_need_prominence_and_share():
+    t = np.arange(0, 60, 0.01)
+    rng = np.random.default_rng(0)
+    y = (
+        np.sin(2 * np.pi * 3 * t)
+        + 0.1 * np.sin(2 * np.pi * 7 * t)
+        + 0.01 * rng.standard_normal(len(t))
+    )
+    f, p = spectral_peaks(t, y)
+    assert abs(f[0] - 3) < 0.06 and any(abs(f - 7) < 0.06)
+    assert p[0] == max(p)
+
+
+def mixed(free_s=60.0, driven_s=60.0, fs=200.0):
+    """A 2 Hz pluck ringing for ``free_s``, then the same mode driven for ``driven_s``."""
+    t1, y1 = decay(2.0, 0.005, free_s, fs=fs)
+    t2, y2, _ = ambient_record(driven_s, fs, [(2.0, 0.01, 0.1)], 30, 4)
+    return np.concatenate([t1, t2 + free_s]), np.concatenate([y1, y2])
+
+
+def test_decide_s_limits_what_is_read(monkeypatch):
+    t, y = mixed(40, 200)
+    assert decide(t, y).driven_share > 0.5
+    monkeypatch.setattr(choice, 'DECIDE_S', 35.0)  # the free decay alone
+    assert decide(t, y).excitation == 'free'
+
+
+def test_a_record_driven_only_after_decide_s_is_decided_on_its_start():
+    t, y = mixed(choice.DECIDE_S - 20, 3 * choice.DECIDE_S, fs=20.0)
+    assert decide(t, y).excitation == 'free'
+
+
+def test_a_decay_ringing_down_into_a_long_noise_tail_stays_free():
+    """The envelope reads the stationary noise after a ring-down as driven: a few per cent of the
+    record's energy, below FREE_BELOW."""
+    d = decide(*decay(2.0, 0.005, 500, fs=50, noise=0.02))
+    assert 1e-3 < d.driven_share < choice.FREE_BELOW and d.excitation == 'free'
+
+
+@pytest.mark.parametrize('factor', [1e-3, 1e3])
+@pytest.mark.parametrize(
+    'name', ['WINDOW_PERIODS', 'PEAK_DB', 'SEGMENT_S', 'DRIVEN_ABOVE', 'FREE_BELOW']
+)
+def test_the_constants_are_pinned_from_both_sides(monkeypatch, name, factor):
+    """Each constant at 0.001x and at 1000x breaks a decision it exists for: a free decay stays
+    free (also ringing down into a long noise tail), a driven 1.2 Hz mode gets the identifier and
+    ~100 s, a mixed record auto."""
+    free = decay(5.0, 0.01, 10)
+    tail = decay(2.0, 0.005, 500, fs=50, noise=0.02)
+    t, y, _ = ambient_record(240, 100, [(1.2, 0.015, 1.0)], 20, 1)
+    both = mixed()
+
+    def right():
+        d = decide(t, y)
+        return (
+            decide(*free).excitation == 'free'
+            and decide(*tail).excitation == 'free'
+            and decide(*both).excitation == 'auto'
+            and d.excitation == 'ambient'
+            and 90 <= d.window_s <= 110
+            and abs(d.fundamental_hz / 1.2 - 1) < 0.03
+        )
+
+    assert right()
+    monkeypatch.setattr(choice, name, getattr(choice, name) * factor)
+    assert not right()
+
+
+def watch(t, y, step=100):
+    """DrivenWatch over ``(t, y)``, asked every ``step`` samples: the answers."""
+    from vib_estimator.core.choice import DrivenWatch
+
+    w = DrivenWatch()
+    out = []
+    for k in range(0, len(t), step):
+        for a, b in zip(t[k : k + step].tolist(), y[k : k + step].tolist()):
+            w.update(a, b)
+        out.append(w.driven())
+    return out
+
+
+@pytest.mark.parametrize('factor', [1e-3, 1e3])
+@pytest.mark.parametrize('name', ['WATCH_S', 'LIVE_LEVEL'])
+def test_the_stream_watch_tells_a_driven_input_and_its_constants_are_pinned(
+    monkeypatch, name, factor
+):
+    """Driven throughout: said once half the watched span (60 s) is in, not before; a decay
+    ringing down into noise: never. Each constant at 0.001x and 1000x breaks one of them."""
+    t, y, _ = ambient_record(300, 100, [(1.2, 0.015, 1.0)], 20, 1)
+    ring_t = np.arange(0, 300, 0.01)
+    ring = np.exp(-0.01 * 2 * np.pi * 2 * ring_t) * np.sin(2 * np.pi * 2 * ring_t)
+    ring += 0.01 * np.random.default_rng(0).standard_normal(len(ring_t))
+
+    def right():
+        said = [s is not None for s in watch(t, y)]  # one answer a second
+        return not any(said[:59]) and sum(said[200:]) >= 90 and not any(watch(ring_t, ring))
+
+    assert right()
+    monkeypatch.setattr(choice, name, getattr(choice, name) * factor)
+    assert not right()
+
+
+def several(freqs, amps, zetas, seconds=10.0, fs=1000.0, clip=None, seed=0):
+    """A free decay of several modes from t = 0.5 s, maybe clipped (its harmonics)."""
+    t = np.arange(0, seconds, 1 / fs)
+    tau = np.maximum(t - 0.5, 0)
+    y = sum(
+        a * np.exp(-z * 2 * np.pi * f * tau) * np.sin(2 * np.pi * f * tau)
+        for f, a, z in zip(freqs, amps, zetas)
+    )
+    if clip is not None:
+        y = np.clip(y, -clip, clip)
+    return t, y + 1e-3 * np.random.default_rng(seed).standard_normal(len(t))
+
+
+@pytest.mark.parametrize('factor', [1e-3, 1e3])
+@pytest.mark.parametrize('name', ['MODE_SHARE', 'MODE_GAP', 'HARMONIC_TOL', 'TRACKED_MODES'])
+def test_a_free_decay_of_several_modes_goes_to_the_mode_tracker(monkeypatch, name, factor):
+    """Two modes 30 % apart and 8/21 Hz at 1:0.3: the tracker; one mode, a heavily clipped one
+    (harmonics) and the simulated arm's three tip masses (a mode that moved, and its moves'
+    peaks): one estimator. Each constant at 0.001x and 1000x breaks one of them."""
+    from vib_estimator.sim import arm_model
+
+    pair = several((10.0, 13.0), (1.0, 0.5), (0.003, 0.003))
+    wide = several((8.0, 21.0), (1.0, 0.3), (0.003, 0.002))
+    one = several((12.03,), (1.0,), (0.003,))
+    clipped = several((12.03,), (1.0,), (0.003,), clip=0.2)
+    arm = arm_model.experiment_5_5(0)
+
+    def right():
+        try:
+            return (
+                decide(*pair).modes == decide(*wide).modes == 3
+                and decide(*one).modes == decide(*clipped).modes == 0
+                and decide(arm.t, arm.torque).modes == 0
+                and 'separate modes (10, 13 Hz)' in decide(*pair).reason
+            )
+        except (TypeError, ValueError):
+            return False
+
+    assert right()
+    monkeypatch.setattr(choice, name, getattr(choice, name) * factor)
+    if name == 'TRACKED_MODES':  # a count of modes the configuration refuses
+        from vib_estimator.core import EstimatorConfig
+
+        with pytest.raises(ValueError):
+            EstimatorConfig(modes=decide(*pair).modes).validate()
+        return
+    assert not right()

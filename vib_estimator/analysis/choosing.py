@@ -1,0 +1,196 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
+"""What ``analyze`` and ``survey`` learn from a record before estimating it
+(:func:`..core.choice.decide`), and what they say with it.
+
+- The default: with no ``--excitation`` (and no ``--paper``) the excitation and the ambient
+  window are the record's (:func:`decided_config`); one line says what was decided, from what,
+  and which option overrides it.
+- An ``--excitation`` that the record contradicts (free on a record driven throughout, ambient on
+  a free decay) costs one ``warning:`` line (:func:`contradiction`).
+- No estimate from the identifier: why, with the numbers, and which option helps
+  (:func:`window_advice`: the window's correlation times of the record's lowest peak).
+
+The lines are printed by the command once the record has been read without error (bad input is
+one ``error:`` line)."""
+
+from __future__ import annotations
+
+import itertools
+import math
+from typing import Iterable, Iterator, Optional, Tuple
+
+import numpy as np
+
+from ..core.ambient import MIN_WINDOW_SAMPLES
+from ..core.choice import DECIDE_S, DRIVEN_ABOVE, FREE_BELOW, WINDOW_PERIODS, Decision, decide
+from ..core.config import EstimatorConfig
+
+#: the damping ratio :func:`window_advice` assumes of the lowest mode (the choice's
+#: :data:`..core.choice.WINDOW_PERIODS` is ~15 correlation times at it)
+ASSUMED_ZETA = 0.02
+
+
+def decides(args) -> bool:
+    """Whether the command line leaves the excitation to the record (no ``--excitation``, no
+    ``--paper``)."""
+    return getattr(args, 'excitation', None) is None and not getattr(args, 'paper', False)
+
+
+def window_given(args) -> bool:
+    """Whether the command line sets the ambient window (``--ambient-window-s``)."""
+    return getattr(args, 'ambient_window_s', None) is not None
+
+
+def decided_config(
+    config: EstimatorConfig, d: Decision, prog: str, keep_window: bool = False
+) -> Tuple[EstimatorConfig, str]:
+    """``config`` with the excitation, (unless ``keep_window``: ``--ambient-window-s`` was
+    given) the ambient window and (unless ``config.modes`` is set) the modes to track of the
+    decision ``d``, and the line that says so."""
+    window = config.ambient_window_s
+    if not keep_window and d.excitation != 'free':
+        window = d.window_s
+    modes = config.modes or d.modes
+    line = (
+        f'{prog}: excitation {d.excitation} (the default decides from the record: {d.reason}; '
+        '--excitation free, ambient or auto overrides'
+        + ('' if d.excitation == 'free' else ', --ambient-window-s the window')
+        + ')'
+    )
+    return config.replace(excitation=d.excitation, ambient_window_s=window, modes=modes), line
+
+
+def contradiction(config: EstimatorConfig, d: Decision, prog: str) -> str:
+    """One ``warning:`` line when the chosen excitation contradicts the record (free decays'
+    estimates of a driven record scatter; the identifier needs a stationary response), else
+    ''."""
+    share = f'{100 * d.driven_share:.0f} % of its energy read driven'
+    if config.excitation == 'free' and d.driven_share > DRIVEN_ABOVE:
+        return (
+            f'{prog}: warning: the record looks driven throughout ({share}): free-decay estimates '
+            'of a driven structure scatter; without --excitation the default would use ambient'
+        )
+    if config.excitation == 'ambient' and d.driven_share < FREE_BELOW:
+        return (
+            f'{prog}: warning: the record looks like free decays ({share}): the identifier '
+            'needs a stationary response; without --excitation the default would use free'
+        )
+    return ''
+
+
+def window_advice(config: EstimatorConfig, d: Optional[Decision]) -> str:
+    """Why a window gave no mode, from the record's lowest spectral peak: how many correlation
+    times ``1 / (2 pi zeta f)`` (at :data:`ASSUMED_ZETA`) of it the window holds, and the window
+    that holds the decision's :data:`..core.choice.WINDOW_PERIODS` periods; '' without a peak."""
+    if d is None or not math.isfinite(d.fundamental_hz):
+        return ''
+    f, window = d.fundamental_hz, config.ambient_window_s
+    times = window * 2 * math.pi * ASSUMED_ZETA * f
+    want = WINDOW_PERIODS / f
+    if window >= want:
+        return ''
+    return (
+        f'the {window:g} s window holds {times:.1f} correlation times of the {f:.3g} Hz peak (at '
+        f'zeta {100 * ASSUMED_ZETA:g} %): --ambient-window-s {math.ceil(want)}'
+    )
+
+
+def short_window(config: EstimatorConfig, d: Optional[Decision]) -> str:
+    """Why no window was analysed: the record is shorter than one, or one holds fewer samples
+    than the identifier needs (:data:`..core.ambient.MIN_WINDOW_SAMPLES`), with the window that
+    would do."""
+    window = config.ambient_window_s
+    if d is not None and math.isfinite(d.rate_hz) and d.span_s >= window:
+        need = math.ceil(MIN_WINDOW_SAMPLES / d.rate_hz)
+        return (
+            f'a {window:g} s window holds {window * d.rate_hz:.0f} samples at {d.rate_hz:.3g} Hz, '
+            f'fewer than the identifier needs ({MIN_WINDOW_SAMPLES}): --ambient-window-s {need}'
+        )
+    text = f'the record is shorter than one window (--ambient-window-s {window:g}'
+    if d is not None and math.isfinite(d.span_s):
+        text += f'; it spans {d.span_s:.3g} s: a shorter window, at the cost of precision'
+    return text + ')'
+
+
+def read_ahead(
+    blocks: Iterable[Tuple[np.ndarray, np.ndarray]],
+) -> Tuple[Optional[Tuple[np.ndarray, np.ndarray]], Iterator[Tuple[np.ndarray, np.ndarray]]]:
+    """The samples ``(t, y)`` of a stream's first :data:`..core.choice.DECIDE_S` s (None if it
+    has none) and every block, the ones read ahead first (memory: those seconds only)."""
+    blocks = iter(blocks)
+    ahead = []
+    for t, y in blocks:
+        if not len(t):
+            continue
+        ahead.append((t, y))
+        if float(t[-1]) - float(ahead[0][0][0]) >= DECIDE_S:
+            break
+    if not ahead:
+        return None, blocks
+    samples = tuple(np.concatenate([b[i] for b in ahead]) for i in (0, 1))
+    return samples, itertools.chain(ahead, blocks)
+
+
+def prepare(
+    args, config: EstimatorConfig, t, y, channels: int, prog: str
+) -> Tuple[EstimatorConfig, Decision, list[str]]:
+    """The configuration a command line and a record ``(t, y)`` give (the default decided from
+    the record: :func:`decides`), the decision, and the lines to print once the record has been
+    estimated (what was decided, or a contradiction)."""
+    d = decide(t, y, channels, config.ambient_window_s)
+    if decides(args):
+        config, line = decided_config(config, d, prog, window_given(args))
+        return config, d, [line]
+    if getattr(args, 'paper', False):
+        return config, d, []  # the paper's configuration, as printed
+    warning = contradiction(config, d, prog)
+    return config, d, [warning] if warning else []
+
+
+def explain_no_estimate(
+    counters, open_samples: Optional[int], config: EstimatorConfig, d: Optional[Decision] = None
+) -> str:
+    """Why a run gave no estimate, from its counters (and the record's decision ``d``: its
+    spectrum), and what to try."""
+    if counters.get('used', 0) == 0:
+        return 'no sample was usable (see the skipped_* counters)'
+    analyses, flat = counters.get('analyses', 0), counters.get('flat_windows', 0)
+    if analyses and flat == analyses:
+        return f'the signal is constant (every window analysed was flat: flat_windows={flat})'
+    if config.excitation == 'ambient':
+        if not analyses:
+            return short_window(config, d)
+        advice = window_advice(config, d)
+        return (
+            f'no mode stood out of the noise, stable over the model orders and in consecutive '
+            f'windows, in {analyses} analyses: '
+            + (
+                advice
+                or 'try --band-hz around the modes of interest or a longer --ambient-window-s'
+            )
+        )
+    held = {k: v for k, v in counters.items() if v and k.startswith('rejected_')}
+    if held:
+        return (
+            'every converged estimate was held back by the quality gate ('
+            + ', '.join(f'{k}={v}' for k, v in held.items())
+            + '): check --min-fit, '
+            '--max-damping, --min-amplitude, or the model (--model)'
+        )
+    text = 'the convergence test (Eqs. 16-17) never fired'
+    if open_samples:
+        text += f' (the last segment ran {open_samples} samples without converging'
+        text += (
+            ', '
+            + (
+                'max_window automatic: 10 s'
+                if not config.max_window
+                else f'max_window {config.max_window:g} s'
+            )
+            + ')'
+        )
+    return (
+        text + f': the signal may not follow --model {config.model} (a decay: try '
+        '--model damped-sinusoid), or try a larger --tolerance or a longer recording'
+    )

@@ -1,0 +1,269 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
+"""What a record needs, decided from the record itself: the default of ``vib-estimator analyze``
+(no ``--excitation``, no ``--paper``), where the whole record is at hand (pure numpy/scipy).
+
+A newcomer passes no option; a plucked beam, a machine driven without rest and a building under
+wind each need another estimator and, when driven, a window sized to the structure. From the
+first :data:`DECIDE_S` seconds of the record (all channels):
+
+1. **The spectrum** (Welch, segments of :data:`SEGMENT_S` s): its peaks standing
+   :data:`PEAK_DB` above their surroundings (prominence) and holding at least
+   :data:`PEAK_SHARE` of the strongest one's power; the strongest is the **dominant** frequency,
+   the lowest the **fundamental**.
+2. **Free or driven**, by the envelope of :mod:`.auto` (:class:`.auto.Envelope`) over the record's
+   first principal component (one channel: the signal), its block :data:`.auto.BLOCK_PERIODS`
+   x :data:`.auto.BLOCK_MARGIN` periods of the dominant frequency (a 1 s block of a 0.8 Hz
+   decay jitters by more than the envelope tests): the share of the record's energy in what it
+   reads as driven (the envelope starts free and needs a few blocks to tell: a record driven
+   throughout shows 80-98 %; the noise a decay rings down into weighs nothing).
+   Below :data:`FREE_BELOW`: ``free`` (the algebraic estimator, exactly as ``--excitation free``);
+   above :data:`DRIVEN_ABOVE`: ``ambient`` (output-only identification); between, one channel:
+   ``auto`` (per stretch), several: the larger share's (the joint estimators take free or
+   ambient).
+3. **Several modes** in a free decay: peaks that are modes of their own (:func:`separate_modes`)
+   send it to the mode tracker (``modes`` :data:`TRACKED_MODES`), each mode numbered.
+4. **The window** of a driven record: :data:`WINDOW_PERIODS` periods of the fundamental
+   (about 15 correlation times ``1 / (2 pi zeta f)`` of a mode at zeta = 2 %: the frequency of a
+   lightly damped mode scatters by more than 2 % across windows of a few correlation times, and
+   the identifier drops it), at least the configured ``ambient_window_s`` and at most
+   :data:`MAX_WINDOW_S`, and no longer than the record allows :data:`MIN_ANALYSES` analyses of.
+
+Each decision carries its reasons in words (:attr:`Decision.reason`), which ``analyze`` prints.
+
+A stream cannot be seen ahead: :class:`DrivenWatch` keeps the same envelope over
+``estimator_node``'s input and tells, over the last :data:`WATCH_S` s, when a free-decay
+estimator is fed a response driven throughout (its ``/diagnostics`` then say so, and which
+``excitation`` helps).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass, field
+from typing import Optional
+
+import numpy as np
+
+from .auto import BLOCK_MARGIN, BLOCK_PERIODS, DRIVEN, FREE, MIN_BLOCK_S, Envelope
+
+#: the first seconds of a record the decision reads
+DECIDE_S = 600.0
+#: samples stamped beyond this many seconds are not read (an absurd stamp)
+MAX_STAMP_S = 1e12
+#: ... nor values farther from the median than this many median absolute deviations (a pluck of
+#: 1 in a long record of 1e-4 noise stands at ~1e4)
+ABSURD = 1e6
+#: Welch segment, s (0.05 Hz resolution: a 1.2 Hz building mode's peak stands apart)
+SEGMENT_S = 20.0
+#: a spectral peak's prominence over its surroundings, dB
+PEAK_DB = 10.0
+#: ... and its power at least this share of the strongest peak's
+PEAK_SHARE = 1e-3
+#: a record whose envelope reads driven for less than this share of its time is a free decay
+FREE_BELOW = 0.1
+#: ... and one read driven for more than this share is driven throughout (the envelope's first
+#: blocks of a driven record read free: 80-98 % measured, a 1.2 Hz mode's 3 s blocks the least)
+DRIVEN_ABOVE = 0.7
+#: a free decay whose spectrum holds several separate modes (:func:`separate_modes`) goes to the
+#: mode tracker with this many modes (on bench_modes' records, modes 3 has every mode within 2 %
+#: from 0.7-2 periods, where the one estimator reports the strongest alone, or a mixture)
+TRACKED_MODES = 3
+#: ... a separate mode: a peak holding at least this share of the strongest's power (the
+#: simulated arm's moves leave peaks of 1-3 %, a second mode at 30 % amplitude 4-16 %)
+MODE_SHARE = 0.02
+#: ... at least this far (relative) from every stronger mode (the arm's three tip masses'
+#: 1.33 / 1.56 Hz, 17 %, are one mode that moved)
+MODE_GAP = 0.25
+#: ... and not within this of a harmonic (2-7 x) of one
+HARMONIC_TOL = 0.02
+#: a driven record's window, in periods of its fundamental (~15 correlation times at zeta 2 %)
+WINDOW_PERIODS = 120.0
+#: the longest window the decision chooses, s
+MAX_WINDOW_S = 300.0
+#: the window leaves the record room for at least this many analyses (one per second)
+MIN_ANALYSES = 60
+
+
+@dataclass(frozen=True)
+class Decision:
+    """The excitation a record needs, the ambient window (s) for a driven one, what the decision
+    saw and why, in words."""
+
+    excitation: str
+    window_s: float
+    driven_share: float
+    dominant_hz: float
+    fundamental_hz: float
+    peaks_hz: tuple = field(default=())
+    reason: str = ''
+    #: the seconds and the mean sampling rate of what was read
+    span_s: float = math.nan
+    rate_hz: float = math.nan
+    #: a free decay of several separate modes: the modes to track (0: one estimator)
+    modes: int = 0
+
+
+def principal_component(y: np.ndarray) -> np.ndarray:
+    """One signal from ``y`` (samples, or samples x channels): the projection of the centred
+    channels on their covariance's leading eigenvector (one channel: the signal centred)."""
+    y = np.asarray(y, dtype=np.float64)
+    y = y - np.mean(y, axis=0)
+    if y.ndim == 1 or y.shape[1] == 1:
+        return y.reshape(-1)
+    _, vectors = np.linalg.eigh(y.T @ y)
+    return y @ vectors[:, -1]
+
+
+def spectral_peaks(t: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(frequencies, powers)`` of the spectrum's peaks (module docstring, 1), strongest first,
+    summed over the channels of ``y``."""
+    from scipy.signal import find_peaks, welch
+
+    fs = (len(t) - 1) / float(t[-1] - t[0])
+    y = np.asarray(y, dtype=np.float64).reshape(len(t), -1)
+    nper = int(min(len(t), max(64, round(SEGMENT_S * fs))))
+    freq, psd = welch(y, fs, nperseg=nper, axis=0, detrend='constant')
+    psd = np.sum(psd, axis=1)
+    level = 10 * np.log10(np.maximum(psd, 1e-300 + 1e-12 * float(np.max(psd))))
+    idx, _ = find_peaks(level, prominence=PEAK_DB)
+    idx = idx[freq[idx] > 2 * fs / nper]  # above the segment's own lowest bins (a drift)
+    if not len(idx):
+        return np.empty(0), np.empty(0)
+    order = idx[np.argsort(psd[idx])[::-1]]
+    order = order[psd[order] >= PEAK_SHARE * psd[order[0]]]
+    return freq[order], psd[order]
+
+
+def driven_share(t: np.ndarray, signal: np.ndarray, dominant_hz: float) -> float:
+    """The share of the record's energy (``signal`` centred, squared) in the samples the envelope
+    (:class:`.auto.Envelope`, its block fitted to ``dominant_hz``) reads as driven: the noise a
+    free decay rings down into (a stationary tail the envelope reads as driven) weighs nothing
+    beside the decay."""
+    block = MIN_BLOCK_S
+    if dominant_hz > 0:
+        block = max(MIN_BLOCK_S, BLOCK_MARGIN * BLOCK_PERIODS / dominant_hz)
+    valid, driven = Envelope(block).feed(t, signal)
+    energy = np.where(valid, (signal - np.mean(signal[valid])) ** 2, 0.0)
+    total = float(np.sum(energy))
+    return float(np.sum(energy[driven])) / total if total > 0 else 0.0
+
+
+def decide(t, y, channels: int = 1, window_s: float = 30.0) -> Decision:
+    """The :class:`Decision` for the record ``(t, y)`` (its first :data:`DECIDE_S` s are read;
+    ``y`` samples or samples x ``channels``), ``window_s`` the shortest window (the configured
+    one)."""
+    t = np.asarray(t, dtype=np.float64)
+    y = np.asarray(y, dtype=np.float64)
+    # finite samples at sane times (an absurd stamp, 1e300 s, would overflow the block index)
+    keep = (np.abs(t) < MAX_STAMP_S) & np.all(np.isfinite(y.reshape(len(t), -1)), axis=1)
+    t, y = t[keep], y[keep]
+    if len(t):  # an absurd value (1e300: the estimator skips it as an outlier) is not read
+        dev = np.abs(y - np.median(y, axis=0)).reshape(len(t), -1)
+        mad = np.median(dev, axis=0)
+        keep = np.all(dev <= ABSURD * np.maximum(mad, np.max(mad) + 1e-300), axis=1)
+        t, y = t[keep], y[keep]
+    if len(t) > 1:
+        n = int(np.searchsorted(t, t[0] + DECIDE_S, 'right'))
+        t, y = t[:n], y[:n]
+    if len(t) < 64 or not t[-1] > t[0]:
+        return Decision('free', window_s, 0.0, math.nan, math.nan, (), 'too short to tell: free')
+    peaks, powers = spectral_peaks(t, y)
+    dominant = float(peaks[0]) if len(peaks) else math.nan
+    fundamental = float(np.min(peaks)) if len(peaks) else math.nan
+    share = driven_share(t, principal_component(y), dominant if len(peaks) else 0.0)
+    span = float(t[-1] - t[0])
+    seen = (
+        f'{100 * share:.0f} % of the energy of {span:.0f} s read driven by the envelope; spectral '
+        'peaks at '
+        + (', '.join(f'{f:.3g}' for f in sorted(peaks[:8])) + ' Hz' if len(peaks) else 'none')
+    )
+    if share < FREE_BELOW:
+        excitation = 'free'
+    elif share > DRIVEN_ABOVE or channels > 1:
+        excitation = 'ambient' if share >= 0.5 else 'free'
+    else:
+        excitation = 'auto'
+    window = window_s
+    if excitation != 'free' and math.isfinite(fundamental):
+        room = max(window_s, span - MIN_ANALYSES)
+        window = min(max(window_s, WINDOW_PERIODS / fundamental), MAX_WINDOW_S, room)
+        seen += (
+            f'; window {window:.0f} s ({window * fundamental:.0f} periods of {fundamental:.3g} Hz)'
+        )
+    modes = 0
+    separate = separate_modes(peaks, powers)
+    if excitation == 'free' and len(separate) > 1:
+        modes = TRACKED_MODES
+        seen += (
+            f'; {len(separate)} separate modes ('
+            + ', '.join(f'{f:.3g}' for f in sorted(separate))
+            + f' Hz): the mode tracker, modes {modes}'
+        )
+    rate = (len(t) - 1) / span
+    return Decision(
+        excitation, window, share, dominant, fundamental, tuple(peaks), seen, span, rate, modes
+    )
+
+
+def separate_modes(peaks: np.ndarray, powers: np.ndarray) -> list[float]:
+    """The spectral peaks (strongest first) that are modes of their own: at least
+    :data:`MODE_SHARE` of the strongest's power, :data:`MODE_GAP` (relative) from every stronger
+    one kept, and no harmonic (within :data:`HARMONIC_TOL`) of one (a clipped or non-sinusoidal
+    response)."""
+    kept: list[float] = []
+    for f, p in zip(peaks.tolist(), powers.tolist()):
+        if p < MODE_SHARE * powers[0] or any(abs(f / k - 1) < MODE_GAP for k in kept):
+            continue
+        if any(abs(f / (k * n) - 1) < HARMONIC_TOL for k in kept for n in range(2, 8)):
+            continue
+        kept.append(f)
+    return kept
+
+
+#: the seconds of a stream :class:`DrivenWatch` judges
+WATCH_S = 120.0
+#: ... and the least mean variance they must hold, relative to the stream's largest block's
+LIVE_LEVEL = 1e-2
+
+
+class DrivenWatch:
+    """Whether a stream's last :data:`WATCH_S` s look driven throughout: the share of their energy
+    in the blocks auto's envelope (:class:`.auto.Envelope`, its block following the free
+    estimates' frequency) read as driven above :data:`DRIVEN_ABOVE`, their mean level at least
+    :data:`LIVE_LEVEL` of the largest block's (not the noise a decay rang down into) and the
+    envelope driven now. Fed sample by sample (:meth:`update`), asked at most once a second
+    (:meth:`driven`)."""
+
+    def __init__(self):
+        self._envelope = Envelope(4 * MIN_BLOCK_S, MAX_WINDOW_S / 10)
+        self._marks: deque = deque()  # (stream time, free energy, driven energy)
+        self._last_t = math.nan
+
+    def update(self, t: float, y: float) -> None:
+        self._envelope.update(t, y)
+        self._last_t = t
+
+    def follow(self, f: float) -> None:
+        """A free estimate of ``f`` Hz: the block holds a few of its periods."""
+        self._envelope.follow(f)
+
+    def driven(self) -> Optional[float]:
+        """The driven share of the last :data:`WATCH_S` s' energy when they look driven
+        throughout (see the class doc), else None. Marks the stream's energies now."""
+        env = self._envelope
+        now = (self._last_t, env.energy[FREE], env.energy[DRIVEN])
+        marks = self._marks
+        if not math.isfinite(now[0]):
+            return None
+        marks.append(now)
+        while len(marks) > 2 and now[0] - marks[1][0] >= WATCH_S:
+            marks.popleft()
+        span = now[0] - marks[0][0]
+        free, driven = now[1] - marks[0][1], now[2] - marks[0][2]
+        if span < WATCH_S / 2 or env.state != DRIVEN or not free + driven > 0:
+            return None
+        share = driven / (free + driven)
+        live = (free + driven) / span >= LIVE_LEVEL * env.peak
+        return share if share > DRIVEN_ABOVE and live else None
