@@ -4,7 +4,8 @@ VENV    := .venv
 STAMP   := $(VENV)/.installed
 export ROS_AUTOMATIC_DISCOVERY_RANGE := LOCALHOST
 
-.PHONY: setup setup-jazzy test-jazzy demo shaping test bench bench-all reproduce compare bags survey survey-ambient survey-temperature clean
+.PHONY: setup setup-jazzy test-jazzy demo shaping test bench bench-all soak reproduce compare \
+	bags survey survey-ambient survey-temperature clean
 
 setup: $(STAMP)
 
@@ -66,6 +67,10 @@ bench-all: bench
 	$(VENV)/bin/python benchmarks/real_data.py
 	$(VENV)/bin/python benchmarks/bench_channels.py
 	$(VENV)/bin/python benchmarks/bench_defaults.py
+
+# the nodes for 6 minutes at speed 10 with a fault every 24 s (docs/soak.md); SOAK_ARGS=--minutes 480
+soak: setup
+	$(VENV)/bin/python benchmarks/soak.py $(SOAK_ARGS)
 
 reproduce: setup
 	$(VENV)/bin/vib-estimator reproduce fig1 --out out/fig1.png

@@ -15,7 +15,7 @@ Loss test. A publisher in another process (reliable QoS, history 1000) sends sam
 of a 1.33 Hz sine (stamps of a notional 500 Hz stream) at a paced rate for one second; the
 subscriber in this process spins its executor until nothing more arrives and counts what its
 callback got. A rate passes when received == sent in REPEATS trials in a row. The subscription
-has the node's QoS (best effort, history 1000): a sample is lost when the history overflows before
+has the node's QoS (best effort, history 5000): a sample is lost when the history overflows before
 the executor takes it, the loss a real best-effort sensor stream suffers. Rates rise and stop at
 the first loss, or when the publisher cannot reach the rate (then the figure is a lower bound).
 An empty-callback subscriber with the same QoS, the ceiling of a Python node, takes turns with

@@ -365,6 +365,58 @@ def test_trend_plot_shows_the_baseline_and_the_alarm_band(tmp_path):
     assert all(np.allclose(line.get_ydata(), 0.01) for line in fig.axes[1].get_lines())
 
 
+def test_links_to_recordings_are_followed_and_counted(tmp_path, capsys):
+    """A folder of symbolic links to bag folders and files (a cycle included) is surveyed as the
+    recordings themselves, and stderr says how many were found (issue 40)."""
+    store = tmp_path / 'store'
+    days = fleet(store, [1.3, 1.31])
+    np.savetxt(store / 'sine.csv', np.column_stack([np.arange(4500) * 0.002] * 2), delimiter=',')
+    links = tmp_path / 'links'
+    links.mkdir()
+    for day in days:
+        (links / day.name).symlink_to(day, target_is_directory=True)
+    (links / 'sine.csv').symlink_to(store / 'sine.csv')
+    (links / 'loop').symlink_to(links, target_is_directory=True)
+    assert main(['survey', str(links), '--format', 'jsonl', '--jobs', '1']) == 0
+    out = capsys.readouterr()
+    rows = jsonl(out.out)
+    assert [Path(r['recording']).name for r in rows] == ['day_00', 'day_01', 'sine.csv']
+    assert not any(r['error'] for r in rows[:2]) and rows[0]['estimates'] > 5
+    assert f'3 recording(s) found in {links}' in out.err
+
+
+@pytest.mark.parametrize('make', ['empty', 'missing', 'only_text'])
+def test_no_recording_found_is_one_error_line_exit_2(tmp_path, capsys, make):
+    target = tmp_path / 'fleet'
+    if make != 'missing':
+        target.mkdir()
+    if make == 'only_text':
+        (target / 'sub').mkdir()
+        (target / 'sub' / 'notes.txt').write_text('not a recording')
+    assert main(['survey', str(target)]) == 2
+    out = capsys.readouterr()
+    assert out.out == ''
+    assert out.err.count('\n') == 1 and 'error: no recording found in' in out.err
+
+
+def test_used_counts_the_samples_used_under_every_excitation(tmp_path, capsys):
+    """A mode's row carries the stream's input counters (ambient reported used 0 for 12 000
+    samples used, issue 40)."""
+    from vib_estimator.sim.frame import modal_record
+
+    t, y = modal_record(80.0, 20.0, [(1.0, 0.02, 1.0)], np.ones((1, 1)), snr_db=20.0, seed=1)
+    y = y.reshape(len(t))
+    y[100] = np.nan
+    np.savetxt(tmp_path / 'run.csv', np.column_stack([t, y]), delimiter=',', header='t,y')
+    for excitation in ('free', 'ambient'):
+        args = ['survey', str(tmp_path), '--format', 'jsonl', '--excitation', excitation]
+        assert main(args + ['--modes', '1', '--ambient-window-s', '40']) == 0
+        (row,) = jsonl(capsys.readouterr().out)
+        assert row['mode'] == 1 and (row['estimates'] > 0 or excitation == 'free'), excitation
+        assert row['samples'] == len(t) and row['skipped_non_finite'] == 1, excitation
+        assert row['used'] == len(t) - 1, excitation
+
+
 def test_trend_legend_is_beside_the_axes_each_entry_once_and_lines_break_at_gaps(tmp_path):
     """Two modes, one missing on a day: no line across that day; 'alarm' listed once."""
     rows = []

@@ -219,3 +219,11 @@ def test_alignment_status_names_a_lagging_topic_and_new_drops():
     assert H.alignment_status(ok, [], 0, grown, grown).level == H.OK  # nothing new
     stale = H.alignment_status(H.Status(H.STALE, 'no input', {}), ['/b'], 5, counters, counters)
     assert stale.level == H.STALE and stale.message.startswith('no input; /b behind')
+
+
+def test_the_identities_fail_when_a_sample_is_unaccounted():
+    c = {'received': 10, 'used': 8, 'skipped_duplicate': 1, 'skipped_outlier': 1}
+    c.update(samples_missing=5, lost_in_queue=2, missing_in_gaps=3)
+    assert all(H.identities(c).values())
+    assert not all(H.identities({**c, 'used': 7}).values())
+    assert not all(H.identities({**c, 'missing_in_gaps': 2}).values())

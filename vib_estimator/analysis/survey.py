@@ -58,6 +58,7 @@ import numpy as np
 
 from ..core import COUNTER_NAMES, EstimatorConfig
 from ..core.choice import decide
+from ..core.estimator import INPUT_COUNTERS
 from ..core.multichannel import mac
 from ..errors import VibEstimatorError, report
 from ..extras import optional
@@ -99,6 +100,12 @@ SUMMARIES = ('weighted', 'median')
 #: natural frequency carries no bias on decaying records and which estimates the damping trended
 DEFAULT_MODEL = 'damped-sinusoid'
 _COUNTERS = tuple(c for c in COUNTER_NAMES if c not in ('received', 'estimates'))
+#: the counters of the input stream, the same in every mode's row
+_INPUT_COUNTERS = tuple(c for c in INPUT_COUNTERS if c in _COUNTERS) + (
+    'gaps',
+    'samples_lost',
+    'skipped_outlier',
+)
 #: the columns of a row, in order
 COLUMNS = (
     ('recording', 'topic', 'component', 'mode')
@@ -251,9 +258,17 @@ _RECORDING_SUFFIXES = ('.mcap', '.db3', '.csv')
 
 def _in_directory(root: Path, ignored: List[Path]) -> Iterable[Path]:
     """The recordings under ``root``; a folder without any (no recording file, no subfolder) is
-    yielded itself (its row says it is not a bag), other files are appended to ``ignored``."""
-    for folder, dirs, files in os.walk(root):
+    yielded itself (its row says it is not a bag), other files are appended to ``ignored``.
+    Symbolic links to folders and files are followed (a folder reached twice, e.g. by a link
+    cycle, is searched once)."""
+    seen = set()
+    for folder, dirs, files in os.walk(root, followlinks=True):
         here = Path(folder)
+        real = os.path.realpath(here)
+        if real in seen:
+            dirs.clear()
+            continue
+        seen.add(real)
         if _is_bag_dir(here):
             dirs.clear()
             yield here
@@ -284,6 +299,12 @@ def find_recordings(inputs: Sequence[str], ignored: Optional[List[Path]] = None)
             else:
                 found.add(match)
     return sorted(found)
+
+
+def is_recording(path: Path) -> bool:
+    """True for what :func:`find_recordings` returns that is a recording (a bag folder, an
+    existing file), False for a name matching nothing or a folder without any."""
+    return _is_bag_dir(path) or path.is_file()
 
 
 # ---------------------------------------------------------------------------------- one recording
@@ -370,12 +391,15 @@ def _stat_rows(
     modes = modes or int(est.mode.max(initial=0))  # a joint estimator numbers its modes
     for mode in range(1, modes + 1) if modes else [0]:
         take = est.mode == mode
+        # the input counters (samples used, skipped, gaps) are the stream's, under every mode and
+        # excitation; a mode's own counters (its estimates, rejections) where the estimator keeps
+        # them (a joint run: the mode's estimates only)
+        stream = result.estimator.counters
+        counters = {c: stream.get(c, 0) for c in _INPUT_COUNTERS}
         if not modes:
-            counters = result.estimator.counters
+            counters = stream
         elif joint is None:
-            counters = result.estimator.mode_counters().get(mode, {})
-        else:
-            counters = {}  # as a one-channel ambient run's: the mode's estimates only
+            counters.update(result.estimator.mode_counters().get(mode, {}))
         rows.append(
             _row(
                 recording,
@@ -980,7 +1004,23 @@ def run(args: argparse.Namespace) -> int:
     except (ValueError, VibEstimatorError) as err:
         return report(err, 'vib-estimator survey')
     ignored: List[Path] = []
-    rows = survey(find_recordings(args.inputs, ignored), options, args.jobs, args.scheduler)
+    recordings = find_recordings(args.inputs, ignored)
+    found = sum(map(is_recording, recordings))
+    if not found:
+        where = ', '.join(args.inputs)
+        return report(
+            ValueError(
+                f'no recording found in {where} (rosbag2 bag folders, .mcap, .db3 or .csv '
+                'files, searched recursively, links followed)'
+            ),
+            'vib-estimator survey',
+        )
+    if any(glob.has_magic(name) or Path(name).is_dir() for name in args.inputs):  # searched
+        print(
+            f'vib-estimator survey: {found} recording(s) found in {", ".join(args.inputs)}',
+            file=sys.stderr,
+        )
+    rows = survey(recordings, options, args.jobs, args.scheduler)
     report_entries(rows, ignored, sys.stderr)
     if base is not None:
         flag(rows, base, args.alarm_rel)

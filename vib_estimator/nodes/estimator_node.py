@@ -9,7 +9,8 @@ and the diagnostics bookkeeping, all without rclpy) and publishes what comes bac
 
 * Input: ``coupling_torque`` (parameter ``input_topic``, read-only) of type ``input_type``
   (read-only; the types and components of :mod:`vib_estimator.io.fields`), best-effort sensor-data
-  QoS with a deeper history (:data:`INPUT_DEPTH`); field ``component``, or with ``components``
+  QoS with a deeper history (:data:`INPUT_DEPTH`), its stamps' cadence watched (:mod:`.cadence`:
+  what never reached the node, counted); field ``component``, or with ``components``
   several fields of each message, estimated jointly (free decays or ``excitation`` ambient:
   docs/channels.md); with ``input_topics`` (read-only, two or more topics of ``input_type``, which
   must have a header) the fields of each topic, the topics' samples aligned by header stamp
@@ -47,6 +48,7 @@ from typing import Optional
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.clock import Clock, ClockType
+from rclpy.event_handler import SubscriptionEventCallbacks
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
 from rclpy.time import Time
@@ -70,6 +72,7 @@ from ..io.fields import (
 )
 from . import health as H
 from .baseline_monitor import BaselineMonitor
+from .cadence import Cadence, Watchdog
 from .mode_shapes import ModeShapesPublisher
 from .parameters import (
     config_of,
@@ -81,10 +84,16 @@ from .parameters import (
 from .runner import run
 from .stream import WARMUP_BUFFER, WARMUP_MESSAGE, EstimatorStream, check_channels
 
-#: input history: sensor-data QoS (best effort) but 1000 deep instead of 5, so that a scheduling
-#: hiccup of up to 2 s at 500 Hz, or a player's burst after a stall, drops nothing
-#: (benchmarks/bench_node.py measures the effect of the depth)
-INPUT_DEPTH = 1000
+#: input history: sensor-data QoS (best effort: it matches best-effort and reliable publishers
+#: alike) but 5000 deep instead of 5, so that a burst of 5000 messages at full publisher speed, a
+#: stall of 10 s at 500 Hz or 1 s at 5 kHz, drops nothing (Fast DDS caps a reader's history at
+#: its default max_samples, 5000: a deeper one held no more). Beyond it the oldest are replaced,
+#: counted from the stamps as lost_in_queue (.cadence). The cost: up to 5000 messages held
+#: (~1 MB of WrenchStamped), and after a long stall the estimates lag by up to that many samples
+#: while the node drains them (benchmarks/bench_node.py measures the effect of the depth).
+#: A reliable input would have lost none in the queue, but cannot match the best-effort sensor
+#: drivers (QoS incompatible) and makes a slow node slow its publisher down.
+INPUT_DEPTH = 5000
 #: how often the end of a warm-up is looked for, and after how long it is announced, s
 WARMUP_POLL = 0.05
 WARMUP_NOTICE = 1.0
@@ -233,6 +242,12 @@ class EstimatorNode(Node):
                 jump_ns=round(self._stream.config.max_gap * 1e9),
             )
         self._align_tick: dict = {}
+        #: each input topic's stamps' cadence (what never reached the node, counted: .cadence)
+        self._cadences = [
+            Cadence(self._stream.health.node_counters, round(self._stream.config.max_gap * 1e9))
+            for _ in self._topics
+        ]
+        self._observe = self._cadences[0].observe  # bound once (data path)
         self._feed = self._stream.feed  # bound once (data path)
         self._ready = self._stream.ready
         self._clock = self.get_clock()
@@ -257,10 +272,11 @@ class EstimatorNode(Node):
             callbacks = [self._on_stamped if has_header(self._input_type) else self._on_unstamped]
         else:
             callbacks = [partial(self._on_topic, i) for i in range(len(self._topics))]
-        self._subscriptions_in = [
-            self.create_subscription(message_class(self._input_type), topic, callback, qos)
-            for topic, callback in zip(self._topics, callbacks)
-        ]
+        self._input_qos = qos
+        self._input_callbacks = callbacks
+        self._subscriptions_in = [self._subscribe(i) for i in range(len(self._topics))]
+        #: each input subscription's watchdog (never deaf: .cadence.Watchdog)
+        self._watchdogs = [Watchdog() for _ in self._topics]
         self._input_names = ','.join(sub.topic_name for sub in self._subscriptions_in)
         self.add_on_set_parameters_callback(self._check_parameters)
         self.add_post_set_parameters_callback(self._apply_parameters)
@@ -276,6 +292,38 @@ class EstimatorNode(Node):
             f'({self._input_type} [{", ".join(self._channels)}]) with '
             f'{self._stream.config}'
         )
+
+    def _subscribe(self, index: int):
+        """The subscription to input topic ``index`` (with the middleware's own count of the
+        samples it lost before the queue)."""
+        return self.create_subscription(
+            message_class(self._input_type),
+            self._topics[index],
+            self._input_callbacks[index],
+            self._input_qos,
+            event_callbacks=SubscriptionEventCallbacks(message_lost=self._on_message_lost),
+        )
+
+    def _watch_inputs(self, now: float) -> None:
+        """Re-create an input subscription whose publishers are matched but from which nothing
+        was taken for long (:class:`.cadence.Watchdog`), with one WARN per silence."""
+        stamped = has_header(self._input_type)
+        for i, watchdog in enumerate(self._watchdogs):
+            sub, cadence = self._subscriptions_in[i], self._cadences[i]
+            taken_at = cadence.last_at if stamped else self._stream.health.input_at
+            matched = sub.get_publisher_count()
+            if not watchdog.check(now, taken_at, matched, cadence.period_s):
+                continue
+            topic = sub.topic_name
+            self.destroy_subscription(sub)
+            self._subscriptions_in[i] = self._subscribe(i)
+            self._stream.health.count('input_resubscribed')
+            if watchdog.episode == 1:
+                self.get_logger().warn(
+                    f'{topic}: {matched} publisher(s) matched but no message taken for '
+                    f'{now - taken_at:.1f} s: the subscription is re-created (counted in '
+                    'input_resubscribed; again, without a log, while the silence lasts)'
+                )
 
     def _read_fields(self):
         """The fields of the current ``component`` / ``components`` (ValueError if bad)."""
@@ -317,6 +365,8 @@ class EstimatorNode(Node):
         if self._aligner is not None:  # the queued samples may carry other fields
             self._aligner.clear()
             self._aligner.jump_ns = round(config_of(self).max_gap * 1e9)
+        for cadence in self._cadences:
+            cadence.back_ns = round(config_of(self).max_gap * 1e9)
         self._stream.configure(config_of(self), self._channels)
         self._outputs.set_modes(self._stream.config.modes)
         self._outputs.set_channels(self._channels, self._stream.config.modes)
@@ -336,7 +386,10 @@ class EstimatorNode(Node):
         """A message with a header: its stamp is the sample's time."""
         value = self._stamped_value(msg)
         if value is not None:
-            self._take(stamp_ns(msg.header), value, msg.header)
+            stamp = stamp_ns(msg.header)
+            if self._observe(stamp, time.monotonic()):
+                self._jumped(stamp)
+            self._take(stamp, value, msg.header)
 
     def _stamped_value(self, msg):
         """The channels' value(s) of a message with a header (its zero stamp replaced by the
@@ -379,10 +432,25 @@ class EstimatorNode(Node):
         if value is None:
             return
         values = value if isinstance(value, tuple) else (value,)
-        for stamp, joint, first in self._aligner.push(
-            index, stamp_ns(msg.header), values, msg.header
-        ):
+        stamp = stamp_ns(msg.header)
+        if self._cadences[index].observe(stamp, time.monotonic()):
+            self._jumped(stamp)
+        for stamp, joint, first in self._aligner.push(index, stamp, values, msg.header):
             self._take(stamp, joint, first)
+
+    def _jumped(self, stamp: int) -> None:
+        """The stamps jumped forward (:mod:`.cadence`: counted in ``stamp_jumps``, no sample
+        counted missing): restart the estimator there, and say so."""
+        self._stream.restart()
+        self.get_logger().warn(
+            f'{self._input_names}: the header stamps jumped forward to '
+            f'{stamp * 1e-9:.9f} s, faster than their live rate can account for (a clock set, a '
+            'source restarted ahead): the estimator restarts (counted in stamp_jumps)'
+        )
+
+    def _on_message_lost(self, info) -> None:
+        """The middleware lost samples of an input topic before its queue (counted)."""
+        self._stream.health.count('lost_in_transport', info.total_count_change)
 
     def _publish(self, estimates, header: Header) -> None:
         """Publish the estimates of the sample of ``header`` (see :class:`Outputs`)."""
@@ -496,7 +564,11 @@ class EstimatorNode(Node):
     def _publish_diagnostics(self) -> None:
         """Publish the status; log the last estimate every 10 s (rclpy's throttled logging costs
         ~0.15 ms a call, too much for the data path)."""
-        status = self._stream.status(time.monotonic())
+        now = time.monotonic()
+        for cadence in self._cadences:
+            cadence.flush(now)
+        status = self._stream.status(now)
+        self._watch_inputs(now)
         if self._aligner is not None:
             counters = self._stream.health.node_counters
             lagging = self._aligner.lagging(round(H.STALE_AFTER * 1e9))

@@ -19,6 +19,8 @@ import math
 from dataclasses import dataclass, replace
 from typing import Dict, Mapping, Optional, Sequence
 
+from .cadence import CADENCE_COUNTERS
+
 #: levels, equal to ``diagnostic_msgs/DiagnosticStatus``'s
 OK, WARN, ERROR, STALE = 0, 1, 2, 3
 #: period of /diagnostics of every node, s
@@ -34,19 +36,56 @@ HELD_BACK = (
     'rejected_inconsistent',
     'max_window_resets',
 )
-#: core counters of bad input: their growth since the previous status makes it WARN (and is logged
-#: once per episode)
-BAD_INPUT = ('gaps', 'samples_lost', 'skipped_outlier')
+#: counters of bad input: their growth since the previous status makes it WARN (and is logged
+#: once per episode): the core's (its short gaps, long ones and the samples they lost, outliers)
+#: and the stamps' cadence's (:mod:`.cadence`)
+BAD_INPUT = (
+    'gaps',
+    'samples_lost',
+    'skipped_outlier',
+    'gap_resets',
+    'cadence_gaps',
+    'samples_missing',
+    'lost_in_queue',
+    'missing_in_gaps',
+    'stamp_jumps',
+)
 #: the node's own counters: zero header stamps replaced by the receipt time; JointState messages
 #: without the configured joint (skipped); samples received while ``band_hz`` reached above the
 #: Nyquist frequency of the input's sampling rate; samples dropped while the kernels compiled (the
 #: oldest beyond the warm-up buffer of :mod:`.stream`)
 NODE_COUNTERS = (
-    'zero_stamps_replaced',
-    'skipped_joint_missing',
-    'band_above_nyquist',
-    'dropped_warmup',
+    (
+        'zero_stamps_replaced',
+        'skipped_joint_missing',
+        'band_above_nyquist',
+        'dropped_warmup',
+    )
+    + CADENCE_COUNTERS
+    + ('lost_in_transport',)
 )
+
+
+#: what each sample the core received became
+RECEIVED_AS = (
+    'used',
+    'skipped_non_finite',
+    'skipped_duplicate',
+    'skipped_out_of_order',
+    'skipped_outlier',
+)
+
+
+def identities(counters: Mapping[str, int]) -> Dict[str, bool]:
+    """The identities the counters satisfy (docs/nodes.md#what-the-counters-count), by name:
+    whether each holds."""
+    c = counters
+    return {
+        'received = used + skipped': c.get('received', 0)
+        == sum(c.get(name, 0) for name in RECEIVED_AS),
+        'samples_missing = lost_in_queue + missing_in_gaps': c.get('samples_missing', 0)
+        == c.get('lost_in_queue', 0) + c.get('missing_in_gaps', 0),
+    }
 
 
 @dataclass(frozen=True)
@@ -164,6 +203,11 @@ class Health:
         totals.update(self.node_counters)
         return totals
 
+    @property
+    def input_at(self) -> float:
+        """The monotonic time of the status that first saw the last input (0 before any)."""
+        return self._input_at or 0.0
+
     # ---- estimates ---------------------------------------------------------------------------
     def record(self, estimate, now: float, totals: Mapping[str, int]) -> None:
         """An estimate was published at ``now``: mode 0 or 1 is the one of ``vibration/frequency``;
@@ -263,11 +307,22 @@ class Health:
         if not any(grown.values()):
             self._bad_warned = False
             return None, None
-        text = (
-            f'input since the last status: {grown["gaps"]} gaps ({grown["samples_lost"]} '
-            f'samples lost; each restarts the estimate), {grown["skipped_outlier"]} outliers '
-            'skipped'
-        )
+        parts = []
+        if grown['cadence_gaps'] or grown['stamp_jumps']:  # the stamps' cadence (.cadence)
+            parts.append(
+                f'{grown["cadence_gaps"]} gaps in the stamps ({grown["samples_missing"]} samples '
+                f'missing: {grown["lost_in_queue"]} lost in the input queue, the node fell '
+                f'behind; {grown["missing_in_gaps"]} never received)'
+            )
+            if grown['stamp_jumps']:
+                parts.append(f'{grown["stamp_jumps"]} forward jumps of the stamps')
+        else:  # the core's view (input without a header, or a gap not told apart yet)
+            parts.append(
+                f'{grown["gaps"] + grown["gap_resets"]} gaps ({grown["samples_lost"]} samples '
+                'lost; each restarts the estimate)'
+            )
+        parts.append(f'{grown["skipped_outlier"]} outliers skipped')
+        text = 'input since the last status: ' + ', '.join(parts)
         hint = ': check the sensor and its stamps (a lasting change of rate costs one gap)'
         log = None if self._bad_warned else text + hint
         self._bad_warned = True

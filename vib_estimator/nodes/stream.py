@@ -250,6 +250,12 @@ class EstimatorStream:
             status.values['channels'] = ','.join(self.channels)
         return status
 
+    def restart(self) -> None:
+        """Forget the signal (a jump of the stamps): the next sample starts afresh, uncompared
+        with the last; counters kept. Nothing during a warm-up (the held samples go on)."""
+        if self.ready:
+            self.estimator.restart()
+
     def _driven_hint(self) -> Optional[str]:
         """With the free-decay estimator, what to say when the input looks driven throughout
         (:class:`~vib_estimator.core.choice.DrivenWatch`); else None."""

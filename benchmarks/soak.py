@@ -1,0 +1,601 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
+"""A soak: the nodes for a long time at speed, with faults on a seeded schedule; prints figures.
+
+    .venv/bin/python benchmarks/soak.py                      # 6 minutes, a fault every 24 s
+    .venv/bin/python benchmarks/soak.py --minutes 480 --fault-every 60      # a working day
+    make soak                                                # the 6-minute run
+
+What runs (each its own process, as an operator starts them): ``sim_node`` at ``--speed`` (10:
+5000 samples/s of stamps in simulated time, ``excitation`` ambient: the arm never at rest) and
+``estimator_node`` on it with ``use_sim_time`` and ``excitation`` ambient (``-p`` adds parameters;
+its defaults, free decays, on the noise-driven arm: median error 0.8 %, the worst 6 %);
+``bag_replayer`` looping ``bags/arm_5_3`` into a second ``estimator_node`` under ``/replay``.
+This process watches ``/diagnostics``, ``vibration/frequency`` and ``vibration/ground_truth`` and
+injects the faults, in turn from a seeded shuffle of:
+
+* ``stop``: SIGSTOP of estimator_node for 2 s, then SIGCONT;
+* ``restart``: sim_node stopped (SIGINT) and started again: its time goes back to 1 s;
+* ``storm``: 200 parameter sets within a second, every other one invalid (each must be answered,
+  the invalid refused, the valid accepted);
+* ``calls``: 100 concurrent ``~/self_test`` and ``~/reset`` calls (each must be answered);
+* ``burst``: sim_node paused (SIGSTOP) and 5000 messages published at full speed on the input
+  topic, their stamps continuing the simulator's: each must be received or counted
+  (``received`` + ``samples_missing`` grow by 5000); then sim_node resumes (its stamps go back);
+* ``gone``: sim_node stopped for 10 s (SIGINT), then started again.
+
+Measured: estimator_node's RSS every second (growth after the first tenth of the run), each
+fault's recovery (steady seconds from its end to the next message taken and to the next estimate
+published), the diagnostics' longest silence outside the stops, the counters' identities
+(docs/nodes.md#what-the-counters-count) at the end, estimates within 2 % of the simulator's
+ground truth outside the fault windows (a fault's window: from its start until the estimator's
+window, 30 s of simulated time, has moved past its end and the backlog drained), the
+logs' tracebacks, and each node's exit code and time after SIGINT. ``--json`` writes the
+figures. Exit 1 when a goal fails (every fault recovered before the next, identities hold, every
+burst message accounted for, every call answered, no traceback, exit 0 within 2 s).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import random
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+os.environ.setdefault('ROS_DOMAIN_ID', str(120 + os.getpid() % 80))
+os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
+
+import rclpy  # noqa: E402
+from diagnostic_msgs.msg import DiagnosticArray  # noqa: E402
+from geometry_msgs.msg import WrenchStamped  # noqa: E402
+from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue  # noqa: E402
+from rcl_interfaces.srv import SetParameters  # noqa: E402
+from rclpy.node import Node  # noqa: E402
+from rclpy.qos import QoSProfile, ReliabilityPolicy  # noqa: E402
+from std_msgs.msg import Float64  # noqa: E402
+from std_srvs.srv import Trigger  # noqa: E402
+
+from vib_estimator.nodes.health import identities  # noqa: E402
+from vib_estimator.nodes.runner import make_executor  # noqa: E402
+from vib_estimator.nodes.sim_node import GROUND_TRUTH_QOS  # noqa: E402
+
+ROOT = Path(__file__).resolve().parent.parent
+BAG = ROOT / 'bags' / 'arm_5_3'
+FAULTS = ('stop', 'restart', 'storm', 'calls', 'burst', 'gone')
+#: the estimator's analysis window (ambient_window_s, its default), simulated s
+WINDOW_S = 30.0
+#: a fault starts only this long (s) before the end of the run, at the latest
+FAULT_S = {'stop': 6.0, 'restart': 6.0, 'storm': 6.0, 'calls': 6.0, 'burst': 15.0, 'gone': 16.0}
+#: the goals of issue 40
+EXIT_WITHIN_S = 2.0
+ACCURACY = 0.02
+#: seconds of steady time a node is given to show it is alive after a start
+START_S = 60.0
+
+
+def executable(name: str) -> str:
+    """The console script next to this interpreter (a venv), else on the PATH."""
+    here = Path(sys.executable).parent / name
+    return str(here) if here.exists() else name
+
+
+class Proc:
+    """A node's process, its stderr in a file (tracebacks are looked for there)."""
+
+    def __init__(self, name: str, args, logs: Path):
+        self.name = name
+        self.args = [executable(args[0]), *args[1:]]
+        self.logs = logs
+        self.runs = 0
+        self.p = None
+        self.start()
+
+    def start(self) -> None:
+        self.runs += 1
+        err = open(self.logs / f'{self.name}.{self.runs}.err', 'w')
+        self.p = subprocess.Popen(self.args, stdout=err, stderr=err)
+
+    def signal(self, sig) -> None:
+        self.p.send_signal(sig)
+
+    def stop(self) -> tuple:
+        """SIGINT; (exit code, seconds to exit) -- code None if killed after 10 s."""
+        t0 = time.monotonic()
+        self.p.send_signal(signal.SIGINT)
+        try:
+            code = self.p.wait(10.0)
+        except subprocess.TimeoutExpired:
+            self.p.kill()
+            self.p.wait()
+            code = None
+        return code, time.monotonic() - t0
+
+    def rss_mb(self) -> float:
+        try:
+            text = Path(f'/proc/{self.p.pid}/status').read_text()
+        except OSError:
+            return math.nan
+        kb = next(int(line.split()[1]) for line in text.splitlines() if line.startswith('VmRSS'))
+        return kb / 1024.0
+
+    def tracebacks(self) -> int:
+        return sum(
+            path.read_text(errors='replace').count('Traceback')
+            for path in self.logs.glob(f'{self.name}.*.err')
+        )
+
+
+class Watch(Node):
+    """The soak's eyes and hands: diagnostics, estimates, truth; faults' service calls."""
+
+    def __init__(self):
+        super().__init__('soak_watch')
+        self.diag = {}  # node name -> [(steady s, level, message, values)]
+        self.estimates = {'/': [], '/replay': []}  # [(steady s, Hz)]
+        self.truth = []  # [(steady s, Hz)]
+        self.create_subscription(DiagnosticArray, '/diagnostics', self._on_diag, 100)
+        for ns in self.estimates:
+            self.create_subscription(
+                Float64,
+                f'{ns.rstrip("/")}/vibration/frequency',
+                lambda m, ns=ns: self.estimates[ns].append((time.monotonic(), m.data)),
+                100,
+            )
+        self.create_subscription(
+            Float64,
+            'vibration/ground_truth',
+            lambda m: self.truth.append((time.monotonic(), m.data)),
+            GROUND_TRUTH_QOS,
+        )
+        # deep histories: 200 answers at once must not overwrite each other in this client
+        deep = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
+        self.set_params = self.create_client(
+            SetParameters, '/estimator_node/set_parameters', qos_profile=deep
+        )
+        self.triggers = {
+            name: self.create_client(Trigger, f'/estimator_node/{name}', qos_profile=deep)
+            for name in ('self_test', 'reset')
+        }
+
+    def _on_diag(self, msg) -> None:
+        now = time.monotonic()
+        for s in msg.status:
+            values = {kv.key: kv.value for kv in s.values}
+            self.diag.setdefault(s.name, []).append((now, s.level[0], s.message, values))
+
+    def counters(self, name='/estimator_node') -> dict:
+        rows = self.diag.get(name)
+        if not rows:
+            return {}
+        return {k: int(v) for k, v in rows[-1][3].items() if v.lstrip('-').isdigit()}
+
+    def truth_at(self, t: float) -> float:
+        before = [f for at, f in self.truth if at <= t]
+        return before[-1] if before else math.nan
+
+
+def param(name: str, value: float) -> Parameter:
+    return Parameter(
+        name=name, value=ParameterValue(type=ParameterType.PARAMETER_DOUBLE, double_value=value)
+    )
+
+
+class Soak:
+    def __init__(self, args, logs: Path):
+        self.args = args
+        self.logs = logs
+        self.rng = random.Random(args.seed)
+        self.seed = 0
+        speed = f'speed:={args.speed}'
+        excitation = f'excitation:={args.excitation}'
+        self.sim_args = ['sim_node', '--ros-args', '-p', speed, '-p', excitation]
+        self.est = Proc(
+            'estimator_node',
+            ['estimator_node', '--ros-args', '-p', 'use_sim_time:=true', *args.estimator_args],
+            logs,
+        )
+        self.sim = self._sim()
+        self.procs = [self.est, self.sim]
+        if args.replayer:
+            self.replay_est = Proc(
+                'replay_estimator',
+                ['estimator_node', '--ros-args', '-r', '__ns:=/replay'],
+                logs,
+            )
+            self.replayer = Proc(
+                'bag_replayer',
+                [
+                    'bag_replayer',
+                    '--ros-args',
+                    '-p',
+                    f'bag:={BAG}',
+                    '-p',
+                    'loop:=true',
+                    '-p',
+                    'topics:=[/coupling_torque]',
+                    '-p',
+                    "remap:=['/coupling_torque:=/replay/coupling_torque']",
+                ],
+                logs,
+            )
+            self.procs += [self.replay_est, self.replayer]
+        rclpy.init()
+        self.watch = Watch()
+        self.ex = make_executor()
+        self.ex.add_node(self.watch)
+        self.rss = []  # (steady s since start, MB)
+        self.faults = []  # dicts
+        self.problems = []
+
+    def _sim(self, proc=None) -> Proc:
+        self.seed += 1
+        args = self.sim_args + ['-p', f'seed:={self.seed}']
+        if proc is None:
+            return Proc('sim_node', args, self.logs)
+        proc.args = [executable(args[0]), *args[1:]]
+        proc.start()
+        return proc
+
+    # ---- helpers ---------------------------------------------------------------------------
+    def spin(self, seconds: float, until=lambda: False) -> bool:
+        """Spin (and sample RSS) for ``seconds`` or until ``until()``."""
+        end = time.monotonic() + seconds
+        while time.monotonic() < end:
+            if until():
+                return True
+            self.ex.spin_once(timeout_sec=0.05)
+            self._sample_rss()
+        return until()
+
+    def _sample_rss(self) -> None:
+        now = time.monotonic() - self.t0
+        if not self.rss or now - self.rss[-1][0] >= 1.0:
+            self.rss.append((now, self.est.rss_mb()))
+
+    def taken(self) -> int:
+        c = self.watch.counters()
+        return c.get('received', 0) + c.get('skipped_joint_missing', 0)
+
+    # ---- faults ----------------------------------------------------------------------------
+    def fault_stop(self, f) -> None:
+        self.est.signal(signal.SIGSTOP)
+        time.sleep(2.0)  # the node is stopped: nothing to spin for it
+        self.est.signal(signal.SIGCONT)
+
+    def fault_restart(self, f) -> None:
+        f['sim_exit'] = self.sim.stop()[0]
+        self._sim(self.sim)
+
+    def fault_gone(self, f) -> None:
+        f['sim_exit'] = self.sim.stop()[0]
+        self.spin(10.0)
+        self._sim(self.sim)
+
+    def fault_storm(self, f) -> None:
+        client = self.watch.set_params
+        if not client.wait_for_service(timeout_sec=5.0):
+            self.problems.append('storm: set_parameters not available')
+            return
+        futures = []
+        t0 = time.monotonic()
+        for i in range(200):
+            valid = i % 2 == 0
+            value = 0.5 if valid else (-1.0 if i % 4 == 1 else math.nan)  # max_gap
+            futures.append(
+                (
+                    valid,
+                    client.call_async(SetParameters.Request(parameters=[param('max_gap', value)])),
+                )
+            )
+            self.ex.spin_once(timeout_sec=0)
+            delay = t0 + (i + 1) / 200 - time.monotonic()
+            if delay > 0:
+                self.spin(delay)
+        self.spin(30.0, lambda: all(fu.done() for _, fu in futures))
+        answered = [fu for _, fu in futures if fu.done()]
+        wrong = sum(
+            fu.result().results[0].successful != valid for valid, fu in futures if fu.done()
+        )
+        f.update(calls=len(futures), answered=len(answered), wrong_verdicts=wrong)
+        if len(answered) != len(futures) or wrong:
+            self.problems.append(f'storm: {len(answered)}/{len(futures)} answered, {wrong} wrong')
+
+    def fault_calls(self, f) -> None:
+        clients = self.watch.triggers
+        if not all(c.wait_for_service(timeout_sec=5.0) for c in clients.values()):
+            self.problems.append('calls: services not available')
+            return
+        futures = [
+            clients['self_test' if i % 2 else 'reset'].call_async(Trigger.Request())
+            for i in range(100)
+        ]
+        self.spin(60.0, lambda: all(fu.done() for fu in futures))
+        answered = sum(fu.done() for fu in futures)
+        f.update(calls=100, answered=answered)
+        if answered != 100:
+            self.problems.append(f'calls: {answered}/100 answered')
+
+    def fault_burst(self, f) -> None:
+        stamps = []
+        sub = self.watch.create_subscription(
+            WrenchStamped,
+            'coupling_torque',
+            lambda m: stamps.append(m.header.stamp.sec * 10**9 + m.header.stamp.nanosec),
+            QoSProfile(depth=100, reliability=ReliabilityPolicy.BEST_EFFORT),
+        )
+        self.spin(5.0, lambda: len(stamps) > 50)
+        self.sim.signal(signal.SIGSTOP)
+        self.spin(1.0)
+        self.watch.destroy_subscription(sub)
+        if len(stamps) < 50:
+            self.sim.signal(signal.SIGCONT)
+            self.problems.append('burst: no input seen to continue')
+            return
+        period = round((stamps[-1] - stamps[-51]) / 50)
+        before = self.watch.counters()
+        self.spin(3.0, lambda: self.taken() >= before.get('received', 0) and self._quiet(before))
+        # made for the burst only: a publisher matched but silent would wake the watchdog
+        reliable = QoSProfile(depth=10000, reliability=ReliabilityPolicy.RELIABLE)
+        burster = self.watch.create_publisher(WrenchStamped, 'coupling_torque', reliable)
+        self.spin(5.0, lambda: burster.get_subscription_count() >= 1)
+        before = self.watch.counters()
+        msg = WrenchStamped()
+        msg.header.frame_id = 'arm_base'
+        t0 = time.monotonic()
+        last = max(stamps)
+        for k in range(1, 5001):
+            msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(last + k * period, 10**9)
+            msg.wrench.torque.z = math.sin(k * 0.02)
+            burster.publish(msg)
+        f['burst_rate'] = 5000 / (time.monotonic() - t0)
+        # one more after a pause closes the burst (a loss at its end is a gap before it)
+        self.spin(1.5)
+        msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(last + 5001 * period, 10**9)
+        burster.publish(msg)
+
+        def accounted():
+            c = self.watch.counters()
+            return (c.get('received', 0) + c.get('samples_missing', 0)) - (
+                before.get('received', 0) + before.get('samples_missing', 0)
+            )
+
+        self.spin(5.0, lambda: accounted() >= 5001)
+        c = self.watch.counters()
+        f.update(
+            received=c.get('received', 0) - before.get('received', 0),
+            missing=c.get('samples_missing', 0) - before.get('samples_missing', 0),
+            transport=c.get('lost_in_transport', 0) - before.get('lost_in_transport', 0),
+        )
+        if accounted() != 5001:
+            self.problems.append(f'burst: {accounted()} of 5001 received or counted')
+        self.watch.destroy_publisher(burster)
+        self.sim.signal(signal.SIGCONT)
+
+    def _quiet(self, before) -> bool:
+        return self.watch.counters().get('received', 0) == before.get('received', 0)
+
+    # ---- the run ---------------------------------------------------------------------------
+    def run(self) -> dict:
+        self.t0 = time.monotonic()
+        if not self.spin(START_S, lambda: self.taken() > 1000 and self.watch.estimates['/']):
+            self.problems.append('no estimate within the start-up time')
+        order = []
+        end = self.t0 + self.args.minutes * 60
+        next_at = time.monotonic() + self.args.fault_every
+        while time.monotonic() + 5 < end:
+            if not order:
+                order = list(self.args.faults)
+                self.rng.shuffle(order)
+            self.spin(max(0.0, next_at - time.monotonic()))
+            kind = order.pop()
+            if time.monotonic() + FAULT_S[kind] > end:  # it would not end (and a node restarted
+                break  # then stopped in its first second dies of the KeyboardInterrupt)
+            f = {'kind': kind, 'start': time.monotonic()}
+            taken0 = self.taken()
+            getattr(self, f'fault_{kind}')(f)
+            f['end'] = time.monotonic()
+            n_est = len(self.watch.estimates['/'])
+            next_at = f['end'] + self.args.fault_every
+            limit = min(next_at, end) - time.monotonic()
+            got = self.spin(limit, lambda: self.taken() > taken0 + 100)
+            f['input_s'] = time.monotonic() - f['end'] if got else math.nan
+            got = self.spin(
+                min(next_at, end) - time.monotonic(),
+                lambda: len(self.watch.estimates['/']) > n_est,
+            )
+            f['estimate_s'] = time.monotonic() - f['end'] if got else math.nan
+            # a fault whose recovery the end of the run cut short is not judged (None)
+            f['recovered'] = got if got or next_at < end else None
+            self.faults.append(f)
+            print(
+                f'{f["start"] - self.t0:7.1f} s  {kind:8s} input after {f["input_s"]:5.2f} s, '
+                f'estimate after {f["estimate_s"]:5.2f} s'
+                + ''.join(
+                    f', {k} {f[k]:.0f}' if isinstance(f[k], float) else f', {k} {f[k]}'
+                    for k in f
+                    if k not in ('kind', 'start', 'end', 'input_s', 'estimate_s', 'recovered')
+                ),
+                flush=True,
+            )
+        self.spin(max(0.0, end - time.monotonic()))
+        return self.finish()
+
+    def finish(self) -> dict:
+        figures = {'faults': self.faults}
+        final = self.watch.counters()
+        exits = {}
+        for proc in self.procs:
+            code, seconds = proc.stop()
+            exits[proc.name] = (code, round(seconds, 2))
+        self.spin(0.5)
+        # the counters
+        ident = identities(final)
+        # accuracy outside the fault windows
+        # a fault's window: from its start until the estimator's window has moved past its end
+        # and the backlog drained (an estimate of samples the fault touched: a burst's are not the
+        # arm's); a fault not recovered, to the end
+        window = WINDOW_S / self.args.speed
+        windows = [
+            (
+                f['start'],
+                f['end'] + window + (f['input_s'] if f['input_s'] == f['input_s'] else 0.0)
+                if f['recovered'] is not False
+                else math.inf,
+            )
+            for f in self.faults
+        ]
+        errors = []
+        for at, hz in self.watch.estimates['/']:
+            if any(a <= at <= b for a, b in windows):
+                continue
+            truth = self.watch.truth_at(at)
+            if truth == truth:
+                errors.append(abs(hz / truth - 1))
+        errors.sort()
+        # RSS after the first tenth
+        settled = [mb for t, mb in self.rss if t >= 0.1 * self.args.minutes * 60 and mb == mb]
+        rss_growth = (max(settled) - settled[0]) if settled else math.nan
+        # diagnostics silences outside the stops
+        stamps = [row[0] for row in self.watch.diag.get('/estimator_node', [])]
+        stops = [(f['start'], f['end'] + 1.5) for f in self.faults if f['kind'] == 'stop']
+        silences = [
+            (b - a, a - self.t0)
+            for a, b in zip(stamps, stamps[1:])
+            if not any(s <= b and a <= e for s, e in stops)
+        ]
+        figures.update(
+            counters=final,
+            identities=ident,
+            estimates=len(self.watch.estimates['/']),
+            replay_estimates=len(self.watch.estimates['/replay']),
+            accuracy_n=len(errors),
+            accuracy_median=errors[len(errors) // 2] if errors else math.nan,
+            accuracy_max=errors[-1] if errors else math.nan,
+            within_2pct=sum(e <= ACCURACY for e in errors) / len(errors) if errors else math.nan,
+            rss_first_mb=self.rss[0][1] if self.rss else math.nan,
+            rss_last_mb=next((mb for _, mb in reversed(self.rss) if mb == mb), math.nan),
+            rss_growth_after_first_tenth_mb=rss_growth,
+            diagnostics_longest_silence_s=max(silences, default=(math.nan, math.nan)),
+            exits=exits,
+            tracebacks={p.name: p.tracebacks() for p in self.procs},
+            problems=self.problems,
+        )
+        for name, ok in ident.items():
+            if not ok:
+                self.problems.append(f'identity fails: {name}')
+        for f in self.faults:
+            if f['recovered'] is False:
+                self.problems.append(
+                    f'{f["kind"]} at {f["start"] - self.t0:.0f} s: no estimate before the next '
+                    'fault'
+                )
+        for name, (code, seconds) in exits.items():
+            if code != 0 or seconds > EXIT_WITHIN_S:
+                self.problems.append(f'{name}: exit {code} after {seconds} s of SIGINT')
+        for name, n in figures['tracebacks'].items():
+            if n:
+                self.problems.append(f'{name}: {n} tracebacks in its log')
+        self.watch.destroy_node()
+        rclpy.try_shutdown()
+        return figures
+
+
+def report(fig: dict) -> None:
+    print('\nfault     n  recovered  input resumed (s, max)  estimate resumed (s, median / max)')
+    for kind in FAULTS:
+        rows = [f for f in fig['faults'] if f['kind'] == kind]
+        if not rows:
+            continue
+        est = sorted(f['estimate_s'] for f in rows if f['recovered'])
+        inp = [f['input_s'] for f in rows if f['input_s'] == f['input_s']]
+        judged = sum(f['recovered'] is not None for f in rows)
+        ok = sum(f['recovered'] is True for f in rows)
+        median = est[len(est) // 2] if est else math.nan
+        print(
+            f'{kind:8s} {len(rows):2d}  {ok:2d}/{judged:<2d}      '
+            f'{max(inp, default=math.nan):6.2f}                  '
+            f'{median:6.2f} / {max(est, default=math.nan):6.2f}'
+        )
+    c = fig['counters']
+    print(
+        f'\ncounters: received {c.get("received")}, used {c.get("used")}, samples_missing '
+        f'{c.get("samples_missing")} (lost_in_queue {c.get("lost_in_queue")}, missing_in_gaps '
+        f'{c.get("missing_in_gaps")}; lost_in_transport {c.get("lost_in_transport")}), '
+        f'stamp_jumps {c.get("stamp_jumps")}, time_jump_resets {c.get("time_jump_resets")}, '
+        f'input_resubscribed {c.get("input_resubscribed")}'
+    )
+    print(
+        'identities: '
+        + ', '.join(f'{k}: {"holds" if v else "FAILS"}' for k, v in fig['identities'].items())
+    )
+    print(
+        f'estimates: {fig["estimates"]} (replayed bag: {fig["replay_estimates"]}); outside the '
+        f'fault windows {fig["accuracy_n"]}: median error {100 * fig["accuracy_median"]:.3f} %, '
+        f'max {100 * fig["accuracy_max"]:.3f} %, within 2 %: {100 * fig["within_2pct"]:.1f} %'
+    )
+    print(
+        f'RSS of estimator_node: {fig["rss_first_mb"]:.1f} MB at start, '
+        f'{fig["rss_last_mb"]:.1f} MB at the end, growth after the first tenth '
+        f'{fig["rss_growth_after_first_tenth_mb"]:.1f} MB'
+    )
+    silence, at = fig['diagnostics_longest_silence_s']
+    print(f'diagnostics: longest silence outside the stops {silence:.2f} s (at {at:.0f} s)')
+    print(
+        'exit after SIGINT: '
+        + ', '.join(f'{n} {c} in {s} s' for n, (c, s) in fig['exits'].items())
+    )
+    print('tracebacks: ' + ', '.join(f'{n} {k}' for n, k in fig['tracebacks'].items()))
+    print('problems: ' + ('; '.join(fig['problems']) or 'none'))
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument('--minutes', type=float, default=6.0, help='wall-clock length of the run')
+    parser.add_argument('--fault-every', type=float, default=24.0, help='seconds between faults')
+    parser.add_argument('--speed', type=float, default=10.0, help="sim_node's speed")
+    parser.add_argument('--seed', type=int, default=0, help='seed of the fault schedule')
+    parser.add_argument(
+        '--excitation', default='ambient', help="sim_node's excitation (ambient: never at rest)"
+    )
+    parser.add_argument('--no-replayer', dest='replayer', action='store_false')
+    parser.add_argument(
+        '--faults',
+        type=lambda text: [k for k in text.split(',') if k in FAULTS] or list(FAULTS),
+        default=list(FAULTS),
+        help=f'the kinds of fault, comma-separated (default: all of {",".join(FAULTS)})',
+    )
+    parser.add_argument(
+        '-p',
+        dest='estimator_args',
+        action='extend',
+        default=['-p', 'excitation:=ambient'],
+        type=lambda text: ['-p', text],
+        metavar='NAME:=VALUE',
+        help='an estimator_node parameter (repeatable; excitation:=ambient is set first, as for a '
+        'structure the simulator drives with noise)',
+    )
+    parser.add_argument('--json', help='write the figures here')
+    args = parser.parse_args(argv)
+    with tempfile.TemporaryDirectory(prefix='vib_soak_') as logs:
+        soak = Soak(args, Path(logs))
+        try:
+            fig = soak.run()
+        except BaseException:
+            for proc in soak.procs:
+                proc.p.kill()
+            raise
+    report(fig)
+    if args.json:
+        Path(args.json).write_text(json.dumps(fig, indent=1, default=str))
+    return 1 if fig['problems'] else 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
