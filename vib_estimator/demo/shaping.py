@@ -260,12 +260,17 @@ def run_shaping(session: Session, args: argparse.Namespace, wall_start: float) -
     )
     session.start_estimator(PAPER_PARAMS)
     driver = ShapingDriver(session)
+    # ready when it takes the reference, commands the arm and its estimate subscription is in
+    # the graph beside the listener's: a shaper that never heard an estimate designs nothing
+    # (seen once in a suite run: every "zvd" move left unshaped)
     session.start(
         'shaper_node',
         ['use_sim_time:=true', 'shaper:=none', f'median_of:={MEDIAN_OF}'],
         lambda: (
             driver.reference_pub.get_subscription_count()
             and listener.counts('position_command')[0]
+            and listener.counts('vibration/frequency')[0] >= 1
+            and listener.counts('vibration/frequency')[1] >= 2
         ),
     )
     driver.move(0.0)  # the shaper holds the arm at 0
