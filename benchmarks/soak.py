@@ -373,7 +373,10 @@ class Soak:
             missing=c.get('samples_missing', 0) - before.get('samples_missing', 0),
             transport=c.get('lost_in_transport', 0) - before.get('lost_in_transport', 0),
         )
-        if accounted() != 5001:
+        # nothing lost uncounted: at least the burst is received or counted (more is the
+        # simulator's samples still in flight when it was stopped: a fresh-clone CI run on the
+        # Jazzy set read 5044 = 4012 received + 1032 missing)
+        if accounted() < 5001:
             self.problems.append(f'burst: {accounted()} of 5001 received or counted')
         self.watch.destroy_publisher(burster)
         self.sim.signal(signal.SIGCONT)

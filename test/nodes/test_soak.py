@@ -37,7 +37,9 @@ def test_a_minute_of_faults(tmp_path):
     storm = next(f for f in fig['faults'] if f['kind'] == 'storm')
     assert storm['answered'] == storm['calls'] == 200 and storm['wrong_verdicts'] == 0
     for burst in (f for f in fig['faults'] if f['kind'] == 'burst'):
-        assert burst['received'] + burst['missing'] == 5001
+        # every burst message received or counted; beyond it, only the simulator's samples in
+        # flight when it was stopped (at most 0.1 s of them at speed 10: 500; a CI run read 43)
+        assert 5001 <= burst['received'] + burst['missing'] <= 5001 + 500, burst
     assert all(fig['identities'].values())
     assert not any(fig['tracebacks'].values())
     # the estimates between faults are the arm's (a minute holds a few hundred, some of them
