@@ -1,12 +1,12 @@
 # Copyright 2026 vib_estimator developers
 # SPDX-License-Identifier: Apache-2.0
-"""core.ambient.whittle_frequencies: the Whittle refinement of the identified frequencies."""
+"""core.whittle.whittle_frequencies: the Whittle refinement of the identified frequencies."""
 
 import math
 
 import numpy as np
 
-from vib_estimator.core.ambient import (
+from vib_estimator.core.whittle import (
     WHITTLE_MAX_DAMPING,
     WHITTLE_MIN_BINS,
     WHITTLE_REACH,
