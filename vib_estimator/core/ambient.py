@@ -196,13 +196,16 @@ class SlidingWindowIdentifier:
     def update(self, t: float, y) -> list:
         """Feed one sample (one value per channel); the estimates of an analysis it completes
         (:meth:`_publish`'s, ascending mode)."""
-        y = np.asarray(y, dtype=np.float64).reshape(-1)
-        if len(y) != self._m:
-            raise ValueError(f'expected {self._m} channel values, got {len(y)}')
+        if isinstance(y, float):  # (a float or numpy float64: no array made)
+            values = [y]
+        else:
+            values = np.asarray(y, dtype=np.float64).reshape(-1).tolist()
+        if len(values) != self._m:
+            raise ValueError(f'expected {self._m} channel values, got {len(values)}')
         t = float(t)
-        if not self._accept(t, bool(np.all(np.isfinite(y)))):
+        if not self._accept(t, all(map(math.isfinite, values))):
             return []
-        self._append(np.array((t,)), y[None, :])
+        self._append(t, values)
         if t >= self._next:
             return self._analysis()
         return []
@@ -215,8 +218,10 @@ class SlidingWindowIdentifier:
         return {k: {'estimates': tr.estimates} for k, tr in enumerate(published, 1)}
 
     # ---- input --------------------------------------------------------------------------------
-    def _append(self, t: np.ndarray, y: np.ndarray) -> None:
-        m = len(t)
+    def _append(self, t, y) -> None:
+        """Append samples: stamps ``t`` (an array) and their rows ``y``, or one stamp (a float)
+        and its values."""
+        m = len(t) if isinstance(t, np.ndarray) else 1
         if self._n + m > len(self._t):
             keep = self._n - self._start
             if keep + m > len(self._t) // 2:  # grow
@@ -230,10 +235,14 @@ class SlidingWindowIdentifier:
                 self._y[:keep] = self._y[self._start : self._n]
             self._fed -= self._start
             self._n, self._start = keep, 0
-        self._t[self._n : self._n + m] = t
-        self._y[self._n : self._n + m] = y
+        if m == 1 and not isinstance(t, np.ndarray):
+            self._t[self._n] = t
+            self._y[self._n] = y
+        else:
+            self._t[self._n : self._n + m] = t
+            self._y[self._n : self._n + m] = y
         if self._n == 0:
-            self._next = float(t[0]) + self._window
+            self._next = float(self._t[0]) + self._window
         self._n += m
 
     def _accept(self, t: float, finite: bool) -> bool:

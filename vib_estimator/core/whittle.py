@@ -70,10 +70,10 @@ def sdof_psd(
     autocovariance ``c_k = variance e^(-zeta wn |k| dt) (cos wd k dt + zeta / sqrt(1 - zeta^2)
     sin wd |k| dt)``, summed in closed form (``c_k = Re(a z^|k|)``, ``z = e^((-zeta wn + i wd)
     dt)``: ``Re(a (1 - z^2) / (1 - 2 z cos w + z^2))``)."""
-    return _sdof_psd(np.cos(np.asarray(w, dtype=np.float64)), frequency_hz, zeta, variance, dt)
+    return sdof_density(np.cos(np.asarray(w, dtype=np.float64)), frequency_hz, zeta, variance, dt)
 
 
-def _sdof_psd(
+def sdof_density(
     c: np.ndarray, frequency_hz: float, zeta: float, variance: float, dt: float
 ) -> np.ndarray:
     """:func:`sdof_psd` at ``c = cos w``, in real arithmetic."""
@@ -101,23 +101,31 @@ def whittle_frequencies(
     x: np.ndarray,
     fs: float,
     modes: np.ndarray,
-    noise: float,
+    noise,
     stds: np.ndarray,
     which: Sequence[int] | None = None,
+    shapes: np.ndarray | None = None,
 ) -> np.ndarray:
     """Each mode's frequency refined to the maximum of the Whittle likelihood of the window
-    ``x`` (one channel, at ``fs``) near it, the other parameters kept (``modes``: rows of
-    frequency, damping ratio, variance on that channel; ``noise``: the white noise's density at
-    ``fs``, its variance there; ``stds``: the frequencies' stds, Hz; ``which``: the modes to
-    refine, all if None; the others' frequencies are returned as given).
+    ``x`` (samples, or samples x channels, at ``fs``) near it, the other parameters kept
+    (``modes``: rows of frequency, damping ratio, variance of the modal coordinate; ``noise``:
+    each channel's white noise density at ``fs``, its variance there; ``stds``: the
+    frequencies' stds, Hz; ``which``: the modes to refine, all if None, the others' frequencies
+    returned as given; ``shapes``: each mode's real unit shape, modes x channels, one channel:
+    1).
 
-    The Whittle log-likelihood of a stationary Gaussian series over the Fourier frequencies
-    ``w_j = 2 pi j / N`` is ``-sum_j (log S(w_j) + I(w_j) / S(w_j))``, ``I`` the periodogram
-    ``|sum_t (x_t - mean) e^(-i w_j t)|^2 / N`` and ``S`` the model density (:func:`sdof_psd` of
-    every mode plus the noise). Maximised over one mode's frequency at a time, the bins within
-    :data:`WHITTLE_SPAN` half-power half-widths (``zeta f``) of it and at most
-    :data:`WHITTLE_GAP` of the way to the nearest other mode, the others at their SSI values,
-    within :data:`WHITTLE_REACH` of the mode's std of the SSI frequency.
+    The Whittle log-likelihood of a stationary Gaussian vector series over the Fourier
+    frequencies ``w_j = 2 pi j / N`` is ``-sum_j (ln det S(w_j) + tr(S(w_j)^-1 I(w_j)))``, ``I``
+    the periodogram matrix ``X_j X_j^H / N`` (``X_j = sum_t (x_t - mean) e^(-i w_j t)``) and ``S``
+    the model's spectral matrix: each mode's SDOF density (:func:`sdof_psd`) times ``phi phi^T``,
+    plus the noise's diagonal (one channel: ``-sum_j (ln S + I / S)``). Maximised over one mode's
+    frequency at a time, the bins within :data:`WHITTLE_SPAN` half-power half-widths
+    (``zeta f``) of it and at most :data:`WHITTLE_GAP` of the way to the nearest other mode, the
+    others at their SSI values, within :data:`WHITTLE_REACH` of the mode's std of the SSI
+    frequency. With ``R`` the rest of ``S`` and ``psi`` the mode's density, ``S = R + psi phi
+    phi^T`` is a rank-one update: ``ln det S = ln det R + ln(1 + psi a)`` and ``tr(S^-1 I) =
+    tr(R^-1 I) - psi b / (1 + psi a)`` (``a = phi^T R^-1 phi``, ``b = |(R^-1 phi)^T X|^2 / N``),
+    so the search costs per bin what one channel's does.
     SSI-cov's frequencies are consistent but not efficient (1.1-1.9x the Whittle bound,
     ``benchmarks/bench_operation.py``); the likelihood's maximum is (asymptotically) at the
     bound. The damping is left to SSI: the periodogram's leakage (the window's Fejer kernel)
@@ -125,10 +133,12 @@ def whittle_frequencies(
     symmetric, not the frequency."""
     from scipy.optimize import minimize_scalar
 
-    n = len(x)
-    spectrum = np.fft.rfft(x - np.mean(x))
-    periodogram = (spectrum.real**2 + spectrum.imag**2) / n
-    w = 2 * math.pi * np.arange(len(periodogram)) / n
+    x = np.asarray(x, dtype=np.float64).reshape(len(x), -1)
+    n, m = x.shape
+    shapes = np.ones((len(modes), m)) if shapes is None else np.asarray(shapes, dtype=np.float64)
+    noise = np.broadcast_to(np.asarray(noise, dtype=np.float64), (m,))
+    spectrum = np.fft.rfft(x - x.mean(axis=0), axis=0)  # bins x channels
+    w = 2 * math.pi * np.arange(len(spectrum)) / n
     hz = w * fs / (2 * math.pi)
     dt = 1.0 / fs
     out = modes[:, 0].copy()
@@ -143,16 +153,22 @@ def whittle_frequencies(
         reach = min(half / 2, WHITTLE_REACH * float(stds[k]))
         if np.count_nonzero(near) < 3:
             continue
-        c, power = np.cos(w[near]), periodogram[near]
-        rest = noise + sum(
-            _sdof_psd(c, fj, zj, max(vj, 1e-300), dt)
-            for j, (fj, zj, vj) in enumerate(modes[:, :3])
-            if j != k
-        )
+        c, spec = np.cos(w[near]), spectrum[near]
+        rest = np.zeros((len(c), m, m))
+        rest[:, np.arange(m), np.arange(m)] = noise
+        for j, (fj, zj, vj) in enumerate(modes[:, :3]):
+            if j != k:
+                psi = sdof_density(c, fj, zj, max(vj, 1e-300), dt)
+                rest += psi[:, None, None] * np.outer(shapes[j], shapes[j])[None]
+        phi = shapes[k]
+        u = np.linalg.solve(rest, np.broadcast_to(phi, (len(c), m))[..., None])[..., 0]
+        a = u @ phi
+        proj = np.sum(u * spec, axis=1)
+        b = (proj.real**2 + proj.imag**2) / n
 
         def negative_log_likelihood(fk, zeta=zeta, variance=max(variance, 1e-300)):
-            density = rest + _sdof_psd(c, fk, zeta, variance, dt)
-            return float(np.sum(np.log(density) + power / density))
+            gain = 1.0 + sdof_density(c, fk, zeta, variance, dt) * a
+            return float(np.sum(np.log(gain) + b / (a * gain)))
 
         best = minimize_scalar(
             negative_log_likelihood,
@@ -182,7 +198,7 @@ def _active_bins(modes, noise_var: float, dt: float, n: int) -> np.ndarray:
 def _log_density_gradient(c: np.ndarray, modes, noise_var: float, dt: float):
     """The model's density ``S`` at ``c = cos w`` and the gradient of ``ln S`` with respect
     to (f, zeta, variance of each mode, the noise variance), one row each."""
-    density = _sdof_psd
+    density = sdof_density
     parts = [density(c, f, z, v, dt) for f, z, v in modes]
     total = noise_var + (np.sum(parts, axis=0) if parts else 0.0)
     grads = []
