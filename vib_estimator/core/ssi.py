@@ -275,6 +275,8 @@ def stable_clusters(
 
 def _cluster_shape(group: np.ndarray, m: int) -> tuple[np.ndarray, np.ndarray]:
     """The cluster's shape and its per-channel uncertainty (see the module doc, step 2)."""
+    if m == 1:  # (what the arithmetic below gives, to rounding: a one-entry shape is 1)
+        return np.ones(1, dtype=complex), np.zeros(1)
     phis = group[:, 3 + m : 3 + 2 * m] + 1j * group[:, 3 + 2 * m : 3 + 3 * m]
     big = phis[np.arange(len(phis)), np.argmax(np.abs(phis), axis=1)]
     size = np.abs(big)

@@ -97,6 +97,26 @@ def peak_ratio(
 
 
 # ---- 2. the frequency refinement ---------------------------------------------------------------
+def _rank_one(c, spec, modes, shapes, noise, k, dt, n) -> tuple[np.ndarray, np.ndarray]:
+    """For mode ``k`` at the bins ``c = cos w`` (``spec``: their Fourier coefficients, bins x
+    channels; ``n``: the window's samples): ``a = phi^T R^-1 phi`` and ``b = |(R^-1 phi)^T X|^2 /
+    n`` of :func:`whittle_frequencies`, ``R`` the noise's diagonal and the other modes' terms."""
+    n_bins, m = spec.shape
+    rest = np.zeros((n_bins, m, m))
+    rest[:, np.arange(m), np.arange(m)] = noise
+    for j, (fj, zj, vj) in enumerate(modes[:, :3]):
+        if j != k:
+            psi = sdof_density(c, fj, zj, max(vj, 1e-300), dt)
+            rest += psi[:, None, None] * np.outer(shapes[j], shapes[j])[None]
+    phi = shapes[k]
+    if m == 1:  # (R^-1 phi without a LAPACK call)
+        u = phi / rest[:, 0]
+    else:
+        u = np.linalg.solve(rest, np.broadcast_to(phi, (n_bins, m))[..., None])[..., 0]
+    proj = np.sum(u * spec, axis=1)
+    return u @ phi, (proj.real**2 + proj.imag**2) / n
+
+
 def whittle_frequencies(
     x: np.ndarray,
     fs: float,
@@ -153,18 +173,8 @@ def whittle_frequencies(
         reach = min(half / 2, WHITTLE_REACH * float(stds[k]))
         if np.count_nonzero(near) < 3:
             continue
-        c, spec = np.cos(w[near]), spectrum[near]
-        rest = np.zeros((len(c), m, m))
-        rest[:, np.arange(m), np.arange(m)] = noise
-        for j, (fj, zj, vj) in enumerate(modes[:, :3]):
-            if j != k:
-                psi = sdof_density(c, fj, zj, max(vj, 1e-300), dt)
-                rest += psi[:, None, None] * np.outer(shapes[j], shapes[j])[None]
-        phi = shapes[k]
-        u = np.linalg.solve(rest, np.broadcast_to(phi, (len(c), m))[..., None])[..., 0]
-        a = u @ phi
-        proj = np.sum(u * spec, axis=1)
-        b = (proj.real**2 + proj.imag**2) / n
+        c = np.cos(w[near])
+        a, b = _rank_one(c, spectrum[near], modes, shapes, noise, k, dt, n)
 
         def negative_log_likelihood(fk, zeta=zeta, variance=max(variance, 1e-300)):
             gain = 1.0 + sdof_density(c, fk, zeta, variance, dt) * a
