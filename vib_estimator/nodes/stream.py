@@ -30,6 +30,8 @@ from collections import deque
 from functools import partial
 from typing import Any, Callable, Dict, Iterator, Optional, Sequence, Tuple
 
+import numpy as np
+
 from ..core.choice import WATCH_S, Decision, StreamChoice
 from ..core.config import EstimatorConfig
 from ..core.estimator import COUNTER_NAMES, Estimate, as_estimates
@@ -48,6 +50,8 @@ WARMUP_BUFFER = 60_000
 #: significant digits of the measured sampling rate the self-test's tones are made for (a rate
 #: that wanders in its last digits gives the same tones, and the kept result)
 SELF_TEST_DIGITS = 3
+#: no samples to prime a new estimator with (:meth:`EstimatorStream.configure`)
+NO_PRIMER = (np.empty(0), np.empty(0))
 #: the diagnostics message while the kernels compile
 WARMUP_MESSAGE = 'compiling estimator kernels (first start)'
 
@@ -139,7 +143,7 @@ class EstimatorStream:
         #: the excitation was last set by :meth:`decision` (not by the user)
         self.decided = False
         #: the samples a new estimator is primed with (:meth:`configure`)
-        self._primer: Sequence = ()
+        self._primer: Tuple[np.ndarray, np.ndarray] = NO_PRIMER
         #: :meth:`decision` is asked (the node's ``decide_excitation``): no hint, a switch
         self.deciding = deciding
         self.configure(config)
@@ -168,7 +172,7 @@ class EstimatorStream:
         unpublished, so that a driven stream's window is not filled again from empty."""
         channels = self.channels if channels is None else tuple(channels)
         check_channels(channels, config)
-        self._primer = self._choice.kept() if prime and channels == self.channels else ()
+        self._primer = self._choice.kept() if prime and channels == self.channels else NO_PRIMER
         self.channels = channels
         create = estimator_factory(channels)
         if self.estimator is not None:
@@ -185,11 +189,13 @@ class EstimatorStream:
         self.estimator = estimator
         self._update = estimator.update  # bound once: the data path's one call
         self._build = None
-        if self._primer:  # fed before any held sample; its counts taken back
-            for t, value in self._primer:
-                estimator.update(t, value)
+        if len(self._primer[0]):  # fed before any held sample; its counts taken back
+            t, y = self._primer
+            values = y.tolist() if y.ndim == 1 else map(tuple, y.tolist())
+            for when, value in zip(t.tolist(), values):
+                estimator.update(when, value)
             self.health.absorb({name: -n for name, n in estimator.counters.items()})
-            self._primer = ()
+            self._primer = NO_PRIMER
 
     def feed(self, stamp_ns: int, value: float) -> Sequence[Estimate]:
         """One sample (stamp in integer ns); the estimates it completes (usually none).
