@@ -82,6 +82,9 @@ HARMONIC_TOL = 0.02
 WINDOW_PERIODS = 120.0
 #: the longest window the decision chooses, s
 MAX_WINDOW_S = 300.0
+#: the damping ratio :func:`window_advice` assumes of the lowest mode (:data:`WINDOW_PERIODS`
+#: is ~15 correlation times at it)
+ASSUMED_ZETA = 0.02
 #: the window leaves the record room for at least this many analyses (one per second)
 MIN_ANALYSES = 60
 
@@ -205,6 +208,24 @@ def decide(t, y, channels: int = 1, window_s: float = 30.0, stream: bool = False
     rate = (len(t) - 1) / span
     return Decision(
         excitation, window, share, dominant, fundamental, tuple(peaks), seen, span, rate, modes
+    )
+
+
+def window_advice(window_s: float, d: Optional[Decision], option: str) -> str:
+    """Why a ``window_s`` window gave no mode, from the record's lowest spectral peak: how many
+    correlation times ``1 / (2 pi zeta f)`` (at :data:`ASSUMED_ZETA`) of it the window holds,
+    and ``option`` with the window that holds :data:`WINDOW_PERIODS` periods of it (at most
+    :data:`MAX_WINDOW_S`); '' without a peak, or when the window holds them."""
+    if d is None or not math.isfinite(d.fundamental_hz):
+        return ''
+    f = d.fundamental_hz
+    times = window_s * 2 * math.pi * ASSUMED_ZETA * f
+    want = min(WINDOW_PERIODS / f, MAX_WINDOW_S)
+    if window_s >= want:
+        return ''
+    return (
+        f'the {window_s:g} s window holds {times:.1f} correlation times of the {f:.3g} Hz peak '
+        f'(at zeta {100 * ASSUMED_ZETA:g} %): {option}{math.ceil(want)}'
     )
 
 

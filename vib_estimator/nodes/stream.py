@@ -32,7 +32,7 @@ from typing import Any, Callable, Dict, Iterator, Optional, Sequence, Tuple
 
 import numpy as np
 
-from ..core.choice import WATCH_S, Decision, StreamChoice
+from ..core.choice import WATCH_S, Decision, StreamChoice, decide, window_advice
 from ..core.config import EstimatorConfig
 from ..core.estimator import COUNTER_NAMES, Estimate, as_estimates
 from ..core.modes import create_estimator
@@ -142,6 +142,10 @@ class EstimatorStream:
         self._choice = StreamChoice(max(1, len(self.channels)))
         #: the excitation was last set by :meth:`decision` (not by the user)
         self.decided = False
+        #: stream time of the last estimate, or of the last configuration (:meth:`_silent_hint`)
+        self._estimated_at: Optional[float] = None
+        #: (stream time, advice) of the last :meth:`_silent_hint` computed
+        self._advice: Tuple[float, str] = (-math.inf, '')
         #: the samples a new estimator is primed with (:meth:`configure`)
         self._primer: Tuple[np.ndarray, np.ndarray] = NO_PRIMER
         #: :meth:`decision` is asked (the node's ``decide_excitation``): no hint, a switch
@@ -179,6 +183,7 @@ class EstimatorStream:
             self.health.absorb(self.estimator.counters)
             self.estimator = None
         self._config = config
+        self._estimated_at = self.last_t
         self.health.forget_modes(config.modes)
         if self._background and not is_warm(config):
             self._build = _Build(config, create)
@@ -207,6 +212,7 @@ class EstimatorStream:
         estimates = as_estimates(self._update(t, value))
         for e in estimates:
             self._choice.follow(getattr(e, 'estimate', e).frequency_hz)
+            self._estimated_at = t
         return estimates
 
     @property
@@ -272,7 +278,12 @@ class EstimatorStream:
             return Status(WARN, WARMUP_MESSAGE, values)
         config = self.config
         status = self.health.status(
-            now, self.counters, self.last_t, config.band_hz, config.modes, self._driven_hint()
+            now,
+            self.counters,
+            self.last_t,
+            config.band_hz,
+            config.modes,
+            self._driven_hint() or self._silent_hint(),
         )
         if len(self.channels) >= MIN_CHANNELS:  # a joint identification: which channels
             status.values['channels'] = ','.join(self.channels)
@@ -295,6 +306,33 @@ class EstimatorStream:
             f'{WATCH_S:g} s): free-decay estimates of a driven structure scatter; '
             'excitation:=ambient identifies its modes (auto: both, per stretch)'
         )
+
+    def _silent_hint(self) -> Optional[str]:
+        """Under the identifier (``excitation`` ambient or auto), when it published nothing for
+        two windows (and a minute): why, from the spectrum of the input's last seconds -- the
+        window's correlation times of their lowest peak and the ``ambient_window_s`` that holds
+        enough (:func:`~vib_estimator.core.choice.window_advice`), computed at most every
+        :data:`~vib_estimator.core.choice.WATCH_S` / 2 s of stream; else None."""
+        config = self.config
+        since = self._estimated_at if self._estimated_at is not None else self._first_t()
+        if config.excitation == 'free' or since is None or self.last_t is None:
+            return None
+        silent = self.last_t - since
+        if silent < max(2 * config.ambient_window_s, 60.0):
+            return None
+        at, advice = self._advice
+        if self.last_t - at >= WATCH_S / 2 or self.last_t < at:
+            t, y = self._choice.kept()
+            d = decide(t, y, max(1, len(self.channels)), config.ambient_window_s, stream=True)
+            advice = window_advice(config.ambient_window_s, d, 'ambient_window_s:=')
+            self._advice = (self.last_t, advice)
+        if not advice:
+            return None
+        return f'no mode for {silent:.0f} s: {advice}'
+
+    def _first_t(self) -> Optional[float]:
+        """Stream time of the first sample (0.0), None before any."""
+        return None if self.origin is None else 0.0
 
     def decision(self) -> Optional[Decision]:
         """What the input needs now, if not what runs (``decide_excitation``; after
