@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from vib_estimator.core import EstimatorConfig, estimate
+from vib_estimator.core.choice import decide
 from vib_estimator.io.csv_reader import read_csv_series
 from vib_estimator.sim import arm_model
 
@@ -86,11 +87,15 @@ def main() -> int:
     real = Path(args.real_data)
     real = real if real.is_dir() else None
     head = ' | '.join(f'min_periods {p:g}: n, within 2 %, > 5 %, conv' for p in args.periods)
-    print(f'| record | impurity | {head} |')
-    print('|---|---|' + '---|' * len(args.periods))
+    print(
+        f'| record | impurity | default (decided): window, n, within 2 %, > 5 %, conv | {head} |'
+    )
+    print('|---|---|---|' + '---|' * len(args.periods))
     for name, t, y, f in records(real):
         cells = []
-        for periods in args.periods:
+        decided = decide(t, y).min_periods
+        decided = decided if np.isfinite(decided) else EstimatorConfig().min_periods
+        for periods in [decided, *args.periods]:
             e = estimate(t, y, EstimatorConfig(min_periods=periods))
             if not len(e):
                 cells.append('none')
@@ -101,6 +106,9 @@ def main() -> int:
                 f'{len(e)}, {100 * np.mean(err <= 0.02):.0f} %, {int(np.sum(err > 0.05))}, '
                 f'{conv:.2f}'
             )
+            if len(cells) == 1:
+                cells[0] = f'{periods:g}: {cells[0]}'
+
         print(f'| {name} | {impurity(t, y):.3f} | ' + ' | '.join(cells) + ' |')
         sys.stdout.flush()
     return 0

@@ -286,3 +286,54 @@ def test_the_stream_choice_keeps_at_most_max_kept_samples(monkeypatch, factor):
     assert right()
     monkeypatch.setattr(choice, 'MAX_KEPT', int(choice.MAX_KEPT * factor))
     assert not right()
+
+
+def pluck_with_a_move(move: float, snr_db: float = 50.0, zeta: float = 0.002, seed: int = 0):
+    """A 2 Hz free decay over 20 s at 1 kHz, with a move (a smooth step of ``move`` times its
+    amplitude, 0.2 s long, at 5 s: the hub of an arm stepping) and white noise."""
+    t = np.arange(0, 20, 1e-3)
+    y = np.exp(-zeta * 2 * np.pi * 2 * t) * np.sin(2 * np.pi * 2 * t + 1)
+    y += move * (0.5 - 0.5 * np.cos(np.pi * np.clip((t - 5.0) / 0.2, 0, 1)))
+    y += 10 ** (-snr_db / 20) / np.sqrt(2) * np.random.default_rng(seed).standard_normal(len(t))
+    return t, y
+
+
+def decided_convergence(t, y) -> tuple[float, float]:
+    """The decision's free-decay window applied (as analyze applies it): the median convergence
+    in periods of the 2 Hz mode and the share within 2 % (NaN, NaN if it cannot run)."""
+    from vib_estimator.core import EstimatorConfig, estimate
+
+    config = EstimatorConfig()
+    try:
+        d = decide(t, y)
+        if math.isfinite(d.min_periods):
+            config = config.replace(min_periods=d.min_periods)
+    except ValueError:
+        return math.nan, math.nan
+    e = estimate(t, y, config)
+    return (
+        float(np.median(e.convergence_time * 2.0)),
+        float(np.mean(np.abs(e.frequency_hz / 2.0 - 1) <= 0.02)),
+    )
+
+
+@pytest.mark.parametrize('factor', [1e-3, 1e3])
+@pytest.mark.parametrize(
+    'name', ['FAST_PERIODS', 'IMPURE', 'IMPURITY_SPAN', 'PEAK_WIDTH', 'FAST_STD']
+)
+def test_a_pure_precise_free_decay_is_estimated_over_a_shorter_window(monkeypatch, name, factor):
+    """One mode, a pure spectrum and precise 0.9-period estimates: published after 0.9 periods,
+    all within 2 % (a small move: 2.5 % of the power near the mode off its peak). A large move
+    (the real arm's step: 22 % off the peak) or 20 dB of noise (its decay's tail: 90 % of the
+    0.9-period estimates within 1.9 %, 1 std) keeps the default 1.25 periods. Each constant at
+    0.001x and 1000x breaks one of them."""
+
+    def right():
+        fast, fast_within = decided_convergence(*pluck_with_a_move(3.0))
+        moved = decided_convergence(*pluck_with_a_move(10.0))[0]
+        noisy = decided_convergence(*pluck_with_a_move(0.0, snr_db=20.0, zeta=0.01))[0]
+        return 0.85 <= fast <= 0.93 and fast_within >= 0.95 and moved >= 1.1 and noisy >= 1.1
+
+    assert right()
+    monkeypatch.setattr(choice, name, getattr(choice, name) * factor)
+    assert not right()
