@@ -84,6 +84,9 @@ def test_one_interface_and_one_counters_vocabulary(kind):
         assert not isinstance(got, type(None))
         out.extend(got)
     assert len(out) == len(result)
+    if not names:  # one channel: samples, or samples x 1 (a joint estimator's layout)
+        again = create_estimator(CONFIGS[kind.name]).process(t, y[:, None])
+        np.testing.assert_array_equal(again.frequency_hz, result.frequency_hz)
     c = batch.counters
     assert c == stream.counters
     assert list(c)[: len(INPUT_COUNTERS)] == list(INPUT_COUNTERS)

@@ -69,9 +69,12 @@ _BOUND = ('_feed', '_p', '_row', '_s', '_seg')
 
 
 def as_series(t: Sequence[float], y: Sequence[float]) -> Tuple[np.ndarray, np.ndarray]:
-    """``t``, ``y`` as contiguous float64 arrays of one length (``ValueError`` otherwise)."""
+    """``t``, ``y`` as contiguous float64 arrays of one length (``ValueError`` otherwise); ``y``
+    may be samples x 1 (one channel, as a joint estimator's input)."""
     t = np.ascontiguousarray(t, dtype=np.float64)
     y = np.ascontiguousarray(y, dtype=np.float64)
+    if y.ndim == 2 and y.shape[1:] == (1,):
+        y = y[:, 0]
     if t.shape != y.shape or t.ndim != 1:
         raise ValueError(f't and y must be 1-D arrays of one length, got {t.shape}, {y.shape}')
     return t, y
