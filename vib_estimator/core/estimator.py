@@ -225,21 +225,12 @@ class EstimateArrays:
         return len(self.t)
 
     def to_list(self) -> List[Estimate]:
+        """The estimates one by one (Python floats and ints)."""
         ints = {K.O_SAMPLES, K.N_OUT}
+        columns = (getattr(self, name) for name in self.__dataclass_fields__)
         return [
             Estimate(*(int(v) if i in ints else float(v) for i, v in enumerate(row)))
-            for row in zip(
-                self.t,
-                self.frequency_hz,
-                self.convergence_time,
-                self.samples,
-                self.fit,
-                self.amplitude,
-                self.damping,
-                self.frequency_std_hz,
-                self.damping_std,
-                self.mode,
-            )
+            for row in zip(*columns)
         ]
 
 
