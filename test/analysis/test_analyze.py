@@ -214,7 +214,7 @@ def test_band_above_nyquist_is_an_error(tmp_path, capsys, samples):
 
 
 def test_excitation_ambient_equals_the_core_and_bad_window_is_refused(tmp_path, capsys):
-    from vib_estimator.core.modes import create_estimator
+    from vib_estimator.core import create_estimator
     from vib_estimator.sim.ambient import ambient_record
 
     t, y, _ = ambient_record(30.0, 500.0, [(5.0, 0.01, 1.0)], 26.0, 0)
@@ -233,7 +233,7 @@ def test_excitation_ambient_equals_the_core_and_bad_window_is_refused(tmp_path, 
 
 
 def test_excitation_auto_equals_the_core_and_free_on_a_free_decay(tmp_path, capsys):
-    from vib_estimator.core.modes import create_estimator
+    from vib_estimator.core import create_estimator
 
     t = np.arange(0.0, 8.0, 0.002)
     y = np.exp(-0.2 * t) * np.sin(2 * np.pi * 1.33 * t + 0.4) + 1e-3 * np.cos(40.0 * t)

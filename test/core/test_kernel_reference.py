@@ -49,8 +49,7 @@ import numpy as np
 import pytest
 from llvmlite.binding import get_host_cpu_features
 
-from vib_estimator.core import EstimatorConfig
-from vib_estimator.core.modes import create_estimator
+from vib_estimator.core import EstimatorConfig, create_estimator
 
 DATA = pathlib.Path(__file__).parent / 'data' / 'kernel_reference.npz'
 FS = 500.0
@@ -277,8 +276,7 @@ def test_streaming_results_are_bit_identical_to_the_reference(reference, name):
     est = create_estimator(_stored_config(reference, name))
     got = []
     for a, b in zip(t, y):
-        e = est.update(a, b)
-        got.extend(e if isinstance(e, list) else [] if e is None else [e])
+        got.extend(est.update(a, b))
     assert len(got) == len(reference[f'{name}/t']) > 0
     for col in COLUMNS:
         _assert_same(name, col, [float(getattr(e, col)) for e in got], reference[f'{name}/{col}'])

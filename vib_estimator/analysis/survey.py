@@ -405,7 +405,7 @@ def _stat_rows(
         counters = {c: stream.get(c, 0) for c in _INPUT_COUNTERS}
         if not modes:
             counters = stream
-        elif joint is None:
+        else:
             counters.update(result.estimator.mode_counters().get(mode, {}))
         rows.append(
             _row(

@@ -64,7 +64,8 @@ from std_msgs.msg import Float64, Float64MultiArray, Header, MultiArrayDimension
 from std_srvs.srv import Trigger
 
 from ..core.config import EstimatorConfig
-from ..core.multichannel import MIN_CHANNELS, JointEstimate
+from ..core.estimator import Estimate
+from ..core.multichannel import MIN_CHANNELS
 from ..core.shapes import SHAPE_ROWS, phases_deg, signed_amplitudes
 from ..errors import StartupError
 from ..io.align import StampAligner
@@ -185,7 +186,7 @@ class Outputs:
             )
         return self._shapes[k]
 
-    def publish_shape(self, joint: JointEstimate) -> None:
+    def publish_shape(self, joint: Estimate) -> None:
         """``vibration/mode<k>/shape``: rows ``shape`` (each channel's signed amplitude),
         ``shape_phase_deg`` (its phase) and ``shape_std`` (its uncertainty), one column per
         channel (``layout.dim[0]``: the rows' names, ``dim[1]``: the channels', comma-joined;
@@ -193,7 +194,7 @@ class Outputs:
         msg = self._shape
         parts = (signed_amplitudes(joint.shape), phases_deg(joint.shape), joint.shape_std)
         msg.data = [float(v) for part in parts for v in part]
-        self._shape_publisher(joint.estimate.mode).publish(msg)
+        self._shape_publisher(joint.mode).publish(msg)
 
     def set_modes(self, modes: int) -> None:
         """Publishers for modes 1..``modes``; those of higher modes are destroyed."""
@@ -484,14 +485,12 @@ class EstimatorNode(Node):
 
     def _publish(self, estimates, header: Header) -> None:
         """Publish the estimates of the sample of ``header`` (see :class:`Outputs`)."""
-        for item in estimates:
-            joint = isinstance(item, JointEstimate)  # several channels: the mode's shape too
-            estimate = item.estimate if joint else item
+        for estimate in estimates:
             self._outputs.publish(estimate, header)
-            if joint:
-                self._outputs.publish_shape(item)
+            if estimate.shape is not None:  # several channels: the mode's shape too
+                self._outputs.publish_shape(estimate)
             if self._mode_shapes is not None:
-                self._mode_shapes.update(estimate, item.shape if joint else None)
+                self._mode_shapes.update(estimate, estimate.shape)
             if self.baseline_monitor.active:
                 self.baseline_monitor.estimate(estimate)
             self._stream.published(estimate, time.monotonic())

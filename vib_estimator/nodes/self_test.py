@@ -19,7 +19,7 @@ from typing import List, Optional, Tuple
 import numpy as np
 
 from ..core.config import EstimatorConfig
-from ..core.modes import create_estimator
+from ..core.factory import create_estimator
 
 #: sampling rate of the tones when the input's is not known yet, Hz
 DEFAULT_RATE_HZ = 500.0

@@ -4,13 +4,11 @@
 
 :class:`EstimatorStream` holds what the node does between a converted message and a publication:
 the stamp time base (``t = seconds_since(stamp, first stamp)``, exactly as the offline
-``vib-estimator analyze``), the estimator of the live configuration (``create_estimator``: one
-:class:`~vib_estimator.core.FrequencyEstimator`, or a mode tracker with ``modes`` >= 1; replaced
-on a change of configuration, its counters kept), and the :class:`~.health.Health` bookkeeping.
-With several ``channels`` (the node's ``components``) the estimator is the joint identifier
-(:func:`~vib_estimator.core.multichannel_free.create_joint_estimator`: free decays or
-``excitation`` ambient, :func:`check_channels`): each sample is a tuple of values, each estimate a
-:class:`~vib_estimator.core.multichannel.JointEstimate` (the estimate and its mode shape).
+``vib-estimator analyze``), the estimator of the live configuration and channels
+(:func:`~vib_estimator.core.create_estimator`; replaced on a change of configuration, its counters
+kept), and the :class:`~.health.Health` bookkeeping. With several ``channels`` (the node's
+``components``) the estimator is a joint one (:func:`check_channels`): each sample is a tuple of
+values, each :class:`~vib_estimator.core.Estimate` carries its mode's shape.
 
 Warm-up. A configuration whose kernels are not compiled in this process yet (the first start, or a
 change to a configuration that runs other kernels) is built in a background thread
@@ -27,17 +25,15 @@ import math
 import threading
 import time
 from collections import deque
-from functools import partial
-from typing import Any, Callable, Dict, Iterator, Optional, Sequence, Tuple
+from typing import Any, Dict, Iterator, Optional, Sequence, Tuple
 
 import numpy as np
 
 from ..core.choice import WATCH_S, Decision, StreamChoice, decide, window_advice
 from ..core.config import EstimatorConfig
-from ..core.estimator import COUNTER_NAMES, Estimate, as_estimates
-from ..core.modes import create_estimator
+from ..core.estimator import COUNTER_NAMES, Estimate
+from ..core.factory import create_estimator, kind_of
 from ..core.multichannel import MIN_CHANNELS
-from ..core.multichannel_free import JOINT_EXCITATIONS, create_joint_estimator
 from ..core.warmup import is_warm, warm
 from ..io.fields import seconds_since
 from .health import WARN, Health, Status
@@ -57,31 +53,18 @@ WARMUP_MESSAGE = 'compiling estimator kernels (first start)'
 
 
 def check_channels(channels: Sequence[str], config: EstimatorConfig) -> None:
-    """ValueError unless ``config`` can identify ``channels`` (names): several need
-    ``excitation`` free or ambient (a joint estimator,
-    :func:`~vib_estimator.core.multichannel_free.create_joint_estimator`)."""
-    if len(channels) >= MIN_CHANNELS and config.excitation not in JOINT_EXCITATIONS:
-        raise ValueError(
-            f'{len(channels)} components ({", ".join(channels)}) need excitation free or '
-            f'ambient (a joint estimation), got excitation {config.excitation}: it takes one '
-            'component'
-        )
-
-
-def estimator_factory(channels: Sequence[str]) -> Callable[[EstimatorConfig], Any]:
-    """What builds the estimator of a configuration for ``channels``: one channel,
-    :func:`~vib_estimator.core.modes.create_estimator`; several, the joint identifier."""
-    if len(channels) < MIN_CHANNELS:
-        return create_estimator
-    return partial(create_joint_estimator, channels=tuple(channels))
+    """ValueError unless ``config`` has an estimator for ``channels`` (the node's components:
+    :func:`~vib_estimator.core.factory.kind_of`)."""
+    what = f'{len(channels)} components ({", ".join(channels)})'
+    kind_of(config, max(len(channels), 1), what)
 
 
 class _Build:
     """An estimator of ``config`` built in a daemon thread (its kernels compiled first)."""
 
-    def __init__(self, config: EstimatorConfig, create: Callable[[EstimatorConfig], Any]):
+    def __init__(self, config: EstimatorConfig, channels: Tuple[str, ...]):
         self.config = config
-        self._create = create
+        self._channels = channels
         self.started = time.monotonic()
         self.seconds = 0.0
         self.estimator = None
@@ -94,7 +77,7 @@ class _Build:
     def _run(self) -> None:
         try:
             warm(self.config)
-            self.estimator = self._create(self.config)
+            self.estimator = create_estimator(self.config, self._channels)
         except Exception as err:  # reported by the node, never lost in a thread
             self.error = err
         self.seconds = time.monotonic() - self.started
@@ -112,8 +95,8 @@ class EstimatorStream:
     applies it (the node's ``decide_excitation``); else the status hints at a driven input.
     ``channels``: the names of the input's channels (the
     node's components); one (or none given) is the single-channel estimator, bit for bit; several
-    feed :meth:`feed` a tuple of values a sample and give
-    :class:`~vib_estimator.core.multichannel.JointEstimate` s (``excitation`` free or ambient).
+    feed :meth:`feed` a tuple of values a sample and give estimates with their ``shape``
+    (``excitation`` free or ambient).
     """
 
     def __init__(
@@ -178,7 +161,6 @@ class EstimatorStream:
         check_channels(channels, config)
         self._primer = self._choice.kept() if prime and channels == self.channels else NO_PRIMER
         self.channels = channels
-        create = estimator_factory(channels)
         if self.estimator is not None:
             self.health.absorb(self.estimator.counters)
             self.estimator = None
@@ -186,9 +168,9 @@ class EstimatorStream:
         self._estimated_at = self.last_t
         self.health.forget_modes(config.modes)
         if self._background and not is_warm(config):
-            self._build = _Build(config, create)
+            self._build = _Build(config, channels)
         else:
-            self._install(create(config))
+            self._install(create_estimator(config, channels))
 
     def _install(self, estimator) -> None:
         self.estimator = estimator
@@ -209,9 +191,9 @@ class EstimatorStream:
             self.origin = stamp_ns
         self.last_t = t = seconds_since(stamp_ns, self.origin)
         self._choice.update(t, value)
-        estimates = as_estimates(self._update(t, value))
+        estimates = self._update(t, value)
         for e in estimates:
-            self._choice.follow(getattr(e, 'estimate', e).frequency_hz)
+            self._choice.follow(e.frequency_hz)
             self._estimated_at = t
         return estimates
 
