@@ -15,10 +15,20 @@ With several ``channels`` (the node's ``components``) the estimator is the joint
 Warm-up. A configuration whose kernels are not compiled in this process yet (the first start, or a
 change to a configuration that runs other kernels) is built in a background thread
 (:func:`~vib_estimator.core.warmup.warm`: seconds from numba's cache, tens of seconds on a first
-start after an install). Meanwhile :attr:`EstimatorStream.ready` is False, the node stays live
-(services, diagnostics) and :meth:`EstimatorStream.hold` keeps the samples that arrive, in order,
-up to :data:`WARMUP_BUFFER` (the oldest beyond it are dropped and counted in ``dropped_warmup``);
-:meth:`EstimatorStream.poll` installs the estimator once it is built and feeds it the held samples.
+start after an install). Meanwhile the node stays live (services, diagnostics), and:
+
+- a configuration of the free-decay estimator (``excitation`` free, ``modes`` 0, one channel, no
+  ``band_hz``: :func:`interpretable`, the default) estimates at once with its kernel uncompiled
+  (:func:`~vib_estimator.core.jit.interpreted`: the same floats, about 100 us a sample):
+  :attr:`EstimatorStream.ready` is True, and :meth:`EstimatorStream.poll` switches it to the
+  compiled kernel once that is built, between two samples (:attr:`EstimatorStream.compiling` until
+  then);
+- any other (the mode tracker, the ambient identifier, several channels, ``band_hz``, whose
+  coloured std costs about a second an estimate uncompiled) is not :attr:`EstimatorStream.ready`:
+  :meth:`EstimatorStream.hold` keeps the samples that arrive, in order, up to
+  :data:`WARMUP_BUFFER` (the oldest beyond it are dropped and counted in ``dropped_warmup``);
+  :meth:`EstimatorStream.poll` installs the estimator once it is built and feeds it the held
+  samples.
 """
 
 from __future__ import annotations
@@ -32,7 +42,7 @@ from typing import Any, Callable, Dict, Iterator, Optional, Sequence, Tuple
 
 from ..core.choice import WATCH_S, DrivenWatch
 from ..core.config import EstimatorConfig
-from ..core.estimator import COUNTER_NAMES, Estimate, as_estimates
+from ..core.estimator import COUNTER_NAMES, Estimate, FrequencyEstimator, as_estimates
 from ..core.modes import create_estimator
 from ..core.multichannel import MIN_CHANNELS
 from ..core.multichannel_free import JOINT_EXCITATIONS, create_joint_estimator
@@ -64,6 +74,18 @@ def check_channels(channels: Sequence[str], config: EstimatorConfig) -> None:
         )
 
 
+def interpretable(config: EstimatorConfig, channels: Sequence[str]) -> bool:
+    """Whether the estimator of ``config`` for ``channels`` can estimate while its kernels
+    compile (with them uncompiled, :class:`~vib_estimator.core.estimator.FrequencyEstimator`'s
+    ``interpret``): the free-decay estimator on one channel, without ``band_hz``."""
+    return (
+        len(channels) < MIN_CHANNELS
+        and config.excitation == 'free'
+        and config.modes == 0
+        and config.band_hz is None
+    )
+
+
 def estimator_factory(channels: Sequence[str]) -> Callable[[EstimatorConfig], Any]:
     """What builds the estimator of a configuration for ``channels``: one channel,
     :func:`~vib_estimator.core.modes.create_estimator`; several, the joint identifier."""
@@ -73,9 +95,12 @@ def estimator_factory(channels: Sequence[str]) -> Callable[[EstimatorConfig], An
 
 
 class _Build:
-    """An estimator of ``config`` built in a daemon thread (its kernels compiled first)."""
+    """An estimator of ``config`` built in a daemon thread (its kernels compiled first; only
+    compiled when ``create`` is None)."""
 
-    def __init__(self, config: EstimatorConfig, create: Callable[[EstimatorConfig], Any]):
+    def __init__(
+        self, config: EstimatorConfig, create: Optional[Callable[[EstimatorConfig], Any]]
+    ):
         self.config = config
         self._create = create
         self.started = time.monotonic()
@@ -90,7 +115,8 @@ class _Build:
     def _run(self) -> None:
         try:
             warm(self.config)
-            self.estimator = self._create(self.config)
+            if self._create is not None:
+                self.estimator = self._create(self.config)
         except Exception as err:  # reported by the node, never lost in a thread
             self.error = err
         self.seconds = time.monotonic() - self.started
@@ -142,8 +168,15 @@ class EstimatorStream:
 
     @property
     def ready(self) -> bool:
-        """False while a configuration's kernels compile (samples are held, not estimated)."""
-        return self._build is None
+        """False while a configuration's kernels compile and it cannot estimate meanwhile
+        (samples are held, not estimated: see the module doc)."""
+        return self.estimator is not None
+
+    @property
+    def compiling(self) -> bool:
+        """True while a configuration's kernels compile (estimating uncompiled meanwhile when
+        :attr:`ready`)."""
+        return self._build is not None
 
     def configure(self, config: EstimatorConfig, channels: Optional[Sequence[str]] = None) -> None:
         """A fresh estimator of ``config`` (a new segment, same time origin, counters kept) for
@@ -160,7 +193,11 @@ class EstimatorStream:
         self._config = config
         self.health.forget_modes(config.modes)
         if self._background and not is_warm(config):
-            self._build = _Build(config, create)
+            if interpretable(config, channels):
+                self._install(FrequencyEstimator(config, interpret=True))
+                self._build = _Build(config, None)
+            else:
+                self._build = _Build(config, create)
         else:
             self._install(create(config))
 
@@ -187,7 +224,7 @@ class EstimatorStream:
         return len(self._held)
 
     def warmup_elapsed(self, now: float) -> float:
-        """Seconds since the running warm-up started (0 when ready)."""
+        """Seconds since the running warm-up started (0 when compiled)."""
         return 0.0 if self._build is None else now - self._build.started
 
     def hold(self, stamp_ns: int, value: float, tag: Any = None) -> bool:
@@ -212,6 +249,10 @@ class EstimatorStream:
             self._build = None
             raise build.error
         self.warmup_seconds = build.seconds
+        if build.estimator is None:  # estimating uncompiled meanwhile: the compiled kernel now
+            self._build = None
+            self.estimator.compiled()
+            return iter(())
         self._install(build.estimator)
         return self._drain()
 
@@ -246,6 +287,8 @@ class EstimatorStream:
         status = self.health.status(
             now, self.counters, self.last_t, config.band_hz, config.modes, self._driven_hint()
         )
+        if self.compiling:  # estimating uncompiled meanwhile
+            status.values['warmup_s'] = self.warmup_elapsed(now)
         if len(self.channels) >= MIN_CHANNELS:  # a joint identification: which channels
             status.values['channels'] = ','.join(self.channels)
         return status
@@ -288,6 +331,7 @@ class EstimatorStream:
         if math.isfinite(rate) and rate > 0:
             rate = float(f'{rate:.{SELF_TEST_DIGITS}g}')
         key = (self.config, rate if math.isfinite(rate) else None)
-        if self._self_test[0] != key:
-            self._self_test = (key, self_test(self.config, rate))
+        if self._self_test[0] != key:  # uncompiled while the kernels compile: the same result
+            create = partial(FrequencyEstimator, interpret=True) if self.compiling else None
+            self._self_test = (key, self_test(self.config, rate, create))
         return self._self_test[1]
