@@ -1048,3 +1048,25 @@ def test_components_are_validated_at_run_time(ros_context):
         assert node.set_parameters([Parameter('excitation', value='free')])[0].successful
     finally:
         node.destroy_node()
+
+
+@pytest.mark.parametrize('deciding', [True, False])
+def test_a_driven_input_switches_the_default_to_the_identifier(make_probe, deciding):
+    """``decide_excitation`` (default true): fed a mode driven throughout, the free-decay node
+    sets its own excitation and window to analyze's decision over the last seconds (a
+    building's 1.2 Hz fundamental: ~100 s); false keeps free and says on /diagnostics which
+    excitation helps."""
+    from vib_estimator.sim.ambient import ambient_record
+
+    p = make_probe(decide_excitation=deciding)
+    t, y, _ = ambient_record(75, 40, [(1.2, 0.015, 1.0)], 20, 1)
+    p.feed([EPOCH_NS + round(s * 1e9) for s in t], y)
+    if deciding:
+        node = p.node
+        assert spin_until(p.executor, lambda: config_of(node).excitation == 'ambient', 5.0)
+        assert 90 <= node.get_parameter('ambient_window_s').value <= 110
+        assert p.node._stream.decided
+    else:
+        status = p.wait_status(lambda s: 'looks driven' in s.message)
+        assert 'excitation:=ambient' in status.message
+        assert config_of(p.node).excitation == 'free'

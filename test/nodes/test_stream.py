@@ -222,3 +222,61 @@ def test_a_driven_input_to_the_free_estimator_is_said_in_the_status_once_logged(
     y = np.exp(-0.01 * 2 * np.pi * 2 * t) * np.sin(2 * np.pi * 2 * t)
     y += 0.002 * np.random.default_rng(0).standard_normal(len(t))
     assert not any('looks driven' in s.message for s in run(EstimatorConfig(), t, y))
+
+
+def decisions(stream, t, y, step=100, estimates=None):
+    """Feed ``(t, y)`` (one status a ``step`` samples, i.e. a second at 100 Hz), applying each
+    :meth:`EstimatorStream.decision` as the node does (primed); the (second, decision) pairs.
+    ``estimates``: a list that gets (second, excitation, estimate) of each estimate."""
+    stamps = EPOCH_NS + np.round(t * 1e9).astype(np.int64)
+    out = []
+    for k in range(0, len(t), step):
+        for s, v in zip(stamps[k : k + step].tolist(), y[k : k + step].tolist()):
+            for e in stream.feed(s, v):
+                if estimates is not None:
+                    estimates.append((k // step, stream.config.excitation, e))
+        stream.status(now=1.0 + k / step)
+        decision = stream.decision()
+        if decision is not None:
+            out.append((k // step, decision))
+            changes = {'excitation': decision.excitation}
+            if decision.excitation != 'free':
+                changes['ambient_window_s'] = decision.window_s
+            stream.configure(stream.config.replace(**changes), prime=True)
+            stream.decided = True
+    return out
+
+
+def test_the_deciding_stream_goes_to_the_identifier_when_driven_and_back_when_free():
+    """``decide_excitation``: a mode driven throughout sends the free-decay estimator to the
+    identifier (analyze's decision over the last seconds: its window for the 1.2 Hz
+    fundamental) once half the watched span is in, without a hint, primed with those seconds
+    (its first estimate once a window is in since the start, not since the switch; the primer
+    uncounted); a pluck later brings it back to free decays; a decay ringing down into noise
+    never leaves free."""
+    from vib_estimator.core.choice import WATCH_S
+    from vib_estimator.sim.ambient import ambient_record
+
+    t, y, _ = ambient_record(150, 100, [(1.2, 0.015, 1.0)], 20, 1)
+    ring_t = np.arange(0, 200, 0.01)
+    ring = 50 * np.exp(-0.01 * 2 * np.pi * 2 * ring_t) * np.sin(2 * np.pi * 2 * ring_t)
+    ring += 0.002 * np.random.default_rng(0).standard_normal(len(ring_t))
+    stream = EstimatorStream(EstimatorConfig(), now=0.0, deciding=True)
+    got_estimates = []
+    got = decisions(
+        stream,
+        np.concatenate([t, t[-1] + 0.01 + ring_t]),
+        np.concatenate([y, ring]),
+        estimates=got_estimates,
+    )
+    assert [d.excitation for _, d in got] == ['ambient', 'free']
+    (went, driven), (back, _) = got
+    assert WATCH_S / 2 <= went <= WATCH_S / 2 + 5 and 90 <= driven.window_s <= 110
+    assert 150 <= back < 150 + WATCH_S and stream.config.excitation == 'free'
+    assert not any('looks driven' in m for m in stream.status(now=1e3).message.split(';'))
+    driven_estimates = [(k, e) for k, x, e in got_estimates if x == 'ambient']
+    assert driven_estimates[0][0] <= driven.window_s + 5  # primed: not went + window
+    assert all(abs(e.frequency_hz / 1.2 - 1) < 0.02 for _, e in driven_estimates)
+    assert stream.counters['received'] == len(t) + len(ring_t)
+    quiet = EstimatorStream(EstimatorConfig(), now=0.0, deciding=True)
+    assert decisions(quiet, ring_t, ring) == []

@@ -150,10 +150,11 @@ def driven_share(t: np.ndarray, signal: np.ndarray, dominant_hz: float) -> float
     return float(np.sum(energy[driven])) / total if total > 0 else 0.0
 
 
-def decide(t, y, channels: int = 1, window_s: float = 30.0) -> Decision:
+def decide(t, y, channels: int = 1, window_s: float = 30.0, stream: bool = False) -> Decision:
     """The :class:`Decision` for the record ``(t, y)`` (its first :data:`DECIDE_S` s are read;
     ``y`` samples or samples x ``channels``), ``window_s`` the shortest window (the configured
-    one)."""
+    one). ``stream``: the record is the last seconds of a stream that goes on (the window is not
+    bounded by the room for :data:`MIN_ANALYSES` analyses)."""
     t = np.asarray(t, dtype=np.float64)
     y = np.asarray(y, dtype=np.float64)
     # finite samples at sane times (an absurd stamp, 1e300 s, would overflow the block index)
@@ -187,7 +188,7 @@ def decide(t, y, channels: int = 1, window_s: float = 30.0) -> Decision:
         excitation = 'auto'
     window = window_s
     if excitation != 'free' and math.isfinite(fundamental):
-        room = max(window_s, span - MIN_ANALYSES)
+        room = math.inf if stream else max(window_s, span - MIN_ANALYSES)
         window = min(max(window_s, WINDOW_PERIODS / fundamental), MAX_WINDOW_S, room)
         seen += (
             f'; window {window:.0f} s ({window * fundamental:.0f} periods of {fundamental:.3g} Hz)'
@@ -233,7 +234,8 @@ class DrivenWatch:
     in the blocks auto's envelope (:class:`.auto.Envelope`, its block following the free
     estimates' frequency) read as driven above :data:`DRIVEN_ABOVE`, their mean level at least
     :data:`LIVE_LEVEL` of the largest block's (not the noise a decay rang down into) and the
-    envelope driven now. Fed sample by sample (:meth:`update`), asked at most once a second
+    envelope driven now. Fed sample by sample (:meth:`update`, which marks the energies every
+    1 % of :data:`WATCH_S` of stream time, however fast it is fed), asked at any pace
     (:meth:`driven`)."""
 
     def __init__(self):
@@ -242,8 +244,14 @@ class DrivenWatch:
         self._last_t = math.nan
 
     def update(self, t: float, y: float) -> None:
-        self._envelope.update(t, y)
+        env = self._envelope
+        env.update(t, y)
         self._last_t = t
+        marks = self._marks
+        if not marks or t - marks[-1][0] >= WATCH_S / 100:  # in stream time, however fast fed
+            marks.append((t, env.energy[FREE], env.energy[DRIVEN]))
+            while len(marks) > 2 and t - marks[1][0] >= WATCH_S:
+                marks.popleft()
 
     def follow(self, f: float) -> None:
         """A free estimate of ``f`` Hz: the block holds a few of its periods."""
@@ -251,19 +259,93 @@ class DrivenWatch:
 
     def driven(self) -> Optional[float]:
         """The driven share of the last :data:`WATCH_S` s' energy when they look driven
-        throughout (see the class doc), else None. Marks the stream's energies now."""
-        env = self._envelope
-        now = (self._last_t, env.energy[FREE], env.energy[DRIVEN])
-        marks = self._marks
-        if not math.isfinite(now[0]):
+        throughout (see the class doc), else None."""
+        share, live = self._mark()
+        if share is None or self._envelope.state != DRIVEN:
             return None
-        marks.append(now)
-        while len(marks) > 2 and now[0] - marks[1][0] >= WATCH_S:
-            marks.popleft()
-        span = now[0] - marks[0][0]
-        free, driven = now[1] - marks[0][1], now[2] - marks[0][2]
-        if span < WATCH_S / 2 or env.state != DRIVEN or not free + driven > 0:
-            return None
-        share = driven / (free + driven)
-        live = (free + driven) / span >= LIVE_LEVEL * env.peak
         return share if share > DRIVEN_ABOVE and live else None
+
+    def freed(self) -> bool:
+        """Whether the last :data:`WATCH_S` s look free: their driven share below
+        :data:`FREE_BELOW` (what :func:`decide` calls a free decay)."""
+        share, _ = self._mark()
+        return share is not None and share < FREE_BELOW
+
+    def _mark(self) -> tuple[Optional[float], bool]:
+        """The driven share of the last :data:`WATCH_S` s (None before half of them are in) and
+        whether they are live (see the class doc)."""
+        env = self._envelope
+        marks = self._marks
+        if not math.isfinite(self._last_t) or not marks:
+            return None, False
+        span = self._last_t - marks[0][0]
+        free = env.energy[FREE] - marks[0][1]
+        driven = env.energy[DRIVEN] - marks[0][2]
+        if span < WATCH_S / 2 or not free + driven > 0:
+            return None, False
+        return driven / (free + driven), (free + driven) / span >= LIVE_LEVEL * env.peak
+
+
+class StreamChoice:
+    """``estimator_node``'s default (``decide_excitation``): :func:`decide` over the last
+    :data:`WATCH_S` s of the stream (all channels), taken once :class:`DrivenWatch` reads them
+    driven throughout while the estimator is the free-decay one; and back to ``free`` once a
+    stream it sent to ``ambient`` reads free (``auto`` follows free stretches itself).
+
+    Fed sample by sample (:meth:`update`, a value or a tuple of the channels' values), asked at
+    any pace (:meth:`driven`, then :meth:`decision`; the node: once a second). A decision that
+    keeps ``free`` is not asked again before :data:`WATCH_S` / 2 s of stream (its spectrum costs
+    ~10 ms).
+    """
+
+    def __init__(self, channels: int = 1):
+        self.watch = DrivenWatch()
+        self.channels = channels
+        self._samples: deque = deque()  # (t, value) of the last WATCH_S s
+        self._retry_at = -math.inf
+        self._share: Optional[float] = None
+
+    def update(self, t: float, value) -> None:
+        self.watch.update(t, value if isinstance(value, float) else value[0])
+        samples = self._samples
+        samples.append((t, value))
+        if t - samples[0][0] > WATCH_S:
+            samples.popleft()
+
+    def follow(self, f: float) -> None:
+        """An estimate of ``f`` Hz (see :meth:`DrivenWatch.follow`)."""
+        self.watch.follow(f)
+
+    def kept(self) -> list:
+        """The (t, value) samples of the last :data:`WATCH_S` s, oldest first."""
+        return list(self._samples)
+
+    def driven(self) -> Optional[float]:
+        """:meth:`DrivenWatch.driven`, kept for :meth:`decision`."""
+        self._share = self.watch.driven()
+        return self._share
+
+    def decision(self, excitation: str, decided: bool, window_s: float) -> Optional[Decision]:
+        """The decision to switch to, or None: from ``free`` (when the watch read the stream driven
+        at the last :meth:`driven`), :func:`decide` over the kept samples, if not ``free``; from
+        an ``ambient`` this choice ``decided``, ``free`` once the stream reads free.
+        ``window_s``: the configured ambient window (the shortest the decision gives)."""
+        samples = self._samples
+        if not samples:
+            return None
+        now = samples[-1][0]
+        if excitation == 'ambient' and decided:
+            if not self.watch.freed():
+                return None
+            reason = (
+                f'under {100 * FREE_BELOW:.0f} % of the energy of the last {WATCH_S:g} s read '
+                'driven by the envelope'
+            )
+            return Decision('free', window_s, 0.0, math.nan, math.nan, (), reason)
+        if excitation != 'free' or self._share is None or now < self._retry_at:
+            return None
+        self._retry_at = now + WATCH_S / 2
+        t = np.fromiter((s[0] for s in samples), np.float64, len(samples))
+        y = np.array([s[1] for s in samples], dtype=np.float64)
+        chosen = decide(t, y, self.channels, window_s, stream=True)
+        return None if chosen.excitation == 'free' else chosen

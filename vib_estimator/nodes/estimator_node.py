@@ -28,6 +28,13 @@ and the diagnostics bookkeeping, all without rclpy) and publishes what comes bac
   every call answered, in turn (a self-test takes ~8 ms at the defaults; the input history
   covers 2 s).
 * ``/diagnostics`` at 1 Hz (steady clock): one status named after the node (:mod:`.health`).
+* ``decide_excitation`` (default true): while ``excitation`` is ``free`` (the default), once the
+  input looks driven throughout its last two minutes, the node sets its own ``excitation`` (and
+  ``ambient_window_s``) to what ``vib-estimator analyze`` decides on those seconds
+  (:meth:`~.stream.EstimatorStream.decision`: a building under wind, a machine driven without
+  rest), with one log line; from an ``ambient`` it set so, back to ``free`` once the input looks
+  free again. False keeps the configured excitation and says on ``/diagnostics`` when the input
+  looks driven.
 
 Time base: the header stamps (``t`` = stamp - first stamp, as the offline ``vib-estimator
 analyze``, so both give the same floats). A zero stamp, and every sample of a type without a header
@@ -50,6 +57,7 @@ from rcl_interfaces.msg import SetParametersResult
 from rclpy.clock import Clock, ClockType
 from rclpy.event_handler import SubscriptionEventCallbacks
 from rclpy.node import Node
+from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
 from rclpy.time import Time
 from std_msgs.msg import Float64, Float64MultiArray, Header, MultiArrayDimension
@@ -77,8 +85,10 @@ from .mode_shapes import ModeShapesPublisher
 from .parameters import (
     config_of,
     config_value,
+    declare,
     declare_config,
     declare_input,
+    descriptor,
     warn_unused_params_files,
 )
 from .runner import run
@@ -104,6 +114,12 @@ SERVICE_DEPTH = 1000
 CORE_NAMES = frozenset(EstimatorConfig.names())
 #: the ROS parameters that choose the fields of the input
 FIELD_NAMES = frozenset(('component', 'components'))
+#: the node's own choice of excitation (module doc)
+DECIDE_DESCRIPTION = (
+    "while excitation is free, switch to what the input needs (analyze's decision over its "
+    'last 120 s: ambient or auto, and the ambient window) once it looks driven throughout, and '
+    'back to free once it looks free again; false keeps the configured excitation'
+)
 #: the Float64 outputs of each estimate, in publication order: (topic under vibration/, field)
 FLOAT_OUTPUTS = (
     ('frequency', 'frequency_hz'),
@@ -219,6 +235,7 @@ class EstimatorNode(Node):
         #: the input topics (several: resolved, their channels are named after them)
         self._topics = topics if len(topics) < 2 else tuple(map(self.resolve_topic_name, topics))
         declare_config(self)
+        deciding = declare(self, 'decide_excitation', True, descriptor(DECIDE_DESCRIPTION))
         mode_shapes = ModeShapesPublisher.declare(self)
         #: warnings about params files that set nothing for this node (also logged)
         self.params_file_warnings = warn_unused_params_files(self, kwargs.get('cli_args'))
@@ -227,7 +244,11 @@ class EstimatorNode(Node):
             self._channels = topic_channels(self._topics, self._fields)
             self._value = channels_getter(self._fields, self._input_type)
             self._stream = EstimatorStream(
-                config_of(self), time.monotonic(), background=True, channels=self._channels
+                config_of(self),
+                time.monotonic(),
+                background=True,
+                channels=self._channels,
+                deciding=deciding,
             )
         except ValueError as err:
             raise StartupError(str(err)) from None
@@ -280,18 +301,24 @@ class EstimatorNode(Node):
         self._input_names = ','.join(sub.topic_name for sub in self._subscriptions_in)
         self.add_on_set_parameters_callback(self._check_parameters)
         self.add_post_set_parameters_callback(self._apply_parameters)
-        self._diagnostics_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
-        # on the steady clock: diagnostics go on (and can say STALE) when sim time stops
-        steady = Clock(clock_type=ClockType.STEADY_TIME)
-        self.create_timer(H.DIAGNOSTICS_PERIOD, self._publish_diagnostics, clock=steady)
-        # while the kernels compile (a first start: see .stream), look for the end of the warm-up
-        self._warmup_timer = self.create_timer(WARMUP_POLL, self._poll_warmup, clock=steady)
-        self._warmup_logged = False
+        self._create_timers()
         self.get_logger().info(
             f'estimating on {self._input_names} '
             f'({self._input_type} [{", ".join(self._channels)}]) with '
             f'{self._stream.config}'
         )
+
+    def _create_timers(self) -> None:
+        """/diagnostics and the warm-up poll, on the steady clock: diagnostics go on (and can
+        say STALE) when sim time stops; while the kernels compile (a first start: see .stream),
+        the poll looks for the end of the warm-up."""
+        self._diagnostics_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
+        steady = Clock(clock_type=ClockType.STEADY_TIME)
+        self.create_timer(H.DIAGNOSTICS_PERIOD, self._publish_diagnostics, clock=steady)
+        self._warmup_timer = self.create_timer(WARMUP_POLL, self._poll_warmup, clock=steady)
+        self._warmup_logged = False
+        #: the parameters being set are the node's own decision (:meth:`_decide`)
+        self._deciding = False
 
     def _subscribe(self, index: int):
         """The subscription to input topic ``index`` (with the middleware's own count of the
@@ -357,8 +384,11 @@ class EstimatorNode(Node):
     def _apply_parameters(self, parameters) -> None:
         """Rebuild the estimator after an accepted change: a fresh segment, same time origin."""
         names = {p.name for p in parameters}
+        if 'decide_excitation' in names:
+            self._stream.deciding = self.get_parameter('decide_excitation').value
         if not names & (CORE_NAMES | FIELD_NAMES):
             return
+        self._stream.decided = self._deciding  # a change of the user's is the user's
         self._fields = self._read_fields()
         self._channels = topic_channels(self._topics, self._fields)
         self._value = channels_getter(self._fields, self._input_type)
@@ -367,7 +397,7 @@ class EstimatorNode(Node):
             self._aligner.jump_ns = round(config_of(self).max_gap * 1e9)
         for cadence in self._cadences:
             cadence.back_ns = round(config_of(self).max_gap * 1e9)
-        self._stream.configure(config_of(self), self._channels)
+        self._stream.configure(config_of(self), self._channels, prime=self._deciding)
         self._outputs.set_modes(self._stream.config.modes)
         self._outputs.set_channels(self._channels, self._stream.config.modes)
         if self._mode_shapes is not None:
@@ -568,6 +598,27 @@ class EstimatorNode(Node):
         (:data:`~vib_estimator.nodes.health.NODE_COUNTERS`)."""
         return self._stream.counters
 
+    def _decide(self) -> None:
+        """Apply the stream's decision (``decide_excitation``), as the node's own parameters."""
+        decision = self._stream.decision()
+        if decision is None:
+            return
+        changes = [Parameter('excitation', value=decision.excitation)]
+        if decision.excitation != 'free':
+            changes.append(Parameter('ambient_window_s', value=float(decision.window_s)))
+        self.get_logger().info(
+            f'excitation {self._stream.config.excitation} -> {decision.excitation}: '
+            f'{decision.reason} (decide_excitation:=false keeps the configured excitation)'
+        )
+        self._deciding = True
+        try:
+            results = self.set_parameters(changes)
+        finally:
+            self._deciding = False
+        refused = [r.reason for r in results if not r.successful]
+        if refused:
+            self.get_logger().warn(f'the decided excitation was refused: {"; ".join(refused)}')
+
     def _publish_diagnostics(self) -> None:
         """Publish the status; log the last estimate every 10 s (rclpy's throttled logging costs
         ~0.15 ms a call, too much for the data path)."""
@@ -587,6 +638,8 @@ class EstimatorNode(Node):
                 self._align_tick,
             )
             self._align_tick = {name: counters[name] for name in H.ALIGN_PROBLEMS}
+        if self._stream.deciding:
+            self._decide()
         if self.baseline_monitor.active:
             status = self.baseline_monitor.status(status)
         if status.log:

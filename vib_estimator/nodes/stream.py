@@ -40,7 +40,7 @@ from collections import deque
 from functools import partial
 from typing import Any, Callable, Dict, Iterator, Optional, Sequence, Tuple
 
-from ..core.choice import WATCH_S, DrivenWatch
+from ..core.choice import WATCH_S, Decision, StreamChoice
 from ..core.config import EstimatorConfig
 from ..core.estimator import COUNTER_NAMES, Estimate, FrequencyEstimator, as_estimates
 from ..core.modes import create_estimator
@@ -130,7 +130,9 @@ class EstimatorStream:
     """Samples in, estimates out, with the node's counters and status (see the module doc).
 
     ``background``: build an estimator whose kernels are not compiled yet in a thread (the node);
-    False builds it at once (tests, tools). ``channels``: the names of the input's channels (the
+    False builds it at once (tests, tools). ``deciding``: the caller asks :meth:`decision` and
+    applies it (the node's ``decide_excitation``); else the status hints at a driven input.
+    ``channels``: the names of the input's channels (the
     node's components); one (or none given) is the single-channel estimator, bit for bit; several
     feed :meth:`feed` a tuple of values a sample and give
     :class:`~vib_estimator.core.multichannel.JointEstimate` s (``excitation`` free or ambient).
@@ -142,6 +144,7 @@ class EstimatorStream:
         now: float,
         background: bool = False,
         channels: Sequence[str] = (),
+        deciding: bool = False,
     ):
         config.validate()
         check_channels(channels, config)
@@ -157,8 +160,14 @@ class EstimatorStream:
         self._self_test: Tuple[Any, Tuple[bool, str]] = (None, (False, ''))
         #: seconds the last warm-up took (None before one ended)
         self.warmup_seconds: Optional[float] = None
-        #: whether the input looks driven throughout (a hint when the estimator is free's)
-        self._watch = DrivenWatch()
+        #: whether the input looks driven throughout, and what it needs (core.choice.StreamChoice)
+        self._choice = StreamChoice(max(1, len(self.channels)))
+        #: the excitation was last set by :meth:`decision` (not by the user)
+        self.decided = False
+        #: the samples a new estimator is primed with (:meth:`configure`)
+        self._primer: Sequence = ()
+        #: :meth:`decision` is asked (the node's ``decide_excitation``): no hint, a switch
+        self.deciding = deciding
         self.configure(config)
 
     @property
@@ -178,13 +187,21 @@ class EstimatorStream:
         :attr:`ready`)."""
         return self._build is not None
 
-    def configure(self, config: EstimatorConfig, channels: Optional[Sequence[str]] = None) -> None:
+    def configure(
+        self,
+        config: EstimatorConfig,
+        channels: Optional[Sequence[str]] = None,
+        prime: bool = False,
+    ) -> None:
         """A fresh estimator of ``config`` (a new segment, same time origin, counters kept) for
         ``channels`` (default: the same); built in the background when its kernels are not
         compiled yet and ``background`` was asked. ValueError if ``config`` cannot take the
-        channels (:func:`check_channels`)."""
+        channels (:func:`check_channels`). ``prime`` (a :meth:`decision` applied): the new
+        estimator is first fed the input's last seconds the decision read, uncounted and
+        unpublished, so that a driven stream's window is not filled again from empty."""
         channels = self.channels if channels is None else tuple(channels)
         check_channels(channels, config)
+        self._primer = self._choice.kept() if prime and channels == self.channels else ()
         self.channels = channels
         create = estimator_factory(channels)
         if self.estimator is not None:
@@ -205,6 +222,11 @@ class EstimatorStream:
         self.estimator = estimator
         self._update = estimator.update  # bound once: the data path's one call
         self._build = None
+        if self._primer:  # fed before any held sample; its counts taken back
+            for t, value in self._primer:
+                estimator.update(t, value)
+            self.health.absorb({name: -n for name, n in estimator.counters.items()})
+            self._primer = ()
 
     def feed(self, stamp_ns: int, value: float) -> Sequence[Estimate]:
         """One sample (stamp in integer ns); the estimates it completes (usually none).
@@ -212,10 +234,10 @@ class EstimatorStream:
         if self.origin is None:
             self.origin = stamp_ns
         self.last_t = t = seconds_since(stamp_ns, self.origin)
-        self._watch.update(t, value if isinstance(value, float) else value[0])
+        self._choice.update(t, value)
         estimates = as_estimates(self._update(t, value))
         for e in estimates:
-            self._watch.follow(getattr(e, 'estimate', e).frequency_hz)
+            self._choice.follow(getattr(e, 'estimate', e).frequency_hz)
         return estimates
 
     @property
@@ -302,14 +324,26 @@ class EstimatorStream:
     def _driven_hint(self) -> Optional[str]:
         """With the free-decay estimator, what to say when the input looks driven throughout
         (:class:`~vib_estimator.core.choice.DrivenWatch`); else None."""
-        share = self._watch.driven()
-        if share is None or self.config.excitation != 'free':
+        share = self._choice.driven()
+        if share is None or self.config.excitation != 'free' or self.deciding:
             return None
         return (
             f'the input looks driven ({100 * share:.0f} % of the energy of the last '
             f'{WATCH_S:g} s): free-decay estimates of a driven structure scatter; '
             'excitation:=ambient identifies its modes (auto: both, per stretch)'
         )
+
+    def decision(self) -> Optional[Decision]:
+        """What the input needs now, if not what runs (``decide_excitation``; after
+        :meth:`status`, which watches the input): from ``free``, once the input looks driven
+        throughout, analyze's decision over its last seconds (excitation and ambient window);
+        from an ``ambient`` decided so, ``free`` once it looks free again
+        (:class:`~vib_estimator.core.choice.StreamChoice`). The caller applies it (the node: as
+        its parameters) and sets :attr:`decided`."""
+        if not self.ready:
+            return None
+        config = self.config
+        return self._choice.decision(config.excitation, self.decided, config.ambient_window_s)
 
     def reset(self) -> Tuple[bool, str]:
         """Start a new segment at the last sample; counters kept. (False, why) during a warm-up."""
