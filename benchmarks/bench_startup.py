@@ -17,10 +17,10 @@ same run, on the same machine state.
   real time) from one second after the node subscribes (discovery settled both ways). *live*:
   spawn to the node's first ``/diagnostics``, and the longest silence of ``/diagnostics`` after it
   (a node blocked in a compile says nothing); *ready*: spawn to the first ``~/self_test`` answer
-  that is not "busy" (called every 0.1 s: the kernels are compiled and the tones ran); *first
-  estimate*: from the first sample sent to the first ``vibration/frequency`` (and from spawn); *lost*: samples sent
-  that the node never counted (its ``received`` + ``dropped_warmup`` against what was sent). Then
-  SIGINT: the exit code.
+  that is not "busy" (called every 0.1 s: the tones ran, compiled or uncompiled); *first
+  estimate*: from the first sample sent to the first ``vibration/frequency`` (and from spawn);
+  *lost*: samples sent that the node never counted (its ``received`` + ``dropped_warmup`` against
+  what was sent). Then SIGINT: the exit code.
 * ``shaper_node``: spawn to its first ``/diagnostics``.
 * ``analyze``: the whole ``vib-estimator analyze`` of a 20 s CSV (500 Hz).
 """
