@@ -129,6 +129,7 @@ class Probe:
             result = future.result()
             if result is not None and not result.message.startswith('busy'):
                 state['ready'] = time.monotonic()
+                state['cpu'] = cpu_seconds(state['pid'])
             state['future'] = None
             state['next'] = time.monotonic() + 0.1
         elif (
@@ -146,7 +147,7 @@ class Probe:
         proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         sent = 0
         msg = self.msg_type()
-        state = {}
+        state = {'pid': proc.pid}
         matched = None
         try:
             while (
@@ -172,6 +173,7 @@ class Probe:
             ready = state['ready'] - start if 'ready' in state else math.nan
             latency = self.first_estimate - first if self.first_estimate else math.nan
             spawned = self.first_estimate - start if self.first_estimate else math.nan
+            cpu = state.get('cpu', math.nan)
             self.spin(1.5)  # a diagnostics period after the first estimate
             live = min(self.first_diag.values(), default=math.nan) - start
             # the longest /diagnostics silence, from the first one to 1.5 s after ready
@@ -182,7 +184,7 @@ class Probe:
             lost = sent - counted if values else -1
         finally:
             code = stop(proc)
-        return live, ready, latency, lost, code, silence, spawned
+        return live, ready, latency, lost, code, silence, spawned, cpu
 
     def first_diagnostics(self, cmd, env):
         """(spawn to first /diagnostics s, exit code) of a node."""
@@ -205,6 +207,17 @@ class Probe:
         self.executor.shutdown()
         self.node.destroy_node()
         self.context.try_shutdown()
+
+
+def cpu_seconds(pid: int) -> float:
+    """CPU seconds (user + system) process ``pid`` used so far: what a start costs whatever the
+    machine's load (its wall-clock figures grow with it)."""
+    try:
+        with open(f'/proc/{pid}/stat') as stat:
+            fields = stat.read().rsplit(')', 1)[1].split()
+    except OSError:
+        return math.nan
+    return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
 
 
 def stop(proc) -> int:
@@ -245,7 +258,7 @@ def checkout(ref: str, where: Path) -> Path:
 
 def noted(rows: list, row: tuple, text: str) -> None:
     """Keep a result row (case, tree, cold/warm, live, ready, lost, exit, first estimate, longest
-    silence, first estimate after spawn) and print it as it comes."""
+    silence, first estimate after spawn, CPU s to ready) and print it as it comes."""
     rows.append(row)
     case, label, kind = row[:3]
     print(f'{case:28s} {label:8s} {kind}: {text}', flush=True)
@@ -285,7 +298,7 @@ def main(argv=None) -> int:
                     cache = tempfile.mkdtemp(dir=tmp)
                     cmd = node_command(tree, 'vib_estimator.nodes.estimator_node', params)
                     for kind in ('cold', 'warm'):
-                        live, ready, latency, lost, code, silence, spawned = probe.estimator(
+                        live, ready, latency, lost, code, silence, spawned, cpu = probe.estimator(
                             cmd, environment(tree, cache)
                         )
                         noted(
@@ -301,11 +314,12 @@ def main(argv=None) -> int:
                                 latency,
                                 silence,
                                 spawned,
+                                cpu,
                             ),
                             f'live {live:6.2f} s (longest /diagnostics silence {silence:5.2f} '
                             f's), ready {ready:6.2f} s, first estimate {latency:6.2f} s after '
                             f'the first sample ({spawned:6.2f} s after spawn), lost {lost}, '
-                            f'exit {code}',
+                            f'exit {code}; {cpu:5.2f} CPU s to ready',
                         )
             if 'shaper_node' in only:
                 for label, tree in trees.items():
@@ -314,14 +328,14 @@ def main(argv=None) -> int:
                     for kind in ('cold', 'warm'):
                         live, code = probe.first_diagnostics(cmd, environment(tree, cache))
                         row = ('shaper_node', label, kind, live, live, 0, code)
-                        noted(rows, row + (math.nan,) * 3, f'live {live:6.2f} s, exit {code}')
+                        noted(rows, row + (math.nan,) * 4, f'live {live:6.2f} s, exit {code}')
             if 'analyze' in only:
                 for label, tree in trees.items():
                     cache = tempfile.mkdtemp(dir=tmp)
                     for kind in ('cold', 'warm'):
                         seconds = analyze_seconds(tree, environment(tree, cache), csv)
                         row = ('analyze (20 s CSV)', label, kind, math.nan, seconds, 0, 0)
-                        noted(rows, row + (math.nan,) * 3, f'{seconds:6.2f} s')
+                        noted(rows, row + (math.nan,) * 4, f'{seconds:6.2f} s')
         finally:
             probe.close()
     print(
@@ -329,10 +343,10 @@ def main(argv=None) -> int:
         f'{args.ref} | live: first /diagnostics; longest silence, cold today / {args.ref} | '
         f'first estimate after '
         f'the first sample, cold today / {args.ref} | first estimate after spawn, cold today / '
-        f'{args.ref}; warm today / {args.ref} | samples lost, cold today / {args.ref} | '
-        'exit on SIGINT |'
+        f'{args.ref}; warm today / {args.ref} | CPU s to ready, cold today / {args.ref}; warm '
+        f'today / {args.ref} | samples lost, cold today / {args.ref} | exit on SIGINT |'
     )
-    print('|---|---|---|---|---|---|---|---|---|---|')
+    print('|---|---|---|---|---|---|---|---|---|---|---|')
     cases = list(dict.fromkeys(r[0] for r in rows))
     for case in cases:
         get = {(r[1], r[2]): r for r in rows if r[0] == case}
@@ -344,7 +358,8 @@ def main(argv=None) -> int:
             f'{ref_w[4]:.2f} s | {today_c[3]:.1f}; {today_c[8]:.1f} / {ref_c[3]:.1f}; '
             f'{ref_c[8]:.1f} s | '
             f'{today_c[7]:.1f} / {ref_c[7]:.1f} s | {today_c[9]:.1f} / {ref_c[9]:.1f}; '
-            f'{today_w[9]:.1f} / {ref_w[9]:.1f} s | {today_c[5]} / {ref_c[5]} | {codes} |'
+            f'{today_w[9]:.1f} / {ref_w[9]:.1f} s | {today_c[10]:.1f} / {ref_c[10]:.1f}; '
+            f'{today_w[10]:.2f} / {ref_w[10]:.2f} s | {today_c[5]} / {ref_c[5]} | {codes} |'
         )
     print(GOALS)
     return 0
