@@ -4,6 +4,8 @@
 to the identifier with a window sized to their fundamental; each constant pinned from both
 sides."""
 
+import math
+
 import numpy as np
 import pytest
 
@@ -237,4 +239,50 @@ def test_a_free_decay_of_several_modes_goes_to_the_mode_tracker(monkeypatch, nam
         with pytest.raises(ValueError):
             EstimatorConfig(modes=decide(*pair).modes).validate()
         return
+    assert not right()
+
+
+def test_the_stream_choice_feeds_the_watch_in_batches_with_the_same_answers():
+    """StreamChoice feeds DrivenWatch in numpy batches (DrivenWatch.feed): the same answers as
+    sample by sample, however it is asked."""
+    from vib_estimator.core.choice import DrivenWatch, StreamChoice
+
+    t, y, _ = ambient_record(200, 100, [(1.2, 0.015, 1.0)], 20, 1)
+    tail = np.arange(200, 320, 0.01)
+    y = np.concatenate([y, 30 * np.exp(-0.3 * (tail - 200)) * np.sin(2 * np.pi * tail)])
+    t = np.concatenate([t, tail])
+    one, batched = DrivenWatch(), StreamChoice()
+    answers = []
+    for k, (a, b) in enumerate(zip(t.tolist(), y.tolist())):
+        one.update(a, b)
+        batched.update(a, b)
+        if k % 337 == 0:
+            answers.append((one.driven(), batched.driven(), one.freed(), batched.watch.freed()))
+    assert all(a == b and c == d for a, b, c, d in answers)
+    assert any(a is not None for a, *_ in answers) and any(c for *_, c, _ in answers)
+
+
+@pytest.mark.parametrize('factor', [1e-3, 1e3])
+def test_the_stream_choice_keeps_at_most_max_kept_samples(monkeypatch, factor):
+    """The node's decision reads the last WATCH_S s, bounded in memory: a 10 kHz stream keeps
+    MAX_KEPT samples (262 s at 1 kHz; 26 s here), a 100 Hz driven one all its 120 s, enough
+    to decide. MAX_KEPT at 0.001x starves the decision, at 1000x the memory is unbounded."""
+    from vib_estimator.core.choice import StreamChoice
+
+    def right():
+        fast = StreamChoice()
+        for a in (np.arange(400_000) / 1e4).tolist():
+            fast.update(a, math.sin(a))
+        t, _ = fast.kept()
+        bounded = len(t) == min(2**18, choice.MAX_KEPT) and abs(t[-1] - 39.9999) < 1e-9
+        t, y, _ = ambient_record(130, 100, [(1.2, 0.015, 1.0)], 20, 1)
+        slow = StreamChoice()
+        for a, b in zip(t.tolist(), y.tolist()):
+            slow.update(a, b)
+        slow.driven()
+        decided = slow.decision('free', False, 30.0)
+        return bounded and decided is not None and 90 <= decided.window_s <= 110
+
+    assert right()
+    monkeypatch.setattr(choice, 'MAX_KEPT', int(choice.MAX_KEPT * factor))
     assert not right()

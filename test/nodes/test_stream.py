@@ -280,3 +280,22 @@ def test_the_deciding_stream_goes_to_the_identifier_when_driven_and_back_when_fr
     assert stream.counters['received'] == len(t) + len(ring_t)
     quiet = EstimatorStream(EstimatorConfig(), now=0.0, deciding=True)
     assert decisions(quiet, ring_t, ring) == []
+
+
+def test_an_identifier_that_finds_no_mode_says_which_window_helps():
+    """Under excitation ambient, a 30 s window on a 0.3 Hz mode publishes nothing: after two
+    windows (and a minute) the status says why in words -- the window's correlation times of the
+    input's lowest peak -- and which ambient_window_s helps (not a counter alone); logged once."""
+    from vib_estimator.sim.ambient import ambient_record
+
+    t, y, _ = ambient_record(150, 100, [(0.3, 0.01, 1.0)], 20, 1)
+    stream = EstimatorStream(EstimatorConfig(excitation='ambient', ambient_window_s=30.0), 0.0)
+    stamps = EPOCH_NS + np.round(t * 1e9).astype(np.int64)
+    statuses = []
+    for k in range(0, len(t), 100):
+        assert not feed(stream, stamps[k : k + 100], y[k : k + 100])
+        statuses.append(stream.status(now=k / 100))
+    said = [k for k, s in enumerate(statuses) if 'ambient_window_s:=300' in s.message]
+    assert said and said[0] == 60 and said == list(range(60, len(statuses)))
+    assert '1.1 correlation times of the 0.3 Hz peak' in statuses[-1].message
+    assert sum('ambient_window_s:=' in (s.log or '') for s in statuses) == 1

@@ -23,12 +23,9 @@ from typing import Iterable, Iterator, Optional, Tuple
 import numpy as np
 
 from ..core.ambient import MIN_WINDOW_SAMPLES
-from ..core.choice import DECIDE_S, DRIVEN_ABOVE, FREE_BELOW, WINDOW_PERIODS, Decision, decide
+from ..core.choice import DECIDE_S, DRIVEN_ABOVE, FREE_BELOW, Decision, decide
+from ..core.choice import window_advice as choice_window_advice
 from ..core.config import EstimatorConfig
-
-#: the damping ratio :func:`window_advice` assumes of the lowest mode (the choice's
-#: :data:`..core.choice.WINDOW_PERIODS` is ~15 correlation times at it)
-ASSUMED_ZETA = 0.02
 
 
 def decides(args) -> bool:
@@ -80,20 +77,9 @@ def contradiction(config: EstimatorConfig, d: Decision, prog: str) -> str:
 
 
 def window_advice(config: EstimatorConfig, d: Optional[Decision]) -> str:
-    """Why a window gave no mode, from the record's lowest spectral peak: how many correlation
-    times ``1 / (2 pi zeta f)`` (at :data:`ASSUMED_ZETA`) of it the window holds, and the window
-    that holds the decision's :data:`..core.choice.WINDOW_PERIODS` periods; '' without a peak."""
-    if d is None or not math.isfinite(d.fundamental_hz):
-        return ''
-    f, window = d.fundamental_hz, config.ambient_window_s
-    times = window * 2 * math.pi * ASSUMED_ZETA * f
-    want = WINDOW_PERIODS / f
-    if window >= want:
-        return ''
-    return (
-        f'the {window:g} s window holds {times:.1f} correlation times of the {f:.3g} Hz peak (at '
-        f'zeta {100 * ASSUMED_ZETA:g} %): --ambient-window-s {math.ceil(want)}'
-    )
+    """Why a window gave no mode, from the record's lowest spectral peak
+    (:func:`..core.choice.window_advice`, the option ``analyze`` takes); '' without one."""
+    return choice_window_advice(config.ambient_window_s, d, '--ambient-window-s ')
 
 
 def short_window(config: EstimatorConfig, d: Optional[Decision]) -> str:

@@ -82,6 +82,9 @@ HARMONIC_TOL = 0.02
 WINDOW_PERIODS = 120.0
 #: the longest window the decision chooses, s
 MAX_WINDOW_S = 300.0
+#: the damping ratio :func:`window_advice` assumes of the lowest mode (:data:`WINDOW_PERIODS`
+#: is ~15 correlation times at it)
+ASSUMED_ZETA = 0.02
 #: the window leaves the record room for at least this many analyses (one per second)
 MIN_ANALYSES = 60
 
@@ -208,6 +211,24 @@ def decide(t, y, channels: int = 1, window_s: float = 30.0, stream: bool = False
     )
 
 
+def window_advice(window_s: float, d: Optional[Decision], option: str) -> str:
+    """Why a ``window_s`` window gave no mode, from the record's lowest spectral peak: how many
+    correlation times ``1 / (2 pi zeta f)`` (at :data:`ASSUMED_ZETA`) of it the window holds,
+    and ``option`` with the window that holds :data:`WINDOW_PERIODS` periods of it (at most
+    :data:`MAX_WINDOW_S`); '' without a peak, or when the window holds them."""
+    if d is None or not math.isfinite(d.fundamental_hz):
+        return ''
+    f = d.fundamental_hz
+    times = window_s * 2 * math.pi * ASSUMED_ZETA * f
+    want = min(WINDOW_PERIODS / f, MAX_WINDOW_S)
+    if window_s >= want:
+        return ''
+    return (
+        f'the {window_s:g} s window holds {times:.1f} correlation times of the {f:.3g} Hz peak '
+        f'(at zeta {100 * ASSUMED_ZETA:g} %): {option}{math.ceil(want)}'
+    )
+
+
 def separate_modes(peaks: np.ndarray, powers: np.ndarray) -> list[float]:
     """The spectral peaks (strongest first) that are modes of their own: at least
     :data:`MODE_SHARE` of the strongest's power, :data:`MODE_GAP` (relative) from every stronger
@@ -227,6 +248,8 @@ def separate_modes(peaks: np.ndarray, powers: np.ndarray) -> list[float]:
 WATCH_S = 120.0
 #: ... and the least mean variance they must hold, relative to the stream's largest block's
 LIVE_LEVEL = 1e-2
+#: the most samples the node keeps for its decision (15 MB with 6 channels; 262 s at 1 kHz)
+MAX_KEPT = 2**18
 
 
 class DrivenWatch:
@@ -249,9 +272,29 @@ class DrivenWatch:
         self._last_t = t
         marks = self._marks
         if not marks or t - marks[-1][0] >= WATCH_S / 100:  # in stream time, however fast fed
-            marks.append((t, env.energy[FREE], env.energy[DRIVEN]))
-            while len(marks) > 2 and t - marks[1][0] >= WATCH_S:
-                marks.popleft()
+            self._mark(t)
+
+    def feed(self, t: np.ndarray, y: np.ndarray) -> None:
+        """:meth:`update` for arrays (the same states and marks, in a few numpy passes)."""
+        start, n = 0, len(t)
+        while start < n:
+            end = start + 1  # the first sample is marked
+            if self._marks:  # else up to the next sample to mark at
+                later = np.flatnonzero(t[start:] - self._marks[-1][0] >= WATCH_S / 100)
+                end = start + int(later[0]) + 1 if len(later) else n + 1
+            with np.errstate(over='ignore', invalid='ignore'):  # as update's floats: inf
+                self._envelope.feed(t[start:end], y[start:end])
+            self._last_t = float(t[min(end, n) - 1])
+            if end <= n:
+                self._mark(self._last_t)
+            start = end
+
+    def _mark(self, t: float) -> None:
+        """Mark the envelope's energies at stream time ``t``; forget marks beyond the span."""
+        env, marks = self._envelope, self._marks
+        marks.append((t, env.energy[FREE], env.energy[DRIVEN]))
+        while len(marks) > 2 and t - marks[1][0] >= WATCH_S:
+            marks.popleft()
 
     def follow(self, f: float) -> None:
         """A free estimate of ``f`` Hz: the block holds a few of its periods."""
@@ -260,7 +303,7 @@ class DrivenWatch:
     def driven(self) -> Optional[float]:
         """The driven share of the last :data:`WATCH_S` s' energy when they look driven
         throughout (see the class doc), else None."""
-        share, live = self._mark()
+        share, live = self._watched_share()
         if share is None or self._envelope.state != DRIVEN:
             return None
         return share if share > DRIVEN_ABOVE and live else None
@@ -268,10 +311,10 @@ class DrivenWatch:
     def freed(self) -> bool:
         """Whether the last :data:`WATCH_S` s look free: their driven share below
         :data:`FREE_BELOW` (what :func:`decide` calls a free decay)."""
-        share, _ = self._mark()
+        share, _ = self._watched_share()
         return share is not None and share < FREE_BELOW
 
-    def _mark(self) -> tuple[Optional[float], bool]:
+    def _watched_share(self) -> tuple[Optional[float], bool]:
         """The driven share of the last :data:`WATCH_S` s (None before half of them are in) and
         whether they are live (see the class doc)."""
         env = self._envelope
@@ -292,36 +335,76 @@ class StreamChoice:
     driven throughout while the estimator is the free-decay one; and back to ``free`` once a
     stream it sent to ``ambient`` reads free (``auto`` follows free stretches itself).
 
-    Fed sample by sample (:meth:`update`, a value or a tuple of the channels' values), asked at
-    any pace (:meth:`driven`, then :meth:`decision`; the node: once a second). A decision that
-    keeps ``free`` is not asked again before :data:`WATCH_S` / 2 s of stream (its spectrum costs
-    ~10 ms).
+    Fed sample by sample (:meth:`update`, a value or a tuple of the channels' values: two list
+    appends; the watch is fed in numpy batches when asked, or every :data:`MAX_KEPT`), asked at
+    any pace (:meth:`driven`, then :meth:`decision`; the node: once a second). What it keeps
+    (:meth:`kept`) is the last :data:`WATCH_S` s, at most :data:`MAX_KEPT` samples (a fast
+    stream's decision reads fewer seconds); a stamp going back by more than 1 % of
+    :data:`WATCH_S` starts it afresh (another time base). A decision that keeps ``free`` is not
+    asked again before :data:`WATCH_S` / 2 s of stream (its spectrum costs ~10 ms).
     """
 
     def __init__(self, channels: int = 1):
         self.watch = DrivenWatch()
         self.channels = channels
-        self._samples: deque = deque()  # (t, value) of the last WATCH_S s
+        self._pending_t: list = []
+        self._pending_y: list = []
+        self._kept: deque = deque()  # (t, y) arrays of the last WATCH_S s, oldest first
+        self._kept_n = 0
         self._retry_at = -math.inf
         self._share: Optional[float] = None
 
     def update(self, t: float, value) -> None:
-        self.watch.update(t, value if isinstance(value, float) else value[0])
-        samples = self._samples
-        samples.append((t, value))
-        if t - samples[0][0] > WATCH_S:
-            samples.popleft()
+        self._pending_t.append(t)
+        self._pending_y.append(value)
+        if len(self._pending_t) >= MAX_KEPT:
+            self._flush()
+
+    def _flush(self) -> None:
+        """Feed the pending samples to the watch (its first channel) and keep them."""
+        if not self._pending_t:
+            return
+        t = np.array(self._pending_t, dtype=np.float64)
+        y = np.array(self._pending_y, dtype=np.float64)
+        self._pending_t, self._pending_y = [], []
+        self.watch.feed(t, y if y.ndim == 1 else y[:, 0])
+        kept = self._kept
+        if kept and t[0] < kept[-1][0][-1] - WATCH_S / 100:
+            kept.clear()
+            self._kept_n = 0
+        kept.append((t, y))
+        self._kept_n += len(t)
+        while len(kept) > 1 and t[-1] - kept[1][0][0] >= WATCH_S:
+            self._kept_n -= len(kept.popleft()[0])
+        excess = self._kept_n - MAX_KEPT
+        while excess > 0:  # the oldest samples go (a copy: the rest of the array is freed)
+            old_t, old_y = kept[0]
+            if len(old_t) <= excess:
+                kept.popleft()
+            else:
+                kept[0] = (old_t[excess:].copy(), old_y[excess:].copy())
+            gone = min(len(old_t), excess)
+            self._kept_n -= gone
+            excess -= gone
 
     def follow(self, f: float) -> None:
-        """An estimate of ``f`` Hz (see :meth:`DrivenWatch.follow`)."""
+        """An estimate of ``f`` Hz (:meth:`DrivenWatch.follow`), after the samples before it."""
+        self._flush()
         self.watch.follow(f)
 
-    def kept(self) -> list:
-        """The (t, value) samples of the last :data:`WATCH_S` s, oldest first."""
-        return list(self._samples)
+    def kept(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(t, y)`` of the kept samples (y: samples, or samples x channels), oldest first."""
+        self._flush()
+        if not self._kept:
+            return np.empty(0), np.empty(0)
+        return (
+            np.concatenate([c[0] for c in self._kept]),
+            np.concatenate([c[1] for c in self._kept]),
+        )
 
     def driven(self) -> Optional[float]:
         """:meth:`DrivenWatch.driven`, kept for :meth:`decision`."""
+        self._flush()
         self._share = self.watch.driven()
         return self._share
 
@@ -330,10 +413,10 @@ class StreamChoice:
         at the last :meth:`driven`), :func:`decide` over the kept samples, if not ``free``; from
         an ``ambient`` this choice ``decided``, ``free`` once the stream reads free.
         ``window_s``: the configured ambient window (the shortest the decision gives)."""
-        samples = self._samples
-        if not samples:
+        t, y = self.kept()
+        if not len(t):
             return None
-        now = samples[-1][0]
+        now = float(t[-1])
         if excitation == 'ambient' and decided:
             if not self.watch.freed():
                 return None
@@ -345,7 +428,5 @@ class StreamChoice:
         if excitation != 'free' or self._share is None or now < self._retry_at:
             return None
         self._retry_at = now + WATCH_S / 2
-        t = np.fromiter((s[0] for s in samples), np.float64, len(samples))
-        y = np.array([s[1] for s in samples], dtype=np.float64)
         chosen = decide(t, y, self.channels, window_s, stream=True)
         return None if chosen.excitation == 'free' else chosen

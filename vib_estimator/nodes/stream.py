@@ -40,7 +40,9 @@ from collections import deque
 from functools import partial
 from typing import Any, Callable, Dict, Iterator, Optional, Sequence, Tuple
 
-from ..core.choice import WATCH_S, Decision, StreamChoice
+import numpy as np
+
+from ..core.choice import WATCH_S, Decision, StreamChoice, decide, window_advice
 from ..core.config import EstimatorConfig
 from ..core.estimator import COUNTER_NAMES, Estimate, FrequencyEstimator, as_estimates
 from ..core.modes import create_estimator
@@ -58,6 +60,8 @@ WARMUP_BUFFER = 60_000
 #: significant digits of the measured sampling rate the self-test's tones are made for (a rate
 #: that wanders in its last digits gives the same tones, and the kept result)
 SELF_TEST_DIGITS = 3
+#: no samples to prime a new estimator with (:meth:`EstimatorStream.configure`)
+NO_PRIMER = (np.empty(0), np.empty(0))
 #: the diagnostics message while the kernels compile
 WARMUP_MESSAGE = 'compiling estimator kernels (first start)'
 
@@ -164,8 +168,12 @@ class EstimatorStream:
         self._choice = StreamChoice(max(1, len(self.channels)))
         #: the excitation was last set by :meth:`decision` (not by the user)
         self.decided = False
+        #: stream time of the last estimate, or of the last configuration (:meth:`_silent_hint`)
+        self._estimated_at: Optional[float] = None
+        #: (stream time, advice) of the last :meth:`_silent_hint` computed
+        self._advice: Tuple[float, str] = (-math.inf, '')
         #: the samples a new estimator is primed with (:meth:`configure`)
-        self._primer: Sequence = ()
+        self._primer: Tuple[np.ndarray, np.ndarray] = NO_PRIMER
         #: :meth:`decision` is asked (the node's ``decide_excitation``): no hint, a switch
         self.deciding = deciding
         self.configure(config)
@@ -201,13 +209,14 @@ class EstimatorStream:
         unpublished, so that a driven stream's window is not filled again from empty."""
         channels = self.channels if channels is None else tuple(channels)
         check_channels(channels, config)
-        self._primer = self._choice.kept() if prime and channels == self.channels else ()
+        self._primer = self._choice.kept() if prime and channels == self.channels else NO_PRIMER
         self.channels = channels
         create = estimator_factory(channels)
         if self.estimator is not None:
             self.health.absorb(self.estimator.counters)
             self.estimator = None
         self._config = config
+        self._estimated_at = self.last_t
         self.health.forget_modes(config.modes)
         if self._background and not is_warm(config):
             if interpretable(config, channels):
@@ -222,11 +231,13 @@ class EstimatorStream:
         self.estimator = estimator
         self._update = estimator.update  # bound once: the data path's one call
         self._build = None
-        if self._primer:  # fed before any held sample; its counts taken back
-            for t, value in self._primer:
-                estimator.update(t, value)
+        if len(self._primer[0]):  # fed before any held sample; its counts taken back
+            t, y = self._primer
+            values = y.tolist() if y.ndim == 1 else map(tuple, y.tolist())
+            for when, value in zip(t.tolist(), values):
+                estimator.update(when, value)
             self.health.absorb({name: -n for name, n in estimator.counters.items()})
-            self._primer = ()
+            self._primer = NO_PRIMER
 
     def feed(self, stamp_ns: int, value: float) -> Sequence[Estimate]:
         """One sample (stamp in integer ns); the estimates it completes (usually none).
@@ -238,6 +249,7 @@ class EstimatorStream:
         estimates = as_estimates(self._update(t, value))
         for e in estimates:
             self._choice.follow(getattr(e, 'estimate', e).frequency_hz)
+            self._estimated_at = t
         return estimates
 
     @property
@@ -307,7 +319,12 @@ class EstimatorStream:
             return Status(WARN, WARMUP_MESSAGE, values)
         config = self.config
         status = self.health.status(
-            now, self.counters, self.last_t, config.band_hz, config.modes, self._driven_hint()
+            now,
+            self.counters,
+            self.last_t,
+            config.band_hz,
+            config.modes,
+            self._driven_hint() or self._silent_hint(),
         )
         if self.compiling:  # estimating uncompiled meanwhile
             status.values['warmup_s'] = self.warmup_elapsed(now)
@@ -332,6 +349,33 @@ class EstimatorStream:
             f'{WATCH_S:g} s): free-decay estimates of a driven structure scatter; '
             'excitation:=ambient identifies its modes (auto: both, per stretch)'
         )
+
+    def _silent_hint(self) -> Optional[str]:
+        """Under the identifier (``excitation`` ambient or auto), when it published nothing for
+        two windows (and a minute): why, from the spectrum of the input's last seconds -- the
+        window's correlation times of their lowest peak and the ``ambient_window_s`` that holds
+        enough (:func:`~vib_estimator.core.choice.window_advice`), computed at most every
+        :data:`~vib_estimator.core.choice.WATCH_S` / 2 s of stream; else None."""
+        config = self.config
+        since = self._estimated_at if self._estimated_at is not None else self._first_t()
+        if config.excitation == 'free' or since is None or self.last_t is None:
+            return None
+        silent = self.last_t - since
+        if silent < max(2 * config.ambient_window_s, 60.0):
+            return None
+        at, advice = self._advice
+        if self.last_t - at >= WATCH_S / 2 or self.last_t < at:
+            t, y = self._choice.kept()
+            d = decide(t, y, max(1, len(self.channels)), config.ambient_window_s, stream=True)
+            advice = window_advice(config.ambient_window_s, d, 'ambient_window_s:=')
+            self._advice = (self.last_t, advice)
+        if not advice:
+            return None
+        return f'no mode for {silent:.0f} s: {advice}'
+
+    def _first_t(self) -> Optional[float]:
+        """Stream time of the first sample (0.0), None before any."""
+        return None if self.origin is None else 0.0
 
     def decision(self) -> Optional[Decision]:
         """What the input needs now, if not what runs (``decide_excitation``; after
