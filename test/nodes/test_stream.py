@@ -126,7 +126,7 @@ def test_a_burst_of_self_tests_runs_the_tones_once(monkeypatch):
     monkeypatch.setattr(
         stream_module,
         'self_test',
-        lambda config, rate: runs.append((config, rate)) or real(config, rate),
+        lambda config, rate, create: runs.append((config, rate)) or real(config, rate, create),
     )
     s = stream_module.EstimatorStream(EstimatorConfig(), 0.0)
     answers = [s.self_test() for _ in range(50)]

@@ -37,7 +37,7 @@ import numpy as np
 
 from . import kernel as K
 from .config import EstimatorConfig
-from .jit import entry
+from .jit import entry, interpreted
 
 #: the input counters every estimator keeps (the first of the kernel's counter array, in order)
 INPUT_COUNTERS = (
@@ -65,7 +65,7 @@ COUNTER_NAMES = INPUT_COUNTERS + (
 
 
 #: the attributes :meth:`FrequencyEstimator._bind` derives (not pickled: compiled code, views)
-_BOUND = ('_feed', '_p', '_row', '_s', '_seg')
+_BOUND = ('_feed', '_k', '_p', '_row', '_s', '_seg')
 
 
 def as_series(t: Sequence[float], y: Sequence[float]) -> Tuple[np.ndarray, np.ndarray]:
@@ -245,9 +245,11 @@ class FrequencyEstimator(Estimator):
     ``counters`` tells how many samples went where and why estimates were held back.
     """
 
-    def __init__(self, config: EstimatorConfig = EstimatorConfig()):
+    def __init__(self, config: EstimatorConfig = EstimatorConfig(), interpret: bool = False):
         config.validate()
         self._config = config
+        #: the kernel's functions: compiled, or uncompiled while ``interpret`` (:meth:`compiled`)
+        self._k = interpreted(K) if interpret else K
         self._n_state = K.N_STATE_FIXED + 2 * config.window + 1
         self._f = K.feed_buffer(config.as_params(), self._n_state, config.buffer_samples)
         self._c = np.zeros(K.N_COUNTERS, dtype=np.int64)
@@ -260,6 +262,20 @@ class FrequencyEstimator(Estimator):
         ``_s``, ``_seg`` (:func:`core.kernel.feed_buffer`'s layout) and the streaming path's
         compiled code, looked up at the first :meth:`update`."""
         self._p, self._row, self._s, self._seg = K.feed_views.py_func(self._f, self._n_state)
+        self._feed = None
+        self.__dict__.setdefault('_k', K)  # unpickled: compiled (the kernel is not pickled)
+
+    @property
+    def interpreted(self) -> bool:
+        """True while the estimator runs its kernel uncompiled (``interpret``)."""
+        return self._k is not K
+
+    def compiled(self) -> None:
+        """Run the compiled kernel from the next sample on (same state, same floats: the
+        uncompiled one computes what it computes, :func:`core.jit.interpreted`). Its first call
+        compiles it, unless it is compiled already (the node compiles it in the background:
+        :mod:`vib_estimator.nodes.stream`)."""
+        self._k = K
         self._feed = None
 
     def __getstate__(self) -> dict:
@@ -276,12 +292,12 @@ class FrequencyEstimator(Estimator):
     def restart(self) -> None:
         """Forget the signal entirely (prefilter, history, running interval and scale too);
         counters are kept."""
-        K.forget_stream(self._s, self._c)
+        self._k.forget_stream(self._s, self._c)
 
     def reset(self) -> None:
         """Start a new estimation segment at the last sample, as after a convergence."""
         if self._c[K.C_HIST_N] >= K.NH:
-            K.reset_segment(
+            self._k.reset_segment(
                 self._s, self._c, self._seg, self._s[K.S_TLAST], self._s[K.S_HY + K.NH - 1]
             )
 
@@ -314,8 +330,10 @@ class FrequencyEstimator(Estimator):
         """
         feed = self._feed
         if feed is None:
-            feed = self._feed = entry(
-                K.feed, (self._f, self._c, self._n_state, 0.0, 0.0, self._optional)
+            feed = self._feed = (
+                self._k.feed
+                if self.interpreted
+                else entry(K.feed, (self._f, self._c, self._n_state, 0.0, 0.0, self._optional))
             )
         if feed(self._f, self._c, self._n_state, t, y, self._optional):
             return (
@@ -333,7 +351,7 @@ class FrequencyEstimator(Estimator):
         size = max(16, len(t) // 100)
         while True:
             out = np.empty((size, K.N_OUT))
-            n, start = K.run(
+            n, start = self._k.run(
                 self._p, self._s, self._c, self._seg, t, y, out, start, self._optional
             )
             chunks.append(out[:n])

@@ -1034,7 +1034,9 @@ def _missing_optional():
 
 def _band_std_if(optional, p, s, seg, n, model, res):
     """:func:`_band_std`, compiled (an overload chosen by the type of ``optional``) only for a
-    configuration with optional features (:func:`optional_features`)."""
+    configuration with optional features (:func:`optional_features`). This body is what runs
+    uncompiled (:func:`core.jit.interpreted`)."""
+    _band_std(p, s, seg, n, model, res)
 
 
 @overload(_band_std_if, inline='always')
@@ -1046,6 +1048,7 @@ def _band_std_if_typed(optional, p, s, seg, n, model, res):
 
 def _target_reached_if(optional, p, s, seg, n, model, f, damping):
     """:func:`_target_reached`, compiled only with optional features (:func:`_band_std_if`)."""
+    return _target_reached(p, s, seg, n, model, f, damping, optional)
 
 
 @overload(_target_reached_if, inline='always')
@@ -1065,6 +1068,7 @@ def _target_reached_if_typed(optional, p, s, seg, n, model, f, damping):
 def _long_window_if(optional, p, s, c, m, one_sided, model, tau, f, damping):
     """:func:`_long_window_spanned`, compiled only with optional features
     (:func:`_band_std_if`)."""
+    return _long_window_spanned(p, s, c, m, one_sided, model, tau, f, damping)
 
 
 @overload(_long_window_if, inline='always')

@@ -508,6 +508,7 @@ class EstimatorNode(Node):
     def _poll_warmup(self) -> None:
         """At the end of a warm-up: install the estimator, estimate on the held samples (in order)
         and say how long it took."""
+        uncompiled = self._stream.ready  # estimating uncompiled meanwhile (see .stream)
         try:
             drained = self._stream.poll()
         except Exception as err:  # a compile that failed: say so, never a silent node
@@ -520,9 +521,13 @@ class EstimatorNode(Node):
                 and self._stream.warmup_elapsed(time.monotonic()) > WARMUP_NOTICE
             ):
                 self._warmup_logged = True
+                meanwhile = (
+                    'estimating with them uncompiled meanwhile'
+                    if uncompiled
+                    else 'samples are held until they are ready'
+                )
                 self.get_logger().info(
-                    f'{WARMUP_MESSAGE}: samples are held until they are '
-                    'ready (`vib-estimator warmup` compiles them ahead)'
+                    f'{WARMUP_MESSAGE}: {meanwhile} (`vib-estimator warmup` compiles them ahead)'
                 )
             return
         self._warmup_timer.cancel()
@@ -537,10 +542,12 @@ class EstimatorNode(Node):
         self._ready = True
         dropped = self._stream.health.node_counters['dropped_warmup']
         seconds = self._stream.warmup_seconds
-        self.get_logger().info(
-            f'estimator kernels ready after {seconds:.1f} s ({held} samples held meanwhile, '
-            f'{dropped} dropped)'
+        meanwhile = (
+            'estimated uncompiled meanwhile'
+            if uncompiled
+            else f'{held} samples held meanwhile, {dropped} dropped'
         )
+        self.get_logger().info(f'estimator kernels ready after {seconds:.1f} s ({meanwhile})')
 
     def _replace_zero_stamp(self, header: Header) -> None:
         """Stamp a message that came without one with its receipt time (node clock)."""

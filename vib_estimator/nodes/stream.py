@@ -13,10 +13,20 @@ values, each :class:`~vib_estimator.core.Estimate` carries its mode's shape.
 Warm-up. A configuration whose kernels are not compiled in this process yet (the first start, or a
 change to a configuration that runs other kernels) is built in a background thread
 (:func:`~vib_estimator.core.warmup.warm`: seconds from numba's cache, tens of seconds on a first
-start after an install). Meanwhile :attr:`EstimatorStream.ready` is False, the node stays live
-(services, diagnostics) and :meth:`EstimatorStream.hold` keeps the samples that arrive, in order,
-up to :data:`WARMUP_BUFFER` (the oldest beyond it are dropped and counted in ``dropped_warmup``);
-:meth:`EstimatorStream.poll` installs the estimator once it is built and feeds it the held samples.
+start after an install). Meanwhile the node stays live (services, diagnostics), and:
+
+- a configuration of the free-decay estimator (``excitation`` free, ``modes`` 0, one channel, no
+  ``band_hz``: :func:`interpretable`, the default) estimates at once with its kernel uncompiled
+  (:func:`~vib_estimator.core.jit.interpreted`: the same floats, about 100 us a sample):
+  :attr:`EstimatorStream.ready` is True, and :meth:`EstimatorStream.poll` switches it to the
+  compiled kernel once that is built, between two samples (:attr:`EstimatorStream.compiling` until
+  then);
+- any other (the mode tracker, the ambient identifier, several channels, ``band_hz``, whose
+  coloured std costs about a second an estimate uncompiled) is not :attr:`EstimatorStream.ready`:
+  :meth:`EstimatorStream.hold` keeps the samples that arrive, in order, up to
+  :data:`WARMUP_BUFFER` (the oldest beyond it are dropped and counted in ``dropped_warmup``);
+  :meth:`EstimatorStream.poll` installs the estimator once it is built and feeds it the held
+  samples.
 """
 
 from __future__ import annotations
@@ -25,13 +35,14 @@ import math
 import threading
 import time
 from collections import deque
+from functools import partial
 from typing import Any, Dict, Iterator, Optional, Sequence, Tuple
 
 import numpy as np
 
 from ..core.choice import WATCH_S, Decision, StreamChoice, decide, window_advice
 from ..core.config import EstimatorConfig
-from ..core.estimator import COUNTER_NAMES, Estimate
+from ..core.estimator import COUNTER_NAMES, Estimate, FrequencyEstimator
 from ..core.factory import create_estimator, kind_of
 from ..core.multichannel import MIN_CHANNELS
 from ..core.warmup import is_warm, warm
@@ -59,10 +70,24 @@ def check_channels(channels: Sequence[str], config: EstimatorConfig) -> None:
     kind_of(config, max(len(channels), 1), what)
 
 
-class _Build:
-    """An estimator of ``config`` built in a daemon thread (its kernels compiled first)."""
+def interpretable(config: EstimatorConfig, channels: Sequence[str]) -> bool:
+    """Whether the estimator of ``config`` for ``channels`` can estimate while its kernels
+    compile (with them uncompiled, :class:`~vib_estimator.core.estimator.FrequencyEstimator`'s
+    ``interpret``): the free-decay estimator on one channel, without ``band_hz``."""
+    return (
+        len(channels) < MIN_CHANNELS
+        and config.excitation == 'free'
+        and config.modes == 0
+        and config.band_hz is None
+    )
 
-    def __init__(self, config: EstimatorConfig, channels: Tuple[str, ...]):
+
+class _Build:
+    """An estimator of ``config`` for ``channels`` built in a daemon thread (its kernels
+    compiled first; only compiled when ``channels`` is None: the stream estimates uncompiled
+    meanwhile)."""
+
+    def __init__(self, config: EstimatorConfig, channels: Optional[Tuple[str, ...]]):
         self.config = config
         self._channels = channels
         self.started = time.monotonic()
@@ -77,7 +102,8 @@ class _Build:
     def _run(self) -> None:
         try:
             warm(self.config)
-            self.estimator = create_estimator(self.config, self._channels)
+            if self._channels is not None:
+                self.estimator = create_estimator(self.config, self._channels)
         except Exception as err:  # reported by the node, never lost in a thread
             self.error = err
         self.seconds = time.monotonic() - self.started
@@ -142,8 +168,15 @@ class EstimatorStream:
 
     @property
     def ready(self) -> bool:
-        """False while a configuration's kernels compile (samples are held, not estimated)."""
-        return self._build is None
+        """False while a configuration's kernels compile and it cannot estimate meanwhile
+        (samples are held, not estimated: see the module doc)."""
+        return self.estimator is not None
+
+    @property
+    def compiling(self) -> bool:
+        """True while a configuration's kernels compile (estimating uncompiled meanwhile when
+        :attr:`ready`)."""
+        return self._build is not None
 
     def configure(
         self,
@@ -155,11 +188,13 @@ class EstimatorStream:
         ``channels`` (default: the same); built in the background when its kernels are not
         compiled yet and ``background`` was asked. ValueError if ``config`` cannot take the
         channels (:func:`check_channels`). ``prime`` (a :meth:`decision` applied): the new
-        estimator is first fed the input's last seconds the decision read, uncounted and
-        unpublished, so that a driven stream's window is not filled again from empty."""
+        identifier (not ``free``) is first fed the input's last seconds the decision read,
+        uncounted and unpublished, so that a driven stream's window is not filled again from
+        empty."""
         channels = self.channels if channels is None else tuple(channels)
         check_channels(channels, config)
-        self._primer = self._choice.kept() if prime and channels == self.channels else NO_PRIMER
+        primes = prime and channels == self.channels and config.excitation != 'free'
+        self._primer = self._choice.kept() if primes else NO_PRIMER
         self.channels = channels
         if self.estimator is not None:
             self.health.absorb(self.estimator.counters)
@@ -168,7 +203,11 @@ class EstimatorStream:
         self._estimated_at = self.last_t
         self.health.forget_modes(config.modes)
         if self._background and not is_warm(config):
-            self._build = _Build(config, channels)
+            if interpretable(config, channels):
+                self._install(FrequencyEstimator(config, interpret=True))
+                self._build = _Build(config, None)
+            else:
+                self._build = _Build(config, channels)
         else:
             self._install(create_estimator(config, channels))
 
@@ -203,7 +242,7 @@ class EstimatorStream:
         return len(self._held)
 
     def warmup_elapsed(self, now: float) -> float:
-        """Seconds since the running warm-up started (0 when ready)."""
+        """Seconds since the running warm-up started (0 when compiled)."""
         return 0.0 if self._build is None else now - self._build.started
 
     def hold(self, stamp_ns: int, value: float, tag: Any = None) -> bool:
@@ -228,6 +267,10 @@ class EstimatorStream:
             self._build = None
             raise build.error
         self.warmup_seconds = build.seconds
+        if build.estimator is None:  # estimating uncompiled meanwhile: the compiled kernel now
+            self._build = None
+            self.estimator.compiled()
+            return iter(())
         self._install(build.estimator)
         return self._drain()
 
@@ -267,6 +310,8 @@ class EstimatorStream:
             config.modes,
             self._driven_hint() or self._silent_hint(),
         )
+        if self.compiling:  # estimating uncompiled meanwhile
+            status.values['warmup_s'] = self.warmup_elapsed(now)
         if len(self.channels) >= MIN_CHANNELS:  # a joint identification: which channels
             status.values['channels'] = ','.join(self.channels)
         return status
@@ -348,6 +393,7 @@ class EstimatorStream:
         if math.isfinite(rate) and rate > 0:
             rate = float(f'{rate:.{SELF_TEST_DIGITS}g}')
         key = (self.config, rate if math.isfinite(rate) else None)
-        if self._self_test[0] != key:
-            self._self_test = (key, self_test(self.config, rate))
+        if self._self_test[0] != key:  # uncompiled while the kernels compile: the same result
+            create = partial(FrequencyEstimator, interpret=True) if self.compiling else None
+            self._self_test = (key, self_test(self.config, rate, create))
         return self._self_test[1]
