@@ -51,7 +51,7 @@ import numpy as np
 
 from .config import EstimatorConfig
 from .correlations import CorrelationCascade
-from .estimator import INPUT_COUNTERS, Estimate, EstimateArrays, as_series
+from .estimator import INPUT_COUNTERS, Estimate, EstimateArrays, Estimator, as_series
 from .ssi import BLOCK_ROWS, WindowModes, block_rows, identify, mac
 from .threads import single_blas_thread
 
@@ -141,7 +141,7 @@ class _Track:
         return max(1.0, math.sqrt(float(np.mean(d * d))))
 
 
-class SlidingWindowIdentifier:
+class SlidingWindowIdentifier(Estimator):
     """The output-only identifier of ``channels`` channels (see the module docstring): the
     samples' buffer (a row of ``channels`` values a sample), their checks and counters, the runs
     of clean samples of a batch, the window each analysis reads (:meth:`_next_window`), its

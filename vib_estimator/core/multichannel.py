@@ -14,13 +14,13 @@ bound and frequency refinement on that channel (:mod:`.whittle`), and its identi
 frequency and shape (:func:`.ambient.continues`).
 
 Interface: :class:`JointAmbientEstimator` ``(config, channels)`` ``.process(t, Y) ->``
-:class:`JointEstimates` (``Y``: samples x channels), ``.update(t, y) -> list[JointEstimate]``,
+:class:`JointEstimates` (``Y``: samples x channels), ``.update(t, y) -> list[Estimate]``,
 ``.counters``, ``.reset()``, ``.restart()``, ``.config``, ``.channels``.
 
-Each estimate: the fields of :class:`..estimator.Estimate` (``amplitude`` = the RMS over channels
-of the modal response summed in quadrature, ``fit`` = share of the summed channel variances the
-modes explain) plus the shape, its uncertainty and the MAC with the mode's previous shape (NaN
-for a mode's first window).
+Each estimate: an :class:`..estimator.Estimate` (``amplitude`` = the RMS over channels of the
+modal response summed in quadrature, ``fit`` = share of the summed channel variances the modes
+explain) with its ``shape``, ``shape_std`` and ``mac`` with the mode's previous shape (NaN for a
+mode's first window).
 
 Bad samples never raise: a sample with any non-finite channel is skipped (``skipped_non_finite``);
 stamps are handled as the single-channel identifier's (duplicates, out of order, gaps and jumps).
@@ -29,7 +29,7 @@ stamps are handled as the single-channel identifier's (duplicates, out of order,
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -43,7 +43,6 @@ MIN_CHANNELS = 2
 __all__ = [
     'MIN_CHANNELS',
     'JointAmbientEstimator',
-    'JointEstimate',
     'JointEstimates',
     'as_channels',
     'continues',
@@ -53,18 +52,6 @@ __all__ = [
 
 
 # ---- streaming ----------------------------------------------------------------------------------
-@dataclass(frozen=True)
-class JointEstimate:
-    """One published mode of a joint identification: the :class:`..estimator.Estimate` fields,
-    the mode's normalised complex ``shape`` (one entry per channel), its per-channel
-    ``shape_std`` and the ``mac`` with the same mode's previous shape (NaN at its first)."""
-
-    estimate: Estimate
-    shape: np.ndarray
-    shape_std: np.ndarray
-    mac: float
-
-
 @dataclass
 class JointEstimates:
     """Estimates of a batch run: the columns of :class:`..estimator.EstimateArrays`, the shapes
@@ -80,11 +67,11 @@ class JointEstimates:
         return len(self.estimates)
 
     @classmethod
-    def of(cls, out: Sequence[JointEstimate], channels: tuple[str, ...]) -> 'JointEstimates':
-        """The columns of the estimates ``out`` of ``channels``, in their order."""
+    def of(cls, out: Sequence[Estimate], channels: tuple[str, ...]) -> 'JointEstimates':
+        """The columns of the estimates ``out`` (with shapes) of ``channels``, in their order."""
         m = len(channels)
         return cls(
-            estimate_columns([e.estimate for e in out]),
+            estimate_columns(out),
             np.array([e.shape for e in out], dtype=complex).reshape(-1, m),
             np.array([e.shape_std for e in out]).reshape(-1, m),
             np.array([e.mac for e in out]),
@@ -127,5 +114,5 @@ class JointAmbientEstimator(SlidingWindowIdentifier):
         out = self._feed(t, y, np.isfinite(y).all(axis=1) & np.isfinite(t))
         return JointEstimates.of(out, self._channels)
 
-    def _publish(self, estimate, shape, shape_std, similarity) -> JointEstimate:
-        return JointEstimate(estimate, shape, shape_std, similarity)
+    def _publish(self, estimate, shape, shape_std, similarity) -> Estimate:
+        return replace(estimate, shape=shape, shape_std=shape_std, mac=similarity)
