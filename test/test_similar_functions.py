@@ -22,17 +22,14 @@ def energy(x, scale=2.0):
     return total / max(len(x), 1)
 '''
 #: the same function with other names, numbers and docstring
-RENAMED = '''
-def power(samples, gain=3.5):
-    """Another docstring, much longer than the first one, which must not count."""
-    acc = 0.0
-    for i, s in enumerate(samples):
-        if s > 0:
-            acc += gain * s * s + i
-        else:
-            acc -= s
-    return acc / max(len(samples), 7)
-'''
+RENAMED = (
+    ORIGINAL.replace('energy', 'power')
+    .replace('scale', 'gain')
+    .replace('total', 'acc')
+    .replace('2.0', '3.5')
+    .replace('1)', '7)')
+    .replace('The docstring is left out.', 'Another, longer docstring, which must not count.')
+)
 OTHER = """
 def unrelated(path):
     with open(path) as f:
@@ -50,6 +47,6 @@ def test_a_renamed_copy_is_found_and_a_different_function_is_not(tmp_path, capsy
     assert similar.main([str(tmp_path)]) == 0
     assert '1.00  a.py:2 energy  ~  b.py:2 power' in capsys.readouterr().out
     # a changed operator and an added statement lower the ratio below 1
-    (tmp_path / 'b.py').write_text(RENAMED.replace('acc -= s', 'acc *= s\n            acc += 1'))
+    (tmp_path / 'b.py').write_text(RENAMED.replace('acc -= v', 'acc *= v\n            acc += 1'))
     assert 0.8 <= similar.similar_pairs(tmp_path, 0.8, 20)[0][0] < 1.0
     assert similar.similar_pairs(tmp_path, 0.99, 20) == []
