@@ -97,6 +97,15 @@ INPUT_DEPTH = 5000
 #: how often the end of a warm-up is looked for, and after how long it is announced, s
 WARMUP_POLL = 0.05
 WARMUP_NOTICE = 1.0
+#: at most this long (s) feeding the samples held during a warm-up in one callback: the rest in
+#: the next turns, the diagnostics and services between them (24 000 held samples fed at once
+#: kept /diagnostics silent for 5.4 s in a soak on a loaded machine)
+DRAIN_SLICE_S = 0.1
+#: the diagnostics are published from the data path when the timer's publication is this late
+#: (s since the last): the EventsExecutor runs the timer's event after every message event
+#: queued before it, and a node behind its input (a backlog after a stall, a starved CPU) once
+#: left /diagnostics silent for 2.4-3.2 s in a soak
+DIAGNOSTICS_OVERDUE = 1.5 * H.DIAGNOSTICS_PERIOD
 #: request history of the services: a burst of calls queues instead of being dropped (rclpy's
 #: default, 10, answered 21 of 100 simultaneous calls)
 SERVICE_DEPTH = 1000
@@ -281,6 +290,7 @@ class EstimatorNode(Node):
         self.add_on_set_parameters_callback(self._check_parameters)
         self.add_post_set_parameters_callback(self._apply_parameters)
         self._diagnostics_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
+        self._diagnostics_due = time.monotonic() + DIAGNOSTICS_OVERDUE
         # on the steady clock: diagnostics go on (and can say STALE) when sim time stops
         steady = Clock(clock_type=ClockType.STEADY_TIME)
         self.create_timer(H.DIAGNOSTICS_PERIOD, self._publish_diagnostics, clock=steady)
@@ -405,6 +415,8 @@ class EstimatorNode(Node):
 
     def _take(self, stamp: int, value, header: Header) -> None:
         """One sample: held during a warm-up, else estimated on and its estimates published."""
+        if time.monotonic() >= self._diagnostics_due:
+            self._publish_diagnostics(timer=False)
         if not self._ready:
             self._hold(stamp, value, header)
             return
@@ -418,6 +430,8 @@ class EstimatorNode(Node):
         handle = self._clock.handle
         with handle:
             now = handle.get_now().nanoseconds
+        if time.monotonic() >= self._diagnostics_due:
+            self._publish_diagnostics(timer=False)
         if not self._ready:
             self._hold(now, self._value(msg), None)
             return
@@ -477,15 +491,19 @@ class EstimatorNode(Node):
             )
 
     def _poll_warmup(self) -> None:
-        """At the end of a warm-up: install the estimator, estimate on the held samples (in order)
-        and say how long it took."""
+        """At the end of a warm-up: install the estimator, estimate on the held samples (in order,
+        :data:`DRAIN_SLICE_S` of them a turn) and say how long it took."""
         try:
-            drained = self._stream.poll()
+            drained = self._stream.poll(DRAIN_SLICE_S)
         except Exception as err:  # a compile that failed: say so, never a silent node
             self._warmup_timer.cancel()
             self.get_logger().error(f'the estimator kernels failed to compile: {err}')
             raise StartupError(f'the estimator kernels failed to compile: {err}') from None
         if drained is None:
+            if self._stream.ready:  # nothing left to wait for (a change to compiled kernels)
+                self._warmup_timer.cancel()
+                self._ready = True
+                return
             if (
                 not self._warmup_logged
                 and self._stream.warmup_elapsed(time.monotonic()) > WARMUP_NOTICE
@@ -496,8 +514,6 @@ class EstimatorNode(Node):
                     'ready (`vib-estimator warmup` compiles them ahead)'
                 )
             return
-        self._warmup_timer.cancel()
-        held = self._stream.held_samples
         for header, estimates in drained:
             self._publish(
                 estimates,
@@ -505,12 +521,15 @@ class EstimatorNode(Node):
                 if header is not None
                 else Header(stamp=Time(nanoseconds=self._stream.origin).to_msg()),
             )
+        if not self._stream.ready:  # more held: the next turn goes on
+            return
+        self._warmup_timer.cancel()
         self._ready = True
         dropped = self._stream.health.node_counters['dropped_warmup']
         seconds = self._stream.warmup_seconds
         self.get_logger().info(
-            f'estimator kernels ready after {seconds:.1f} s ({held} samples held meanwhile, '
-            f'{dropped} dropped)'
+            f'estimator kernels ready after {seconds:.1f} s ({self._stream.warmup_held} samples '
+            f'held meanwhile, {dropped} dropped)'
         )
 
     def _replace_zero_stamp(self, header: Header) -> None:
@@ -561,14 +580,17 @@ class EstimatorNode(Node):
         (:data:`~vib_estimator.nodes.health.NODE_COUNTERS`)."""
         return self._stream.counters
 
-    def _publish_diagnostics(self) -> None:
+    def _publish_diagnostics(self, timer: bool = True) -> None:
         """Publish the status; log the last estimate every 10 s (rclpy's throttled logging costs
-        ~0.15 ms a call, too much for the data path)."""
+        ~0.15 ms a call, too much for the data path). From the 1-s timer, or from the data path
+        when the timer's turn is late (``timer`` False: input flows, the watchdog is not asked)."""
         now = time.monotonic()
+        self._diagnostics_due = now + DIAGNOSTICS_OVERDUE
         for cadence in self._cadences:
             cadence.flush(now)
         status = self._stream.status(now)
-        self._watch_inputs(now)
+        if timer:
+            self._watch_inputs(now)
         if self._aligner is not None:
             counters = self._stream.health.node_counters
             lagging = self._aligner.lagging(round(H.STALE_AFTER * 1e9))

@@ -18,7 +18,11 @@ change to a configuration that runs other kernels) is built in a background thre
 start after an install). Meanwhile :attr:`EstimatorStream.ready` is False, the node stays live
 (services, diagnostics) and :meth:`EstimatorStream.hold` keeps the samples that arrive, in order,
 up to :data:`WARMUP_BUFFER` (the oldest beyond it are dropped and counted in ``dropped_warmup``);
-:meth:`EstimatorStream.poll` installs the estimator once it is built and feeds it the held samples.
+:meth:`EstimatorStream.poll` installs the estimator once it is built and feeds it the held samples,
+a slice of at most its ``budget_s`` seconds a call (the node's single thread answers its services
+and publishes its diagnostics between slices; a minute of input held took seconds to feed at
+once); samples that arrive meanwhile are held behind them, and :attr:`EstimatorStream.ready`
+turns True once none is left.
 """
 
 from __future__ import annotations
@@ -28,7 +32,7 @@ import threading
 import time
 from collections import deque
 from functools import partial
-from typing import Any, Callable, Dict, Iterator, Optional, Sequence, Tuple
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 
 from ..core.choice import WATCH_S, DrivenWatch
 from ..core.config import EstimatorConfig
@@ -129,8 +133,9 @@ class EstimatorStream:
         self._build: Optional[_Build] = None
         self._held: deque = deque()
         self._self_test: Tuple[Any, Tuple[bool, str]] = (None, (False, ''))
-        #: seconds the last warm-up took (None before one ended)
+        #: seconds the last warm-up took (None before one ended), samples held when it ended
         self.warmup_seconds: Optional[float] = None
+        self.warmup_held = 0
         #: whether the input looks driven throughout (a hint when the estimator is free's)
         self._watch = DrivenWatch()
         self.configure(config)
@@ -142,8 +147,9 @@ class EstimatorStream:
 
     @property
     def ready(self) -> bool:
-        """False while a configuration's kernels compile (samples are held, not estimated)."""
-        return self._build is None
+        """False while a configuration's kernels compile and until the samples held meanwhile
+        are fed (samples are held, not estimated)."""
+        return self._build is None and not self._held
 
     def configure(self, config: EstimatorConfig, channels: Optional[Sequence[str]] = None) -> None:
         """A fresh estimator of ``config`` (a new segment, same time origin, counters kept) for
@@ -201,27 +207,35 @@ class EstimatorStream:
             return self.health.count('dropped_warmup') == 1
         return False
 
-    def poll(self) -> Optional[Iterator[Tuple[Any, Sequence[Estimate]]]]:
-        """None while the warm-up goes on (or when there is none); once it has ended, install the
-        estimator and return an iterator of (tag, estimates) over the held samples, in order,
-        for those that complete estimates. Raises the build's error if it failed."""
+    def poll(self, budget_s: float = math.inf) -> Optional[List[Tuple[Any, Sequence[Estimate]]]]:
+        """None while the warm-up goes on (or when nothing is held); once it has ended, install
+        the estimator, feed it the held samples in order for up to ``budget_s`` seconds (at least
+        one), and return the (tag, estimates) of those that completed estimates. Call again until
+        :attr:`ready` (samples held after this call wait behind those left). Raises the build's
+        error if it failed."""
         build = self._build
-        if build is None or not build.done:
+        if build is not None:
+            if not build.done:
+                return None
+            if build.error is not None:
+                self._build = None
+                raise build.error
+            self.warmup_seconds = build.seconds
+            self.warmup_held = len(self._held)
+            self._install(build.estimator)
+        elif not self._held:
             return None
-        if build.error is not None:
-            self._build = None
-            raise build.error
-        self.warmup_seconds = build.seconds
-        self._install(build.estimator)
-        return self._drain()
-
-    def _drain(self) -> Iterator[Tuple[Any, Sequence[Estimate]]]:
-        held = self._held
+        held, feed, clock = self._held, self.feed, time.monotonic
+        deadline = clock() + budget_s
+        out = []
         while held:
             stamp_ns, value, tag = held.popleft()
-            estimates = self.feed(stamp_ns, value)
+            estimates = feed(stamp_ns, value)
             if estimates:
-                yield tag, estimates
+                out.append((tag, estimates))
+            if clock() >= deadline:
+                break
+        return out
 
     def published(self, estimate: Estimate, now: float) -> None:
         """``estimate`` was published at ``now`` (monotonic s)."""
