@@ -26,8 +26,18 @@ EXECUTABLES = frozenset(
 SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
 
+#: whether this process is one of :data:`EXECUTABLES` (:func:`early` installed its handler)
+_executable = False
+
+
 def _exit_now(signum, frame) -> None:
     os._exit(0)
+
+
+def in_executable() -> bool:
+    """Whether this process is one of the package's node executables (its ``main`` ends the
+    process; a test calling it in its own process is not)."""
+    return _executable
 
 
 def early(argv0: str) -> bool:
@@ -40,6 +50,8 @@ def early(argv0: str) -> bool:
         or signal.getsignal(signal.SIGINT) is not signal.default_int_handler
     ):
         return False
+    global _executable
+    _executable = True
     for signum in SIGNALS:
         signal.signal(signum, _exit_now)
     return True
