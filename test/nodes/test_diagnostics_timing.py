@@ -6,7 +6,7 @@ EventsExecutor thread runs the 1-s timer's event after every event queued before
 
 * the samples held during a warm-up are fed in slices (``DRAIN_SLICE_S`` a turn), the timer's
   event between them (fed at once they were one long callback);
-* a node behind its input (a backlog: here each sample made to cost 1 ms, as on a starved CPU)
+* a node behind its input (a backlog: here each sample made to cost 2 ms, as on a starved CPU)
   publishes its diagnostics from the data path once the timer's are ``DIAGNOSTICS_OVERDUE`` late.
 
 In process, through the node's topic; the publication times of /diagnostics are recorded at the
@@ -27,13 +27,13 @@ from .test_estimator_node import make_probe, message, sine_stamps
 
 __all__ = ['make_probe']  # the fixture, used by name
 
-#: the samples of each phase, and what each costs the node (busy, s): seconds of work each
-SAMPLES = 3000
-COST_S = 0.001
-#: the most samples fed between two publications: with the timer and the overdue limit, about a
-#: second and a half's (1500 or fewer: fewer when the machine is loaded, since each sample's cost
-#: is wall time); a whole phase's (4000) when the diagnostics wait behind it. Counted in samples,
-#: not seconds, so that a loaded machine slowing the whole test does not fail it.
+#: the samples of each phase, and what each costs the node (busy wall time, s): 4 s of work each
+SAMPLES = 2000
+COST_S = 0.002
+#: the most samples fed between two publications: with the timer and the overdue limit, at most
+#: a second and a half's (750: each sample costs at least COST_S; fewer when the machine is
+#: loaded); a whole phase's (2000) when the diagnostics wait behind it. Counted in samples, not
+#: seconds, so that a loaded machine slowing the whole test does not fail it.
 MOST_BETWEEN = SAMPLES // 2
 
 
