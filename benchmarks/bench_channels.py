@@ -41,11 +41,9 @@ from pathlib import Path
 import numpy as np
 from bench_operation import HCT_FILE, HCT_MODES, REAL_DATA, ssi_cov_window  # benchmarks/
 
-from vib_estimator.core import EstimatorConfig
+from vib_estimator.core import EstimatorConfig, create_estimator
 from vib_estimator.core.ambient import HOP_S, AmbientEstimator
-from vib_estimator.core.modes import create_estimator
 from vib_estimator.core.multichannel import JOINT_BLOCK_ROWS, JointAmbientEstimator, mac
-from vib_estimator.core.multichannel_free import JointFreeEstimator
 from vib_estimator.extras import optional
 from vib_estimator.sim.frame import frame_record, modal_record
 
@@ -320,7 +318,7 @@ def free_decays(seeds=10):
         for seed in range(seeds):
             rng = np.random.default_rng(seed)
             y = decay[:, None] * shape + 0.02 * rng.standard_normal((len(t), len(names)))
-            est = JointFreeEstimator(config, names).process(t, y).estimates
+            est = create_estimator(config, names).process(t, y).estimates
             joint += list(est.frequency_hz / 5.0 - 1)
             z += list((est.frequency_hz - 5.0) / est.frequency_std_hz)
             for c in range(len(names)):
@@ -335,7 +333,7 @@ def free_decays(seeds=10):
     shapes = {5.0: np.array([1.0, 0.7, 0.0]), 17.0: np.array([0.0, 0.0, 1.0])}
     y = decay[:, None] * shapes[5.0] + 0.5 * high[:, None] * shapes[17.0]
     y += 0.01 * np.random.default_rng(4).standard_normal(y.shape)
-    r = JointFreeEstimator(EstimatorConfig(modes=2), names).process(t, y)
+    r = create_estimator(EstimatorConfig(modes=2), names).process(t, y)
     print('\n5 Hz on a and b only, 17 Hz on c only (modes: 2), noise 0.01:')
     for f, true in shapes.items():
         near = np.abs(r.estimates.frequency_hz / f - 1) < 0.02

@@ -34,7 +34,7 @@ import json, sys, time
 c0, w0 = time.process_time(), time.perf_counter()
 import numpy as np
 from vib_estimator.core.config import EstimatorConfig
-from vib_estimator.core.modes import create_estimator
+from vib_estimator.core import create_estimator
 est = create_estimator(EstimatorConfig().replace(**json.loads(sys.argv[1])))
 t = np.arange(2000) / 500.0
 y = np.sin(2 * np.pi * 2.0 * t) + 0.01 * np.cos(2 * np.pi * 37.0 * t)
@@ -76,8 +76,8 @@ def profile(config: dict) -> None:
     import numpy as np
     from numba.core import event
 
+    from vib_estimator.core import create_estimator
     from vib_estimator.core.config import EstimatorConfig
-    from vib_estimator.core.modes import create_estimator
 
     marks = []
 

@@ -2,7 +2,9 @@
 # SPDX-License-Identifier: Apache-2.0
 """What a newcomer gets: ``vib-estimator analyze FILE`` with no option but the column(s), on the
 kinds of record users bring, beside ``--excitation free`` (the default until 4 Dec 2026) and the
-documented tuned options, in the same run.
+documented tuned options, in the same run; and ``estimator_node``'s defaults on the same record
+streamed (its :class:`~vib_estimator.nodes.stream.EstimatorStream`, in process, one status a
+second of the record, each ``decide_excitation`` decision applied as the node applies it).
 
 Records: free decays (synthetic, the simulated arm's bag, the real aluminium beams and the real
 flexible-link arm when ``../shared/real-data`` is there), white-noise-driven modes (one, two,
@@ -30,6 +32,9 @@ from pathlib import Path
 import numpy as np
 
 from vib_estimator.cli import main as cli
+from vib_estimator.core import EstimatorConfig
+from vib_estimator.io.csv_reader import read_csv_columns, read_csv_series
+from vib_estimator.nodes.stream import EstimatorStream
 from vib_estimator.sim import arm_model
 from vib_estimator.sim.ambient import ambient_record
 from vib_estimator.sim.frame import frame_record
@@ -137,6 +142,41 @@ def run(path: Path, args: list[str]):
     return code, rows, err.getvalue(), cpu
 
 
+def streamed(path: Path, select: list[str]):
+    """``estimator_node``'s defaults on the record streamed (module doc): exit 0, its estimates as
+    ``analyze``'s rows, the decisions (excitation and window, in words), the CPU seconds."""
+    if select[:1] == ['--columns']:
+        t, y, names = read_csv_columns(path, select[1])
+    else:
+        series = read_csv_series(path, select[1] if select else None)
+        t, y, names = series.t, series.y, ['y']
+    start = time.process_time()
+    channels = names if np.ndim(y) == 2 and len(names) > 1 else ()
+    stream = EstimatorStream(EstimatorConfig(), now=0.0, channels=channels, deciding=True)
+    stamps = (np.round((t - t[0]) * 1e9) + 10**18).astype(np.int64).tolist()
+    values = [tuple(v) for v in y.tolist()] if channels else np.ravel(y).tolist()
+    rows, decided, next_status = [], [], float(t[0]) + 1.0
+    for k, (stamp, value) in enumerate(zip(stamps, values)):
+        for e in stream.feed(stamp, value):
+            row = {'frequency_hz': e.frequency_hz, 'convergence_time_s': e.convergence_time}
+            shape = getattr(e, 'shape', None)
+            for i, a in enumerate(() if shape is None else shape.tolist()):
+                row[f'shape_ch{i + 1:02d}'] = float(np.real(a))
+            rows.append(row)
+        if t[k] >= next_status:
+            next_status += 1.0
+            stream.status(now=float(t[k]))
+            decision = stream.decision()
+            if decision is not None:
+                changes = {'excitation': decision.excitation}
+                if decision.excitation != 'free':
+                    changes['ambient_window_s'] = decision.window_s
+                stream.configure(stream.config.replace(**changes), prime=True)
+                stream.decided = True
+                decided.append(f'{decision.excitation} {decision.window_s:.0f} s at {t[k]:.0f} s')
+    return 0, rows, ', '.join(decided), time.process_time() - start
+
+
 def mac(a: np.ndarray, b: np.ndarray) -> float:
     return float(abs(np.vdot(a, b)) ** 2 / (np.vdot(a, a).real * np.vdot(b, b).real))
 
@@ -204,6 +244,10 @@ def main() -> int:
                 status = score(rows, truth, kind, shapes) if code == 0 else f'exit {code}'
                 print(f'| {name} | {label} | {status} | {cpu:.1f} | {decided} |')
                 sys.stdout.flush()
+            code, rows, decided, cpu = streamed(path, select)
+            status = score(rows, truth, kind, shapes)
+            print(f'| {name} | node defaults, streamed | {status} | {cpu:.1f} | {decided} |')
+            sys.stdout.flush()
         cost(Path(tmp))
     return 0
 

@@ -40,8 +40,7 @@ from pathlib import Path
 
 import numpy as np
 
-from vib_estimator.core import EstimatorConfig, FrequencyEstimator
-from vib_estimator.core.modes import create_estimator
+from vib_estimator.core import EstimatorConfig, FrequencyEstimator, create_estimator
 
 VARIANTS = {
     'refine=0 (paper)': dict(refine=0),

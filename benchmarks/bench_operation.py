@@ -42,9 +42,8 @@ from pathlib import Path
 
 import numpy as np
 
-from vib_estimator.core import EstimatorConfig
+from vib_estimator.core import EstimatorConfig, create_estimator
 from vib_estimator.core.ambient import whittle_std
-from vib_estimator.core.modes import create_estimator
 from vib_estimator.extras import optional
 from vib_estimator.sim.ambient import ambient_record
 

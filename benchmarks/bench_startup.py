@@ -17,10 +17,10 @@ same run, on the same machine state.
   real time) from one second after the node subscribes (discovery settled both ways). *live*:
   spawn to the node's first ``/diagnostics``, and the longest silence of ``/diagnostics`` after it
   (a node blocked in a compile says nothing); *ready*: spawn to the first ``~/self_test`` answer
-  that is not "busy" (called every 0.1 s: the kernels are compiled and the tones ran); *first
-  estimate*: from the first sample sent to the first ``vibration/frequency``; *lost*: samples sent
-  that the node never counted (its ``received`` + ``dropped_warmup`` against what was sent). Then
-  SIGINT: the exit code.
+  that is not "busy" (called every 0.1 s: the tones ran, compiled or uncompiled); *first
+  estimate*: from the first sample sent to the first ``vibration/frequency`` (and from spawn);
+  *lost*: samples sent that the node never counted (its ``received`` + ``dropped_warmup`` against
+  what was sent). Then SIGINT: the exit code.
 * ``shaper_node``: spawn to its first ``/diagnostics``.
 * ``analyze``: the whole ``vib-estimator analyze`` of a 20 s CSV (500 Hz).
 """
@@ -52,12 +52,14 @@ ESTIMATOR_CASES = {
     'estimator_node (modes: 3)': ['modes:=3'],
     'estimator_node (band_hz)': ['band_hz:=[1.0, 20.0]'],
 }
-GOALS = 'goals: warm ready <= 2 s, cold ready <= 10 s'
+GOALS = 'goals: warm ready <= 2 s, cold ready <= 10 s, cold first estimate <= 10 s after spawn'
 
 
 def node_command(tree: Path, module: str, params):
     code = f'import sys; from {module} import main; sys.exit(main())'
-    cmd = [sys.executable, '-c', code, '--ros-args']
+    # -P: without it ``-c`` puts the working directory ahead of PYTHONPATH, and a run from the
+    # repository measured this tree's package for the reference too (figures before 2026-12-05)
+    cmd = [sys.executable, '-P', '-c', code, '--ros-args']
     for p in params:
         cmd += ['-p', p]
     return cmd
@@ -127,6 +129,7 @@ class Probe:
             result = future.result()
             if result is not None and not result.message.startswith('busy'):
                 state['ready'] = time.monotonic()
+                state['cpu'] = cpu_seconds(state['pid'])
             state['future'] = None
             state['next'] = time.monotonic() + 0.1
         elif (
@@ -144,7 +147,7 @@ class Probe:
         proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         sent = 0
         msg = self.msg_type()
-        state = {}
+        state = {'pid': proc.pid}
         matched = None
         try:
             while (
@@ -169,6 +172,8 @@ class Probe:
                 self.spin(0.002)
             ready = state['ready'] - start if 'ready' in state else math.nan
             latency = self.first_estimate - first if self.first_estimate else math.nan
+            spawned = self.first_estimate - start if self.first_estimate else math.nan
+            cpu = state.get('cpu', math.nan)
             self.spin(1.5)  # a diagnostics period after the first estimate
             live = min(self.first_diag.values(), default=math.nan) - start
             # the longest /diagnostics silence, from the first one to 1.5 s after ready
@@ -179,7 +184,7 @@ class Probe:
             lost = sent - counted if values else -1
         finally:
             code = stop(proc)
-        return live, ready, latency, lost, code, silence
+        return live, ready, latency, lost, code, silence, spawned, cpu
 
     def first_diagnostics(self, cmd, env):
         """(spawn to first /diagnostics s, exit code) of a node."""
@@ -204,6 +209,17 @@ class Probe:
         self.context.try_shutdown()
 
 
+def cpu_seconds(pid: int) -> float:
+    """CPU seconds (user + system) process ``pid`` used so far: what a start costs whatever the
+    machine's load (its wall-clock figures grow with it)."""
+    try:
+        with open(f'/proc/{pid}/stat') as stat:
+            fields = stat.read().rsplit(')', 1)[1].split()
+    except OSError:
+        return math.nan
+    return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
+
+
 def stop(proc) -> int:
     if proc.poll() is None:
         proc.send_signal(signal.SIGINT)
@@ -220,7 +236,7 @@ def analyze_seconds(tree: Path, env: dict, csv: Path) -> float:
     code = 'import sys; from vib_estimator.cli import main; sys.exit(main())'
     start = time.monotonic()
     done = subprocess.run(
-        [sys.executable, '-c', code, 'analyze', str(csv)],
+        [sys.executable, '-P', '-c', code, 'analyze', str(csv)],
         env=env,
         stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE,
@@ -242,7 +258,7 @@ def checkout(ref: str, where: Path) -> Path:
 
 def noted(rows: list, row: tuple, text: str) -> None:
     """Keep a result row (case, tree, cold/warm, live, ready, lost, exit, first estimate, longest
-    silence) and print it as it comes."""
+    silence, first estimate after spawn, CPU s to ready) and print it as it comes."""
     rows.append(row)
     case, label, kind = row[:3]
     print(f'{case:28s} {label:8s} {kind}: {text}', flush=True)
@@ -282,15 +298,28 @@ def main(argv=None) -> int:
                     cache = tempfile.mkdtemp(dir=tmp)
                     cmd = node_command(tree, 'vib_estimator.nodes.estimator_node', params)
                     for kind in ('cold', 'warm'):
-                        live, ready, latency, lost, code, silence = probe.estimator(
+                        live, ready, latency, lost, code, silence, spawned, cpu = probe.estimator(
                             cmd, environment(tree, cache)
                         )
                         noted(
                             rows,
-                            (case, label, kind, live, ready, lost, code, latency, silence),
+                            (
+                                case,
+                                label,
+                                kind,
+                                live,
+                                ready,
+                                lost,
+                                code,
+                                latency,
+                                silence,
+                                spawned,
+                                cpu,
+                            ),
                             f'live {live:6.2f} s (longest /diagnostics silence {silence:5.2f} '
                             f's), ready {ready:6.2f} s, first estimate {latency:6.2f} s after '
-                            f'the first sample, lost {lost}, exit {code}',
+                            f'the first sample ({spawned:6.2f} s after spawn), lost {lost}, '
+                            f'exit {code}; {cpu:5.2f} CPU s to ready',
                         )
             if 'shaper_node' in only:
                 for label, tree in trees.items():
@@ -299,24 +328,25 @@ def main(argv=None) -> int:
                     for kind in ('cold', 'warm'):
                         live, code = probe.first_diagnostics(cmd, environment(tree, cache))
                         row = ('shaper_node', label, kind, live, live, 0, code)
-                        noted(rows, row + (math.nan,) * 2, f'live {live:6.2f} s, exit {code}')
+                        noted(rows, row + (math.nan,) * 4, f'live {live:6.2f} s, exit {code}')
             if 'analyze' in only:
                 for label, tree in trees.items():
                     cache = tempfile.mkdtemp(dir=tmp)
                     for kind in ('cold', 'warm'):
                         seconds = analyze_seconds(tree, environment(tree, cache), csv)
                         row = ('analyze (20 s CSV)', label, kind, math.nan, seconds, 0, 0)
-                        noted(rows, row + (math.nan,) * 2, f'{seconds:6.2f} s')
+                        noted(rows, row + (math.nan,) * 4, f'{seconds:6.2f} s')
         finally:
             probe.close()
     print(
         f'\n| case | cold ready, today | cold, {args.ref} | warm ready, today | warm, '
         f'{args.ref} | live: first /diagnostics; longest silence, cold today / {args.ref} | '
         f'first estimate after '
-        f'the first sample, cold today / {args.ref} | samples lost, cold today / {args.ref} | '
-        'exit on SIGINT |'
+        f'the first sample, cold today / {args.ref} | first estimate after spawn, cold today / '
+        f'{args.ref}; warm today / {args.ref} | CPU s to ready, cold today / {args.ref}; warm '
+        f'today / {args.ref} | samples lost, cold today / {args.ref} | exit on SIGINT |'
     )
-    print('|---|---|---|---|---|---|---|---|---|')
+    print('|---|---|---|---|---|---|---|---|---|---|---|')
     cases = list(dict.fromkeys(r[0] for r in rows))
     for case in cases:
         get = {(r[1], r[2]): r for r in rows if r[0] == case}
@@ -327,7 +357,9 @@ def main(argv=None) -> int:
             f'| {case} | {today_c[4]:.1f} s | {ref_c[4]:.1f} s | {today_w[4]:.2f} s | '
             f'{ref_w[4]:.2f} s | {today_c[3]:.1f}; {today_c[8]:.1f} / {ref_c[3]:.1f}; '
             f'{ref_c[8]:.1f} s | '
-            f'{today_c[7]:.1f} / {ref_c[7]:.1f} s | {today_c[5]} / {ref_c[5]} | {codes} |'
+            f'{today_c[7]:.1f} / {ref_c[7]:.1f} s | {today_c[9]:.1f} / {ref_c[9]:.1f}; '
+            f'{today_w[9]:.1f} / {ref_w[9]:.1f} s | {today_c[10]:.1f} / {ref_c[10]:.1f}; '
+            f'{today_w[10]:.2f} / {ref_w[10]:.2f} s | {today_c[5]} / {ref_c[5]} | {codes} |'
         )
     print(GOALS)
     return 0

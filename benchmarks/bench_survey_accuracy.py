@@ -30,8 +30,7 @@ from dataclasses import replace
 import numpy as np
 
 from vib_estimator.analysis.survey import SUMMARIES, summarise
-from vib_estimator.core import EstimatorConfig
-from vib_estimator.core.modes import create_estimator
+from vib_estimator.core import EstimatorConfig, create_estimator
 from vib_estimator.sim import arm_model
 from vib_estimator.sim.ambient import ambient_record
 from vib_estimator.sim.signals import plucked_decays

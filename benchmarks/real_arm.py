@@ -24,8 +24,7 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import least_squares
 
-from vib_estimator.core import EstimatorConfig
-from vib_estimator.core.modes import create_estimator
+from vib_estimator.core import EstimatorConfig, create_estimator
 from vib_estimator.io.csv_reader import read_csv_series
 
 LIMIT_CYCLE_HZ = 1.812

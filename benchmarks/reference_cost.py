@@ -32,7 +32,7 @@ if kw.get('band_hz') is not None:
 config = EstimatorConfig(**kw)
 t, y = data['t'], data['y']
 if y.ndim == 1:
-    from vib_estimator.core.modes import create_estimator
+    from vib_estimator.core import create_estimator
     make = lambda: create_estimator(config)
 else:
     from vib_estimator.core.multichannel import JointAmbientEstimator

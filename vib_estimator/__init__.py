@@ -13,7 +13,7 @@ imports rclpy):
 * ``nodes``    -- the ROS 2 nodes, one module each, and their shared runner and parameter helpers
 * ``cli``      -- the ``vib-estimator`` dispatcher; ``demo`` -- the live demo
 
-The core's public API is importable from the top: ``from vib_estimator import FrequencyEstimator``
+The core's public API is importable from the top: ``from vib_estimator import create_estimator``
 (loaded on first use, so ``vib-estimator --help`` and the nodes start without compiling anything
 they do not need).
 """
@@ -22,8 +22,8 @@ from importlib import import_module
 
 #: the names of ``vib_estimator.core.__all__`` (written out: importing core would load numba)
 _CORE = tuple(
-    'MODELS COUNTER_NAMES EstimatorConfig Estimate EstimateArrays FrequencyEstimator '
-    'estimate'.split()
+    'MODELS COUNTER_NAMES KINDS EstimatorConfig Estimate EstimateArrays Estimator '
+    'FrequencyEstimator create_estimator estimate'.split()
 )
 __all__ = list(_CORE)
 

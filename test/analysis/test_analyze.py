@@ -10,8 +10,17 @@ import pytest
 
 from vib_estimator.cli import main
 from vib_estimator.core import EstimatorConfig, estimate
+from vib_estimator.core.choice import decide
 from vib_estimator.io.bags import WrenchSeries, write_wrench_series
 from vib_estimator.io.fields import seconds_since
+
+
+def decided(t, y, config=None):
+    """What ``analyze`` with no ``--excitation`` estimates: ``config`` (default: the defaults)
+    with the free-decay window its decision gives (core.choice.fast_window)."""
+    config = config or EstimatorConfig()
+    periods = decide(t, y).min_periods
+    return estimate(t, y, config.replace(min_periods=periods) if np.isfinite(periods) else config)
 
 
 @pytest.fixture
@@ -37,7 +46,8 @@ def test_csv_estimates_equal_the_core(tmp_path, capsys, samples):
     )
     assert main(['analyze', str(path), '--column', 'torque']) == 0
     rows = jsonl(capsys.readouterr().out)
-    expected = estimate(t, y)
+    expected = decided(t, y)
+    assert decide(t, y).min_periods == 0.9  # a clean pluck (core.choice.fast_window)
     assert len(rows) == len(expected) > 5
     assert [r['frequency_hz'] for r in rows] == expected.frequency_hz.tolist()
     assert [r['t'] for r in rows] == expected.t.tolist()
@@ -71,7 +81,7 @@ def test_csv_with_comments_and_no_header_and_options(tmp_path, capsys, samples):
     lines = out.out.splitlines()
     assert lines[0].startswith('t,frequency_hz')
     cfg = EstimatorConfig(model='biased-sinusoid', band_hz=(0.5, 5.0))
-    expected = estimate(t, y + 0.5, cfg)
+    expected = decided(t, y + 0.5, cfg)
     assert len(lines) - 1 == len(expected) > 3
     column = lines[0].split(',').index('frequency_hz')
     assert [float(ln.split(',')[column]) for ln in lines[1:]] == expected.frequency_hz.tolist()
@@ -85,7 +95,7 @@ def test_bag_input_uses_header_stamps(tmp_path, capsys, samples):
     write_wrench_series(tmp_path / 'bag', WrenchSeries(stamps, y, 'arm', '/coupling_torque'))
     assert main(['analyze', str(tmp_path / 'bag'), '--format', 'jsonl']) == 0
     rows = jsonl(capsys.readouterr().out)
-    expected = estimate(seconds_since(stamps, stamps[0]), y)
+    expected = decided(seconds_since(stamps, stamps[0]), y)
     assert [r['frequency_hz'] for r in rows] == expected.frequency_hz.tolist()
     assert (
         rows[0]['stamp_ns']
@@ -177,7 +187,7 @@ def test_every_input_type_of_a_bag_and_the_topic_choice(tmp_path, capsys, sample
             )
             bag.write_message(imu, s + 123_456, msg)  # received later than stamped
             bag.write_message(raw, s, T['std_msgs/msg/Float64'](data=v))
-    expected = estimate(seconds_since(stamps, stamps[0]), y).frequency_hz.tolist()
+    expected = decided(seconds_since(stamps, stamps[0]), y).frequency_hz.tolist()
     for args in (['--topic', '/imu', '--component', 'linear_acceleration.x'], ['--topic', '/raw']):
         assert main(['analyze', str(tmp_path / 'bag')] + args) == 0
         assert [r['frequency_hz'] for r in jsonl(capsys.readouterr().out)] == expected
@@ -204,7 +214,7 @@ def test_band_above_nyquist_is_an_error(tmp_path, capsys, samples):
 
 
 def test_excitation_ambient_equals_the_core_and_bad_window_is_refused(tmp_path, capsys):
-    from vib_estimator.core.modes import create_estimator
+    from vib_estimator.core import create_estimator
     from vib_estimator.sim.ambient import ambient_record
 
     t, y, _ = ambient_record(30.0, 500.0, [(5.0, 0.01, 1.0)], 26.0, 0)
@@ -223,7 +233,7 @@ def test_excitation_ambient_equals_the_core_and_bad_window_is_refused(tmp_path, 
 
 
 def test_excitation_auto_equals_the_core_and_free_on_a_free_decay(tmp_path, capsys):
-    from vib_estimator.core.modes import create_estimator
+    from vib_estimator.core import create_estimator
 
     t = np.arange(0.0, 8.0, 0.002)
     y = np.exp(-0.2 * t) * np.sin(2 * np.pi * 1.33 * t + 0.4) + 1e-3 * np.cos(40.0 * t)

@@ -9,8 +9,7 @@ import numpy as np
 
 from vib_estimator.analysis import interval as I
 from vib_estimator.analysis import survey as S
-from vib_estimator.core import EstimatorConfig
-from vib_estimator.core.modes import create_estimator
+from vib_estimator.core import EstimatorConfig, create_estimator
 from vib_estimator.sim.signals import plucked_decays
 
 DAYS = 40

@@ -7,14 +7,13 @@ import math
 import numpy as np
 import pytest
 
-from vib_estimator.core import EstimatorConfig, FrequencyEstimator
+from vib_estimator.core import EstimatorConfig, FrequencyEstimator, create_estimator
 from vib_estimator.core.ambient import (
     AmbientEstimator,
     sdof_psd,
     whittle_fisher,
     whittle_std,
 )
-from vib_estimator.core.modes import create_estimator
 from vib_estimator.sim.ambient import ambient_record
 from vib_estimator.sim.signals import fig1_signal
 
@@ -254,8 +253,7 @@ def test_memory_is_flat_over_a_long_stream():
     import gc
     import tracemalloc
 
-    from vib_estimator.core import ambient
-    from vib_estimator.core.modes import create_estimator
+    from vib_estimator.core import ambient, create_estimator
 
     fs, block = 200.0, 60.0
     est = create_estimator(EstimatorConfig(excitation='auto', ambient_window_s=30.0))

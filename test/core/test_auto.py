@@ -7,10 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from vib_estimator.core import EstimatorConfig
+from vib_estimator.core import EstimatorConfig, create_estimator
 from vib_estimator.core.ambient import HOP_S
 from vib_estimator.core.auto import AutoEstimator, is_driven, is_free_decay
-from vib_estimator.core.modes import create_estimator
 from vib_estimator.sim.ambient import ambient_record, sdof_response
 
 FS, F, ZETA = 500.0, 5.0, 0.01

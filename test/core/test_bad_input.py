@@ -11,8 +11,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from vib_estimator.core import EstimatorConfig, FrequencyEstimator
-from vib_estimator.core.modes import create_estimator
+from vib_estimator.core import EstimatorConfig, FrequencyEstimator, create_estimator
 from vib_estimator.sim.signals import gappy_sine
 
 FS, F0 = 500.0, 2.0

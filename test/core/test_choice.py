@@ -4,6 +4,8 @@
 to the identifier with a window sized to their fundamental; each constant pinned from both
 sides."""
 
+import math
+
 import numpy as np
 import pytest
 
@@ -237,4 +239,101 @@ def test_a_free_decay_of_several_modes_goes_to_the_mode_tracker(monkeypatch, nam
         with pytest.raises(ValueError):
             EstimatorConfig(modes=decide(*pair).modes).validate()
         return
+    assert not right()
+
+
+def test_the_stream_choice_feeds_the_watch_in_batches_with_the_same_answers():
+    """StreamChoice feeds DrivenWatch in numpy batches (DrivenWatch.feed): the same answers as
+    sample by sample, however it is asked."""
+    from vib_estimator.core.choice import DrivenWatch, StreamChoice
+
+    t, y, _ = ambient_record(200, 100, [(1.2, 0.015, 1.0)], 20, 1)
+    tail = np.arange(200, 320, 0.01)
+    y = np.concatenate([y, 30 * np.exp(-0.3 * (tail - 200)) * np.sin(2 * np.pi * tail)])
+    t = np.concatenate([t, tail])
+    one, batched = DrivenWatch(), StreamChoice()
+    answers = []
+    for k, (a, b) in enumerate(zip(t.tolist(), y.tolist())):
+        one.update(a, b)
+        batched.update(a, b)
+        if k % 337 == 0:
+            answers.append((one.driven(), batched.driven(), one.freed(), batched.watch.freed()))
+    assert all(a == b and c == d for a, b, c, d in answers)
+    assert any(a is not None for a, *_ in answers) and any(c for *_, c, _ in answers)
+
+
+@pytest.mark.parametrize('factor', [1e-3, 1e3])
+def test_the_stream_choice_keeps_at_most_max_kept_samples(monkeypatch, factor):
+    """The node's decision reads the last WATCH_S s, bounded in memory: a 10 kHz stream keeps
+    MAX_KEPT samples (262 s at 1 kHz; 26 s here), a 100 Hz driven one all its 120 s, enough
+    to decide. MAX_KEPT at 0.001x starves the decision, at 1000x the memory is unbounded."""
+    from vib_estimator.core.choice import StreamChoice
+
+    def right():
+        fast = StreamChoice()
+        for a in (np.arange(400_000) / 1e4).tolist():
+            fast.update(a, math.sin(a))
+        t, _ = fast.kept()
+        bounded = len(t) == min(2**18, choice.MAX_KEPT) and abs(t[-1] - 39.9999) < 1e-9
+        t, y, _ = ambient_record(130, 100, [(1.2, 0.015, 1.0)], 20, 1)
+        slow = StreamChoice()
+        for a, b in zip(t.tolist(), y.tolist()):
+            slow.update(a, b)
+        slow.driven()
+        decided = slow.decision('free', False, 30.0)
+        return bounded and decided is not None and 90 <= decided.window_s <= 110
+
+    assert right()
+    monkeypatch.setattr(choice, 'MAX_KEPT', int(choice.MAX_KEPT * factor))
+    assert not right()
+
+
+def pluck_with_a_move(move: float, snr_db: float = 50.0, zeta: float = 0.002, seed: int = 0):
+    """A 2 Hz free decay over 20 s at 1 kHz, with a move (a smooth step of ``move`` times its
+    amplitude, 0.2 s long, at 5 s: the hub of an arm stepping) and white noise."""
+    t = np.arange(0, 20, 1e-3)
+    y = np.exp(-zeta * 2 * np.pi * 2 * t) * np.sin(2 * np.pi * 2 * t + 1)
+    y += move * (0.5 - 0.5 * np.cos(np.pi * np.clip((t - 5.0) / 0.2, 0, 1)))
+    y += 10 ** (-snr_db / 20) / np.sqrt(2) * np.random.default_rng(seed).standard_normal(len(t))
+    return t, y
+
+
+def decided_convergence(t, y) -> tuple[float, float]:
+    """The decision's free-decay window applied (as analyze applies it): the median convergence
+    in periods of the 2 Hz mode and the share within 2 % (NaN, NaN if it cannot run)."""
+    from vib_estimator.core import EstimatorConfig, estimate
+
+    config = EstimatorConfig()
+    try:
+        d = decide(t, y)
+        if math.isfinite(d.min_periods):
+            config = config.replace(min_periods=d.min_periods)
+    except ValueError:
+        return math.nan, math.nan
+    e = estimate(t, y, config)
+    return (
+        float(np.median(e.convergence_time * 2.0)),
+        float(np.mean(np.abs(e.frequency_hz / 2.0 - 1) <= 0.02)),
+    )
+
+
+@pytest.mark.parametrize('factor', [1e-3, 1e3])
+@pytest.mark.parametrize(
+    'name', ['FAST_PERIODS', 'IMPURE', 'IMPURITY_SPAN', 'PEAK_WIDTH', 'FAST_STD']
+)
+def test_a_pure_precise_free_decay_is_estimated_over_a_shorter_window(monkeypatch, name, factor):
+    """One mode, a pure spectrum and precise 0.9-period estimates: published after 0.9 periods,
+    all within 2 % (a small move: 2.5 % of the power near the mode off its peak). A large move
+    (the real arm's step: 22 % off the peak) or 20 dB of noise (its decay's tail: 90 % of the
+    0.9-period estimates within 1.9 %, 1 std) keeps the default 1.25 periods. Each constant at
+    0.001x and 1000x breaks one of them."""
+
+    def right():
+        fast, fast_within = decided_convergence(*pluck_with_a_move(3.0))
+        moved = decided_convergence(*pluck_with_a_move(10.0))[0]
+        noisy = decided_convergence(*pluck_with_a_move(0.0, snr_db=20.0, zeta=0.01))[0]
+        return 0.85 <= fast <= 0.93 and fast_within >= 0.95 and moved >= 1.1 and noisy >= 1.1
+
+    assert right()
+    monkeypatch.setattr(choice, name, getattr(choice, name) * factor)
     assert not right()

@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import math
 import pathlib
 import sys
 
@@ -49,8 +50,11 @@ import numpy as np
 import pytest
 from llvmlite.binding import get_host_cpu_features
 
-from vib_estimator.core import EstimatorConfig
-from vib_estimator.core.modes import create_estimator
+from vib_estimator.core import EstimatorConfig, create_estimator
+from vib_estimator.core import kernel as K
+from vib_estimator.core import uncertainty as U
+from vib_estimator.core.estimator import FrequencyEstimator
+from vib_estimator.core.jit import interpreted
 
 DATA = pathlib.Path(__file__).parent / 'data' / 'kernel_reference.npz'
 FS = 500.0
@@ -277,11 +281,89 @@ def test_streaming_results_are_bit_identical_to_the_reference(reference, name):
     est = create_estimator(_stored_config(reference, name))
     got = []
     for a, b in zip(t, y):
-        e = est.update(a, b)
-        got.extend(e if isinstance(e, list) else [] if e is None else [e])
+        got.extend(est.update(a, b))
     assert len(got) == len(reference[f'{name}/t']) > 0
     for col in COLUMNS:
         _assert_same(name, col, [float(getattr(e, col)) for e in got], reference[f'{name}/{col}'])
+
+
+# ---- the same kernel uncompiled (core.jit.interpreted) ------------------------------------------
+# A node whose kernels are not compiled yet estimates with the uncompiled kernel while they compile
+# (nodes/stream.py), then switches to the compiled one in the middle of the stream: both must give
+# the reference's floats, batch and streaming, and the switch must not show.
+
+#: the cases that between them run every branch of the free-decay kernel: the long window, gaps
+#: and outliers, the band-pass and its coloured std (about a second an estimate uncompiled: one
+#: case), the target std, the damped and biased models, the paper's test and trapezoid,
+#: max_window resets
+INTERPRETED_CASES = [
+    'default-irregular',
+    'target-band',
+    'damped-long',
+    'biased-target',
+    'one-sided-trapezoid',
+    'short-window',
+]
+#: samples of each signal run uncompiled (the whole signal is 15 000; ~100 us a sample)
+PREFIX = 6000
+
+
+def _prefix(reference, name):
+    """(t, y, the reference columns of the estimates) of the case's first PREFIX samples."""
+    kind, seed = next(c[1:3] for c in CASES if c[0] == name)
+    t, y = _signal(kind, seed)
+    t, y = t[:PREFIX], y[:PREFIX]
+    keep = reference[f'{name}/t'] <= t[-1]  # the estimator is causal
+    return t, y, {col: reference[f'{name}/{col}'][keep] for col in COLUMNS}
+
+
+def test_the_interpreted_kernel_calls_no_compiled_function():
+    k = interpreted(K)
+    for fn in (k.run, k.feed, k.step, k._band_std, k._band_std_if, k.U.refine):
+        assert type(fn).__name__ == 'function', fn
+    assert k.U is interpreted(U) and k.U.refine.__globals__['_gauss_newton'] is k.U._gauss_newton
+    assert k.borrowed is not K.borrowed and k.math.hypot(3.0, 4.0) == 5.0
+    assert interpreted(K) is k  # built once
+
+
+def test_the_interpreted_math_is_the_compiled_math():
+    """numba's math.hypot is the C library's; Python's rounds 48 of these 10 000 differently."""
+    compiled = numba.njit(lambda x, y: math.hypot(x, y))
+    pairs = np.random.default_rng(0).standard_normal((10_000, 2))
+    k = interpreted(K)
+    for x, y in pairs:
+        assert k.U.math.hypot(x, y) == compiled(x, y)
+    assert k.math.sqrt is math.sqrt and k.math.exp is math.exp
+
+
+@pytest.mark.parametrize('name', INTERPRETED_CASES)
+def test_the_interpreted_kernel_gives_the_reference_floats(reference, name):
+    t, y, want = _prefix(reference, name)
+    est = FrequencyEstimator(_stored_config(reference, name), interpret=True)
+    got = _columns(est.process(t, y))
+    assert est.interpreted and len(got['t']) == len(want['t']) > 2
+    for col in COLUMNS:
+        _assert_same(name, col, got[col], want[col])
+
+
+@pytest.mark.parametrize('name', ['default-irregular', 'damped-long'])
+def test_streaming_switches_to_the_compiled_kernel_unseen(reference, name):
+    t, y, want = _prefix(reference, name)
+    config = _stored_config(reference, name)
+    est = FrequencyEstimator(config, interpret=True)
+    got = []
+    for i in range(len(t)):
+        if i == PREFIX // 2:
+            est.compiled()
+            assert not est.interpreted
+        got.extend(est.update(t[i], y[i]))
+    middle = t[PREFIX // 2]
+    assert any(e.t < middle for e in got) and any(e.t > middle for e in got)
+    for col in COLUMNS:
+        _assert_same(name, col, [float(getattr(e, col)) for e in got], want[col])
+    batch = FrequencyEstimator(config)
+    batch.process(t, y)
+    assert est.counters == batch.counters
 
 
 if __name__ == '__main__':

@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from vib_estimator.core import COUNTER_NAMES, EstimatorConfig, FrequencyEstimator
-from vib_estimator.core.modes import FINDER_COUNTERS, ModeTracker, create_estimator
+from vib_estimator.core import COUNTER_NAMES, EstimatorConfig, FrequencyEstimator, create_estimator
+from vib_estimator.core.modes import FINDER_COUNTERS, ModeTracker
 from vib_estimator.io.csv_reader import read_csv_series
 
 CFG = EstimatorConfig(modes=3, model='damped-sinusoid')

@@ -72,6 +72,7 @@ def test_a_node_behind_its_work_publishes_its_diagnostics_every_second(make_prob
     release = threading.Event()
     monkeypatch.setattr(S, 'is_warm', lambda config: False)
     monkeypatch.setattr(S, 'warm', lambda config: release.wait(60.0))
+    monkeypatch.setattr(S, 'interpretable', lambda config, channels: False)  # held meanwhile
     p = make_probe()
     node = p.node
     recorder = Recorder(node._diagnostics_pub)

@@ -710,8 +710,8 @@ class TwoBandTracker:
         ]
 
     def update(self, t, y):
-        found = [(k, e.update(t, y)) for k, e in enumerate(self._estimators, 1)]
-        return [Estimate(**{**e.__dict__, 'mode': k}) for k, e in found if e]
+        found = [(k, e) for k, est in enumerate(self._estimators, 1) for e in est.update(t, y)]
+        return [Estimate(**{**e.__dict__, 'mode': k}) for k, e in found]
 
     @property
     def counters(self):
@@ -733,7 +733,9 @@ def test_each_mode_on_its_own_topics(make_probe, monkeypatch):
     monkeypatch.setattr(
         stream,
         'create_estimator',
-        lambda config: TwoBandTracker(config) if config.modes else FrequencyEstimator(config),
+        lambda config, channels=(): (
+            TwoBandTracker(config) if config.modes else FrequencyEstimator(config)
+        ),
     )
     p = make_probe(modes=2)
     n = 3000
@@ -970,7 +972,7 @@ def test_three_axis_imu_gives_the_modes_with_their_shapes(make_probe):
 def test_three_axis_imu_free_decay_is_estimated_jointly(make_probe):
     """excitation free (the default) with three IMU axes: a pluck's joint free-decay estimates on
     mode1/frequency and their shapes on mode1/shape, those of the core's joint estimator."""
-    from vib_estimator.core.multichannel_free import JointFreeEstimator
+    from vib_estimator.core import create_estimator
 
     p = make_probe(1, input_type=fields.IMU, components=IMU_AXES)
     t = np.arange(2000) / FS
@@ -979,7 +981,7 @@ def test_three_axis_imu_free_decay_is_estimated_jointly(make_probe):
     y = decay[:, None] * true + 0.02 * np.random.default_rng(9).standard_normal((len(t), 3))
     stamps = sine_stamps(len(t))
     p.publish([channels_message(fields.IMU, IMU_AXES, s, v) for s, v in zip(stamps, y)])
-    expected = JointFreeEstimator(config_of(p.node), IMU_AXES).process(
+    expected = create_estimator(config_of(p.node), IMU_AXES).process(
         seconds_since(np.asarray(stamps, dtype=np.int64), stamps[0]), y
     )
     e = expected.estimates
@@ -1048,3 +1050,25 @@ def test_components_are_validated_at_run_time(ros_context):
         assert node.set_parameters([Parameter('excitation', value='free')])[0].successful
     finally:
         node.destroy_node()
+
+
+@pytest.mark.parametrize('deciding', [True, False])
+def test_a_driven_input_switches_the_default_to_the_identifier(make_probe, deciding):
+    """``decide_excitation`` (default true): fed a mode driven throughout, the free-decay node
+    sets its own excitation and window to analyze's decision over the last seconds (a
+    building's 1.2 Hz fundamental: ~100 s); false keeps free and says on /diagnostics which
+    excitation helps."""
+    from vib_estimator.sim.ambient import ambient_record
+
+    p = make_probe(decide_excitation=deciding)
+    t, y, _ = ambient_record(75, 40, [(1.2, 0.015, 1.0)], 20, 1)
+    p.feed([EPOCH_NS + round(s * 1e9) for s in t], y)
+    if deciding:
+        node = p.node
+        assert spin_until(p.executor, lambda: config_of(node).excitation == 'ambient', 5.0)
+        assert 90 <= node.get_parameter('ambient_window_s').value <= 110
+        assert p.node._stream.decided
+    else:
+        status = p.wait_status(lambda s: 'looks driven' in s.message)
+        assert 'excitation:=ambient' in status.message
+        assert config_of(p.node).excitation == 'free'

@@ -11,7 +11,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from std_msgs.msg import Float64, Float64MultiArray
 
-from vib_estimator.core.multichannel_free import JointFreeEstimator
+from vib_estimator.core import create_estimator
 from vib_estimator.io import fields
 from vib_estimator.io.fields import seconds_since
 from vib_estimator.nodes.estimator_node import EstimatorNode, message_class
@@ -154,7 +154,7 @@ def test_three_topics_are_aligned_by_stamp_and_estimated_jointly(topics_probe):
     c = p.node.counters
     assert c['aligned'] == int(keep.sum()) and c['dropped_unaligned'] == 2 * len(lost)
     kept = np.asarray(stamps, dtype=np.int64)[keep]
-    expected = JointFreeEstimator(config_of(p.node), CHANNELS).process(
+    expected = create_estimator(config_of(p.node), CHANNELS).process(
         seconds_since(kept, kept[0]), y[keep]
     )
     e = expected.estimates

@@ -41,6 +41,7 @@ def test_params_file_holds_the_defaults():
         assert params.pop(name) == default, name
     assert params.pop('baseline_file') == params.pop('covariate_topics') == ''
     assert params.pop('health_window_s') == DEFAULT_WINDOW_S
+    assert params.pop('decide_excitation') is True  # the node's own choice (estimator_node)
     defaults = EstimatorConfig()
     assert set(params) == set(EstimatorConfig.names())
     for name, value in params.items():

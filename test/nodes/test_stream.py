@@ -126,7 +126,7 @@ def test_a_burst_of_self_tests_runs_the_tones_once(monkeypatch):
     monkeypatch.setattr(
         stream_module,
         'self_test',
-        lambda config, rate: runs.append((config, rate)) or real(config, rate),
+        lambda config, rate, create: runs.append((config, rate)) or real(config, rate, create),
     )
     s = stream_module.EstimatorStream(EstimatorConfig(), 0.0)
     answers = [s.self_test() for _ in range(50)]
@@ -137,7 +137,7 @@ def test_a_burst_of_self_tests_runs_the_tones_once(monkeypatch):
 
 # ---- several channels (the node's components) ---------------------------------------------------
 def test_channels_one_is_the_single_channel_stream_several_the_joint_identifier():
-    from vib_estimator.core.multichannel import JointAmbientEstimator, JointEstimate
+    from vib_estimator.core.multichannel import JointAmbientEstimator
     from vib_estimator.nodes.stream import check_channels
     from vib_estimator.sim.frame import modal_record
 
@@ -161,10 +161,10 @@ def test_channels_one_is_the_single_channel_stream_several_the_joint_identifier(
     stream = EstimatorStream(config, now=0.0, channels=names)
     got = [e for s, row in zip(stamps, y.tolist()) for e in stream.feed(int(s), tuple(row))]
     expected = JointAmbientEstimator(config, names).process((stamps - stamps[0]) * 1e-9, y)
-    assert all(isinstance(e, JointEstimate) for e in got) and len(got) == len(expected) > 10
-    assert [e.estimate.frequency_hz for e in got] == expected.estimates.frequency_hz.tolist()
+    assert all(e.shape is not None for e in got) and len(got) == len(expected) > 10
+    assert [e.frequency_hz for e in got] == expected.estimates.frequency_hz.tolist()
     for e in got:
-        stream.published(e.estimate, now=0.5)
+        stream.published(e, now=0.5)
     assert stream.status(now=1.0).values['channels'] == 'a,b,c'
     with pytest.raises(ValueError, match='need excitation free or ambient'):
         stream.configure(EstimatorConfig(excitation='auto'), names)  # refused: unchanged
@@ -174,8 +174,7 @@ def test_channels_one_is_the_single_channel_stream_several_the_joint_identifier(
 
 def test_several_channels_of_free_decays_are_estimated_jointly():
     """excitation free with three channels: the joint free-decay estimator's floats, shapes."""
-    from vib_estimator.core.multichannel import JointEstimate
-    from vib_estimator.core.multichannel_free import JointFreeEstimator
+    from vib_estimator.core import create_estimator
 
     names = ('x', 'y', 'z')
     stamps = EPOCH_NS + np.round(np.arange(3000) * 1e9 / 500.0).astype(np.int64)
@@ -185,9 +184,9 @@ def test_several_channels_of_free_decays_are_estimated_jointly():
     y = decay[:, None] * np.array([0.2, 1.0, -0.5]) + 0.02 * rng.standard_normal((len(t), 3))
     stream = EstimatorStream(EstimatorConfig(), now=0.0, channels=names)
     got = [e for s, row in zip(stamps, y.tolist()) for e in stream.feed(int(s), tuple(row))]
-    expected = JointFreeEstimator(EstimatorConfig(), names).process(t, y)
-    assert all(isinstance(e, JointEstimate) for e in got) and len(got) == len(expected) > 10
-    assert [e.estimate.frequency_hz for e in got] == expected.estimates.frequency_hz.tolist()
+    expected = create_estimator(EstimatorConfig(), names).process(t, y)
+    assert all(e.shape is not None for e in got) and len(got) == len(expected) > 10
+    assert [e.frequency_hz for e in got] == expected.estimates.frequency_hz.tolist()
     assert np.array_equal([e.shape for e in got], expected.shapes)
     assert stream.status(now=1.0).values['channels'] == 'x,y,z'
 
@@ -222,3 +221,80 @@ def test_a_driven_input_to_the_free_estimator_is_said_in_the_status_once_logged(
     y = np.exp(-0.01 * 2 * np.pi * 2 * t) * np.sin(2 * np.pi * 2 * t)
     y += 0.002 * np.random.default_rng(0).standard_normal(len(t))
     assert not any('looks driven' in s.message for s in run(EstimatorConfig(), t, y))
+
+
+def decisions(stream, t, y, step=100, estimates=None):
+    """Feed ``(t, y)`` (one status a ``step`` samples, i.e. a second at 100 Hz), applying each
+    :meth:`EstimatorStream.decision` as the node does (primed); the (second, decision) pairs.
+    ``estimates``: a list that gets (second, excitation, estimate) of each estimate."""
+    stamps = EPOCH_NS + np.round(t * 1e9).astype(np.int64)
+    out = []
+    for k in range(0, len(t), step):
+        for s, v in zip(stamps[k : k + step].tolist(), y[k : k + step].tolist()):
+            for e in stream.feed(s, v):
+                if estimates is not None:
+                    estimates.append((k // step, stream.config.excitation, e))
+        stream.status(now=1.0 + k / step)
+        decision = stream.decision()
+        if decision is not None:
+            out.append((k // step, decision))
+            changes = {'excitation': decision.excitation}
+            if decision.excitation != 'free':
+                changes['ambient_window_s'] = decision.window_s
+            stream.configure(stream.config.replace(**changes), prime=True)
+            stream.decided = True
+    return out
+
+
+def test_the_deciding_stream_goes_to_the_identifier_when_driven_and_back_when_free():
+    """``decide_excitation``: a mode driven throughout sends the free-decay estimator to the
+    identifier (analyze's decision over the last seconds: its window for the 1.2 Hz
+    fundamental) once half the watched span is in, without a hint, primed with those seconds
+    (its first estimate once a window is in since the start, not since the switch; the primer
+    uncounted); a pluck later brings it back to free decays; a decay ringing down into noise
+    never leaves free."""
+    from vib_estimator.core.choice import WATCH_S
+    from vib_estimator.sim.ambient import ambient_record
+
+    t, y, _ = ambient_record(150, 100, [(1.2, 0.015, 1.0)], 20, 1)
+    ring_t = np.arange(0, 200, 0.01)
+    ring = 50 * np.exp(-0.01 * 2 * np.pi * 2 * ring_t) * np.sin(2 * np.pi * 2 * ring_t)
+    ring += 0.002 * np.random.default_rng(0).standard_normal(len(ring_t))
+    stream = EstimatorStream(EstimatorConfig(), now=0.0, deciding=True)
+    got_estimates = []
+    got = decisions(
+        stream,
+        np.concatenate([t, t[-1] + 0.01 + ring_t]),
+        np.concatenate([y, ring]),
+        estimates=got_estimates,
+    )
+    assert [d.excitation for _, d in got] == ['ambient', 'free']
+    (went, driven), (back, _) = got
+    assert WATCH_S / 2 <= went <= WATCH_S / 2 + 5 and 90 <= driven.window_s <= 110
+    assert 150 <= back < 150 + WATCH_S and stream.config.excitation == 'free'
+    assert not any('looks driven' in m for m in stream.status(now=1e3).message.split(';'))
+    driven_estimates = [(k, e) for k, x, e in got_estimates if x == 'ambient']
+    assert driven_estimates[0][0] <= driven.window_s + 5  # primed: not went + window
+    assert all(abs(e.frequency_hz / 1.2 - 1) < 0.02 for _, e in driven_estimates)
+    assert stream.counters['received'] == len(t) + len(ring_t)
+    quiet = EstimatorStream(EstimatorConfig(), now=0.0, deciding=True)
+    assert decisions(quiet, ring_t, ring) == []
+
+
+def test_an_identifier_that_finds_no_mode_says_which_window_helps():
+    """Under excitation ambient, a 30 s window on a 0.3 Hz mode publishes nothing: after two
+    windows (and a minute) the status says why in words -- the window's correlation times of the
+    input's lowest peak -- and which ambient_window_s helps (not a counter alone); logged once."""
+    from vib_estimator.sim.ambient import ambient_record
+
+    t, y, _ = ambient_record(150, 100, [(0.3, 0.01, 1.0)], 20, 1)
+    stream = EstimatorStream(EstimatorConfig(excitation='ambient', ambient_window_s=30.0), 0.0)
+    stamps = EPOCH_NS + np.round(t * 1e9).astype(np.int64)
+    statuses = []
+    for k in range(0, len(t), 100):
+        assert not feed(stream, stamps[k : k + 100], y[k : k + 100])
+        statuses.append(stream.status(now=k / 100))
+    said = [k for k, s in enumerate(statuses) if 'ambient_window_s:=300' in s.message]
+    assert said and said[0] == 60 and said == list(range(60, len(statuses)))
+    assert '1.1 correlation times of the 0.3 Hz peak' in statuses[-1].message
+    assert sum('ambient_window_s:=' in (s.log or '') for s in statuses) == 1

@@ -1,8 +1,9 @@
 # Copyright 2026 vib_estimator developers
 # SPDX-License-Identifier: Apache-2.0
 """A node is live from its first second: a cold start (empty numba cache) answers its services and
-publishes /diagnostics while its kernels compile, holds its input, and Ctrl-C leaves a cache the
-next start uses. The warm-up's bookkeeping itself is tested without ROS below."""
+publishes /diagnostics while its kernels compile, estimates with them uncompiled meanwhile (the
+default configuration) or holds its input (the others), and Ctrl-C leaves a cache the next start
+uses. The warm-up's bookkeeping itself is tested without ROS below."""
 
 from __future__ import annotations
 
@@ -18,7 +19,12 @@ import numpy as np
 from vib_estimator.core import EstimatorConfig
 from vib_estimator.core.estimator import FrequencyEstimator
 from vib_estimator.io.fields import seconds_since
-from vib_estimator.nodes.stream import WARMUP_BUFFER, WARMUP_MESSAGE, EstimatorStream
+from vib_estimator.nodes.stream import (
+    WARMUP_BUFFER,
+    WARMUP_MESSAGE,
+    EstimatorStream,
+    interpretable,
+)
 
 
 def _tone(n, rate=500.0, f=4.0):
@@ -27,8 +33,10 @@ def _tone(n, rate=500.0, f=4.0):
 
 
 def test_held_samples_are_drained_in_order_into_the_estimator():
-    config = EstimatorConfig(refine=0)  # a compile key the session fixture did not warm
+    # a compile key the session fixture did not warm; band_hz: held, not estimated uncompiled
+    config = EstimatorConfig(refine=0, band_hz=(1.0, 20.0))
     stream = EstimatorStream(config, time.monotonic(), background=True)
+    assert not interpretable(config, ()) and not stream.ready and stream.compiling
     assert not stream.ready
     ok, why = stream.self_test()
     assert not ok and why.startswith('busy')
@@ -50,7 +58,39 @@ def test_held_samples_are_drained_in_order_into_the_estimator():
     direct = FrequencyEstimator(config).process(base, y)
     assert [f for _, f in got] == list(direct.frequency_hz)  # the same floats, in order
     tags = [tag for tag, _ in got]
-    assert tags == sorted(tags) and len(tags) == len(direct) > 10
+    assert tags == sorted(tags) and len(tags) == len(direct) > 5
+    assert stream.counters['received'] == len(t) and stream.counters['dropped_warmup'] == 0
+
+
+def test_the_default_estimates_uncompiled_while_it_compiles_then_switches_unseen():
+    config = EstimatorConfig(refine=0)  # a compile key the session fixture did not warm
+    assert interpretable(config, ()) and interpretable(EstimatorConfig(), ())
+    stream = EstimatorStream(config, time.monotonic(), background=True)
+    assert stream.ready and stream.compiling and stream.estimator.interpreted
+    assert stream.reset()[0]
+    ok, why = stream.self_test()  # uncompiled too: no waiting for the compile
+    assert ok, why
+    status = stream.status(time.monotonic())
+    assert status.message != WARMUP_MESSAGE and status.values['warmup_s'] >= 0.0
+    t, y = _tone(2000)
+    stamps = (1_000_000_000 + np.round(t * 1e9)).astype(np.int64)
+    got = []
+    for k in range(1000):
+        got += [e.frequency_hz for e in stream.feed(int(stamps[k]), float(y[k]))]
+    uncompiled = len(got)
+    assert stream.estimator.interpreted  # only poll switches, between two samples
+    deadline = time.monotonic() + 120
+    drained = None
+    while drained is None and time.monotonic() < deadline:
+        drained = stream.poll()
+        time.sleep(0.005)
+    assert drained is not None and list(drained) == [] and not stream.compiling
+    assert not stream.estimator.interpreted and 'warmup_s' not in stream.status(0.0).values
+    for k in range(1000, len(t)):
+        got += [e.frequency_hz for e in stream.feed(int(stamps[k]), float(y[k]))]
+    base = np.array([seconds_since(int(s), int(stamps[0])) for s in stamps])  # the node's base
+    direct = FrequencyEstimator(config).process(base, y)
+    assert got == list(direct.frequency_hz) and 0 < uncompiled < len(got)  # the same floats
     assert stream.counters['received'] == len(t) and stream.counters['dropped_warmup'] == 0
 
 
@@ -61,8 +101,9 @@ def test_held_samples_are_fed_in_slices_and_later_ones_wait_behind(monkeypatch):
     from vib_estimator.nodes import stream as S
 
     monkeypatch.setattr(S, 'is_warm', lambda config: False)  # a warm-up, however compiled
-    config = EstimatorConfig()
+    config = EstimatorConfig(band_hz=(1.0, 20.0))  # held, not estimated uncompiled
     stream = EstimatorStream(config, time.monotonic(), background=True)
+    assert not stream.ready and stream.compiling
     t, y = _tone(2000)
     stamps = (1_000_000_000 + np.round(t * 1e9)).astype(np.int64)
     for k in range(1000):
@@ -175,15 +216,23 @@ def test_a_cold_node_is_live_while_it_compiles_and_ctrl_c_keeps_the_cache(ros_co
         # first start, interrupted while it compiles: exit 0, no traceback, a partial cache
         proc = _start_node(tmp_path)
         assert watcher.spin_until(lambda: watcher.last()[0] is not None, 30)
-        status, _ = watcher.last()
-        assert status.level == DiagnosticStatus.WARN and status.message == WARMUP_MESSAGE
+        status, values = watcher.last()
+        # the default configuration estimates with its kernels uncompiled while they compile
+        assert status.level != DiagnosticStatus.ERROR and status.message != WARMUP_MESSAGE
+        assert 'warmup_s' in values, values
+        assert watcher.spin_until(lambda: watcher.pub.get_subscription_count() > 0, 30)
+        watcher.spin_until(lambda: False, 1.0)  # discovery settles both ways
+        watcher.publish(400)
+        assert watcher.spin_until(lambda: int(watcher.last()[1].get('estimates', 0)) > 0, 30)
+        assert 'warmup_s' in watcher.last()[1], 'estimates only once compiled'
         # interrupted once a first kernel is compiled and kept (numba saves each one as it ends;
         # how soon after the first status that is depends on the machine's load)
         assert watcher.spin_until(lambda: any(tmp_path.rglob('*.nbi')), 120), 'nothing kept'
         code, output = _interrupt(proc)
         assert code == 0 and 'Traceback' not in output, output
-        # second start on that cache: live at once, services answer, input held, then estimates
+        # second start on that cache: live at once, services answer, estimates, compiled
         watcher.statuses.clear()
+        watcher.sent = 0
         proc = _start_node(tmp_path)
         try:
             result = watcher.call(watcher.self_test)
@@ -195,7 +244,9 @@ def test_a_cold_node_is_live_while_it_compiles_and_ctrl_c_keeps_the_cache(ros_co
             watcher.publish(400)
             ready = watcher.spin_until(
                 lambda: (
-                    watcher.last()[0] is not None and watcher.last()[0].message != WARMUP_MESSAGE
+                    watcher.last()[0] is not None
+                    and watcher.last()[0].message != WARMUP_MESSAGE
+                    and 'warmup_s' not in watcher.last()[1]
                 ),
                 240,
             )

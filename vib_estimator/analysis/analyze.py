@@ -28,9 +28,9 @@ from typing import Optional, Tuple
 
 import numpy as np
 
-from ..core import MODELS, EstimateArrays, EstimatorConfig
+from ..core import MODELS, EstimateArrays, EstimatorConfig, create_estimator
 from ..core.config import EXCITATIONS, PAPER
-from ..core.modes import create_estimator
+from ..core.factory import kind_of
 from ..errors import VibEstimatorError, report
 from ..io.align import ALIGN_TOLERANCE_S
 from ..io.csv_reader import csv_layout
@@ -363,17 +363,18 @@ def run(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
     estimates = result.estimates
-    _print(estimates, signal.origin_ns, args.format, config.modes or config.excitation != 'free')
+    numbered = kind_of(config).numbered
+    _print(estimates, signal.origin_ns, args.format, numbered)
     counters = result.estimator.counters
     extra = f', messages_without_component={signal.skipped}' if signal.skipped else ''
     extra += f', corrupt_records={signal.corrupt}' if signal.topic else ''
-    open_samples = getattr(result.estimator, 'segment_samples', None)
+    open_samples = result.estimator.segment_samples
     if open_samples is not None:
         extra += f', open_segment_samples={open_samples}'
     print(
         'analyze: ' + ', '.join(f'{k}={v}' for k, v in counters.items()) + extra, file=sys.stderr
     )
-    mode = estimates.mode if config.modes or config.excitation != 'free' else None
+    mode = estimates.mode if numbered else None
     why = '' if len(estimates) else explain_no_estimate(counters, open_samples, config, decision)
     if len(estimates) == 0:
         print('analyze: no estimate: ' + why, file=sys.stderr)

@@ -7,15 +7,14 @@ of one bag topic) and ``analyze BAG --topics /a,/b,/c`` (the ``--component`` or
 modes with their shapes.
 
 One column (``--columns b``) is exactly ``--column b``, one component exactly ``--component``.
-Two or more go to the joint estimator of the excitation: free decays
-(:mod:`..core.multichannel_free`) or ``--excitation ambient`` (:mod:`..core.multichannel`);
-``auto`` takes one channel. Each estimate row (JSONL, CSV, table) gains, per channel
-``<name>``: ``shape_<name>`` (the signed amplitude, :func:`..core.shapes.signed_amplitudes`),
-``shape_phase_deg_<name>`` (its phase, degrees, 0 or 180 for a real mode), ``shape_std_<name>``
-(its uncertainty) and ``mac`` (with the same mode's previous estimate; null at its first); a
-bag's rows also ``stamp_ns``, as ``--component``'s. ``--plot``: the estimates over time by mode
-and each mode's shape as a bar plot of the channel amplitudes (median over the mode's
-estimates).
+Two or more go to the joint estimator of the excitation (:func:`..core.create_estimator`: free
+decays or ``--excitation ambient``; ``auto`` takes one channel). Each estimate row (JSONL, CSV,
+table) gains, per channel ``<name>``: ``shape_<name>`` (the signed amplitude,
+:func:`..core.shapes.signed_amplitudes`), ``shape_phase_deg_<name>`` (its phase, degrees, 0 or
+180 for a real mode), ``shape_std_<name>`` (its uncertainty) and ``mac`` (with the same
+mode's previous estimate; null at its first); a bag's rows also ``stamp_ns``, as
+``--component``'s. ``--plot``: the estimates over time by mode and each mode's shape as a bar
+plot of the channel amplitudes (median over the mode's estimates).
 """
 
 from __future__ import annotations
@@ -24,9 +23,9 @@ import sys
 
 import numpy as np
 
-from ..core.config import EstimatorConfig
+from ..core import EstimatorConfig, create_estimator
+from ..core.factory import kind_of
 from ..core.multichannel import JointEstimates
-from ..core.multichannel_free import JOINT_EXCITATIONS, create_joint_estimator
 from ..core.shapes import SHAPE_ROWS, phases_deg, signed_amplitudes
 from ..errors import BagError, CsvError
 from ..io.csv_reader import column_names, read_csv_columns
@@ -70,13 +69,9 @@ def channel_list(option: str, text: str) -> tuple[str, ...]:
 
 
 def need_joint(what: str, config: EstimatorConfig) -> None:
-    """ValueError unless ``config`` has a joint estimator (``excitation`` free or ambient):
-    ``what`` (several channels) needs one."""
-    if config.excitation not in JOINT_EXCITATIONS:
-        raise ValueError(
-            f'{what} need --excitation free or ambient (a joint estimation), got '
-            f'{config.excitation}: it takes one --column or --component'
-        )
+    """ValueError unless ``config`` has a joint estimator: ``what`` (several channels) needs one
+    (:func:`..core.factory.kind_of`)."""
+    kind_of(config, 2, what, '--excitation')
 
 
 def read_channels(path, topic, names, strict: bool = False, info=None):
@@ -141,7 +136,7 @@ def joint_run(t: np.ndarray, y: np.ndarray, names, config: EstimatorConfig):
     bad = np.flatnonzero(~(np.diff(t) > 0))
     if bad.size:
         raise ValueError(f'time is not strictly increasing at sample {int(bad[0]) + 1}')
-    estimator = create_joint_estimator(config, names)
+    estimator = create_estimator(config, names)
     return estimator, estimator.process(t, y)
 
 

@@ -23,12 +23,9 @@ from typing import Iterable, Iterator, Optional, Tuple
 import numpy as np
 
 from ..core.ambient import MIN_WINDOW_SAMPLES
-from ..core.choice import DECIDE_S, DRIVEN_ABOVE, FREE_BELOW, WINDOW_PERIODS, Decision, decide
+from ..core.choice import DECIDE_S, DRIVEN_ABOVE, FREE_BELOW, Decision, decide
+from ..core.choice import window_advice as choice_window_advice
 from ..core.config import EstimatorConfig
-
-#: the damping ratio :func:`window_advice` assumes of the lowest mode (the choice's
-#: :data:`..core.choice.WINDOW_PERIODS` is ~15 correlation times at it)
-ASSUMED_ZETA = 0.02
 
 
 def decides(args) -> bool:
@@ -42,23 +39,40 @@ def window_given(args) -> bool:
     return getattr(args, 'ambient_window_s', None) is not None
 
 
+def periods_given(args) -> bool:
+    """Whether the command line sets the free-decay window (``--min-periods``)."""
+    return getattr(args, 'min_periods', None) is not None
+
+
 def decided_config(
-    config: EstimatorConfig, d: Decision, prog: str, keep_window: bool = False
+    config: EstimatorConfig,
+    d: Decision,
+    prog: str,
+    keep_window: bool = False,
+    keep_periods: bool = False,
 ) -> Tuple[EstimatorConfig, str]:
     """``config`` with the excitation, (unless ``keep_window``: ``--ambient-window-s`` was
-    given) the ambient window and (unless ``config.modes`` is set) the modes to track of the
-    decision ``d``, and the line that says so."""
+    given) the ambient window, (unless ``config.modes`` is set) the modes to track and (unless
+    ``keep_periods``: ``--min-periods`` was given) the free-decay window of the decision ``d``,
+    and the line that says so."""
     window = config.ambient_window_s
     if not keep_window and d.excitation != 'free':
         window = d.window_s
     modes = config.modes or d.modes
+    periods = config.min_periods
+    if not keep_periods and math.isfinite(d.min_periods):
+        periods = d.min_periods
     line = (
         f'{prog}: excitation {d.excitation} (the default decides from the record: {d.reason}; '
         '--excitation free, ambient or auto overrides'
         + ('' if d.excitation == 'free' else ', --ambient-window-s the window')
+        + (', --min-periods the window' if math.isfinite(d.min_periods) else '')
         + ')'
     )
-    return config.replace(excitation=d.excitation, ambient_window_s=window, modes=modes), line
+    changed = config.replace(
+        excitation=d.excitation, ambient_window_s=window, modes=modes, min_periods=periods
+    )
+    return changed, line
 
 
 def contradiction(config: EstimatorConfig, d: Decision, prog: str) -> str:
@@ -80,20 +94,9 @@ def contradiction(config: EstimatorConfig, d: Decision, prog: str) -> str:
 
 
 def window_advice(config: EstimatorConfig, d: Optional[Decision]) -> str:
-    """Why a window gave no mode, from the record's lowest spectral peak: how many correlation
-    times ``1 / (2 pi zeta f)`` (at :data:`ASSUMED_ZETA`) of it the window holds, and the window
-    that holds the decision's :data:`..core.choice.WINDOW_PERIODS` periods; '' without a peak."""
-    if d is None or not math.isfinite(d.fundamental_hz):
-        return ''
-    f, window = d.fundamental_hz, config.ambient_window_s
-    times = window * 2 * math.pi * ASSUMED_ZETA * f
-    want = WINDOW_PERIODS / f
-    if window >= want:
-        return ''
-    return (
-        f'the {window:g} s window holds {times:.1f} correlation times of the {f:.3g} Hz peak (at '
-        f'zeta {100 * ASSUMED_ZETA:g} %): --ambient-window-s {math.ceil(want)}'
-    )
+    """Why a window gave no mode, from the record's lowest spectral peak
+    (:func:`..core.choice.window_advice`, the option ``analyze`` takes); '' without one."""
+    return choice_window_advice(config.ambient_window_s, d, '--ambient-window-s ')
 
 
 def short_window(config: EstimatorConfig, d: Optional[Decision]) -> str:
@@ -140,7 +143,7 @@ def prepare(
     estimated (what was decided, or a contradiction)."""
     d = decide(t, y, channels, config.ambient_window_s)
     if decides(args):
-        config, line = decided_config(config, d, prog, window_given(args))
+        config, line = decided_config(config, d, prog, window_given(args), periods_given(args))
         return config, d, [line]
     if getattr(args, 'paper', False):
         return config, d, []  # the paper's configuration, as printed

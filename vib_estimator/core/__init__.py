@@ -1,20 +1,35 @@
 # Copyright 2026 vib_estimator developers
 # SPDX-License-Identifier: Apache-2.0
-"""The mathematics, with no rclpy: configuration, the compiled kernel, the estimator API.
+"""The mathematics, with no rclpy: configuration, the compiled kernel, the estimators.
 
-Public API: :class:`EstimatorConfig`, :class:`FrequencyEstimator`, :class:`Estimate`,
-:class:`EstimateArrays`, :func:`estimate`, ``MODELS``, ``COUNTER_NAMES``.
+Public API: :class:`EstimatorConfig`; :func:`create_estimator` ``(config, channels=())``, the
+estimator of a configuration (the table :data:`KINDS` of :mod:`.factory`: which estimator serves
+which excitation, one channel or several); :class:`Estimator`, the interface every estimator has
+(``update``, ``process``, ``reset``, ``restart``, ``config``, ``channels``, ``counters``);
+:class:`Estimate`, :class:`EstimateArrays`; :class:`FrequencyEstimator` (the paper's algebraic
+estimator) and :func:`estimate`; ``MODELS``, ``COUNTER_NAMES``.
 """
 
 from .config import MODELS, EstimatorConfig
-from .estimator import COUNTER_NAMES, Estimate, EstimateArrays, FrequencyEstimator, estimate
+from .estimator import (
+    COUNTER_NAMES,
+    Estimate,
+    EstimateArrays,
+    Estimator,
+    FrequencyEstimator,
+    estimate,
+)
+from .factory import KINDS, create_estimator
 
 __all__ = [
     'MODELS',
     'COUNTER_NAMES',
+    'KINDS',
     'EstimatorConfig',
     'Estimate',
     'EstimateArrays',
+    'Estimator',
     'FrequencyEstimator',
+    'create_estimator',
     'estimate',
 ]

@@ -69,7 +69,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .config import EstimatorConfig
-from .estimator import INPUT_COUNTERS, Estimate, EstimateArrays, as_series
+from .estimator import INPUT_COUNTERS, Estimate, EstimateArrays, Estimator, as_series
 from .jit import jit
 from .threads import single_blas_thread
 
@@ -1101,7 +1101,7 @@ class _Track:
         return max(1.0, math.sqrt(float(np.mean(d * d))))
 
 
-class SlidingWindowIdentifier:
+class SlidingWindowIdentifier(Estimator):
     """The sliding window both output-only identifiers share (this module's, one channel, and
     :class:`vib_estimator.core.multichannel.JointAmbientEstimator`): the samples' buffer (``y``:
     one value or one row of ``channels`` values a sample), their checks and counters, the runs of

@@ -54,7 +54,7 @@ import numpy as np
 
 from .ambient import MATCH_TOL, AmbientEstimator
 from .config import EstimatorConfig
-from .estimator import Estimate, EstimateArrays, as_estimates, as_series
+from .estimator import INPUT_COUNTERS, Estimate, EstimateArrays, Estimator, as_series
 
 #: envelope blocks per ambient window
 BLOCKS_PER_WINDOW = 30
@@ -464,7 +464,7 @@ class Envelope:
         self.peak = max(self.peak, energy)
 
 
-class AutoEstimator:
+class AutoEstimator(Estimator):
     """The free-decay estimator and the ambient identifier, each publishing in its own stretches
     (see the module docstring)."""
 
@@ -507,15 +507,16 @@ class AutoEstimator:
 
     @property
     def counters(self) -> dict[str, int]:
-        """The free-decay estimator's counters, the identifier's own (``ambient_`` + name) and
-        the envelope's blocks in each state (``free_blocks``, ``driven_blocks``) and the estimates
+        """The free-decay estimator's counters, the identifier's others (those of the same name
+        as ``ambient_`` + name: ``ambient_rejected_damping``, ``ambient_estimates``) and the
+        envelope's blocks in each state (``free_blocks``, ``driven_blocks``) and the estimates
         each published (``estimates_free``, ``estimates_driven``)."""
         c = dict(self._free.counters)
         for name, n in self._ambient.counters.items():
             if name not in c:
                 c[name] = n
-            elif name == 'estimates':
-                c['ambient_estimates'] = n
+            elif name not in INPUT_COUNTERS:
+                c['ambient_' + name] = n
         c.update(self._envelope.changes)
         c['free_blocks'] = self._envelope.blocks[FREE]
         c['driven_blocks'] = self._envelope.blocks[DRIVEN]
@@ -531,9 +532,12 @@ class AutoEstimator:
         return {k: {'estimates': int(m[2])} for k, m in enumerate(order, 1)}
 
     def restart(self) -> None:
+        """Forget the signal and the known modes; counters are kept (the envelope's too)."""
         self._free.restart()
         self._ambient.restart()
+        counted = self._envelope.blocks, self._envelope.changes
         self._envelope.restart()
+        self._envelope.blocks, self._envelope.changes = counted
         self._modes = []
         self._filled = 0
 
@@ -568,7 +572,7 @@ class AutoEstimator:
         """Feed one sample; the estimates it completes that belong to the current stretch."""
         self._envelope.update(float(t), float(y))
         self._remember(float(t), float(y))
-        free = as_estimates(self._free.update(t, y))
+        free = self._free.update(t, y)
         self._ambient.idle = self._envelope.state == FREE
         ambient = self._ambient.update(t, y)
         if self._envelope.state == FREE:

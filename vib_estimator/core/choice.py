@@ -82,6 +82,26 @@ HARMONIC_TOL = 0.02
 WINDOW_PERIODS = 120.0
 #: the longest window the decision chooses, s
 MAX_WINDOW_S = 300.0
+#: a free decay of one mode whose spectrum is pure and whose estimates over this many periods
+#: are precise (:func:`fast_window`) is estimated over this window (the long window,
+#: ``min_periods``) rather than the default 1.25 periods: the real beams 0.90-0.92 periods to an
+#: estimate, 99-100 % within 2 % (bench_first_estimate.py)
+FAST_PERIODS = 0.9
+#: ... pure: at most this share of the power within :data:`IMPURITY_SPAN` of the mode lies
+#: farther than :data:`PEAK_WIDTH` from it (:func:`impurity`: free decays 0.000-0.07, the real
+#: arm's closed-loop limit cycle 0.30, which a window of one period reads 2 % high)
+IMPURE = 0.1
+#: ... the span around the mode (a factor each way: an octave) and the peak's half width
+#: (relative)
+IMPURITY_SPAN = 2.0
+PEAK_WIDTH = 0.15
+#: ... precise: 90 % of the trial estimates over :data:`FAST_PERIODS` have a relative frequency
+#: std at most this (2 % is then ~3 stds; the real beams 0.26-0.56 %, decays in 20-30 dB of
+#: noise 1.4-3.2 %, whose tails need the longer window)
+FAST_STD = 0.007
+#: the damping ratio :func:`window_advice` assumes of the lowest mode (:data:`WINDOW_PERIODS`
+#: is ~15 correlation times at it)
+ASSUMED_ZETA = 0.02
 #: the window leaves the record room for at least this many analyses (one per second)
 MIN_ANALYSES = 60
 
@@ -103,6 +123,8 @@ class Decision:
     rate_hz: float = math.nan
     #: a free decay of several separate modes: the modes to track (0: one estimator)
     modes: int = 0
+    #: a free decay of one mode: the window it allows (:func:`fast_window`; NaN: the configured)
+    min_periods: float = math.nan
 
 
 def principal_component(y: np.ndarray) -> np.ndarray:
@@ -116,19 +138,27 @@ def principal_component(y: np.ndarray) -> np.ndarray:
     return y @ vectors[:, -1]
 
 
-def spectral_peaks(t: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``(frequencies, powers)`` of the spectrum's peaks (module docstring, 1), strongest first,
-    summed over the channels of ``y``."""
-    from scipy.signal import find_peaks, welch
+def spectrum(t: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+    """Welch's spectrum of ``(t, y)`` (segments of :data:`SEGMENT_S` s), summed over the channels
+    of ``y``: ``(frequencies, powers, the lowest frequency it resolves)``."""
+    from scipy.signal import welch
 
     fs = (len(t) - 1) / float(t[-1] - t[0])
     y = np.asarray(y, dtype=np.float64).reshape(len(t), -1)
     nper = int(min(len(t), max(64, round(SEGMENT_S * fs))))
     freq, psd = welch(y, fs, nperseg=nper, axis=0, detrend='constant')
-    psd = np.sum(psd, axis=1)
+    return freq, np.sum(psd, axis=1), 2 * fs / nper
+
+
+def spectral_peaks(t: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(frequencies, powers)`` of the spectrum's peaks (module docstring, 1), strongest first,
+    summed over the channels of ``y``."""
+    from scipy.signal import find_peaks
+
+    freq, psd, lowest = spectrum(t, y)
     level = 10 * np.log10(np.maximum(psd, 1e-300 + 1e-12 * float(np.max(psd))))
     idx, _ = find_peaks(level, prominence=PEAK_DB)
-    idx = idx[freq[idx] > 2 * fs / nper]  # above the segment's own lowest bins (a drift)
+    idx = idx[freq[idx] > lowest]  # above the segment's own lowest bins (a drift)
     if not len(idx):
         return np.empty(0), np.empty(0)
     order = idx[np.argsort(psd[idx])[::-1]]
@@ -150,10 +180,11 @@ def driven_share(t: np.ndarray, signal: np.ndarray, dominant_hz: float) -> float
     return float(np.sum(energy[driven])) / total if total > 0 else 0.0
 
 
-def decide(t, y, channels: int = 1, window_s: float = 30.0) -> Decision:
+def decide(t, y, channels: int = 1, window_s: float = 30.0, stream: bool = False) -> Decision:
     """The :class:`Decision` for the record ``(t, y)`` (its first :data:`DECIDE_S` s are read;
     ``y`` samples or samples x ``channels``), ``window_s`` the shortest window (the configured
-    one)."""
+    one). ``stream``: the record is the last seconds of a stream that goes on (the window is not
+    bounded by the room for :data:`MIN_ANALYSES` analyses)."""
     t = np.asarray(t, dtype=np.float64)
     y = np.asarray(y, dtype=np.float64)
     # finite samples at sane times (an absurd stamp, 1e300 s, would overflow the block index)
@@ -187,7 +218,7 @@ def decide(t, y, channels: int = 1, window_s: float = 30.0) -> Decision:
         excitation = 'auto'
     window = window_s
     if excitation != 'free' and math.isfinite(fundamental):
-        room = max(window_s, span - MIN_ANALYSES)
+        room = math.inf if stream else max(window_s, span - MIN_ANALYSES)
         window = min(max(window_s, WINDOW_PERIODS / fundamental), MAX_WINDOW_S, room)
         seen += (
             f'; window {window:.0f} s ({window * fundamental:.0f} periods of {fundamental:.3g} Hz)'
@@ -201,9 +232,74 @@ def decide(t, y, channels: int = 1, window_s: float = 30.0) -> Decision:
             + ', '.join(f'{f:.3g}' for f in sorted(separate))
             + f' Hz): the mode tracker, modes {modes}'
         )
+    periods = math.nan
+    if excitation == 'free' and not modes and channels == 1 and math.isfinite(dominant):
+        periods, why = fast_window(t, y, dominant)
+        seen += f'; {why}'
     rate = (len(t) - 1) / span
     return Decision(
-        excitation, window, share, dominant, fundamental, tuple(peaks), seen, span, rate, modes
+        excitation,
+        window,
+        share,
+        dominant,
+        fundamental,
+        tuple(peaks),
+        seen,
+        span,
+        rate,
+        modes,
+        periods,
+    )
+
+
+def impurity(t: np.ndarray, y: np.ndarray, f: float) -> float:
+    """The share of the power of ``(t, y)`` within :data:`IMPURITY_SPAN` of ``f`` (either way)
+    that lies farther than :data:`PEAK_WIDTH` (relative) from it (Welch, :func:`spectrum`)."""
+    freq, psd, _ = spectrum(t, y)
+    near = (freq > f / IMPURITY_SPAN) & (freq < f * IMPURITY_SPAN)
+    total = float(np.sum(psd[near]))
+    off = float(np.sum(psd[near & (np.abs(freq / f - 1) > PEAK_WIDTH)]))
+    return off / total if total > 0 else math.nan
+
+
+def fast_window(t: np.ndarray, y: np.ndarray, f: float) -> tuple[float, str]:
+    """The window (``min_periods``) for a free decay of one mode at ``f`` Hz: :data:`FAST_PERIODS`
+    when its spectrum is pure (:func:`impurity` below :data:`IMPURE`) and 90 % of its estimates
+    over that window (a trial over the samples) have a relative std at most :data:`FAST_STD`;
+    else NaN (the configured window). With the reason in words."""
+    from .config import EstimatorConfig
+    from .estimator import estimate
+
+    spread = impurity(t, y, f)
+    if not spread <= IMPURE:
+        return math.nan, f'{100 * spread:.0f} % of the power near {f:.3g} Hz off its peak'
+    trial = estimate(t, y, EstimatorConfig(min_periods=FAST_PERIODS))
+    if not len(trial):
+        return math.nan, f'no estimate over {FAST_PERIODS:g} periods'
+    std = float(np.quantile(trial.frequency_std_hz / trial.frequency_hz, 0.9))
+    if not std <= FAST_STD:
+        return math.nan, f'90 % of the {FAST_PERIODS:g}-period estimates within {100 * std:.2g} %'
+    return FAST_PERIODS, (
+        f'a pure peak ({100 * spread:.1f} % off it) and 90 % of the {FAST_PERIODS:g}-period '
+        f'estimates within {100 * std:.2g} % (1 std): min_periods {FAST_PERIODS:g}'
+    )
+
+
+def window_advice(window_s: float, d: Optional[Decision], option: str) -> str:
+    """Why a ``window_s`` window gave no mode, from the record's lowest spectral peak: how many
+    correlation times ``1 / (2 pi zeta f)`` (at :data:`ASSUMED_ZETA`) of it the window holds,
+    and ``option`` with the window that holds :data:`WINDOW_PERIODS` periods of it (at most
+    :data:`MAX_WINDOW_S`); '' without a peak, or when the window holds them."""
+    if d is None or not math.isfinite(d.fundamental_hz):
+        return ''
+    f = d.fundamental_hz
+    times = window_s * 2 * math.pi * ASSUMED_ZETA * f
+    want = min(WINDOW_PERIODS / f, MAX_WINDOW_S)
+    if window_s >= want:
+        return ''
+    return (
+        f'the {window_s:g} s window holds {times:.1f} correlation times of the {f:.3g} Hz peak '
+        f'(at zeta {100 * ASSUMED_ZETA:g} %): {option}{math.ceil(want)}'
     )
 
 
@@ -226,6 +322,8 @@ def separate_modes(peaks: np.ndarray, powers: np.ndarray) -> list[float]:
 WATCH_S = 120.0
 #: ... and the least mean variance they must hold, relative to the stream's largest block's
 LIVE_LEVEL = 1e-2
+#: the most samples the node keeps for its decision (15 MB with 6 channels; 262 s at 1 kHz)
+MAX_KEPT = 2**18
 
 
 class DrivenWatch:
@@ -233,7 +331,8 @@ class DrivenWatch:
     in the blocks auto's envelope (:class:`.auto.Envelope`, its block following the free
     estimates' frequency) read as driven above :data:`DRIVEN_ABOVE`, their mean level at least
     :data:`LIVE_LEVEL` of the largest block's (not the noise a decay rang down into) and the
-    envelope driven now. Fed sample by sample (:meth:`update`), asked at most once a second
+    envelope driven now. Fed sample by sample (:meth:`update`, which marks the energies every
+    1 % of :data:`WATCH_S` of stream time, however fast it is fed), asked at any pace
     (:meth:`driven`)."""
 
     def __init__(self):
@@ -242,8 +341,34 @@ class DrivenWatch:
         self._last_t = math.nan
 
     def update(self, t: float, y: float) -> None:
-        self._envelope.update(t, y)
+        env = self._envelope
+        env.update(t, y)
         self._last_t = t
+        marks = self._marks
+        if not marks or t - marks[-1][0] >= WATCH_S / 100:  # in stream time, however fast fed
+            self._mark(t)
+
+    def feed(self, t: np.ndarray, y: np.ndarray) -> None:
+        """:meth:`update` for arrays (the same states and marks, in a few numpy passes)."""
+        start, n = 0, len(t)
+        while start < n:
+            end = start + 1  # the first sample is marked
+            if self._marks:  # else up to the next sample to mark at
+                later = np.flatnonzero(t[start:] - self._marks[-1][0] >= WATCH_S / 100)
+                end = start + int(later[0]) + 1 if len(later) else n + 1
+            with np.errstate(over='ignore', invalid='ignore'):  # as update's floats: inf
+                self._envelope.feed(t[start:end], y[start:end])
+            self._last_t = float(t[min(end, n) - 1])
+            if end <= n:
+                self._mark(self._last_t)
+            start = end
+
+    def _mark(self, t: float) -> None:
+        """Mark the envelope's energies at stream time ``t``; forget marks beyond the span."""
+        env, marks = self._envelope, self._marks
+        marks.append((t, env.energy[FREE], env.energy[DRIVEN]))
+        while len(marks) > 2 and t - marks[1][0] >= WATCH_S:
+            marks.popleft()
 
     def follow(self, f: float) -> None:
         """A free estimate of ``f`` Hz: the block holds a few of its periods."""
@@ -251,19 +376,131 @@ class DrivenWatch:
 
     def driven(self) -> Optional[float]:
         """The driven share of the last :data:`WATCH_S` s' energy when they look driven
-        throughout (see the class doc), else None. Marks the stream's energies now."""
-        env = self._envelope
-        now = (self._last_t, env.energy[FREE], env.energy[DRIVEN])
-        marks = self._marks
-        if not math.isfinite(now[0]):
+        throughout (see the class doc), else None."""
+        share, live = self._watched_share()
+        if share is None or self._envelope.state != DRIVEN:
             return None
-        marks.append(now)
-        while len(marks) > 2 and now[0] - marks[1][0] >= WATCH_S:
-            marks.popleft()
-        span = now[0] - marks[0][0]
-        free, driven = now[1] - marks[0][1], now[2] - marks[0][2]
-        if span < WATCH_S / 2 or env.state != DRIVEN or not free + driven > 0:
-            return None
-        share = driven / (free + driven)
-        live = (free + driven) / span >= LIVE_LEVEL * env.peak
         return share if share > DRIVEN_ABOVE and live else None
+
+    def freed(self) -> bool:
+        """Whether the last :data:`WATCH_S` s look free: their driven share below
+        :data:`FREE_BELOW` (what :func:`decide` calls a free decay)."""
+        share, _ = self._watched_share()
+        return share is not None and share < FREE_BELOW
+
+    def _watched_share(self) -> tuple[Optional[float], bool]:
+        """The driven share of the last :data:`WATCH_S` s (None before half of them are in) and
+        whether they are live (see the class doc)."""
+        env = self._envelope
+        marks = self._marks
+        if not math.isfinite(self._last_t) or not marks:
+            return None, False
+        span = self._last_t - marks[0][0]
+        free = env.energy[FREE] - marks[0][1]
+        driven = env.energy[DRIVEN] - marks[0][2]
+        if span < WATCH_S / 2 or not free + driven > 0:
+            return None, False
+        return driven / (free + driven), (free + driven) / span >= LIVE_LEVEL * env.peak
+
+
+class StreamChoice:
+    """``estimator_node``'s default (``decide_excitation``): :func:`decide` over the last
+    :data:`WATCH_S` s of the stream (all channels), taken once :class:`DrivenWatch` reads them
+    driven throughout while the estimator is the free-decay one; and back to ``free`` once a
+    stream it sent to ``ambient`` reads free (``auto`` follows free stretches itself).
+
+    Fed sample by sample (:meth:`update`, a value or a tuple of the channels' values: two list
+    appends; the watch is fed in numpy batches when asked, or every :data:`MAX_KEPT`), asked at
+    any pace (:meth:`driven`, then :meth:`decision`; the node: once a second). What it keeps
+    (:meth:`kept`) is the last :data:`WATCH_S` s, at most :data:`MAX_KEPT` samples (a fast
+    stream's decision reads fewer seconds); a stamp going back by more than 1 % of
+    :data:`WATCH_S` starts it afresh (another time base). A decision that keeps ``free`` is not
+    asked again before :data:`WATCH_S` / 2 s of stream (its spectrum costs ~10 ms).
+    """
+
+    def __init__(self, channels: int = 1):
+        self.watch = DrivenWatch()
+        self.channels = channels
+        self._pending_t: list = []
+        self._pending_y: list = []
+        self._kept: deque = deque()  # (t, y) arrays of the last WATCH_S s, oldest first
+        self._kept_n = 0
+        self._retry_at = -math.inf
+        self._share: Optional[float] = None
+
+    def update(self, t: float, value) -> None:
+        self._pending_t.append(t)
+        self._pending_y.append(value)
+        if len(self._pending_t) >= MAX_KEPT:
+            self._flush()
+
+    def _flush(self) -> None:
+        """Feed the pending samples to the watch (its first channel) and keep them."""
+        if not self._pending_t:
+            return
+        t = np.array(self._pending_t, dtype=np.float64)
+        y = np.array(self._pending_y, dtype=np.float64)
+        self._pending_t, self._pending_y = [], []
+        self.watch.feed(t, y if y.ndim == 1 else y[:, 0])
+        kept = self._kept
+        if kept and t[0] < kept[-1][0][-1] - WATCH_S / 100:
+            kept.clear()
+            self._kept_n = 0
+        kept.append((t, y))
+        self._kept_n += len(t)
+        while len(kept) > 1 and t[-1] - kept[1][0][0] >= WATCH_S:
+            self._kept_n -= len(kept.popleft()[0])
+        excess = self._kept_n - MAX_KEPT
+        while excess > 0:  # the oldest samples go (a copy: the rest of the array is freed)
+            old_t, old_y = kept[0]
+            if len(old_t) <= excess:
+                kept.popleft()
+            else:
+                kept[0] = (old_t[excess:].copy(), old_y[excess:].copy())
+            gone = min(len(old_t), excess)
+            self._kept_n -= gone
+            excess -= gone
+
+    def follow(self, f: float) -> None:
+        """An estimate of ``f`` Hz (:meth:`DrivenWatch.follow`), after the samples before it."""
+        self._flush()
+        self.watch.follow(f)
+
+    def kept(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(t, y)`` of the kept samples (y: samples, or samples x channels), oldest first."""
+        self._flush()
+        if not self._kept:
+            return np.empty(0), np.empty(0)
+        return (
+            np.concatenate([c[0] for c in self._kept]),
+            np.concatenate([c[1] for c in self._kept]),
+        )
+
+    def driven(self) -> Optional[float]:
+        """:meth:`DrivenWatch.driven`, kept for :meth:`decision`."""
+        self._flush()
+        self._share = self.watch.driven()
+        return self._share
+
+    def decision(self, excitation: str, decided: bool, window_s: float) -> Optional[Decision]:
+        """The decision to switch to, or None: from ``free`` (when the watch read the stream driven
+        at the last :meth:`driven`), :func:`decide` over the kept samples, if not ``free``; from
+        an ``ambient`` this choice ``decided``, ``free`` once the stream reads free.
+        ``window_s``: the configured ambient window (the shortest the decision gives)."""
+        t, y = self.kept()
+        if not len(t):
+            return None
+        now = float(t[-1])
+        if excitation == 'ambient' and decided:
+            if not self.watch.freed():
+                return None
+            reason = (
+                f'under {100 * FREE_BELOW:.0f} % of the energy of the last {WATCH_S:g} s read '
+                'driven by the envelope'
+            )
+            return Decision('free', window_s, 0.0, math.nan, math.nan, (), reason)
+        if excitation != 'free' or self._share is None or now < self._retry_at:
+            return None
+        self._retry_at = now + WATCH_S / 2
+        chosen = decide(t, y, self.channels, window_s, stream=True)
+        return None if chosen.excitation == 'free' else chosen

@@ -3,7 +3,8 @@
 """Algebraic on-line frequency estimator of Trapero, Sira-Ramirez & Feliu (pure numpy/numba core).
 
 Streaming: ``FrequencyEstimator.update(t, y)`` takes one timestamped sample and returns an
-:class:`Estimate` when the convergence test (Eqs. 16-17) fires; the estimator then resets and
+:class:`Estimate` (in a sequence of one, else an empty one) when the convergence test (Eqs. 16-17)
+fires; the estimator then resets and
 starts again, giving the consecutive estimates of Section 5.3. Batch:
 ``FrequencyEstimator.process(t, y)`` runs the same compiled step over arrays and returns the same
 floats.
@@ -29,14 +30,14 @@ noise (d ~ t^4).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
-from typing import Dict, List, Optional, Sequence, Tuple
+from dataclasses import dataclass, field
+from typing import Dict, List, Optional, Protocol, Sequence, Tuple
 
 import numpy as np
 
 from . import kernel as K
 from .config import EstimatorConfig
-from .jit import entry
+from .jit import entry, interpreted
 
 #: the input counters every estimator keeps (the first of the kernel's counter array, in order)
 INPUT_COUNTERS = (
@@ -64,13 +65,16 @@ COUNTER_NAMES = INPUT_COUNTERS + (
 
 
 #: the attributes :meth:`FrequencyEstimator._bind` derives (not pickled: compiled code, views)
-_BOUND = ('_feed', '_p', '_row', '_s', '_seg')
+_BOUND = ('_feed', '_k', '_p', '_row', '_s', '_seg')
 
 
 def as_series(t: Sequence[float], y: Sequence[float]) -> Tuple[np.ndarray, np.ndarray]:
-    """``t``, ``y`` as contiguous float64 arrays of one length (``ValueError`` otherwise)."""
+    """``t``, ``y`` as contiguous float64 arrays of one length (``ValueError`` otherwise); ``y``
+    may be samples x 1 (one channel, as a joint estimator's input)."""
     t = np.ascontiguousarray(t, dtype=np.float64)
     y = np.ascontiguousarray(y, dtype=np.float64)
+    if y.ndim == 2 and y.shape[1:] == (1,):
+        y = y[:, 0]
     if t.shape != y.shape or t.ndim != 1:
         raise ValueError(f't and y must be 1-D arrays of one length, got {t.shape}, {y.shape}')
     return t, y
@@ -91,6 +95,14 @@ class Estimate:
         frequency_std_hz: predicted standard deviation of ``frequency_hz`` (NaN if not computed).
         damping_std: predicted standard deviation of ``damping`` (NaN if not computed).
         mode: the mode it belongs to, 1 = the lowest (``modes`` >= 1); 0 with ``modes`` = 0.
+        shape: a joint estimator's mode shape, normalised, complex, one entry per channel
+            (None with one channel; :mod:`.multichannel`).
+        shape_std: its uncertainty per channel (None with one channel).
+        mac: the MAC of ``shape`` with the same mode's previous one (NaN at its first and with
+            one channel).
+
+    ``as_dict`` (the published fields) leaves the shape fields out; they take no part in
+    equality.
     """
 
     t: float
@@ -103,6 +115,9 @@ class Estimate:
     frequency_std_hz: float = math.nan
     damping_std: float = math.nan
     mode: int = 0
+    shape: Optional[np.ndarray] = field(default=None, compare=False, repr=False)
+    shape_std: Optional[np.ndarray] = field(default=None, compare=False, repr=False)
+    mac: float = field(default=math.nan, compare=False, repr=False)
 
     @property
     def omega(self) -> float:
@@ -125,12 +140,49 @@ class Estimate:
         }
 
 
-def as_estimates(result) -> Sequence[Estimate]:
-    """An estimator's ``update`` result as a sequence: none (``None`` or an empty list), the one
-    :class:`Estimate` of the free-decay estimator, or the list of the others."""
-    if not result:
-        return ()
-    return result if isinstance(result, list) else (result,)
+class Estimator(Protocol):
+    """What every estimator is (:mod:`.factory` builds the one of a configuration).
+
+    - ``update(t, y)``: one sample (``y``: one value, or with several :attr:`channels` one per
+      channel); the estimates it completes, a sequence (empty, usually).
+    - ``process(t, y)``: arrays of samples (``y``: samples, or samples x channels), continuing
+      the stream; the estimates as columns (:class:`EstimateArrays`; a joint estimator's
+      :class:`~.multichannel.JointEstimates` add the shapes). Streaming equals batch.
+    - ``reset()``: a new segment or window at the last sample; ``restart()``: forget the
+      signal; both keep the counters.
+    - ``config``; ``channels``: the channel names of a joint estimator, () for one channel.
+    - ``mode_counters()``: each numbered mode's own counters ({} where there are none);
+      ``segment_samples``: samples of the open segment, not yet in an estimate (None where the
+      estimator has no segment).
+    - ``counters``: name -> count since construction, one vocabulary for all: the
+      :data:`INPUT_COUNTERS` first, with ``received = used + skipped_non_finite +
+      skipped_duplicate + skipped_out_of_order + skipped_outlier`` (the last only where an
+      outlier rule exists); ``estimates``, those published; ``rejected_<why>``, candidates held
+      back and why; the others are named in the estimator's module.
+
+    The estimators subclass it, for the defaults of ``channels``, ``segment_samples`` and
+    ``mode_counters``.
+    """
+
+    channels: Tuple[str, ...] = ()
+    segment_samples: Optional[int] = None
+
+    @property
+    def config(self) -> EstimatorConfig: ...
+
+    @property
+    def counters(self) -> Dict[str, int]: ...
+
+    def mode_counters(self) -> Dict[int, Dict[str, int]]:
+        return {}
+
+    def update(self, t: float, y) -> Sequence[Estimate]: ...
+
+    def process(self, t: Sequence[float], y): ...
+
+    def reset(self) -> None: ...
+
+    def restart(self) -> None: ...
 
 
 @dataclass
@@ -173,25 +225,16 @@ class EstimateArrays:
         return len(self.t)
 
     def to_list(self) -> List[Estimate]:
+        """The estimates one by one (Python floats and ints)."""
         ints = {K.O_SAMPLES, K.N_OUT}
+        columns = (getattr(self, name) for name in self.__dataclass_fields__)
         return [
             Estimate(*(int(v) if i in ints else float(v) for i, v in enumerate(row)))
-            for row in zip(
-                self.t,
-                self.frequency_hz,
-                self.convergence_time,
-                self.samples,
-                self.fit,
-                self.amplitude,
-                self.damping,
-                self.frequency_std_hz,
-                self.damping_std,
-                self.mode,
-            )
+            for row in zip(*columns)
         ]
 
 
-class FrequencyEstimator:
+class FrequencyEstimator(Estimator):
     """Streaming algebraic frequency estimator; see the module docstring.
 
     Bad samples never raise: a non-finite value, a duplicate or an out-of-order stamp, or an
@@ -202,9 +245,11 @@ class FrequencyEstimator:
     ``counters`` tells how many samples went where and why estimates were held back.
     """
 
-    def __init__(self, config: EstimatorConfig = EstimatorConfig()):
+    def __init__(self, config: EstimatorConfig = EstimatorConfig(), interpret: bool = False):
         config.validate()
         self._config = config
+        #: the kernel's functions: compiled, or uncompiled while ``interpret`` (:meth:`compiled`)
+        self._k = interpreted(K) if interpret else K
         self._n_state = K.N_STATE_FIXED + 2 * config.window + 1
         self._f = K.feed_buffer(config.as_params(), self._n_state, config.buffer_samples)
         self._c = np.zeros(K.N_COUNTERS, dtype=np.int64)
@@ -217,6 +262,20 @@ class FrequencyEstimator:
         ``_s``, ``_seg`` (:func:`core.kernel.feed_buffer`'s layout) and the streaming path's
         compiled code, looked up at the first :meth:`update`."""
         self._p, self._row, self._s, self._seg = K.feed_views.py_func(self._f, self._n_state)
+        self._feed = None
+        self.__dict__.setdefault('_k', K)  # unpickled: compiled (the kernel is not pickled)
+
+    @property
+    def interpreted(self) -> bool:
+        """True while the estimator runs its kernel uncompiled (``interpret``)."""
+        return self._k is not K
+
+    def compiled(self) -> None:
+        """Run the compiled kernel from the next sample on (same state, same floats: the
+        uncompiled one computes what it computes, :func:`core.jit.interpreted`). Its first call
+        compiles it, unless it is compiled already (the node compiles it in the background:
+        :mod:`vib_estimator.nodes.stream`)."""
+        self._k = K
         self._feed = None
 
     def __getstate__(self) -> dict:
@@ -233,12 +292,12 @@ class FrequencyEstimator:
     def restart(self) -> None:
         """Forget the signal entirely (prefilter, history, running interval and scale too);
         counters are kept."""
-        K.forget_stream(self._s, self._c)
+        self._k.forget_stream(self._s, self._c)
 
     def reset(self) -> None:
         """Start a new estimation segment at the last sample, as after a convergence."""
         if self._c[K.C_HIST_N] >= K.NH:
-            K.reset_segment(
+            self._k.reset_segment(
                 self._s, self._c, self._seg, self._s[K.S_TLAST], self._s[K.S_HY + K.NH - 1]
             )
 
@@ -260,8 +319,9 @@ class FrequencyEstimator:
         df = self._s[K.S_DF]
         return self._s[K.S_NF] / df if df != 0.0 and self._c[K.C_SEG_N] > 1 else math.nan
 
-    def update(self, t: float, y: float) -> Optional[Estimate]:
-        """Feed one sample (time in s, any origin); return an estimate when one is published.
+    def update(self, t: float, y: float) -> Sequence[Estimate]:
+        """Feed one sample (time in s, any origin); the estimate it publishes, if any (a
+        sequence of none or one, as every :class:`Estimator`'s).
 
         :func:`core.kernel.feed` (the step on one sample, as the batch kernel over a one-sample
         array), called through its compiled code for these argument types
@@ -270,14 +330,18 @@ class FrequencyEstimator:
         """
         feed = self._feed
         if feed is None:
-            feed = self._feed = entry(
-                K.feed, (self._f, self._c, self._n_state, 0.0, 0.0, self._optional)
+            feed = self._feed = (
+                self._k.feed
+                if self.interpreted
+                else entry(K.feed, (self._f, self._c, self._n_state, 0.0, 0.0, self._optional))
             )
         if feed(self._f, self._c, self._n_state, t, y, self._optional):
-            return Estimate(
-                *(int(v) if i == K.O_SAMPLES else float(v) for i, v in enumerate(self._row[0]))
+            return (
+                Estimate(
+                    *(int(v) if i == K.O_SAMPLES else float(v) for i, v in enumerate(self._row[0]))
+                ),
             )
-        return None
+        return ()
 
     def process(self, t: Sequence[float], y: Sequence[float]) -> EstimateArrays:
         """Feed arrays of samples (continuing the stream); return the estimates as columns."""
@@ -287,7 +351,7 @@ class FrequencyEstimator:
         size = max(16, len(t) // 100)
         while True:
             out = np.empty((size, K.N_OUT))
-            n, start = K.run(
+            n, start = self._k.run(
                 self._p, self._s, self._c, self._seg, t, y, out, start, self._optional
             )
             chunks.append(out[:n])

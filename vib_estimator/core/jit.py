@@ -25,8 +25,14 @@ batch rate went up 3.6x without them (docs/benchmarks.md, issue 24).
 
 from __future__ import annotations
 
+import math
+import sys
+from types import FunctionType, ModuleType, SimpleNamespace
+
+import numpy as np
 from numba import njit, typeof, types
 from numba.core import cgutils
+from numba.core.dispatcher import Dispatcher
 from numba.extending import intrinsic
 
 
@@ -80,3 +86,59 @@ def borrowed(typingctx, array):
         return view._getvalue()
 
     return array(array), codegen
+
+
+def _identity(array):
+    """:func:`borrowed` outside compiled code: the array itself."""
+    return array
+
+
+#: ``math`` as compiled code has it: numba's ``math.hypot`` is the C library's (``np.hypot``),
+#: Python's its own (they differ in the last bit)
+_MATH = SimpleNamespace(**{k: getattr(math, k) for k in dir(math) if not k.startswith('_')})
+_MATH.hypot = lambda x, y: float(np.hypot(x, y))
+
+_interpreted: dict = {}
+
+
+def interpreted(module) -> SimpleNamespace:
+    """``module`` with its compiled functions as the plain Python they are written in: each
+    :func:`jit` function (and each function defined in the module, such as the Python bodies of
+    its overloads) runs uncompiled, calling the others uncompiled; a compiled function of another
+    module it calls (``U.refine``) is that module's :func:`interpreted` one; :func:`borrowed` is
+    the array itself. Built once per module (no compile, a few milliseconds).
+
+    The same arithmetic in the same order, IEEE doubles both ways (no ``fastmath``): the results
+    are the compiled code's floats (``test/core/test_interpreted.py``), about 100x slower. A
+    start whose kernels are not compiled yet estimates with it while they compile
+    (:mod:`vib_estimator.nodes.stream`); it calls nothing that would compile.
+    """
+    name = module.__name__
+    if name in _interpreted:
+        return _interpreted[name]
+    space: dict = dict(vars(module))
+    result = _interpreted[name] = SimpleNamespace()
+    for key, value in vars(module).items():
+        fn = value.py_func if isinstance(value, Dispatcher) else value
+        if isinstance(fn, FunctionType) and fn.__module__ == name:
+            space[key] = FunctionType(
+                fn.__code__, space, fn.__name__, fn.__defaults__, fn.__closure__
+            )
+        elif isinstance(value, Dispatcher):  # another module's compiled function
+            space[key] = getattr(interpreted(sys.modules[fn.__module__]), fn.__name__)
+        elif isinstance(value, ModuleType) and _compiled(value) and value is not module:
+            space[key] = interpreted(value)
+        elif value is borrowed:
+            space[key] = _identity
+        elif value is math:
+            space[key] = _MATH
+    result.__dict__.update(space)
+    return result
+
+
+def _compiled(module) -> bool:
+    """Whether ``module`` defines compiled functions (its :func:`interpreted` form differs)."""
+    return any(
+        isinstance(v, Dispatcher) and v.py_func.__module__ == module.__name__
+        for v in vars(module).values()
+    )

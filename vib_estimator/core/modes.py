@@ -4,8 +4,8 @@
 
 Interface:
 
-* ``create_estimator(config)`` -- a :class:`FrequencyEstimator` when ``config.modes == 0``, else a
-  :class:`ModeTracker`.
+* :func:`..factory.create_estimator` builds a :class:`ModeTracker` for ``excitation`` free with
+  ``modes`` >= 1 (a :class:`FrequencyEstimator` with ``modes`` = 0).
 * ``ModeTracker.update(t, y) -> List[Estimate]`` (each with ``mode`` >= 1, 1 = the lowest
   frequency), ``process(t, y) -> EstimateArrays`` (with the ``mode`` column, sorted by time),
   ``counters`` (aggregate: the names of ``COUNTER_NAMES`` plus the finder's own),
@@ -63,14 +63,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Dict, List, Sequence, Union
+from typing import Dict, List, Sequence
 
 import numpy as np
 
-from .ambient import AmbientEstimator
-from .auto import AutoEstimator
 from .config import EstimatorConfig
-from .estimator import COUNTER_NAMES, Estimate, EstimateArrays, FrequencyEstimator, as_series
+from .estimator import COUNTER_NAMES, Estimate, EstimateArrays, Estimator, as_series
 from .jit import borrowed, jit
 from .kernel import BAND_DAMPING, advance, discretise
 from .subspace import N_R, R_AMP, R_ENERGY, R_NU, R_ZETA, analyse, init_subspace
@@ -738,7 +736,7 @@ class ModeStatus:
     band_hz: tuple  # the frequencies whose poles are this mode's
 
 
-class ModeTracker:
+class ModeTracker(Estimator):
     """Find and track up to ``config.modes`` modes; see the module docstring."""
 
     def __init__(self, config: EstimatorConfig):
@@ -882,16 +880,3 @@ class ModeTracker:
             init_subspace(self._qs[s, : m // 3 + 1, : self._npc])
         self._lams[:, 0] = 0.0
         self._lams[:, 1:] = math.nan
-
-
-def create_estimator(
-    config: EstimatorConfig,
-) -> Union[FrequencyEstimator, ModeTracker, AmbientEstimator, AutoEstimator]:
-    """The estimator of a configuration: with ``excitation`` = ambient the output-only
-    identifier (:mod:`.ambient`), with auto both, each in its stretches (:mod:`.auto`); else one
-    estimator (``modes`` = 0) or a mode tracker."""
-    if config.excitation == 'ambient':
-        return AmbientEstimator(config)
-    if config.excitation == 'auto':
-        return AutoEstimator(config, create_estimator(config.replace(excitation='free')))
-    return FrequencyEstimator(config) if config.modes == 0 else ModeTracker(config)

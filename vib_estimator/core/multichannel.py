@@ -8,7 +8,7 @@ correlations, each with its **shape** -- how much, and in which phase, each chan
 One channel is not routed here: it stays :class:`..ambient.AmbientEstimator`, bit for bit.
 
 Interface: :class:`JointAmbientEstimator` ``(config, channels)`` ``.process(t, Y) ->``
-:class:`JointEstimates` (``Y``: samples x channels), ``.update(t, y) -> list[JointEstimate]``,
+:class:`JointEstimates` (``Y``: samples x channels), ``.update(t, y) -> list[Estimate]``,
 ``.counters``, ``.reset()``, ``.restart()``, ``.config``, ``.channels``.
 
 Method, per analysis (every :data:`..ambient.HOP_S` of input once ``ambient_window_s`` of samples
@@ -40,9 +40,9 @@ are reused) with matrices in place of scalars:
    between the two is published with the estimate (``mac``, NaN for a mode's first window).
    Confirmation, loss and numbering are the single-channel identifier's.
 
-Each estimate: the fields of :class:`..estimator.Estimate` (``amplitude`` = the RMS over channels
-of the modal response summed in quadrature, ``fit`` = share of the summed channel variances the
-modes explain) plus the shape, its uncertainty and the MAC.
+Each estimate: an :class:`..estimator.Estimate` (``amplitude`` = the RMS over channels of the
+modal response summed in quadrature, ``fit`` = share of the summed channel variances the modes
+explain) with its ``shape``, ``shape_std`` and ``mac``.
 
 Bad samples never raise: a sample with any non-finite channel is skipped (``skipped_non_finite``);
 stamps are handled as the single-channel identifier's (duplicates, out of order, gaps and jumps).
@@ -341,18 +341,6 @@ def identify_joint(
 
 
 # ---- streaming ----------------------------------------------------------------------------------
-@dataclass(frozen=True)
-class JointEstimate:
-    """One published mode of a joint identification: the :class:`..estimator.Estimate` fields,
-    the mode's normalised complex ``shape`` (one entry per channel), its per-channel
-    ``shape_std`` and the ``mac`` with the same mode's previous shape (NaN at its first)."""
-
-    estimate: Estimate
-    shape: np.ndarray
-    shape_std: np.ndarray
-    mac: float
-
-
 @dataclass
 class JointEstimates:
     """Estimates of a batch run: the columns of :class:`..estimator.EstimateArrays`, the shapes
@@ -368,11 +356,11 @@ class JointEstimates:
         return len(self.estimates)
 
     @classmethod
-    def of(cls, out: Sequence[JointEstimate], channels: tuple[str, ...]) -> 'JointEstimates':
-        """The columns of the estimates ``out`` of ``channels``, in their order."""
+    def of(cls, out: Sequence[Estimate], channels: tuple[str, ...]) -> 'JointEstimates':
+        """The columns of the estimates ``out`` (with shapes) of ``channels``, in their order."""
         m = len(channels)
         return cls(
-            estimate_columns([e.estimate for e in out]),
+            estimate_columns(out),
             np.array([e.shape for e in out], dtype=complex).reshape(-1, m),
             np.array([e.shape_std for e in out]).reshape(-1, m),
             np.array([e.mac for e in out]),
@@ -417,7 +405,7 @@ class JointAmbientEstimator(SlidingWindowIdentifier):
     def channels(self) -> tuple[str, ...]:
         return self._channels
 
-    def update(self, t: float, y: Sequence[float]) -> list[JointEstimate]:
+    def update(self, t: float, y: Sequence[float]) -> list[Estimate]:
         """Feed one sample (one value per channel); the estimates of an analysis it completes."""
         y = np.asarray(y, dtype=np.float64).reshape(-1)
         if len(y) != len(self._channels):
@@ -438,7 +426,7 @@ class JointAmbientEstimator(SlidingWindowIdentifier):
         return JointEstimates.of(out, self._channels)
 
     # ---- analysis -----------------------------------------------------------------------------
-    def _analyse(self) -> list[JointEstimate]:
+    def _analyse(self) -> list[Estimate]:
         window = self._next_window()
         if window is None:
             return []
@@ -468,7 +456,7 @@ class JointAmbientEstimator(SlidingWindowIdentifier):
 
     def _track(
         self, modes: JointModes, total: float, t: float, span: float, n: int
-    ) -> list[JointEstimate]:
+    ) -> list[Estimate]:
         """Match the window's modes to the tracked ones, publish the confirmed ones."""
         tracks = self._tracks
         match = self._match(modes)
@@ -500,8 +488,20 @@ class JointAmbientEstimator(SlidingWindowIdentifier):
             scale = tr.calibration(t, f, fstd, z, zstd, self._window)
             tr.estimates += 1
             est = Estimate(
-                t, f, span, n, explained, tr.amplitude, z, fstd * scale, zstd * scale, k
+                t,
+                f,
+                span,
+                n,
+                explained,
+                tr.amplitude,
+                z,
+                fstd * scale,
+                zstd * scale,
+                k,
+                modes.shapes[i],
+                modes.shape_std[i],
+                similarity,
             )
-            out.append(JointEstimate(est, modes.shapes[i], modes.shape_std[i], similarity))
+            out.append(est)
         self._c['estimates'] += len(out)
         return out

@@ -5,13 +5,13 @@
 ``excitation = free`` with two or more channels (the axes of a tip IMU, a strain gauge per link,
 accelerometers on a beam) after a pluck: each estimate is fitted to all channels at once, with the
 mode's **shape** -- how much, and in which phase, each channel moves in it. One channel is not
-routed here: it stays :func:`..modes.create_estimator`'s estimator, bit for bit.
+routed here: it stays the one-channel estimator of :func:`..factory.create_estimator`, bit for bit.
 
 Interface (that of :class:`..multichannel.JointAmbientEstimator`): :class:`JointFreeEstimator`
-``(config, channels)`` ``.process(t, Y) ->`` :class:`..multichannel.JointEstimates` (``Y``:
-samples x channels), ``.update(t, y) -> list[JointEstimate]``, ``.counters``, ``.reset()``,
-``.restart()``, ``.config``, ``.channels``; :func:`create_joint_estimator` picks it or the
-ambient one by ``config.excitation``.
+``(config, channels, single)`` ``.process(t, Y) ->`` :class:`..multichannel.JointEstimates` (``Y``:
+samples x channels), ``.update(t, y) -> list[Estimate]``, ``.counters``, ``.reset()``,
+``.restart()``, ``.config``, ``.channels``; :func:`..factory.create_estimator` picks it for
+``excitation`` free and several channels.
 
 Method:
 
@@ -65,19 +65,16 @@ rows kept, so their gaps and jumps are handled as with one channel.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from .ambient import MATCH_TOL, MAX_TRACKS
 from .config import EstimatorConfig
-from .estimator import INPUT_COUNTERS, Estimate
-from .modes import create_estimator
+from .estimator import INPUT_COUNTERS, Estimate, Estimator
 from .multichannel import (
     MIN_CHANNELS,
-    JointAmbientEstimator,
-    JointEstimate,
     JointEstimates,
     as_channels,
     continues,
@@ -104,8 +101,6 @@ HALVINGS = 4
 STEP_TOL = 1e-3
 #: a joint fit further than this (relative) from its start is not published
 MAX_MOVE = 0.1
-#: the excitations with a joint estimator (``auto`` takes one channel)
-JOINT_EXCITATIONS = ('free', 'ambient')
 #: the joint identifier's own counters, after the input counters
 JOINT_COUNTERS = ('events', 'joint_fits', 'merged_events', 'rejected_joint', 'estimates')
 
@@ -289,12 +284,18 @@ class _Mode:
         self.frequency, self.shape, self.last_t = frequency, shape, t
 
 
-class JointFreeEstimator:
+class JointFreeEstimator(Estimator):
     """Joint free-decay estimation of several channels; see the module docstring.
 
-    ``channels``: the channel names (their count is the number of columns fed)."""
+    ``channels``: the channel names (their count is the number of columns fed); ``single``: makes
+    one channel's estimator (:func:`..factory.create_estimator` of ``config``, one channel)."""
 
-    def __init__(self, config: EstimatorConfig, channels: Sequence[str]):
+    def __init__(
+        self,
+        config: EstimatorConfig,
+        channels: Sequence[str],
+        single: Callable[[], Estimator],
+    ):
         config.validate()
         if config.excitation != 'free':
             raise ValueError(f'JointFreeEstimator needs excitation free, got {config.excitation}')
@@ -306,6 +307,7 @@ class JointFreeEstimator:
         self._config = config
         self._channels = channels
         self._room = int(config.buffer_samples)
+        self._single = single
         self._c = dict.fromkeys(INPUT_COUNTERS + JOINT_COUNTERS, 0)
         self._retired: dict[str, int] = {}  # the counters of the channels' estimators restarted
         self._estimators: list = []
@@ -341,7 +343,7 @@ class JointFreeEstimator:
         """Forget the signal and the known modes; counters are kept."""
         self._retired = self._channel_counters()
         m = len(self._channels)
-        self._estimators = [create_estimator(self._config) for _ in range(m)]
+        self._estimators = [self._single() for _ in range(m)]
         self._rows = np.empty((2 * self._room, 1 + m))  # t, channels: the last rows kept
         self._n = 0
         self._last = -math.inf
@@ -405,7 +407,7 @@ class JointFreeEstimator:
         self._n += len(t)
 
     # ---- streaming and batch ------------------------------------------------------------------
-    def update(self, t: float, y: Sequence[float]) -> list[JointEstimate]:
+    def update(self, t: float, y: Sequence[float]) -> list[Estimate]:
         """Feed one sample (one value per channel); the estimates it completes."""
         values = [float(v) for v in y]
         if len(values) != len(self._channels):
@@ -416,8 +418,7 @@ class JointFreeEstimator:
         self._append(np.array((t,)), np.array((values,)))
         events = []
         for c, est in enumerate(self._estimators):
-            out = est.update(t, values[c])
-            for e in [out] if isinstance(out, Estimate) else out or ():
+            for e in est.update(t, values[c]):
                 events.append((int(self._row_of(np.array((e.t,)))[0]), c, e))
         return self._events(events) if events else []  # (no BLAS-thread switch per sample)
 
@@ -427,7 +428,7 @@ class JointFreeEstimator:
         t, y = as_channels(t, y, len(self._channels))
         keep = self._keep(t, y)
         t, y = t[keep], y[keep]
-        out: list[JointEstimate] = []
+        out: list[Estimate] = []
         # in blocks of the row store's room: each event's window is still held when it is fitted
         for lo in range(0, len(t), self._room):
             tb, yb = t[lo : lo + self._room], y[lo : lo + self._room]
@@ -443,7 +444,7 @@ class JointFreeEstimator:
 
     # ---- events ---------------------------------------------------------------------------------
     @single_blas_thread
-    def _events(self, events) -> list[JointEstimate]:
+    def _events(self, events) -> list[Estimate]:
         out = []
         for index, c, e in events:
             self._c['events'] += 1
@@ -489,7 +490,7 @@ class JointFreeEstimator:
                     degrees[ch] = SLOW_DEGREE
         return omega, sigma, degrees
 
-    def _event(self, index: int, c: int, e: Estimate) -> JointEstimate | None:
+    def _event(self, index: int, c: int, e: Estimate) -> Estimate | None:
         rows = self._window(index, int(e.samples))
         t = rows[:, 0]
         span = float(t[-1] - t[0]) if len(t) > 1 else 0.0
@@ -513,8 +514,21 @@ class JointFreeEstimator:
         shape_std = fit.amplitude_std / float(np.linalg.norm(fit.amplitudes))
         similarity, k = self._identify(f, shape, e.t)
         amplitude = float(np.sqrt(np.mean(np.abs(fit.amplitudes) ** 2)))
-        est = Estimate(e.t, f, e.convergence_time, len(t), fit.fit, amplitude, z, fstd, zstd, k)
-        return JointEstimate(est, shape, shape_std, similarity)
+        return Estimate(
+            e.t,
+            f,
+            e.convergence_time,
+            len(t),
+            fit.fit,
+            amplitude,
+            z,
+            fstd,
+            zstd,
+            k,
+            shape,
+            shape_std,
+            similarity,
+        )
 
     def _nearest(self, f: float) -> _Mode | None:
         """The known mode nearest ``f`` within ``MATCH_TOL`` (None if none)."""
@@ -543,17 +557,3 @@ class JointFreeEstimator:
 def _zeta(e: Estimate) -> float:
     """An estimate's damping ratio, 0 when it has none (undamped models)."""
     return e.damping if math.isfinite(e.damping) and abs(e.damping) < 1 else 0.0
-
-
-def create_joint_estimator(config: EstimatorConfig, channels: Sequence[str]):
-    """The joint estimator of ``config`` for several ``channels``: free decays
-    (:class:`JointFreeEstimator`) or ambient (:class:`..multichannel.JointAmbientEstimator`);
-    ValueError for ``excitation`` auto (one channel only)."""
-    if config.excitation == 'ambient':
-        return JointAmbientEstimator(config, channels)
-    if config.excitation == 'free':
-        return JointFreeEstimator(config, channels)
-    raise ValueError(
-        f'several channels need excitation free or ambient, got {config.excitation} '
-        '(auto takes one channel)'
-    )

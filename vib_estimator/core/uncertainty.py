@@ -348,7 +348,8 @@ def _goodness(seg, n, th, rss, res):
     ymean /= n
     sstot = 0.0
     for i in range(n):
-        sstot += (seg[1, i] - ymean) ** 2
+        d = seg[1, i] - ymean
+        sstot += d * d  # what numba makes of ** 2 (Python's pow may round differently)
     res[R_FIT] = 1.0 - rss / sstot if sstot > 0.0 else -1.0
     res[R_AMP] = math.hypot(th[0], th[1])
 
@@ -362,7 +363,8 @@ def _moments_of_result(model, th, cov, s2, res):
         wn = math.sqrt(w * w + sig * sig)
         # gradients of w_n and zeta = sigma / w_n with respect to (w_d, sigma)
         gw = (w / wn, sig / wn)
-        gz = (-sig * w / wn**3, w * w / wn**3)
+        wn3 = wn * (wn * wn)  # what numba makes of wn**3 (Python's pow may round differently)
+        gz = (-sig * w / wn3, w * w / wn3)
         var_w = s2 * (
             gw[0] * gw[0] * cov[2, 2] + 2 * gw[0] * gw[1] * cov[2, 3] + gw[1] * gw[1] * cov[3, 3]
         )

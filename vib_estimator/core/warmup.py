@@ -23,7 +23,7 @@ from typing import Callable, Dict, Hashable, Optional, Sequence, Tuple
 import numpy as np
 
 from .config import EstimatorConfig
-from .modes import create_estimator
+from .factory import create_estimator
 
 #: the synthetic signal: a lightly damped tone at 500 Hz, enough samples for several estimates
 RATE_HZ = 500.0

@@ -28,6 +28,13 @@ and the diagnostics bookkeeping, all without rclpy) and publishes what comes bac
   every call answered, in turn (a self-test takes ~8 ms at the defaults; the input history
   covers 2 s).
 * ``/diagnostics`` at 1 Hz (steady clock): one status named after the node (:mod:`.health`).
+* ``decide_excitation`` (default true): while ``excitation`` is ``free`` (the default), once the
+  input looks driven throughout its last two minutes, the node sets its own ``excitation`` (and
+  ``ambient_window_s``) to what ``vib-estimator analyze`` decides on those seconds
+  (:meth:`~.stream.EstimatorStream.decision`: a building under wind, a machine driven without
+  rest), with one log line; from an ``ambient`` it set so, back to ``free`` once the input looks
+  free again. False keeps the configured excitation and says on ``/diagnostics`` when the input
+  looks driven.
 
 Time base: the header stamps (``t`` = stamp - first stamp, as the offline ``vib-estimator
 analyze``, so both give the same floats). A zero stamp, and every sample of a type without a header
@@ -50,13 +57,15 @@ from rcl_interfaces.msg import SetParametersResult
 from rclpy.clock import Clock, ClockType
 from rclpy.event_handler import SubscriptionEventCallbacks
 from rclpy.node import Node
+from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
 from rclpy.time import Time
 from std_msgs.msg import Float64, Float64MultiArray, Header, MultiArrayDimension
 from std_srvs.srv import Trigger
 
 from ..core.config import EstimatorConfig
-from ..core.multichannel import MIN_CHANNELS, JointEstimate
+from ..core.estimator import Estimate
+from ..core.multichannel import MIN_CHANNELS
 from ..core.shapes import SHAPE_ROWS, phases_deg, signed_amplitudes
 from ..errors import StartupError
 from ..io.align import StampAligner
@@ -77,8 +86,10 @@ from .mode_shapes import ModeShapesPublisher
 from .parameters import (
     config_of,
     config_value,
+    declare,
     declare_config,
     declare_input,
+    descriptor,
     warn_unused_params_files,
 )
 from .runner import run
@@ -113,6 +124,12 @@ SERVICE_DEPTH = 1000
 CORE_NAMES = frozenset(EstimatorConfig.names())
 #: the ROS parameters that choose the fields of the input
 FIELD_NAMES = frozenset(('component', 'components'))
+#: the node's own choice of excitation (module doc)
+DECIDE_DESCRIPTION = (
+    "while excitation is free, switch to what the input needs (analyze's decision over its "
+    'last 120 s: ambient or auto, and the ambient window) once it looks driven throughout, and '
+    'back to free once it looks free again; false keeps the configured excitation'
+)
 #: the Float64 outputs of each estimate, in publication order: (topic under vibration/, field)
 FLOAT_OUTPUTS = (
     ('frequency', 'frequency_hz'),
@@ -178,7 +195,7 @@ class Outputs:
             )
         return self._shapes[k]
 
-    def publish_shape(self, joint: JointEstimate) -> None:
+    def publish_shape(self, joint: Estimate) -> None:
         """``vibration/mode<k>/shape``: rows ``shape`` (each channel's signed amplitude),
         ``shape_phase_deg`` (its phase) and ``shape_std`` (its uncertainty), one column per
         channel (``layout.dim[0]``: the rows' names, ``dim[1]``: the channels', comma-joined;
@@ -186,7 +203,7 @@ class Outputs:
         msg = self._shape
         parts = (signed_amplitudes(joint.shape), phases_deg(joint.shape), joint.shape_std)
         msg.data = [float(v) for part in parts for v in part]
-        self._shape_publisher(joint.estimate.mode).publish(msg)
+        self._shape_publisher(joint.mode).publish(msg)
 
     def set_modes(self, modes: int) -> None:
         """Publishers for modes 1..``modes``; those of higher modes are destroyed."""
@@ -228,6 +245,7 @@ class EstimatorNode(Node):
         #: the input topics (several: resolved, their channels are named after them)
         self._topics = topics if len(topics) < 2 else tuple(map(self.resolve_topic_name, topics))
         declare_config(self)
+        deciding = declare(self, 'decide_excitation', True, descriptor(DECIDE_DESCRIPTION))
         mode_shapes = ModeShapesPublisher.declare(self)
         #: warnings about params files that set nothing for this node (also logged)
         self.params_file_warnings = warn_unused_params_files(self, kwargs.get('cli_args'))
@@ -236,7 +254,11 @@ class EstimatorNode(Node):
             self._channels = topic_channels(self._topics, self._fields)
             self._value = channels_getter(self._fields, self._input_type)
             self._stream = EstimatorStream(
-                config_of(self), time.monotonic(), background=True, channels=self._channels
+                config_of(self),
+                time.monotonic(),
+                background=True,
+                channels=self._channels,
+                deciding=deciding,
             )
         except ValueError as err:
             raise StartupError(str(err)) from None
@@ -289,19 +311,25 @@ class EstimatorNode(Node):
         self._input_names = ','.join(sub.topic_name for sub in self._subscriptions_in)
         self.add_on_set_parameters_callback(self._check_parameters)
         self.add_post_set_parameters_callback(self._apply_parameters)
-        self._diagnostics_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
-        self._diagnostics_due = time.monotonic() + DIAGNOSTICS_OVERDUE
-        # on the steady clock: diagnostics go on (and can say STALE) when sim time stops
-        steady = Clock(clock_type=ClockType.STEADY_TIME)
-        self.create_timer(H.DIAGNOSTICS_PERIOD, self._publish_diagnostics, clock=steady)
-        # while the kernels compile (a first start: see .stream), look for the end of the warm-up
-        self._warmup_timer = self.create_timer(WARMUP_POLL, self._poll_warmup, clock=steady)
-        self._warmup_logged = False
+        self._create_timers()
         self.get_logger().info(
             f'estimating on {self._input_names} '
             f'({self._input_type} [{", ".join(self._channels)}]) with '
             f'{self._stream.config}'
         )
+
+    def _create_timers(self) -> None:
+        """/diagnostics and the warm-up poll, on the steady clock: diagnostics go on (and can
+        say STALE) when sim time stops; while the kernels compile (a first start: see .stream),
+        the poll looks for the end of the warm-up."""
+        self._diagnostics_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
+        self._diagnostics_due = time.monotonic() + DIAGNOSTICS_OVERDUE
+        steady = Clock(clock_type=ClockType.STEADY_TIME)
+        self.create_timer(H.DIAGNOSTICS_PERIOD, self._publish_diagnostics, clock=steady)
+        self._warmup_timer = self.create_timer(WARMUP_POLL, self._poll_warmup, clock=steady)
+        self._warmup_logged = False
+        #: the parameters being set are the node's own decision (:meth:`_decide`)
+        self._deciding = False
 
     def _subscribe(self, index: int):
         """The subscription to input topic ``index`` (with the middleware's own count of the
@@ -367,8 +395,11 @@ class EstimatorNode(Node):
     def _apply_parameters(self, parameters) -> None:
         """Rebuild the estimator after an accepted change: a fresh segment, same time origin."""
         names = {p.name for p in parameters}
+        if 'decide_excitation' in names:
+            self._stream.deciding = self.get_parameter('decide_excitation').value
         if not names & (CORE_NAMES | FIELD_NAMES):
             return
+        self._stream.decided = self._deciding  # a change of the user's is the user's
         self._fields = self._read_fields()
         self._channels = topic_channels(self._topics, self._fields)
         self._value = channels_getter(self._fields, self._input_type)
@@ -377,13 +408,13 @@ class EstimatorNode(Node):
             self._aligner.jump_ns = round(config_of(self).max_gap * 1e9)
         for cadence in self._cadences:
             cadence.back_ns = round(config_of(self).max_gap * 1e9)
-        self._stream.configure(config_of(self), self._channels)
+        self._stream.configure(config_of(self), self._channels, prime=self._deciding)
         self._outputs.set_modes(self._stream.config.modes)
         self._outputs.set_channels(self._channels, self._stream.config.modes)
         if self._mode_shapes is not None:
             self._mode_shapes.set_channels(self._channels)
         self._ready = self._stream.ready
-        if not self._ready:
+        if not self._ready or self._stream.compiling:  # (estimating uncompiled meanwhile)
             self._warmup_logged = False
             self._warmup_timer.reset()
         self.get_logger().info(
@@ -468,14 +499,12 @@ class EstimatorNode(Node):
 
     def _publish(self, estimates, header: Header) -> None:
         """Publish the estimates of the sample of ``header`` (see :class:`Outputs`)."""
-        for item in estimates:
-            joint = isinstance(item, JointEstimate)  # several channels: the mode's shape too
-            estimate = item.estimate if joint else item
+        for estimate in estimates:
             self._outputs.publish(estimate, header)
-            if joint:
-                self._outputs.publish_shape(item)
+            if estimate.shape is not None:  # several channels: the mode's shape too
+                self._outputs.publish_shape(estimate)
             if self._mode_shapes is not None:
-                self._mode_shapes.update(estimate, item.shape if joint else None)
+                self._mode_shapes.update(estimate, estimate.shape)
             if self.baseline_monitor.active:
                 self.baseline_monitor.estimate(estimate)
             self._stream.published(estimate, time.monotonic())
@@ -493,6 +522,7 @@ class EstimatorNode(Node):
     def _poll_warmup(self) -> None:
         """At the end of a warm-up: install the estimator, estimate on the held samples (in order,
         :data:`DRAIN_SLICE_S` of them a turn) and say how long it took."""
+        uncompiled = self._stream.ready  # estimating uncompiled meanwhile (see .stream)
         try:
             drained = self._stream.poll(DRAIN_SLICE_S)
         except Exception as err:  # a compile that failed: say so, never a silent node
@@ -500,7 +530,7 @@ class EstimatorNode(Node):
             self.get_logger().error(f'the estimator kernels failed to compile: {err}')
             raise StartupError(f'the estimator kernels failed to compile: {err}') from None
         if drained is None:
-            if self._stream.ready:  # nothing left to wait for (a change to compiled kernels)
+            if self._stream.ready and not self._stream.compiling:  # nothing left to wait for
                 self._warmup_timer.cancel()
                 self._ready = True
                 return
@@ -509,9 +539,13 @@ class EstimatorNode(Node):
                 and self._stream.warmup_elapsed(time.monotonic()) > WARMUP_NOTICE
             ):
                 self._warmup_logged = True
+                meanwhile = (
+                    'estimating with them uncompiled meanwhile'
+                    if uncompiled
+                    else 'samples are held until they are ready'
+                )
                 self.get_logger().info(
-                    f'{WARMUP_MESSAGE}: samples are held until they are '
-                    'ready (`vib-estimator warmup` compiles them ahead)'
+                    f'{WARMUP_MESSAGE}: {meanwhile} (`vib-estimator warmup` compiles them ahead)'
                 )
             return
         for header, estimates in drained:
@@ -527,10 +561,12 @@ class EstimatorNode(Node):
         self._ready = True
         dropped = self._stream.health.node_counters['dropped_warmup']
         seconds = self._stream.warmup_seconds
-        self.get_logger().info(
-            f'estimator kernels ready after {seconds:.1f} s ({self._stream.warmup_held} samples '
-            f'held meanwhile, {dropped} dropped)'
+        meanwhile = (
+            'estimated uncompiled meanwhile'
+            if uncompiled
+            else f'{self._stream.warmup_held} samples held meanwhile, {dropped} dropped'
         )
+        self.get_logger().info(f'estimator kernels ready after {seconds:.1f} s ({meanwhile})')
 
     def _replace_zero_stamp(self, header: Header) -> None:
         """Stamp a message that came without one with its receipt time (node clock)."""
@@ -580,6 +616,27 @@ class EstimatorNode(Node):
         (:data:`~vib_estimator.nodes.health.NODE_COUNTERS`)."""
         return self._stream.counters
 
+    def _decide(self) -> None:
+        """Apply the stream's decision (``decide_excitation``), as the node's own parameters."""
+        decision = self._stream.decision()
+        if decision is None:
+            return
+        changes = [Parameter('excitation', value=decision.excitation)]
+        if decision.excitation != 'free':
+            changes.append(Parameter('ambient_window_s', value=float(decision.window_s)))
+        self.get_logger().info(
+            f'excitation {self._stream.config.excitation} -> {decision.excitation}: '
+            f'{decision.reason} (decide_excitation:=false keeps the configured excitation)'
+        )
+        self._deciding = True
+        try:
+            results = self.set_parameters(changes)
+        finally:
+            self._deciding = False
+        refused = [r.reason for r in results if not r.successful]
+        if refused:
+            self.get_logger().warn(f'the decided excitation was refused: {"; ".join(refused)}')
+
     def _publish_diagnostics(self, timer: bool = True) -> None:
         """Publish the status; log the last estimate every 10 s (rclpy's throttled logging costs
         ~0.15 ms a call, too much for the data path). From the 1-s timer, or from the data path
@@ -602,6 +659,8 @@ class EstimatorNode(Node):
                 self._align_tick,
             )
             self._align_tick = {name: counters[name] for name in H.ALIGN_PROBLEMS}
+        if self._stream.deciding:
+            self._decide()
         if self.baseline_monitor.active:
             status = self.baseline_monitor.status(status)
         if status.log:

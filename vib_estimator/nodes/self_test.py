@@ -14,12 +14,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import List, Optional, Tuple
+from typing import Any, Callable, List, Optional, Tuple
 
 import numpy as np
 
 from ..core.config import EstimatorConfig
-from ..core.modes import create_estimator
+from ..core.factory import create_estimator
 
 #: sampling rate of the tones when the input's is not known yet, Hz
 DEFAULT_RATE_HZ = 500.0
@@ -77,9 +77,14 @@ def tone_frequencies(band_hz: Optional[Tuple[float, float]], sample_rate_hz: flo
 
 
 def run_tone(
-    config: EstimatorConfig, frequency_hz: float, sample_rate_hz: float, seed: int = SEED
+    config: EstimatorConfig,
+    frequency_hz: float,
+    sample_rate_hz: float,
+    seed: int = SEED,
+    create: Optional[Callable[[EstimatorConfig], Any]] = None,
 ) -> ToneResult:
-    """One tone through a fresh estimator of ``config``."""
+    """One tone through a fresh estimator of ``config`` (``create(config)``; default
+    :func:`~vib_estimator.core.modes.create_estimator`)."""
     if frequency_hz >= sample_rate_hz / 2:
         return ToneResult(
             frequency_hz,
@@ -94,17 +99,22 @@ def run_tone(
     t = np.arange(n) / sample_rate_hz
     y = amplitude * np.sin(2 * np.pi * frequency_hz * t + rng.uniform(0, 2 * np.pi))
     y += rng.normal(0.0, amplitude / math.sqrt(2) * 10 ** (-SNR_DB / 20), n)
-    estimates = create_estimator(config).process(t, y)
+    estimates = (create or create_estimator)(config).process(t, y)
     median = float(np.median(estimates.frequency_hz)) if len(estimates) else math.nan
     return ToneResult(frequency_hz, len(estimates), median)
 
 
-def self_test(config: EstimatorConfig, sample_rate_hz: Optional[float] = None) -> Tuple[bool, str]:
+def self_test(
+    config: EstimatorConfig,
+    sample_rate_hz: Optional[float] = None,
+    create: Optional[Callable[[EstimatorConfig], Any]] = None,
+) -> Tuple[bool, str]:
     """(all tones passed, one line per tone) for ``config`` at the input's sampling rate
-    (:data:`DEFAULT_RATE_HZ` when not known)."""
+    (:data:`DEFAULT_RATE_HZ` when not known), through estimators ``create`` makes (see
+    :func:`run_tone`)."""
     rate = sample_rate_hz if sample_rate_hz and math.isfinite(sample_rate_hz) else DEFAULT_RATE_HZ
     results = [
-        run_tone(config, f, rate, SEED + i)
+        run_tone(config, f, rate, SEED + i, create)
         for i, f in enumerate(tone_frequencies(config.band_hz, rate))
     ]
     ok = all(r.passed for r in results)

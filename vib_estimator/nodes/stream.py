@@ -4,25 +4,32 @@
 
 :class:`EstimatorStream` holds what the node does between a converted message and a publication:
 the stamp time base (``t = seconds_since(stamp, first stamp)``, exactly as the offline
-``vib-estimator analyze``), the estimator of the live configuration (``create_estimator``: one
-:class:`~vib_estimator.core.FrequencyEstimator`, or a mode tracker with ``modes`` >= 1; replaced
-on a change of configuration, its counters kept), and the :class:`~.health.Health` bookkeeping.
-With several ``channels`` (the node's ``components``) the estimator is the joint identifier
-(:func:`~vib_estimator.core.multichannel_free.create_joint_estimator`: free decays or
-``excitation`` ambient, :func:`check_channels`): each sample is a tuple of values, each estimate a
-:class:`~vib_estimator.core.multichannel.JointEstimate` (the estimate and its mode shape).
+``vib-estimator analyze``), the estimator of the live configuration and channels
+(:func:`~vib_estimator.core.create_estimator`; replaced on a change of configuration, its counters
+kept), and the :class:`~.health.Health` bookkeeping. With several ``channels`` (the node's
+``components``) the estimator is a joint one (:func:`check_channels`): each sample is a tuple of
+values, each :class:`~vib_estimator.core.Estimate` carries its mode's shape.
 
 Warm-up. A configuration whose kernels are not compiled in this process yet (the first start, or a
 change to a configuration that runs other kernels) is built in a background thread
 (:func:`~vib_estimator.core.warmup.warm`: seconds from numba's cache, tens of seconds on a first
-start after an install). Meanwhile :attr:`EstimatorStream.ready` is False, the node stays live
-(services, diagnostics) and :meth:`EstimatorStream.hold` keeps the samples that arrive, in order,
-up to :data:`WARMUP_BUFFER` (the oldest beyond it are dropped and counted in ``dropped_warmup``);
-:meth:`EstimatorStream.poll` installs the estimator once it is built and feeds it the held samples,
-a slice of at most its ``budget_s`` seconds a call (the node's single thread answers its services
-and publishes its diagnostics between slices; a minute of input held took seconds to feed at
-once); samples that arrive meanwhile are held behind them, and :attr:`EstimatorStream.ready`
-turns True once none is left.
+start after an install). Meanwhile the node stays live (services, diagnostics), and:
+
+- a configuration of the free-decay estimator (``excitation`` free, ``modes`` 0, one channel, no
+  ``band_hz``: :func:`interpretable`, the default) estimates at once with its kernel uncompiled
+  (:func:`~vib_estimator.core.jit.interpreted`: the same floats, about 100 us a sample):
+  :attr:`EstimatorStream.ready` is True, and :meth:`EstimatorStream.poll` switches it to the
+  compiled kernel once that is built, between two samples (:attr:`EstimatorStream.compiling` until
+  then);
+- any other (the mode tracker, the ambient identifier, several channels, ``band_hz``, whose
+  coloured std costs about a second an estimate uncompiled) is not :attr:`EstimatorStream.ready`:
+  :meth:`EstimatorStream.hold` keeps the samples that arrive, in order, up to
+  :data:`WARMUP_BUFFER` (the oldest beyond it are dropped and counted in ``dropped_warmup``);
+  :meth:`EstimatorStream.poll` installs the estimator once it is built and feeds it the held
+  samples, a slice of at most its ``budget_s`` seconds a call (the node's single thread answers
+  its services and publishes its diagnostics between slices; a minute of input held took seconds
+  to feed at once); samples that arrive meanwhile are held behind them, and
+  :attr:`EstimatorStream.ready` turns True once none is left.
 """
 
 from __future__ import annotations
@@ -32,14 +39,15 @@ import threading
 import time
 from collections import deque
 from functools import partial
-from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
+from typing import Any, Dict, List, Optional, Sequence, Tuple
 
-from ..core.choice import WATCH_S, DrivenWatch
+import numpy as np
+
+from ..core.choice import WATCH_S, Decision, StreamChoice, decide, window_advice
 from ..core.config import EstimatorConfig
-from ..core.estimator import COUNTER_NAMES, Estimate, as_estimates
-from ..core.modes import create_estimator
+from ..core.estimator import COUNTER_NAMES, Estimate, FrequencyEstimator
+from ..core.factory import create_estimator, kind_of
 from ..core.multichannel import MIN_CHANNELS
-from ..core.multichannel_free import JOINT_EXCITATIONS, create_joint_estimator
 from ..core.warmup import is_warm, warm
 from ..io.fields import seconds_since
 from .health import WARN, Health, Status
@@ -52,36 +60,39 @@ WARMUP_BUFFER = 60_000
 #: significant digits of the measured sampling rate the self-test's tones are made for (a rate
 #: that wanders in its last digits gives the same tones, and the kept result)
 SELF_TEST_DIGITS = 3
+#: no samples to prime a new estimator with (:meth:`EstimatorStream.configure`)
+NO_PRIMER = (np.empty(0), np.empty(0))
 #: the diagnostics message while the kernels compile
 WARMUP_MESSAGE = 'compiling estimator kernels (first start)'
 
 
 def check_channels(channels: Sequence[str], config: EstimatorConfig) -> None:
-    """ValueError unless ``config`` can identify ``channels`` (names): several need
-    ``excitation`` free or ambient (a joint estimator,
-    :func:`~vib_estimator.core.multichannel_free.create_joint_estimator`)."""
-    if len(channels) >= MIN_CHANNELS and config.excitation not in JOINT_EXCITATIONS:
-        raise ValueError(
-            f'{len(channels)} components ({", ".join(channels)}) need excitation free or '
-            f'ambient (a joint estimation), got excitation {config.excitation}: it takes one '
-            'component'
-        )
+    """ValueError unless ``config`` has an estimator for ``channels`` (the node's components:
+    :func:`~vib_estimator.core.factory.kind_of`)."""
+    what = f'{len(channels)} components ({", ".join(channels)})'
+    kind_of(config, max(len(channels), 1), what)
 
 
-def estimator_factory(channels: Sequence[str]) -> Callable[[EstimatorConfig], Any]:
-    """What builds the estimator of a configuration for ``channels``: one channel,
-    :func:`~vib_estimator.core.modes.create_estimator`; several, the joint identifier."""
-    if len(channels) < MIN_CHANNELS:
-        return create_estimator
-    return partial(create_joint_estimator, channels=tuple(channels))
+def interpretable(config: EstimatorConfig, channels: Sequence[str]) -> bool:
+    """Whether the estimator of ``config`` for ``channels`` can estimate while its kernels
+    compile (with them uncompiled, :class:`~vib_estimator.core.estimator.FrequencyEstimator`'s
+    ``interpret``): the free-decay estimator on one channel, without ``band_hz``."""
+    return (
+        len(channels) < MIN_CHANNELS
+        and config.excitation == 'free'
+        and config.modes == 0
+        and config.band_hz is None
+    )
 
 
 class _Build:
-    """An estimator of ``config`` built in a daemon thread (its kernels compiled first)."""
+    """An estimator of ``config`` for ``channels`` built in a daemon thread (its kernels
+    compiled first; only compiled when ``channels`` is None: the stream estimates uncompiled
+    meanwhile)."""
 
-    def __init__(self, config: EstimatorConfig, create: Callable[[EstimatorConfig], Any]):
+    def __init__(self, config: EstimatorConfig, channels: Optional[Tuple[str, ...]]):
         self.config = config
-        self._create = create
+        self._channels = channels
         self.started = time.monotonic()
         self.seconds = 0.0
         self.estimator = None
@@ -94,7 +105,8 @@ class _Build:
     def _run(self) -> None:
         try:
             warm(self.config)
-            self.estimator = self._create(self.config)
+            if self._channels is not None:
+                self.estimator = create_estimator(self.config, self._channels)
         except Exception as err:  # reported by the node, never lost in a thread
             self.error = err
         self.seconds = time.monotonic() - self.started
@@ -108,10 +120,12 @@ class EstimatorStream:
     """Samples in, estimates out, with the node's counters and status (see the module doc).
 
     ``background``: build an estimator whose kernels are not compiled yet in a thread (the node);
-    False builds it at once (tests, tools). ``channels``: the names of the input's channels (the
+    False builds it at once (tests, tools). ``deciding``: the caller asks :meth:`decision` and
+    applies it (the node's ``decide_excitation``); else the status hints at a driven input.
+    ``channels``: the names of the input's channels (the
     node's components); one (or none given) is the single-channel estimator, bit for bit; several
-    feed :meth:`feed` a tuple of values a sample and give
-    :class:`~vib_estimator.core.multichannel.JointEstimate` s (``excitation`` free or ambient).
+    feed :meth:`feed` a tuple of values a sample and give estimates with their ``shape``
+    (``excitation`` free or ambient).
     """
 
     def __init__(
@@ -120,6 +134,7 @@ class EstimatorStream:
         now: float,
         background: bool = False,
         channels: Sequence[str] = (),
+        deciding: bool = False,
     ):
         config.validate()
         check_channels(channels, config)
@@ -136,8 +151,18 @@ class EstimatorStream:
         #: seconds the last warm-up took (None before one ended), samples held when it ended
         self.warmup_seconds: Optional[float] = None
         self.warmup_held = 0
-        #: whether the input looks driven throughout (a hint when the estimator is free's)
-        self._watch = DrivenWatch()
+        #: whether the input looks driven throughout, and what it needs (core.choice.StreamChoice)
+        self._choice = StreamChoice(max(1, len(self.channels)))
+        #: the excitation was last set by :meth:`decision` (not by the user)
+        self.decided = False
+        #: stream time of the last estimate, or of the last configuration (:meth:`_silent_hint`)
+        self._estimated_at: Optional[float] = None
+        #: (stream time, advice) of the last :meth:`_silent_hint` computed
+        self._advice: Tuple[float, str] = (-math.inf, '')
+        #: the samples a new estimator is primed with (:meth:`configure`)
+        self._primer: Tuple[np.ndarray, np.ndarray] = NO_PRIMER
+        #: :meth:`decision` is asked (the node's ``decide_excitation``): no hint, a switch
+        self.deciding = deciding
         self.configure(config)
 
     @property
@@ -147,33 +172,61 @@ class EstimatorStream:
 
     @property
     def ready(self) -> bool:
-        """False while a configuration's kernels compile and until the samples held meanwhile
-        are fed (samples are held, not estimated)."""
-        return self._build is None and not self._held
+        """False while a configuration's kernels compile and it cannot estimate meanwhile, and
+        until the samples held meanwhile are fed (samples are held, not estimated: see the module
+        doc)."""
+        return self.estimator is not None and not self._held
 
-    def configure(self, config: EstimatorConfig, channels: Optional[Sequence[str]] = None) -> None:
+    @property
+    def compiling(self) -> bool:
+        """True while a configuration's kernels compile (estimating uncompiled meanwhile when
+        :attr:`ready`)."""
+        return self._build is not None
+
+    def configure(
+        self,
+        config: EstimatorConfig,
+        channels: Optional[Sequence[str]] = None,
+        prime: bool = False,
+    ) -> None:
         """A fresh estimator of ``config`` (a new segment, same time origin, counters kept) for
         ``channels`` (default: the same); built in the background when its kernels are not
         compiled yet and ``background`` was asked. ValueError if ``config`` cannot take the
-        channels (:func:`check_channels`)."""
+        channels (:func:`check_channels`). ``prime`` (a :meth:`decision` applied): the new
+        identifier (not ``free``) is first fed the input's last seconds the decision read,
+        uncounted and unpublished, so that a driven stream's window is not filled again from
+        empty."""
         channels = self.channels if channels is None else tuple(channels)
         check_channels(channels, config)
+        primes = prime and channels == self.channels and config.excitation != 'free'
+        self._primer = self._choice.kept() if primes else NO_PRIMER
         self.channels = channels
-        create = estimator_factory(channels)
         if self.estimator is not None:
             self.health.absorb(self.estimator.counters)
             self.estimator = None
         self._config = config
+        self._estimated_at = self.last_t
         self.health.forget_modes(config.modes)
         if self._background and not is_warm(config):
-            self._build = _Build(config, create)
+            if interpretable(config, channels):
+                self._install(FrequencyEstimator(config, interpret=True))
+                self._build = _Build(config, None)
+            else:
+                self._build = _Build(config, channels)
         else:
-            self._install(create(config))
+            self._install(create_estimator(config, channels))
 
     def _install(self, estimator) -> None:
         self.estimator = estimator
         self._update = estimator.update  # bound once: the data path's one call
         self._build = None
+        if len(self._primer[0]):  # fed before any held sample; its counts taken back
+            t, y = self._primer
+            values = y.tolist() if y.ndim == 1 else map(tuple, y.tolist())
+            for when, value in zip(t.tolist(), values):
+                estimator.update(when, value)
+            self.health.absorb({name: -n for name, n in estimator.counters.items()})
+            self._primer = NO_PRIMER
 
     def feed(self, stamp_ns: int, value: float) -> Sequence[Estimate]:
         """One sample (stamp in integer ns); the estimates it completes (usually none).
@@ -181,10 +234,11 @@ class EstimatorStream:
         if self.origin is None:
             self.origin = stamp_ns
         self.last_t = t = seconds_since(stamp_ns, self.origin)
-        self._watch.update(t, value if isinstance(value, float) else value[0])
-        estimates = as_estimates(self._update(t, value))
+        self._choice.update(t, value)
+        estimates = self._update(t, value)
         for e in estimates:
-            self._watch.follow(getattr(e, 'estimate', e).frequency_hz)
+            self._choice.follow(e.frequency_hz)
+            self._estimated_at = t
         return estimates
 
     @property
@@ -193,7 +247,7 @@ class EstimatorStream:
         return len(self._held)
 
     def warmup_elapsed(self, now: float) -> float:
-        """Seconds since the running warm-up started (0 when ready)."""
+        """Seconds since the running warm-up started (0 when compiled)."""
         return 0.0 if self._build is None else now - self._build.started
 
     def hold(self, stamp_ns: int, value: float, tag: Any = None) -> bool:
@@ -221,6 +275,10 @@ class EstimatorStream:
                 self._build = None
                 raise build.error
             self.warmup_seconds = build.seconds
+            if build.estimator is None:  # estimating uncompiled meanwhile: the compiled kernel now
+                self._build = None
+                self.estimator.compiled()
+                return []
             self.warmup_held = len(self._held)
             self._install(build.estimator)
         elif not self._held:
@@ -258,8 +316,15 @@ class EstimatorStream:
             return Status(WARN, WARMUP_MESSAGE, values)
         config = self.config
         status = self.health.status(
-            now, self.counters, self.last_t, config.band_hz, config.modes, self._driven_hint()
+            now,
+            self.counters,
+            self.last_t,
+            config.band_hz,
+            config.modes,
+            self._driven_hint() or self._silent_hint(),
         )
+        if self.compiling:  # estimating uncompiled meanwhile
+            status.values['warmup_s'] = self.warmup_elapsed(now)
         if len(self.channels) >= MIN_CHANNELS:  # a joint identification: which channels
             status.values['channels'] = ','.join(self.channels)
         return status
@@ -273,14 +338,53 @@ class EstimatorStream:
     def _driven_hint(self) -> Optional[str]:
         """With the free-decay estimator, what to say when the input looks driven throughout
         (:class:`~vib_estimator.core.choice.DrivenWatch`); else None."""
-        share = self._watch.driven()
-        if share is None or self.config.excitation != 'free':
+        share = self._choice.driven()
+        if share is None or self.config.excitation != 'free' or self.deciding:
             return None
         return (
             f'the input looks driven ({100 * share:.0f} % of the energy of the last '
             f'{WATCH_S:g} s): free-decay estimates of a driven structure scatter; '
             'excitation:=ambient identifies its modes (auto: both, per stretch)'
         )
+
+    def _silent_hint(self) -> Optional[str]:
+        """Under the identifier (``excitation`` ambient or auto), when it published nothing for
+        two windows (and a minute): why, from the spectrum of the input's last seconds -- the
+        window's correlation times of their lowest peak and the ``ambient_window_s`` that holds
+        enough (:func:`~vib_estimator.core.choice.window_advice`), computed at most every
+        :data:`~vib_estimator.core.choice.WATCH_S` / 2 s of stream; else None."""
+        config = self.config
+        since = self._estimated_at if self._estimated_at is not None else self._first_t()
+        if config.excitation == 'free' or since is None or self.last_t is None:
+            return None
+        silent = self.last_t - since
+        if silent < max(2 * config.ambient_window_s, 60.0):
+            return None
+        at, advice = self._advice
+        if self.last_t - at >= WATCH_S / 2 or self.last_t < at:
+            t, y = self._choice.kept()
+            d = decide(t, y, max(1, len(self.channels)), config.ambient_window_s, stream=True)
+            advice = window_advice(config.ambient_window_s, d, 'ambient_window_s:=')
+            self._advice = (self.last_t, advice)
+        if not advice:
+            return None
+        return f'no mode for {silent:.0f} s: {advice}'
+
+    def _first_t(self) -> Optional[float]:
+        """Stream time of the first sample (0.0), None before any."""
+        return None if self.origin is None else 0.0
+
+    def decision(self) -> Optional[Decision]:
+        """What the input needs now, if not what runs (``decide_excitation``; after
+        :meth:`status`, which watches the input): from ``free``, once the input looks driven
+        throughout, analyze's decision over its last seconds (excitation and ambient window);
+        from an ``ambient`` decided so, ``free`` once it looks free again
+        (:class:`~vib_estimator.core.choice.StreamChoice`). The caller applies it (the node: as
+        its parameters) and sets :attr:`decided`."""
+        if not self.ready:
+            return None
+        config = self.config
+        return self._choice.decision(config.excitation, self.decided, config.ambient_window_s)
 
     def reset(self) -> Tuple[bool, str]:
         """Start a new segment at the last sample; counters kept. (False, why) during a warm-up."""
@@ -302,6 +406,7 @@ class EstimatorStream:
         if math.isfinite(rate) and rate > 0:
             rate = float(f'{rate:.{SELF_TEST_DIGITS}g}')
         key = (self.config, rate if math.isfinite(rate) else None)
-        if self._self_test[0] != key:
-            self._self_test = (key, self_test(self.config, rate))
+        if self._self_test[0] != key:  # uncompiled while the kernels compile: the same result
+            create = partial(FrequencyEstimator, interpret=True) if self.compiling else None
+            self._self_test = (key, self_test(self.config, rate, create))
         return self._self_test[1]
