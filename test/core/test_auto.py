@@ -413,3 +413,25 @@ def test_a_rise_within_min_blocks_of_a_pluck_is_no_onset():
     assert _changes(early) == {'onsets': 0, 'rang_down': 0, 'became_driven': 0}
     late = [1.0, 0.99, 0.98, 0.97] + [2.0 * d for d in decay]
     assert _changes(late)['onsets'] == 1
+
+
+def test_a_driven_stretch_rings_down_when_its_energy_drops_tenfold():
+    """``DROP`` (10): a driven stretch (energy halving and doubling) whose forcing stops, the
+    structure ringing down into a noise 300 x below it: back to free once 6 blocks are 10 x below
+    the stretch's median (at 10000 x, the noise never is)."""
+    driven = [1.0, 0.5] * 8
+    down = [0.3**k for k in range(1, 5)] + [3e-3] * 8
+    assert _changes(driven + down) == {'onsets': 0, 'rang_down': 1, 'became_driven': 1}
+
+
+def test_a_rise_after_a_wandering_stretch_is_no_onset_for_a_ringing_one():
+    """``SETTLE`` (1.1): in a stretch whose free estimates passed the free-decay test, a rise by
+    more than RISE is an onset only after blocks that rang down (none more than 1.1 x the one
+    before); after blocks that wandered down and up by 1.3 x it is not: driven."""
+    from vib_estimator.core.auto import Envelope
+
+    blocks = [1.2, 0.8, 1.0, 0.7, 0.9, 0.75, 1.2, 1.2]
+    env = Envelope(1.0)
+    env.ringing = True
+    env.feed(*_energies(blocks))
+    assert env.changes == {'onsets': 0, 'rang_down': 0, 'became_driven': 1}
