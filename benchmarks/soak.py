@@ -46,8 +46,11 @@ import signal
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from pathlib import Path
+
+import numpy as np
 
 os.environ.setdefault('ROS_DOMAIN_ID', str(120 + os.getpid() % 80))
 os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
@@ -78,6 +81,10 @@ EXIT_WITHIN_S = 2.0
 ACCURACY = 0.02
 #: seconds of steady time a node is given to show it is alive after a start
 START_S = 60.0
+#: shaper_node's reference moves every this many seconds (0 and 0.5 rad in turn)
+REFERENCE_EVERY_S = 3.0
+#: the hidden soak's RSS limit (issue 40: 20 MB growth; 10 MB after the first 10 min of 8 h)
+RSS_GROWTH_MB = 20.0
 
 
 def executable(name: str) -> str:
@@ -95,6 +102,7 @@ class Proc:
         self.logs = logs
         self.runs = 0
         self.p = None
+        self.rss = []  # (steady s since the soak's start, MB, run)
         self.start()
 
     def start(self) -> None:
@@ -125,6 +133,12 @@ class Proc:
         kb = next(int(line.split()[1]) for line in text.splitlines() if line.startswith('VmRSS'))
         return kb / 1024.0
 
+    def rss_growth_mb(self, after: float) -> float:
+        """RSS growth of its last run from its first sample at or after ``after`` (steady s
+        since the soak's start) to its largest."""
+        run = [mb for t, mb, k in self.rss if k == self.runs and t >= after and mb == mb]
+        return max(run) - run[0] if run else math.nan
+
     def tracebacks(self) -> int:
         return sum(
             path.read_text(errors='replace').count('Traceback')
@@ -132,15 +146,61 @@ class Proc:
         )
 
 
+class Diagnostics(Node):
+    """/diagnostics as they arrive, each stamped on reception: spun in a thread of its own, so
+    that what the soak's main thread does (a stopped node waited for, a burst published) never
+    delays a reception (a silence is the nodes', not the soak's)."""
+
+    def __init__(self):
+        super().__init__('soak_diagnostics')
+        self.rows = {}  # node name -> [(steady s, level, message, values)]
+        self.create_subscription(DiagnosticArray, '/diagnostics', self._on_diag, 100)
+        self.executor_ = make_executor()
+        self.executor_.add_node(self)
+        self._thread = threading.Thread(target=self._spin, name='soak diagnostics', daemon=True)
+        self._stop = False
+        self._thread.start()
+
+    def _spin(self) -> None:
+        while not self._stop and rclpy.ok():
+            self.executor_.spin_once(timeout_sec=0.05)
+
+    def _on_diag(self, msg) -> None:
+        now = time.monotonic()
+        for s in msg.status:
+            values = {kv.key: kv.value for kv in s.values}
+            self.rows.setdefault(s.name, []).append((now, s.level[0], s.message, values))
+
+    def close(self) -> None:
+        self._stop = True
+        self._thread.join(5.0)
+        self.executor_.shutdown()
+        self.destroy_node()
+
+
 class Watch(Node):
-    """The soak's eyes and hands: diagnostics, estimates, truth; faults' service calls."""
+    """The soak's eyes and hands: estimates, truth; faults' service calls (diagnostics:
+    :class:`Diagnostics`)."""
 
     def __init__(self):
         super().__init__('soak_watch')
-        self.diag = {}  # node name -> [(steady s, level, message, values)]
+        self.listener = Diagnostics()
+        self.diag = self.listener.rows
+        #: shaper_node's reference: a move every REFERENCE_EVERY_S (reliable, as a controller's)
+        self.reference = self.create_publisher(Float64, 'reference', 10)
+        self.references = 0
+        self.reference_at = -math.inf
+        self.reference_matched = math.inf
+        #: the replayed bag's input as the replay estimator gets it: messages, loops (stamps back)
+        self.replayed = {'messages': 0, 'loops': 0, 'last': -1}
+        self.create_subscription(
+            WrenchStamped,
+            '/replay/coupling_torque',
+            self._on_replayed,
+            QoSProfile(depth=1000, reliability=ReliabilityPolicy.BEST_EFFORT),
+        )
         self.estimates = {'/': [], '/replay': []}  # [(steady s, Hz)]
         self.truth = []  # [(steady s, Hz)]
-        self.create_subscription(DiagnosticArray, '/diagnostics', self._on_diag, 100)
         for ns in self.estimates:
             self.create_subscription(
                 Float64,
@@ -164,11 +224,20 @@ class Watch(Node):
             for name in ('self_test', 'reset')
         }
 
-    def _on_diag(self, msg) -> None:
-        now = time.monotonic()
-        for s in msg.status:
-            values = {kv.key: kv.value for kv in s.values}
-            self.diag.setdefault(s.name, []).append((now, s.level[0], s.message, values))
+    def _on_replayed(self, msg) -> None:
+        r = self.replayed
+        stamp = msg.header.stamp.sec * 10**9 + msg.header.stamp.nanosec
+        r['messages'] += 1
+        r['loops'] += stamp < r['last']
+        r['last'] = stamp
+        if r.get('offset') is None:
+            # what the replay estimator will be held to: the messages after its first one (the
+            # replayer starts once a subscriber, maybe this one, is matched; the estimator may
+            # come later): those seen here when its diagnostics first show one received, less
+            # those it had received (lenient by the few in flight at that moment)
+            c = self.counters('/replay/estimator_node')
+            if c.get('received', 0) > 0:
+                r['offset'] = r['messages'] - c['received']
 
     def counters(self, name='/estimator_node') -> dict:
         rows = self.diag.get(name)
@@ -226,6 +295,10 @@ class Soak:
                 logs,
             )
             self.procs += [self.replay_est, self.replayer]
+        if args.shaper:
+            # on the estimator's vibration/frequency, the soak's reference; wall-clock ticks
+            self.shaper = Proc('shaper_node', ['shaper_node'], logs)
+            self.procs.append(self.shaper)
         rclpy.init()
         self.watch = Watch()
         self.ex = make_executor()
@@ -258,6 +331,27 @@ class Soak:
         now = time.monotonic() - self.t0
         if not self.rss or now - self.rss[-1][0] >= 1.0:
             self.rss.append((now, self.est.rss_mb()))
+            for proc in self.procs:
+                proc.rss.append((now, proc.rss_mb(), proc.runs))
+            w = self.watch
+            if (
+                self.args.shaper
+                and now - w.reference_at >= REFERENCE_EVERY_S
+                and self._reference_matched(now)  # sent: taken by the shaper
+            ):
+                w.reference_at = now
+                self.watch.reference.publish(Float64(data=0.5 * (self.watch.references % 2)))
+                self.watch.references += 1
+
+    def _reference_matched(self, now: float) -> bool:
+        """Whether the shaper has been matched on the reference for a second (discovery ends at
+        either side in turn: a message sent at the first match may find no reader yet)."""
+        w = self.watch
+        if w.reference.get_subscription_count() == 0:
+            w.reference_matched = math.inf
+        elif w.reference_matched == math.inf:
+            w.reference_matched = now
+        return now - w.reference_matched >= 1.0
 
     def taken(self) -> int:
         c = self.watch.counters()
@@ -381,6 +475,67 @@ class Soak:
         self.watch.destroy_publisher(burster)
         self.sim.signal(signal.SIGCONT)
 
+    def _others(self, settled: dict) -> dict:
+        """The replayed bag and the shaper: what each node took of what was sent to it, the
+        longest silence of its diagnostics, and (the shaper) how soon after each fault it took an
+        estimate again."""
+        out = {'unaccounted': []}
+        if self.args.replayer:
+            c = settled['replay/estimator_node']
+            sent = self.watch.replayed['messages'] - (self.watch.replayed.get('offset') or 0)
+            took = c.get('received', 0) + c.get('samples_missing', 0)
+            out['replay'] = dict(
+                seen_by_soak=self.watch.replayed['messages'],
+                sent_after_its_first=sent,
+                loops=self.watch.replayed['loops'],
+                received=c.get('received'),
+                samples_missing=c.get('samples_missing'),
+                time_jump_resets=c.get('time_jump_resets'),
+                estimates=len(self.watch.estimates['/replay']),
+                silence_s=self._silence('/replay/estimator_node'),
+            )
+            if took < sent:
+                out['unaccounted'].append(f'replay: {took} received or counted of {sent} seen')
+        if self.args.shaper:
+            c = settled['shaper_node']
+            published = len(self.watch.estimates['/'])
+            rows = self.watch.diag.get('/shaper_node', [])
+            taken_at = []  # steady s at which frequency_estimates grew
+            last = None
+            for at, _, _, values in rows:
+                n = int(values.get('frequency_estimates', 0))
+                if last is not None and n > last:
+                    taken_at.append(at)
+                last = n
+            resumed = [
+                min((t for t in taken_at if t > f['end']), default=math.inf) - f['end']
+                for f in self.faults
+            ]
+            out['shaper'] = dict(
+                references_sent=self.watch.references,
+                references=c.get('references'),
+                estimates_published=published,
+                frequency_estimates=c.get('frequency_estimates'),
+                estimates_ignored=c.get('estimates_ignored'),
+                commands_published=c.get('commands_published'),
+                estimate_resumed_s=max(resumed, default=math.nan),
+                silence_s=self._silence('/shaper_node'),
+            )
+            if c.get('references', 0) + c.get('references_skipped', 0) < self.watch.references:
+                out['unaccounted'].append(
+                    f'shaper: {c.get("references")} references of {self.watch.references}'
+                )
+            if c.get('frequency_estimates', 0) + c.get('estimates_ignored', 0) < published:
+                out['unaccounted'].append(
+                    f'shaper: {c.get("frequency_estimates")} estimates of {published} published'
+                )
+        return out
+
+    def _silence(self, name: str) -> float:
+        """The longest interval between two diagnostics of ``name`` (s)."""
+        stamps = [row[0] for row in self.watch.diag.get(name, [])]
+        return float(max(np.diff(stamps))) if len(stamps) > 1 else math.nan
+
     def _quiet(self, before) -> bool:
         return self.watch.counters().get('received', 0) == before.get('received', 0)
 
@@ -432,11 +587,22 @@ class Soak:
 
     def finish(self) -> dict:
         figures = {'faults': self.faults}
-        final = self.watch.counters()
         exits = {}
-        for proc in self.procs:
+        # the sources first (sim_node, bag_replayer); the nodes they feed publish what they
+        # took, then their counters are read and they are stopped
+        sources = [p for p in self.procs if p.name in ('sim_node', 'bag_replayer')]
+        for proc in sources:
             code, seconds = proc.stop()
             exits[proc.name] = (code, round(seconds, 2))
+        self.spin(3.0)
+        final = self.watch.counters()
+        settled = {
+            n: self.watch.counters(f'/{n}') for n in ('replay/estimator_node', 'shaper_node')
+        }
+        for proc in self.procs:
+            if proc not in sources:
+                code, seconds = proc.stop()
+                exits[proc.name] = (code, round(seconds, 2))
         self.spin(0.5)
         # the counters
         ident = identities(final)
@@ -463,8 +629,17 @@ class Soak:
                 errors.append(abs(hz / truth - 1))
         errors.sort()
         # RSS after the first tenth
-        settled = [mb for t, mb in self.rss if t >= 0.1 * self.args.minutes * 60 and mb == mb]
-        rss_growth = (max(settled) - settled[0]) if settled else math.nan
+        tenth = 0.1 * self.args.minutes * 60
+        after = [mb for t, mb in self.rss if t >= tenth and mb == mb]
+        rss_growth = (max(after) - after[0]) if after else math.nan
+        # (a node restarted by the faults, sim_node, has no long life to measure)
+        growth = {p.name: round(p.rss_growth_mb(tenth), 1) for p in self.procs if p.runs == 1}
+        peaks = {
+            p.name: round(max((mb for _, mb, _ in p.rss if mb == mb), default=0), 1)
+            for p in self.procs
+        }
+        # what the replay estimator and the shaper took of what was sent to them
+        others = self._others(settled)
         # diagnostics silences outside the stops
         stamps = [row[0] for row in self.watch.diag.get('/estimator_node', [])]
         stops = [(f['start'], f['end'] + 1.5) for f in self.faults if f['kind'] == 'stop']
@@ -485,6 +660,9 @@ class Soak:
             rss_first_mb=self.rss[0][1] if self.rss else math.nan,
             rss_last_mb=next((mb for _, mb in reversed(self.rss) if mb == mb), math.nan),
             rss_growth_after_first_tenth_mb=rss_growth,
+            rss_growth_mb=growth,
+            rss_peak_mb=peaks,
+            others=others,
             diagnostics_longest_silence_s=max(silences, default=(math.nan, math.nan)),
             exits=exits,
             tracebacks={p.name: p.tracebacks() for p in self.procs},
@@ -499,12 +677,19 @@ class Soak:
                     f'{f["kind"]} at {f["start"] - self.t0:.0f} s: no estimate before the next '
                     'fault'
                 )
+        for name, mb in growth.items():
+            # (a shorter run's first tenth is the start-up, the estimator's buffer filling)
+            if mb > RSS_GROWTH_MB and self.args.minutes >= 5:
+                self.problems.append(f'{name}: RSS grew {mb} MB after the first tenth')
+        for what in others.get('unaccounted', []):
+            self.problems.append(what)
         for name, (code, seconds) in exits.items():
             if code != 0 or seconds > EXIT_WITHIN_S:
                 self.problems.append(f'{name}: exit {code} after {seconds} s of SIGINT')
         for name, n in figures['tracebacks'].items():
             if n:
                 self.problems.append(f'{name}: {n} tracebacks in its log')
+        self.watch.listener.close()
         self.watch.destroy_node()
         rclpy.try_shutdown()
         return figures
@@ -554,6 +739,33 @@ def report(fig: dict) -> None:
         'exit after SIGINT: '
         + ', '.join(f'{n} {c} in {s} s' for n, (c, s) in fig['exits'].items())
     )
+    print(
+        'RSS growth after the first tenth (MB): '
+        + ', '.join(f'{n} {mb}' for n, mb in fig['rss_growth_mb'].items())
+        + '; peak (MB): '
+        + ', '.join(f'{n} {mb}' for n, mb in fig['rss_peak_mb'].items())
+    )
+    replay = fig['others'].get('replay')
+    if replay:
+        print(
+            f'replayed bag: {replay["loops"]} loops, {replay["seen_by_soak"]} messages seen by '
+            f"the soak ({replay['sent_after_its_first']} counted from the replay estimator's "
+            'first), '
+            f'the replay estimator received {replay["received"]} (missing '
+            f'{replay["samples_missing"]}, {replay["time_jump_resets"]} time-jump restarts), '
+            f'{replay["estimates"]} estimates, its diagnostics silent {replay["silence_s"]:.2f} s '
+            'at most'
+        )
+    shaper = fig['others'].get('shaper')
+    if shaper:
+        print(
+            f'shaper_node: took {shaper["references"]} of {shaper["references_sent"]} references, '
+            f'{shaper["frequency_estimates"]} (+{shaper["estimates_ignored"]} ignored) of '
+            f'{shaper["estimates_published"]} estimates published, '
+            f'{shaper["commands_published"]} commands; an estimate taken again '
+            f'{shaper["estimate_resumed_s"]:.2f} s after a fault at most; its diagnostics silent '
+            f'{shaper["silence_s"]:.2f} s at most'
+        )
     print('tracebacks: ' + ', '.join(f'{n} {k}' for n, k in fig['tracebacks'].items()))
     print('problems: ' + ('; '.join(fig['problems']) or 'none'))
 
@@ -568,6 +780,7 @@ def main(argv=None) -> int:
         '--excitation', default='ambient', help="sim_node's excitation (ambient: never at rest)"
     )
     parser.add_argument('--no-replayer', dest='replayer', action='store_false')
+    parser.add_argument('--no-shaper', dest='shaper', action='store_false')
     parser.add_argument(
         '--faults',
         type=lambda text: [k for k in text.split(',') if k in FAULTS] or list(FAULTS),

@@ -82,14 +82,57 @@ def test_close_pair_resolved():
         assert len(f_mode) >= 25 and abs(np.median(f_mode) / f - 1) < 0.01, mode
 
 
+def _wandering(seed, steps, rel, step_s, steady_s=0.0, fs=100.0):
+    """A 5 Hz mode (zeta 1 %, 26 dB) whose frequency is ``5 (1 + rel x_k)`` over its k-th
+    ``step_s`` stretch (``x_k``: ``rel`` a float, standard normal draws; a str, +-1 in turn),
+    then 5 Hz for ``steady_s``."""
+    from vib_estimator.sim.ambient import sdof_response
+
+    rng = np.random.default_rng(seed)
+    n = int(step_s * fs)
+    x = rng.standard_normal(steps) if isinstance(rel, float) else (-1.0) ** np.arange(steps)
+    rel = float(rel)
+    parts = [sdof_response(n, fs, 5.0 * (1 + rel * xk), 0.01, 1.0, rng) for xk in x]
+    parts.append(sdof_response(int(steady_s * fs), fs, 5.0, 0.01, 1.0, rng))
+    y = np.concatenate(parts)
+    return np.arange(len(y)) / fs, y + 10**-1.3 * rng.standard_normal(len(y))
+
+
 def test_frequency_std_is_calibrated():
-    # RMS of error / own std over two records; consecutive windows overlap (few independent
-    # values), so the band is wide: the benchmark measures it over more seeds
-    z = []
-    for seed in (3, 4):
-        est, _ = _run([(5.0, 0.01, 1.0)], seed=seed)
-        z.extend((est.frequency_hz - 5.0) / est.frequency_std_hz)
-    assert 0.4 < math.sqrt(np.mean(np.square(z))) < 2.5
+    """RMS of error / own std. On a stationary record the Whittle stds are nearly right; on one
+    whose mode moves by +-1.2 % every 20 s window (a structure whose temperature moves), they
+    are about half the scatter (RMS 1.9-2.7 uncalibrated, 2.1-2.3 on seeds 0-1): the
+    calibration against the mode's own earlier estimates (``HISTORY_WINDOWS``) brings it to
+    1.2-1.9 (1.2 on seeds 0-1). Consecutive windows overlap (few independent values): the bands
+    are wide."""
+
+    def rms_z(records):
+        z = []
+        for t, y in records:
+            est = AmbientEstimator(AMBIENT).process(t, y)
+            z.extend((est.frequency_hz - 5.0) / est.frequency_std_hz)
+        return math.sqrt(np.mean(np.square(z)))
+
+    stationary = [ambient_record(60.0, FS, [(5.0, 0.01, 1.0)], 26.0, s)[:2] for s in (3, 4)]
+    assert 0.4 < rms_z(stationary) < 2.5
+    assert 0.6 < rms_z([_wandering(s, 8, '0.012', 20.0) for s in (0, 1)]) < 1.65
+
+
+def test_std_calibration_forgets_an_earlier_stretch():
+    """The calibration reads the mode's estimates of the last ``HISTORY_WINDOWS`` (4) windows
+    only: 85 s after a stretch whose mode alternated by +-1.4 % every window, the stds are
+    those of an estimator started after that stretch (remembered, 0.98-1.35 x theirs)."""
+    t, y = _wandering(2, 5, '0.014', 20.0, steady_s=120.0)
+    after = t >= 100.0
+    whole = AmbientEstimator(AMBIENT).process(t, y)
+    fresh = AmbientEstimator(AMBIENT).process(t[after], y[after])
+    late_w, late_f = whole.t >= 205.0, fresh.t >= 205.0
+    assert late_w.sum() >= 15
+    np.testing.assert_array_equal(whole.t[late_w], fresh.t[late_f])
+    np.testing.assert_allclose(whole.frequency_hz[late_w], fresh.frequency_hz[late_f], rtol=1e-9)
+    np.testing.assert_allclose(
+        whole.frequency_std_hz[late_w], fresh.frequency_std_hz[late_f], rtol=1e-6
+    )
 
 
 def test_streaming_equals_batch_and_bad_samples_are_counted():
@@ -199,13 +242,14 @@ def test_a_record_too_slow_to_decimate_is_identified_at_every_analysis():
 
 def test_publication_rule_scripted(monkeypatch):
     """The identity rule alone (ambient.identify scripted per analysis): the first mode publishes
-    after CONFIRM analyses; a published one missing from one analysis publishes again as soon as
-    it is seen; a pole beside a published mode publishes only after CONFIRM_BESIDE analyses
-    running (shorter runs: a coloured excitation's statistical poles never publish)."""
+    after 3 analyses (``CONFIRM``); a published one missing from one analysis publishes again as
+    soon as it is seen; a pole beside a published mode publishes only after 8 analyses running
+    (``CONFIRM_BESIDE``; shorter runs: a coloured excitation's statistical poles, which last 1-8
+    analyses, never publish). The expectations are the documented figures, not the constants."""
     from vib_estimator.core import ambient
     from vib_estimator.core.ssi import WindowModes
 
-    beside = ambient.CONFIRM_BESIDE
+    confirm, beside = 3, 8
     short = range(10, 10 + beside - 1)  # one analysis too few
     long = range(30, 30 + beside + 4)
     calls = []
@@ -227,11 +271,10 @@ def test_publication_rule_scripted(monkeypatch):
     est = AmbientEstimator(AMBIENT).process(t, np.random.default_rng(0).standard_normal(len(t)))
     n = len(calls)
     assert n >= 45
-    # the analysis of each estimate, from its stamp (one a second; the first estimate's is the
-    # CONFIRM-th)
-    k = ambient.CONFIRM + np.round((est.t - est.t[0]) / ambient.HOP_S).astype(int)
+    # the analysis of each estimate, from its stamp (one a second, the window's 20 s first)
+    k = np.round(est.t - AMBIENT.ambient_window_s).astype(int) + 1
     by_f = {f: k[est.frequency_hz == f].tolist() for f in (5.0, 7.0, 9.0)}
-    assert by_f[5.0] == [j for j in range(ambient.CONFIRM, n + 1) if j != 6]
+    assert by_f[5.0] == [j for j in range(confirm, n + 1) if j != 6]
     assert by_f[7.0] == []
     assert by_f[9.0] == list(range(long[0] + beside - 1, long[-1] + 1))
     # numbered by frequency among the published: the 9 Hz mode is 2 while both publish

@@ -372,3 +372,65 @@ def test_the_arm_moved_every_10_s_is_free():
     assert est.driven_s == 0 and est.counters['onsets'] >= 1
     same = np.isin(e.t, free.t)
     assert same.all() and len(e) >= 0.85 * len(free) >= 25  # 14 of 35 when the move was driven
+
+
+def _energies(blocks, fs=100.0):
+    """A 5 Hz tone whose 1 s blocks have the variances ``blocks`` (whole periods each)."""
+    t = np.arange(int(len(blocks) * fs)) / fs
+    amp = np.sqrt(2 * np.repeat(np.asarray(blocks, dtype=float), int(fs)))
+    return t, amp * np.sin(2 * math.pi * 5.0 * t)
+
+
+def _changes(blocks):
+    from vib_estimator.core.auto import Envelope
+
+    env = Envelope(1.0)
+    env.feed(*_energies(blocks + [blocks[-1]]))  # the last block closes
+    return env.changes
+
+
+def test_the_onset_rule_is_a_rise_sudden_against_the_blocks_before():
+    """``SHARP`` (6): a rise by x2.5 (above RISE, below ONSET) after a smooth ring-down (x0.95
+    a block: the rise is 18 times its steps) is an onset, not a driven stretch, without the
+    free-decay test's help; a driven response's energy halving and doubling block after block
+    (its rises as large as its steps) never is: it stays driven."""
+    ring = [0.95**k for k in range(8)]
+    assert _changes(ring + [2.5 * ring[-1] * 0.95**k for k in range(6)]) == {
+        'onsets': 1,
+        'rang_down': 0,
+        'became_driven': 0,
+    }
+    assert _changes([1.0, 0.5] * 8) == {'onsets': 0, 'rang_down': 0, 'became_driven': 1}
+
+
+def test_a_rise_within_min_blocks_of_a_pluck_is_no_onset():
+    """``MIN_BLOCKS`` (3): a rise by x2 (below ONSET) two blocks after a pluck, the blocks before
+    it steady, is too early to tell sudden from wandering: neither an onset nor driven (the decay
+    then goes on); from MIN_BLOCKS blocks on the same rise is an onset."""
+    decay = [0.9**k for k in range(8)]
+    early = [1.0, 0.99] + [2.0 * d for d in decay]
+    assert _changes(early) == {'onsets': 0, 'rang_down': 0, 'became_driven': 0}
+    late = [1.0, 0.99, 0.98, 0.97] + [2.0 * d for d in decay]
+    assert _changes(late)['onsets'] == 1
+
+
+def test_a_driven_stretch_rings_down_when_its_energy_drops_tenfold():
+    """``DROP`` (10): a driven stretch (energy halving and doubling) whose forcing stops, the
+    structure ringing down into a noise 300 x below it: back to free once 6 blocks are 10 x below
+    the stretch's median (at 10000 x, the noise never is)."""
+    driven = [1.0, 0.5] * 8
+    down = [0.3**k for k in range(1, 5)] + [3e-3] * 8
+    assert _changes(driven + down) == {'onsets': 0, 'rang_down': 1, 'became_driven': 1}
+
+
+def test_a_rise_after_a_wandering_stretch_is_no_onset_for_a_ringing_one():
+    """``SETTLE`` (1.1): in a stretch whose free estimates passed the free-decay test, a rise by
+    more than RISE is an onset only after blocks that rang down (none more than 1.1 x the one
+    before); after blocks that wandered down and up by 1.3 x it is not: driven."""
+    from vib_estimator.core.auto import Envelope
+
+    blocks = [1.2, 0.8, 1.0, 0.7, 0.9, 0.75, 1.2, 1.2]
+    env = Envelope(1.0)
+    env.ringing = True
+    env.feed(*_energies(blocks))
+    assert env.changes == {'onsets': 0, 'rang_down': 0, 'became_driven': 1}

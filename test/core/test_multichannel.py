@@ -128,3 +128,32 @@ def test_one_channel_is_refused_and_bad_samples_are_counted():
     assert (c['received'], c['skipped_non_finite'], c['skipped_duplicate']) == (10, 1, 1)
     with pytest.raises(ValueError, match='2 channels'):
         est.process(t, np.ones((10, 3)))
+
+
+def test_a_mode_continues_a_track_only_with_a_similar_shape():
+    """``MAC_MATCH`` (0.5): a window's mode within MATCH_TOL of a tracked one continues it when
+    their shapes' MAC is 0.7 (the scatter of a weakly excited mode's shape), not when it is 0.3
+    (another mode at nearly the same frequency: a building's two bending directions)."""
+    from vib_estimator.core.multichannel import continues
+
+    last = np.array([1.0, 0.0, 0.0])
+    similar = np.array([1.0, math.sqrt(3 / 7), 0.0])  # MAC 0.7
+    other = np.array([1.0, 0.0, math.sqrt(7 / 3)])  # MAC 0.3
+    assert mac(similar, last) == pytest.approx(0.7) and mac(other, last) == pytest.approx(0.3)
+    assert continues(5.05, similar, 5.0, last) == pytest.approx(0.01)
+    assert continues(5.05, other, 5.0, last) is None
+    assert continues(5.05, last, 5.0, last) == pytest.approx(0.01)
+
+
+def test_close_modes_with_different_shapes_stay_two():
+    """``MAC_SAME`` (0.9): two modes 1 % apart (2.0 and 2.02 Hz, closer than MERGE_TOL), each
+    on its own channels, are two modes, each near its frequency (merged whatever their shapes,
+    one mode at 2.0 Hz is published)."""
+    modes = [(2.0, 0.005, 1.0), (2.02, 0.005, 1.0)]
+    shapes = np.array([[1.0, 0.0], [0.0, 1.0], [0.5, -0.5]])
+    t, y = modal_record(200.0, FS, modes, shapes, snr_db=20.0, seed=0)
+    e = JointAmbientEstimator(CONFIG, ['a', 'b', 'c']).process(t, y).estimates
+    late = e.t > 100.0
+    assert set(e.mode[late].tolist()) == {1, 2}
+    for mode, (f, _, _) in enumerate(modes, 1):
+        assert abs(np.median(e.frequency_hz[late & (e.mode == mode)]) / f - 1) < 0.005

@@ -169,3 +169,35 @@ def test_restart_forgets_the_modes_and_keeps_the_counters():
     assert np.isnan(again.mac[0])  # a new first estimate: the modes were forgotten
     assert est.counters['estimates'] == 2 * before['estimates']
     assert est.counters['rejected_fit'] == 2 * before['rejected_fit']
+
+
+def test_a_fit_that_ran_off_from_its_start_is_not_published():
+    """``MAX_MOVE`` (10 %): 5 Hz on channels a and c, a 7 Hz mode 3 x stronger on b and c; a
+    joint fit started from a channel's 5 Hz estimate that the 7 Hz mode pulled away is rejected
+    (``rejected_joint``): every published estimate lies within 5 % of a mode (published, one lay
+    13.7 % off)."""
+    t, low = decay(5.0, 0.01)
+    _, high = decay(7.0, 0.01, phase=1.0)
+    y = np.column_stack((low, 3 * high, 3 * high + 0.2 * low))
+    y += 0.02 * np.random.default_rng(0).standard_normal(y.shape)
+    estimator = create_estimator(EstimatorConfig(), NAMES)
+    est = estimator.process(t, y).estimates
+    off = np.min(np.abs(est.frequency_hz[:, None] / np.array([5.0, 7.0]) - 1), axis=1)
+    assert len(est) >= 40 and estimator.counters['rejected_joint'] >= 1
+    assert off.max() < 0.05
+
+
+def test_the_other_mode_is_a_term_of_the_fit_when_the_window_resolves_it():
+    """``MIN_SEPARATION`` (0.5 cycles): 5 and 7.5 Hz on every channel (``modes`` 2); each joint
+    fit carries the other mode as a term when the window holds half a cycle of their difference:
+    RMS errors 0.21 and 0.18 % (the other mode left out of every fit: 0.79 and 1.33 %; taken in
+    however close, unresolved ones included: 0.65 and 0.52 %)."""
+    t, low = decay(5.0, 0.01)
+    _, high = decay(7.5, 0.01, phase=1.0)
+    y = np.column_stack((low + 0.8 * high, low - 0.5 * high, 0.3 * low + high))
+    y += 0.02 * np.random.default_rng(0).standard_normal(y.shape)
+    est = create_estimator(EstimatorConfig(modes=2), NAMES).process(t, y).estimates
+    for f in (5.0, 7.5):
+        err = est.frequency_hz / f - 1
+        err = err[np.abs(err) < 0.03]
+        assert len(err) >= 15 and rms(err) < 0.004, (f, len(err), rms(err))

@@ -328,17 +328,16 @@ def test_executable_plays_to_the_end_and_exits_0(tmp_path):
 
 
 def test_replay_into_estimator_node_matches_analyze(ros_context, executor, monkeypatch, capsys):
-    """The estimator node fed by the replayer gives the floats ``vib-estimator analyze`` gives."""
+    """The estimator node fed by the replayer gives the floats ``vib-estimator analyze`` gives
+    with the node's configuration (``--excitation free``: the node cannot decide a free decay's
+    window from the record ahead, analyze's default can)."""
     from vib_estimator.cli import main
     from vib_estimator.nodes import estimator_node
 
     series = read_wrench_series(BAGS / 'arm_5_3')
-    assert (
-        main(
-            ['analyze', str(BAGS / 'arm_5_3'), '--topic', '/coupling_torque', '--format', 'jsonl']
-        )
-        == 0
-    )
+    bag = str(BAGS / 'arm_5_3')
+    args = ['analyze', bag, '--topic', '/coupling_torque', '--excitation', 'free']
+    assert main([*args, '--format', 'jsonl']) == 0
     offline = [json.loads(line)['frequency_hz'] for line in capsys.readouterr().out.splitlines()]
     assert len(offline) > 0
     # The input is best effort: when a loaded machine stalls this one-thread executor, the

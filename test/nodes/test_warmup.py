@@ -94,6 +94,38 @@ def test_the_default_estimates_uncompiled_while_it_compiles_then_switches_unseen
     assert stream.counters['received'] == len(t) and stream.counters['dropped_warmup'] == 0
 
 
+def test_held_samples_are_fed_in_slices_and_later_ones_wait_behind(monkeypatch):
+    """poll(budget_s) feeds at least one held sample and stops at its budget (the node's other
+    callbacks run between slices); samples held meanwhile are fed after the rest, the estimates
+    those of the whole stream in order, and the stream is ready once none is left."""
+    from vib_estimator.nodes import stream as S
+
+    monkeypatch.setattr(S, 'is_warm', lambda config: False)  # a warm-up, however compiled
+    config = EstimatorConfig(band_hz=(1.0, 20.0))  # held, not estimated uncompiled
+    stream = EstimatorStream(config, time.monotonic(), background=True)
+    assert not stream.ready and stream.compiling
+    t, y = _tone(2000)
+    stamps = (1_000_000_000 + np.round(t * 1e9)).astype(np.int64)
+    for k in range(1000):
+        stream.hold(int(stamps[k]), float(y[k]), k)
+    deadline = time.monotonic() + 120
+    while stream.poll(0.0) is None and time.monotonic() < deadline:  # the first slice: 1 sample
+        time.sleep(0.005)
+    got, polls, k = [], 1, 1000
+    while not stream.ready:
+        if k < len(t):  # one more arrives during each slice
+            stream.hold(int(stamps[k]), float(y[k]), k)
+            k += 1
+        got += stream.poll(0.0)
+        polls += 1
+    assert polls == len(t) == stream.counters['received']  # one sample a zero-budget slice
+    assert stream.poll(0.0) is None and stream.warmup_held == 1000
+    base = np.array([seconds_since(int(s), int(stamps[0])) for s in stamps])
+    direct = FrequencyEstimator(config).process(base, y)
+    assert [e.frequency_hz for _, estimates in got for e in estimates] == list(direct.frequency_hz)
+    assert [tag for tag, _ in got] == sorted(tag for tag, _ in got) and len(direct) > 5
+
+
 def test_a_full_warmup_buffer_drops_the_oldest_and_counts_them():
     stream = EstimatorStream(
         EstimatorConfig(refine=0, model='damped-sinusoid'), time.monotonic(), background=True

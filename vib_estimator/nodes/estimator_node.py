@@ -108,6 +108,15 @@ INPUT_DEPTH = 5000
 #: how often the end of a warm-up is looked for, and after how long it is announced, s
 WARMUP_POLL = 0.05
 WARMUP_NOTICE = 1.0
+#: at most this long (s) feeding the samples held during a warm-up in one callback: the rest in
+#: the next turns, the diagnostics and services between them (24 000 held samples fed at once
+#: kept /diagnostics silent for 5.4 s in a soak on a loaded machine)
+DRAIN_SLICE_S = 0.1
+#: the diagnostics are published from the data path when the timer's publication is this late
+#: (s since the last): the EventsExecutor runs the timer's event after every message event
+#: queued before it, and a node behind its input (a backlog after a stall, a starved CPU) once
+#: left /diagnostics silent for 2.4-3.2 s in a soak
+DIAGNOSTICS_OVERDUE = 1.5 * H.DIAGNOSTICS_PERIOD
 #: request history of the services: a burst of calls queues instead of being dropped (rclpy's
 #: default, 10, answered 21 of 100 simultaneous calls)
 SERVICE_DEPTH = 1000
@@ -314,6 +323,7 @@ class EstimatorNode(Node):
         say STALE) when sim time stops; while the kernels compile (a first start: see .stream),
         the poll looks for the end of the warm-up."""
         self._diagnostics_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
+        self._diagnostics_due = time.monotonic() + DIAGNOSTICS_OVERDUE
         steady = Clock(clock_type=ClockType.STEADY_TIME)
         self.create_timer(H.DIAGNOSTICS_PERIOD, self._publish_diagnostics, clock=steady)
         self._warmup_timer = self.create_timer(WARMUP_POLL, self._poll_warmup, clock=steady)
@@ -404,7 +414,7 @@ class EstimatorNode(Node):
         if self._mode_shapes is not None:
             self._mode_shapes.set_channels(self._channels)
         self._ready = self._stream.ready
-        if not self._ready:
+        if not self._ready or self._stream.compiling:  # (estimating uncompiled meanwhile)
             self._warmup_logged = False
             self._warmup_timer.reset()
         self.get_logger().info(
@@ -436,6 +446,8 @@ class EstimatorNode(Node):
 
     def _take(self, stamp: int, value, header: Header) -> None:
         """One sample: held during a warm-up, else estimated on and its estimates published."""
+        if time.monotonic() >= self._diagnostics_due:
+            self._publish_diagnostics(timer=False)
         if not self._ready:
             self._hold(stamp, value, header)
             return
@@ -449,6 +461,8 @@ class EstimatorNode(Node):
         handle = self._clock.handle
         with handle:
             now = handle.get_now().nanoseconds
+        if time.monotonic() >= self._diagnostics_due:
+            self._publish_diagnostics(timer=False)
         if not self._ready:
             self._hold(now, self._value(msg), None)
             return
@@ -506,16 +520,20 @@ class EstimatorNode(Node):
             )
 
     def _poll_warmup(self) -> None:
-        """At the end of a warm-up: install the estimator, estimate on the held samples (in order)
-        and say how long it took."""
+        """At the end of a warm-up: install the estimator, estimate on the held samples (in order,
+        :data:`DRAIN_SLICE_S` of them a turn) and say how long it took."""
         uncompiled = self._stream.ready  # estimating uncompiled meanwhile (see .stream)
         try:
-            drained = self._stream.poll()
+            drained = self._stream.poll(DRAIN_SLICE_S)
         except Exception as err:  # a compile that failed: say so, never a silent node
             self._warmup_timer.cancel()
             self.get_logger().error(f'the estimator kernels failed to compile: {err}')
             raise StartupError(f'the estimator kernels failed to compile: {err}') from None
         if drained is None:
+            if self._stream.ready and not self._stream.compiling:  # nothing left to wait for
+                self._warmup_timer.cancel()
+                self._ready = True
+                return
             if (
                 not self._warmup_logged
                 and self._stream.warmup_elapsed(time.monotonic()) > WARMUP_NOTICE
@@ -530,8 +548,6 @@ class EstimatorNode(Node):
                     f'{WARMUP_MESSAGE}: {meanwhile} (`vib-estimator warmup` compiles them ahead)'
                 )
             return
-        self._warmup_timer.cancel()
-        held = self._stream.held_samples
         for header, estimates in drained:
             self._publish(
                 estimates,
@@ -539,13 +555,16 @@ class EstimatorNode(Node):
                 if header is not None
                 else Header(stamp=Time(nanoseconds=self._stream.origin).to_msg()),
             )
+        if not self._stream.ready:  # more held: the next turn goes on
+            return
+        self._warmup_timer.cancel()
         self._ready = True
         dropped = self._stream.health.node_counters['dropped_warmup']
         seconds = self._stream.warmup_seconds
         meanwhile = (
             'estimated uncompiled meanwhile'
             if uncompiled
-            else f'{held} samples held meanwhile, {dropped} dropped'
+            else f'{self._stream.warmup_held} samples held meanwhile, {dropped} dropped'
         )
         self.get_logger().info(f'estimator kernels ready after {seconds:.1f} s ({meanwhile})')
 
@@ -618,14 +637,17 @@ class EstimatorNode(Node):
         if refused:
             self.get_logger().warn(f'the decided excitation was refused: {"; ".join(refused)}')
 
-    def _publish_diagnostics(self) -> None:
+    def _publish_diagnostics(self, timer: bool = True) -> None:
         """Publish the status; log the last estimate every 10 s (rclpy's throttled logging costs
-        ~0.15 ms a call, too much for the data path)."""
+        ~0.15 ms a call, too much for the data path). From the 1-s timer, or from the data path
+        when the timer's turn is late (``timer`` False: input flows, the watchdog is not asked)."""
         now = time.monotonic()
+        self._diagnostics_due = now + DIAGNOSTICS_OVERDUE
         for cadence in self._cadences:
             cadence.flush(now)
         status = self._stream.status(now)
-        self._watch_inputs(now)
+        if timer:
+            self._watch_inputs(now)
         if self._aligner is not None:
             counters = self._stream.health.node_counters
             lagging = self._aligner.lagging(round(H.STALE_AFTER * 1e9))

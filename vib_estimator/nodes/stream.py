@@ -26,7 +26,10 @@ start after an install). Meanwhile the node stays live (services, diagnostics), 
   :meth:`EstimatorStream.hold` keeps the samples that arrive, in order, up to
   :data:`WARMUP_BUFFER` (the oldest beyond it are dropped and counted in ``dropped_warmup``);
   :meth:`EstimatorStream.poll` installs the estimator once it is built and feeds it the held
-  samples.
+  samples, a slice of at most its ``budget_s`` seconds a call (the node's single thread answers
+  its services and publishes its diagnostics between slices; a minute of input held took seconds
+  to feed at once); samples that arrive meanwhile are held behind them, and
+  :attr:`EstimatorStream.ready` turns True once none is left.
 """
 
 from __future__ import annotations
@@ -36,7 +39,7 @@ import threading
 import time
 from collections import deque
 from functools import partial
-from typing import Any, Dict, Iterator, Optional, Sequence, Tuple
+from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -145,8 +148,9 @@ class EstimatorStream:
         self._build: Optional[_Build] = None
         self._held: deque = deque()
         self._self_test: Tuple[Any, Tuple[bool, str]] = (None, (False, ''))
-        #: seconds the last warm-up took (None before one ended)
+        #: seconds the last warm-up took (None before one ended), samples held when it ended
         self.warmup_seconds: Optional[float] = None
+        self.warmup_held = 0
         #: whether the input looks driven throughout, and what it needs (core.choice.StreamChoice)
         self._choice = StreamChoice(max(1, len(self.channels)))
         #: the excitation was last set by :meth:`decision` (not by the user)
@@ -168,9 +172,10 @@ class EstimatorStream:
 
     @property
     def ready(self) -> bool:
-        """False while a configuration's kernels compile and it cannot estimate meanwhile
-        (samples are held, not estimated: see the module doc)."""
-        return self.estimator is not None
+        """False while a configuration's kernels compile and it cannot estimate meanwhile, and
+        until the samples held meanwhile are fed (samples are held, not estimated: see the module
+        doc)."""
+        return self.estimator is not None and not self._held
 
     @property
     def compiling(self) -> bool:
@@ -256,31 +261,39 @@ class EstimatorStream:
             return self.health.count('dropped_warmup') == 1
         return False
 
-    def poll(self) -> Optional[Iterator[Tuple[Any, Sequence[Estimate]]]]:
-        """None while the warm-up goes on (or when there is none); once it has ended, install the
-        estimator and return an iterator of (tag, estimates) over the held samples, in order,
-        for those that complete estimates. Raises the build's error if it failed."""
+    def poll(self, budget_s: float = math.inf) -> Optional[List[Tuple[Any, Sequence[Estimate]]]]:
+        """None while the warm-up goes on (or when nothing is held); once it has ended, install
+        the estimator, feed it the held samples in order for up to ``budget_s`` seconds (at least
+        one), and return the (tag, estimates) of those that completed estimates. Call again until
+        :attr:`ready` (samples held after this call wait behind those left). Raises the build's
+        error if it failed."""
         build = self._build
-        if build is None or not build.done:
+        if build is not None:
+            if not build.done:
+                return None
+            if build.error is not None:
+                self._build = None
+                raise build.error
+            self.warmup_seconds = build.seconds
+            if build.estimator is None:  # estimating uncompiled meanwhile: the compiled kernel now
+                self._build = None
+                self.estimator.compiled()
+                return []
+            self.warmup_held = len(self._held)
+            self._install(build.estimator)
+        elif not self._held:
             return None
-        if build.error is not None:
-            self._build = None
-            raise build.error
-        self.warmup_seconds = build.seconds
-        if build.estimator is None:  # estimating uncompiled meanwhile: the compiled kernel now
-            self._build = None
-            self.estimator.compiled()
-            return iter(())
-        self._install(build.estimator)
-        return self._drain()
-
-    def _drain(self) -> Iterator[Tuple[Any, Sequence[Estimate]]]:
-        held = self._held
+        held, feed, clock = self._held, self.feed, time.monotonic
+        deadline = clock() + budget_s
+        out = []
         while held:
             stamp_ns, value, tag = held.popleft()
-            estimates = self.feed(stamp_ns, value)
+            estimates = feed(stamp_ns, value)
             if estimates:
-                yield tag, estimates
+                out.append((tag, estimates))
+            if clock() >= deadline:
+                break
+        return out
 
     def published(self, estimate: Estimate, now: float) -> None:
         """``estimate`` was published at ``now`` (monotonic s)."""

@@ -1,0 +1,106 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
+"""/diagnostics stay timely while estimator_node is behind its work (issue 40: a soak once saw
+them silent for 3.2 s, and 5.4 s at a start on a loaded machine). The node's single
+EventsExecutor thread runs the 1-s timer's event after every event queued before it, so:
+
+* the samples held during a warm-up are fed in slices (``DRAIN_SLICE_S`` a turn), the timer's
+  event between them (fed at once they were one long callback);
+* a node behind its input (a backlog: here each sample made to cost 2 ms, as on a starved CPU)
+  publishes its diagnostics from the data path once the timer's are ``DIAGNOSTICS_OVERDUE`` late.
+
+In process, through the node's topic; the publication times of /diagnostics are recorded at the
+node's publisher (a subscriber in the same executor would wait behind the same queue)."""
+
+from __future__ import annotations
+
+import threading
+import time
+
+import numpy as np
+
+from vib_estimator.nodes import estimator_node as E
+from vib_estimator.nodes import stream as S
+from vib_estimator.nodes.runner import spin_until
+
+from .test_estimator_node import make_probe, message, sine_stamps
+
+__all__ = ['make_probe']  # the fixture, used by name
+
+#: the samples of each phase, and what each costs the node (busy wall time, s): 4 s of work each
+SAMPLES = 2000
+COST_S = 0.002
+#: the most samples fed between two publications: with the timer and the overdue limit, at most
+#: a second and a half's (750: each sample costs at least COST_S; fewer when the machine is
+#: loaded); a whole phase's (2000) when the diagnostics wait behind it. Counted in samples, not
+#: seconds, so that a loaded machine slowing the whole test does not fail it.
+MOST_BETWEEN = SAMPLES // 2
+
+
+class Recorder:
+    """Stands for the node's /diagnostics publisher: at each publication, the samples fed."""
+
+    def __init__(self, publisher):
+        self.publisher = publisher
+        self.fed = 0  # samples fed so far (counted by :meth:`slow`)
+        self.at = []  # self.fed at each publication
+
+    def publish(self, msg) -> None:
+        self.at.append(self.fed)
+        self.publisher.publish(msg)
+
+    def slow(self, feed):
+        """``feed`` costing :data:`COST_S` of wall time a sample (a node starved of CPU)."""
+
+        def fed(stamp, value):
+            until = time.perf_counter() + COST_S
+            while time.perf_counter() < until:
+                pass
+            self.fed += 1
+            return feed(stamp, value)
+
+        return fed
+
+    def between(self, start: int, end: int) -> list:
+        """The samples fed between publications, from ``start`` fed to ``end``."""
+        marks = [start] + [n for n in self.at if start < n < end] + [end]
+        return list(np.diff(marks))
+
+
+def test_a_node_behind_its_work_publishes_its_diagnostics_every_second(make_probe, monkeypatch):
+    # a warm-up held until the test lets it end (its kernels are compiled: it ends at once)
+    release = threading.Event()
+    monkeypatch.setattr(S, 'is_warm', lambda config: False)
+    monkeypatch.setattr(S, 'warm', lambda config: release.wait(60.0))
+    monkeypatch.setattr(S, 'interpretable', lambda config, channels: False)  # held meanwhile
+    p = make_probe()
+    node = p.node
+    recorder = Recorder(node._diagnostics_pub)
+    node._diagnostics_pub = recorder
+    node._stream.feed = recorder.slow(node._stream.feed)
+    node._feed = node._stream.feed
+    stamps = sine_stamps(2 * SAMPLES)
+    values = np.sin(2 * np.pi * 1.33 * np.arange(2 * SAMPLES) / 500.0)
+    msgs = [message(p.input_type, 'torque.z', s, v) for s, v in zip(stamps, values)]
+
+    # 1. the warm-up's held samples, fed in slices
+    for msg in msgs[:SAMPLES]:
+        p.pub.publish(msg)
+    assert spin_until(p.executor, lambda: node._stream.held_samples == SAMPLES, 20.0)
+    assert not node._ready and recorder.fed == 0
+    release.set()
+    assert spin_until(p.executor, lambda: node._ready, 60.0), node._stream.held_samples
+    between = recorder.between(0, SAMPLES)
+    assert recorder.fed == SAMPLES and max(between) <= MOST_BETWEEN, between
+
+    # 2. a backlog of input in front of the timer's event
+    for msg in msgs[SAMPLES:]:
+        p.pub.publish(msg)
+    t0 = time.monotonic()
+    assert spin_until(p.executor, lambda: node.counters['received'] == 2 * SAMPLES, 60.0)
+    seconds = time.monotonic() - t0
+    between = recorder.between(SAMPLES, 2 * SAMPLES)
+    assert max(between) <= MOST_BETWEEN, between
+    # and not more often than the timer's period (one from the data path per late turn)
+    assert len(between) - 1 <= seconds / E.H.DIAGNOSTICS_PERIOD + 2, (between, seconds)
+    assert node.counters['received'] == 2 * SAMPLES and node.counters['samples_missing'] == 0
