@@ -43,7 +43,8 @@ from bench_operation import HCT_FILE, HCT_MODES, REAL_DATA, ssi_cov_window  # be
 
 from vib_estimator.core import EstimatorConfig, create_estimator
 from vib_estimator.core.ambient import HOP_S, AmbientEstimator
-from vib_estimator.core.multichannel import JOINT_BLOCK_ROWS, JointAmbientEstimator, mac
+from vib_estimator.core.multichannel import JointAmbientEstimator, mac
+from vib_estimator.core.ssi import block_rows
 from vib_estimator.extras import optional
 from vib_estimator.sim.frame import frame_record, modal_record
 
@@ -52,8 +53,8 @@ FRAME_FS = 50.0
 FRAME_S = 600.0
 WINDOW_S = 60.0
 ZETA = 0.02
-#: the peer's block rows (those of the joint identifier, ``multichannel.JOINT_BLOCK_ROWS``)
-PEER_ROWS = JOINT_BLOCK_ROWS
+#: the peer's block rows (those of the joint identifier with two channels, ``ssi.block_rows``)
+PEER_ROWS = block_rows(2)
 #: an estimate counts for a mode within this relative distance
 NEAR = 0.05
 

@@ -12,7 +12,7 @@ Tower record (one channel, ``--band-hz 0.5 6`` -- the published modes' range -- 
 window; skipped if ../shared is absent). Per true mode: this package's RMS and median error,
 share within 2 %, count beyond 5 %, damping median over the truth, RMS of error / its own
 frequency std (calibration: 0.7-1.5 is the goal); the share of spurious estimates (> 10 % from
-every mode); the Whittle bound (``core.ambient.whittle_std``, the asymptotic Cramer-Rao bound of a
+every mode); the Whittle bound (``core.whittle.whittle_std``, the asymptotic Cramer-Rao bound of a
 noise-driven mode in white noise over the window's samples) and the RMS error over it; the peer
 (pyOMA2 SSI-cov on consecutive 20 s windows, decimated to >= 4x the highest true frequency,
 block rows 40, orders to 30, the pole nearest the true frequency at order 20:
@@ -43,7 +43,7 @@ from pathlib import Path
 import numpy as np
 
 from vib_estimator.core import EstimatorConfig, create_estimator
-from vib_estimator.core.ambient import whittle_std
+from vib_estimator.core.whittle import whittle_std
 from vib_estimator.extras import optional
 from vib_estimator.sim.ambient import ambient_record
 

@@ -52,15 +52,18 @@ MODULES = tuple(
         'auto',
         'choice',
         'config',
+        'correlations',
         'estimator',
         'health_model',
         'kernel',
         'modes',
         'multichannel',
         'multichannel_free',
+        'ssi',
         'subspace',
         'uncertainty',
         'warmup',
+        'whittle',
     )
 ) + ('analysis/choosing.py', 'analysis/summary.py')
 
@@ -77,6 +80,7 @@ TESTS = {
         'test/analysis/test_choosing.py',
     ],
     'config': ['test/core/test_estimator.py'],
+    'correlations': ['test/core/test_ambient_incremental.py', 'test/core/test_ambient.py'],
     'estimator': ['test/core/test_estimator.py', 'test/core/test_bad_input.py'],
     'health_model': ['test/core/test_health_model.py'],
     'kernel': [
@@ -96,6 +100,7 @@ TESTS = {
     'multichannel_free': [
         'test/core/test_multichannel_free.py',
     ],
+    'ssi': ['test/core/test_ambient.py', 'test/core/test_multichannel.py'],
     'subspace': ['test/core/test_subspace.py', 'test/core/test_modes.py'],
     'uncertainty': [
         'test/core/test_estimator.py',
@@ -103,6 +108,7 @@ TESTS = {
         'test/core/test_kernel_reference.py',
     ],
     'warmup': ['test/nodes/test_warmup.py'],
+    'whittle': ['test/core/test_whittle_refinement.py', 'test/core/test_ambient.py'],
     'choosing': ['test/analysis/test_choosing.py'],
     'summary': ['test/analysis/test_summary.py'],
 }

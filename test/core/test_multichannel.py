@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from vib_estimator.core import EstimatorConfig
-from vib_estimator.core.ambient import correlation_matrices
+from vib_estimator.core.correlations import correlation_matrices
 from vib_estimator.core.multichannel import JointAmbientEstimator, mac, normalise_shape
 from vib_estimator.sim.arm_model import simulate_driven
 from vib_estimator.sim.frame import frame_record, modal_record, shear_frame

@@ -1,12 +1,13 @@
 # Copyright 2026 vib_estimator developers
 # SPDX-License-Identifier: Apache-2.0
-"""core.ambient.whittle_frequencies: the Whittle refinement of the identified frequencies."""
+"""core.whittle.whittle_frequencies: the Whittle refinement of the identified frequencies."""
 
 import math
 
 import numpy as np
+import pytest
 
-from vib_estimator.core.ambient import (
+from vib_estimator.core.whittle import (
     WHITTLE_MAX_DAMPING,
     WHITTLE_MIN_BINS,
     WHITTLE_REACH,
@@ -70,3 +71,32 @@ def test_what_it_leaves_alone_and_how_far_it_moves():
     rows = np.array([(5.05, MODE[1], 1.0)])
     moved = whittle_frequencies(y, FS, rows, noise, np.array([std]))[0]
     assert 0 < 5.05 - moved <= WHITTLE_REACH * std * (1 + 1e-6)
+
+
+def test_several_channels_refine_with_every_channel_and_one_column_is_one_channel():
+    """The likelihood of every channel refines to a smaller RMS error over 20 seeded windows than
+    the best channel's alone: the mode seen through its shape on four channels, each with its
+    own noise 10 dB above the mode's variance (there the measurement noise, which the channels
+    average, sets the error, not the excitation, which they share). One column with a unit
+    shape is the one-channel likelihood."""
+    from vib_estimator.sim.frame import modal_record
+
+    shape = np.array([1.0, -1.0, 1.0, 1.0])
+    unit = shape / np.linalg.norm(shape)
+    variance = float(np.sum(shape**2))  # the modal coordinate's, for a unit shape
+    n = round(SECONDS * FS)
+    joint, alone = [], []
+    for seed in range(20):
+        _, y = modal_record(SECONDS, FS, [MODE], shape[:, None], -10.0, seed)
+        noise = np.full(4, float(np.mean(shape**2)) * MODE[2] * 10.0)
+        bound = whittle_std([(MODE[0], MODE[1], MODE[2])], noise[0], FS, n)[0][0]
+        start = MODE[0] + (2 if seed % 2 else -2) * bound
+        rows = np.array([(start, MODE[1], variance * MODE[2])])
+        got = whittle_frequencies(y, FS, rows, noise, np.array([bound]), shapes=unit[None])
+        joint.append(got[0] - MODE[0])
+        one = np.array([(start, MODE[1], MODE[2])])
+        alone.append(whittle_frequencies(y[:, 0], FS, one, noise[0], np.array([bound]))[0] - 5)
+        column = whittle_frequencies(y[:, :1], FS, one, noise[:1], np.array([bound]), shapes=[[1]])
+        assert column[0] == pytest.approx(alone[-1] + 5, abs=1e-6 * bound)
+    rms = [math.sqrt(np.mean(np.square(e))) for e in (joint, alone)]
+    assert rms[0] < 0.9 * rms[1], rms  # 0.0256 against 0.0320 Hz

@@ -212,27 +212,24 @@ def spectrum_figure(path: Path, record: Record) -> None:
 def stabilisation_poles(record: Record):
     """(model orders, the SSI-cov poles of the record's last window at each order, the stable
     clusters' rows, the rate they are at), computed as the ambient estimators do
-    (:func:`..core.ambient.ssi_poles` / :func:`..core.multichannel.joint_poles` of the window's
-    correlations at the rate :func:`..core.ambient.decimation_level` picks for the highest
-    mode)."""
-    from ..core import ambient as A
-    from ..core.multichannel import joint_poles, joint_rows
+    (:func:`..core.ssi.ssi_poles` of the window's correlations at the rate
+    :func:`..core.ssi.decimation_level` picks for the highest mode)."""
+    from ..core import ssi
+    from ..core.ambient import COUNTER_NAMES
+    from ..core.correlations import CorrelationCascade
 
     fs = 1.0 / float(np.median(np.diff(record.t)))
     n = min(len(record.t), round(record.config.ambient_window_s * fs))
     y = record.y[-n:]
-    m = y.shape[1]
-    rows = A.BLOCK_ROWS if m == 1 else joint_rows(m)
-    cascade = A.CorrelationCascade.of(y, 2 * rows)
+    cascade = CorrelationCascade.of(y, 2 * ssi.block_rows(y.shape[1]))
     top = max((md.frequency_hz for md in record.modes), default=0.0)
-    level = A.decimation_level(cascade, fs, top) if top > 0 else 0
+    level = ssi.decimation_level(cascade, fs, top) if top > 0 else 0
     rate = fs / 2**level
-    r = cascade.correlations(level)
-    poles = A.ssi_poles(r[:, 0, 0], rate) if m == 1 else joint_poles(r, rate)
+    poles = ssi.ssi_poles(cascade.correlations(level), rate)
     band = record.config.band_hz or (0.0, math.inf)
-    counts = dict.fromkeys(A.COUNTER_NAMES, 0)
-    stable = A.stable_clusters(poles, rate, record.config.max_damping, band, counts)
-    return A.ORDERS, poles, stable, rate
+    counts = dict.fromkeys(COUNTER_NAMES, 0)
+    stable = ssi.stable_clusters(poles, rate, record.config.max_damping, band, counts)
+    return ssi.ORDERS, poles, stable, rate
 
 
 def stabilisation_figure(path: Path, record: Record) -> None:
