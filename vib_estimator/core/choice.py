@@ -184,7 +184,8 @@ def decide(t, y, channels: int = 1, window_s: float = 30.0, stream: bool = False
     """The :class:`Decision` for the record ``(t, y)`` (its first :data:`DECIDE_S` s are read;
     ``y`` samples or samples x ``channels``), ``window_s`` the shortest window (the configured
     one). ``stream``: the record is the last seconds of a stream that goes on (the window is not
-    bounded by the room for :data:`MIN_ANALYSES` analyses)."""
+    bounded by the room for :data:`MIN_ANALYSES` analyses, and a free decay's window is not
+    decided: :func:`fast_window`'s trial would run, maybe compile, in the node's executor)."""
     t = np.asarray(t, dtype=np.float64)
     y = np.asarray(y, dtype=np.float64)
     # finite samples at sane times (an absurd stamp, 1e300 s, would overflow the block index)
@@ -233,7 +234,13 @@ def decide(t, y, channels: int = 1, window_s: float = 30.0, stream: bool = False
             + f' Hz): the mode tracker, modes {modes}'
         )
     periods = math.nan
-    if excitation == 'free' and not modes and channels == 1 and math.isfinite(dominant):
+    # a stream (the node) keeps its window: the trial would compile the free-decay kernels there
+    if (
+        excitation == 'free'
+        and not (modes or stream)
+        and channels == 1
+        and math.isfinite(dominant)
+    ):
         periods, why = fast_window(t, y, dominant)
         seen += f'; {why}'
     rate = (len(t) - 1) / span
