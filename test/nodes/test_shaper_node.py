@@ -229,7 +229,9 @@ def test_parameters(ros_context, executor):
 
 def test_live_demo_short_run(tmp_path):
     """vib-estimator demo --shaping end to end (sim_node, estimator_node, shaper_node as
-    processes, in lockstep), on 6 simulated seconds per mass."""
+    processes, in lockstep), on 6 simulated seconds per mass. At speed 5: at 10 the shaper
+    takes 5000 /clock ticks a second, and on a loaded 2-core machine (a CI run on the Jazzy set)
+    its estimates queued behind them until the demo's end, so it designed nothing in time."""
     exe = Path(sys.executable).parent / 'vib-estimator'
     out = tmp_path / 'shaping.png'
     proc = subprocess.run(
@@ -240,7 +242,7 @@ def test_live_demo_short_run(tmp_path):
             '--seconds-per-mass',
             '6',
             '--speed',
-            '10',
+            '5',
             '--domain-id',
             os.environ['ROS_DOMAIN_ID'],
             '--out',

@@ -20,7 +20,7 @@ SOAK = Path(__file__).resolve().parents[2] / 'benchmarks' / 'soak.py'
 
 def test_a_minute_of_faults(tmp_path):
     out = tmp_path / 'soak.json'
-    args = ['--minutes', '1', '--fault-every', '8', '--seed', '4']
+    args = ['--minutes', '1', '--fault-every', '10', '--seed', '4']
     run = subprocess.run(
         [sys.executable, str(SOAK), *args, '--json', str(out)],
         capture_output=True,
