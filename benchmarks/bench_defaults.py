@@ -168,10 +168,7 @@ def streamed(path: Path, select: list[str]):
             stream.status(now=float(t[k]))
             decision = stream.decision()
             if decision is not None:
-                changes = {'excitation': decision.excitation}
-                if decision.excitation != 'free':
-                    changes['ambient_window_s'] = decision.window_s
-                stream.configure(stream.config.replace(**changes), prime=True)
+                stream.configure(stream.config.replace(**decision.changes()), prime=True)
                 stream.decided = True
                 decided.append(f'{decision.excitation} {decision.window_s:.0f} s at {t[k]:.0f} s')
     return 0, rows, ', '.join(decided), time.process_time() - start

@@ -166,8 +166,7 @@ def watch(t, y, step=100):
     w = DrivenWatch()
     out = []
     for k in range(0, len(t), step):
-        for a, b in zip(t[k : k + step].tolist(), y[k : k + step].tolist()):
-            w.update(a, b)
+        w.feed(t[k : k + step], y[k : k + step])
         out.append(w.driven())
     return out
 
@@ -243,8 +242,8 @@ def test_a_free_decay_of_several_modes_goes_to_the_mode_tracker(monkeypatch, nam
 
 
 def test_the_stream_choice_feeds_the_watch_in_batches_with_the_same_answers():
-    """StreamChoice feeds DrivenWatch in numpy batches (DrivenWatch.feed): the same answers as
-    sample by sample, however it is asked."""
+    """StreamChoice feeds DrivenWatch in numpy batches (DrivenWatch.feed) when asked: the
+    same answers as a watch fed sample by sample, however it is asked."""
     from vib_estimator.core.choice import DrivenWatch, StreamChoice
 
     t, y, _ = ambient_record(200, 100, [(1.2, 0.015, 1.0)], 20, 1)
@@ -254,7 +253,7 @@ def test_the_stream_choice_feeds_the_watch_in_batches_with_the_same_answers():
     one, batched = DrivenWatch(), StreamChoice()
     answers = []
     for k, (a, b) in enumerate(zip(t.tolist(), y.tolist())):
-        one.update(a, b)
+        one.feed(np.array([a]), np.array([b]))
         batched.update(a, b)
         if k % 337 == 0:
             answers.append((one.driven(), batched.driven(), one.freed(), batched.watch.freed()))

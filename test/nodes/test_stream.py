@@ -238,10 +238,7 @@ def decisions(stream, t, y, step=100, estimates=None):
         decision = stream.decision()
         if decision is not None:
             out.append((k // step, decision))
-            changes = {'excitation': decision.excitation}
-            if decision.excitation != 'free':
-                changes['ambient_window_s'] = decision.window_s
-            stream.configure(stream.config.replace(**changes), prime=True)
+            stream.configure(stream.config.replace(**decision.changes()), prime=True)
             stream.decided = True
     return out
 

@@ -126,6 +126,13 @@ class Decision:
     #: a free decay of one mode: the window it allows (:func:`fast_window`; NaN: the configured)
     min_periods: float = math.nan
 
+    def changes(self) -> dict:
+        """The configuration fields a stream switching to this decision sets (the node's
+        parameters): the excitation, and a driven one's window."""
+        if self.excitation == 'free':
+            return {'excitation': 'free'}
+        return {'excitation': self.excitation, 'ambient_window_s': float(self.window_s)}
+
 
 def principal_component(y: np.ndarray) -> np.ndarray:
     """One signal from ``y`` (samples, or samples x channels): the projection of the centred
@@ -338,32 +345,25 @@ class DrivenWatch:
     in the blocks auto's envelope (:class:`.auto.Envelope`, its block following the free
     estimates' frequency) read as driven above :data:`DRIVEN_ABOVE`, their mean level at least
     :data:`LIVE_LEVEL` of the largest block's (not the noise a decay rang down into) and the
-    envelope driven now. Fed sample by sample (:meth:`update`, which marks the energies every
-    1 % of :data:`WATCH_S` of stream time, however fast it is fed), asked at any pace
-    (:meth:`driven`)."""
+    envelope driven now. Fed in batches (:meth:`feed`, which marks the energies every 1 % of
+    :data:`WATCH_S` of stream time, however fast it is fed), asked at any pace (:meth:`driven`)."""
 
     def __init__(self):
         self._envelope = Envelope(4 * MIN_BLOCK_S, MAX_WINDOW_S / 10)
         self._marks: deque = deque()  # (stream time, free energy, driven energy)
         self._last_t = math.nan
 
-    def update(self, t: float, y: float) -> None:
-        env = self._envelope
-        env.update(t, y)
-        self._last_t = t
-        marks = self._marks
-        if not marks or t - marks[-1][0] >= WATCH_S / 100:  # in stream time, however fast fed
-            self._mark(t)
-
     def feed(self, t: np.ndarray, y: np.ndarray) -> None:
-        """:meth:`update` for arrays (the same states and marks, in a few numpy passes)."""
+        """Samples ``(t, y)`` (arrays), in a few numpy passes: the energies are marked at the
+        first sample and then every 1 % of :data:`WATCH_S` of stream time, however fast the
+        stream is fed, so any batching gives the same marks."""
         start, n = 0, len(t)
         while start < n:
             end = start + 1  # the first sample is marked
             if self._marks:  # else up to the next sample to mark at
                 later = np.flatnonzero(t[start:] - self._marks[-1][0] >= WATCH_S / 100)
                 end = start + int(later[0]) + 1 if len(later) else n + 1
-            with np.errstate(over='ignore', invalid='ignore'):  # as update's floats: inf
+            with np.errstate(over='ignore', invalid='ignore'):  # a huge sample: inf energy
                 self._envelope.feed(t[start:end], y[start:end])
             self._last_t = float(t[min(end, n) - 1])
             if end <= n:

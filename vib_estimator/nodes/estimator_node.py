@@ -621,9 +621,7 @@ class EstimatorNode(Node):
         decision = self._stream.decision()
         if decision is None:
             return
-        changes = [Parameter('excitation', value=decision.excitation)]
-        if decision.excitation != 'free':
-            changes.append(Parameter('ambient_window_s', value=float(decision.window_s)))
+        changes = [Parameter(name, value=value) for name, value in decision.changes().items()]
         self.get_logger().info(
             f'excitation {self._stream.config.excitation} -> {decision.excitation}: '
             f'{decision.reason} (decide_excitation:=false keeps the configured excitation)'

@@ -354,7 +354,7 @@ class EstimatorStream:
         enough (:func:`~vib_estimator.core.choice.window_advice`), computed at most every
         :data:`~vib_estimator.core.choice.WATCH_S` / 2 s of stream; else None."""
         config = self.config
-        since = self._estimated_at if self._estimated_at is not None else self._first_t()
+        since = self._estimated_at if self._estimated_at is not None else 0.0
         if config.excitation == 'free' or since is None or self.last_t is None:
             return None
         silent = self.last_t - since
@@ -369,10 +369,6 @@ class EstimatorStream:
         if not advice:
             return None
         return f'no mode for {silent:.0f} s: {advice}'
-
-    def _first_t(self) -> Optional[float]:
-        """Stream time of the first sample (0.0), None before any."""
-        return None if self.origin is None else 0.0
 
     def decision(self) -> Optional[Decision]:
         """What the input needs now, if not what runs (``decide_excitation``; after
