@@ -172,9 +172,6 @@ LONG_WINDOW_PERIODS = 0.75
 #: spans this many periods (the default window's; the noisy decays of bench_first_estimate.py
 #: then keep that window's accuracy in their tails and publish earlier where they are precise)
 HELD_PERIODS = 1.25
-#: ... and a segment's fit may start at the previous estimate when its algebraic estimate, not
-#: yet converged, agrees with it within ``consistency``, or this fraction with that gate off
-EARLY_AGREE = 0.03
 #: automatic max_window: this long at least (s), and min_periods + this many periods
 AUTO_WINDOW_S = 10.0
 AUTO_WINDOW_PERIODS = 2.0
@@ -845,12 +842,12 @@ def _long_window_spanned(p, s, c, m, one_sided, model, tau, f, damping):
 def _early_start(p, s, tau, f):
     """``early_std_rel``: True when a segment whose algebraic estimate ``f`` has not passed the
     convergence test spans ``min_periods`` periods of the previous segment's estimate and ``f``
-    agrees with it within ``consistency`` (else :data:`EARLY_AGREE`): the same mode, so the fit
-    may start there. Not once the segment is held (:func:`_held`)."""
+    agrees with it within ``consistency`` (off with that gate off): the same mode, so the fit may
+    start there. Not once the segment is held (:func:`_held`)."""
     prev = s[S_FPREV]
     if p[P_EARLY] <= 0.0 or prev <= 0.0 or s[S_HELD] or tau * prev < p[P_MINPER]:
         return False
-    return abs(f - prev) <= (p[P_CONSIST] if p[P_CONSIST] > 0.0 else EARLY_AGREE) * prev
+    return abs(f - prev) <= p[P_CONSIST] * prev
 
 
 @jit(inline='always')
