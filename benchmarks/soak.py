@@ -583,12 +583,21 @@ class Soak:
             # windows take to come (not a steady time: a loaded machine slows the simulator and
             # the node alike)
             taken_in, window = self.taken(), self.window_samples()
+            flowing = [taken_in, time.monotonic()]  # the last count taken, and when it grew
 
             def estimated():
                 return len(self.watch.estimates['/']) > n_est
 
             def gave_up():
-                return self.taken() - taken_in > RECOVERY_WINDOWS * window
+                # enough data and no estimate, or the input gone again for a fault's spacing
+                # (deaf after a few messages)
+                taken = self.taken()
+                if taken > flowing[0]:
+                    flowing[:] = [taken, time.monotonic()]
+                return (
+                    taken - taken_in > RECOVERY_WINDOWS * window
+                    or time.monotonic() - flowing[1] > self.args.fault_every
+                )
 
             self.spin(
                 (end if got else min(next_at, end)) - time.monotonic(),
@@ -606,6 +615,8 @@ class Soak:
                 f['recovered'] = False if next_at < end else None
             else:
                 f['recovered'] = False if gave_up() else None
+                if time.monotonic() - flowing[1] > self.args.fault_every:
+                    f['deaf'] = True  # input again for a moment, then none
             next_at = max(next_at, time.monotonic())
             self.faults.append(f)
             print(
@@ -733,6 +744,8 @@ class Soak:
                     + (
                         'no input before the next fault'
                         if f['input_s'] != f['input_s']
+                        else 'input again, then none (deaf)'
+                        if f.get('deaf')
                         else f'no estimate within {RECOVERY_WINDOWS:g} estimator windows of input'
                     )
                 )
