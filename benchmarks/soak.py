@@ -14,7 +14,7 @@ its defaults, free decays, on the noise-driven arm: median error 0.8 %, the wors
 This process watches ``/diagnostics``, ``vibration/frequency`` and ``vibration/ground_truth`` and
 injects the faults, in turn from a seeded shuffle of:
 
-* ``stop``: SIGSTOP of estimator_node for 2 s, then SIGCONT;
+* ``stop``: SIGSTOP of estimator_node for 2 s (``--stop-s``), then SIGCONT;
 * ``restart``: sim_node stopped (SIGINT) and started again: its time goes back to 1 s;
 * ``storm``: 200 parameter sets within a second, every other one invalid (each must be answered,
   the invalid refused, the valid accepted);
@@ -26,12 +26,14 @@ injects the faults, in turn from a seeded shuffle of:
 
 Measured: estimator_node's RSS every second (growth after the first tenth of the run), each
 fault's recovery (steady seconds from its end to the next message taken and to the next estimate
-published), the diagnostics' longest silence outside the stops, the counters' identities
+published; the estimator windows of data the node took from one to the other), the
+diagnostics' longest silence outside the stops, the counters' identities
 (docs/nodes.md#what-the-counters-count) at the end, estimates within 2 % of the simulator's
 ground truth outside the fault windows (a fault's window: from its start until the estimator's
 window, 30 s of simulated time, has moved past its end and the backlog drained), the
 logs' tracebacks, and each node's exit code and time after SIGINT. ``--json`` writes the
-figures. Exit 1 when a goal fails (every fault recovered before the next, identities hold, every
+figures. Exit 1 when a goal fails (every fault recovered: input again before the next fault and
+an estimate within 3 estimator windows of data, 2 after a stop; identities hold, every
 burst message accounted for, every call answered, no traceback, exit 0 within 2 s).
 """
 
@@ -83,6 +85,16 @@ ACCURACY = 0.02
 START_S = 60.0
 #: shaper_node's reference moves every this many seconds (0 and 0.5 rad in turn)
 REFERENCE_EVERY_S = 3.0
+#: a fault's figures the soak prints in its own words (the others: name and value)
+SHOWN = ('kind', 'start', 'end', 'input_s', 'estimate_s', 'windows', 'recovered')
+#: a fault is recovered by an estimate within this many estimator windows of data taken after
+#: input came again
+RECOVERY_WINDOWS = 3.0
+#: after a stop of the node, an estimate within this many (one window of data when the stall
+#: restarted the estimator; a second for what was taken before the restart point)
+STALL_WINDOWS = 2.0
+#: sim_node's sampling rate, Hz (the estimator's sample_rate_hz until its diagnostics say it)
+SAMPLE_RATE_HZ = 500.0
 #: the hidden soak's RSS limit (issue 40: 20 MB growth; 10 MB after the first 10 min of 8 h)
 RSS_GROWTH_MB = 20.0
 
@@ -360,7 +372,7 @@ class Soak:
     # ---- faults ----------------------------------------------------------------------------
     def fault_stop(self, f) -> None:
         self.est.signal(signal.SIGSTOP)
-        time.sleep(2.0)  # the node is stopped: nothing to spin for it
+        time.sleep(self.args.stop_s)  # the node is stopped: nothing to spin for it
         self.est.signal(signal.SIGCONT)
 
     def fault_restart(self, f) -> None:
@@ -553,8 +565,11 @@ class Soak:
                 self.rng.shuffle(order)
             self.spin(max(0.0, next_at - time.monotonic()))
             kind = order.pop()
-            if time.monotonic() + FAULT_S[kind] > end:  # it would not end (and a node restarted
-                break  # then stopped in its first second dies of the KeyboardInterrupt)
+            longer = max(0.0, self.args.stop_s - 2.0) if kind == 'stop' else 0.0
+            # it would not end (and a node restarted then stopped in its first second dies of
+            # the KeyboardInterrupt)
+            if time.monotonic() + FAULT_S[kind] + longer > end:
+                break
             f = {'kind': kind, 'start': time.monotonic()}
             taken0 = self.taken()
             getattr(self, f'fault_{kind}')(f)
@@ -564,30 +579,81 @@ class Soak:
             limit = min(next_at, end) - time.monotonic()
             got = self.spin(limit, lambda: self.taken() > taken0 + 100)
             f['input_s'] = time.monotonic() - f['end'] if got else math.nan
-            got = self.spin(
-                min(next_at, end) - time.monotonic(),
-                lambda: len(self.watch.estimates['/']) > n_est,
+            # then an estimate, waited for as long as the data of RECOVERY_WINDOWS estimator
+            # windows take to come (not a steady time: a loaded machine slows the simulator and
+            # the node alike)
+            taken_in, window = self.taken(), self.window_samples()
+            flowing = [taken_in, time.monotonic()]  # the last count taken, and when it grew
+
+            def estimated():
+                return len(self.watch.estimates['/']) > n_est
+
+            def gave_up():
+                # enough data and no estimate, or the input gone again for a fault's spacing
+                # (deaf after a few messages)
+                taken = self.taken()
+                if taken > flowing[0]:
+                    flowing[:] = [taken, time.monotonic()]
+                return (
+                    taken - taken_in > RECOVERY_WINDOWS * window
+                    or time.monotonic() - flowing[1] > self.args.fault_every
+                )
+
+            self.spin(
+                (end if got else min(next_at, end)) - time.monotonic(),
+                lambda: estimated() or gave_up(),
             )
+            got = estimated()
             f['estimate_s'] = time.monotonic() - f['end'] if got else math.nan
+            # estimator windows of data taken from input taken again to an estimate (the
+            # diagnostics' count, up to a second old: lenient by a second's samples)
+            f['windows'] = (self.taken() - taken_in) / window if got else math.nan
             # a fault whose recovery the end of the run cut short is not judged (None)
-            f['recovered'] = got if got or next_at < end else None
+            if got:
+                f['recovered'] = True
+            elif f['input_s'] != f['input_s']:
+                f['recovered'] = False if next_at < end else None
+            else:
+                f['recovered'] = False if gave_up() else None
+                if time.monotonic() - flowing[1] > self.args.fault_every:
+                    f['deaf'] = True  # input again for a moment, then none
+            next_at = max(next_at, time.monotonic())
             self.faults.append(f)
             print(
                 f'{f["start"] - self.t0:7.1f} s  {kind:8s} input after {f["input_s"]:5.2f} s, '
-                f'estimate after {f["estimate_s"]:5.2f} s'
+                f'estimate after {f["estimate_s"]:5.2f} s ({f["windows"]:.2f} windows after input)'
                 + ''.join(
                     f', {k} {f[k]:.0f}' if isinstance(f[k], float) else f', {k} {f[k]}'
                     for k in f
-                    if k not in ('kind', 'start', 'end', 'input_s', 'estimate_s', 'recovered')
+                    if k not in SHOWN
                 ),
                 flush=True,
             )
         self.spin(max(0.0, end - time.monotonic()))
         return self.finish()
 
+    def window_samples(self) -> float:
+        """The samples of one estimator window: :meth:`window_s` at the input's rate (the
+        estimator's ``sample_rate_hz``, else the simulator's 500 Hz)."""
+        rows = self.watch.diag.get('/estimator_node') or [(0, 0, '', {})]
+        try:
+            rate = float(rows[-1][3].get('sample_rate_hz', 'nan'))
+        except ValueError:
+            rate = math.nan
+        return self.window_s() * (rate if rate > 0 else SAMPLE_RATE_HZ)
+
+    def window_s(self) -> float:
+        """The estimator's analysis window, simulated s (``-p ambient_window_s:=``, else its
+        default)."""
+        given = [a.split(':=')[1] for a in self.args.estimator_args if 'ambient_window_s:=' in a]
+        return float(given[-1]) if given else WINDOW_S
+
     def finish(self) -> dict:
         figures = {'faults': self.faults}
         exits = {}
+        # no reference after this: one sent in the last second before the shaper's counters are
+        # read below was not in them yet ('shaper: 118 references of 119', ~1 run in 3)
+        self.watch.reference_at = math.inf
         # the sources first (sim_node, bag_replayer); the nodes they feed publish what they
         # took, then their counters are read and they are stopped
         sources = [p for p in self.procs if p.name in ('sim_node', 'bag_replayer')]
@@ -674,8 +740,19 @@ class Soak:
         for f in self.faults:
             if f['recovered'] is False:
                 self.problems.append(
-                    f'{f["kind"]} at {f["start"] - self.t0:.0f} s: no estimate before the next '
-                    'fault'
+                    f'{f["kind"]} at {f["start"] - self.t0:.0f} s: '
+                    + (
+                        'no input before the next fault'
+                        if f['input_s'] != f['input_s']
+                        else 'input again, then none (deaf)'
+                        if f.get('deaf')
+                        else f'no estimate within {RECOVERY_WINDOWS:g} estimator windows of input'
+                    )
+                )
+            elif f['kind'] == 'stop' and f['windows'] > STALL_WINDOWS:
+                self.problems.append(
+                    f'stop at {f["start"] - self.t0:.0f} s: an estimate {f["windows"]:.1f} '
+                    'estimator windows after input was taken again'
                 )
         for name, mb in growth.items():
             # (a shorter run's first tenth is the start-up, the estimator's buffer filling)
@@ -696,7 +773,10 @@ class Soak:
 
 
 def report(fig: dict) -> None:
-    print('\nfault     n  recovered  input resumed (s, max)  estimate resumed (s, median / max)')
+    print(
+        '\nfault     n  recovered  input resumed (s, max)  estimate resumed (s, median / max)'
+        '  windows after input (max)'
+    )
     for kind in FAULTS:
         rows = [f for f in fig['faults'] if f['kind'] == kind]
         if not rows:
@@ -706,10 +786,12 @@ def report(fig: dict) -> None:
         judged = sum(f['recovered'] is not None for f in rows)
         ok = sum(f['recovered'] is True for f in rows)
         median = est[len(est) // 2] if est else math.nan
+        windows = [f['windows'] for f in rows if f['windows'] == f['windows']]
         print(
             f'{kind:8s} {len(rows):2d}  {ok:2d}/{judged:<2d}      '
             f'{max(inp, default=math.nan):6.2f}                  '
             f'{median:6.2f} / {max(est, default=math.nan):6.2f}'
+            f'                 {max(windows, default=math.nan):5.2f}'
         )
     c = fig['counters']
     print(
@@ -776,6 +858,9 @@ def main(argv=None) -> int:
     parser.add_argument('--fault-every', type=float, default=24.0, help='seconds between faults')
     parser.add_argument('--speed', type=float, default=10.0, help="sim_node's speed")
     parser.add_argument('--seed', type=int, default=0, help='seed of the fault schedule')
+    parser.add_argument(
+        '--stop-s', type=float, default=2.0, help="a stop's length: SIGSTOP to SIGCONT, s"
+    )
     parser.add_argument(
         '--excitation', default='ambient', help="sim_node's excitation (ambient: never at rest)"
     )

@@ -5,6 +5,8 @@ drained backlog told from a live stream, a jump not counted as lost samples (iss
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -165,6 +167,17 @@ def test_the_watchdog_does_not_count_the_time_the_node_itself_was_held():
     assert fired(w, 16.0, 20.0, 9.9) == [17.0]  # 3 s after the node ran again
 
 
+def test_a_message_taken_just_before_the_node_was_held_does_not_start_the_silence_there():
+    """The estimator_node's log of a 5-s SIGSTOP: checked at 37.27 s, a message taken at 37.72 s,
+    stopped, checked again at 42.73 s -- it re-created the subscription at once ('no message
+    taken for 5.0 s'): the silence was measured from the message taken before the stall."""
+    w = C.Watchdog()
+    for t in (35.25, 36.25, 37.25):
+        assert not w.check(t, t, 1, math.nan)  # data flows
+    assert not w.check(42.75, 37.75, 1, math.nan)  # held from 37.75: the silence starts now
+    assert [t for t in (43.75, 44.75, 46.0) if w.check(t, 37.75, 1, math.nan)] == [46.0]
+
+
 @pytest.mark.parametrize(
     'name, factor, test',
     [
@@ -197,6 +210,11 @@ def test_the_watchdog_does_not_count_the_time_the_node_itself_was_held():
             'WATCHDOG_HELD_S',
             1e-3,
             test_the_watchdog_recreates_a_silent_subscription_once_then_backs_off,
+        ),
+        (
+            'WATCHDOG_HELD_S',
+            1e3,
+            test_a_message_taken_just_before_the_node_was_held_does_not_start_the_silence_there,
         ),
     ],
 )

@@ -205,12 +205,13 @@ class Watchdog:
         ``taken_at`` (steady s; 0: none yet), ``matched`` publishers, input expected every
         ``period_s`` steady s (NaN: unknown)."""
         held, self._checked = now - self._checked > WATCHDOG_HELD_S, now
-        if held:  # the node itself was held (stopped, starved): no silence measured across it
-            self._since = max(self._since, now)
         if taken_at > self._taken_at:  # data flows: a new episode may start
             self._taken_at = self._since = taken_at
             self._wait = WATCHDOG_MIN_S
             self.episode = 0
+        if held:  # the node itself was held (stopped, starved): no silence measured across it
+            # (after the message taken: one taken just before the stall began is older than it)
+            self._since = max(self._since, now)
         if self._taken_at <= 0.0 or matched <= 0:
             return False
         wait = self._wait

@@ -14,7 +14,9 @@ node is destroyed, and the process exits 0 (before :func:`run`, while the module
 ends the process at once: :mod:`.stopping`). The
 executor is :class:`rclpy.experimental.EventsExecutor`: measured by ``benchmarks/bench_node.py`` it
 sustains several times the message rate of the default ``SingleThreadedExecutor`` on this package's
-workload (see the README's figures).
+workload (see the README's figures). Each node's participant talks UDP only unless the user
+chooses its transports (:func:`stall_safe_transports`: shared memory left a node deaf for good
+after a stall of its own, docs/nodes.md#never-deaf).
 """
 
 from __future__ import annotations
@@ -74,6 +76,27 @@ def init_or_error(args: Optional[Sequence[str]]) -> Optional[str]:
     return error
 
 
+#: the Fast DDS environment variable that chooses a participant's transports (Fast DDS >= 2.13)
+TRANSPORTS_VARIABLE = 'FASTDDS_BUILTIN_TRANSPORTS'
+#: this package's nodes' default: UDP only. Fast DDS's shared-memory transport takes a reader that
+#: has not read its port for about two health-check periods (1 s each) for dead -- a process
+#: stopped or starved of CPU for 2 s -- and the writers and the reader, when it runs again,
+#: re-create its port; in Fast DDS 2.14 one side can be left on a segment the other has removed,
+#: and the node stays deaf to that writer for good (re-creating the subscription does not change
+#: the participant's port). Over UDP a stalled reader only loses what its socket could not hold.
+NODE_TRANSPORTS = 'UDPv4'
+
+
+def stall_safe_transports(environ=os.environ) -> bool:
+    """Set the nodes' transports (:data:`NODE_TRANSPORTS`) unless the user chose some
+    (:data:`TRANSPORTS_VARIABLE` already set, e.g. ``DEFAULT`` for shared memory again); True when
+    set. Before ``rclpy.init``: the participant reads it when it is created."""
+    if environ.get(TRANSPORTS_VARIABLE):
+        return False
+    environ[TRANSPORTS_VARIABLE] = NODE_TRANSPORTS
+    return True
+
+
 def make_executor(context=None):
     """Return the executor the package's nodes spin in (one place to change it)."""
     return EventsExecutor(context=context)
@@ -120,6 +143,7 @@ def run(
     be finished at SIGINT, still fails the process).
     """
     stop = StopRequest()
+    stall_safe_transports()
     error = init_or_error(args)
     if error is not None:
         print(f'error: {error}', file=sys.stderr)
