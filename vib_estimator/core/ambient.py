@@ -179,6 +179,7 @@ class SlidingWindowIdentifier(Estimator):
         """Forget the signal and the tracked modes; counters are kept."""
         self._tracks = []
         self._last = -math.inf
+        self._since_search = math.inf  # analyses since the last search (the first searches)
         self._clear()
 
     def reset(self) -> None:
@@ -347,8 +348,15 @@ class SlidingWindowIdentifier(Estimator):
             return None
         span = float(ts[-1] - ts[0])
         self._c['analyses'] += 1
-        known = max((tr.frequency for tr in self._tracks if tr.published), default=0.0)
-        search = self._c['analyses'] % SEARCH_EVERY == 1
+        # the highest mode tracked: while a mode is published, a new one a search found above it
+        # is identified at every analysis until it is confirmed or lost (not only by the next
+        # search: CONFIRM_BESIDE analyses running would never see it)
+        tracks = self._tracks
+        known = max((tr.frequency for tr in tracks), default=0.0)
+        if not any(tr.published for tr in tracks):
+            known = 0.0
+        search = self._since_search >= SEARCH_EVERY - 1
+        self._since_search = 0 if search else self._since_search + 1
         return ts, self._cascade, (len(ts) - 1) / span, span, known, search
 
     def _slide(self) -> np.ndarray:
