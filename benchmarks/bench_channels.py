@@ -41,7 +41,7 @@ from pathlib import Path
 import numpy as np
 from bench_operation import HCT_FILE, HCT_MODES, REAL_DATA, ssi_cov_window  # benchmarks/
 
-from vib_estimator.core import EstimatorConfig, create_estimator
+from vib_estimator.core import EstimatorConfig, ambient, create_estimator
 from vib_estimator.core.ambient import HOP_S, AmbientEstimator
 from vib_estimator.core.multichannel import JointAmbientEstimator, mac
 from vib_estimator.core.ssi import block_rows
@@ -90,6 +90,16 @@ def peer(y, fs, freqs):
     return [np.array(e) for e in errs], [np.array(z) for z in zetas], ends
 
 
+def joint_every_second(config, names, t, y):
+    """The joint identifier's output with an analysis every :data:`ambient.HOP_S` whatever the
+    window."""
+    share, ambient.HOP_SHARE = ambient.HOP_SHARE, 0.0
+    try:
+        return JointAmbientEstimator(config, names).process(t, y)
+    finally:
+        ambient.HOP_SHARE = share
+
+
 def same_windows(t, estimates, j, f, ends, hop):
     """Pairs (joint error, index into the peer's list) of the joint estimates of mode ``j``
     whose window is a peer window (its end within half a ``hop`` of the window's last sample)."""
@@ -117,7 +127,9 @@ def frame(seeds, with_peer):
     for seed in range(1, seeds + 1):
         t, y, freqs, shapes = frame_record(FRAME_S, FRAME_FS, ZETA, 20.0, seed)
         names = [f's{i}' for i in range(1, 6)]
-        r = JointAmbientEstimator(config, names).process(t, y)
+        # every second (HOP_S), not every hop_s of the window: the peer's windows, which end on
+        # whole seconds, are then among the identifier's (same_windows)
+        r = joint_every_second(config, names, t, y)
         e = r.estimates
         errs = per_mode(e.frequency_hz, freqs)
         rel = e.frequency_hz[:, None] / freqs[None, :] - 1

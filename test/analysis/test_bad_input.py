@@ -130,7 +130,7 @@ def test_a_constant_signal_in_operation_says_so():
         text.encode(), '--columns', 'zero,a,b', '--excitation', 'ambient', '--format', 'jsonl'
     )
     rows = [json.loads(line) for line in out.splitlines()]
-    assert code == 0 and len(rows) >= 10
+    assert code == 0 and len(rows) >= 5  # (6: 30-32 s, then the 30 s window every 5 s)
     assert all(abs(r['frequency_hz'] / 3 - 1) < 0.05 and r['shape_zero'] == 0 for r in rows)
 
 

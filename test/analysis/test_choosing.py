@@ -73,7 +73,7 @@ def test_a_driven_record_gets_the_identifier_and_its_modes(capsys, driven):
     f = np.array([r['frequency_hz'] for r in rows])
     for true in (2.0, 7.0):
         near = np.abs(f / true - 1) <= 0.02
-        assert near.sum() > 20
+        assert near.sum() > 10  # (13-14: the 60 s window every 5 s once confirmed)
     assert np.all(np.min(np.abs(f[:, None] / [2.0, 7.0] - 1), axis=1) <= 0.05)
     # the summary is per mode; the window option keeps its value
     assert 'mode 1: f = 2.0' in err and 'mode 2: f = 7.0' in err
@@ -136,7 +136,7 @@ def test_no_mode_from_a_short_window_says_which_window_helps(capsys, tmp_path):
     assert 'the record is shorter than one window (--ambient-window-s 300; it spans 200 s' in err
     # the default sizes the window itself and finds the mode
     rows, err = analyze(capsys, path)
-    assert 'window 140 s' in err and len(rows) > 40
+    assert 'window 140 s' in err and len(rows) > 10  # (13: every 5 s once confirmed)
     err = np.abs(np.array([r['frequency_hz'] for r in rows]) / 0.5 - 1)
     assert np.mean(err <= 0.02) >= 0.9 and np.all(err <= 0.05)  # issue 37's driven goals
 

@@ -63,7 +63,7 @@ def test_each_stretch_has_the_right_kind_of_estimates(record):
     assert len(err) >= 10 and not ambient.any() and np.all(np.abs(err) < 0.02)
     # driven, once recognised: the identifier's estimates, within tolerance
     err, ambient = _stretch(e, DRIVEN[0] + MARGIN, DRIVEN[1])
-    assert len(err) >= 50 and np.mean(ambient) >= 0.95
+    assert len(err) >= 15 and np.mean(ambient) >= 0.95  # (23: the 30 s window every 5 s)
     assert np.mean(np.abs(err[ambient]) <= 0.02) >= 0.95 and np.all(np.abs(err) < 0.05)
     # back to free after the pluck: the free-decay estimates again
     err, ambient = _stretch(e, PLUCK + 1.0, FREE2[1])
@@ -169,9 +169,13 @@ def test_a_second_mode_is_neither_noise_nor_misfit(monkeypatch):
     assert verdicts()[1].count(True) >= 3
 
 
-def test_the_identifier_idles_in_free_stretches(record):
+def test_the_identifier_idles_in_free_stretches(record, monkeypatch):
     """The identifier slides its window but identifies nothing while the envelope reads free: on
-    a free decay it never analyses; on the record it analyses only the driven stretch."""
+    a free decay it never analyses; on the record it analyses only the driven stretch (counted
+    at an analysis a second, whatever the window)."""
+    from vib_estimator.core import ambient
+
+    monkeypatch.setattr(ambient, 'HOP_SHARE', 0.0)
     t, y, e = record
     est = create_estimator(AUTO)
     n = int(FREE1[1] * FS)
@@ -209,7 +213,8 @@ def test_a_driven_record_publishes_no_free_decay_estimate(zeta):
     t, y, _ = ambient_record(60.0, FS, [(F, zeta, 1.0)], 26.0, 5)
     est = create_estimator(AUTO)
     e = est.process(t, y)
-    assert len(e) >= 20 and est.counters['not_free_decay'] > 0
+    # (the identifier's: from 32 s, confirmed a second apart, then every 5 s: 7)
+    assert len(e) >= 6 and est.counters['not_free_decay'] > 0
     assert est.counters['estimates_free'] == 0
     assert np.all(e.convergence_time >= 0.9 * AUTO.ambient_window_s)
     assert np.all(np.abs(e.frequency_hz / F - 1) < 0.05)

@@ -457,9 +457,9 @@ def test_driven_arm_tracked_in_operation():
         spin_until(executor, lambda: False, 0.3)
         t, f = listener.estimates()
         f0 = natural_frequency_hz(0.04555)
-        assert len(f) >= 15
+        assert len(f) >= 6  # (8: 20 s in, confirmed a second apart, then every 4 s)
         assert np.median(np.abs(f / f0 - 1)) < 0.01
-        assert np.all(np.diff(t) > 0.5)  # one per analysis, every second
+        assert np.all(np.diff(t) > 0.5)  # one per analysis
     finally:
         executor.shutdown()
         for node in nodes:

@@ -13,7 +13,9 @@ node stream and ``analyze`` use): :class:`AmbientEstimator` ``.update(t, y) -> L
 ``.process(t, y) -> EstimateArrays``, ``.counters``, ``.reset()``, ``.restart()``, ``.config``;
 several channels: :class:`vib_estimator.core.multichannel.JointAmbientEstimator`.
 
-Method, per analysis (every :data:`HOP_S` of input once ``ambient_window_s`` of samples are in):
+Method, per analysis, once ``ambient_window_s`` of samples are in: every :data:`HOP_S` (1 s) of
+input while a mode is to be confirmed, every :func:`hop_s` (a fifth of the window, 1-5 s) once
+every mode tracked is published:
 
 1. **The window's correlations** (:mod:`.correlations`): kept up to date as samples arrive at the
    input rate, and at the rates halved from it, whose unmoved middle is kept.
@@ -64,8 +66,17 @@ from .estimator import (
 from .ssi import BLOCK_ROWS, WindowModes, block_rows, identify, mac
 from .threads import single_blas_thread
 
-#: seconds of input between two analyses (the estimates' update period)
+#: seconds of input between two analyses (the estimates' update period) of a short window
+#: (:func:`hop_s`)
 HOP_S = 1.0
+#: a longer window is analysed every this share of it: consecutive windows that share most of
+#: their samples give nearly the same estimates, each at the cost of a whole analysis (the
+#: identifier's whole cost; issue 37 asks >= 1000x real time per 500 Hz channel: a 30 s window
+#: every second ran ~310x) ...
+HOP_SHARE = 0.2
+#: ... but at least every this many seconds (a long window on a short record still gives
+#: estimates enough to confirm and calibrate its modes)
+MAX_HOP_S = 5.0
 #: fewest samples a window must hold to be analysed (twice the one channel's lags, and two)
 MIN_WINDOW_SAMPLES = 4 * BLOCK_ROWS + 2
 #: a window's mode continues a tracked mode within this relative frequency ...
@@ -96,6 +107,12 @@ COUNTER_NAMES = INPUT_COUNTERS + (
     'modes_lost',
     'estimates',
 )
+
+
+def hop_s(window_s: float) -> float:
+    """Seconds of input between two analyses of a window of ``window_s``: :data:`HOP_SHARE` of
+    it, at least :data:`HOP_S` and at most :data:`MAX_HOP_S`."""
+    return max(HOP_S, min(MAX_HOP_S, HOP_SHARE * window_s))
 
 
 def continues(f: float, shape: np.ndarray, frequency: float, last_shape: np.ndarray):
@@ -188,6 +205,8 @@ class SlidingWindowIdentifier(Estimator):
         """Forget the signal and the tracked modes; counters are kept."""
         self._tracks = []
         self._last = -math.inf
+        self._since_search = math.inf  # analyses since the last search (the first searches)
+        self._hop = HOP_S  # to the next analysis (:meth:`_track`)
         self._clear()
 
     def reset(self) -> None:
@@ -344,17 +363,24 @@ class SlidingWindowIdentifier(Estimator):
             return None
         span = float(ts[-1] - ts[0])
         self._c['analyses'] += 1
-        known = max((tr.frequency for tr in self._tracks if tr.published), default=0.0)
-        search = self._c['analyses'] % SEARCH_EVERY == 1
+        # the highest mode tracked: while a mode is published, a new one a search found above it
+        # is identified at every analysis until it is confirmed or lost (not only by the next
+        # search: CONFIRM_BESIDE analyses running would never see it)
+        tracks = self._tracks
+        known = max((tr.frequency for tr in tracks), default=0.0)
+        if not any(tr.published for tr in tracks):
+            known = 0.0
+        search = self._since_search >= SEARCH_EVERY - 1
+        self._since_search = 0 if search else self._since_search + 1
         return ts, self._cascade, (len(ts) - 1) / span, span, known, search
 
     def _slide(self) -> np.ndarray:
         """Schedule the next analysis and slide the window (and the cascade) to end at the last
         sample; its samples' times."""
         t_end = self._t[self._n - 1]
-        self._next += HOP_S
+        self._next += self._hop
         if self._next <= t_end:
-            self._next = t_end + HOP_S
+            self._next = t_end + self._hop
         first = self._start + int(
             np.searchsorted(self._t[self._start : self._n], t_end - self._window, 'left')
         )
@@ -435,6 +461,10 @@ class SlidingWindowIdentifier(Estimator):
             )
             out.append(self._publish(est, modes.shapes[i], modes.shape_std[i], similarity))
         self._c['estimates'] += len(out)
+        # every second while a mode is to be confirmed (CONFIRM analyses running: as soon as at
+        # any window), else every hop_s of the window
+        settled = bool(tracks) and all(tr.published for tr in tracks)
+        self._hop = hop_s(self._window) if settled else HOP_S
         return out
 
 
