@@ -22,7 +22,9 @@ same run, on the same machine state.
   *lost*: samples sent that the node never counted (its ``received`` + ``dropped_warmup`` against
   what was sent). Then SIGINT: the exit code.
 * ``shaper_node``: spawn to its first ``/diagnostics``.
-* ``analyze``: the whole ``vib-estimator analyze`` of a 20 s CSV (500 Hz).
+* ``analyze``: the whole ``vib-estimator analyze`` of a 20 s CSV (a 5 Hz sine at 500 Hz: the
+  free-decay estimator) and of an 11 s two-mode free decay (10 and 13 Hz, 1 : 0.5, at 1 kHz, as
+  ``bench_defaults.py`` makes it: the default chooses the mode tracker), wall and CPU seconds.
 """
 
 from __future__ import annotations
@@ -30,6 +32,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import resource
 import signal
 import subprocess
 import sys
@@ -232,8 +235,10 @@ def stop(proc) -> int:
     return proc.returncode
 
 
-def analyze_seconds(tree: Path, env: dict, csv: Path) -> float:
+def analyze_seconds(tree: Path, env: dict, csv: Path):
+    """(wall s, CPU s) of one ``vib-estimator analyze csv`` (nan, nan if it failed)."""
     code = 'import sys; from vib_estimator.cli import main; sys.exit(main())'
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.monotonic()
     done = subprocess.run(
         [sys.executable, '-P', '-c', code, 'analyze', str(csv)],
@@ -242,9 +247,28 @@ def analyze_seconds(tree: Path, env: dict, csv: Path) -> float:
         stderr=subprocess.PIPE,
         text=True,
     )
-    if done.returncode:
-        return math.nan
-    return time.monotonic() - start
+    wall = time.monotonic() - start
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime
+    return (math.nan, math.nan) if done.returncode else (wall, cpu)
+
+
+def write_csv(path: Path, t, y) -> Path:
+    np.savetxt(path, np.column_stack([t, y]), delimiter=',', header='t,y', comments='', fmt='%.9g')
+    return path
+
+
+def two_mode_decay() -> tuple:
+    """bench_defaults.py's 'decay 10 / 13 Hz, 1:0.5': 1 s of noise, then the decay, 1 kHz."""
+    rng = np.random.default_rng(0)
+    rng.standard_normal(5000)  # bench_defaults draws the 5 Hz decay's noise first
+    t = np.arange(0, 11, 0.001)
+    tau = np.maximum(t - 1.0, 0)
+    y = sum(
+        a * np.exp(-z * 2 * np.pi * f * tau) * np.sin(2 * np.pi * f * tau)
+        for f, a, z in ((10.0, 1.0, 0.003), (13.0, 0.5, 0.003))
+    )
+    return t, y + 0.05 / np.sqrt(2) * 10 ** (-1.5) * rng.standard_normal(len(t))
 
 
 def checkout(ref: str, where: Path) -> Path:
@@ -278,16 +302,11 @@ def main(argv=None) -> int:
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         trees = {'today': ROOT, args.ref: checkout(args.ref, tmp)}
-        csv = tmp / 'tone.csv'
         t = np.arange(int(20 * RATE_HZ)) / RATE_HZ
-        np.savetxt(
-            csv,
-            np.column_stack([t, np.sin(2 * np.pi * TONE_HZ * t)]),
-            delimiter=',',
-            header='t,y',
-            comments='',
-            fmt='%.9g',
-        )
+        records = {
+            'analyze (20 s CSV)': write_csv(tmp / 'tone.csv', t, np.sin(2 * np.pi * TONE_HZ * t)),
+            'analyze (two-mode decay)': write_csv(tmp / 'two.csv', *two_mode_decay()),
+        }
         probe = Probe()
         rows = []
         try:
@@ -329,13 +348,14 @@ def main(argv=None) -> int:
                         live, code = probe.first_diagnostics(cmd, environment(tree, cache))
                         row = ('shaper_node', label, kind, live, live, 0, code)
                         noted(rows, row + (math.nan,) * 4, f'live {live:6.2f} s, exit {code}')
-            if 'analyze' in only:
+            for case, csv in records.items() if 'analyze' in only else ():
                 for label, tree in trees.items():
                     cache = tempfile.mkdtemp(dir=tmp)
                     for kind in ('cold', 'warm'):
-                        seconds = analyze_seconds(tree, environment(tree, cache), csv)
-                        row = ('analyze (20 s CSV)', label, kind, math.nan, seconds, 0, 0)
-                        noted(rows, row + (math.nan,) * 4, f'{seconds:6.2f} s')
+                        seconds, cpu = analyze_seconds(tree, environment(tree, cache), csv)
+                        row = (case, label, kind, math.nan, seconds, 0, 0)
+                        row += (math.nan,) * 3 + (cpu,)
+                        noted(rows, row, f'{seconds:6.2f} s, {cpu:6.2f} CPU s')
         finally:
             probe.close()
     print(
