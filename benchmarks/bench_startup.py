@@ -185,9 +185,16 @@ class Probe:
             values = next(iter(self.last_values.values()), {})
             counted = int(values.get('received', 0)) + int(values.get('dropped_warmup', 0))
             lost = sent - counted if values else -1
+            # the background compile's end (no warmup_s any more): the warm run finds it all
+            while time.monotonic() - start < TIMEOUT_S and proc.poll() is None:
+                now = next(iter(self.last_values.values()), {})
+                if now and 'warmup_s' not in now:
+                    break
+                self.spin(0.05)
+            compiled, compiled_cpu = time.monotonic() - start, cpu_seconds(proc.pid)
         finally:
             code = stop(proc)
-        return live, ready, latency, lost, code, silence, spawned, cpu
+        return live, ready, latency, lost, code, silence, spawned, cpu, compiled, compiled_cpu
 
     def first_diagnostics(self, cmd, env):
         """(spawn to first /diagnostics s, exit code) of a node."""
@@ -282,7 +289,8 @@ def checkout(ref: str, where: Path) -> Path:
 
 def noted(rows: list, row: tuple, text: str) -> None:
     """Keep a result row (case, tree, cold/warm, live, ready, lost, exit, first estimate, longest
-    silence, first estimate after spawn, CPU s to ready) and print it as it comes."""
+    silence, first estimate after spawn, CPU s to ready, compiled after spawn s, its CPU s) and
+    print it as it comes."""
     rows.append(row)
     case, label, kind = row[:3]
     print(f'{case:28s} {label:8s} {kind}: {text}', flush=True)
@@ -317,8 +325,8 @@ def main(argv=None) -> int:
                     cache = tempfile.mkdtemp(dir=tmp)
                     cmd = node_command(tree, 'vib_estimator.nodes.estimator_node', params)
                     for kind in ('cold', 'warm'):
-                        live, ready, latency, lost, code, silence, spawned, cpu = probe.estimator(
-                            cmd, environment(tree, cache)
+                        live, ready, latency, lost, code, silence, spawned, cpu, compiled, ccpu = (
+                            probe.estimator(cmd, environment(tree, cache))
                         )
                         noted(
                             rows,
@@ -334,11 +342,14 @@ def main(argv=None) -> int:
                                 silence,
                                 spawned,
                                 cpu,
+                                compiled,
+                                ccpu,
                             ),
                             f'live {live:6.2f} s (longest /diagnostics silence {silence:5.2f} '
                             f's), ready {ready:6.2f} s, first estimate {latency:6.2f} s after '
                             f'the first sample ({spawned:6.2f} s after spawn), lost {lost}, '
-                            f'exit {code}; {cpu:5.2f} CPU s to ready',
+                            f'exit {code}; {cpu:5.2f} CPU s to ready; compiled after '
+                            f'{compiled:6.2f} s, {ccpu:5.2f} CPU s',
                         )
             if 'shaper_node' in only:
                 for label, tree in trees.items():
@@ -347,14 +358,14 @@ def main(argv=None) -> int:
                     for kind in ('cold', 'warm'):
                         live, code = probe.first_diagnostics(cmd, environment(tree, cache))
                         row = ('shaper_node', label, kind, live, live, 0, code)
-                        noted(rows, row + (math.nan,) * 4, f'live {live:6.2f} s, exit {code}')
+                        noted(rows, row + (math.nan,) * 6, f'live {live:6.2f} s, exit {code}')
             for case, csv in records.items() if 'analyze' in only else ():
                 for label, tree in trees.items():
                     cache = tempfile.mkdtemp(dir=tmp)
                     for kind in ('cold', 'warm'):
                         seconds, cpu = analyze_seconds(tree, environment(tree, cache), csv)
                         row = (case, label, kind, math.nan, seconds, 0, 0)
-                        row += (math.nan,) * 3 + (cpu,)
+                        row += (math.nan,) * 3 + (cpu, math.nan, math.nan)
                         noted(rows, row, f'{seconds:6.2f} s, {cpu:6.2f} CPU s')
         finally:
             probe.close()
@@ -364,9 +375,10 @@ def main(argv=None) -> int:
         f'first estimate after '
         f'the first sample, cold today / {args.ref} | first estimate after spawn, cold today / '
         f'{args.ref}; warm today / {args.ref} | CPU s to ready, cold today / {args.ref}; warm '
-        f'today / {args.ref} | samples lost, cold today / {args.ref} | exit on SIGINT |'
+        f'today / {args.ref} | compiled (background), cold: s after spawn; CPU s, today / '
+        f'{args.ref} | samples lost, cold today / {args.ref} | exit on SIGINT |'
     )
-    print('|---|---|---|---|---|---|---|---|---|---|---|')
+    print('|---|---|---|---|---|---|---|---|---|---|---|---|')
     cases = list(dict.fromkeys(r[0] for r in rows))
     for case in cases:
         get = {(r[1], r[2]): r for r in rows if r[0] == case}
@@ -379,7 +391,8 @@ def main(argv=None) -> int:
             f'{ref_c[8]:.1f} s | '
             f'{today_c[7]:.1f} / {ref_c[7]:.1f} s | {today_c[9]:.1f} / {ref_c[9]:.1f}; '
             f'{today_w[9]:.1f} / {ref_w[9]:.1f} s | {today_c[10]:.1f} / {ref_c[10]:.1f}; '
-            f'{today_w[10]:.2f} / {ref_w[10]:.2f} s | {today_c[5]} / {ref_c[5]} | {codes} |'
+            f'{today_w[10]:.2f} / {ref_w[10]:.2f} s | {today_c[11]:.1f}; {today_c[12]:.1f} / '
+            f'{ref_c[11]:.1f}; {ref_c[12]:.1f} | {today_c[5]} / {ref_c[5]} | {codes} |'
         )
     print(GOALS)
     return 0
