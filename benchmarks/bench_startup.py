@@ -182,9 +182,6 @@ class Probe:
             # the longest /diagnostics silence, from the first one to 1.5 s after ready
             gaps = np.diff(self.diag_times)
             silence = float(gaps.max()) if len(gaps) else math.nan
-            values = next(iter(self.last_values.values()), {})
-            counted = int(values.get('received', 0)) + int(values.get('dropped_warmup', 0))
-            lost = sent - counted if values else -1
             # the background compile's end (no warmup_s any more): the warm run finds it all
             while time.monotonic() - start < TIMEOUT_S and proc.poll() is None:
                 now = next(iter(self.last_values.values()), {})
@@ -192,6 +189,12 @@ class Probe:
                     break
                 self.spin(0.05)
             compiled, compiled_cpu = time.monotonic() - start, cpu_seconds(proc.pid)
+            # lost: never counted, once the node has drained what it had queued (a node behind
+            # its input while it compiles holds up to its input depth, 10 s at 500 Hz)
+            self.spin(2.5)
+            values = next(iter(self.last_values.values()), {})
+            counted = int(values.get('received', 0)) + int(values.get('dropped_warmup', 0))
+            lost = sent - counted if values else -1
         finally:
             code = stop(proc)
         return live, ready, latency, lost, code, silence, spawned, cpu, compiled, compiled_cpu
