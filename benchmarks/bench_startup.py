@@ -308,6 +308,11 @@ def main(argv=None) -> int:
         action='append',
         help='run only these cases (repeatable)',
     )
+    parser.add_argument(
+        '--case',
+        action='append',
+        help='only the estimator_node cases whose name holds this (repeatable), e.g. modes',
+    )
     args = parser.parse_args(argv)
     only = set(args.only or ['estimator_node', 'shaper_node', 'analyze'])
     with tempfile.TemporaryDirectory() as tmp:
@@ -324,6 +329,8 @@ def main(argv=None) -> int:
             for case, params in ESTIMATOR_CASES.items():
                 if 'estimator_node' not in only:
                     break
+                if args.case and not any(c in case for c in args.case):
+                    continue
                 for label, tree in trees.items():
                     cache = tempfile.mkdtemp(dir=tmp)
                     cmd = node_command(tree, 'vib_estimator.nodes.estimator_node', params)

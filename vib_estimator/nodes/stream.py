@@ -390,8 +390,11 @@ class EstimatorStream:
 
         The tones are seeded, so the result is a function of (configuration, rate): it is kept,
         and a burst of calls costs one run, not one each -- the data path, which shares the node's
-        single executor thread, is held up once."""
-        if not self.ready:
+        single executor thread, is held up once. While the kernels compile the tones run
+        uncompiled only for the algebraic estimator without ``band_hz`` (0.1 CPU s): with
+        ``band_hz`` (0.5 CPU s) or the mode tracker (0.9), sharing Python's lock with the
+        compile, they held the data path up for seconds (21 s on a loaded machine): busy."""
+        if not self.ready or (self.compiling and (self.config.band_hz or self.config.modes)):
             return False, f'busy: {WARMUP_MESSAGE}'
         rate = self.health.sample_rate_hz
         if math.isfinite(rate) and rate > 0:
