@@ -93,10 +93,11 @@ def main() -> int:
     print('|---|---|---|' + '---|' * len(args.periods))
     for name, t, y, f in records(real):
         cells = []
-        decided = decide(t, y).min_periods
-        decided = decided if np.isfinite(decided) else EstimatorConfig().min_periods
-        for periods in [decided, *args.periods]:
-            e = estimate(t, y, EstimatorConfig(min_periods=periods))
+        d = decide(t, y)
+        decided = d.min_periods if np.isfinite(d.min_periods) else EstimatorConfig().min_periods
+        for k, periods in enumerate([decided, *args.periods]):
+            early = d.early_std_rel if k == 0 else 0.0
+            e = estimate(t, y, EstimatorConfig(min_periods=periods, early_std_rel=early))
             if not len(e):
                 cells.append('none')
                 continue

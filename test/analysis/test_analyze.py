@@ -19,8 +19,10 @@ def decided(t, y, config=None):
     """What ``analyze`` with no ``--excitation`` estimates: ``config`` (default: the defaults)
     with the free-decay window its decision gives (core.choice.fast_window)."""
     config = config or EstimatorConfig()
-    periods = decide(t, y).min_periods
-    return estimate(t, y, config.replace(min_periods=periods) if np.isfinite(periods) else config)
+    d = decide(t, y)
+    if np.isfinite(d.min_periods):
+        config = config.replace(min_periods=d.min_periods, early_std_rel=d.early_std_rel)
+    return estimate(t, y, config)
 
 
 @pytest.fixture

@@ -46,11 +46,24 @@ def driven(tmp_path):
 
 
 def test_a_free_decay_gives_exactly_the_free_estimator_s_output(capsys, free_decay):
+    """A pure decay: ``free`` with the decided window (0.9 periods where precise, core.choice);
+    every row of ``free`` with those options, none of ``free``'s default window."""
     rows, err = analyze(capsys, free_decay)
     assert 'analyze: excitation free (the default decides from the record' in err
-    free, err_free = analyze(capsys, free_decay, '--excitation', 'free')
+    assert 'min_periods 0.9' in err
+    free, err_free = analyze(
+        capsys,
+        free_decay,
+        '--excitation',
+        'free',
+        '--min-periods',
+        '0.9',
+        '--early-std-rel',
+        '0.007',
+    )
     assert rows == free and len(rows) > 10
     assert 'decides from the record' not in err_free
+    assert analyze(capsys, free_decay, '--excitation', 'free')[0] != rows
 
 
 def test_a_driven_record_gets_the_identifier_and_its_modes(capsys, driven):

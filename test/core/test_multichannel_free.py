@@ -146,6 +146,34 @@ def test_bad_rows_are_counted_and_change_nothing_else():
     )
 
 
+@pytest.mark.parametrize('back', [True, False], ids=['time-back', 'gap'])
+def test_a_stream_whose_time_went_back_or_paused_is_followed(back):
+    """A pluck, then the same pluck again with stamps from 0 (a bag looping, a source restarted)
+    or 10 s after the first ended (a gap beyond max_gap): one restart counted (the one input
+    policy, core.estimator.accept_sample), no sample skipped, the second pluck estimated as the
+    first (the same floats), in batch, in chunks and sample by sample."""
+    t, y = plucked(7)
+    again = t if back else t + t[-1] + 10.0
+    tt, yy = np.concatenate([t, again]), np.concatenate([y, y])
+    first = create_estimator(EstimatorConfig(), NAMES).process(t, y)
+    est = create_estimator(EstimatorConfig(), NAMES)
+    got = est.process(tt, yy)
+    c = est.counters
+    assert c['used'] == c['received'] == len(tt)
+    assert (c['time_jump_resets'], c['gap_resets']) == ((1, 0) if back else (0, 1))
+    second = got.estimates.frequency_hz[len(first) :]
+    assert len(got) == 2 * len(first) > 10
+    assert np.allclose(second, first.estimates.frequency_hz, rtol=1e-9, atol=0)
+    stream = create_estimator(EstimatorConfig(), NAMES)
+    streamed = [e.frequency_hz for ti, yi in zip(tt, yy) for e in stream.update(ti, yi)]
+    assert streamed == got.estimates.frequency_hz.tolist() and stream.counters == c
+    chunked = create_estimator(EstimatorConfig(), NAMES)
+    parts = [chunked.process(tt[i : i + 900], yy[i : i + 900]) for i in range(0, len(tt), 900)]
+    assert np.concatenate([p.estimates.frequency_hz for p in parts]).tolist() == (
+        got.estimates.frequency_hz.tolist()
+    )
+
+
 def test_factory_and_refusals():
     assert isinstance(create_estimator(EstimatorConfig(), NAMES), JointFreeEstimator)
     with pytest.raises(ValueError, match='free or ambient'):

@@ -194,6 +194,53 @@ def test_csv_error_in_a_late_block_names_the_row(tmp_path, monkeypatch):
         list(open_signal(path).blocks())
 
 
+def logger_file(path, rate='1000', samples=3000, extra=''):
+    """A logger's file without a time column (the shared pendulum's layout): a header of
+    settings, their values, then one sample per row."""
+    values = '\n'.join(f'{np.sin(i / 50):.9g}' for i in range(samples))
+    path.write_text(
+        f'trigger_start_deg, sample_rate, duration_sec\n90, {rate}, 3\n{extra}{values}\n'
+    )
+    return path
+
+
+@pytest.mark.parametrize('blocks', [1 << 12, 1 << 19])
+def test_a_file_without_a_time_column_is_read_at_its_stated_rate(
+    tmp_path, monkeypatch, break_extra, blocks
+):
+    """Its samples at i / rate, the same by pyarrow (several blocks or one), by the exact rules
+    and by the streaming reader; named ``signal``, after a time column ``t``."""
+    monkeypatch.setattr(csv_reader, 'CSV_BLOCK_BYTES', blocks)
+    path = logger_file(tmp_path / 'swing.txt')
+    series = read_csv_series(path)
+    assert series.name == 'signal' and len(series.t) == 3000
+    assert np.array_equal(series.t, np.arange(3000) / 1000.0)
+    assert np.array_equal(
+        series.y, np.array([float(f'{np.sin(i / 50):.9g}') for i in range(3000)])
+    )
+    streamed = [np.concatenate(c) for c in zip(*open_signal(path).blocks())]
+    assert np.array_equal(streamed[0], series.t) and np.array_equal(streamed[1], series.y)
+    assert csv_reader.column_names(path, 'all') == ['signal']
+    break_extra('pyarrow', ImportError('not installed'))  # the exact rules
+    exact = read_csv_series(path)
+    assert np.array_equal(exact.t, series.t) and np.array_equal(exact.y, series.y)
+
+
+def test_a_file_without_a_time_column_errors(tmp_path):
+    """A rate that is not positive, and a sample that is not a number (its row counted with the
+    two header rows), are ``error:`` lines; settings followed by rows of several cells are an
+    ordinary CSV (the second column the signal)."""
+    with pytest.raises(CsvError, match='sample rate sample_rate = 0 is not positive'):
+        read_csv_series(logger_file(tmp_path / 'a.txt', rate='0'))
+    bad = logger_file(tmp_path / 'b.txt', samples=10)
+    bad.write_text(bad.read_text() + 'x\n')
+    with pytest.raises(CsvError, match='data row 13 is not numbers'):
+        read_csv_series(bad)
+    plain = tmp_path / 'c.csv'
+    plain.write_text('t, fs, y\n0, 100, 1\n0.01, 100, 2\n')
+    assert read_csv_series(plain).y.tolist() == [100.0, 100.0]
+
+
 WRENCH = 'geometry_msgs/msg/WrenchStamped'
 
 

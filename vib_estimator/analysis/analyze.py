@@ -56,6 +56,7 @@ _CONFIG_OPTIONS = {
     'max_damping': float,
     'max_gap': float,
     'target_std_rel': float,
+    'early_std_rel': float,
     'gap_intervals': float,
     'outlier_ratio': float,
     'modes': int,

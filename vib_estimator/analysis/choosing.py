@@ -59,9 +59,9 @@ def decided_config(
     if not keep_window and d.excitation != 'free':
         window = d.window_s
     modes = config.modes or d.modes
-    periods = config.min_periods
+    periods, early = config.min_periods, config.early_std_rel
     if not keep_periods and math.isfinite(d.min_periods):
-        periods = d.min_periods
+        periods, early = d.min_periods, early or d.early_std_rel
     line = (
         f'{prog}: excitation {d.excitation} (the default decides from the record: {d.reason}; '
         '--excitation free, ambient or auto overrides'
@@ -70,7 +70,11 @@ def decided_config(
         + ')'
     )
     changed = config.replace(
-        excitation=d.excitation, ambient_window_s=window, modes=modes, min_periods=periods
+        excitation=d.excitation,
+        ambient_window_s=window,
+        modes=modes,
+        min_periods=periods,
+        early_std_rel=early,
     )
     return changed, line
 

@@ -51,7 +51,16 @@ import numpy as np
 
 from .config import EstimatorConfig
 from .correlations import CorrelationCascade
-from .estimator import INPUT_COUNTERS, Estimate, EstimateArrays, Estimator, as_series
+from .estimator import (
+    INPUT_COUNTERS,
+    RESTART,
+    SKIP,
+    Estimate,
+    EstimateArrays,
+    Estimator,
+    accept_sample,
+    as_series,
+)
 from .ssi import BLOCK_ROWS, WindowModes, block_rows, identify, mac
 from .threads import single_blas_thread
 
@@ -247,25 +256,13 @@ class SlidingWindowIdentifier(Estimator):
 
     def _accept(self, t: float, finite: bool) -> bool:
         """Count one sample (``finite``: its values are); False if skipped. A gap or a long jump
-        back clears the window."""
-        c = self._c
-        c['received'] += 1
-        if not (finite and math.isfinite(t)):
-            c['skipped_non_finite'] += 1
+        back clears the window (:func:`.estimator.accept_sample`)."""
+        action = accept_sample(self._c, self._last, t, finite, self._config.max_gap)
+        if action == SKIP:
             return False
-        last = self._last
-        if t <= last:
-            if last - t > self._config.max_gap:
-                c['time_jump_resets'] += 1
-                self._clear()
-            else:
-                c['skipped_duplicate' if t == last else 'skipped_out_of_order'] += 1
-                return False
-        elif t - last > self._config.max_gap and self._n:
-            c['gap_resets'] += 1
+        if action == RESTART:
             self._clear()
         self._last = t
-        c['used'] += 1
         return True
 
     def _due(self) -> list:

@@ -82,22 +82,26 @@ HARMONIC_TOL = 0.02
 WINDOW_PERIODS = 120.0
 #: the longest window the decision chooses, s
 MAX_WINDOW_S = 300.0
-#: a free decay of one mode whose spectrum is pure and whose estimates over this many periods
-#: are precise (:func:`fast_window`) is estimated over this window (the long window,
-#: ``min_periods``) rather than the default 1.25 periods: the real beams 0.90-0.92 periods to an
-#: estimate, 99-100 % within 2 % (bench_first_estimate.py)
+#: a free decay of one mode whose spectrum is pure (:func:`fast_window`) is estimated over this
+#: window (the long window, ``min_periods``) rather than the default 1.25 periods, where its
+#: estimates are precise (:data:`FAST_STD`): the real beams 0.90-0.92 periods to an estimate,
+#: 99-100 % within 2 % (bench_first_estimate.py)
 FAST_PERIODS = 0.9
 #: ... pure: at most this share of the power within :data:`IMPURITY_SPAN` of the mode lies
-#: farther than :data:`PEAK_WIDTH` from it (:func:`impurity`: free decays 0.000-0.07, the real
-#: arm's closed-loop limit cycle 0.30, which a window of one period reads 2 % high)
-IMPURE = 0.1
+#: farther than :data:`PEAK_WIDTH` from it (:func:`impurity`: free decays 0.000-0.03, 0.066 in
+#: 20 dB of noise; the real arm's closed-loop limit cycle 0.30, which a window of one period
+#: reads 2 % high while its predicted std says 0.2 %; a record whose frequency moved,
+#: bags/arm_5_5, 0.047: its 1.25-period fits across the moves fail where the shorter window's
+#: estimates are held, 2 estimates in its last stretch against 3)
+IMPURE = 0.04
 #: ... the span around the mode (a factor each way: an octave) and the peak's half width
 #: (relative)
 IMPURITY_SPAN = 2.0
 PEAK_WIDTH = 0.15
-#: ... precise: 90 % of the trial estimates over :data:`FAST_PERIODS` have a relative frequency
-#: std at most this (2 % is then ~3 stds; the real beams 0.26-0.56 %, decays in 20-30 dB of
-#: noise 1.4-3.2 %, whose tails need the longer window)
+#: ... precise: an estimate over :data:`FAST_PERIODS` whose predicted relative frequency std
+#: exceeds this waits for the default window (``early_std_rel``, core.kernel.HELD_PERIODS): 2 %
+#: is then ~3 stds; a decay's tail in its noise (1.4-3.2 % at 0.9 periods in 20-30 dB) keeps the
+#: default's accuracy there (bench_first_estimate.py: 95-100 % within 2 %)
 FAST_STD = 0.007
 #: the damping ratio :func:`window_advice` assumes of the lowest mode (:data:`WINDOW_PERIODS`
 #: is ~15 correlation times at it)
@@ -125,6 +129,8 @@ class Decision:
     modes: int = 0
     #: a free decay of one mode: the window it allows (:func:`fast_window`; NaN: the configured)
     min_periods: float = math.nan
+    #: ... and the precision an estimate over it needs (``early_std_rel``; 0: the configured)
+    early_std_rel: float = 0.0
 
     def changes(self) -> dict:
         """The configuration fields a stream switching to this decision sets (the node's
@@ -192,7 +198,7 @@ def decide(t, y, channels: int = 1, window_s: float = 30.0, stream: bool = False
     ``y`` samples or samples x ``channels``), ``window_s`` the shortest window (the configured
     one). ``stream``: the record is the last seconds of a stream that goes on (the window is not
     bounded by the room for :data:`MIN_ANALYSES` analyses, and a free decay's window is not
-    decided: :func:`fast_window`'s trial would run, maybe compile, in the node's executor)."""
+    decided: the node cannot see a spectrum ahead, and a stream's default stays ``free``'s)."""
     t = np.asarray(t, dtype=np.float64)
     y = np.asarray(y, dtype=np.float64)
     # finite samples at sane times (an absurd stamp, 1e300 s, would overflow the block index)
@@ -240,15 +246,15 @@ def decide(t, y, channels: int = 1, window_s: float = 30.0, stream: bool = False
             + ', '.join(f'{f:.3g}' for f in sorted(separate))
             + f' Hz): the mode tracker, modes {modes}'
         )
-    periods = math.nan
-    # a stream (the node) keeps its window: the trial would compile the free-decay kernels there
+    periods, early = math.nan, 0.0
+    # a stream (the node) keeps its window
     if (
         excitation == 'free'
         and not (modes or stream)
         and channels == 1
         and math.isfinite(dominant)
     ):
-        periods, why = fast_window(t, y, dominant)
+        periods, early, why = fast_window(t, y, dominant)
         seen += f'; {why}'
     rate = (len(t) - 1) / span
     return Decision(
@@ -263,6 +269,7 @@ def decide(t, y, channels: int = 1, window_s: float = 30.0, stream: bool = False
         rate,
         modes,
         periods,
+        early,
     )
 
 
@@ -276,26 +283,21 @@ def impurity(t: np.ndarray, y: np.ndarray, f: float) -> float:
     return off / total if total > 0 else math.nan
 
 
-def fast_window(t: np.ndarray, y: np.ndarray, f: float) -> tuple[float, str]:
-    """The window (``min_periods``) for a free decay of one mode at ``f`` Hz: :data:`FAST_PERIODS`
-    when its spectrum is pure (:func:`impurity` below :data:`IMPURE`) and 90 % of its estimates
-    over that window (a trial over the samples) have a relative std at most :data:`FAST_STD`;
-    else NaN (the configured window). With the reason in words."""
-    from .config import EstimatorConfig
-    from .estimator import estimate
-
+def fast_window(t: np.ndarray, y: np.ndarray, f: float) -> tuple[float, float, str]:
+    """The window (``min_periods``) and the precision its estimates need (``early_std_rel``) for
+    a free decay of one mode at ``f`` Hz: :data:`FAST_PERIODS` and :data:`FAST_STD` when its
+    spectrum is pure (:func:`impurity` below :data:`IMPURE`); else (NaN, 0: the configured
+    window). With the reason in words."""
     spread = impurity(t, y, f)
     if not spread <= IMPURE:
-        return math.nan, f'{100 * spread:.0f} % of the power near {f:.3g} Hz off its peak'
-    trial = estimate(t, y, EstimatorConfig(min_periods=FAST_PERIODS))
-    if not len(trial):
-        return math.nan, f'no estimate over {FAST_PERIODS:g} periods'
-    std = float(np.quantile(trial.frequency_std_hz / trial.frequency_hz, 0.9))
-    if not std <= FAST_STD:
-        return math.nan, f'90 % of the {FAST_PERIODS:g}-period estimates within {100 * std:.2g} %'
-    return FAST_PERIODS, (
-        f'a pure peak ({100 * spread:.1f} % off it) and 90 % of the {FAST_PERIODS:g}-period '
-        f'estimates within {100 * std:.2g} % (1 std): min_periods {FAST_PERIODS:g}'
+        return math.nan, 0.0, f'{100 * spread:.0f} % of the power near {f:.3g} Hz off its peak'
+    return (
+        FAST_PERIODS,
+        FAST_STD,
+        (
+            f'a pure peak ({100 * spread:.1f} % off it): min_periods {FAST_PERIODS:g} where the '
+            f'estimate is within {100 * FAST_STD:.2g} % (1 std), else 1.25'
+        ),
     )
 
 

@@ -200,6 +200,15 @@ class EstimatorConfig:
         0.0,
         1.0,
     )
+    early_std_rel: float = _param(
+        0.0,
+        'with a long window (min_periods >= '
+        f'{K.LONG_WINDOW_PERIODS:g} and refine), an estimate whose predicted relative '
+        'standard deviation of the frequency exceeds this waits until its segment spans '
+        f'{K.HELD_PERIODS:g} periods (0 = off)',
+        0.0,
+        1.0,
+    )
     modes: int = _param(
         0,
         'modes to find and track by a multi-scale subspace fit, each '
@@ -340,4 +349,5 @@ class EstimatorConfig:
         p[K.P_CONSIST] = self.consistency
         p[K.P_GAPN] = self.gap_intervals
         p[K.P_OUTLIER] = self.outlier_ratio
+        p[K.P_EARLY] = self.early_std_rel
         return p

@@ -49,6 +49,37 @@ INPUT_COUNTERS = (
     'time_jump_resets',
     'gap_resets',
 )
+#: :func:`accept_sample`'s answers: skip the sample, keep it, keep it after a restart
+SKIP, KEEP, RESTART = 0, 1, 2
+
+
+def accept_sample(c: Dict[str, int], last: float, t: float, finite: bool, max_gap: float) -> int:
+    """The input policy of the estimators written in Python (the kernel's ``_accept_time`` is
+    the same rule compiled): count a sample of stamp ``t`` in ``c`` (the :data:`INPUT_COUNTERS`)
+    after the last kept stamp ``last`` (-inf: none) and say what to do with it. Non-finite
+    (stamp or a value): skipped. A repeated stamp or a step back within ``max_gap``: skipped
+    (``skipped_duplicate``, ``skipped_out_of_order``). A jump back beyond it (a restarted
+    source, a bag looping) or a step forward beyond it (a gap): :data:`RESTART`
+    (``time_jump_resets``, ``gap_resets``): the caller forgets its signal and keeps the
+    sample, so a stream whose time went back is followed, never skipped for good."""
+    c['received'] += 1
+    if not (finite and math.isfinite(t)):
+        c['skipped_non_finite'] += 1
+        return SKIP
+    if t <= last:
+        if last - t <= max_gap:
+            c['skipped_duplicate' if t == last else 'skipped_out_of_order'] += 1
+            return SKIP
+        c['time_jump_resets'] += 1
+        c['used'] += 1
+        return RESTART
+    c['used'] += 1
+    if t - last > max_gap and math.isfinite(last):
+        c['gap_resets'] += 1
+        return RESTART
+    return KEEP
+
+
 #: counter names, in the order of :mod:`vib_estimator.core.kernel`'s counter array
 COUNTER_NAMES = INPUT_COUNTERS + (
     'rejected_at_rest',

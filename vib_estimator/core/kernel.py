@@ -90,8 +90,9 @@ from .uncertainty import MODEL_BIASED, MODEL_DAMPED, MODEL_SINUSOID, TWO_PI
     P_CONSIST,
     P_GAPN,
     P_OUTLIER,
+    P_EARLY,
     N_PARAMS,
-) = range(25)  # N_*: the slots' number
+) = range(26)  # N_*: the slots' number
 
 # ---- counter array layout (int64) -----------------------------------------------------------
 (
@@ -148,7 +149,8 @@ S_UNIT = S_WH + 1  # scratch unit vector
 S_FLAST = S_UNIT + NH  # long windows: the segment's first converged half-period estimate
 S_DLAST = S_FLAST + 1  # ... and its damping ratio (damped model), where the fit starts
 S_NEXT = S_DLAST + 1  # segment length at which target_std_rel is checked next
-S_RES = S_NEXT + 1  # result of the refinement (core.uncertainty's layout)
+S_HELD = S_NEXT + 1  # long windows: 1 once ``early_std_rel`` held the segment to HELD_PERIODS
+S_RES = S_HELD + 1  # result of the refinement (core.uncertainty's layout)
 S_WORK = S_RES + U.N_RESULT  # the refinement's scratch
 NBJ = 4  # band std: prefilter states of the Jacobian's 4 columns
 S_BANDJ = S_WORK + U.N_WORK  # ... (3 sections x (2 states, previous input) each)
@@ -166,6 +168,10 @@ O_T, O_F, O_CONV, O_SAMPLES, O_FIT, O_AMP, O_DAMP, O_FSTD, O_DSTD, N_OUT = range
 #: publishes, as printed. (At 0.9 periods the long window converges in 0.90-0.92 periods on the
 #: real beams, the convergence test in 0.95-0.98, bench_first_estimate.py.)
 LONG_WINDOW_PERIODS = 0.75
+#: ``early_std_rel``: a long-window estimate less precise than that is held until the segment
+#: spans this many periods (the default window's; the noisy decays of bench_first_estimate.py
+#: then keep that window's accuracy in their tails and publish earlier where they are precise)
+HELD_PERIODS = 1.25
 #: automatic max_window: this long at least (s), and min_periods + this many periods
 AUTO_WINDOW_S = 10.0
 AUTO_WINDOW_PERIODS = 2.0
@@ -276,6 +282,7 @@ def reset_segment(s, c, seg, t0, y0):
     s[S_FLAST] = 0.0
     s[S_DLAST] = 0.0
     s[S_NEXT] = 0.0
+    s[S_HELD] = 0.0
     c[C_SEG_N] = 1
     c[C_MA_N] = 0
 
@@ -823,8 +830,39 @@ def _long_window_spanned(p, s, c, m, one_sided, model, tau, f, damping):
             s[S_DLAST] = (
                 min(max(damping, -p[P_MAXDAMP]), p[P_MAXDAMP]) if model == MODEL_DAMPED else 0.0
             )
+        elif _early_start(p, s, tau, f):
+            s[S_FLAST] = s[S_FPREV]
+            s[S_DLAST] = 0.0
+            return True
         return False
-    return tau * s[S_FLAST] >= p[P_MINPER]
+    return tau * s[S_FLAST] >= (max(p[P_MINPER], HELD_PERIODS) if s[S_HELD] else p[P_MINPER])
+
+
+@jit(inline='always')
+def _early_start(p, s, tau, f):
+    """``early_std_rel``: True when a segment whose algebraic estimate ``f`` has not passed the
+    convergence test spans ``min_periods`` periods of the previous segment's estimate and ``f``
+    agrees with it within ``consistency`` (off with that gate off): the same mode, so the fit may
+    start there. Not once the segment is held (:func:`_held`)."""
+    prev = s[S_FPREV]
+    if p[P_EARLY] <= 0.0 or prev <= 0.0 or s[S_HELD] or tau * prev < p[P_MINPER]:
+        return False
+    return abs(f - prev) <= p[P_CONSIST] * prev
+
+
+@jit(inline='always')
+def _held(p, s, tau, res):
+    """``early_std_rel``: True (and the segment held to :data:`HELD_PERIODS`, see
+    :func:`_long_window_spanned`) when a long-window estimate short of that span has a predicted
+    relative std of f above ``early_std_rel``: a decay ringing into its noise is estimated over
+    the longer window there, and over ``min_periods`` where it is precise."""
+    if p[P_EARLY] <= 0.0 or s[S_HELD] or tau * s[S_FLAST] >= HELD_PERIODS:
+        return False
+    if res[U.R_FSTD] <= p[P_EARLY] * res[U.R_F]:  # False for a NaN std: held
+        return False
+    s[S_HELD] = 1.0
+    s[S_FLAST] = 0.0  # from here the segment is the default long window's
+    return True
 
 
 @jit(inline='always')
@@ -911,6 +949,8 @@ def step(p, s, c, seg, t, y, out, row, optional=None):
         return 0
     res = s[S_RES : S_RES + U.N_RESULT]
     _refine(p, s, seg, n_fit, model, f, damping, res, optional)
+    if not local_start and _held(p, s, tau, res):
+        return 0
     start, f = f, res[U.R_F]
     consistent = True
     if p[P_REFINE] > 0.0 and math.isfinite(res[U.R_FIT]):

@@ -58,8 +58,10 @@ Method:
 A fit is published only if it is finite, within :data:`MAX_MOVE` of its start and
 ``|zeta| <= max_damping``; else counted (``rejected_joint``). Bad samples never raise: a
 row with a non-finite stamp or channel is skipped (``skipped_non_finite``), a repeated or earlier
-stamp too (``skipped_duplicate``, ``skipped_out_of_order``); the channels' estimators see only the
-rows kept, so their gaps and jumps are handled as with one channel.
+stamp within ``max_gap`` too (``skipped_duplicate``, ``skipped_out_of_order``); a jump back or a
+gap beyond it restarts (``time_jump_resets``, ``gap_resets``: :func:`.estimator.accept_sample`,
+the input policy the identifier shares); the channels' estimators see only the rows kept, so
+their gaps and jumps are handled as with one channel.
 """
 
 from __future__ import annotations
@@ -72,7 +74,7 @@ import numpy as np
 
 from .ambient import MATCH_TOL, MAX_TRACKS
 from .config import EstimatorConfig
-from .estimator import INPUT_COUNTERS, Estimate, Estimator
+from .estimator import INPUT_COUNTERS, RESTART, SKIP, Estimate, Estimator, accept_sample
 from .multichannel import (
     MIN_CHANNELS,
     JointEstimates,
@@ -356,29 +358,40 @@ class JointFreeEstimator(Estimator):
             est.reset()
 
     # ---- input --------------------------------------------------------------------------------
-    def _keep(self, t: np.ndarray, y: np.ndarray) -> np.ndarray:
-        """The rows to keep (finite, after the last kept stamp), counted (:meth:`_accept`)."""
+    def _keep(self, t: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The rows to keep and the kept rows that restart (a jump back or a gap beyond
+        ``max_gap``), counted (:func:`.estimator.accept_sample`)."""
         finite = np.isfinite(t) & np.all(np.isfinite(y), axis=1)
-        return np.array(
-            [self._accept(ti, ok) for ti, ok in zip(t.tolist(), finite.tolist())], bool
-        )
+        actions = np.empty(len(t), np.int8)
+        last = self._last
+        for i, (ti, ok) in enumerate(zip(t.tolist(), finite.tolist())):
+            actions[i] = accept_sample(self._c, last, ti, ok, self._config.max_gap)
+            if actions[i] != SKIP:
+                last = ti
+        self._last = last
+        kept = actions != SKIP
+        return kept, (actions == RESTART)[kept]
 
     def _accept(self, t: float, finite: bool) -> bool:
-        """Whether a row of stamp ``t`` (its values all finite or not) is kept, counted: finite
-        and after the last kept stamp."""
-        c = self._c
-        c['received'] += 1
-        if not finite:
-            c['skipped_non_finite'] += 1
-        elif t == self._last:
-            c['skipped_duplicate'] += 1
-        elif t < self._last:
-            c['skipped_out_of_order'] += 1
-        else:
-            self._last = t
-            c['used'] += 1
-            return True
-        return False
+        """Whether a row of stamp ``t`` (its values all finite or not) is kept, counted
+        (:func:`.estimator.accept_sample`): a jump back or a gap beyond ``max_gap`` empties the
+        row store (the channels' estimators restart themselves on it)."""
+        action = accept_sample(self._c, self._last, t, finite, self._config.max_gap)
+        if action == SKIP:
+            return False
+        if action == RESTART:
+            self._forget_signal()
+        self._last = t
+        return True
+
+    def _forget_signal(self) -> None:
+        """After a restart (:meth:`_accept`): the row store emptied, the channels' recent
+        estimates forgotten, the known modes kept by frequency and shape but not by time (a
+        stream whose time went back would otherwise merge every event into them)."""
+        self._n = 0
+        self._recent.clear()
+        for mode in self._modes:
+            mode.last_t = -math.inf
 
     def _row_of(self, times: np.ndarray) -> np.ndarray:
         """The store index of the row nearest each of ``times`` (an estimate's stamp is its
@@ -426,8 +439,19 @@ class JointFreeEstimator(Estimator):
         """Feed arrays (``y``: samples x channels; continuing the stream); the estimates by
         time."""
         t, y = as_channels(t, y, len(self._channels))
-        keep = self._keep(t, y)
+        keep, restarts = self._keep(t, y)
         t, y = t[keep], y[keep]
+        out: list[Estimate] = []
+        # a restart empties the row store: each piece from one is appended alone
+        cuts = [0, *np.flatnonzero(restarts).tolist(), len(t)]
+        for a, b in zip(cuts[:-1], cuts[1:]):
+            if a < b and restarts[a]:
+                self._forget_signal()
+            out += self._process_rows(t[a:b], y[a:b])
+        return JointEstimates.of(out, self._channels)
+
+    def _process_rows(self, t: np.ndarray, y: np.ndarray) -> list[Estimate]:
+        """Kept rows, increasing, without a restart among them: their joint estimates."""
         out: list[Estimate] = []
         # in blocks of the row store's room: each event's window is still held when it is fitted
         for lo in range(0, len(t), self._room):
@@ -440,7 +464,7 @@ class JointFreeEstimator(Estimator):
                 events += [(int(i), c, e) for i, e in zip(index, cols.to_list())]
             events.sort(key=lambda ev: ev[0])  # stable: by time, then channel, then order
             out += self._events(events)
-        return JointEstimates.of(out, self._channels)
+        return out
 
     # ---- events ---------------------------------------------------------------------------------
     @single_blas_thread

@@ -8,6 +8,10 @@ Without a header row, the last comment line before the data names the columns wh
 name per column (``# time_s,accel_g  (notes)``: names separated by commas, up to two spaces or a
 parenthesis; :func:`comment_names`).
 Empty cells and ``nan`` are kept as NaN (the estimator skips and counts them).
+A logger's file without a time column is read too: a header row of settings that names the sample
+rate (``sample_rate``, ``sampling_rate``, ``fs``, ``rate``, optionally ``_hz``), the row of their
+values, then one sample per row (:func:`rate_layout`): the time is the row's index over the rate,
+and the layout shows it as a time column 0 named ``t`` and the samples as column 1, ``signal``.
 
 This module holds the rules (:func:`csv_layout` finds the header, the column and where the data
 start; :func:`iter_csv_rows` is the exact row-by-row reading, with the error messages) and the fast
@@ -20,6 +24,7 @@ read by the exact rules instead, so the result and the error messages are those 
 from __future__ import annotations
 
 import csv
+import math
 import re
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -63,6 +68,13 @@ class CsvLayout:
     indices: Tuple[int, ...] = ()
     #: every column's name: the header's, a comment line's (:func:`comment_names`) or its index
     names: Tuple[str, ...] = ()
+    #: samples per second of a file without a time column (:func:`rate_layout`; 0: column 0 is
+    #: the time): its columns are then the layout's columns 1 on
+    rate: float = 0.0
+
+    def cell(self, index: int) -> int:
+        """The file's column of the layout's column ``index``."""
+        return index - 1 if self.rate else index
 
     @property
     def columns(self) -> Tuple[int, ...]:
@@ -110,10 +122,53 @@ def csv_layout(path, column: Optional[str] = None) -> CsvLayout:
     except (OSError, UnicodeDecodeError, csv.Error) as err:
         raise CsvError(f'cannot read {path} as CSV: {err}') from None
     width = len(data[2])
+    if header is not None:
+        timed = rate_layout(path, header, data, column)
+        if timed is not None:
+            return timed
     names = header or comment_names(path, data[1], width) or [str(i) for i in range(width)]
     index = _column_index(path, column, names, width)
     return CsvLayout(
         path, index, names[index], width, header is not None, data[1], names=tuple(names)
+    )
+
+
+#: a header cell that names the sample rate (:func:`rate_layout`)
+_RATE = re.compile(r'(sample_?rate|sampling_?rate|fs|rate)(_?hz)?', re.IGNORECASE)
+#: the names :func:`rate_layout` gives the time and the samples
+RATE_NAMES = ('t', 'signal')
+
+
+def rate_layout(path: Path, header: List[str], settings, column: Optional[str]):
+    """The layout of a file without a time column (module doc), or None when ``header`` (the
+    first row) and ``settings`` (the next: line, offset, cells) are not a header of settings
+    naming the sample rate followed by one sample per row."""
+    keys = [i for i, name in enumerate(header) if _RATE.fullmatch(name)]
+    if len(keys) != 1 or len(settings[2]) != len(header):
+        return None
+    try:
+        rate = _number(settings[2][keys[0]])
+        with path.open('rb') as handle:
+            handle.seek(settings[1])
+            handle.readline()
+            sample = next(_rows(handle), None)
+        if sample is None or len(sample[2]) != 1:
+            return None
+        _number(sample[2][0])
+    except (ValueError, OSError, UnicodeDecodeError, csv.Error):
+        return None
+    if not (math.isfinite(rate) and rate > 0):
+        raise CsvError(f'{path}: the sample rate {header[keys[0]]} = {rate:g} is not positive')
+    index = _column_index(path, column, list(RATE_NAMES), 2)
+    return CsvLayout(
+        path,
+        index,
+        RATE_NAMES[index],
+        2,
+        True,
+        sample[1],
+        names=RATE_NAMES,
+        rate=rate,
     )
 
 
@@ -162,15 +217,17 @@ def iter_csv_rows(layout: CsvLayout) -> Iterator[Tuple[float, float]]:
 
 def iter_csv_column_rows(layout: CsvLayout) -> Iterator[Tuple[float, List[float]]]:
     """(t, [value of each of ``layout.columns``]) of every data row, by the exact rules."""
-    columns = layout.columns
+    columns = [layout.cell(i) for i in layout.columns]
+    rate = layout.rate
     try:
         with layout.path.open('rb') as handle:
             handle.seek(layout.data_offset)
             for count, (_, _, row) in enumerate(_rows(handle)):
                 try:
-                    yield _number(row[0]), [_number(row[i]) for i in columns]
+                    t = count / rate if rate else _number(row[0])
+                    yield t, [_number(row[i]) for i in columns]
                 except (ValueError, IndexError):
-                    line = count + 2 if layout.has_header else count + 1
+                    line = count + (3 if rate else 2 if layout.has_header else 1)
                     raise CsvError(
                         f'{layout.path}: data row {line} is not numbers in columns 0 '
                         f'and {", ".join(map(str, columns))}: {",".join(row)!r}'
@@ -198,8 +255,9 @@ def csv_column_blocks(
         yield from _exact_blocks(layout, 0, block_rows)
         return
 
-    names = [f'c{i}' for i in range(layout.width)]
-    wanted = [names[0]] + [names[i] for i in layout.columns]
+    rate = layout.rate
+    names = [f'c{i}' for i in range(layout.width - (1 if rate else 0))]
+    wanted = ([] if rate else [names[0]]) + [names[layout.cell(i)] for i in layout.columns]
     done = 0
     try:
         # read by arrow itself, not through a Python file: a Python read allocates a fresh 2 MB
@@ -223,10 +281,15 @@ def csv_column_blocks(
                 ),
             )
             for batch in reader:
-                t = np.asarray(batch.column(names[0]).to_numpy(zero_copy_only=False), np.float64)
+                if rate:
+                    t = (done + np.arange(batch.num_rows)) / rate
+                else:
+                    t = np.asarray(
+                        batch.column(names[0]).to_numpy(zero_copy_only=False), np.float64
+                    )
                 y = np.empty((len(t), len(layout.columns)))
                 for k, i in enumerate(layout.columns):
-                    y[:, k] = batch.column(names[i]).to_numpy(zero_copy_only=False)
+                    y[:, k] = batch.column(names[layout.cell(i)]).to_numpy(zero_copy_only=False)
                 done += len(t)
                 yield t, y
     except (pa.ArrowInvalid, pa.ArrowTypeError, pa.ArrowNotImplementedError):
