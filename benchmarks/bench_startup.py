@@ -22,7 +22,9 @@ same run, on the same machine state.
   *lost*: samples sent that the node never counted (its ``received`` + ``dropped_warmup`` against
   what was sent). Then SIGINT: the exit code.
 * ``shaper_node``: spawn to its first ``/diagnostics``.
-* ``analyze``: the whole ``vib-estimator analyze`` of a 20 s CSV (500 Hz).
+* ``analyze``: the whole ``vib-estimator analyze`` of a 20 s CSV (a 5 Hz sine at 500 Hz: the
+  free-decay estimator) and of an 11 s two-mode free decay (10 and 13 Hz, 1 : 0.5, at 1 kHz, as
+  ``bench_defaults.py`` makes it: the default chooses the mode tracker), wall and CPU seconds.
 """
 
 from __future__ import annotations
@@ -30,6 +32,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import resource
 import signal
 import subprocess
 import sys
@@ -179,12 +182,22 @@ class Probe:
             # the longest /diagnostics silence, from the first one to 1.5 s after ready
             gaps = np.diff(self.diag_times)
             silence = float(gaps.max()) if len(gaps) else math.nan
+            # the background compile's end (no warmup_s any more): the warm run finds it all
+            while time.monotonic() - start < TIMEOUT_S and proc.poll() is None:
+                now = next(iter(self.last_values.values()), {})
+                if now and 'warmup_s' not in now:
+                    break
+                self.spin(0.05)
+            compiled, compiled_cpu = time.monotonic() - start, cpu_seconds(proc.pid)
+            # lost: never counted, once the node has drained what it had queued (a node behind
+            # its input while it compiles holds up to its input depth, 10 s at 500 Hz)
+            self.spin(2.5)
             values = next(iter(self.last_values.values()), {})
             counted = int(values.get('received', 0)) + int(values.get('dropped_warmup', 0))
             lost = sent - counted if values else -1
         finally:
             code = stop(proc)
-        return live, ready, latency, lost, code, silence, spawned, cpu
+        return live, ready, latency, lost, code, silence, spawned, cpu, compiled, compiled_cpu
 
     def first_diagnostics(self, cmd, env):
         """(spawn to first /diagnostics s, exit code) of a node."""
@@ -232,8 +245,10 @@ def stop(proc) -> int:
     return proc.returncode
 
 
-def analyze_seconds(tree: Path, env: dict, csv: Path) -> float:
+def analyze_seconds(tree: Path, env: dict, csv: Path):
+    """(wall s, CPU s) of one ``vib-estimator analyze csv`` (nan, nan if it failed)."""
     code = 'import sys; from vib_estimator.cli import main; sys.exit(main())'
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.monotonic()
     done = subprocess.run(
         [sys.executable, '-P', '-c', code, 'analyze', str(csv)],
@@ -242,9 +257,28 @@ def analyze_seconds(tree: Path, env: dict, csv: Path) -> float:
         stderr=subprocess.PIPE,
         text=True,
     )
-    if done.returncode:
-        return math.nan
-    return time.monotonic() - start
+    wall = time.monotonic() - start
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime
+    return (math.nan, math.nan) if done.returncode else (wall, cpu)
+
+
+def write_csv(path: Path, t, y) -> Path:
+    np.savetxt(path, np.column_stack([t, y]), delimiter=',', header='t,y', comments='', fmt='%.9g')
+    return path
+
+
+def two_mode_decay() -> tuple:
+    """bench_defaults.py's 'decay 10 / 13 Hz, 1:0.5': 1 s of noise, then the decay, 1 kHz."""
+    rng = np.random.default_rng(0)
+    rng.standard_normal(5000)  # bench_defaults draws the 5 Hz decay's noise first
+    t = np.arange(0, 11, 0.001)
+    tau = np.maximum(t - 1.0, 0)
+    y = sum(
+        a * np.exp(-z * 2 * np.pi * f * tau) * np.sin(2 * np.pi * f * tau)
+        for f, a, z in ((10.0, 1.0, 0.003), (13.0, 0.5, 0.003))
+    )
+    return t, y + 0.05 / np.sqrt(2) * 10 ** (-1.5) * rng.standard_normal(len(t))
 
 
 def checkout(ref: str, where: Path) -> Path:
@@ -258,7 +292,8 @@ def checkout(ref: str, where: Path) -> Path:
 
 def noted(rows: list, row: tuple, text: str) -> None:
     """Keep a result row (case, tree, cold/warm, live, ready, lost, exit, first estimate, longest
-    silence, first estimate after spawn, CPU s to ready) and print it as it comes."""
+    silence, first estimate after spawn, CPU s to ready, compiled after spawn s, its CPU s) and
+    print it as it comes."""
     rows.append(row)
     case, label, kind = row[:3]
     print(f'{case:28s} {label:8s} {kind}: {text}', flush=True)
@@ -273,33 +308,35 @@ def main(argv=None) -> int:
         action='append',
         help='run only these cases (repeatable)',
     )
+    parser.add_argument(
+        '--case',
+        action='append',
+        help='only the estimator_node cases whose name holds this (repeatable), e.g. modes',
+    )
     args = parser.parse_args(argv)
     only = set(args.only or ['estimator_node', 'shaper_node', 'analyze'])
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         trees = {'today': ROOT, args.ref: checkout(args.ref, tmp)}
-        csv = tmp / 'tone.csv'
         t = np.arange(int(20 * RATE_HZ)) / RATE_HZ
-        np.savetxt(
-            csv,
-            np.column_stack([t, np.sin(2 * np.pi * TONE_HZ * t)]),
-            delimiter=',',
-            header='t,y',
-            comments='',
-            fmt='%.9g',
-        )
+        records = {
+            'analyze (20 s CSV)': write_csv(tmp / 'tone.csv', t, np.sin(2 * np.pi * TONE_HZ * t)),
+            'analyze (two-mode decay)': write_csv(tmp / 'two.csv', *two_mode_decay()),
+        }
         probe = Probe()
         rows = []
         try:
             for case, params in ESTIMATOR_CASES.items():
                 if 'estimator_node' not in only:
                     break
+                if args.case and not any(c in case for c in args.case):
+                    continue
                 for label, tree in trees.items():
                     cache = tempfile.mkdtemp(dir=tmp)
                     cmd = node_command(tree, 'vib_estimator.nodes.estimator_node', params)
                     for kind in ('cold', 'warm'):
-                        live, ready, latency, lost, code, silence, spawned, cpu = probe.estimator(
-                            cmd, environment(tree, cache)
+                        live, ready, latency, lost, code, silence, spawned, cpu, compiled, ccpu = (
+                            probe.estimator(cmd, environment(tree, cache))
                         )
                         noted(
                             rows,
@@ -315,11 +352,14 @@ def main(argv=None) -> int:
                                 silence,
                                 spawned,
                                 cpu,
+                                compiled,
+                                ccpu,
                             ),
                             f'live {live:6.2f} s (longest /diagnostics silence {silence:5.2f} '
                             f's), ready {ready:6.2f} s, first estimate {latency:6.2f} s after '
                             f'the first sample ({spawned:6.2f} s after spawn), lost {lost}, '
-                            f'exit {code}; {cpu:5.2f} CPU s to ready',
+                            f'exit {code}; {cpu:5.2f} CPU s to ready; compiled after '
+                            f'{compiled:6.2f} s, {ccpu:5.2f} CPU s',
                         )
             if 'shaper_node' in only:
                 for label, tree in trees.items():
@@ -328,14 +368,15 @@ def main(argv=None) -> int:
                     for kind in ('cold', 'warm'):
                         live, code = probe.first_diagnostics(cmd, environment(tree, cache))
                         row = ('shaper_node', label, kind, live, live, 0, code)
-                        noted(rows, row + (math.nan,) * 4, f'live {live:6.2f} s, exit {code}')
-            if 'analyze' in only:
+                        noted(rows, row + (math.nan,) * 6, f'live {live:6.2f} s, exit {code}')
+            for case, csv in records.items() if 'analyze' in only else ():
                 for label, tree in trees.items():
                     cache = tempfile.mkdtemp(dir=tmp)
                     for kind in ('cold', 'warm'):
-                        seconds = analyze_seconds(tree, environment(tree, cache), csv)
-                        row = ('analyze (20 s CSV)', label, kind, math.nan, seconds, 0, 0)
-                        noted(rows, row + (math.nan,) * 4, f'{seconds:6.2f} s')
+                        seconds, cpu = analyze_seconds(tree, environment(tree, cache), csv)
+                        row = (case, label, kind, math.nan, seconds, 0, 0)
+                        row += (math.nan,) * 3 + (cpu, math.nan, math.nan)
+                        noted(rows, row, f'{seconds:6.2f} s, {cpu:6.2f} CPU s')
         finally:
             probe.close()
     print(
@@ -344,9 +385,10 @@ def main(argv=None) -> int:
         f'first estimate after '
         f'the first sample, cold today / {args.ref} | first estimate after spawn, cold today / '
         f'{args.ref}; warm today / {args.ref} | CPU s to ready, cold today / {args.ref}; warm '
-        f'today / {args.ref} | samples lost, cold today / {args.ref} | exit on SIGINT |'
+        f'today / {args.ref} | compiled (background), cold: s after spawn; CPU s, today / '
+        f'{args.ref} | samples lost, cold today / {args.ref} | exit on SIGINT |'
     )
-    print('|---|---|---|---|---|---|---|---|---|---|---|')
+    print('|---|---|---|---|---|---|---|---|---|---|---|---|')
     cases = list(dict.fromkeys(r[0] for r in rows))
     for case in cases:
         get = {(r[1], r[2]): r for r in rows if r[0] == case}
@@ -359,7 +401,8 @@ def main(argv=None) -> int:
             f'{ref_c[8]:.1f} s | '
             f'{today_c[7]:.1f} / {ref_c[7]:.1f} s | {today_c[9]:.1f} / {ref_c[9]:.1f}; '
             f'{today_w[9]:.1f} / {ref_w[9]:.1f} s | {today_c[10]:.1f} / {ref_c[10]:.1f}; '
-            f'{today_w[10]:.2f} / {ref_w[10]:.2f} s | {today_c[5]} / {ref_c[5]} | {codes} |'
+            f'{today_w[10]:.2f} / {ref_w[10]:.2f} s | {today_c[11]:.1f}; {today_c[12]:.1f} / '
+            f'{ref_c[11]:.1f}; {ref_c[12]:.1f} | {today_c[5]} / {ref_c[5]} | {codes} |'
         )
     print(GOALS)
     return 0

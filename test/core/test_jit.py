@@ -38,3 +38,18 @@ def test_borrowing_leaves_the_reference_counts_as_they_were():
     for _ in range(1000):
         _fill_through_views(a, b)
     assert (sys.getrefcount(a), sys.getrefcount(b)) == before
+
+
+# ---- available: compiled code in memory or numba's cache, never a compile ---------------------
+@njit
+def _twice(x):
+    return 2.0 * x
+
+
+def test_available_says_whether_a_call_would_compile_and_never_compiles():
+    from vib_estimator.core.jit import available
+
+    assert not available(_twice, (1.0,)) and not _twice.signatures  # nothing compiled
+    assert _twice(1.0) == 2.0
+    assert available(_twice, (1.0,)) and not available(_twice, (np.zeros(2),))
+    assert len(_twice.signatures) == 1

@@ -28,9 +28,10 @@ from typing import Optional, Tuple
 
 import numpy as np
 
-from ..core import MODELS, EstimateArrays, EstimatorConfig, create_estimator
+from ..core import MODELS, EstimateArrays, EstimatorConfig
 from ..core.config import EXCITATIONS, PAPER
-from ..core.factory import kind_of
+from ..core.estimator import run_batch
+from ..core.factory import batch_estimator, kind_of
 from ..errors import VibEstimatorError, report
 from ..io.align import ALIGN_TOLERANCE_S
 from ..io.csv_reader import csv_layout
@@ -230,7 +231,7 @@ def estimate_signal(
     Raises ValueError (no samples, time not increasing, band above Nyquist) and the readers'
     CsvError/BagError.
     """
-    estimator = create_estimator(config)
+    estimator = batch_estimator(config)  # uncompiled at first when not compiled yet
     parts, kept = [], []
     count, previous, first_t, nyquist_checked = 0, 0.0, None, False
     for t, y in signal.blocks() if blocks is None else blocks:
@@ -243,8 +244,8 @@ def estimate_signal(
             )
             nyquist_checked = True
         first_t = float(t[0]) if first_t is None else first_t
+        parts.append(run_batch(estimator, t, y, count))
         count, previous = count + len(t), float(t[-1])
-        parts.append(estimator.process(t, y))
         if keep_samples:
             kept.append((t, y))
     if count == 0:

@@ -37,7 +37,7 @@ import numpy as np
 
 from . import kernel as K
 from .config import EstimatorConfig
-from .jit import entry, interpreted
+from .jit import available, entry, interpreted
 
 #: the input counters every estimator keeps (the first of the kernel's counter array, in order)
 INPUT_COUNTERS = (
@@ -100,10 +100,15 @@ _BOUND = ('_feed', '_k', '_p', '_row', '_s', '_seg')
 
 
 def as_series(t: Sequence[float], y: Sequence[float]) -> Tuple[np.ndarray, np.ndarray]:
-    """``t``, ``y`` as contiguous float64 arrays of one length (``ValueError`` otherwise); ``y``
-    may be samples x 1 (one channel, as a joint estimator's input)."""
-    t = np.ascontiguousarray(t, dtype=np.float64)
-    y = np.ascontiguousarray(y, dtype=np.float64)
+    """``t``, ``y`` as contiguous, writeable float64 arrays of one length (``ValueError``
+    otherwise); ``y`` may be samples x 1 (one channel, as a joint estimator's input).
+
+    Writeable: numba compiles a kernel once more for a read-only array (another type), so a
+    CSV's read-only time column (pyarrow's) cost ``analyze`` a compile of 10-20 s that
+    ``vib-estimator warmup`` had paid already for writeable arrays; a read-only block is copied.
+    """
+    t = np.require(t, np.float64, ('C', 'W'))
+    y = np.require(y, np.float64, ('C', 'W'))
     if y.ndim == 2 and y.shape[1:] == (1,):
         y = y[:, 0]
     if t.shape != y.shape or t.ndim != 1:
@@ -191,12 +196,14 @@ class Estimator(Protocol):
       outlier rule exists); ``estimates``, those published; ``rejected_<why>``, candidates held
       back and why; the others are named in the estimator's module.
 
-    The estimators subclass it, for the defaults of ``channels``, ``segment_samples`` and
-    ``mode_counters``.
+    The estimators subclass it, for the defaults of ``channels``, ``segment_samples``,
+    ``interpreted`` and ``mode_counters``.
     """
 
     channels: Tuple[str, ...] = ()
     segment_samples: Optional[int] = None
+    #: True while it runs its kernels uncompiled (:func:`.factory.create_uncompiled`)
+    interpreted: bool = False
 
     @property
     def config(self) -> EstimatorConfig: ...
@@ -309,6 +316,13 @@ class FrequencyEstimator(Estimator):
         self._k = K
         self._feed = None
 
+    def kernels_available(self) -> bool:
+        """Whether the compiled batch kernel is in memory or numba's cache
+        (:func:`core.jit.available`: running it compiles nothing)."""
+        one = np.zeros(1)
+        args = (self._p, self._s, self._c, self._seg, one, one, self._row, 0, self._optional)
+        return available(K.run, args)
+
     def __getstate__(self) -> dict:
         return {k: v for k, v in self.__dict__.items() if k not in _BOUND}
 
@@ -393,8 +407,44 @@ class FrequencyEstimator(Estimator):
         return EstimateArrays.from_rows(rows)
 
 
+#: a batch run whose compiled kernels are neither in memory nor in numba's cache runs this many
+#: samples uncompiled before it compiles them (:func:`run_batch`): about 5 CPU s of the
+#: algebraic estimator (~100 us a sample), 5-10 of the mode tracker, less than their compile
+#: (20-25 CPU s on a 2-core machine, docs/startup.md), so a newcomer's first ``analyze`` of a
+#: record of a few minutes answers in seconds, and a longer record pays the compile once
+UNCOMPILED_SAMPLES = 50_000
+
+
+def batch_start(estimator) -> None:
+    """Make ``estimator`` (one built uncompiled: ``interpret``) compiled at once if its compiled
+    kernels cost nothing to run (in memory or numba's cache: ``kernels_available``); else it
+    starts uncompiled, and :func:`run_batch` compiles them after :data:`UNCOMPILED_SAMPLES`."""
+    if estimator.kernels_available():
+        estimator.compiled()
+
+
+def run_batch(estimator, t, y, fed: int = 0) -> EstimateArrays:
+    """``estimator.process(t, y)`` for the samples after the ``fed`` already processed, switched
+    to its compiled kernels at sample :data:`UNCOMPILED_SAMPLES` if it still runs uncompiled
+    (:func:`batch_start`). The switch is between two samples, on the same state; the algebraic
+    estimator's floats are the same either way, the mode tracker's within ~1e-9 relative
+    (:class:`~.modes.ModeTracker`)."""
+    if not estimator.interpreted:
+        return estimator.process(t, y)
+    k = max(UNCOMPILED_SAMPLES - fed, 0)
+    if k >= len(t):
+        return estimator.process(t, y)
+    t, y = np.asarray(t), np.asarray(y)
+    first = estimator.process(t[:k], y[:k])
+    estimator.compiled()
+    return EstimateArrays.concatenate([first, estimator.process(t[k:], y[k:])])
+
+
 def estimate(
     t: Sequence[float], y: Sequence[float], config: EstimatorConfig = EstimatorConfig()
 ) -> EstimateArrays:
-    """Batch convenience: run a fresh estimator over a whole record."""
-    return FrequencyEstimator(config).process(t, y)
+    """Batch convenience: run a fresh estimator over a whole record (uncompiled when its kernels
+    would have to be compiled for it, up to :data:`UNCOMPILED_SAMPLES`: :func:`run_batch`)."""
+    estimator = FrequencyEstimator(config, interpret=True)
+    batch_start(estimator)
+    return run_batch(estimator, t, y)

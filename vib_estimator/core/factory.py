@@ -23,7 +23,7 @@ from typing import Callable, Optional, Sequence
 from .ambient import AmbientEstimator
 from .auto import AutoEstimator
 from .config import EstimatorConfig
-from .estimator import Estimator, FrequencyEstimator
+from .estimator import Estimator, FrequencyEstimator, batch_start
 from .modes import ModeTracker
 from .multichannel import MIN_CHANNELS, JointAmbientEstimator
 from .multichannel_free import JointFreeEstimator
@@ -33,7 +33,9 @@ from .multichannel_free import JointFreeEstimator
 class Kind:
     """A row of :data:`KINDS`: ``build(config, channels)`` makes the estimator of ``excitation``
     for one channel or (``joint``) several; ``tracks`` True: only with ``modes`` >= 1, False:
-    only with ``modes`` = 0, None: any; ``numbered``: its estimates carry a mode number."""
+    only with ``modes`` = 0, None: any; ``numbered``: its estimates carry a mode number;
+    ``uncompiled(config)``: the same estimator with its kernels uncompiled (estimating at once
+    while they compile: :func:`create_uncompiled`), None where it has none to run so."""
 
     name: str
     excitation: str
@@ -41,6 +43,7 @@ class Kind:
     build: Callable[[EstimatorConfig, tuple], Estimator]
     tracks: Optional[bool] = None
     numbered: bool = True
+    uncompiled: Optional[Callable[[EstimatorConfig], Estimator]] = None
 
     def takes(self, config: EstimatorConfig, joint: bool) -> bool:
         """Whether this row is the estimator of ``config`` for one channel or several."""
@@ -50,8 +53,23 @@ class Kind:
 
 #: the estimators, a row each (module doc)
 KINDS = (
-    Kind('algebraic', 'free', False, lambda c, _: FrequencyEstimator(c), False, False),
-    Kind('mode tracker', 'free', False, lambda c, _: ModeTracker(c), tracks=True),
+    Kind(
+        'algebraic',
+        'free',
+        False,
+        lambda c, _: FrequencyEstimator(c),
+        False,
+        False,
+        partial(FrequencyEstimator, interpret=True),
+    ),
+    Kind(
+        'mode tracker',
+        'free',
+        False,
+        lambda c, _: ModeTracker(c),
+        tracks=True,
+        uncompiled=partial(ModeTracker, interpret=True),
+    ),
     Kind('ambient', 'ambient', False, lambda c, _: AmbientEstimator(c)),
     Kind(
         'auto',
@@ -95,3 +113,25 @@ def create_estimator(config: EstimatorConfig, channels: Sequence[str] = ()) -> E
     :data:`KINDS` that takes them (:func:`kind_of`; ValueError if none)."""
     channels = tuple(str(c) for c in channels)
     return kind_of(config, max(len(channels), 1)).build(config, channels)
+
+
+def create_uncompiled(
+    config: EstimatorConfig, channels: Sequence[str] = ()
+) -> Optional[Estimator]:
+    """The estimator of :func:`create_estimator` with its kernels uncompiled (its row's
+    ``uncompiled``: the one-channel free-decay estimators, with or without ``band_hz`` and
+    ``modes``), built without compiling anything; None for the others. Its ``compiled()``
+    switches it to its compiled kernels between two samples."""
+    kind = kind_of(config, max(len(channels), 1))
+    return None if kind.uncompiled is None else kind.uncompiled(config)
+
+
+def batch_estimator(config: EstimatorConfig, channels: Sequence[str] = ()) -> Estimator:
+    """The estimator of :func:`create_estimator` for a batch run (``analyze``): uncompiled at
+    first when its compiled kernels would have to be compiled for it (:func:`create_uncompiled`,
+    :func:`~.estimator.batch_start`; feed it with :func:`~.estimator.run_batch`)."""
+    estimator = create_uncompiled(config, channels)
+    if estimator is None:
+        return create_estimator(config, channels)
+    batch_start(estimator)
+    return estimator

@@ -15,14 +15,15 @@ change to a configuration that runs other kernels) is built in a background thre
 (:func:`~vib_estimator.core.warmup.warm`: seconds from numba's cache, tens of seconds on a first
 start after an install). Meanwhile the node stays live (services, diagnostics), and:
 
-- a configuration of the free-decay estimator (``excitation`` free, ``modes`` 0, one channel, no
-  ``band_hz``: :func:`interpretable`, the default) estimates at once with its kernel uncompiled
-  (:func:`~vib_estimator.core.jit.interpreted`: the same floats, about 100 us a sample):
+- a configuration of the free-decay estimators on one channel (``excitation`` free, with or
+  without ``band_hz`` and ``modes``: :func:`interpretable`, the default) estimates at once with
+  its kernels uncompiled (:func:`~vib_estimator.core.factory.create_uncompiled`: the algebraic
+  estimator's floats, about 100 us a sample; the mode tracker's within ~1e-9 relative):
   :attr:`EstimatorStream.ready` is True, and :meth:`EstimatorStream.poll` switches it to the
   compiled kernel once that is built, between two samples (:attr:`EstimatorStream.compiling` until
   then);
-- any other (the mode tracker, the ambient identifier, several channels, ``band_hz``, whose
-  coloured std costs about a second an estimate uncompiled) is not :attr:`EstimatorStream.ready`:
+- any other (the ambient identifier, ``auto``, several channels) is not
+  :attr:`EstimatorStream.ready`:
   :meth:`EstimatorStream.hold` keeps the samples that arrive, in order, up to
   :data:`WARMUP_BUFFER` (the oldest beyond it are dropped and counted in ``dropped_warmup``);
   :meth:`EstimatorStream.poll` installs the estimator once it is built and feeds it the held
@@ -38,15 +39,14 @@ import math
 import threading
 import time
 from collections import deque
-from functools import partial
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
 from ..core.choice import WATCH_S, Decision, StreamChoice, decide, window_advice
 from ..core.config import EstimatorConfig
-from ..core.estimator import COUNTER_NAMES, Estimate, FrequencyEstimator
-from ..core.factory import create_estimator, kind_of
+from ..core.estimator import COUNTER_NAMES, Estimate
+from ..core.factory import create_estimator, create_uncompiled, kind_of
 from ..core.multichannel import MIN_CHANNELS
 from ..core.warmup import is_warm, warm
 from ..io.fields import seconds_since
@@ -75,14 +75,9 @@ def check_channels(channels: Sequence[str], config: EstimatorConfig) -> None:
 
 def interpretable(config: EstimatorConfig, channels: Sequence[str]) -> bool:
     """Whether the estimator of ``config`` for ``channels`` can estimate while its kernels
-    compile (with them uncompiled, :class:`~vib_estimator.core.estimator.FrequencyEstimator`'s
-    ``interpret``): the free-decay estimator on one channel, without ``band_hz``."""
-    return (
-        len(channels) < MIN_CHANNELS
-        and config.excitation == 'free'
-        and config.modes == 0
-        and config.band_hz is None
-    )
+    compile (with them uncompiled: :func:`~vib_estimator.core.factory.create_uncompiled`): the
+    free-decay estimators on one channel, ``band_hz`` and ``modes`` included."""
+    return kind_of(config, max(len(channels), 1)).uncompiled is not None
 
 
 class _Build:
@@ -209,7 +204,7 @@ class EstimatorStream:
         self.health.forget_modes(config.modes)
         if self._background and not is_warm(config):
             if interpretable(config, channels):
-                self._install(FrequencyEstimator(config, interpret=True))
+                self._install(create_uncompiled(config, channels))
                 self._build = _Build(config, None)
             else:
                 self._build = _Build(config, channels)
@@ -395,14 +390,17 @@ class EstimatorStream:
 
         The tones are seeded, so the result is a function of (configuration, rate): it is kept,
         and a burst of calls costs one run, not one each -- the data path, which shares the node's
-        single executor thread, is held up once."""
-        if not self.ready:
+        single executor thread, is held up once. While the kernels compile the tones run
+        uncompiled only for the algebraic estimator without ``band_hz`` (0.1 CPU s): with
+        ``band_hz`` (0.5 CPU s) or the mode tracker (0.9), sharing Python's lock with the
+        compile, they held the data path up for seconds (21 s on a loaded machine): busy."""
+        if not self.ready or (self.compiling and (self.config.band_hz or self.config.modes)):
             return False, f'busy: {WARMUP_MESSAGE}'
         rate = self.health.sample_rate_hz
         if math.isfinite(rate) and rate > 0:
             rate = float(f'{rate:.{SELF_TEST_DIGITS}g}')
         key = (self.config, rate if math.isfinite(rate) else None)
         if self._self_test[0] != key:  # uncompiled while the kernels compile: the same result
-            create = partial(FrequencyEstimator, interpret=True) if self.compiling else None
+            create = create_uncompiled if self.compiling else None
             self._self_test = (key, self_test(self.config, rate, create))
         return self._self_test[1]
