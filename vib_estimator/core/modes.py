@@ -49,6 +49,14 @@ How the modes are found and estimated (everything compiled, one call per sample)
   (``rejected_inconsistent``). The pole that confirms a new mode is its first estimate when its
   window starts after the candidate's first one and it lies within ``CONSISTENCY`` of it. Modes are
   numbered by ascending frequency among the modes that have published.
+* **The fast scale**: once a mode has published, and no two modes lie within ``CLOSE_RATIO`` (a
+  close pair is not resolved in a period), its fast scale (the longest window of at most
+  ``C_FAST`` periods of the lowest mode and ``C_TRACK`` cycles of its own) is analysed beside
+  its publishing one, and the relative deviation of its pole from the publishing window's is kept
+  (a running mean of its square over ``DEV_N`` analyses); while that RMS is ``DEV_MAX`` or less
+  (2 % is then 4 of it) the mode publishes from the fast scale, its longer window still analysed
+  as the reference (a clean decay's dominant mode: 0.77 periods to an estimate instead of 1.54;
+  a noisy one, or a mode ringing down into the noise, keeps or returns to its longer window).
 * **First estimates**: until its first estimate a mode publishes under ``C_CAP`` even in a close
   pair, and while the scales are fast after an excitation or the analysed scale is such a mode's,
   the analysis refines its close pairs as undamped
@@ -105,6 +113,11 @@ SUSPECT_CYCLES = 5.0  # ... is a harmonic unless seen over this many cycles
 CONSISTENCY = 0.01  # a published pole lies this close to the mode's previous pole,
 CONSISTENCY_FIRST = 0.03  # ... a close pair's first one (undamped refinement) this close
 LOSE_PERIODS = 3.0  # a mode unseen for this many of its periods is lost
+C_FAST = 1.0  # a mode's fast scale: the longest window of at most this many periods of the
+#: lowest mode (and C_TRACK of its own); it publishes from it once the RMS of its poles' relative
+#: deviations from the publishing window's (a running mean over DEV_N analyses) is DEV_MAX or less
+DEV_MAX = 0.005
+DEV_N = 8.0
 N_STEP = 15  # intervals whose median is the grid step
 MAX_FILL = 64  # grid steps interpolated between two samples at most (else a restart)
 NPEND = 16  # candidates kept
@@ -187,8 +200,11 @@ FINDER_COUNTERS = {
     SL_INCONS,
     SL_HARM,
     SL_FIT,
+    SL_REF,
+    SL_DEV,
+    SL_NDEV,
     N_SL,
-) = range(15)  # N_*: the slots' number
+) = range(18)  # N_*: the slots' number
 #: per-mode counters: name -> column of sl (and, for the lost modes' sums, of ic after I_RET)
 MODE_COUNTERS = {
     'estimates': SL_EST,
@@ -392,6 +408,36 @@ def _owner(b, sl, k, t, fmin, cap):
 
 
 @jit
+def _fast(b, sl, k, t, fmin, long):
+    """Mode k's fast scale (``C_FAST``): the longest window shorter than scale ``long``'s of at
+    most ``C_FAST`` periods of the lowest mode, ``C_TRACK`` of its own, starting after the mode's
+    start; -1 for none."""
+    f = sl[k, SL_F]
+    best = -1
+    for s in range(max(long, 0)):
+        w = _scale_len(s) * b[B_DT]
+        if fmin * w > C_FAST or t - w < sl[k, SL_START]:
+            break
+        if f * w >= C_TRACK:
+            best = s
+    return best
+
+
+@jit
+def _publisher(b, sl, k, t, fmin, cap):
+    """(the scale mode k publishes from, its window of reference, its fast scale): the fast scale
+    (:func:`_fast`) once its poles kept within ``DEV_MAX`` (RMS over ``DEV_N`` analyses) of the
+    reference's, the reference (:func:`_owner`) else."""
+    long = _owner(b, sl, k, t, fmin, _mode_cap(sl, k, cap))[0]
+    fast = -1
+    if sl[k, SL_FIRST] < math.inf and cap == C_CAP:  # a close pair needs its long windows
+        fast = _fast(b, sl, k, t, fmin, long)
+    if fast >= 0 and sl[k, SL_NDEV] >= DEV_N and sl[k, SL_DEV] <= DEV_MAX**2:
+        return fast, long, fast
+    return long, long, fast
+
+
+@jit
 def _remove(ic, sl, k):
     """Mode k is lost: its counters go to the lost modes' sums."""
     sl[k, SL_ACTIVE] = 0.0
@@ -543,9 +589,18 @@ def _analysis(b, ic, sl, pd, qs, lams, pa, s, t, out):
             continue
         used[best] = 1
         sl[k, SL_SEEN] = t
-        if _owner(b, sl, k, t, fmin, _mode_cap(sl, k, cap))[0] != s:
-            continue
         f = pp[best, 0]
+        owner, long, fast = _publisher(b, sl, k, t, fmin, cap)
+        if s == long:
+            sl[k, SL_REF] = f
+        elif s == fast and sl[k, SL_REF] > 0.0:
+            # the fast scale's deviation from the reference: a running mean over DEV_N
+            sl[k, SL_DEV] += ((f / sl[k, SL_REF] - 1.0) ** 2 - sl[k, SL_DEV]) / min(
+                sl[k, SL_NDEV] + 1.0, DEV_N
+            )
+            sl[k, SL_NDEV] += 1.0
+        if owner != s:
+            continue
         prev = sl[k, SL_PREV]
         sl[k, SL_PREV] = f
         sl[k, SL_F] = f
@@ -570,6 +625,9 @@ def _analysis(b, ic, sl, pd, qs, lams, pa, s, t, out):
             for o in _owner(b, sl, k, t, fmin, _mode_cap(sl, k, cap)):
                 if o >= 0:
                     ic[I_BUSY + o] = 1
+            o = _publisher(b, sl, k, t, fmin, cap)[2]
+            if o >= 0:
+                ic[I_BUSY + o] = 1
 
 
 # ---- input, one sample, a run of samples --------------------------------------------------
