@@ -49,14 +49,15 @@ How the modes are found and estimated (everything compiled, one call per sample)
   (``rejected_inconsistent``). The pole that confirms a new mode is its first estimate when its
   window starts after the candidate's first one and it lies within ``CONSISTENCY`` of it. Modes are
   numbered by ascending frequency among the modes that have published.
-* **The fast scale**: once a mode has published, and no two modes lie within ``CLOSE_RATIO`` (a
-  close pair is not resolved in a period), its fast scale (the longest window of at most
-  ``C_FAST`` periods of the lowest mode and ``C_TRACK`` cycles of its own) is analysed beside
+* **The fast scale**: once a mode has published, its fast scale (the longest window of at most
+  ``C_FAST`` periods of the lowest mode, ``C_CAP`` when two modes lie within ``CLOSE_RATIO``: a
+  close pair is not resolved in a period, and ``C_TRACK`` cycles of its own) is analysed beside
   its publishing one, and the relative deviation of its pole from the publishing window's is kept
   (a running mean of its square over ``DEV_N`` analyses); while that RMS is ``DEV_MAX`` or less
   (2 % is then 4 of it) the mode publishes from the fast scale, its longer window still analysed
-  as the reference (a clean decay's dominant mode: 0.77 periods to an estimate instead of 1.54;
-  a noisy one, or a mode ringing down into the noise, keeps or returns to its longer window).
+  as the reference (clean decays' dominant modes: 0.77 periods to an estimate instead of 1.54,
+  a close pair's 1.92 instead of 2.72; a noisy one, or a mode ringing down into the noise, keeps
+  or returns to its longer window).
 * **First estimates**: until its first estimate a mode publishes under ``C_CAP`` even in a close
   pair, and while the scales are fast after an excitation or the analysed scale is such a mode's,
   the analysis refines its close pairs as undamped
@@ -408,7 +409,7 @@ def _owner(b, sl, k, t, fmin, cap):
 
 
 @jit
-def _fast(b, sl, k, t, fmin, long):
+def _fast(b, sl, k, t, fmin, long, cap):
     """Mode k's fast scale (``C_FAST``): the longest window shorter than scale ``long``'s of at
     most ``C_FAST`` periods of the lowest mode, ``C_TRACK`` of its own, starting after the mode's
     start; -1 for none."""
@@ -416,7 +417,7 @@ def _fast(b, sl, k, t, fmin, long):
     best = -1
     for s in range(max(long, 0)):
         w = _scale_len(s) * b[B_DT]
-        if fmin * w > C_FAST or t - w < sl[k, SL_START]:
+        if fmin * w > cap or t - w < sl[k, SL_START]:
             break
         if f * w >= C_TRACK:
             best = s
@@ -430,8 +431,8 @@ def _publisher(b, sl, k, t, fmin, cap):
     reference's, the reference (:func:`_owner`) else."""
     long = _owner(b, sl, k, t, fmin, _mode_cap(sl, k, cap))[0]
     fast = -1
-    if sl[k, SL_FIRST] < math.inf and cap == C_CAP:  # a close pair needs its long windows
-        fast = _fast(b, sl, k, t, fmin, long)
+    if sl[k, SL_FIRST] < math.inf:  # a close pair is not resolved in a period: C_CAP
+        fast = _fast(b, sl, k, t, fmin, long, C_FAST if cap == C_CAP else C_CAP)
     if fast >= 0 and sl[k, SL_NDEV] >= DEV_N and sl[k, SL_DEV] <= DEV_MAX**2:
         return fast, long, fast
     return long, long, fast
