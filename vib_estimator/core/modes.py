@@ -216,7 +216,7 @@ MODE_COUNTERS = {
 # ---- candidates pd[i]: frequency (Hz), start of the first window, last seen ---------------------
 PD_F, PD_START, PD_SEEN = range(3)
 # ---- parameters pa -----------------------------------------------------------------------------
-PA_MAXGAP, PA_K, PA_BLO, PA_BHI, PA_MAXDAMP, PA_MINFIT, PA_P = range(7)
+PA_MAXGAP, PA_K, PA_BLO, PA_BHI, PA_MAXDAMP, PA_MINFIT, PA_P, PA_FAST = range(8)
 # ---- output rows: the estimate's fields (EstimateArrays order), then the mode -------------------
 (O_T, O_F, O_CONV, O_SAMPLES, O_FIT, O_AMP, O_DAMP, O_FSTD, O_DSTD, O_MODE, N_O) = range(11)
 
@@ -425,13 +425,13 @@ def _fast(b, sl, k, t, fmin, long, cap):
 
 
 @jit
-def _publisher(b, sl, k, t, fmin, cap):
+def _publisher(b, sl, pa, k, t, fmin, cap):
     """(the scale mode k publishes from, its window of reference, its fast scale): the fast scale
     (:func:`_fast`) once its poles kept within ``DEV_MAX`` (RMS over ``DEV_N`` analyses) of the
     reference's, the reference (:func:`_owner`) else."""
     long = _owner(b, sl, k, t, fmin, _mode_cap(sl, k, cap))[0]
     fast = -1
-    if sl[k, SL_FIRST] < math.inf:  # a close pair is not resolved in a period: C_CAP
+    if sl[k, SL_FIRST] < math.inf and pa[PA_FAST] != 0.0:  # a close pair: C_CAP (module doc)
         fast = _fast(b, sl, k, t, fmin, long, C_FAST if cap == C_CAP else C_CAP)
     if fast >= 0 and sl[k, SL_NDEV] >= DEV_N and sl[k, SL_DEV] <= DEV_MAX**2:
         return fast, long, fast
@@ -591,7 +591,7 @@ def _analysis(b, ic, sl, pd, qs, lams, pa, s, t, out):
         used[best] = 1
         sl[k, SL_SEEN] = t
         f = pp[best, 0]
-        owner, long, fast = _publisher(b, sl, k, t, fmin, cap)
+        owner, long, fast = _publisher(b, sl, pa, k, t, fmin, cap)
         if s == long:
             sl[k, SL_REF] = f
         elif s == fast and sl[k, SL_REF] > 0.0:
@@ -626,7 +626,7 @@ def _analysis(b, ic, sl, pd, qs, lams, pa, s, t, out):
             for o in _owner(b, sl, k, t, fmin, _mode_cap(sl, k, cap)):
                 if o >= 0:
                     ic[I_BUSY + o] = 1
-            o = _publisher(b, sl, k, t, fmin, cap)[2]
+            o = _publisher(b, sl, pa, k, t, fmin, cap)[2]
             if o >= 0:
                 ic[I_BUSY + o] = 1
 
@@ -747,7 +747,7 @@ F_SL = N_B
 F_PD = F_SL + KMAX * N_SL
 F_LAM = F_PD + NPEND * 3
 F_PA = F_LAM + NS * 3 * PCOL  # per scale: eigenvalues, poles (re, im) of its last analysis
-N_F = F_PA + 7
+N_F = F_PA + 8
 
 
 @jit
@@ -796,9 +796,11 @@ class ModeStatus:
 
 
 class ModeTracker(Estimator):
-    """Find and track up to ``config.modes`` modes; see the module docstring."""
+    """Find and track up to ``config.modes`` modes; see the module docstring. ``fast`` False: no
+    fast scale (each mode publishes from its long window: the joint free estimator's events, whose
+    joint fits over a fast scale's window of under a period scatter)."""
 
-    def __init__(self, config: EstimatorConfig):
+    def __init__(self, config: EstimatorConfig, fast: bool = True):
         config.validate()
         if config.modes < 1:
             raise ValueError('ModeTracker needs modes >= 1 (FrequencyEstimator for modes = 0)')
@@ -824,6 +826,7 @@ class ModeTracker(Estimator):
             config.max_damping,
             config.min_fit,
             self._npc,
+            float(fast),
         )
         self._out = np.empty((ROOM, N_O))
         self._t1 = np.zeros(1)  # the streaming path's sample, fed to the batch kernel
