@@ -81,7 +81,11 @@ KINDS = (
         'joint free',
         'free',
         True,
-        lambda c, names: JointFreeEstimator(c, names, partial(create_estimator, c)),
+        lambda c, names: JointFreeEstimator(
+            c,
+            names,
+            partial(ModeTracker, c, fast=False) if c.modes else partial(create_estimator, c),
+        ),
     ),
     Kind('joint ambient', 'ambient', True, JointAmbientEstimator),
 )
