@@ -55,8 +55,6 @@ from .config import EstimatorConfig
 from .correlations import CorrelationCascade
 from .estimator import (
     INPUT_COUNTERS,
-    RESTART,
-    SKIP,
     Estimate,
     EstimateArrays,
     Estimator,
@@ -276,11 +274,8 @@ class SlidingWindowIdentifier(Estimator):
     def _accept(self, t: float, finite: bool) -> bool:
         """Count one sample (``finite``: its values are); False if skipped. A gap or a long jump
         back clears the window (:func:`.estimator.accept_sample`)."""
-        action = accept_sample(self._c, self._last, t, finite, self._config.max_gap)
-        if action == SKIP:
+        if not accept_sample(self._c, self._last, t, finite, self._config.max_gap, self._clear):
             return False
-        if action == RESTART:
-            self._clear()
         self._last = t
         return True
 

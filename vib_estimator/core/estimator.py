@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Dict, List, Optional, Protocol, Sequence, Tuple
+from typing import Callable, Dict, List, Optional, Protocol, Sequence, Tuple
 
 import numpy as np
 
@@ -49,35 +49,36 @@ INPUT_COUNTERS = (
     'time_jump_resets',
     'gap_resets',
 )
-#: :func:`accept_sample`'s answers: skip the sample, keep it, keep it after a restart
-SKIP, KEEP, RESTART = 0, 1, 2
 
 
-def accept_sample(c: Dict[str, int], last: float, t: float, finite: bool, max_gap: float) -> int:
+def accept_sample(
+    c: Dict[str, int],
+    last: float,
+    t: float,
+    finite: bool,
+    max_gap: float,
+    restart: Callable[[], None],
+) -> bool:
     """The input policy of the estimators written in Python (the kernel's ``_accept_time`` is
     the same rule compiled): count a sample of stamp ``t`` in ``c`` (the :data:`INPUT_COUNTERS`)
-    after the last kept stamp ``last`` (-inf: none) and say what to do with it. Non-finite
-    (stamp or a value): skipped. A repeated stamp or a step back within ``max_gap``: skipped
+    after the last kept stamp ``last`` (-inf: none); True if it is kept. Non-finite (stamp or a
+    value): skipped. A repeated stamp or a step back within ``max_gap``: skipped
     (``skipped_duplicate``, ``skipped_out_of_order``). A jump back beyond it (a restarted
-    source, a bag looping) or a step forward beyond it (a gap): :data:`RESTART`
-    (``time_jump_resets``, ``gap_resets``): the caller forgets its signal and keeps the
-    sample, so a stream whose time went back is followed, never skipped for good."""
+    source, a bag looping) or a step forward beyond it (a gap): ``restart()`` is called
+    (``time_jump_resets``, ``gap_resets``: the caller forgets its signal) and the sample kept,
+    so a stream whose time went back is followed, never skipped for good."""
     c['received'] += 1
     if not (finite and math.isfinite(t)):
         c['skipped_non_finite'] += 1
-        return SKIP
-    if t <= last:
-        if last - t <= max_gap:
-            c['skipped_duplicate' if t == last else 'skipped_out_of_order'] += 1
-            return SKIP
-        c['time_jump_resets'] += 1
-        c['used'] += 1
-        return RESTART
+        return False
+    if t <= last and last - t <= max_gap:
+        c['skipped_duplicate' if t == last else 'skipped_out_of_order'] += 1
+        return False
     c['used'] += 1
-    if t - last > max_gap and math.isfinite(last):
-        c['gap_resets'] += 1
-        return RESTART
-    return KEEP
+    if t <= last or (t - last > max_gap and math.isfinite(last)):
+        c['time_jump_resets' if t <= last else 'gap_resets'] += 1
+        restart()
+    return True
 
 
 #: counter names, in the order of :mod:`vib_estimator.core.kernel`'s counter array

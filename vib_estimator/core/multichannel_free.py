@@ -69,12 +69,13 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 
 from .ambient import MATCH_TOL, MAX_TRACKS
 from .config import EstimatorConfig
-from .estimator import INPUT_COUNTERS, RESTART, SKIP, Estimate, Estimator, accept_sample
+from .estimator import INPUT_COUNTERS, Estimate, Estimator, accept_sample
 from .multichannel import (
     MIN_CHANNELS,
     JointEstimates,
@@ -362,25 +363,23 @@ class JointFreeEstimator(Estimator):
         """The rows to keep and the kept rows that restart (a jump back or a gap beyond
         ``max_gap``), counted (:func:`.estimator.accept_sample`)."""
         finite = np.isfinite(t) & np.all(np.isfinite(y), axis=1)
-        actions = np.empty(len(t), np.int8)
+        kept = np.zeros(len(t), bool)
+        restarts = np.zeros(len(t), bool)
         last = self._last
         for i, (ti, ok) in enumerate(zip(t.tolist(), finite.tolist())):
-            actions[i] = accept_sample(self._c, last, ti, ok, self._config.max_gap)
-            if actions[i] != SKIP:
-                last = ti
+            mark = partial(restarts.__setitem__, i, True)
+            if accept_sample(self._c, last, ti, ok, self._config.max_gap, mark):
+                kept[i], last = True, ti
         self._last = last
-        kept = actions != SKIP
-        return kept, (actions == RESTART)[kept]
+        return kept, restarts[kept]
 
     def _accept(self, t: float, finite: bool) -> bool:
         """Whether a row of stamp ``t`` (its values all finite or not) is kept, counted
         (:func:`.estimator.accept_sample`): a jump back or a gap beyond ``max_gap`` empties the
         row store (the channels' estimators restart themselves on it)."""
-        action = accept_sample(self._c, self._last, t, finite, self._config.max_gap)
-        if action == SKIP:
+        gap = self._config.max_gap
+        if not accept_sample(self._c, self._last, t, finite, gap, self._forget_signal):
             return False
-        if action == RESTART:
-            self._forget_signal()
         self._last = t
         return True
 
