@@ -68,11 +68,3 @@ def test_a_segment_not_yet_converged_starts_at_the_previous_estimate(seed):
     assert len(e) >= 1.1 * n_default
     assert np.median(e.convergence_time * 5) <= 1.2
     assert np.mean(np.abs(e.frequency_hz / 5 - 1) <= 0.02) >= 0.95
-
-
-def test_early_std_rel_off_is_the_long_window_unchanged():
-    """0 (the default) is exactly the long window: the same floats as before the option."""
-    t, y = decay(30.0)
-    a = estimate(t, y, EstimatorConfig(min_periods=FAST_PERIODS))
-    b = estimate(t, y, EstimatorConfig(min_periods=FAST_PERIODS, early_std_rel=0.0))
-    assert np.array_equal(a.frequency_hz, b.frequency_hz) and len(a) > 10

@@ -365,11 +365,15 @@ class JointFreeEstimator(Estimator):
         finite = np.isfinite(t) & np.all(np.isfinite(y), axis=1)
         kept = np.zeros(len(t), bool)
         restarts = np.zeros(len(t), bool)
-        last = self._last
+        last, gap = self._last, self._config.max_gap
+        restarted: list = []
+        mark = partial(restarted.append, None)  # accept_sample's restart
         for i, (ti, ok) in enumerate(zip(t.tolist(), finite.tolist())):
-            mark = partial(restarts.__setitem__, i, True)
-            if accept_sample(self._c, last, ti, ok, self._config.max_gap, mark):
+            if accept_sample(self._c, last, ti, ok, gap, mark):
                 kept[i], last = True, ti
+                if restarted:
+                    restarts[i] = True
+                    restarted.clear()
         self._last = last
         return kept, restarts[kept]
 
@@ -478,16 +482,10 @@ class JointFreeEstimator(Estimator):
         return out
 
     def _window(self, index: int, samples: int) -> np.ndarray:
-        """The rows of an event's window: the last ``samples`` up to ``index``, after the last
-        gap longer than ``max_gap``."""
+        """The rows of an event's window: the last ``samples`` up to ``index`` (the store holds
+        no gap longer than ``max_gap``: one empties it, :meth:`_forget_signal`)."""
         lo = max(0, index + 1 - min(samples, self._room))
-        rows = self._rows[lo : index + 1]
-        gap = self._config.max_gap
-        if gap > 0 and len(rows) > 1:
-            jumps = np.flatnonzero(np.diff(rows[:, 0]) > gap)
-            if len(jumps):
-                rows = rows[jumps[-1] + 1 :]
-        return rows
+        return self._rows[lo : index + 1]
 
     def _terms(self, c: int, e: Estimate, span: float):
         """``(omega, sigma, degrees)``: the fit's start values, the event's mode first (its
