@@ -204,7 +204,6 @@ class SlidingWindowIdentifier(Estimator):
         self._tracks = []
         self._last = -math.inf
         self._since_search = math.inf  # analyses since the last search (the first searches)
-        self._hop = HOP_S  # to the next analysis (:meth:`_track`)
         self._clear()
 
     def reset(self) -> None:
@@ -303,7 +302,7 @@ class SlidingWindowIdentifier(Estimator):
         i, n = 0, len(t)
         while i < n:
             j = i
-            if finite[i] and t[i] > self._last and (t[i] - self._last <= gap or not self._n):
+            if finite[i] and t[i] > self._last and t[i] - self._last <= gap:
                 d = np.diff(t[i : min(n, i + 65536)])
                 bad = ~((d > 0) & (d <= gap)) | ~finite[i + 1 : i + 1 + len(d)]
                 j = i + 1 + (int(np.argmax(bad)) if bad.any() else len(d))
@@ -373,9 +372,14 @@ class SlidingWindowIdentifier(Estimator):
         """Schedule the next analysis and slide the window (and the cascade) to end at the last
         sample; its samples' times."""
         t_end = self._t[self._n - 1]
-        self._next += self._hop
+        # every second while a mode is to be confirmed (CONFIRM analyses running: as soon as at
+        # any window), else every hop_s of the window
+        tracks = self._tracks
+        settled = bool(tracks) and all(tr.published for tr in tracks)
+        hop = hop_s(self._window) if settled else HOP_S
+        self._next += hop
         if self._next <= t_end:
-            self._next = t_end + self._hop
+            self._next = t_end + hop
         first = self._start + int(
             np.searchsorted(self._t[self._start : self._n], t_end - self._window, 'left')
         )
@@ -456,10 +460,6 @@ class SlidingWindowIdentifier(Estimator):
             )
             out.append(self._publish(est, modes.shapes[i], modes.shape_std[i], similarity))
         self._c['estimates'] += len(out)
-        # every second while a mode is to be confirmed (CONFIRM analyses running: as soon as at
-        # any window), else every hop_s of the window
-        settled = bool(tracks) and all(tr.published for tr in tracks)
-        self._hop = hop_s(self._window) if settled else HOP_S
         return out
 
 

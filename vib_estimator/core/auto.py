@@ -327,9 +327,12 @@ class Envelope:
     def __init__(self, block_s: float, max_block_s: float = math.inf):
         self.base_s = block_s
         self.max_block_s = max(block_s, max_block_s)
+        self.blocks = {FREE: 0, DRIVEN: 0}  # blocks closed in each state
+        self.changes = {'onsets': 0, 'rang_down': 0, 'became_driven': 0}
         self.restart()
 
     def restart(self) -> None:
+        """Forget the signal; the counters (:attr:`blocks`, :attr:`changes`) are kept."""
         self.block_s = self.base_s
         self.seconds = {FREE: 0.0, DRIVEN: 0.0}  # the blocks closed in each state, s
         #: the energy of the blocks closed in each state (their variance x their seconds) and the
@@ -346,8 +349,6 @@ class Envelope:
         self._energies: list[float] = []  # since the last onset, at most HORIZON_BLOCKS
         self._driven: list[float] = []  # the driven stretch's last BLOCKS_PER_WINDOW blocks
         self._quiet = 0  # consecutive blocks DROP below the driven stretch's median
-        self.blocks = {FREE: 0, DRIVEN: 0}  # blocks closed in each state
-        self.changes = {'onsets': 0, 'rang_down': 0, 'became_driven': 0}
 
     def fitted_block(self, f: float) -> float:
         """The block for a free estimate of ``f`` Hz: :data:`BLOCK_PERIODS` of its periods at the
@@ -535,9 +536,7 @@ class AutoEstimator(Estimator):
         """Forget the signal and the known modes; counters are kept (the envelope's too)."""
         self._free.restart()
         self._ambient.restart()
-        counted = self._envelope.blocks, self._envelope.changes
         self._envelope.restart()
-        self._envelope.blocks, self._envelope.changes = counted
         self._modes = []
         self._filled = 0
 

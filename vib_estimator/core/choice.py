@@ -496,10 +496,10 @@ class StreamChoice:
         at the last :meth:`driven`), :func:`decide` over the kept samples, if not ``free``; from
         an ``ambient`` this choice ``decided``, ``free`` once the stream reads free.
         ``window_s``: the configured ambient window (the shortest the decision gives)."""
-        t, y = self.kept()
-        if not len(t):
+        self._flush()
+        if not self._kept:
             return None
-        now = float(t[-1])
+        now = float(self._kept[-1][0][-1])
         if excitation == 'ambient' and decided:
             if not self.watch.freed():
                 return None
@@ -511,5 +511,5 @@ class StreamChoice:
         if excitation != 'free' or self._share is None or now < self._retry_at:
             return None
         self._retry_at = now + WATCH_S / 2
-        chosen = decide(t, y, self.channels, window_s, stream=True)
+        chosen = decide(*self.kept(), self.channels, window_s, stream=True)
         return None if chosen.excitation == 'free' else chosen

@@ -35,8 +35,10 @@ DECIMATE_ORDER, DECIMATE_CUTOFF = 8, 0.45
 #: squared distance from zero or the products' offset may be flat: its window is read
 #: (:meth:`CorrelationCascade.flat`; far above those products' rounding)
 FLAT_SUSPECT = 1e-6
+#: block rows p of the correlation Hankel matrix of one channel (lags 1 .. 2p; core.ssi)
+BLOCK_ROWS = 40
 #: the decimated window holds at least this many samples (20 x the single channel's block rows)
-MIN_SAMPLES = 800
+MIN_SAMPLES = 20 * BLOCK_ROWS
 #: a :class:`LagProducts` recomputes its sums from its window after this many slides (bounds the
 #: rounding of the updates; the sums are otherwise exact)
 REFRESH_SLIDES = 64

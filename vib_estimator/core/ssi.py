@@ -54,11 +54,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .correlations import CorrelationCascade
+from .correlations import BLOCK_ROWS, CorrelationCascade
 from .whittle import sdof_density, whittle_frequencies, whittle_std
 
-#: block rows p of the correlation Hankel matrix of one channel (lags 1 .. 2p)
-BLOCK_ROWS = 40
 #: with several channels fewer block rows: ``rows x channels`` at most about this (above the
 #: highest model order, ``ORDERS``' 28; one channel: :data:`BLOCK_ROWS`, two: 20). Measured on
 #: the 5-storey frame (5 channels, 10 seeds, RMS frequency error of every estimate, modes 1-5;

@@ -123,15 +123,13 @@ def whittle_frequencies(
     modes: np.ndarray,
     noise,
     stds: np.ndarray,
-    which: Sequence[int] | None = None,
     shapes: np.ndarray | None = None,
 ) -> np.ndarray:
     """Each mode's frequency refined to the maximum of the Whittle likelihood of the window
     ``x`` (samples, or samples x channels, at ``fs``) near it, the other parameters kept
     (``modes``: rows of frequency, damping ratio, variance of the modal coordinate; ``noise``:
     each channel's white noise density at ``fs``, its variance there; ``stds``: the
-    frequencies' stds, Hz; ``which``: the modes to refine, all if None, the others' frequencies
-    returned as given; ``shapes``: each mode's real unit shape, modes x channels, one channel:
+    frequencies' stds, Hz; ``shapes``: each mode's real unit shape, modes x channels, one channel:
     1).
 
     The Whittle log-likelihood of a stationary Gaussian vector series over the Fourier
@@ -162,7 +160,7 @@ def whittle_frequencies(
     hz = w * fs / (2 * math.pi)
     dt = 1.0 / fs
     out = modes[:, 0].copy()
-    for k in range(len(modes)) if which is None else which:
+    for k in range(len(modes)):
         f, zeta, variance = modes[k, :3]
         if zeta * f * n / fs < WHITTLE_MIN_BINS or zeta > WHITTLE_MAX_DAMPING:
             continue  # a peak narrower than the bins (their leakage shapes it), or a wide one

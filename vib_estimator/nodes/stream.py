@@ -216,10 +216,7 @@ class EstimatorStream:
         self._update = estimator.update  # bound once: the data path's one call
         self._build = None
         if len(self._primer[0]):  # fed before any held sample; its counts taken back
-            t, y = self._primer
-            values = y.tolist() if y.ndim == 1 else map(tuple, y.tolist())
-            for when, value in zip(t.tolist(), values):
-                estimator.update(when, value)
+            estimator.process(*self._primer)  # (streaming equals batch)
             self.health.absorb({name: -n for name, n in estimator.counters.items()})
             self._primer = NO_PRIMER
 
@@ -350,7 +347,7 @@ class EstimatorStream:
         :data:`~vib_estimator.core.choice.WATCH_S` / 2 s of stream; else None."""
         config = self.config
         since = self._estimated_at if self._estimated_at is not None else 0.0
-        if config.excitation == 'free' or since is None or self.last_t is None:
+        if config.excitation == 'free' or self.last_t is None:
             return None
         silent = self.last_t - since
         if silent < max(2 * config.ambient_window_s, 60.0):
