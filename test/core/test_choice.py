@@ -344,3 +344,31 @@ def test_a_pure_free_decay_is_estimated_over_a_shorter_window_where_precise(
     assert right()
     monkeypatch.setattr(choice, name, getattr(choice, name) * factor)
     assert not right()
+
+
+@pytest.mark.parametrize('factor', [1e-3, 1e3])
+@pytest.mark.parametrize('name', ['FAST_ZETA', 'DECAY_BLOCK_PERIODS'])
+def test_a_heavily_damped_decay_keeps_the_default_window(monkeypatch, name, factor):
+    """A decay damped at 3 % falls by 16 % within 0.9 periods, a shift of the frequency the
+    biased sinusoid's std does not hold: it keeps 1.25 periods (100 % within 2 %; 62 % over 0.9
+    periods), while a lightly damped one gets 0.9. Its damping ratio read from its envelope
+    within 5 % (0.5 %, 3 %). Each constant at 0.001x and 1000x breaks one of them."""
+
+    def right():
+        zetas = [
+            choice.decay_zeta(*pluck_with_a_move(0.0, 40.0, zeta=z), 2.0) for z in (5e-3, 0.03)
+        ]
+        light = decided_convergence(*pluck_with_a_move(0.0, 40.0, zeta=0.005))
+        heavy = decided_convergence(*pluck_with_a_move(0.0, 40.0, zeta=0.03))
+        return (
+            abs(zetas[0] / 5e-3 - 1) < 0.05
+            and abs(zetas[1] / 0.03 - 1) < 0.05
+            and light[0] <= 0.93
+            and light[1] >= 0.95
+            and heavy[0] >= 1.1
+            and heavy[1] >= 0.95
+        )
+
+    assert right()
+    monkeypatch.setattr(choice, name, getattr(choice, name) * factor)
+    assert not right()

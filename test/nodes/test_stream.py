@@ -278,6 +278,37 @@ def test_the_deciding_stream_goes_to_the_identifier_when_driven_and_back_when_fr
     assert decisions(quiet, ring_t, ring) == []
 
 
+def test_the_deciding_stream_publishes_no_free_estimate_of_a_driven_input_before_it_decides():
+    """Before it decides (its first minute), the deciding stream's free-decay estimator publishes
+    only estimates whose signal passes the free-decay test (as ``auto``'s free stretches): a
+    driven mode's free estimates, up to 8 % off here, are held back and counted
+    (``not_free_decay``, one of the held-back counters the status names); a free decay's are
+    those of ``free``, float for float; without ``decide_excitation`` they are published."""
+    from vib_estimator.sim.ambient import ambient_record
+
+    t, y, _ = ambient_record(55, 500, [(5.0, 0.01, 1.0)], 20, 0)
+
+    def run(deciding, t, y):
+        stream = EstimatorStream(EstimatorConfig(), now=0.0, deciding=deciding)
+        got = []
+        decisions(stream, t, y, step=500, estimates=got)
+        return stream, [e for _, _, e in got]
+
+    undecided, held = run(False, t, y)
+    off = [abs(e.frequency_hz / 5 - 1) for e in held]
+    assert max(off) > 0.05 and undecided.counters['not_free_decay'] == 0
+    deciding, published = run(True, t, y)
+    assert all(abs(e.frequency_hz / 5 - 1) <= 0.02 for e in published)
+    assert len(published) <= 2 and deciding.counters['not_free_decay'] >= len(held) - 2
+    assert 'not_free_decay' in deciding.status(now=56.0).message
+    ring_t = np.arange(0, 12, 0.002)
+    ring = np.exp(-0.01 * 2 * np.pi * 5 * ring_t) * np.sin(2 * np.pi * 5 * ring_t)
+    ring += 0.002 * np.random.default_rng(0).standard_normal(len(ring_t))
+    _, free = run(True, ring_t, ring)
+    offline = FrequencyEstimator().process(np.round(ring_t * 1e9).astype(np.int64) * 1e-9, ring)
+    assert len(free) >= 40 and [e.frequency_hz for e in free] == offline.frequency_hz.tolist()
+
+
 def test_an_identifier_that_finds_no_mode_says_which_window_helps():
     """Under excitation ambient, a 30 s window on a 0.3 Hz mode publishes nothing: after two
     windows (and a minute) the status says why in words -- the window's correlation times of the

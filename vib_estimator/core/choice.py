@@ -46,7 +46,16 @@ from typing import Optional
 
 import numpy as np
 
-from .auto import BLOCK_MARGIN, BLOCK_PERIODS, DRIVEN, FREE, MIN_BLOCK_S, Envelope
+from .auto import (
+    BLOCK_MARGIN,
+    BLOCK_PERIODS,
+    DRIVEN,
+    FREE,
+    MIN_BLOCK_S,
+    TEST_PERIODS,
+    Envelope,
+    is_free_decay,
+)
 
 #: the first seconds of a record the decision reads
 DECIDE_S = 600.0
@@ -103,6 +112,14 @@ PEAK_WIDTH = 0.15
 #: is then ~3 stds; a decay's tail in its noise (1.4-3.2 % at 0.9 periods in 20-30 dB) keeps the
 #: default's accuracy there (bench_first_estimate.py: 95-100 % within 2 %)
 FAST_STD = 0.007
+#: ... and only for a decay no more damped than this (damping ratio, :func:`decay_zeta`): over
+#: 0.9 periods a decay at 3 % falls by 16 %, which the biased sinusoid reads as a shift of the
+#: frequency its std does not hold (a 5 Hz decay at 3 %, 40 dB: 44-100 % within 2 % against
+#: 88-100 % over 1.25 periods; 10 Hz at 5 %: 43-100 % against 100 %; a 2 Hz decay at 2 %, 40 dB:
+#: 85-88 % against 100 %, at 1.5 % 94-97 %, at 1.2 % 100 %: 3 seeds each)
+FAST_ZETA = 0.015
+#: the envelope blocks of :func:`decay_zeta`, in periods
+DECAY_BLOCK_PERIODS = 2.0
 #: the damping ratio :func:`window_advice` assumes of the lowest mode (:data:`WINDOW_PERIODS`
 #: is ~15 correlation times at it)
 ASSUMED_ZETA = 0.02
@@ -283,20 +300,53 @@ def impurity(t: np.ndarray, y: np.ndarray, f: float) -> float:
     return off / total if total > 0 else math.nan
 
 
+def decay_zeta(t: np.ndarray, y: np.ndarray, f: float) -> float:
+    """The damping ratio of a free decay at ``f`` Hz from its envelope: the variance of blocks of
+    :data:`DECAY_BLOCK_PERIODS` periods, from the block after the most energetic one on while
+    they fall (none rising 1.5 x: a next pluck) and stand 10 x above the noise (the last quarter's
+    median block, when flat: a decay that rang down), fitted by ``exp(-2 zeta 2 pi f t)`` over
+    the noise; NaN with fewer than 3 such blocks."""
+    fs = (len(t) - 1) / float(t[-1] - t[0]) if len(t) > 1 else math.nan
+    n = int(round(DECAY_BLOCK_PERIODS * fs / f)) if f > 0 and math.isfinite(fs) else 0
+    m = len(y) // n if n >= 4 else 0
+    if m < 4:
+        return math.nan
+    energy = y[: m * n].reshape(m, n).var(axis=1)
+    peak = int(np.argmax(energy))
+    tail = energy[-max(2, m // 4) :]
+    half = len(tail) // 2
+    # the noise the decay rang down into: the last quarter, if flat (else it still decays)
+    flat = np.mean(tail[:half]) <= 1.2 * np.mean(tail[half:])
+    floor = float(np.median(tail)) if flat else 0.0
+    k = peak + 1
+    while k < m and energy[k] > 10 * floor and (k == peak + 1 or energy[k] <= 1.5 * energy[k - 1]):
+        k += 1
+    if k - peak - 1 < 3:
+        return math.nan
+    centres = (np.arange(peak + 1, k) + 0.5) * n / fs
+    slope = np.polyfit(centres, np.log(energy[peak + 1 : k] - floor), 1)[0]
+    return float(-slope / 2 / (2 * math.pi * f))
+
+
 def fast_window(t: np.ndarray, y: np.ndarray, f: float) -> tuple[float, float, str]:
     """The window (``min_periods``) and the precision its estimates need (``early_std_rel``) for
     a free decay of one mode at ``f`` Hz: :data:`FAST_PERIODS` and :data:`FAST_STD` when its
-    spectrum is pure (:func:`impurity` below :data:`IMPURE`); else (NaN, 0: the configured
+    spectrum is pure (:func:`impurity` below :data:`IMPURE`) and it is lightly damped
+    (:func:`decay_zeta` at most :data:`FAST_ZETA`, or unknown); else (NaN, 0: the configured
     window). With the reason in words."""
     spread = impurity(t, y, f)
     if not spread <= IMPURE:
         return math.nan, 0.0, f'{100 * spread:.0f} % of the power near {f:.3g} Hz off its peak'
+    zeta = decay_zeta(t, y, f)
+    if zeta > FAST_ZETA:
+        return math.nan, 0.0, f'a decay damped at {100 * zeta:.1f} % (its envelope)'
     return (
         FAST_PERIODS,
         FAST_STD,
         (
-            f'a pure peak ({100 * spread:.1f} % off it): min_periods {FAST_PERIODS:g} where the '
-            f'estimate is within {100 * FAST_STD:.2g} % (1 std), else 1.25'
+            f'a pure, lightly damped peak ({100 * spread:.1f} % off it): min_periods '
+            f'{FAST_PERIODS:g} where the estimate is within {100 * FAST_STD:.2g} % (1 std), '
+            'else 1.25'
         ),
     )
 
@@ -484,6 +534,30 @@ class StreamChoice:
             np.concatenate([c[0] for c in self._kept]),
             np.concatenate([c[1] for c in self._kept]),
         )
+
+    def recent(self, seconds: float) -> tuple[np.ndarray, np.ndarray]:
+        """``(t, y)`` of the kept samples of the last ``seconds`` s (at least; y: the first
+        channel), oldest first."""
+        self._flush()
+        parts: list = []
+        for t, y in reversed(self._kept):
+            parts.append((t, y if y.ndim == 1 else y[:, 0]))
+            if parts[0][0][-1] - t[0] >= seconds:
+                break
+        if not parts:
+            return np.empty(0), np.empty(0)
+        return np.concatenate([p[0] for p in parts[::-1]]), np.concatenate(
+            [p[1] for p in parts[::-1]]
+        )
+
+    def free_decay(self, f: float) -> Optional[bool]:
+        """:func:`.auto.is_free_decay` of a free estimate of ``f`` Hz that the last sample
+        completed, over the samples before it (the first channel): False when the signal is no
+        free decay (a driven response: the estimate is of no mode), None when too short to tell.
+        """
+        if not f > 0:
+            return None
+        return is_free_decay(*self.recent((TEST_PERIODS + 2) / f), f)
 
     def driven(self) -> Optional[float]:
         """:meth:`DrivenWatch.driven`, kept for :meth:`decision`."""

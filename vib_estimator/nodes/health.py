@@ -35,6 +35,7 @@ HELD_BACK = (
     'rejected_damping',
     'rejected_inconsistent',
     'max_window_resets',
+    'not_free_decay',
 )
 #: counters of bad input: their growth since the previous status makes it WARN (and is logged
 #: once per episode): the core's (its short gaps, long ones and the samples they lost, outliers)
@@ -53,13 +54,15 @@ BAD_INPUT = (
 #: the node's own counters: zero header stamps replaced by the receipt time; JointState messages
 #: without the configured joint (skipped); samples received while ``band_hz`` reached above the
 #: Nyquist frequency of the input's sampling rate; samples dropped while the kernels compiled (the
-#: oldest beyond the warm-up buffer of :mod:`.stream`)
+#: oldest beyond the warm-up buffer of :mod:`.stream`); free estimates held back by the free-decay
+#: test while the node decides its excitation (added to ``auto``'s counter of the same name)
 NODE_COUNTERS = (
     (
         'zero_stamps_replaced',
         'skipped_joint_missing',
         'band_above_nyquist',
         'dropped_warmup',
+        'not_free_decay',
     )
     + CADENCE_COUNTERS
     + ('lost_in_transport',)
@@ -198,9 +201,9 @@ class Health:
         """The counters since start: the core's (live estimator + replaced ones), then the
         node's."""
         totals = dict(self._base)
-        for name, value in core_counters.items():
-            totals[name] = totals.get(name, 0) + value
-        totals.update(self.node_counters)
+        for counters in (core_counters, self.node_counters):  # one name in both: added
+            for name, value in counters.items():
+                totals[name] = totals.get(name, 0) + value
         return totals
 
     @property
@@ -247,6 +250,7 @@ class Health:
         input shows that the configuration does not fit; logged when it starts); OK otherwise.
         """
         tick = self._tick
+        counted = dict(self.node_counters)  # what this call adds goes into the values too
         messages = totals.get('received', 0) + totals['skipped_joint_missing']
         if messages > tick.messages:
             self._input_at = now
@@ -294,8 +298,10 @@ class Health:
             'input_rate_hz': input_rate,
             'sample_rate_hz': self.sample_rate_hz,
             **self._mode_values(now, modes),
-            **totals,
-            **self.node_counters,
+            **{
+                name: n + self.node_counters.get(name, 0) - counted.get(name, 0)
+                for name, n in totals.items()
+            },
         }
         return Status(level, message, values, log)
 

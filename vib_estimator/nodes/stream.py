@@ -228,10 +228,33 @@ class EstimatorStream:
         self.last_t = t = seconds_since(stamp_ns, self.origin)
         self._choice.update(t, value)
         estimates = self._update(t, value)
+        if not estimates:
+            return estimates
+        tested = self._tests_free_decay()
+        kept = []
         for e in estimates:
             self._choice.follow(e.frequency_hz)
+            if tested and self._choice.free_decay(e.frequency_hz) is False:
+                self.health.count('not_free_decay')
+                continue
             self._estimated_at = t
-        return estimates
+            kept.append(e)
+        return kept
+
+    def _tests_free_decay(self) -> bool:
+        """Whether each free estimate must pass the free-decay test to be published
+        (:meth:`~vib_estimator.core.choice.StreamChoice.free_decay`, as ``auto`` tests its free
+        stretches): while the node decides its excitation and runs the algebraic estimator on
+        one channel (``excitation`` free, no ``modes``, no ``band_hz``), so that a driven input
+        gets no free-decay estimates of no mode before the decision (its first minute)."""
+        config = self._config
+        return (
+            self.deciding
+            and config.excitation == 'free'
+            and config.modes == 0
+            and config.band_hz is None
+            and len(self.channels) < MIN_CHANNELS
+        )
 
     @property
     def held_samples(self) -> int:
@@ -293,9 +316,15 @@ class EstimatorStream:
 
     @property
     def counters(self) -> Dict[str, int]:
-        """The core counters since start (across configurations) and the node's own."""
+        """The core counters since start (across configurations) and the node's own;
+        ``estimates``: those published (the core's, less those the free-decay test held back,
+        ``not_free_decay``)."""
         core = self.estimator.counters if self.estimator is not None else _IDLE_COUNTERS
-        return self.health.totals(core)
+        totals = self.health.totals(core)
+        totals['estimates'] = (
+            totals.get('estimates', 0) - self.health.node_counters['not_free_decay']
+        )
+        return totals
 
     def status(self, now: float) -> Status:
         """The diagnostics status at ``now`` (monotonic s)."""
