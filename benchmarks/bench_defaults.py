@@ -170,7 +170,12 @@ def streamed(path: Path, select: list[str]):
             if decision is not None:
                 stream.configure(stream.config.replace(**decision.changes()), prime=True)
                 stream.decided = True
-                decided.append(f'{decision.excitation} {decision.window_s:.0f} s at {t[k]:.0f} s')
+                what = (
+                    f'modes {decision.modes}'
+                    if decision.excitation == 'free'
+                    else f'{decision.window_s:.0f} s'
+                )
+                decided.append(f'{decision.excitation} {what} at {t[k]:.0f} s')
     return 0, rows, ', '.join(decided), time.process_time() - start
 
 

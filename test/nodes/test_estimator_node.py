@@ -1072,3 +1072,22 @@ def test_a_driven_input_switches_the_default_to_the_identifier(make_probe, decid
         status = p.wait_status(lambda s: 'looks driven' in s.message)
         assert 'excitation:=ambient' in status.message
         assert config_of(p.node).excitation == 'free'
+
+
+def test_a_silent_decay_of_several_modes_sets_the_nodes_modes(make_probe):
+    """``decide_excitation``: a pluck of two beating modes, which the one-mode estimator cannot
+    fit, sets the node's own ``modes`` to 3 (the mode tracker, primed with the decay so far):
+    both modes are then published on their topics (test_stream.py has the rule)."""
+    t = np.arange(0, 8, 1 / 500)
+    tau = np.maximum(t - 1.0, 0)
+    y = sum(
+        a * np.exp(-0.003 * 2 * np.pi * f * tau) * np.sin(2 * np.pi * f * tau)
+        for f, a in ((10.0, 1.0), (13.0, 0.5))
+    )
+    y += 1e-3 * np.random.default_rng(0).standard_normal(len(t))
+    p = make_probe(**{name: getattr(EstimatorConfig(), name) for name in PAPER})  # defaults
+    p.feed([EPOCH_NS + round(s * 1e9) for s in t], y)
+    node = p.node
+    assert spin_until(p.executor, lambda: config_of(node).modes == 3, 10.0)
+    assert node.get_parameter('modes').value == 3 and config_of(node).excitation == 'free'
+    assert p.node._stream.decided

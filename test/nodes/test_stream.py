@@ -309,6 +309,50 @@ def test_the_deciding_stream_publishes_no_free_estimate_of_a_driven_input_before
     assert len(free) >= 40 and [e.frequency_hz for e in free] == offline.frequency_hz.tolist()
 
 
+def plucked(modes, seconds=12.0, rate=500.0):
+    """A pluck at 1 s of ``modes`` ((f, amplitude, zeta), ...) in 1e-3 of white noise."""
+    t = np.arange(0, seconds, 1 / rate)
+    tau = np.maximum(t - 1.0, 0)
+    y = sum(
+        a * np.exp(-z * 2 * np.pi * f * tau) * np.sin(2 * np.pi * f * tau) for f, a, z in modes
+    )
+    return t, y + 1e-3 * np.random.default_rng(0).standard_normal(len(t))
+
+
+@pytest.mark.parametrize('factor', [1e-3, 1e3])
+def test_a_silent_decay_of_several_modes_goes_to_the_mode_tracker(monkeypatch, factor):
+    """A pluck of a 10 and a 13 Hz mode beats: the one-mode estimator publishes nothing. After
+    ``SILENT_S`` s of silence while the input rings, the deciding stream asks analyze's decision
+    over its last seconds and takes the mode tracker (``modes`` 3, primed): both modes, within
+    2 %, from 3 s after the pluck. A beam's pluck (4.27 Hz, and a 26.7 Hz mode that dies in a
+    second) keeps the one-mode estimator: it is never silent that long. ``SILENT_S`` at 0.001x
+    sends the beam to the tracker (its first second's spectrum), at 1000x leaves the pair
+    silent."""
+    from vib_estimator.core import choice
+
+    def run(modes):
+        stream = EstimatorStream(EstimatorConfig(), now=0.0, deciding=True)
+        got = []
+        decided = decisions(stream, *plucked(modes), step=500, estimates=got)
+        return decided, np.array([e.frequency_hz for _, _, e in got]), stream
+
+    def right():
+        decided, f, stream = run(((10.0, 1.0, 0.003), (13.0, 0.5, 0.003)))
+        pair = (
+            [(x.excitation, x.modes) for _, x in decided] == [('free', 3)]
+            and decided[0][0] <= 4
+            and stream.config.modes == 3
+            and all(np.any(np.abs(f / m - 1) <= 0.02) for m in (10.0, 13.0))
+            and np.all(np.min(np.abs(f[:, None] / [10.0, 13.0] - 1), axis=1) <= 0.02)
+        )
+        decided, f, _ = run(((4.27, 1.0, 0.005), (26.7, 1.0, 0.02)))
+        return pair and decided == [] and len(f) >= 30 and np.all(np.abs(f / 4.27 - 1) <= 0.02)
+
+    assert right()
+    monkeypatch.setattr(choice, 'SILENT_S', choice.SILENT_S * factor)
+    assert not right()
+
+
 def test_an_identifier_that_finds_no_mode_says_which_window_helps():
     """Under excitation ambient, a 30 s window on a 0.3 Hz mode publishes nothing: after two
     windows (and a minute) the status says why in words -- the window's correlation times of the

@@ -347,6 +347,7 @@ class Envelope:
         self._k = 0
         self._n, self._s1, self._s2 = 0, 0.0, 0.0
         self._energies: list[float] = []  # since the last onset, at most HORIZON_BLOCKS
+        self.last_energy: Optional[float] = None  # the last block's
         self._driven: list[float] = []  # the driven stretch's last BLOCKS_PER_WINDOW blocks
         self._quiet = 0  # consecutive blocks DROP below the driven stretch's median
 
@@ -437,6 +438,7 @@ class Envelope:
         energy = max(0.0, self._s2 / n - m * m)
         self._n, self._s1, self._s2 = 0, 0.0, 0.0
         e = self._energies
+        self.last_energy = energy
         onset = bool(e) and _is_onset(e, energy, self.state == FREE, self.ringing)
         if onset:
             self.ringing = False

@@ -151,9 +151,10 @@ class Decision:
 
     def changes(self) -> dict:
         """The configuration fields a stream switching to this decision sets (the node's
-        parameters): the excitation, and a driven one's window."""
+        parameters): the excitation, a driven one's window, a free decay's modes (when
+        several)."""
         if self.excitation == 'free':
-            return {'excitation': 'free'}
+            return {'excitation': 'free', **({'modes': self.modes} if self.modes else {})}
         return {'excitation': self.excitation, 'ambient_window_s': float(self.window_s)}
 
 
@@ -390,6 +391,10 @@ WATCH_S = 120.0
 LIVE_LEVEL = 1e-2
 #: the most samples the node keeps for its decision (15 MB with 6 channels; 262 s at 1 kHz)
 MAX_KEPT = 2**18
+#: a stream whose free-decay estimator has published nothing for this many seconds, while it
+#: rings after an onset, is asked whether it is a decay of several modes (their beating fails
+#: the one-mode fits: a 10 and a 13 Hz mode gave no estimate at all); again this often
+SILENT_S = 3.0
 
 
 class DrivenWatch:
@@ -441,6 +446,19 @@ class DrivenWatch:
             return None
         return share if share > DRIVEN_ABOVE and live else None
 
+    def ringing(self) -> bool:
+        """Whether the stream rings freely now: the envelope's stretch free, begun by an onset
+        (a pluck, not the rest or noise the stream started with), and its last block at least
+        :data:`LIVE_LEVEL` of the largest block's."""
+        env = self._envelope
+        last = env.last_energy
+        return (
+            env.state == FREE
+            and env.changes['onsets'] > 0
+            and last is not None
+            and last >= LIVE_LEVEL * env.peak
+        )
+
     def freed(self) -> bool:
         """Whether the last :data:`WATCH_S` s look free: their driven share below
         :data:`FREE_BELOW` (what :func:`decide` calls a free decay)."""
@@ -486,6 +504,8 @@ class StreamChoice:
         self._kept_n = 0
         self._retry_at = -math.inf
         self._share: Optional[float] = None
+        self._estimated_at = -math.inf  # stream time of the last free estimate (follow)
+        self._silent_retry = -math.inf
 
     def update(self, t: float, value) -> None:
         self._pending_t.append(t)
@@ -505,6 +525,7 @@ class StreamChoice:
         if kept and t[0] < kept[-1][0][-1] - WATCH_S / 100:
             kept.clear()
             self._kept_n = 0
+            self._estimated_at = self._silent_retry = -math.inf
         kept.append((t, y))
         self._kept_n += len(t)
         while len(kept) > 1 and t[-1] - kept[1][0][0] >= WATCH_S:
@@ -524,6 +545,8 @@ class StreamChoice:
         """An estimate of ``f`` Hz (:meth:`DrivenWatch.follow`), after the samples before it."""
         self._flush()
         self.watch.follow(f)
+        if self._kept:
+            self._estimated_at = float(self._kept[-1][0][-1])
 
     def kept(self) -> tuple[np.ndarray, np.ndarray]:
         """``(t, y)`` of the kept samples (y: samples, or samples x channels), oldest first."""
@@ -534,6 +557,18 @@ class StreamChoice:
             np.concatenate([c[0] for c in self._kept]),
             np.concatenate([c[1] for c in self._kept]),
         )
+
+    def _several_modes(self, now: float, window_s: float) -> Optional[Decision]:
+        """:func:`decide`'s free decay of several modes over the kept samples, asked (at most
+        every :data:`SILENT_S` s) when no free estimate came for that long while the stream
+        rings (:meth:`DrivenWatch.ringing`); else None."""
+        if now - max(self._estimated_at, self._silent_retry) < SILENT_S:
+            return None
+        self._silent_retry = now
+        if not self.watch.ringing():
+            return None
+        chosen = decide(*self.kept(), self.channels, window_s, stream=True)
+        return chosen if chosen.excitation == 'free' and chosen.modes else None
 
     def recent(self, seconds: float) -> tuple[np.ndarray, np.ndarray]:
         """``(t, y)`` of the kept samples of the last ``seconds`` s (at least; y: the first
@@ -565,15 +600,23 @@ class StreamChoice:
         self._share = self.watch.driven()
         return self._share
 
-    def decision(self, excitation: str, decided: bool, window_s: float) -> Optional[Decision]:
+    def decision(
+        self, excitation: str, decided: bool, window_s: float, modes: int = 0
+    ) -> Optional[Decision]:
         """The decision to switch to, or None: from ``free`` (when the watch read the stream driven
         at the last :meth:`driven`), :func:`decide` over the kept samples, if not ``free``; from
-        an ``ambient`` this choice ``decided``, ``free`` once the stream reads free.
+        ``free`` with ``modes`` 0 whose estimator has been silent for :data:`SILENT_S` s while the
+        stream rings after an onset, a free decay of several modes (the mode tracker); from an
+        ``ambient`` this choice ``decided``, ``free`` once the stream reads free.
         ``window_s``: the configured ambient window (the shortest the decision gives)."""
         self._flush()
         if not self._kept:
             return None
         now = float(self._kept[-1][0][-1])
+        if excitation == 'free' and modes == 0 and self.channels == 1:
+            several = self._several_modes(now, window_s)
+            if several is not None:
+                return several
         if excitation == 'ambient' and decided:
             if not self.watch.freed():
                 return None

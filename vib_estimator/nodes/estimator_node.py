@@ -622,9 +622,12 @@ class EstimatorNode(Node):
         if decision is None:
             return
         changes = [Parameter(name, value=value) for name, value in decision.changes().items()]
+        config = self._stream.config
+        what = f'excitation {config.excitation} -> {decision.excitation}'
+        if decision.changes().get('modes', config.modes) != config.modes:
+            what += f', modes {config.modes} -> {decision.modes}'
         self.get_logger().info(
-            f'excitation {self._stream.config.excitation} -> {decision.excitation}: '
-            f'{decision.reason} (decide_excitation:=false keeps the configured excitation)'
+            f'{what}: {decision.reason} (decide_excitation:=false keeps the configured excitation)'
         )
         self._deciding = True
         try:

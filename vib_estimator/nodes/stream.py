@@ -188,12 +188,16 @@ class EstimatorStream:
         ``channels`` (default: the same); built in the background when its kernels are not
         compiled yet and ``background`` was asked. ValueError if ``config`` cannot take the
         channels (:func:`check_channels`). ``prime`` (a :meth:`decision` applied): the new
-        identifier (not ``free``) is first fed the input's last seconds the decision read,
-        uncounted and unpublished, so that a driven stream's window is not filled again from
-        empty."""
+        identifier (not ``free``), or mode tracker, is first fed the input's last seconds the
+        decision read, uncounted and unpublished, so that a driven stream's window is not filled
+        again from empty (a decay's modes go on being tracked)."""
         channels = self.channels if channels is None else tuple(channels)
         check_channels(channels, config)
-        primes = prime and channels == self.channels and config.excitation != 'free'
+        primes = (
+            prime
+            and channels == self.channels
+            and (config.excitation != 'free' or config.modes > 0)
+        )
         self._primer = self._choice.kept() if primes else NO_PRIMER
         self.channels = channels
         if self.estimator is not None:
@@ -394,14 +398,17 @@ class EstimatorStream:
     def decision(self) -> Optional[Decision]:
         """What the input needs now, if not what runs (``decide_excitation``; after
         :meth:`status`, which watches the input): from ``free``, once the input looks driven
-        throughout, analyze's decision over its last seconds (excitation and ambient window);
+        throughout, analyze's decision over its last seconds (excitation and ambient window), or
+        when its estimator stays silent on a ringing input, a decay of several modes (``modes``);
         from an ``ambient`` decided so, ``free`` once it looks free again
         (:class:`~vib_estimator.core.choice.StreamChoice`). The caller applies it (the node: as
         its parameters) and sets :attr:`decided`."""
         if not self.ready:
             return None
         config = self.config
-        return self._choice.decision(config.excitation, self.decided, config.ambient_window_s)
+        return self._choice.decision(
+            config.excitation, self.decided, config.ambient_window_s, config.modes
+        )
 
     def reset(self) -> Tuple[bool, str]:
         """Start a new segment at the last sample; counters kept. (False, why) during a warm-up."""
