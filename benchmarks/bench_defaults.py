@@ -170,11 +170,13 @@ def streamed(path: Path, select: list[str]):
             if decision is not None:
                 stream.configure(stream.config.replace(**decision.changes()), prime=True)
                 stream.decided = True
-                what = (
-                    f'modes {decision.modes}'
-                    if decision.excitation == 'free'
-                    else f'{decision.window_s:.0f} s'
-                )
+                what = f'{decision.window_s:.0f} s'
+                if decision.excitation == 'free':
+                    what = (
+                        f'modes {decision.modes}'
+                        if decision.modes
+                        else f'min_periods {decision.min_periods:g}'
+                    )
                 decided.append(f'{decision.excitation} {what} at {t[k]:.0f} s')
     return 0, rows, ', '.join(decided), time.process_time() - start
 

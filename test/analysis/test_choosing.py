@@ -46,8 +46,11 @@ def driven(tmp_path):
 
 
 def test_a_free_decay_gives_exactly_the_free_estimator_s_output(capsys, free_decay):
-    """A pure decay: ``free`` with the decided window (0.9 periods where precise, core.choice);
-    every row of ``free`` with those options, none of ``free``'s default window."""
+    """A pure, clean decay: ``free`` with the decided window (0.9 periods where precise,
+    core.choice: ``FAST_STD_CLEAN``); every row of ``free`` with those options, none of
+    ``free``'s default window."""
+    from vib_estimator.core.choice import FAST_STD_CLEAN
+
     rows, err = analyze(capsys, free_decay)
     assert 'analyze: excitation free (the default decides from the record' in err
     assert 'min_periods 0.9' in err
@@ -59,7 +62,7 @@ def test_a_free_decay_gives_exactly_the_free_estimator_s_output(capsys, free_dec
         '--min-periods',
         '0.9',
         '--early-std-rel',
-        '0.007',
+        str(FAST_STD_CLEAN),
     )
     assert rows == free and len(rows) > 10
     assert 'decides from the record' not in err_free

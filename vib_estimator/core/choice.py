@@ -110,8 +110,15 @@ PEAK_WIDTH = 0.15
 #: ... precise: an estimate over :data:`FAST_PERIODS` whose predicted relative frequency std
 #: exceeds this waits for the default window (``early_std_rel``, core.kernel.HELD_PERIODS): 2 %
 #: is then ~3 stds; a decay's tail in its noise (1.4-3.2 % at 0.9 periods in 20-30 dB) keeps the
-#: default's accuracy there (bench_first_estimate.py: 95-100 % within 2 %)
+#: default's accuracy there (bench_first_estimate.py: 95-100 % within 2 %; at 0.01 a 2 Hz decay
+#: in 20 dB fell to 87 %)
 FAST_STD = 0.007
+#: ... and this (2 % at 2 stds) for a clean record, its signal-to-noise ratio (:func:`snr_db`) at
+#: least :data:`CLEAN_SNR_DB`: lightly damped decays at 35-45 dB, 6 seeds each (5 Dec): 0.007
+#: left the 35-40 dB ones at a median of 1.11-1.26 periods, 0.01 gives 0.90-1.04 at 93-99 %
+#: within 2 % (mean 97-99 %)
+FAST_STD_CLEAN = 0.01
+CLEAN_SNR_DB = 33.0
 #: ... and only for a decay no more damped than this (damping ratio, :func:`decay_zeta`): over
 #: 0.9 periods a decay at 3 % falls by 16 %, which the biased sinusoid reads as a shift of the
 #: frequency its std does not hold (a 5 Hz decay at 3 %, 40 dB: 44-100 % within 2 % against
@@ -152,9 +159,14 @@ class Decision:
     def changes(self) -> dict:
         """The configuration fields a stream switching to this decision sets (the node's
         parameters): the excitation, a driven one's window, a free decay's modes (when
-        several)."""
+        several) or window (when decided)."""
         if self.excitation == 'free':
-            return {'excitation': 'free', **({'modes': self.modes} if self.modes else {})}
+            out: dict = {'excitation': 'free'}
+            if self.modes:
+                out['modes'] = self.modes
+            if math.isfinite(self.min_periods):
+                out.update(min_periods=self.min_periods, early_std_rel=self.early_std_rel)
+            return out
         return {'excitation': self.excitation, 'ambient_window_s': float(self.window_s)}
 
 
@@ -316,9 +328,11 @@ def decay_zeta(t: np.ndarray, y: np.ndarray, f: float) -> float:
     peak = int(np.argmax(energy))
     tail = energy[-max(2, m // 4) :]
     half = len(tail) // 2
-    # the noise the decay rang down into: the last quarter, if flat (else it still decays)
-    flat = np.mean(tail[:half]) <= 1.2 * np.mean(tail[half:])
-    floor = float(np.median(tail)) if flat else 0.0
+    # the noise the decay rang down into: the last quarter, if flat and 10 dB below the peak
+    # (else it still decays)
+    level = float(np.median(tail))
+    flat = np.mean(tail[:half]) <= 1.2 * np.mean(tail[half:]) and level <= 0.1 * energy.max()
+    floor = level if flat else 0.0
     k = peak + 1
     while k < m and energy[k] > 10 * floor and (k == peak + 1 or energy[k] <= 1.5 * energy[k - 1]):
         k += 1
@@ -329,25 +343,45 @@ def decay_zeta(t: np.ndarray, y: np.ndarray, f: float) -> float:
     return float(-slope / 2 / (2 * math.pi * f))
 
 
+def snr_db(t: np.ndarray, y: np.ndarray, f: float) -> float:
+    """The signal-to-noise ratio of a free decay at ``f`` Hz, dB: its most energetic block of
+    :data:`DECAY_BLOCK_PERIODS` periods (variance) over the noise's variance, the least of the
+    blocks' second differences' variance / 6 (white noise's; a sinusoid's second difference is
+    ``(2 pi f / fs)^2`` of it, and the least block is where the decay has rung down); NaN when
+    the record holds fewer than 2 blocks."""
+    fs = (len(t) - 1) / float(t[-1] - t[0]) if len(t) > 1 else math.nan
+    n = int(round(DECAY_BLOCK_PERIODS * fs / f)) if f > 0 and math.isfinite(fs) else 0
+    m = len(y) // n if n >= 4 else 0
+    if m < 2:
+        return math.nan
+    blocks = y[: m * n].reshape(m, n)
+    noise = float(np.min(np.diff(blocks, 2, axis=1).var(axis=1))) / 6
+    peak = float(np.max(blocks.var(axis=1)))
+    return 10 * math.log10(peak / noise) if noise > 0 else math.inf
+
+
 def fast_window(t: np.ndarray, y: np.ndarray, f: float) -> tuple[float, float, str]:
     """The window (``min_periods``) and the precision its estimates need (``early_std_rel``) for
-    a free decay of one mode at ``f`` Hz: :data:`FAST_PERIODS` and :data:`FAST_STD` when its
-    spectrum is pure (:func:`impurity` below :data:`IMPURE`) and it is lightly damped
-    (:func:`decay_zeta` at most :data:`FAST_ZETA`, or unknown); else (NaN, 0: the configured
-    window). With the reason in words."""
+    a free decay of one mode at ``f`` Hz: :data:`FAST_PERIODS` and :data:`FAST_STD`
+    (:data:`FAST_STD_CLEAN` at :data:`CLEAN_SNR_DB` and above) when its spectrum is pure
+    (:func:`impurity` below :data:`IMPURE`) and it is lightly damped (:func:`decay_zeta` at
+    most :data:`FAST_ZETA`, or unknown); else (NaN, 0: the configured window). With the reason
+    in words."""
     spread = impurity(t, y, f)
     if not spread <= IMPURE:
         return math.nan, 0.0, f'{100 * spread:.0f} % of the power near {f:.3g} Hz off its peak'
     zeta = decay_zeta(t, y, f)
     if zeta > FAST_ZETA:
         return math.nan, 0.0, f'a decay damped at {100 * zeta:.1f} % (its envelope)'
+    snr = snr_db(t, y, f)
+    precision = FAST_STD_CLEAN if snr >= CLEAN_SNR_DB else FAST_STD
     return (
         FAST_PERIODS,
-        FAST_STD,
+        precision,
         (
-            f'a pure, lightly damped peak ({100 * spread:.1f} % off it): min_periods '
-            f'{FAST_PERIODS:g} where the estimate is within {100 * FAST_STD:.2g} % (1 std), '
-            'else 1.25'
+            f'a pure, lightly damped peak ({100 * spread:.1f} % off it, {snr:.0f} dB): '
+            f'min_periods {FAST_PERIODS:g} where the estimate is within '
+            f'{100 * precision:.2g} % (1 std), else 1.25'
         ),
     )
 
@@ -409,6 +443,12 @@ class DrivenWatch:
         self._envelope = Envelope(4 * MIN_BLOCK_S, MAX_WINDOW_S / 10)
         self._marks: deque = deque()  # (stream time, free energy, driven energy)
         self._last_t = math.nan
+        #: the stream time the last onset was seen at (the end of the batch it closed in; the
+        #: stream's start is the first), the onsets so far, and the frequency of the last free
+        #: estimate
+        self.onset_t = math.nan
+        self.onsets = 0
+        self.followed_hz = math.nan
 
     def feed(self, t: np.ndarray, y: np.ndarray) -> None:
         """Samples ``(t, y)`` (arrays), in a few numpy passes: the energies are marked at the
@@ -423,6 +463,9 @@ class DrivenWatch:
             with np.errstate(over='ignore', invalid='ignore'):  # a huge sample: inf energy
                 self._envelope.feed(t[start:end], y[start:end])
             self._last_t = float(t[min(end, n) - 1])
+            if self._envelope.changes['onsets'] + 1 != self.onsets:
+                self.onsets = self._envelope.changes['onsets'] + 1
+                self.onset_t = self._last_t if self.onsets > 1 else float(t[0])
             if end <= n:
                 self._mark(self._last_t)
             start = end
@@ -437,6 +480,7 @@ class DrivenWatch:
     def follow(self, f: float) -> None:
         """A free estimate of ``f`` Hz: the block holds a few of its periods."""
         self._envelope.follow(f)
+        self.followed_hz = f
 
     def driven(self) -> Optional[float]:
         """The driven share of the last :data:`WATCH_S` s' energy when they look driven
@@ -450,14 +494,14 @@ class DrivenWatch:
         """Whether the stream rings freely now: the envelope's stretch free, begun by an onset
         (a pluck, not the rest or noise the stream started with), and its last block at least
         :data:`LIVE_LEVEL` of the largest block's."""
+        return self._envelope.changes['onsets'] > 0 and self.live()
+
+    def live(self) -> bool:
+        """Whether the envelope's stretch is free and its last block at least :data:`LIVE_LEVEL`
+        of the largest block's (not the noise a decay rang down into)."""
         env = self._envelope
         last = env.last_energy
-        return (
-            env.state == FREE
-            and env.changes['onsets'] > 0
-            and last is not None
-            and last >= LIVE_LEVEL * env.peak
-        )
+        return env.state == FREE and last is not None and last >= LIVE_LEVEL * env.peak
 
     def freed(self) -> bool:
         """Whether the last :data:`WATCH_S` s look free: their driven share below
@@ -506,6 +550,7 @@ class StreamChoice:
         self._share: Optional[float] = None
         self._estimated_at = -math.inf  # stream time of the last free estimate (follow)
         self._silent_retry = -math.inf
+        self._window_onset = 0  # the onset whose decay was last read for its window
 
     def update(self, t: float, value) -> None:
         self._pending_t.append(t)
@@ -570,6 +615,23 @@ class StreamChoice:
         chosen = decide(*self.kept(), self.channels, window_s, stream=True)
         return chosen if chosen.excitation == 'free' and chosen.modes else None
 
+    def _decay_window(self, now: float) -> Optional[Decision]:
+        """:func:`decide`'s window for the decay since the last onset, read once per onset when
+        its free stretch has shown a decay at the last free estimate's frequency
+        (:func:`decay_zeta`: at least 8 periods, three blocks of two falling; asked again until
+        it has); None if it allows none (an impure or heavily damped decay) or not yet."""
+        watch = self.watch
+        f = watch.followed_hz
+        if watch.onsets == self._window_onset or not f > 0 or not watch.live():
+            return None
+        t, y = self.recent(now - watch.onset_t)
+        if not decay_zeta(t, y, f) > 0:  # no decay seen yet (a driven response's wandering)
+            return None
+        self._window_onset = watch.onsets
+        chosen = decide(t, y)
+        ok = chosen.excitation == 'free' and not chosen.modes
+        return chosen if ok and math.isfinite(chosen.min_periods) else None
+
     def recent(self, seconds: float) -> tuple[np.ndarray, np.ndarray]:
         """``(t, y)`` of the kept samples of the last ``seconds`` s (at least; y: the first
         channel), oldest first."""
@@ -601,12 +663,20 @@ class StreamChoice:
         return self._share
 
     def decision(
-        self, excitation: str, decided: bool, window_s: float, modes: int = 0
+        self,
+        excitation: str,
+        decided: bool,
+        window_s: float,
+        modes: int = 0,
+        windowed: bool = False,
     ) -> Optional[Decision]:
         """The decision to switch to, or None: from ``free`` (when the watch read the stream driven
         at the last :meth:`driven`), :func:`decide` over the kept samples, if not ``free``; from
         ``free`` with ``modes`` 0 whose estimator has been silent for :data:`SILENT_S` s while the
-        stream rings after an onset, a free decay of several modes (the mode tracker); from an
+        stream rings after an onset, a free decay of several modes (the mode tracker); from
+        ``free`` on the default window (``windowed`` False), once per onset when it has shown
+        a decay, the window that decay allows (:func:`fast_window`, as ``analyze`` decides it);
+        from an
         ``ambient`` this choice ``decided``, ``free`` once the stream reads free.
         ``window_s``: the configured ambient window (the shortest the decision gives)."""
         self._flush()
@@ -617,6 +687,10 @@ class StreamChoice:
             several = self._several_modes(now, window_s)
             if several is not None:
                 return several
+            if not windowed:
+                window = self._decay_window(now)
+                if window is not None:
+                    return window
         if excitation == 'ambient' and decided:
             if not self.watch.freed():
                 return None

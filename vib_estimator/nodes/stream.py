@@ -62,6 +62,8 @@ WARMUP_BUFFER = 60_000
 SELF_TEST_DIGITS = 3
 #: no samples to prime a new estimator with (:meth:`EstimatorStream.configure`)
 NO_PRIMER = (np.empty(0), np.empty(0))
+#: the free-decay window a stream's decision may replace (the configured default's)
+DEFAULT_WINDOW = (EstimatorConfig().min_periods, EstimatorConfig().early_std_rel)
 #: the diagnostics message while the kernels compile
 WARMUP_MESSAGE = 'compiling estimator kernels (first start)'
 
@@ -406,8 +408,9 @@ class EstimatorStream:
         if not self.ready:
             return None
         config = self.config
+        windowed = (config.min_periods, config.early_std_rel) != DEFAULT_WINDOW
         return self._choice.decision(
-            config.excitation, self.decided, config.ambient_window_s, config.modes
+            config.excitation, self.decided, config.ambient_window_s, config.modes, windowed
         )
 
     def reset(self) -> Tuple[bool, str]:
