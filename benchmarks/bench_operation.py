@@ -33,7 +33,8 @@ decides from the record (``core.choice.decide``, applied by ``analysis.choosing.
 -- beside ``--excitation ambient`` (the ``--window``) and the peer, on the synthetic records plus a
 lightly damped 2 Hz mode (bench_defaults'), the arm under a random command and the arm free then
 driven (:func:`free_then_driven`): per mode, the median error, RMS error / Whittle bound (at the
-window each run used; synthetic records), RMS of error / std, within 2 %, beyond 5 %.
+window each run used; synthetic records), RMS of error / std, within 2 %, beyond 5 %; on the
+arm free then driven also the peer's windows of the driven stretch alone.
 """
 
 from __future__ import annotations
