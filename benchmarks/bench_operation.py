@@ -5,6 +5,7 @@ vs the Whittle bound at the window used.
 
     .venv/bin/python benchmarks/bench_operation.py [--seeds 3] [--window 30] [--no-peer]
         [--real-data ../shared/real-data] [--real-only] [--arm-only] [--free-only] [--ref REV]
+        [--default]
 
 Synthetic records (``vib_estimator.sim.ambient``: white-noise-driven modes, 500 Hz, 180 s, the
 estimates of the whole record, i.e. from the first full window on) and the real Heritage Court
@@ -26,6 +27,14 @@ benchmarks' records (bench_precision, bench_modes, the real beams): the share of
 free``'s estimates it publishes unchanged, what it adds, and the seconds it judged driven
 (``--free-only``: that section alone); with the paper's reproductions (``vib-estimator compare``'s
 records) and the simulated arm moved every 10 s.
+
+``--default`` (issue 37, item 6): the default -- no option, the configuration ``analyze``
+decides from the record (``core.choice.decide``, applied by ``analysis.choosing.decided_config``)
+-- beside ``--excitation ambient`` (the ``--window``) and the peer, on the synthetic records plus a
+lightly damped 2 Hz mode (bench_defaults'), the arm under a random command and the arm free then
+driven (:func:`free_then_driven`): per mode, the median error, RMS error / Whittle bound (at the
+window each run used; synthetic records), RMS of error / std, within 2 %, beyond 5 %; on the
+arm free then driven also the peer's windows of the driven stretch alone.
 """
 
 from __future__ import annotations
@@ -68,6 +77,10 @@ HCT_FILE = Path('heritage_court_tower') / 'hct_setup1.csv'
 #: this package's excitations benchmarked on the driven records (a row each)
 EXCITATIONS = ('ambient', 'auto')
 HCT_MODES = (1.23, 1.29, 1.45, 3.85, 4.26, 5.35)
+#: ``--default``'s records beyond :data:`CASES`: a lightly damped 2 Hz mode (bench_defaults')
+DEFAULT_CASES = {**CASES, '1 mode 2 Hz, zeta 0.2 %, 20 dB': ([(2.0, 0.002, 1.0)], 20.0)}
+#: :func:`free_then_driven`: the seconds the arm rings freely before the random command
+FREE_S = 40.0
 PEER_WINDOW_S = 20.0
 PEER_ORDER = 20
 #: hard criteria: damping < 20 %; the mode-shape ones (MPC, MPD) mean nothing with one channel
@@ -367,6 +380,153 @@ def free_decays(real_data):
         sys.stdout.flush()
 
 
+def free_then_driven(seed):
+    """The arm (45.55 g, 1.33 Hz) moved to 1 rad and back (0-4 s), ringing freely, then under a
+    random command (level 0.3, as :func:`arm`'s) from :data:`FREE_S` s to :data:`DURATION`:
+    ``(t, y, f)``."""
+    from vib_estimator.sim.arm_model import DrivenArmSimulator, Move
+
+    sim = DrivenArmSimulator(
+        rate_hz=FS,
+        seed=seed,
+        schedule=(Move(0.0, 1.0, 1.0), Move(3.0, 0.0, 1.0)),
+        excitation='moves',
+        level=0.3,
+    )
+    rows = []
+    for k in range(int(round(DURATION * FS))):
+        if k == int(round(FREE_S * FS)):
+            sim.excitation = 'random'
+        rows.append(sim.step())
+    rows = np.array(rows)
+    return rows[:, 0], rows[:, 1], float(rows[0, 2])
+
+
+def default_runs(t, y, window):
+    """(label, configuration) of ``--default``: the default as ``analyze`` decides it from the
+    record, and ``--excitation ambient`` with the ``window``."""
+    from vib_estimator.analysis.choosing import decided_config
+    from vib_estimator.core.choice import decide
+
+    base = EstimatorConfig()
+    config, _ = decided_config(base, decide(t, y, 1, base.ambient_window_s), 'analyze')
+    what = f'{config.excitation}' + (
+        f' {config.ambient_window_s:.0f} s' if config.excitation != 'free' else ''
+    )
+    return (
+        (f'default ({what})', config),
+        (f'ambient ({window:g} s)', base.replace(excitation='ambient', ambient_window_s=window)),
+    )
+
+
+def defaults(seeds, window, peer):
+    """``--default``: module doc."""
+    from vib_estimator.sim.arm_model import simulate_driven
+
+    def arm_random(seed):
+        rec = simulate_driven(DURATION, 'random', 0.3, seed=seed)
+        return rec.t, rec.torque, None, [float(rec.f_true[0])]
+
+    def arm_mixed(seed):
+        t, y, f = free_then_driven(seed)
+        return t, y, None, [f]
+
+    def synthetic_record(modes, snr):
+        def make(seed):
+            t, y, noise_var = ambient_record(DURATION, FS, modes, snr, seed)
+            return t, y, noise_var, [m[0] for m in modes]
+
+        return make
+
+    cases = [
+        (name, modes, synthetic_record(modes, snr)) for name, (modes, snr) in DEFAULT_CASES.items()
+    ]
+    arm_mode = [(1.3306, 0.004, 1.0)]
+    cases.append(('arm, random command (level 0.3)', arm_mode, arm_random))
+    cases.append((f'arm, free {FREE_S:g} s then a random command', arm_mode, arm_mixed))
+    print(
+        f'\n## The default (no option) beside --excitation ambient ({window:g} s) and the peer: '
+        f'{FS:g} Hz, {DURATION:g} s, {seeds} seeds'
+    )
+    print(
+        '| record | configuration | mode | median err | RMS err / bound | RMS err/std '
+        '| within 2 % | > 5 % | estimates |'
+    )
+    print('|---|---|---|---|---|---|---|---|---|')
+    for name, modes, make in cases:
+        rows = {}
+        peer_err = {k: [] for k in range(len(modes))}
+        peer_driven = {k: [] for k in range(len(modes))}
+        for seed in range(seeds):
+            t, y, noise_var, truth = make(seed)
+            for label, config in default_runs(t, y, window):
+                key = label.split(' (')[0]
+                row = rows.setdefault(
+                    key, {'labels': [], 'n': 0, 'err': {}, 'norm': {}, 'cal': {}}
+                )
+                row['labels'].append(label.split(' (')[1][:-1] if '(' in label else '')
+                e, _ = ours(t, y, config)
+                row['n'] += len(e)
+                idx, dist = assign(e.frequency_hz, truth)
+                bounds = None
+                if noise_var is not None and config.excitation != 'free':
+                    n_window = int(config.ambient_window_s * FS) + 1
+                    bounds = whittle_std(modes, noise_var, FS, n_window)
+                for k, f in enumerate(truth):
+                    m = (idx == k) & (dist <= 0.10)
+                    rel = e.frequency_hz[m] / f - 1
+                    row['err'].setdefault(k, []).extend(rel)
+                    row['cal'].setdefault(k, []).extend(
+                        (e.frequency_hz[m] - f) / e.frequency_std_hz[m]
+                    )
+                    if bounds is not None:
+                        row['norm'].setdefault(k, []).extend(rel / (bounds[k][0] / f))
+            if peer:
+                for k, (f, vals) in enumerate(peer_ssi(t, y, FS, truth).items()):
+                    peer_err[k].extend(v[0] / f - 1 for v in vals)
+                if make is arm_mixed:  # the peer's driven windows alone (no free decay in them)
+                    after = t >= FREE_S
+                    for k, (f, vals) in enumerate(peer_ssi(t[after], y[after], FS, truth).items()):
+                        peer_driven[k].extend(v[0] / f - 1 for v in vals)
+        for key, row in rows.items():
+            what = sorted(set(row['labels']))
+            label = key + (f' ({" / ".join(what)})' if what != [''] else '')
+            for k, f in enumerate(truth):
+                print(
+                    default_row(
+                        name if k == 0 and key == 'default' else '',
+                        label if k == 0 else '',
+                        f,
+                        row['err'].get(k, []),
+                        row['norm'].get(k, []),
+                        row['cal'].get(k, []),
+                        row['n'] if k == 0 else None,
+                    )
+                )
+        if peer:
+            for k, f in enumerate(truth):
+                label = f'SSI-cov (pyOMA2) {PEER_WINDOW_S:g} s' if k == 0 else ''
+                print(default_row('', label, f, peer_err[k], [], [], None))
+            for k, f in enumerate(truth if peer_driven[0] else ()):
+                label = f'SSI-cov, the windows from {FREE_S:g} s' if k == 0 else ''
+                print(default_row('', label, f, peer_driven[k], [], [], None))
+        sys.stdout.flush()
+
+
+def default_row(name, label, f, err, norm, cal, n):
+    """One row of :func:`defaults`' table."""
+    a = np.abs(np.asarray(err, dtype=float))
+    if not len(a):
+        return f'| {name} | {label} | {f:g} Hz | none | | | | | {"" if n is None else n} |'
+    rms_norm = f'{math.sqrt(np.mean(np.square(norm))):.2f}' if len(norm) else '-'
+    rms_cal = f'{math.sqrt(np.mean(np.square(cal))):.2f}' if len(cal) else '-'
+    return (
+        f'| {name} | {label} | {f:g} Hz | {100 * np.median(a):.3f} % | {rms_norm} | {rms_cal} | '
+        f'{100 * np.mean(a <= 0.02):.1f} % | {int(np.count_nonzero(a > 0.05))} | '
+        f'{"" if n is None else n} |'
+    )
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--seeds', type=int, default=3)
@@ -385,6 +545,11 @@ def main():
     parser.add_argument(
         '--ref', help="time this revision's identifiers beside (e.g. main; git archive)"
     )
+    parser.add_argument(
+        '--default',
+        action='store_true',
+        help='only the default (decided from the record) beside ambient and the peer',
+    )
     args = parser.parse_args()
     # without pyOMA2 (left out on a Jazzy machine, or not loading) no peer column: one warning line
     args.no_peer = args.no_peer or optional('pyoma2') is None
@@ -393,6 +558,9 @@ def main():
         from reference_cost import Reference  # benchmarks/
 
         ref = Reference(args.ref)
+    if args.default:
+        defaults(args.seeds, args.window, not args.no_peer)
+        return
     if args.free_only:
         free_decays(args.real_data)
         return
