@@ -103,8 +103,10 @@ class Probe:
         self.trigger = Trigger.Request
         self.reset()
 
-    def reset(self):
+    def reset(self, pid=None):
+        self.pid = pid
         self.first_estimate = None
+        self.first_estimate_cpu = math.nan
         self.first_diag = {}
         self.diag_times = []
         self.last_values = {}
@@ -112,6 +114,7 @@ class Probe:
     def _on_frequency(self, msg):
         if self.first_estimate is None:
             self.first_estimate = time.monotonic()
+            self.first_estimate_cpu = cpu_seconds(self.pid) if self.pid else math.nan
 
     def _on_diagnostics(self, msg):
         self.diag_times.append(time.monotonic())
@@ -148,6 +151,7 @@ class Probe:
         self.reset()
         start = time.monotonic()
         proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        self.pid = proc.pid
         sent = 0
         msg = self.msg_type()
         state = {'pid': proc.pid}
@@ -197,7 +201,20 @@ class Probe:
             lost = sent - counted if values else -1
         finally:
             code = stop(proc)
-        return live, ready, latency, lost, code, silence, spawned, cpu, compiled, compiled_cpu
+        self.pid = None
+        return (
+            live,
+            ready,
+            latency,
+            lost,
+            code,
+            silence,
+            spawned,
+            cpu,
+            compiled,
+            compiled_cpu,
+            self.first_estimate_cpu,
+        )
 
     def first_diagnostics(self, cmd, env):
         """(spawn to first /diagnostics s, exit code) of a node."""
@@ -311,8 +328,8 @@ def print_runs(rows: list) -> None:
     first sample; after spawn) and CPU s to ready, cold and warm."""
     print(
         '\n| case | run | ready, cold / warm | first estimate after the first sample, cold / warm '
-        '| first estimate after spawn, cold / warm | CPU s to ready, cold / warm | lost, cold / '
-        'warm | exit |'
+        '| first estimate after spawn, cold / warm (CPU s) | CPU s to ready, cold / warm '
+        '| lost, cold / warm | exit |'
     )
     print('|---|---|---|---|---|---|---|---|')
     for case, label in dict.fromkeys((r[0], r[1]) for r in rows):
@@ -320,8 +337,8 @@ def print_runs(rows: list) -> None:
         c, w = get['cold'], get['warm']
         print(
             f'| {case} | {label} | {c[4]:.2f} / {w[4]:.2f} s | {c[7]:.2f} / {w[7]:.2f} s | '
-            f'{c[9]:.2f} / {w[9]:.2f} s | {c[10]:.2f} / {w[10]:.2f} | {c[5]} / {w[5]} | '
-            f'{c[6]}, {w[6]} |'
+            f'{c[9]:.2f} / {w[9]:.2f} s ({c[13]:.2f} / {w[13]:.2f}) | {c[10]:.2f} / {w[10]:.2f} '
+            f'| {c[5]} / {w[5]} | {c[6]}, {w[6]} |'
         )
 
 
@@ -377,8 +394,9 @@ def main(argv=None) -> int:
                     cache = tempfile.mkdtemp(dir=tmp)
                     cmd = node_command(tree, 'vib_estimator.nodes.estimator_node', params)
                     for kind in ('cold', 'warm'):
+                        got = probe.estimator(cmd, environment(tree, cache))
                         live, ready, latency, lost, code, silence, spawned, cpu, compiled, ccpu = (
-                            probe.estimator(cmd, environment(tree, cache))
+                            got[:10]
                         )
                         noted(
                             rows,
@@ -396,10 +414,12 @@ def main(argv=None) -> int:
                                 cpu,
                                 compiled,
                                 ccpu,
+                                got[10],
                             ),
                             f'live {live:6.2f} s (longest /diagnostics silence {silence:5.2f} '
                             f's), ready {ready:6.2f} s, first estimate {latency:6.2f} s after '
-                            f'the first sample ({spawned:6.2f} s after spawn), lost {lost}, '
+                            f'the first sample ({spawned:6.2f} s after spawn, {got[10]:5.2f} CPU '
+                            f's), lost {lost}, '
                             f'exit {code}; {cpu:5.2f} CPU s to ready; compiled after '
                             f'{compiled:6.2f} s, {ccpu:5.2f} CPU s',
                         )
@@ -410,14 +430,14 @@ def main(argv=None) -> int:
                     for kind in ('cold', 'warm'):
                         live, code = probe.first_diagnostics(cmd, environment(tree, cache))
                         row = ('shaper_node', label, kind, live, live, 0, code)
-                        noted(rows, row + (math.nan,) * 6, f'live {live:6.2f} s, exit {code}')
+                        noted(rows, row + (math.nan,) * 7, f'live {live:6.2f} s, exit {code}')
             for case, csv in records.items() if 'analyze' in only else ():
                 for label, tree in runs(trees, args.repeat):
                     cache = tempfile.mkdtemp(dir=tmp)
                     for kind in ('cold', 'warm'):
                         seconds, cpu = analyze_seconds(tree, environment(tree, cache), csv)
                         row = (case, label, kind, math.nan, seconds, 0, 0)
-                        row += (math.nan,) * 3 + (cpu, math.nan, math.nan)
+                        row += (math.nan,) * 3 + (cpu, math.nan, math.nan, math.nan)
                         noted(rows, row, f'{seconds:6.2f} s, {cpu:6.2f} CPU s')
         finally:
             probe.close()
