@@ -103,8 +103,10 @@ class Probe:
         self.trigger = Trigger.Request
         self.reset()
 
-    def reset(self):
+    def reset(self, pid=None):
+        self.pid = pid
         self.first_estimate = None
+        self.first_estimate_cpu = math.nan
         self.first_diag = {}
         self.diag_times = []
         self.last_values = {}
@@ -112,6 +114,7 @@ class Probe:
     def _on_frequency(self, msg):
         if self.first_estimate is None:
             self.first_estimate = time.monotonic()
+            self.first_estimate_cpu = cpu_seconds(self.pid) if self.pid else math.nan
 
     def _on_diagnostics(self, msg):
         self.diag_times.append(time.monotonic())
@@ -148,6 +151,7 @@ class Probe:
         self.reset()
         start = time.monotonic()
         proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        self.pid = proc.pid
         sent = 0
         msg = self.msg_type()
         state = {'pid': proc.pid}
@@ -197,7 +201,20 @@ class Probe:
             lost = sent - counted if values else -1
         finally:
             code = stop(proc)
-        return live, ready, latency, lost, code, silence, spawned, cpu, compiled, compiled_cpu
+        self.pid = None
+        return (
+            live,
+            ready,
+            latency,
+            lost,
+            code,
+            silence,
+            spawned,
+            cpu,
+            compiled,
+            compiled_cpu,
+            self.first_estimate_cpu,
+        )
 
     def first_diagnostics(self, cmd, env):
         """(spawn to first /diagnostics s, exit code) of a node."""
@@ -299,7 +316,34 @@ def noted(rows: list, row: tuple, text: str) -> None:
     print(f'{case:28s} {label:8s} {kind}: {text}', flush=True)
 
 
+def runs(trees: dict, repeat: int):
+    """(label, tree) of each run: every tree ``repeat`` times, labelled ``today#2`` etc."""
+    for k in range(repeat):
+        for label, tree in trees.items():
+            yield (label if k == 0 else f'{label}#{k + 1}'), tree
+
+
+def print_runs(rows: list) -> None:
+    """One table line per case and run (--no-ref, --repeat): ready, first estimate (after the
+    first sample; after spawn) and CPU s to ready, cold and warm."""
+    print(
+        '\n| case | run | ready, cold / warm | first estimate after the first sample, cold / warm '
+        '| first estimate after spawn, cold / warm (CPU s) | CPU s to ready, cold / warm '
+        '| lost, cold / warm | exit |'
+    )
+    print('|---|---|---|---|---|---|---|---|')
+    for case, label in dict.fromkeys((r[0], r[1]) for r in rows):
+        get = {r[2]: r for r in rows if r[:2] == (case, label)}
+        c, w = get['cold'], get['warm']
+        print(
+            f'| {case} | {label} | {c[4]:.2f} / {w[4]:.2f} s | {c[7]:.2f} / {w[7]:.2f} s | '
+            f'{c[9]:.2f} / {w[9]:.2f} s ({c[13]:.2f} / {w[13]:.2f}) | {c[10]:.2f} / {w[10]:.2f} '
+            f'| {c[5]} / {w[5]} | {c[6]}, {w[6]} |'
+        )
+
+
 def main(argv=None) -> int:
+    global TIMEOUT_S
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--ref', default='7374e6d', help='reference commit (default 7374e6d)')
     parser.add_argument(
@@ -309,15 +353,30 @@ def main(argv=None) -> int:
         help='run only these cases (repeatable)',
     )
     parser.add_argument(
+        '--timeout',
+        type=float,
+        default=TIMEOUT_S,
+        help='seconds a node start may take, its background compile included',
+    )
+    parser.add_argument(
+        '--no-ref', action='store_true', help='this tree only (no reference commit)'
+    )
+    parser.add_argument(
+        '--repeat', type=int, default=1, help='run each case (cold, then warm) this many times'
+    )
+    parser.add_argument(
         '--case',
         action='append',
         help='only the estimator_node cases whose name holds this (repeatable), e.g. modes',
     )
     args = parser.parse_args(argv)
+    TIMEOUT_S = args.timeout
     only = set(args.only or ['estimator_node', 'shaper_node', 'analyze'])
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
-        trees = {'today': ROOT, args.ref: checkout(args.ref, tmp)}
+        trees = (
+            {'today': ROOT} if args.no_ref else {'today': ROOT, args.ref: checkout(args.ref, tmp)}
+        )
         t = np.arange(int(20 * RATE_HZ)) / RATE_HZ
         records = {
             'analyze (20 s CSV)': write_csv(tmp / 'tone.csv', t, np.sin(2 * np.pi * TONE_HZ * t)),
@@ -331,12 +390,13 @@ def main(argv=None) -> int:
                     break
                 if args.case and not any(c in case for c in args.case):
                     continue
-                for label, tree in trees.items():
+                for label, tree in runs(trees, args.repeat):
                     cache = tempfile.mkdtemp(dir=tmp)
                     cmd = node_command(tree, 'vib_estimator.nodes.estimator_node', params)
                     for kind in ('cold', 'warm'):
+                        got = probe.estimator(cmd, environment(tree, cache))
                         live, ready, latency, lost, code, silence, spawned, cpu, compiled, ccpu = (
-                            probe.estimator(cmd, environment(tree, cache))
+                            got[:10]
                         )
                         noted(
                             rows,
@@ -354,31 +414,38 @@ def main(argv=None) -> int:
                                 cpu,
                                 compiled,
                                 ccpu,
+                                got[10],
                             ),
                             f'live {live:6.2f} s (longest /diagnostics silence {silence:5.2f} '
                             f's), ready {ready:6.2f} s, first estimate {latency:6.2f} s after '
-                            f'the first sample ({spawned:6.2f} s after spawn), lost {lost}, '
+                            f'the first sample ({spawned:6.2f} s after spawn, {got[10]:5.2f} CPU '
+                            f's), lost {lost}, '
                             f'exit {code}; {cpu:5.2f} CPU s to ready; compiled after '
                             f'{compiled:6.2f} s, {ccpu:5.2f} CPU s',
                         )
             if 'shaper_node' in only:
-                for label, tree in trees.items():
+                for label, tree in runs(trees, args.repeat):
                     cache = tempfile.mkdtemp(dir=tmp)
                     cmd = node_command(tree, 'vib_estimator.nodes.shaper_node', [])
                     for kind in ('cold', 'warm'):
                         live, code = probe.first_diagnostics(cmd, environment(tree, cache))
                         row = ('shaper_node', label, kind, live, live, 0, code)
-                        noted(rows, row + (math.nan,) * 6, f'live {live:6.2f} s, exit {code}')
+                        noted(rows, row + (math.nan,) * 7, f'live {live:6.2f} s, exit {code}')
             for case, csv in records.items() if 'analyze' in only else ():
-                for label, tree in trees.items():
+                for label, tree in runs(trees, args.repeat):
                     cache = tempfile.mkdtemp(dir=tmp)
                     for kind in ('cold', 'warm'):
                         seconds, cpu = analyze_seconds(tree, environment(tree, cache), csv)
                         row = (case, label, kind, math.nan, seconds, 0, 0)
-                        row += (math.nan,) * 3 + (cpu, math.nan, math.nan)
+                        row += (math.nan,) * 3 + (cpu, math.nan, math.nan, math.nan)
                         noted(rows, row, f'{seconds:6.2f} s, {cpu:6.2f} CPU s')
         finally:
             probe.close()
+    print(f'load average at the end: {os.getloadavg()}')
+    if args.no_ref or args.repeat > 1:
+        print_runs(rows)
+        print(GOALS)
+        return 0
     print(
         f'\n| case | cold ready, today | cold, {args.ref} | warm ready, today | warm, '
         f'{args.ref} | live: first /diagnostics; longest silence, cold today / {args.ref} | '

@@ -184,23 +184,23 @@ def principal_component(y: np.ndarray) -> np.ndarray:
 def spectrum(t: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
     """Welch's spectrum of ``(t, y)`` (segments of :data:`SEGMENT_S` s), summed over the channels
     of ``y``: ``(frequencies, powers, the lowest frequency it resolves)``."""
-    from scipy.signal import welch
+    from .spectra import welch  # scipy.signal's, in numpy (.spectra: its import cost)
 
     fs = (len(t) - 1) / float(t[-1] - t[0])
     y = np.asarray(y, dtype=np.float64).reshape(len(t), -1)
     nper = int(min(len(t), max(64, round(SEGMENT_S * fs))))
-    freq, psd = welch(y, fs, nperseg=nper, axis=0, detrend='constant')
+    freq, psd = welch(y, fs, nper)
     return freq, np.sum(psd, axis=1), 2 * fs / nper
 
 
 def spectral_peaks(t: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``(frequencies, powers)`` of the spectrum's peaks (module docstring, 1), strongest first,
     summed over the channels of ``y``."""
-    from scipy.signal import find_peaks
+    from .spectra import peaks_by_prominence  # scipy.signal's find_peaks (prominence only)
 
     freq, psd, lowest = spectrum(t, y)
     level = 10 * np.log10(np.maximum(psd, 1e-300 + 1e-12 * float(np.max(psd))))
-    idx, _ = find_peaks(level, prominence=PEAK_DB)
+    idx = peaks_by_prominence(level, PEAK_DB)
     idx = idx[freq[idx] > lowest]  # above the segment's own lowest bins (a drift)
     if not len(idx):
         return np.empty(0), np.empty(0)
