@@ -15,6 +15,7 @@ in its peak (< 0.07 on all of these), the real arm's closed-loop limit cycle spr
 around the mode, and a window of about one period reads that spread as a 2 % shift.
 
     cd benchmarks && ../.venv/bin/python bench_first_estimate.py [--real-data DIR] [--periods P..]
+    cd benchmarks && ../.venv/bin/python bench_first_estimate.py --sweep   # SWEEP, 6 seeds each
 """
 
 from __future__ import annotations
@@ -66,6 +67,59 @@ def records(real: Path | None):
     return out
 
 
+#: the sweep's decays (``--sweep``): frequency (Hz), damping ratio, SNR (dB, at the start)
+SWEEP = (
+    (5.0, 0.01, 30),
+    (5.0, 0.01, 35),
+    (5.0, 0.01, 40),
+    (5.0, 0.01, 45),
+    (5.0, 0.005, 40),
+    (9.4, 0.003, 35),
+    (16.4, 0.0025, 35),
+    (0.8, 0.01, 35),
+    (0.8, 0.01, 30),
+    (2.0, 0.012, 40),
+    (30.0, 0.004, 40),
+    (5.0, 0.005, 20),
+    (2.0, 0.03, 40),
+    (10.0, 0.05, 50),
+)
+
+
+def sweep(seeds: int = 6) -> int:
+    """The decided configuration (as ``analyze`` applies it) on each of :data:`SWEEP`, ringing
+    six time constants at 50 samples a period, over ``seeds`` noise seeds: the least and mean
+    share within 2 %, the median and largest of the records' median convergence (periods)."""
+    print('| decay | early_std_rel decided | within 2 %: least, mean | conv: median, largest |')
+    print('|---|---|---|---|')
+    for f, zeta, snr in SWEEP:
+        res = []
+        for seed in range(seeds):
+            rng = np.random.default_rng(300 + seed)
+            fs = max(100.0, 50.0 * f)
+            t = np.arange(0, min(30.0, 6.0 / (zeta * 2 * np.pi * f)), 1 / fs)
+            y = np.exp(-zeta * 2 * np.pi * f * t) * np.sin(2 * np.pi * f * t + seed)
+            y += 10 ** (-snr / 20) / np.sqrt(2) * rng.standard_normal(len(t))
+            d = decide(t, y)
+            config = EstimatorConfig()
+            if np.isfinite(d.min_periods):
+                config = config.replace(min_periods=d.min_periods, early_std_rel=d.early_std_rel)
+            e = estimate(t, y, config)
+            err = np.abs(e.frequency_hz / f - 1)
+            conv = np.median(e.convergence_time * f) if len(e) else np.nan
+            res.append((100 * np.mean(err <= 0.02) if len(e) else 0.0, conv, config.early_std_rel))
+        within = [r[0] for r in res]
+        conv = [r[1] for r in res]
+        early = sorted({r[2] for r in res})
+        print(
+            f'| {f:g} Hz, zeta {zeta:g}, {snr} dB | {", ".join(f"{x:g}" for x in early)} | '
+            f'{min(within):.0f} %, {np.mean(within):.1f} % | '
+            f'{np.nanmedian(conv):.2f}, {np.nanmax(conv):.2f} |'
+        )
+        sys.stdout.flush()
+    return 0
+
+
 def impurity(t: np.ndarray, y: np.ndarray) -> float:
     """The module doc's impurity of the record's spectrum."""
     from scipy.signal import welch
@@ -83,7 +137,12 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--real-data', default=str(ROOT.parent / 'shared' / 'real-data'))
     parser.add_argument('--periods', type=float, nargs='+', default=[1.25, 1.0, 0.9])
+    parser.add_argument(
+        '--sweep', action='store_true', help='the decided window on SWEEP, 6 seeds each'
+    )
     args = parser.parse_args()
+    if args.sweep:
+        return sweep()
     real = Path(args.real_data)
     real = real if real.is_dir() else None
     head = ' | '.join(f'min_periods {p:g}: n, within 2 %, > 5 %, conv' for p in args.periods)
