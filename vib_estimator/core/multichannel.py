@@ -11,7 +11,7 @@ block rows :func:`.ssi.block_rows`), each mode's shape and its uncertainty (the 
 stable model orders), close clusters merged only when their shapes agree (MAC >=
 :data:`.ssi.MAC_SAME`), a mode kept when it stands above the noise on at least one channel, its
 bound and frequency refinement on that channel (:mod:`.whittle`), and its identity over time by
-frequency and shape (:func:`.ambient.continues`).
+frequency and shape (:mod:`.identity`).
 
 Interface: :class:`JointAmbientEstimator` ``(config, channels)`` ``.process(t, Y) ->``
 :class:`JointEstimates` (``Y``: samples x channels), ``.update(t, y) -> list[Estimate]``,
@@ -33,22 +33,12 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .ambient import SlidingWindowIdentifier, continues, estimate_columns
+from .ambient import SlidingWindowIdentifier, estimate_columns
 from .config import EstimatorConfig
 from .estimator import Estimate, EstimateArrays, as_series
-from .ssi import mac, normalise_shape
 
 #: the fewest channels of a joint identification (one channel is the single-channel identifier's)
 MIN_CHANNELS = 2
-__all__ = [
-    'MIN_CHANNELS',
-    'JointAmbientEstimator',
-    'JointEstimates',
-    'as_channels',
-    'continues',
-    'mac',
-    'normalise_shape',
-]
 
 
 # ---- streaming ----------------------------------------------------------------------------------

@@ -44,12 +44,12 @@ Method:
    and ``zeta = sigma / w_n``. Information adds over channels: the joint std is below every single
    channel's, and a mode invisible on some channels is estimated from the others.
 4. **Shape**: ``phi_c = b_c - i a_c`` (``y_c = Re(phi_c e^((-sigma + i w) u))``), normalised
-   (:func:`..multichannel.normalise_shape`); its std per channel ``s_c sqrt(var a_c + var b_c)``
+   (:func:`.shapes.normalise_shape`); its std per channel ``s_c sqrt(var a_c + var b_c)``
    from the amplitudes' least-squares covariance, scaled as the shape.
-5. **Identity over time**: an estimate continues the known mode nearest in frequency (within
-   :data:`..ambient.MATCH_TOL`) whose last shape it matches (MAC >= :data:`..multichannel.
-   MAC_MATCH`), as the joint ambient identifier's; else it is a new mode (at most
-   :data:`..ambient.MAX_TRACKS`, the least recent forgotten). ``mode`` = its rank by frequency
+5. **Identity over time** (:mod:`.identity`, the rule every estimator shares): an estimate
+   continues the known mode nearest in frequency (within :data:`.identity.MATCH_TOL`) whose last
+   shape it matches (MAC >= :data:`.identity.MAC_MATCH`); else it is a new mode (at most
+   :data:`.identity.MAX_TRACKS`, the least recent forgotten). ``mode`` = its rank by frequency
    among the known modes, 1 = the lowest (also with ``modes`` = 0: the node's
    ``vibration/mode<k>/shape`` needs k >= 1). Several channels converge on one mode at about the
    same time: an event within half its window of that mode's last estimate is merged into it
@@ -73,17 +73,11 @@ from functools import partial
 
 import numpy as np
 
-from .ambient import MATCH_TOL, MAX_TRACKS
 from .config import EstimatorConfig
 from .estimator import INPUT_COUNTERS, Estimate, Estimator, accept_sample
-from .multichannel import (
-    MIN_CHANNELS,
-    JointEstimates,
-    as_channels,
-    continues,
-    mac,
-    normalise_shape,
-)
+from .identity import ModeRegister
+from .multichannel import MIN_CHANNELS, JointEstimates, as_channels
+from .shapes import normalise_shape
 from .threads import single_blas_thread
 
 #: other modes estimated within this many seconds before an event are terms of its fit
@@ -278,15 +272,6 @@ def natural(fit: JointFit) -> tuple[float, float, float, float]:
 
 
 # ---- the identifier -----------------------------------------------------------------------------
-class _Mode:
-    """A known mode: its last frequency, shape and estimate time."""
-
-    __slots__ = ('frequency', 'shape', 'last_t')
-
-    def __init__(self, frequency: float, shape: np.ndarray, t: float):
-        self.frequency, self.shape, self.last_t = frequency, shape, t
-
-
 class JointFreeEstimator(Estimator):
     """Joint free-decay estimation of several channels; see the module docstring.
 
@@ -350,7 +335,7 @@ class JointFreeEstimator(Estimator):
         self._rows = np.empty((2 * self._room, 1 + m))  # t, channels: the last rows kept
         self._n = 0
         self._last = -math.inf
-        self._modes: list[_Mode] = []
+        self._modes = ModeRegister(replace=True)
         self._recent: dict[tuple[int, int], tuple[float, float, float]] = {}
 
     def reset(self) -> None:
@@ -393,7 +378,7 @@ class JointFreeEstimator(Estimator):
         stream whose time went back would otherwise merge every event into them)."""
         self._n = 0
         self._recent.clear()
-        for mode in self._modes:
+        for mode in self._modes.modes:
             mode.last_t = -math.inf
 
     def _row_of(self, times: np.ndarray) -> np.ndarray:
@@ -517,7 +502,7 @@ class JointFreeEstimator(Estimator):
         span = float(t[-1] - t[0]) if len(t) > 1 else 0.0
         zeta = _zeta(e)  # the channel's estimate: a start value of its mode's later events
         self._recent[(c, e.mode)] = (e.t, e.omega * math.sqrt(1 - zeta**2), e.omega * zeta)
-        mode = self._nearest(e.frequency_hz)
+        mode = self._modes.match([e.frequency_hz]).get(0)  # by frequency alone
         if mode is not None and e.t - mode.last_t < span / 2:
             self._c['merged_events'] += 1
             return None
@@ -533,7 +518,8 @@ class JointFreeEstimator(Estimator):
             return None
         shape = normalise_shape(fit.amplitudes)
         shape_std = fit.amplitude_std / float(np.linalg.norm(fit.amplitudes))
-        similarity, k = self._identify(f, shape, e.t)
+        mode = self._modes.observe_one(f, e.t, shape)
+        similarity, k = mode.mac, self._modes.number(mode)
         amplitude = float(np.sqrt(np.mean(np.abs(fit.amplitudes) ** 2)))
         return Estimate(
             e.t,
@@ -550,29 +536,6 @@ class JointFreeEstimator(Estimator):
             shape_std,
             similarity,
         )
-
-    def _nearest(self, f: float) -> _Mode | None:
-        """The known mode nearest ``f`` within ``MATCH_TOL`` (None if none)."""
-        near = [m for m in self._modes if abs(f / m.frequency - 1) <= MATCH_TOL]
-        return min(near, key=lambda m: abs(f / m.frequency - 1)) if near else None
-
-    def _identify(self, f: float, shape: np.ndarray, t: float) -> tuple[float, int]:
-        """``(MAC with the mode's last shape or NaN, mode number)``: the known mode this
-        estimate continues (module doc, step 5), updated, or a new one."""
-        dists = [(continues(f, shape, m.frequency, m.shape), m) for m in self._modes]
-        near = [(d, m) for d, m in dists if d is not None]
-        if near:
-            mode = min(near, key=lambda pair: pair[0])[1]
-            similarity = mac(shape, mode.shape)
-            mode.frequency, mode.shape, mode.last_t = f, shape, t
-        else:
-            if len(self._modes) >= MAX_TRACKS:
-                self._modes.remove(min(self._modes, key=lambda m: m.last_t))
-            mode = _Mode(f, shape, t)
-            self._modes.append(mode)
-            similarity = math.nan
-        rank = 1 + sum(m.frequency < mode.frequency for m in self._modes)
-        return similarity, rank
 
 
 def _zeta(e: Estimate) -> float:
