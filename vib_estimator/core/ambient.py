@@ -163,10 +163,6 @@ class SlidingWindowIdentifier(Estimator):
         self.restart()
 
     @property
-    def config(self) -> EstimatorConfig:
-        return self._config
-
-    @property
     def counters(self) -> dict[str, int]:
         return dict(self._c)
 
@@ -391,22 +387,7 @@ class AmbientEstimator(SlidingWindowIdentifier):
     def process(self, t: Sequence[float], y: Sequence[float]) -> EstimateArrays:
         """Feed arrays of samples (continuing the stream); the estimates as columns, by time."""
         t, y = as_series(t, y)
-        return estimate_columns(self._feed(t, y[:, None], np.isfinite(t) & np.isfinite(y)))
+        return EstimateArrays.of(self._feed(t, y[:, None], np.isfinite(t) & np.isfinite(y)))
 
     def _publish(self, estimate: Estimate, shape, shape_std, similarity) -> Estimate:
         return estimate
-
-
-def estimate_columns(estimates: list[Estimate]) -> EstimateArrays:
-    """Estimates as the columns of :class:`EstimateArrays`."""
-    names = list(EstimateArrays.__dataclass_fields__)
-    ints = ('samples', 'mode')
-    return EstimateArrays(
-        **{
-            name: np.array(
-                [getattr(e, name) for e in estimates],
-                dtype=np.int64 if name in ints else np.float64,
-            )
-            for name in names
-        }
-    )

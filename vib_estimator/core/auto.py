@@ -489,10 +489,6 @@ class AutoEstimator(Estimator):
         self._filled = 0
 
     @property
-    def config(self) -> EstimatorConfig:
-        return self._config
-
-    @property
     def block_s(self) -> float:
         """The envelope's block, s (now)."""
         return self._envelope.block_s

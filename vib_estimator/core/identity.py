@@ -23,9 +23,10 @@ several) go through it:
 4. **Number** (:meth:`ModeRegister.number`): published modes are numbered by ascending frequency,
    1 = the lowest (the compiled mode tracker's ``mode`` key numbers its modes so too).
 
-The compiled mode tracker (:mod:`.modes`) matches single poles of windows of a fraction of a
-period to a few periods inside its kernel, not estimates: its own tolerances (``modes.MATCH_TOL``
-= 0.06, ``PENDING_TOL``, ``DUPLICATE_TOL``) are those poles' scatter, twice an estimate's.
+The compiled mode tracker (:mod:`.modes`) is apart: inside its kernel it matches single poles,
+of windows from 0.7 of a period to a few periods, to its modes, not published estimates to
+known modes; its tolerances (``modes.MATCH_TOL`` = 0.06, ``PENDING_TOL``, ``DUPLICATE_TOL``,
+``LOSE_PERIODS``) are those poles', pinned by its own tests (test/core/test_modes.py).
 """
 
 from __future__ import annotations

@@ -33,7 +33,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .ambient import SlidingWindowIdentifier, estimate_columns
+from .ambient import SlidingWindowIdentifier
 from .config import EstimatorConfig
 from .estimator import Estimate, EstimateArrays, as_series
 
@@ -61,12 +61,21 @@ class JointEstimates:
         """The columns of the estimates ``out`` (with shapes) of ``channels``, in their order."""
         m = len(channels)
         return cls(
-            estimate_columns(out),
+            EstimateArrays.of(out),
             np.array([e.shape for e in out], dtype=complex).reshape(-1, m),
             np.array([e.shape_std for e in out]).reshape(-1, m),
             np.array([e.mac for e in out]),
             channels,
         )
+
+
+def channel_names(channels: Sequence[str], what: str, hint: str = '') -> tuple[str, ...]:
+    """``channels`` as names; ValueError if they are fewer than :data:`MIN_CHANNELS` (``what``
+    needs them; ``hint``: what to do instead)."""
+    names = tuple(str(c) for c in channels)
+    if len(names) < MIN_CHANNELS:
+        raise ValueError(f'{what} needs at least {MIN_CHANNELS} channels, got {len(names)}{hint}')
+    return names
 
 
 def as_channels(t: Sequence[float], y: np.ndarray, channels: int) -> tuple[np.ndarray, np.ndarray]:
@@ -84,25 +93,16 @@ class JointAmbientEstimator(SlidingWindowIdentifier):
     ``channels``: the channel names (their count is the number of columns fed)."""
 
     def __init__(self, config: EstimatorConfig, channels: Sequence[str]):
-        channels = tuple(str(c) for c in channels)
-        if len(channels) < MIN_CHANNELS:
-            raise ValueError(
-                f'a joint identification needs at least {MIN_CHANNELS} channels, '
-                f'got {len(channels)} (one channel: excitation ambient, one column)'
-            )
-        self._channels = channels
-        super().__init__(config, len(channels))
-
-    @property
-    def channels(self) -> tuple[str, ...]:
-        return self._channels
+        hint = ' (one channel: excitation ambient, one column)'
+        self.channels = channel_names(channels, 'a joint identification', hint)
+        super().__init__(config, len(self.channels))
 
     def process(self, t: Sequence[float], y: np.ndarray) -> JointEstimates:
         """Feed arrays (``y``: samples x channels; continuing the stream); the estimates by
         time."""
-        t, y = as_channels(t, y, len(self._channels))
+        t, y = as_channels(t, y, len(self.channels))
         out = self._feed(t, y, np.isfinite(y).all(axis=1) & np.isfinite(t))
-        return JointEstimates.of(out, self._channels)
+        return JointEstimates.of(out, self.channels)
 
     def _publish(self, estimate, shape, shape_std, similarity) -> Estimate:
         return replace(estimate, shape=shape, shape_std=shape_std, mac=similarity)

@@ -76,7 +76,7 @@ import numpy as np
 from .config import EstimatorConfig
 from .estimator import INPUT_COUNTERS, Estimate, Estimator, accept_sample
 from .identity import ModeRegister
-from .multichannel import MIN_CHANNELS, JointEstimates, as_channels
+from .multichannel import JointEstimates, as_channels, channel_names
 from .shapes import normalise_shape
 from .threads import single_blas_thread
 
@@ -287,27 +287,14 @@ class JointFreeEstimator(Estimator):
         config.validate()
         if config.excitation != 'free':
             raise ValueError(f'JointFreeEstimator needs excitation free, got {config.excitation}')
-        channels = tuple(str(c) for c in channels)
-        if len(channels) < MIN_CHANNELS:
-            raise ValueError(
-                f'a joint estimation needs at least {MIN_CHANNELS} channels, got {len(channels)}'
-            )
         self._config = config
-        self._channels = channels
+        self.channels = channel_names(channels, 'a joint estimation')
         self._room = int(config.buffer_samples)
         self._single = single
         self._c = dict.fromkeys(INPUT_COUNTERS + JOINT_COUNTERS, 0)
         self._retired: dict[str, int] = {}  # the counters of the channels' estimators restarted
         self._estimators: list = []
         self.restart()
-
-    @property
-    def config(self) -> EstimatorConfig:
-        return self._config
-
-    @property
-    def channels(self) -> tuple[str, ...]:
-        return self._channels
 
     @property
     def counters(self) -> dict[str, int]:
@@ -330,7 +317,7 @@ class JointFreeEstimator(Estimator):
     def restart(self) -> None:
         """Forget the signal and the known modes; counters are kept."""
         self._retired = self._channel_counters()
-        m = len(self._channels)
+        m = len(self.channels)
         self._estimators = [self._single() for _ in range(m)]
         self._rows = np.empty((2 * self._room, 1 + m))  # t, channels: the last rows kept
         self._n = 0
@@ -362,18 +349,8 @@ class JointFreeEstimator(Estimator):
         self._last = last
         return kept, restarts[kept]
 
-    def _accept(self, t: float, finite: bool) -> bool:
-        """Whether a row of stamp ``t`` (its values all finite or not) is kept, counted
-        (:func:`.estimator.accept_sample`): a jump back or a gap beyond ``max_gap`` empties the
-        row store (the channels' estimators restart themselves on it)."""
-        gap = self._config.max_gap
-        if not accept_sample(self._c, self._last, t, finite, gap, self._forget_signal):
-            return False
-        self._last = t
-        return True
-
     def _forget_signal(self) -> None:
-        """After a restart (:meth:`_accept`): the row store emptied, the channels' recent
+        """After a restart (:meth:`_keep`): the row store emptied, the channels' recent
         estimates forgotten, the known modes kept by frequency and shape but not by time (a
         stream whose time went back would otherwise merge every event into them)."""
         self._n = 0
@@ -411,12 +388,15 @@ class JointFreeEstimator(Estimator):
     def update(self, t: float, y: Sequence[float]) -> list[Estimate]:
         """Feed one sample (one value per channel); the estimates it completes."""
         values = [float(v) for v in y]
-        if len(values) != len(self._channels):
-            raise ValueError(f'expected {len(self._channels)} channel values, got {len(values)}')
-        t = float(t)
-        if not self._accept(t, math.isfinite(t) and all(map(math.isfinite, values))):
+        if len(values) != len(self.channels):
+            raise ValueError(f'expected {len(self.channels)} channel values, got {len(values)}')
+        t, row = float(t), np.array((values,))
+        kept, restart = self._keep(np.array((t,)), row)
+        if not kept[0]:
             return []
-        self._append(np.array((t,)), np.array((values,)))
+        if restart[0]:
+            self._forget_signal()
+        self._append(np.array((t,)), row)
         events = []
         for c, est in enumerate(self._estimators):
             for e in est.update(t, values[c]):
@@ -426,7 +406,7 @@ class JointFreeEstimator(Estimator):
     def process(self, t: Sequence[float], y: np.ndarray) -> JointEstimates:
         """Feed arrays (``y``: samples x channels; continuing the stream); the estimates by
         time."""
-        t, y = as_channels(t, y, len(self._channels))
+        t, y = as_channels(t, y, len(self.channels))
         keep, restarts = self._keep(t, y)
         t, y = t[keep], y[keep]
         out: list[Estimate] = []
@@ -436,7 +416,7 @@ class JointFreeEstimator(Estimator):
             if a < b and restarts[a]:
                 self._forget_signal()
             out += self._process_rows(t[a:b], y[a:b])
-        return JointEstimates.of(out, self._channels)
+        return JointEstimates.of(out, self.channels)
 
     def _process_rows(self, t: np.ndarray, y: np.ndarray) -> list[Estimate]:
         """Kept rows, increasing, without a restart among them: their joint estimates."""
@@ -480,9 +460,7 @@ class JointFreeEstimator(Estimator):
         a slower mode the window does not resolve, else 0 for biased-sinusoid, -1)."""
         omega = [self._recent[(c, e.mode)][1]]
         sigma = [self._recent[(c, e.mode)][2]]
-        degrees = np.full(
-            len(self._channels), 0 if self._config.model == 'biased-sinusoid' else -1
-        )
+        degrees = np.full(len(self.channels), 0 if self._config.model == 'biased-sinusoid' else -1)
         if self._config.modes:
             for (ch, _), (t, w, s) in sorted(self._recent.items()):
                 if e.t - t > CONTEXT_S:
