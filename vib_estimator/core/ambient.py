@@ -142,8 +142,8 @@ class SlidingWindowIdentifier(Estimator):
     of clean samples of a batch, the window each analysis reads (:meth:`_next_window`), its
     identification (:func:`.ssi.identify`) and the modes' identity over time (:meth:`_track`).
     :class:`AmbientEstimator` (one channel) and
-    :class:`vib_estimator.core.multichannel.JointAmbientEstimator` (several) give it their
-    outputs (:meth:`_publish`)."""
+    :class:`vib_estimator.core.multichannel.JointAmbientEstimator` (several, named
+    :attr:`channels`: its estimates carry their shapes) give out its estimates."""
 
     def __init__(self, config: EstimatorConfig, channels: int = 1):
         config.validate()
@@ -187,7 +187,7 @@ class SlidingWindowIdentifier(Estimator):
 
     def update(self, t: float, y) -> list:
         """Feed one sample (one value per channel); the estimates of an analysis it completes
-        (:meth:`_publish`'s, ascending mode)."""
+        (ascending mode)."""
         if isinstance(y, float):  # (a float or numpy float64: no array made)
             values = [y]
         else:
@@ -331,11 +331,6 @@ class SlidingWindowIdentifier(Estimator):
         return ts
 
     # ---- analysis -----------------------------------------------------------------------------
-    def _publish(self, estimate: Estimate, shape, shape_std, similarity):
-        """One published mode as the subclass gives it out (its estimate, its shape, the shape's
-        per-channel std, the MAC with its previous shape)."""
-        raise NotImplementedError
-
     def _analyse(self) -> list:
         window = self._next_window()
         if window is None:
@@ -369,10 +364,9 @@ class SlidingWindowIdentifier(Estimator):
             scale = tr.calibration(t, f, fstd, z, zstd, self._window)
             tr.estimates += 1
             k = register.number(tr)
-            est = Estimate(
-                t, f, span, n, explained, tr.amplitude, z, fstd * scale, zstd * scale, k
-            )
-            out.append(self._publish(est, modes.shapes[i], modes.shape_std[i], tr.mac))
+            shape = (modes.shapes[i], modes.shape_std[i], tr.mac) if self.channels else ()
+            est = (t, f, span, n, explained, tr.amplitude, z, fstd * scale, zstd * scale, k)
+            out.append(Estimate(*est, *shape))
         self._c['estimates'] += len(out)
         return out
 
@@ -388,6 +382,3 @@ class AmbientEstimator(SlidingWindowIdentifier):
         """Feed arrays of samples (continuing the stream); the estimates as columns, by time."""
         t, y = as_series(t, y)
         return EstimateArrays.of(self._feed(t, y[:, None], np.isfinite(t) & np.isfinite(y)))
-
-    def _publish(self, estimate: Estimate, shape, shape_std, similarity) -> Estimate:
-        return estimate

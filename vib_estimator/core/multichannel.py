@@ -29,7 +29,7 @@ stamps are handled as the single-channel identifier's (duplicates, out of order,
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -103,6 +103,3 @@ class JointAmbientEstimator(SlidingWindowIdentifier):
         t, y = as_channels(t, y, len(self.channels))
         out = self._feed(t, y, np.isfinite(y).all(axis=1) & np.isfinite(t))
         return JointEstimates.of(out, self.channels)
-
-    def _publish(self, estimate, shape, shape_std, similarity) -> Estimate:
-        return replace(estimate, shape=shape, shape_std=shape_std, mac=similarity)
