@@ -194,9 +194,11 @@ class SlidingWindowIdentifier(Estimator):
             values = np.asarray(y, dtype=np.float64).reshape(-1).tolist()
         if len(values) != self._m:
             raise ValueError(f'expected {self._m} channel values, got {len(values)}')
-        t = float(t)
-        if not self._accept(t, all(map(math.isfinite, values))):
+        t, finite = float(t), all(map(math.isfinite, values))
+        # a gap or a long jump back clears the window
+        if not accept_sample(self._c, self._last, t, finite, self._config.max_gap, self._clear):
             return []
+        self._last = t
         self._append(t, values)
         if t >= self._next:
             return self._analysis()
@@ -234,21 +236,21 @@ class SlidingWindowIdentifier(Estimator):
             self._next = float(self._t[0]) + self._window
         self._n += m
 
-    def _accept(self, t: float, finite: bool) -> bool:
-        """Count one sample (``finite``: its values are); False if skipped. A gap or a long jump
-        back clears the window (:func:`.estimator.accept_sample`)."""
-        if not accept_sample(self._c, self._last, t, finite, self._config.max_gap, self._clear):
-            return False
-        self._last = t
-        return True
-
     def _due(self) -> list:
-        """The analysis due now (:meth:`_analyse`), or, :attr:`idle`, only the window's slide."""
-        if not self.idle:
-            return self._analyse()
-        self._slide()
-        self._c['analyses_idle'] += 1
-        return []
+        """The analysis due now (:func:`.ssi.identify` of the window, :meth:`_track`), or,
+        :attr:`idle`, only the window's slide."""
+        if self.idle:
+            self._slide()
+            self._c['analyses_idle'] += 1
+            return []
+        window = self._next_window()
+        if window is None:
+            return []
+        ts, cascade, fs, span, known, search = window
+        modes, total = identify(
+            cascade, fs, self._config.max_damping, self._band, self._c, known, search
+        )
+        return self._track(modes, total, float(ts[-1]), span, len(ts))
 
     @single_blas_thread
     def _analysis(self) -> list:
@@ -331,16 +333,6 @@ class SlidingWindowIdentifier(Estimator):
         return ts
 
     # ---- analysis -----------------------------------------------------------------------------
-    def _analyse(self) -> list:
-        window = self._next_window()
-        if window is None:
-            return []
-        ts, cascade, fs, span, known, search = window
-        modes, total = identify(
-            cascade, fs, self._config.max_damping, self._band, self._c, known, search
-        )
-        return self._track(modes, total, float(ts[-1]), span, len(ts))
-
     def _track(self, modes: WindowModes, total: float, t: float, span: float, n: int) -> list:
         """Match the window's modes to the tracked ones (:class:`.identity.ModeRegister`),
         publish the confirmed ones."""

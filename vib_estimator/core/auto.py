@@ -41,7 +41,8 @@ their free-decay estimates fail the test).
 One ``mode`` scheme (:mod:`.identity`, the rule every estimator shares): every published estimate
 continues the mode within :data:`.identity.MATCH_TOL` of its frequency (else starts one), modes
 are numbered by ascending frequency, 1 = the lowest, as the mode tracker and the identifier number
-theirs; a mode unseen for a window is forgotten.
+theirs; a mode unseen for a window is forgotten (and at most :data:`.identity.MAX_TRACKS` are
+known, the least recent forgotten for a new one).
 """
 
 from __future__ import annotations
