@@ -43,7 +43,8 @@ from bench_operation import HCT_FILE, HCT_MODES, REAL_DATA, ssi_cov_window  # be
 
 from vib_estimator.core import EstimatorConfig, ambient, create_estimator
 from vib_estimator.core.ambient import HOP_S, AmbientEstimator
-from vib_estimator.core.multichannel import JointAmbientEstimator, mac
+from vib_estimator.core.multichannel import JointAmbientEstimator
+from vib_estimator.core.shapes import mac
 from vib_estimator.core.ssi import block_rows
 from vib_estimator.extras import optional
 from vib_estimator.sim.frame import frame_record, modal_record

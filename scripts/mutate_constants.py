@@ -55,6 +55,7 @@ MODULES = tuple(
         'correlations',
         'estimator',
         'health_model',
+        'identity',
         'kernel',
         'modes',
         'multichannel',
@@ -83,6 +84,11 @@ TESTS = {
     'correlations': ['test/core/test_ambient_incremental.py', 'test/core/test_ambient.py'],
     'estimator': ['test/core/test_estimator.py', 'test/core/test_bad_input.py'],
     'health_model': ['test/core/test_health_model.py'],
+    'identity': [
+        'test/core/test_identity.py',
+        'test/core/test_ambient.py',
+        'test/core/test_auto.py',
+    ],
     'kernel': [
         'test/core/test_estimator.py',
         'test/core/test_bad_input.py',

@@ -224,8 +224,7 @@ def test_a_mode_whose_frequency_moved_is_listed_and_marked_per_stretch(tmp_path)
     median across them."""
     from vib_estimator.analysis.report import Record, write_report
     from vib_estimator.core import EstimatorConfig
-    from vib_estimator.core.ambient import estimate_columns
-    from vib_estimator.core.estimator import Estimate
+    from vib_estimator.core.estimator import Estimate, EstimateArrays
 
     truth = [(0.0, 1.64), (10.0, 1.33), (20.0, 1.15)]
     est = [
@@ -236,7 +235,7 @@ def test_a_mode_whose_frequency_moved_is_listed_and_marked_per_stretch(tmp_path)
     t = np.arange(0, 30, 0.002)
     y = np.sin(2 * np.pi * 1.3 * t)
     record = Record('x.csv', 'vib-estimator analyze x.csv', ('y',), t, y,
-                    estimate_columns(est), EstimatorConfig(), {})  # fmt: skip
+                    EstimateArrays.of(est), EstimatorConfig(), {})  # fmt: skip
     page = write_report(tmp_path, record).read_text()
     rows = re.findall(r'\(t ([\d.]+)–([\d.]+) s\)</td><td>([\d.]+) ', page)
     assert len(rows) == 3

@@ -9,7 +9,8 @@ import pytest
 
 from vib_estimator.core import EstimatorConfig
 from vib_estimator.core.correlations import correlation_matrices
-from vib_estimator.core.multichannel import JointAmbientEstimator, mac, normalise_shape
+from vib_estimator.core.multichannel import JointAmbientEstimator
+from vib_estimator.core.shapes import mac
 from vib_estimator.sim.arm_model import simulate_driven
 from vib_estimator.sim.frame import frame_record, modal_record, shear_frame
 
@@ -106,15 +107,6 @@ def test_correlation_matrices_are_the_direct_sums():
         assert np.allclose(r[k], direct)
 
 
-def test_mac_and_normalisation():
-    a = np.array([1.0, -2.0, 0.5])
-    assert mac(a, (0.3 - 2j) * a) == pytest.approx(1.0)
-    assert mac(a, np.array([2.0, 1.0, 0.0])) == pytest.approx(0.0)
-    s = normalise_shape((0.3 - 2j) * a)
-    assert np.linalg.norm(s) == pytest.approx(1.0)
-    assert np.allclose(s, a / -np.linalg.norm(a))  # the largest entry (-2) real and positive
-
-
 def test_one_channel_is_refused_and_bad_samples_are_counted():
     with pytest.raises(ValueError, match='at least 2 channels'):
         JointAmbientEstimator(CONFIG, ['a'])
@@ -129,21 +121,6 @@ def test_one_channel_is_refused_and_bad_samples_are_counted():
     assert (c['received'], c['skipped_non_finite'], c['skipped_duplicate']) == (10, 1, 1)
     with pytest.raises(ValueError, match='2 channels'):
         est.process(t, np.ones((10, 3)))
-
-
-def test_a_mode_continues_a_track_only_with_a_similar_shape():
-    """``MAC_MATCH`` (0.5): a window's mode within MATCH_TOL of a tracked one continues it when
-    their shapes' MAC is 0.7 (the scatter of a weakly excited mode's shape), not when it is 0.3
-    (another mode at nearly the same frequency: a building's two bending directions)."""
-    from vib_estimator.core.multichannel import continues
-
-    last = np.array([1.0, 0.0, 0.0])
-    similar = np.array([1.0, math.sqrt(3 / 7), 0.0])  # MAC 0.7
-    other = np.array([1.0, 0.0, math.sqrt(7 / 3)])  # MAC 0.3
-    assert mac(similar, last) == pytest.approx(0.7) and mac(other, last) == pytest.approx(0.3)
-    assert continues(5.05, similar, 5.0, last) == pytest.approx(0.01)
-    assert continues(5.05, other, 5.0, last) is None
-    assert continues(5.05, last, 5.0, last) == pytest.approx(0.01)
 
 
 def test_close_modes_with_different_shapes_stay_two():

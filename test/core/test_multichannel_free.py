@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from vib_estimator.core import EstimatorConfig, create_estimator
-from vib_estimator.core.multichannel import mac
 from vib_estimator.core.multichannel_free import JointFreeEstimator, joint_fit
+from vib_estimator.core.shapes import mac
 
 FS = 500.0
 NAMES = ('a', 'b', 'c')

@@ -13,7 +13,7 @@ from rclpy.parameter import Parameter
 from std_msgs.msg import Float64MultiArray
 from visualization_msgs.msg import Marker, MarkerArray
 
-from vib_estimator.core.multichannel import mac
+from vib_estimator.core.shapes import mac
 from vib_estimator.io import fields
 from vib_estimator.io.geometry import load_geometry, parse_geometry
 from vib_estimator.nodes.estimator_node import EstimatorNode, message_class

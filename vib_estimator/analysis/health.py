@@ -24,7 +24,7 @@ from typing import Callable, Dict, List, Optional, Sequence, Tuple
 import numpy as np
 
 from ..core import health_model as hm
-from ..core.multichannel import mac
+from ..core.shapes import mac
 from ..io.covariates import covariate_means, parse_covariates
 
 #: ``--sequential``: the sequential test beside the per-recording one (default first)

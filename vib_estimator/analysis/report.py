@@ -28,8 +28,7 @@ import numpy as np
 
 from ..core.config import EstimatorConfig
 from ..core.estimator import EstimateArrays
-from ..core.multichannel import mac
-from ..core.shapes import phases_deg, signed_amplitudes
+from ..core.shapes import mac, phases_deg, signed_amplitudes
 from ..io.fields import UNKNOWN_UNIT
 from .plotting import PSD_RESOLUTION, mark_modes, mode_colour, pyplot, save_figure, welch_psd
 from .summary import ModeSummary, summarise_modes, summary_lines
@@ -103,7 +102,7 @@ def damping_std(record: Record, mode: ModeSummary) -> float:
 
 
 def mac_matrix(shapes: Sequence[np.ndarray]) -> np.ndarray:
-    """The MAC (:func:`..core.multichannel.mac`) of every pair of ``shapes``."""
+    """The MAC (:func:`..core.shapes.mac`) of every pair of ``shapes``."""
     return np.array([[mac(a, b) for b in shapes] for a in shapes]).reshape(len(shapes), -1)
 
 

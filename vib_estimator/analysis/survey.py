@@ -59,7 +59,7 @@ import numpy as np
 from ..core import COUNTER_NAMES, EstimatorConfig
 from ..core.choice import decide
 from ..core.estimator import INPUT_COUNTERS
-from ..core.multichannel import mac
+from ..core.shapes import mac
 from ..errors import VibEstimatorError, report
 from ..extras import optional
 from ..io.csv_reader import column_names

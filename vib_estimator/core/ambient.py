@@ -26,14 +26,15 @@ every mode tracked is published:
 3. **Calibrated standard deviations**: the bound scaled up by the factor the mode's own
    estimates from non-overlapping earlier windows show it to be too small (variance across
    windows: :meth:`_Track.calibration`).
-4. **Identity over time** (stability across windows): each mode continues the nearest tracked
-   mode within :data:`MATCH_TOL` whose last shape it matches (MAC >= :data:`MAC_MATCH`; with one
-   channel every shape matches); the MAC between the two is published with a joint estimate. A
-   new mode publishes once seen by :data:`CONFIRM` consecutive analyses (:data:`CONFIRM_BESIDE`
-   beside published modes; ``modes_found``), a published one whenever seen; one unseen for a
-   window is lost (``modes_lost``). With ``modes`` >= 1 at most that many (the strongest)
-   publish. Published modes are numbered by ascending frequency, 1 = the lowest, as the mode
-   tracker's ``mode`` key.
+4. **Identity over time** (stability across windows; :mod:`.identity`, the rule every estimator
+   shares): each mode continues the nearest tracked mode within :data:`.identity.MATCH_TOL`
+   whose last shape it matches (with one channel every shape matches); the MAC between the two
+   is published with a joint estimate. A new mode publishes once seen by
+   :data:`.identity.CONFIRM` consecutive analyses (:data:`.identity.CONFIRM_BESIDE` beside
+   published modes; ``modes_found``), a published one whenever seen; one unseen for a window is
+   lost (``modes_lost``). With ``modes`` >= 1 at most that many (the strongest) publish.
+   Published modes are numbered by ascending frequency, 1 = the lowest, as the mode tracker's
+   ``mode`` key.
 
 Each estimate: ``t`` = the window's last stamp, ``convergence_time`` = the window's span (the
 window used), ``samples`` = its samples, ``amplitude`` = RMS of the modal response (summed in
@@ -61,7 +62,8 @@ from .estimator import (
     accept_sample,
     as_series,
 )
-from .ssi import BLOCK_ROWS, WindowModes, block_rows, identify, mac
+from .identity import CONFIRM, CONFIRM_BESIDE, Mode, ModeRegister
+from .ssi import BLOCK_ROWS, WindowModes, block_rows, identify
 from .threads import single_blas_thread
 
 #: seconds of input between two analyses (the estimates' update period) of a short window
@@ -77,21 +79,10 @@ HOP_SHARE = 0.2
 MAX_HOP_S = 5.0
 #: fewest samples a window must hold to be analysed (twice the one channel's lags, and two)
 MIN_WINDOW_SAMPLES = 4 * BLOCK_ROWS + 2
-#: a window's mode continues a tracked mode within this relative frequency ...
-MATCH_TOL = 0.03
-#: ... if their shapes' MAC is at least this
-MAC_MATCH = 0.5
 #: while modes are known, one analysis in this many searches the full rate for higher ones
 SEARCH_EVERY = 5
 #: a mode's estimates over this many windows calibrate its stds (:meth:`_Track.calibration`)
 HISTORY_WINDOWS = 4
-#: consecutive analyses that must see a new mode before it publishes, while none is published
-CONFIRM = 3
-#: ... and beside published modes: a coloured excitation's continuum (a randomly commanded arm's)
-#: gives statistical poles beside a strong mode that last 1-8 analyses; a mode persists
-CONFIRM_BESIDE = 8
-#: most modes tracked at once
-MAX_TRACKS = 8
 
 COUNTER_NAMES = INPUT_COUNTERS + (
     'analyses',
@@ -113,34 +104,14 @@ def hop_s(window_s: float) -> float:
     return max(HOP_S, min(MAX_HOP_S, HOP_SHARE * window_s))
 
 
-def continues(f: float, shape: np.ndarray, frequency: float, last_shape: np.ndarray):
-    """The relative frequency distance of a mode (``f``, ``shape``) from a tracked one
-    (``frequency``, ``last_shape``) if it continues it -- within :data:`MATCH_TOL` and with a MAC
-    of at least :data:`MAC_MATCH` --, else None."""
-    dist = abs(f / frequency - 1)
-    return dist if dist <= MATCH_TOL and mac(shape, last_shape) >= MAC_MATCH else None
-
-
 # ---- streaming ----------------------------------------------------------------------------------
-class _Track:
-    """A mode followed across windows, with its last shape."""
+class _Track(Mode):
+    """A mode followed across windows (:class:`.identity.Mode`), with its recent estimates."""
 
-    __slots__ = (
-        'amplitude',
-        'estimates',
-        'frequency',
-        'history',
-        'last_t',
-        'published',
-        'seen',
-        'shape',
-    )
+    __slots__ = ('history',)
 
-    def __init__(self, frequency: float, t: float):
-        self.frequency, self.seen, self.last_t, self.published = frequency, 1, t, False
-        self.amplitude = 0.0
-        self.estimates = 0
-        self.shape = np.ones(1, dtype=complex)  # (its last shape)
+    def __init__(self, frequency: float, t: float, shape=None):
+        super().__init__(frequency, t, shape)
         self.history: list[tuple[float, float, float, float, float]] = []
 
     def calibration(
@@ -171,8 +142,8 @@ class SlidingWindowIdentifier(Estimator):
     of clean samples of a batch, the window each analysis reads (:meth:`_next_window`), its
     identification (:func:`.ssi.identify`) and the modes' identity over time (:meth:`_track`).
     :class:`AmbientEstimator` (one channel) and
-    :class:`vib_estimator.core.multichannel.JointAmbientEstimator` (several) give it their
-    outputs (:meth:`_publish`)."""
+    :class:`vib_estimator.core.multichannel.JointAmbientEstimator` (several, named
+    :attr:`channels`: its estimates carry their shapes) give out its estimates."""
 
     def __init__(self, config: EstimatorConfig, channels: int = 1):
         config.validate()
@@ -183,7 +154,7 @@ class SlidingWindowIdentifier(Estimator):
         self._m = channels
         self._t = np.empty(1 << 14)
         self._y = np.empty((1 << 14, channels))
-        self._tracks: list = []
+        self._register = ModeRegister(self._window, CONFIRM, CONFIRM_BESIDE, new=_Track)
         self._cascade = CorrelationCascade(2 * block_rows(channels), channels)
         #: while True, a window that is due only slides (counted ``analyses_idle``): nothing is
         #: identified or published, the tracked modes wait (``excitation = auto`` in a free
@@ -192,16 +163,12 @@ class SlidingWindowIdentifier(Estimator):
         self.restart()
 
     @property
-    def config(self) -> EstimatorConfig:
-        return self._config
-
-    @property
     def counters(self) -> dict[str, int]:
         return dict(self._c)
 
     def restart(self) -> None:
         """Forget the signal and the tracked modes; counters are kept."""
-        self._tracks = []
+        self._register.clear()
         self._last = -math.inf
         self._since_search = math.inf  # analyses since the last search (the first searches)
         self._clear()
@@ -220,16 +187,18 @@ class SlidingWindowIdentifier(Estimator):
 
     def update(self, t: float, y) -> list:
         """Feed one sample (one value per channel); the estimates of an analysis it completes
-        (:meth:`_publish`'s, ascending mode)."""
+        (ascending mode)."""
         if isinstance(y, float):  # (a float or numpy float64: no array made)
             values = [y]
         else:
             values = np.asarray(y, dtype=np.float64).reshape(-1).tolist()
         if len(values) != self._m:
             raise ValueError(f'expected {self._m} channel values, got {len(values)}')
-        t = float(t)
-        if not self._accept(t, all(map(math.isfinite, values))):
+        t, finite = float(t), all(map(math.isfinite, values))
+        # a gap or a long jump back clears the window
+        if not accept_sample(self._c, self._last, t, finite, self._config.max_gap, self._clear):
             return []
+        self._last = t
         self._append(t, values)
         if t >= self._next:
             return self._analysis()
@@ -237,10 +206,7 @@ class SlidingWindowIdentifier(Estimator):
 
     def mode_counters(self) -> dict[int, dict[str, int]]:
         """Each current mode's estimates (as the mode tracker's ``mode_counters``)."""
-        published = sorted(
-            (tr for tr in self._tracks if tr.published), key=lambda tr: tr.frequency
-        )
-        return {k: {'estimates': tr.estimates} for k, tr in enumerate(published, 1)}
+        return self._register.counters()
 
     # ---- input --------------------------------------------------------------------------------
     def _append(self, t, y) -> None:
@@ -270,21 +236,21 @@ class SlidingWindowIdentifier(Estimator):
             self._next = float(self._t[0]) + self._window
         self._n += m
 
-    def _accept(self, t: float, finite: bool) -> bool:
-        """Count one sample (``finite``: its values are); False if skipped. A gap or a long jump
-        back clears the window (:func:`.estimator.accept_sample`)."""
-        if not accept_sample(self._c, self._last, t, finite, self._config.max_gap, self._clear):
-            return False
-        self._last = t
-        return True
-
     def _due(self) -> list:
-        """The analysis due now (:meth:`_analyse`), or, :attr:`idle`, only the window's slide."""
-        if not self.idle:
-            return self._analyse()
-        self._slide()
-        self._c['analyses_idle'] += 1
-        return []
+        """The analysis due now (:func:`.ssi.identify` of the window, :meth:`_track`), or,
+        :attr:`idle`, only the window's slide."""
+        if self.idle:
+            self._slide()
+            self._c['analyses_idle'] += 1
+            return []
+        window = self._next_window()
+        if window is None:
+            return []
+        ts, cascade, fs, span, known, search = window
+        modes, total = identify(
+            cascade, fs, self._config.max_damping, self._band, self._c, known, search
+        )
+        return self._track(modes, total, float(ts[-1]), span, len(ts))
 
     @single_blas_thread
     def _analysis(self) -> list:
@@ -323,30 +289,6 @@ class SlidingWindowIdentifier(Estimator):
                     out.extend(self._due())
         return out
 
-    def _confirm(self, seen: dict, t: float) -> tuple[list, list]:
-        """After an analysis at ``t`` (``seen``: the tracks it saw, by id): forget the unseen
-        unpublished tracks and the published ones unseen for a window, publish those seen
-        ``CONFIRM`` analyses running (``CONFIRM_BESIDE`` once a mode is published) and the
-        published ones seen again (the ``modes`` strongest if set); ``(the tracks to publish
-        now, every published track by ascending frequency: the mode numbers)``."""
-        tracks = self._tracks
-        for tr in list(tracks):
-            if id(tr) not in seen:
-                tr.seen = 0
-                if not tr.published or t - tr.last_t > self._window:
-                    tracks.remove(tr)
-                    self._c['modes_lost'] += tr.published
-        need = CONFIRM_BESIDE if any(tr.published for tr in tracks) else CONFIRM
-        ready = [tr for tr in tracks if id(tr) in seen and (tr.published or tr.seen >= need)]
-        if self._config.modes:
-            ready = sorted(ready, key=lambda tr: -tr.amplitude)[: self._config.modes]
-        for tr in ready:
-            if not tr.published:
-                tr.published = True
-                self._c['modes_found'] += 1
-        numbered = sorted((tr for tr in tracks if tr.published), key=lambda tr: tr.frequency)
-        return ready, numbered
-
     def _next_window(self):
         """Advance to the next analysis; ``(samples' times, their correlations (the
         :class:`CorrelationCascade`, brought up to the last sample), rate, span, the highest
@@ -360,7 +302,7 @@ class SlidingWindowIdentifier(Estimator):
         # the highest mode tracked: while a mode is published, a new one a search found above it
         # is identified at every analysis until it is confirmed or lost (not only by the next
         # search: CONFIRM_BESIDE analyses running would never see it)
-        tracks = self._tracks
+        tracks = self._register.modes
         known = max((tr.frequency for tr in tracks), default=0.0)
         if not any(tr.published for tr in tracks):
             known = 0.0
@@ -374,7 +316,7 @@ class SlidingWindowIdentifier(Estimator):
         t_end = self._t[self._n - 1]
         # every second while a mode is to be confirmed (CONFIRM analyses running: as soon as at
         # any window), else every hop_s of the window
-        tracks = self._tracks
+        tracks = self._register.modes
         settled = bool(tracks) and all(tr.published for tr in tracks)
         hop = hop_s(self._window) if settled else HOP_S
         self._next += hop
@@ -391,74 +333,32 @@ class SlidingWindowIdentifier(Estimator):
         return ts
 
     # ---- analysis -----------------------------------------------------------------------------
-    def _publish(self, estimate: Estimate, shape, shape_std, similarity):
-        """One published mode as the subclass gives it out (its estimate, its shape, the shape's
-        per-channel std, the MAC with its previous shape)."""
-        raise NotImplementedError
-
-    def _analyse(self) -> list:
-        window = self._next_window()
-        if window is None:
-            return []
-        ts, cascade, fs, span, known, search = window
-        modes, total = identify(
-            cascade, fs, self._config.max_damping, self._band, self._c, known, search
-        )
-        return self._track(modes, total, float(ts[-1]), span, len(ts))
-
-    def _match(self, modes: WindowModes) -> dict[int, int]:
-        """Each window mode's track: nearest in frequency within :data:`MATCH_TOL` among those
-        whose shape it matches (:func:`continues`; published tracks first)."""
-        tracks = self._tracks
-        pairs = []
-        for i in range(len(modes)):
-            for j, tr in enumerate(tracks):
-                dist = continues(modes.frequency[i], modes.shapes[i], tr.frequency, tr.shape)
-                if dist is not None:
-                    pairs.append((not tr.published, dist, i, j))
-        match: dict[int, int] = {}
-        used = set()
-        for _, _, i, j in sorted(pairs):
-            if i not in match and j not in used:
-                match[i] = j
-                used.add(j)
-        return match
-
     def _track(self, modes: WindowModes, total: float, t: float, span: float, n: int) -> list:
-        """Match the window's modes to the tracked ones, publish the confirmed ones."""
-        tracks = self._tracks
-        match = self._match(modes)
-        seen: dict[int, tuple[int, float]] = {}
+        """Match the window's modes to the tracked ones (:class:`.identity.ModeRegister`),
+        publish the confirmed ones."""
+        register = self._register
+        match = register.match(modes.frequency.tolist(), modes.shapes)
+        seen: dict = {}
         for i in range(len(modes)):
-            if i in match:
-                tr = tracks[match[i]]
-                tr.seen += 1
-                similarity = mac(modes.shapes[i], tr.shape)
-            elif len(tracks) < MAX_TRACKS:
-                tr = _Track(float(modes.frequency[i]), t)
-                tracks.append(tr)
-                similarity = math.nan
-            else:
-                continue
-            tr.frequency, tr.last_t = float(modes.frequency[i]), t
-            tr.amplitude = math.sqrt(float(np.sum(modes.variances[i])))
-            tr.shape = modes.shapes[i]
-            seen[id(tr)] = (i, similarity)
-        ready, numbered = self._confirm(seen, t)
+            tr = register.observe(float(modes.frequency[i]), t, modes.shapes[i], match.get(i))
+            if tr is not None:
+                tr.amplitude = math.sqrt(float(np.sum(modes.variances[i])))
+                seen[tr] = i
+        ready, found, lost = register.settle(seen, t, self._config.modes)
+        self._c['modes_found'] += found
+        self._c['modes_lost'] += lost
         explained = min(1.0, float(np.sum(modes.variances)) / total) if total > 0 else 0.0
         out = []
-        for k, tr in enumerate(numbered, 1):
-            if tr not in ready:
-                continue
-            i, similarity = seen[id(tr)]
+        for tr in sorted(ready, key=lambda tr: tr.frequency):
+            i = seen[tr]
             f, z = float(modes.frequency[i]), float(modes.damping[i])
             fstd, zstd = float(modes.frequency_std[i]), float(modes.damping_std[i])
             scale = tr.calibration(t, f, fstd, z, zstd, self._window)
             tr.estimates += 1
-            est = Estimate(
-                t, f, span, n, explained, tr.amplitude, z, fstd * scale, zstd * scale, k
-            )
-            out.append(self._publish(est, modes.shapes[i], modes.shape_std[i], similarity))
+            k = register.number(tr)
+            shape = (modes.shapes[i], modes.shape_std[i], tr.mac) if self.channels else ()
+            est = (t, f, span, n, explained, tr.amplitude, z, fstd * scale, zstd * scale, k)
+            out.append(Estimate(*est, *shape))
         self._c['estimates'] += len(out)
         return out
 
@@ -473,22 +373,4 @@ class AmbientEstimator(SlidingWindowIdentifier):
     def process(self, t: Sequence[float], y: Sequence[float]) -> EstimateArrays:
         """Feed arrays of samples (continuing the stream); the estimates as columns, by time."""
         t, y = as_series(t, y)
-        return estimate_columns(self._feed(t, y[:, None], np.isfinite(t) & np.isfinite(y)))
-
-    def _publish(self, estimate: Estimate, shape, shape_std, similarity) -> Estimate:
-        return estimate
-
-
-def estimate_columns(estimates: list[Estimate]) -> EstimateArrays:
-    """Estimates as the columns of :class:`EstimateArrays`."""
-    names = list(EstimateArrays.__dataclass_fields__)
-    ints = ('samples', 'mode')
-    return EstimateArrays(
-        **{
-            name: np.array(
-                [getattr(e, name) for e in estimates],
-                dtype=np.int64 if name in ints else np.float64,
-            )
-            for name in names
-        }
-    )
+        return EstimateArrays.of(self._feed(t, y[:, None], np.isfinite(t) & np.isfinite(y)))

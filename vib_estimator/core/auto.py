@@ -38,10 +38,11 @@ in a driven one: on a record that is a free decay throughout the output is the f
 one the identifier's (its first blocks are free until the envelope has shown it is driven, but
 their free-decay estimates fail the test).
 
-One ``mode`` scheme: every published estimate continues the mode within
-:data:`~.ambient.MATCH_TOL` of its frequency (else starts one), modes are numbered by ascending
-frequency, 1 = the lowest, as the mode tracker and the identifier number theirs; a mode unseen for
-a window is forgotten.
+One ``mode`` scheme (:mod:`.identity`, the rule every estimator shares): every published estimate
+continues the mode within :data:`.identity.MATCH_TOL` of its frequency (else starts one), modes
+are numbered by ascending frequency, 1 = the lowest, as the mode tracker and the identifier number
+theirs; a mode unseen for a window is forgotten (and at most :data:`.identity.MAX_TRACKS` are
+known, the least recent forgotten for a new one).
 """
 
 from __future__ import annotations
@@ -52,9 +53,10 @@ from typing import Optional, Sequence, Tuple
 
 import numpy as np
 
-from .ambient import MATCH_TOL, AmbientEstimator
+from .ambient import AmbientEstimator
 from .config import EstimatorConfig
 from .estimator import INPUT_COUNTERS, Estimate, EstimateArrays, Estimator, as_series
+from .identity import ModeRegister
 
 #: envelope blocks per ambient window
 BLOCKS_PER_WINDOW = 30
@@ -482,16 +484,12 @@ class AutoEstimator(Estimator):
             max(MIN_BLOCK_S, config.ambient_window_s / BLOCKS_PER_WINDOW),
             config.ambient_window_s / MAX_BLOCK_FRACTION,
         )
-        self._modes: list[list[float]] = []  # [frequency, last t] of the known modes
+        self._modes = ModeRegister(config.ambient_window_s, replace=True)  # the known modes
         self._published = {FREE: 0, DRIVEN: 0}
         self._test = config.modes == 0  # the free-decay test of each free estimate
         self._not_free = 0  # free estimates the test held back
         self._history = np.empty((2, 2 * HISTORY))  # the last HISTORY valid samples (t, y)
         self._filled = 0
-
-    @property
-    def config(self) -> EstimatorConfig:
-        return self._config
 
     @property
     def block_s(self) -> float:
@@ -531,15 +529,14 @@ class AutoEstimator(Estimator):
 
     def mode_counters(self) -> dict[int, dict[str, int]]:
         """Each known mode's estimates, by its number."""
-        order = sorted(self._modes, key=lambda m: m[0])
-        return {k: {'estimates': int(m[2])} for k, m in enumerate(order, 1)}
+        return self._modes.counters()
 
     def restart(self) -> None:
         """Forget the signal and the known modes; counters are kept (the envelope's too)."""
         self._free.restart()
         self._ambient.restart()
         self._envelope.restart()
-        self._modes = []
+        self._modes.clear()
         self._filled = 0
 
     def reset(self) -> None:
@@ -666,11 +663,6 @@ class AutoEstimator(Estimator):
     def _rank(self, f: float, t: float, kind: str) -> int:
         """The mode number, in the shared scheme, of a ``kind`` estimate of ``f`` Hz at ``t``."""
         self._published[kind] += 1
-        window = self._config.ambient_window_s
-        self._modes = [m for m in self._modes if t - m[1] <= window]
-        near = min(self._modes, key=lambda m: abs(f / m[0] - 1), default=None)
-        if near is None or abs(f / near[0] - 1) > MATCH_TOL:
-            near = [f, t, 0]
-            self._modes.append(near)
-        near[0], near[1], near[2] = f, t, near[2] + 1
-        return 1 + sum(m[0] < f for m in self._modes if m is not near)
+        mode = self._modes.observe_one(f, t)
+        mode.estimates += 1
+        return self._modes.number(mode)

@@ -207,7 +207,8 @@ class Estimator(Protocol):
     interpreted: bool = False
 
     @property
-    def config(self) -> EstimatorConfig: ...
+    def config(self) -> EstimatorConfig:
+        return self._config
 
     @property
     def counters(self) -> Dict[str, int]: ...
@@ -259,6 +260,20 @@ class EstimateArrays:
         cols = {n: np.concatenate([getattr(p, n) for p in parts]) for n in names}
         order = np.argsort(cols['t'], kind='stable')
         return cls(**{n: c[order] for n, c in cols.items()})
+
+    @classmethod
+    def of(cls, estimates: Sequence[Estimate]) -> 'EstimateArrays':
+        """The columns of ``estimates`` (the inverse of :meth:`to_list`)."""
+        ints = ('samples', 'mode')
+        return cls(
+            **{
+                name: np.array(
+                    [getattr(e, name) for e in estimates],
+                    dtype=np.int64 if name in ints else np.float64,
+                )
+                for name in cls.__dataclass_fields__
+            }
+        )
 
     def __len__(self) -> int:
         return len(self.t)
@@ -330,10 +345,6 @@ class FrequencyEstimator(Estimator):
     def __setstate__(self, state: dict) -> None:
         self.__dict__.update(state)
         self._bind()
-
-    @property
-    def config(self) -> EstimatorConfig:
-        return self._config
 
     def restart(self) -> None:
         """Forget the signal entirely (prefilter, history, running interval and scale too);

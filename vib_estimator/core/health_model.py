@@ -41,7 +41,7 @@ from typing import Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from .multichannel import mac
+from .shapes import mac
 
 #: version of the saved baseline's layout (``version:`` in the YAML file)
 VERSION = 1

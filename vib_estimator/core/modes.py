@@ -871,10 +871,6 @@ class ModeTracker(Estimator):
         (:func:`core.jit.available`: running it compiles nothing)."""
         return available(_run, (self._fs, self._ic, self._qs, self._t1, self._y1, self._out, 0))
 
-    @property
-    def config(self) -> EstimatorConfig:
-        return self._config
-
     # ---- streaming and batch ---------------------------------------------------------------
     def update(self, t: float, y: float) -> List[Estimate]:
         """Feed one sample; return the estimates published at it (ascending mode)."""

@@ -11,7 +11,7 @@ block rows :func:`.ssi.block_rows`), each mode's shape and its uncertainty (the 
 stable model orders), close clusters merged only when their shapes agree (MAC >=
 :data:`.ssi.MAC_SAME`), a mode kept when it stands above the noise on at least one channel, its
 bound and frequency refinement on that channel (:mod:`.whittle`), and its identity over time by
-frequency and shape (:func:`.ambient.continues`).
+frequency and shape (:mod:`.identity`).
 
 Interface: :class:`JointAmbientEstimator` ``(config, channels)`` ``.process(t, Y) ->``
 :class:`JointEstimates` (``Y``: samples x channels), ``.update(t, y) -> list[Estimate]``,
@@ -29,26 +29,16 @@ stamps are handled as the single-channel identifier's (duplicates, out of order,
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
-from .ambient import SlidingWindowIdentifier, continues, estimate_columns
+from .ambient import SlidingWindowIdentifier
 from .config import EstimatorConfig
 from .estimator import Estimate, EstimateArrays, as_series
-from .ssi import mac, normalise_shape
 
 #: the fewest channels of a joint identification (one channel is the single-channel identifier's)
 MIN_CHANNELS = 2
-__all__ = [
-    'MIN_CHANNELS',
-    'JointAmbientEstimator',
-    'JointEstimates',
-    'as_channels',
-    'continues',
-    'mac',
-    'normalise_shape',
-]
 
 
 # ---- streaming ----------------------------------------------------------------------------------
@@ -71,12 +61,21 @@ class JointEstimates:
         """The columns of the estimates ``out`` (with shapes) of ``channels``, in their order."""
         m = len(channels)
         return cls(
-            estimate_columns(out),
+            EstimateArrays.of(out),
             np.array([e.shape for e in out], dtype=complex).reshape(-1, m),
             np.array([e.shape_std for e in out]).reshape(-1, m),
             np.array([e.mac for e in out]),
             channels,
         )
+
+
+def channel_names(channels: Sequence[str], what: str, hint: str = '') -> tuple[str, ...]:
+    """``channels`` as names; ValueError if they are fewer than :data:`MIN_CHANNELS` (``what``
+    needs them; ``hint``: what to do instead)."""
+    names = tuple(str(c) for c in channels)
+    if len(names) < MIN_CHANNELS:
+        raise ValueError(f'{what} needs at least {MIN_CHANNELS} channels, got {len(names)}{hint}')
+    return names
 
 
 def as_channels(t: Sequence[float], y: np.ndarray, channels: int) -> tuple[np.ndarray, np.ndarray]:
@@ -94,25 +93,13 @@ class JointAmbientEstimator(SlidingWindowIdentifier):
     ``channels``: the channel names (their count is the number of columns fed)."""
 
     def __init__(self, config: EstimatorConfig, channels: Sequence[str]):
-        channels = tuple(str(c) for c in channels)
-        if len(channels) < MIN_CHANNELS:
-            raise ValueError(
-                f'a joint identification needs at least {MIN_CHANNELS} channels, '
-                f'got {len(channels)} (one channel: excitation ambient, one column)'
-            )
-        self._channels = channels
-        super().__init__(config, len(channels))
-
-    @property
-    def channels(self) -> tuple[str, ...]:
-        return self._channels
+        hint = ' (one channel: excitation ambient, one column)'
+        self.channels = channel_names(channels, 'a joint identification', hint)
+        super().__init__(config, len(self.channels))
 
     def process(self, t: Sequence[float], y: np.ndarray) -> JointEstimates:
         """Feed arrays (``y``: samples x channels; continuing the stream); the estimates by
         time."""
-        t, y = as_channels(t, y, len(self._channels))
+        t, y = as_channels(t, y, len(self.channels))
         out = self._feed(t, y, np.isfinite(y).all(axis=1) & np.isfinite(t))
-        return JointEstimates.of(out, self._channels)
-
-    def _publish(self, estimate, shape, shape_std, similarity) -> Estimate:
-        return replace(estimate, shape=shape, shape_std=shape_std, mac=similarity)
+        return JointEstimates.of(out, self.channels)

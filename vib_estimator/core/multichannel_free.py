@@ -44,12 +44,12 @@ Method:
    and ``zeta = sigma / w_n``. Information adds over channels: the joint std is below every single
    channel's, and a mode invisible on some channels is estimated from the others.
 4. **Shape**: ``phi_c = b_c - i a_c`` (``y_c = Re(phi_c e^((-sigma + i w) u))``), normalised
-   (:func:`..multichannel.normalise_shape`); its std per channel ``s_c sqrt(var a_c + var b_c)``
+   (:func:`.shapes.normalise_shape`); its std per channel ``s_c sqrt(var a_c + var b_c)``
    from the amplitudes' least-squares covariance, scaled as the shape.
-5. **Identity over time**: an estimate continues the known mode nearest in frequency (within
-   :data:`..ambient.MATCH_TOL`) whose last shape it matches (MAC >= :data:`..multichannel.
-   MAC_MATCH`), as the joint ambient identifier's; else it is a new mode (at most
-   :data:`..ambient.MAX_TRACKS`, the least recent forgotten). ``mode`` = its rank by frequency
+5. **Identity over time** (:mod:`.identity`, the rule every estimator shares): an estimate
+   continues the known mode nearest in frequency (within :data:`.identity.MATCH_TOL`) whose last
+   shape it matches (MAC >= :data:`.identity.MAC_MATCH`); else it is a new mode (at most
+   :data:`.identity.MAX_TRACKS`, the least recent forgotten). ``mode`` = its rank by frequency
    among the known modes, 1 = the lowest (also with ``modes`` = 0: the node's
    ``vibration/mode<k>/shape`` needs k >= 1). Several channels converge on one mode at about the
    same time: an event within half its window of that mode's last estimate is merged into it
@@ -73,17 +73,11 @@ from functools import partial
 
 import numpy as np
 
-from .ambient import MATCH_TOL, MAX_TRACKS
 from .config import EstimatorConfig
 from .estimator import INPUT_COUNTERS, Estimate, Estimator, accept_sample
-from .multichannel import (
-    MIN_CHANNELS,
-    JointEstimates,
-    as_channels,
-    continues,
-    mac,
-    normalise_shape,
-)
+from .identity import ModeRegister
+from .multichannel import JointEstimates, as_channels, channel_names
+from .shapes import normalise_shape
 from .threads import single_blas_thread
 
 #: other modes estimated within this many seconds before an event are terms of its fit
@@ -278,15 +272,6 @@ def natural(fit: JointFit) -> tuple[float, float, float, float]:
 
 
 # ---- the identifier -----------------------------------------------------------------------------
-class _Mode:
-    """A known mode: its last frequency, shape and estimate time."""
-
-    __slots__ = ('frequency', 'shape', 'last_t')
-
-    def __init__(self, frequency: float, shape: np.ndarray, t: float):
-        self.frequency, self.shape, self.last_t = frequency, shape, t
-
-
 class JointFreeEstimator(Estimator):
     """Joint free-decay estimation of several channels; see the module docstring.
 
@@ -302,27 +287,14 @@ class JointFreeEstimator(Estimator):
         config.validate()
         if config.excitation != 'free':
             raise ValueError(f'JointFreeEstimator needs excitation free, got {config.excitation}')
-        channels = tuple(str(c) for c in channels)
-        if len(channels) < MIN_CHANNELS:
-            raise ValueError(
-                f'a joint estimation needs at least {MIN_CHANNELS} channels, got {len(channels)}'
-            )
         self._config = config
-        self._channels = channels
+        self.channels = channel_names(channels, 'a joint estimation')
         self._room = int(config.buffer_samples)
         self._single = single
         self._c = dict.fromkeys(INPUT_COUNTERS + JOINT_COUNTERS, 0)
         self._retired: dict[str, int] = {}  # the counters of the channels' estimators restarted
         self._estimators: list = []
         self.restart()
-
-    @property
-    def config(self) -> EstimatorConfig:
-        return self._config
-
-    @property
-    def channels(self) -> tuple[str, ...]:
-        return self._channels
 
     @property
     def counters(self) -> dict[str, int]:
@@ -345,12 +317,12 @@ class JointFreeEstimator(Estimator):
     def restart(self) -> None:
         """Forget the signal and the known modes; counters are kept."""
         self._retired = self._channel_counters()
-        m = len(self._channels)
+        m = len(self.channels)
         self._estimators = [self._single() for _ in range(m)]
         self._rows = np.empty((2 * self._room, 1 + m))  # t, channels: the last rows kept
         self._n = 0
         self._last = -math.inf
-        self._modes: list[_Mode] = []
+        self._modes = ModeRegister(replace=True)
         self._recent: dict[tuple[int, int], tuple[float, float, float]] = {}
 
     def reset(self) -> None:
@@ -377,23 +349,13 @@ class JointFreeEstimator(Estimator):
         self._last = last
         return kept, restarts[kept]
 
-    def _accept(self, t: float, finite: bool) -> bool:
-        """Whether a row of stamp ``t`` (its values all finite or not) is kept, counted
-        (:func:`.estimator.accept_sample`): a jump back or a gap beyond ``max_gap`` empties the
-        row store (the channels' estimators restart themselves on it)."""
-        gap = self._config.max_gap
-        if not accept_sample(self._c, self._last, t, finite, gap, self._forget_signal):
-            return False
-        self._last = t
-        return True
-
     def _forget_signal(self) -> None:
-        """After a restart (:meth:`_accept`): the row store emptied, the channels' recent
+        """After a restart (:meth:`_keep`): the row store emptied, the channels' recent
         estimates forgotten, the known modes kept by frequency and shape but not by time (a
         stream whose time went back would otherwise merge every event into them)."""
         self._n = 0
         self._recent.clear()
-        for mode in self._modes:
+        for mode in self._modes.modes:
             mode.last_t = -math.inf
 
     def _row_of(self, times: np.ndarray) -> np.ndarray:
@@ -426,12 +388,15 @@ class JointFreeEstimator(Estimator):
     def update(self, t: float, y: Sequence[float]) -> list[Estimate]:
         """Feed one sample (one value per channel); the estimates it completes."""
         values = [float(v) for v in y]
-        if len(values) != len(self._channels):
-            raise ValueError(f'expected {len(self._channels)} channel values, got {len(values)}')
-        t = float(t)
-        if not self._accept(t, math.isfinite(t) and all(map(math.isfinite, values))):
+        if len(values) != len(self.channels):
+            raise ValueError(f'expected {len(self.channels)} channel values, got {len(values)}')
+        t, row = float(t), np.array((values,))
+        kept, restart = self._keep(np.array((t,)), row)
+        if not kept[0]:
             return []
-        self._append(np.array((t,)), np.array((values,)))
+        if restart[0]:
+            self._forget_signal()
+        self._append(np.array((t,)), row)
         events = []
         for c, est in enumerate(self._estimators):
             for e in est.update(t, values[c]):
@@ -441,7 +406,7 @@ class JointFreeEstimator(Estimator):
     def process(self, t: Sequence[float], y: np.ndarray) -> JointEstimates:
         """Feed arrays (``y``: samples x channels; continuing the stream); the estimates by
         time."""
-        t, y = as_channels(t, y, len(self._channels))
+        t, y = as_channels(t, y, len(self.channels))
         keep, restarts = self._keep(t, y)
         t, y = t[keep], y[keep]
         out: list[Estimate] = []
@@ -451,7 +416,7 @@ class JointFreeEstimator(Estimator):
             if a < b and restarts[a]:
                 self._forget_signal()
             out += self._process_rows(t[a:b], y[a:b])
-        return JointEstimates.of(out, self._channels)
+        return JointEstimates.of(out, self.channels)
 
     def _process_rows(self, t: np.ndarray, y: np.ndarray) -> list[Estimate]:
         """Kept rows, increasing, without a restart among them: their joint estimates."""
@@ -495,9 +460,7 @@ class JointFreeEstimator(Estimator):
         a slower mode the window does not resolve, else 0 for biased-sinusoid, -1)."""
         omega = [self._recent[(c, e.mode)][1]]
         sigma = [self._recent[(c, e.mode)][2]]
-        degrees = np.full(
-            len(self._channels), 0 if self._config.model == 'biased-sinusoid' else -1
-        )
+        degrees = np.full(len(self.channels), 0 if self._config.model == 'biased-sinusoid' else -1)
         if self._config.modes:
             for (ch, _), (t, w, s) in sorted(self._recent.items()):
                 if e.t - t > CONTEXT_S:
@@ -517,7 +480,7 @@ class JointFreeEstimator(Estimator):
         span = float(t[-1] - t[0]) if len(t) > 1 else 0.0
         zeta = _zeta(e)  # the channel's estimate: a start value of its mode's later events
         self._recent[(c, e.mode)] = (e.t, e.omega * math.sqrt(1 - zeta**2), e.omega * zeta)
-        mode = self._nearest(e.frequency_hz)
+        mode = self._modes.match([e.frequency_hz]).get(0)  # by frequency alone
         if mode is not None and e.t - mode.last_t < span / 2:
             self._c['merged_events'] += 1
             return None
@@ -533,7 +496,8 @@ class JointFreeEstimator(Estimator):
             return None
         shape = normalise_shape(fit.amplitudes)
         shape_std = fit.amplitude_std / float(np.linalg.norm(fit.amplitudes))
-        similarity, k = self._identify(f, shape, e.t)
+        mode = self._modes.observe_one(f, e.t, shape)
+        similarity, k = mode.mac, self._modes.number(mode)
         amplitude = float(np.sqrt(np.mean(np.abs(fit.amplitudes) ** 2)))
         return Estimate(
             e.t,
@@ -550,29 +514,6 @@ class JointFreeEstimator(Estimator):
             shape_std,
             similarity,
         )
-
-    def _nearest(self, f: float) -> _Mode | None:
-        """The known mode nearest ``f`` within ``MATCH_TOL`` (None if none)."""
-        near = [m for m in self._modes if abs(f / m.frequency - 1) <= MATCH_TOL]
-        return min(near, key=lambda m: abs(f / m.frequency - 1)) if near else None
-
-    def _identify(self, f: float, shape: np.ndarray, t: float) -> tuple[float, int]:
-        """``(MAC with the mode's last shape or NaN, mode number)``: the known mode this
-        estimate continues (module doc, step 5), updated, or a new one."""
-        dists = [(continues(f, shape, m.frequency, m.shape), m) for m in self._modes]
-        near = [(d, m) for d, m in dists if d is not None]
-        if near:
-            mode = min(near, key=lambda pair: pair[0])[1]
-            similarity = mac(shape, mode.shape)
-            mode.frequency, mode.shape, mode.last_t = f, shape, t
-        else:
-            if len(self._modes) >= MAX_TRACKS:
-                self._modes.remove(min(self._modes, key=lambda m: m.last_t))
-            mode = _Mode(f, shape, t)
-            self._modes.append(mode)
-            similarity = math.nan
-        rank = 1 + sum(m.frequency < mode.frequency for m in self._modes)
-        return similarity, rank
 
 
 def _zeta(e: Estimate) -> float:

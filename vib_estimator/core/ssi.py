@@ -55,6 +55,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .correlations import BLOCK_ROWS, CorrelationCascade
+from .shapes import mac, normalise_shape
 from .whittle import sdof_density, whittle_frequencies, whittle_std
 
 #: with several channels fewer block rows: ``rows x channels`` at most about this (above the
@@ -92,21 +93,6 @@ TOP_NU = 0.4
 NEIGHBOURS = 0.2
 #: a mode whose predicted relative frequency std exceeds this is not published
 MAX_STD_REL = 0.02
-
-
-def mac(a: np.ndarray, b: np.ndarray) -> float:
-    """Modal assurance criterion ``|a^H b|^2 / (|a|^2 |b|^2)`` of two (complex) shapes: 1 for
-    shapes equal up to a complex scale, 0 for orthogonal ones."""
-    a, b = np.asarray(a), np.asarray(b)
-    den = float(np.vdot(a, a).real * np.vdot(b, b).real)
-    return float(abs(np.vdot(a, b)) ** 2 / den) if den > 0 else 0.0
-
-
-def normalise_shape(phi: np.ndarray) -> np.ndarray:
-    """``phi`` scaled to unit length with its largest entry real and positive."""
-    k = int(np.argmax(np.abs(phi)))
-    scale = phi[k] / abs(phi[k]) * np.linalg.norm(phi) if abs(phi[k]) > 0 else 1.0
-    return phi / scale
 
 
 def block_rows(channels: int) -> int:
