@@ -26,9 +26,19 @@ Prints (one run, same machine, same signal: 2 M samples of a noisy 1.33 Hz sine 
   loaded the same way, beside this one for each configuration, ``modes`` = 3 and streaming,
   timed alternately: rates and this/then ratios (the outputs are bit-identical,
   test/core/test_kernel_reference.py).
+- the default's cost (issue 37, item 7: :func:`default_cost`), beside ``free`` (and ``ambient``
+  on the driven record) in the same run: batch through ``analyze``'s own path (the decision,
+  ``analysis.choosing.prepare``, then ``analysis.analyze.estimate_signal``; the CSV parsing
+  excluded), streaming through the node's (``EstimatorStream.feed``, with the status and the
+  decision it asks each second), and cold compile (``vib-estimator analyze`` in a fresh process
+  with an empty ``NUMBA_CACHE_DIR``: ``bench_startup.analyze_seconds``), each beside its goal.
 Numba compiles once before timing; each figure is the best of 3 repeats.
+
+    python benchmarks/bench_estimator.py                  # everything (a few minutes)
+    python benchmarks/bench_estimator.py --default-only   # the default's cost alone
 """
 
+import argparse
 import atexit
 import importlib
 import shutil
@@ -225,7 +235,181 @@ def best(fn, repeats=3):
     return min(times)
 
 
+#: issue 37's goals for the default (item 7)
+GOAL_FREE_MSPS = 2.0  # batch, a one-channel free decay, M samples/s
+GOAL_DRIVEN_X = 1000.0  # batch, a 500 Hz driven channel, x real time
+GOAL_STREAM_US = 2.0  # streaming, mean us per sample
+GOAL_COLD_S = 5.0  # cold compile: at most this many CPU s over ``free``'s
+
+
+def plucked(n: int, fs: float = 500.0, seed: int = 1):
+    """``n`` samples at ``fs`` of a 1.33 Hz mode at zeta 1 % plucked every 30 s (a free decay
+    throughout, as the shared arm's), noise 1 % of the pluck."""
+    t = np.arange(n) / fs
+    tau = np.mod(t, 30.0)
+    y = np.exp(-0.01 * 2 * np.pi * 1.33 * tau) * np.sin(2 * np.pi * 1.33 * tau)
+    return t, y + 0.01 * np.random.default_rng(seed).standard_normal(n)
+
+
+def driven_record():
+    """bench_defaults.cost's driven record: 600 s at 500 Hz of a 5 and a 17 Hz mode driven by
+    white noise, 20 dB."""
+    from vib_estimator.sim.ambient import ambient_record
+
+    t, y, _ = ambient_record(600, 500, [(5.0, 0.01, 1.0), (17.0, 0.005, 0.3)], 20, 1)
+    return t, y
+
+
+def analyzed(t, y, excitation=None) -> float:
+    """CPU s of ``analyze``'s path on ``(t, y)`` with ``--excitation excitation`` (None: the
+    default, decided from the record), the CSV parsing excluded: the decision
+    (``choosing.prepare``, which ``analyze`` runs whatever the options: a forced excitation is
+    checked against the record) and ``estimate_signal`` over the record as one block."""
+    from types import SimpleNamespace
+
+    from vib_estimator.analysis.analyze import estimate_signal
+    from vib_estimator.analysis.choosing import prepare
+
+    args = SimpleNamespace(excitation=excitation, paper=False)
+    config = EstimatorConfig() if excitation is None else EstimatorConfig(excitation=excitation)
+    start = time.process_time()
+    config, _, _ = prepare(args, config, t, y, 1, 'analyze')
+    estimate_signal(SimpleNamespace(path='record', topic=''), config, False, [(t, y)])
+    return time.process_time() - start
+
+
+def streamed_cost(t, y, deciding=None) -> float:
+    """Mean CPU us per sample of ``EstimatorStream(EstimatorConfig(), deciding=...).feed`` over
+    ``(t, y)`` as the node feeds it (integer ns stamps, Python floats), with the ``status`` it
+    asks each second of the record and (``deciding``) the ``decision``, applied as the node
+    applies it; ``deciding`` None: the bare estimator's ``update`` (no stream)."""
+    from vib_estimator.nodes.stream import EstimatorStream
+
+    stamps = (np.round(t * 1e9).astype(np.int64) + 10**18).tolist()
+    values, seconds = y.tolist(), t.tolist()
+    if deciding is None:
+        update = create_estimator(EstimatorConfig()).update
+        start = time.process_time()
+        for a, b in zip(seconds, values):
+            update(a, b)
+        return (time.process_time() - start) / len(t) * 1e6
+    stream = EstimatorStream(EstimatorConfig(), now=0.0, deciding=deciding)
+    feed, due = stream.feed, 1.0
+    start = time.process_time()
+    for stamp, value, now in zip(stamps, values, seconds):
+        feed(stamp, value)
+        if now >= due:  # the node's 1-s timer
+            due += 1.0
+            stream.status(now)
+            decision = stream.decision() if deciding else None
+            if decision is not None:
+                stream.configure(stream.config.replace(**decision.changes()), prime=True)
+                stream.decided = True
+    return (time.process_time() - start) / len(t) * 1e6
+
+
+def verdict(met: bool) -> str:
+    return 'met' if met else '**not met**'
+
+
+def default_cost(cold: bool = True) -> None:
+    """The default's cost beside ``free`` (and ``ambient``), in the same run, alternating
+    (module doc; issue 37, item 7)."""
+    n = 2_000_000
+    tf, yf = plucked(n)
+    td, yd = driven_record()
+    print(
+        '\nthe default (no option) beside the forced excitation, same run; CPU s, best of 3, '
+        'alternating'
+    )
+    analyzed(tf[:20000], yf[:20000])  # compile
+    analyzed(td[:30000], yd[:30000])
+    for name, (t, y), forced in (
+        ('free decay (1.33 Hz plucked every 30 s), 2 M samples', (tf, yf), ('free',)),
+        ('5 + 17 Hz driven, 600 s at 500 Hz', (td, yd), ('free', 'ambient')),
+    ):
+        times = {e: [] for e in (None, *forced)}
+        for _ in range(3):
+            for e in times:
+                times[e].append(analyzed(t, y, e))
+        span = float(t[-1] - t[0])
+        for e, cpu in times.items():
+            best_s = min(cpu)
+            label = 'default' if e is None else f'--excitation {e}'
+            line = (
+                f'batch {name:52s} {label:22s} {best_s:6.2f} s {len(t) / best_s / 1e6:6.2f} M '
+                f'samples/s {span / best_s:7.0f}x real time'
+            )
+            if e is None and 'driven' in name:
+                met = span / best_s >= GOAL_DRIVEN_X
+                line += f'   goal >= {GOAL_DRIVEN_X:.0f}x: {verdict(met)}'
+            elif e is None:
+                met = len(t) / best_s / 1e6 >= GOAL_FREE_MSPS
+                line += f'   goal >= {GOAL_FREE_MSPS:g} M samples/s: {verdict(met)}'
+            print(line, flush=True)
+    m = 200_000  # 400 s of the free decay; the driven record's 600 s
+    streamed_cost(tf[:5000], yf[:5000], True)  # compile
+    for name, (t, y) in (
+        ('free decay, 400 s at 500 Hz', (tf[:m], yf[:m])),
+        ('5 + 17 Hz driven, 600 s at 500 Hz', (td, yd)),
+    ):
+        cost = {k: [] for k in ('deciding', 'not deciding', 'bare update')}
+        for _ in range(3):
+            for k, deciding in zip(cost, (True, False, None)):
+                cost[k].append(streamed_cost(t, y, deciding))
+        us = {k: min(v) for k, v in cost.items()}
+        print(
+            f'streaming {name:34s} default (deciding) {us["deciding"]:6.2f} us/sample   '
+            f'deciding=False {us["not deciding"]:6.2f}   bare update {us["bare update"]:6.2f}   '
+            f'goal <= {GOAL_STREAM_US:g}: {verdict(us["deciding"] <= GOAL_STREAM_US)}',
+            flush=True,
+        )
+    if cold:
+        cold_compile(tf, yf, td, yd)
+
+
+def cold_compile(tf, yf, td, yd) -> None:
+    """``vib-estimator analyze`` of a 60 s free decay and a 120 s driven record, each in a fresh
+    process with an empty ``NUMBA_CACHE_DIR`` (``bench_startup.analyze_seconds``), the default
+    beside ``--excitation free`` (the default until 4 Dec 2026) and, driven, ``ambient``."""
+    from bench_startup import analyze_seconds, environment, write_csv  # benchmarks/
+
+    root = Path(__file__).resolve().parents[1]
+    print('\ncold analyze (empty NUMBA_CACHE_DIR, one process each): CPU s / wall s')
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        free = write_csv(tmp / 'free.csv', tf[:30000], yf[:30000])
+        driven = write_csv(tmp / 'driven.csv', td[:60000], yd[:60000])
+        got = {}
+        for name, csv, forced in (
+            ('free decay, 60 s', free, ('free',)),
+            ('driven, 120 s', driven, ('free', 'ambient')),
+        ):
+            for e in (None, *forced):
+                with tempfile.TemporaryDirectory(dir=tmp) as cache:
+                    extra = () if e is None else ('--excitation', e)
+                    wall, cpu = analyze_seconds(root, environment(root, cache), csv, extra)
+                got[name, e] = cpu
+                label = 'default' if e is None else f'--excitation {e}'
+                line = f'cold {name:18s} {label:22s} {cpu:6.1f} / {wall:6.1f} s'
+                if e is None:
+                    print(line, flush=True)
+                    continue
+                over = got[name, None] - cpu
+                line += f'   default - this {over:+5.1f} CPU s'
+                if e == 'free':
+                    line += f' (goal <= +{GOAL_COLD_S:g}: {verdict(over <= GOAL_COLD_S)})'
+                print(line, flush=True)
+
+
 def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument('--default-only', action='store_true', help="only the default's cost")
+    parser.add_argument('--no-cold', action='store_true', help='without the cold compiles')
+    args = parser.parse_args()
+    if args.default_only:
+        default_cost(not args.no_cold)
+        return
     rng = np.random.default_rng(0)
     n = 2_000_000
     t = np.arange(n) * 0.002
@@ -271,6 +455,7 @@ def main() -> None:
     compare_dispatch(t, y)
     compare_previous(t, y)
     compare_split(t, y)
+    default_cost(not args.no_cold)
 
 
 if __name__ == '__main__':

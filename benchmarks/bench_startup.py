@@ -262,13 +262,13 @@ def stop(proc) -> int:
     return proc.returncode
 
 
-def analyze_seconds(tree: Path, env: dict, csv: Path):
-    """(wall s, CPU s) of one ``vib-estimator analyze csv`` (nan, nan if it failed)."""
+def analyze_seconds(tree: Path, env: dict, csv: Path, extra=()):
+    """(wall s, CPU s) of one ``vib-estimator analyze csv *extra`` (nan, nan if it failed)."""
     code = 'import sys; from vib_estimator.cli import main; sys.exit(main())'
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.monotonic()
     done = subprocess.run(
-        [sys.executable, '-P', '-c', code, 'analyze', str(csv)],
+        [sys.executable, '-P', '-c', code, 'analyze', str(csv), *extra],
         env=env,
         stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE,

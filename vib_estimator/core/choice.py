@@ -193,12 +193,12 @@ def spectrum(t: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, floa
     return freq, np.sum(psd, axis=1), 2 * fs / nper
 
 
-def spectral_peaks(t: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def spectral_peaks(t: np.ndarray, y: np.ndarray, spec=None) -> tuple[np.ndarray, np.ndarray]:
     """``(frequencies, powers)`` of the spectrum's peaks (module docstring, 1), strongest first,
-    summed over the channels of ``y``."""
+    summed over the channels of ``y`` (``spec``: its :func:`spectrum`, if computed already)."""
     from .spectra import peaks_by_prominence  # scipy.signal's find_peaks (prominence only)
 
-    freq, psd, lowest = spectrum(t, y)
+    freq, psd, lowest = spectrum(t, y) if spec is None else spec
     level = 10 * np.log10(np.maximum(psd, 1e-300 + 1e-12 * float(np.max(psd))))
     idx = peaks_by_prominence(level, PEAK_DB)
     idx = idx[freq[idx] > lowest]  # above the segment's own lowest bins (a drift)
@@ -244,7 +244,8 @@ def decide(t, y, channels: int = 1, window_s: float = 30.0, stream: bool = False
         t, y = t[:n], y[:n]
     if len(t) < 64 or not t[-1] > t[0]:
         return Decision('free', window_s, 0.0, math.nan, math.nan, (), 'too short to tell: free')
-    peaks, powers = spectral_peaks(t, y)
+    spec = spectrum(t, y)  # once: the peaks and a free decay's fast_window read it
+    peaks, powers = spectral_peaks(t, y, spec)
     dominant = float(peaks[0]) if len(peaks) else math.nan
     fundamental = float(np.min(peaks)) if len(peaks) else math.nan
     share = driven_share(t, principal_component(y), dominant if len(peaks) else 0.0)
@@ -284,7 +285,7 @@ def decide(t, y, channels: int = 1, window_s: float = 30.0, stream: bool = False
         and channels == 1
         and math.isfinite(dominant)
     ):
-        periods, early, why = fast_window(t, y, dominant)
+        periods, early, why = fast_window(t, y, dominant, spec)
         seen += f'; {why}'
     rate = (len(t) - 1) / span
     return Decision(
@@ -303,10 +304,10 @@ def decide(t, y, channels: int = 1, window_s: float = 30.0, stream: bool = False
     )
 
 
-def impurity(t: np.ndarray, y: np.ndarray, f: float) -> float:
+def impurity(t: np.ndarray, y: np.ndarray, f: float, spec=None) -> float:
     """The share of the power of ``(t, y)`` within :data:`IMPURITY_SPAN` of ``f`` (either way)
     that lies farther than :data:`PEAK_WIDTH` (relative) from it (Welch, :func:`spectrum`)."""
-    freq, psd, _ = spectrum(t, y)
+    freq, psd, _ = spectrum(t, y) if spec is None else spec
     near = (freq > f / IMPURITY_SPAN) & (freq < f * IMPURITY_SPAN)
     total = float(np.sum(psd[near]))
     off = float(np.sum(psd[near & (np.abs(freq / f - 1) > PEAK_WIDTH)]))
@@ -360,14 +361,14 @@ def snr_db(t: np.ndarray, y: np.ndarray, f: float) -> float:
     return 10 * math.log10(peak / noise) if noise > 0 else math.inf
 
 
-def fast_window(t: np.ndarray, y: np.ndarray, f: float) -> tuple[float, float, str]:
+def fast_window(t: np.ndarray, y: np.ndarray, f: float, spec=None) -> tuple[float, float, str]:
     """The window (``min_periods``) and the precision its estimates need (``early_std_rel``) for
     a free decay of one mode at ``f`` Hz: :data:`FAST_PERIODS` and :data:`FAST_STD`
     (:data:`FAST_STD_CLEAN` at :data:`CLEAN_SNR_DB` and above) when its spectrum is pure
     (:func:`impurity` below :data:`IMPURE`) and it is lightly damped (:func:`decay_zeta` at
     most :data:`FAST_ZETA`, or unknown); else (NaN, 0: the configured window). With the reason
-    in words."""
-    spread = impurity(t, y, f)
+    in words. ``spec``: the :func:`spectrum` of ``(t, y)``, if computed already."""
+    spread = impurity(t, y, f, spec)
     if not spread <= IMPURE:
         return math.nan, 0.0, f'{100 * spread:.0f} % of the power near {f:.3g} Hz off its peak'
     zeta = decay_zeta(t, y, f)
