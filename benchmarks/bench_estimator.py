@@ -278,17 +278,18 @@ def analyzed(t, y, excitation=None) -> float:
     return time.process_time() - start
 
 
-def streamed_cost(t, y, deciding=None) -> float:
+def streamed_cost(t, y, deciding=None, config=None) -> float:
     """Mean CPU us per sample of ``EstimatorStream(EstimatorConfig(), deciding=...).feed`` over
     ``(t, y)`` as the node feeds it (integer ns stamps, Python floats), with the ``status`` it
     asks each second of the record and (``deciding``) the ``decision``, applied as the node
-    applies it; ``deciding`` None: the bare estimator's ``update`` (no stream)."""
+    applies it; ``deciding`` None: the bare estimator's ``update`` (no stream) of ``config``
+    (default: ``EstimatorConfig()``)."""
     from vib_estimator.nodes.stream import EstimatorStream
 
     stamps = (np.round(t * 1e9).astype(np.int64) + 10**18).tolist()
     values, seconds = y.tolist(), t.tolist()
     if deciding is None:
-        update = create_estimator(EstimatorConfig()).update
+        update = create_estimator(config or EstimatorConfig()).update
         start = time.process_time()
         for a, b in zip(seconds, values):
             update(a, b)
@@ -353,14 +354,17 @@ def default_cost(cold: bool = True) -> None:
         ('free decay, 400 s at 500 Hz', (tf[:m], yf[:m])),
         ('5 + 17 Hz driven, 600 s at 500 Hz', (td, yd)),
     ):
-        cost = {k: [] for k in ('deciding', 'not deciding', 'bare update')}
+        ambient = EstimatorConfig(excitation='ambient')
+        cost = {k: [] for k in ('deciding', 'not deciding', 'bare update', 'ambient update')}
         for _ in range(3):
-            for k, deciding in zip(cost, (True, False, None)):
-                cost[k].append(streamed_cost(t, y, deciding))
+            for k, deciding in zip(cost, (True, False, None, None)):
+                config = ambient if k == 'ambient update' else None
+                cost[k].append(streamed_cost(t, y, deciding, config))
         us = {k: min(v) for k, v in cost.items()}
         print(
             f'streaming {name:34s} default (deciding) {us["deciding"]:6.2f} us/sample   '
-            f'deciding=False {us["not deciding"]:6.2f}   bare update {us["bare update"]:6.2f}   '
+            f'deciding=False {us["not deciding"]:6.2f}   bare update: free '
+            f'{us["bare update"]:5.2f}, ambient {us["ambient update"]:5.2f}   '
             f'goal <= {GOAL_STREAM_US:g}: {verdict(us["deciding"] <= GOAL_STREAM_US)}',
             flush=True,
         )
