@@ -373,20 +373,22 @@ def default_cost(cold: bool = True) -> None:
 
 
 def cold_compile(tf, yf, td, yd) -> None:
-    """``vib-estimator analyze`` of a 60 s free decay and a 120 s driven record, each in a fresh
-    process with an empty ``NUMBA_CACHE_DIR`` (``bench_startup.analyze_seconds``), the default
-    beside ``--excitation free`` (the default until 4 Dec 2026) and, driven, ``ambient``."""
+    """``vib-estimator analyze`` of a 120 s free decay and a 120 s driven record (60000 samples:
+    beyond ``core.estimator.UNCOMPILED_SAMPLES``, where ``analyze`` compiles the algebraic
+    estimator's kernels), each in a fresh process with an empty ``NUMBA_CACHE_DIR``
+    (``bench_startup.analyze_seconds``), the default beside ``--excitation free`` (the default
+    until 4 Dec 2026) and, driven, ``ambient``."""
     from bench_startup import analyze_seconds, environment, write_csv  # benchmarks/
 
     root = Path(__file__).resolve().parents[1]
     print('\ncold analyze (empty NUMBA_CACHE_DIR, one process each): CPU s / wall s')
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
-        free = write_csv(tmp / 'free.csv', tf[:30000], yf[:30000])
+        free = write_csv(tmp / 'free.csv', tf[:60000], yf[:60000])
         driven = write_csv(tmp / 'driven.csv', td[:60000], yd[:60000])
         got = {}
         for name, csv, forced in (
-            ('free decay, 60 s', free, ('free',)),
+            ('free decay, 120 s', free, ('free',)),
             ('driven, 120 s', driven, ('free', 'ambient')),
         ):
             for e in (None, *forced):
