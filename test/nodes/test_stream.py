@@ -5,6 +5,8 @@ replacement, counters, status (the reset service: test_estimator_node.py)."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -15,6 +17,15 @@ from vib_estimator.nodes import health as H
 from vib_estimator.nodes.stream import EstimatorStream
 
 EPOCH_NS = 1_700_000_000 * 10**9
+#: a real aluminium beam's free decay (``../shared/real-data``, beside the repository or above)
+BEAM_50 = next(
+    (
+        p / 'shared' / 'real-data' / 'aluminium_cantilever_adxl357' / '50cm_uniform_1000Hz.csv'
+        for p in Path(__file__).resolve().parents[2].parents
+        if (p / 'shared' / 'real-data').is_dir()
+    ),
+    Path('/nonexistent'),
+)
 
 
 def sine(n, start=0, fs=500.0):
@@ -387,6 +398,82 @@ def test_a_clean_decay_sets_the_streams_window_as_analyze_decides_it():
     assert all(abs(e.frequency_hz / 2 - 1) <= 0.02 for e in late)
     decided, _, stream = run(0.03)
     assert decided == [] and stream.config.min_periods == EstimatorConfig().min_periods
+
+
+class Counted:
+    """``core.choice``'s free-decay tests and window reads (``decide`` without ``stream``),
+    counted."""
+
+    def __init__(self, monkeypatch):
+        from vib_estimator.core import choice
+
+        self.tests = self.reads = 0
+        test, read = choice.is_free_decay, choice.decide
+
+        def counting_test(*args):
+            self.tests += 1
+            return test(*args)
+
+        def counting_read(*args, **kw):
+            self.reads += 'stream' not in kw
+            return read(*args, **kw)
+
+        monkeypatch.setattr(choice, 'is_free_decay', counting_test)
+        monkeypatch.setattr(choice, 'decide', counting_read)
+
+    def run(self, t, y, step=500):
+        """Decisions, the estimates up to the first, and (tests, reads) of a deciding stream."""
+        self.tests = self.reads = 0
+        stream = EstimatorStream(EstimatorConfig(), now=0.0, deciding=True)
+        got = []
+        decided = decisions(stream, t, y, step=step, estimates=got)
+        early = [e for k, _, e in got if not decided or k <= decided[0][0]]
+        return decided, early, (self.tests, self.reads)
+
+
+@pytest.mark.parametrize('factor', [1e-3, 1e3])
+def test_a_free_stretch_that_passed_the_free_decay_test_is_trusted(monkeypatch, factor):
+    """A free stretch whose estimates passed the free-decay test ``TRUSTED_PASSES`` times
+    running (no onset, no block read driven between) is trusted: a 12 s pluck's ~40 estimates
+    take at most 4 tests (each ~1 ms: 4 us a sample at an estimate a period), while a driven
+    input's are all tested, none published before the decision."""
+    from vib_estimator.core import choice
+    from vib_estimator.sim.ambient import ambient_record
+
+    counted = Counted(monkeypatch)
+
+    def right():
+        _, free, (tests, _) = counted.run(*plucked(((5.0, 1.0, 0.005),)))
+        t, y, _ = ambient_record(50, 500, [(5.0, 0.01, 1.0)], 20, 0)
+        _, driven, (shaken, _) = counted.run(t, y)
+        return 1 <= tests <= 4 and len(free) >= 5 and driven == [] and shaken >= 20
+
+    assert right()
+    monkeypatch.setattr(choice, 'TRUSTED_PASSES', round(choice.TRUSTED_PASSES * factor))
+    assert not right()
+
+
+@pytest.mark.skipif(not BEAM_50.is_file(), reason='../shared/real-data is absent')
+@pytest.mark.parametrize('factor', [1e-3, 1e3])
+def test_a_decay_showing_several_modes_is_read_again_for_its_window(monkeypatch, factor):
+    """The real 50 cm beam's first seconds show its 39 Hz mode beside the 6.05 Hz one: its
+    window is read again, a second later (``WINDOW_READS``), and gets 0.9 periods; a decay of
+    three modes is read at most that often (6 reads in 30 s)."""
+    from vib_estimator.core import choice
+    from vib_estimator.io.csv_reader import read_csv_series
+
+    counted = Counted(monkeypatch)
+    beam = read_csv_series(BEAM_50)
+
+    def right():
+        decided, _, _ = counted.run(beam.t - beam.t[0], np.ravel(beam.y), step=1000)
+        three = ((8.0, 1.0, 0.003), (21.0, 0.3, 0.002), (55.0, 0.05, 0.002))
+        _, _, (_, reads) = counted.run(*plucked(three, 30.0))
+        return [d.min_periods for _, d in decided] == [0.9] and reads <= 6
+
+    assert right()
+    monkeypatch.setattr(choice, 'WINDOW_READS', round(choice.WINDOW_READS * factor))
+    assert not right()
 
 
 def test_an_identifier_that_finds_no_mode_says_which_window_helps():

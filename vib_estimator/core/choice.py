@@ -430,6 +430,11 @@ MAX_KEPT = 2**18
 #: rings after an onset, is asked whether it is a decay of several modes (their beating fails
 #: the one-mode fits: a 10 and a 13 Hz mode gave no estimate at all); again this often
 SILENT_S = 3.0
+#: the most times a decay's window is read (a decision a second) while it shows several modes
+WINDOW_READS = 5
+#: free-decay tests passed running in a stretch (no onset, no block read driven between) after
+#: which its later free estimates are trusted untested (:meth:`StreamChoice.free_decay`)
+TRUSTED_PASSES = 3
 
 
 class DrivenWatch:
@@ -490,6 +495,11 @@ class DrivenWatch:
         if share is None or self._envelope.state != DRIVEN:
             return None
         return share if share > DRIVEN_ABOVE and live else None
+
+    @property
+    def driven_blocks(self) -> int:
+        """The envelope's blocks read driven so far."""
+        return self._envelope.blocks[DRIVEN]
 
     def ringing(self) -> bool:
         """Whether the stream rings freely now: the envelope's stretch free, begun by an onset
@@ -552,6 +562,9 @@ class StreamChoice:
         self._estimated_at = -math.inf  # stream time of the last free estimate (follow)
         self._silent_retry = -math.inf
         self._window_onset = 0  # the onset whose decay was last read for its window
+        self._window_reads = 0  # ... and how many times (several modes: read again)
+        #: ((onsets, driven blocks) of the stretch, free-decay tests passed running in it)
+        self._passed: tuple = ((-1, -1), 0)
 
     def update(self, t: float, value) -> None:
         self._pending_t.append(t)
@@ -620,7 +633,8 @@ class StreamChoice:
         """:func:`decide`'s window for the decay since the last onset, read once per onset when
         its free stretch has shown a decay at the last free estimate's frequency
         (:func:`decay_zeta`: at least 8 periods, three blocks of two falling; asked again until
-        it has); None if it allows none (an impure or heavily damped decay) or not yet."""
+        it has; and again, up to :data:`WINDOW_READS` times, while it shows several modes); None
+        if it allows none (an impure or heavily damped decay) or not yet."""
         watch = self.watch
         f = watch.followed_hz
         if watch.onsets == self._window_onset or not f > 0 or not watch.live():
@@ -628,8 +642,14 @@ class StreamChoice:
         t, y = self.recent(now - watch.onset_t)
         if not decay_zeta(t, y, f) > 0:  # no decay seen yet (a driven response's wandering)
             return None
-        self._window_onset = watch.onsets
         chosen = decide(t, y)
+        self._window_reads = self._window_reads + 1 if self._window_onset == -watch.onsets else 1
+        # several modes this early may be a pluck's higher modes not yet rung down (a beam's
+        # 39 Hz beside its 6 Hz for 2 s): read again, a second later, up to WINDOW_READS times
+        if not chosen.modes or self._window_reads >= WINDOW_READS:
+            self._window_onset = watch.onsets
+        else:
+            self._window_onset = -watch.onsets  # (pending: read again)
         ok = chosen.excitation == 'free' and not chosen.modes
         return chosen if ok and math.isfinite(chosen.min_periods) else None
 
@@ -652,10 +672,19 @@ class StreamChoice:
         """:func:`.auto.is_free_decay` of a free estimate of ``f`` Hz that the last sample
         completed, over the samples before it (the first channel): False when the signal is no
         free decay (a driven response: the estimate is of no mode), None when too short to tell.
-        """
+        Once :data:`TRUSTED_PASSES` estimates running have passed since the last onset, with no
+        block read driven meanwhile, the stretch is a free decay: True without a test (the test
+        costs ~1 ms, about 4 us a sample at one estimate a period)."""
         if not f > 0:
             return None
-        return is_free_decay(*self.recent((TEST_PERIODS + 2) / f), f)
+        watch = self.watch
+        stretch = (watch.onsets, watch.driven_blocks)
+        if self._passed[0] == stretch and self._passed[1] >= TRUSTED_PASSES:
+            return True  # a free stretch that passed: not tested again until it changes
+        verdict = is_free_decay(*self.recent((TEST_PERIODS + 2) / f), f)
+        passes = self._passed[1] if self._passed[0] == stretch else 0
+        self._passed = (stretch, passes + 1 if verdict is True else 0)
+        return verdict
 
     def driven(self) -> Optional[float]:
         """:meth:`DrivenWatch.driven`, kept for :meth:`decision`."""
