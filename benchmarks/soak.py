@@ -286,7 +286,7 @@ class Soak:
         self.seed = 0
         speed = f'speed:={args.speed}'
         excitation = f'excitation:={args.excitation}'
-        self.sim_args = ['sim_node', '--ros-args', '-p', speed, '-p', excitation]
+        self.sim_args = ['sim_node', '--ros-args', '-p', speed, '-p', excitation, *args.sim_args]
         self.est = Proc(
             'estimator_node',
             ['estimator_node', '--ros-args', '-p', 'use_sim_time:=true', *args.estimator_args],
@@ -984,6 +984,16 @@ def main(argv=None) -> int:
         metavar='NAME:=VALUE',
         help='an estimator_node parameter (repeatable; excitation:=ambient is set first, as for a '
         'structure the simulator drives with noise)',
+    )
+    parser.add_argument(
+        '--sim-param',
+        dest='sim_args',
+        action='extend',
+        default=[],
+        type=lambda text: ['-p', text],
+        metavar='NAME:=VALUE',
+        help='a sim_node parameter (repeatable), e.g. "schedule:=[0.0, 0.0, 1.0, 0.0]": no '
+        'ramp at each (re)start, the arm driven by the ambient disturbance (and the shaper) only',
     )
     parser.add_argument('--json', help='write the figures here')
     parser.add_argument(

@@ -83,3 +83,43 @@ def test_a_node_listens_on_no_shared_memory_port_with_localhost_discovery():
     assert listens_on_shared_memory('plain', 'LOCALHOST')
     assert not listens_on_shared_memory('node', 'LOCALHOST')
     assert not listens_on_shared_memory('node', 'SUBNET')
+
+
+def test_an_invalid_handle_from_the_executor_is_skipped_unless_it_never_ends(monkeypatch):
+    """rclpy's EventsExecutor can dispatch a QoS event of a subscription destroyed meanwhile
+    (InvalidHandle; ros2/rclpy#1644): the node goes on; an endless series still fails."""
+    from rclpy._rclpy_pybind11 import InvalidHandle
+
+    class Executor:
+        def __init__(self, failures):
+            self.failures, self.spins = failures, 0
+
+        def add_node(self, node):
+            pass
+
+        def spin_once(self, timeout_sec):
+            self.spins += 1
+            if self.spins <= self.failures:
+                raise InvalidHandle('cannot use Destroyable because destruction was requested')
+
+    class Node:
+        exit_code = 0
+
+        def destroy_node(self):
+            pass
+
+    monkeypatch.setattr(runner, 'init_or_error', lambda args: None)
+    monkeypatch.setattr(runner.rclpy, 'ok', lambda: True)
+    for failures, survives in ((3, True), (runner.MAX_INVALID_HANDLES + 1, False)):
+        executor = Executor(failures)
+        monkeypatch.setattr(runner, 'make_executor', lambda: executor)
+        spun = lambda node: executor.spins > failures + 2  # noqa: E731
+        if survives:
+            assert runner.run(Node, [], done=spun) == 0
+        else:
+            try:
+                runner.run(Node, [], done=spun)
+            except InvalidHandle:
+                pass
+            else:
+                raise AssertionError('an endless series of InvalidHandle was skipped')

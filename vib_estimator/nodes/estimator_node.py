@@ -346,15 +346,20 @@ class EstimatorNode(Node):
         #: the parameters being set are the node's own decision (:meth:`_decide`)
         self._deciding = False
 
-    def _subscribe(self, index: int):
-        """The subscription to input topic ``index`` (with the middleware's own count of the
-        samples it lost before the queue)."""
+    def _subscribe(self, index: int, lost_events: bool = True):
+        """The subscription to input topic ``index`` (with ``lost_events``, the middleware's own
+        count of the samples it lost before the queue). A subscription the watchdog re-creates
+        has none: rclpy's EventsExecutor dispatches a QoS event of a subscription destroyed
+        meanwhile (InvalidHandle, or a segmentation fault; ros2/rclpy#1644) -- re-created every
+        20 ms under sim_node at speed 10 it failed 5 runs in 6 within 3-41 s, without the event
+        callback 0 in 2 runs of 2500 re-creations (docs/nodes.md#never-deaf)."""
+        events = SubscriptionEventCallbacks(message_lost=self._on_message_lost)
         return self.create_subscription(
             message_class(self._input_type),
             self._topics[index],
             self._input_callbacks[index],
             self._input_qos,
-            event_callbacks=SubscriptionEventCallbacks(message_lost=self._on_message_lost),
+            event_callbacks=events if lost_events else None,
         )
 
     def _watch_inputs(self, now: float) -> None:
@@ -369,7 +374,7 @@ class EstimatorNode(Node):
                 continue
             topic = sub.topic_name
             self.destroy_subscription(sub)
-            self._subscriptions_in[i] = self._subscribe(i)
+            self._subscriptions_in[i] = self._subscribe(i, lost_events=False)
             self._stream.health.count('input_resubscribed')
             if watchdog.episode == 1:
                 self.get_logger().warn(
