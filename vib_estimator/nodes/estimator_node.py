@@ -351,8 +351,9 @@ class EstimatorNode(Node):
         count of the samples it lost before the queue). A subscription the watchdog re-creates
         has none: rclpy's EventsExecutor dispatches a QoS event of a subscription destroyed
         meanwhile (InvalidHandle, or a segmentation fault; ros2/rclpy#1644) -- re-created every
-        20 ms under sim_node at speed 10 it failed 5 runs in 6 within 3-41 s, without the event
-        callback 0 in 2 runs of 2500 re-creations (docs/nodes.md#never-deaf)."""
+        20 ms under sim_node at speed 10 it died in 4 runs of 4 within 4-37 s, without the event
+        callback 0 in 2 runs of 2500 re-creations (benchmarks/resubscribe.py;
+        docs/nodes.md#never-deaf)."""
         events = SubscriptionEventCallbacks(message_lost=self._on_message_lost)
         return self.create_subscription(
             message_class(self._input_type),
