@@ -68,7 +68,7 @@ bench-all: bench
 	$(VENV)/bin/python benchmarks/bench_channels.py
 	$(VENV)/bin/python benchmarks/bench_defaults.py
 
-# the nodes for 6 minutes at speed 10 with a fault every 24 s (docs/soak.md); SOAK_ARGS=--minutes 480
+# the nodes for 6 minutes at speed 10 with a fault every 24 s (docs/soak.md); SOAK_ARGS=--sim-hours 8
 soak: setup
 	$(VENV)/bin/python benchmarks/soak.py $(SOAK_ARGS)
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from diagnostic_msgs.msg import DiagnosticStatus
+from rclpy.event_handler import QoSSubscriptionEventType
 
 from vib_estimator.nodes.health import identities
 from vib_estimator.nodes.runner import spin_until
@@ -94,6 +95,14 @@ def test_a_gap_before_a_stop_is_counted_by_the_diagnostics(make_probe):
     assert '1 gaps in the stamps (5 samples missing' in status.message
 
 
+MESSAGE_LOST = QoSSubscriptionEventType.RCL_SUBSCRIPTION_MESSAGE_LOST
+
+
+def lost_events(sub):
+    """The QoS event types a subscription has handlers for."""
+    return {handler.event_type for handler in sub.event_handlers}
+
+
 def test_a_subscription_that_stops_delivering_is_recreated_with_one_warn(make_probe, monkeypatch):
     """Never deaf: the middleware stops delivering (stubbed: the subscription's messages are
     dropped before the node's callback) while a publisher stays matched; the watchdog re-creates
@@ -105,6 +114,7 @@ def test_a_subscription_that_stops_delivering_is_recreated_with_one_warn(make_pr
     stamps = sine_stamps(500)
     p.feed(stamps, sine(stamps))
     (sub,) = p.node._subscriptions_in
+    assert MESSAGE_LOST in lost_events(sub)  # the middleware's lost samples, counted
     sub.callback = lambda msg: None  # deaf
     warnings = []
     logger = p.node.get_logger()
@@ -120,6 +130,9 @@ def test_a_subscription_that_stops_delivering_is_recreated_with_one_warn(make_pr
 
     assert spin_until(p.executor, keep_publishing, 20.0), (p.node.counters, warnings)
     assert p.node._subscriptions_in[0] is not sub
+    # re-created without a QoS event callback (rclpy's EventsExecutor dispatched the event of a
+    # destroyed subscription: docs/nodes.md#never-deaf)
+    assert MESSAGE_LOST not in lost_events(p.node._subscriptions_in[0])
     assert p.node.counters['input_resubscribed'] == 1
     resubscribed = [w for w in warnings if 'subscription is re-created' in w]
     assert len(resubscribed) == 1 and '1 publisher(s) matched' in resubscribed[0]

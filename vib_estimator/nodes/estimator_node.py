@@ -104,7 +104,26 @@ from .stream import WARMUP_BUFFER, WARMUP_MESSAGE, EstimatorStream, check_channe
 #: while the node drains them (benchmarks/bench_node.py measures the effect of the depth).
 #: A reliable input would have lost none in the queue, but cannot match the best-effort sensor
 #: drivers (QoS incompatible) and makes a slow node slow its publisher down.
+#: Fast DDS 2.14, its log at Warning, says "HISTORY DEPTH '5000' is inconsistent with
+#: max_samples_per_instance '400' ... Effectively using max_samples_per_instance as depth" (its
+#: QoS check compares the depth with the default per-instance limit). Not so for a topic without
+#: keys (every ROS message here): its reader history sets max_samples_per_instance to max_samples
+#: (5000), so the depth is honoured -- a reader that took nothing keeps the newest 5000 of a burst
+#: (400 at depth 400); a depth above 5000 would keep the oldest 5000 and drop the newest, not a
+#: keep-last history (test/nodes/test_input_history.py; docs/nodes.md#the-input-qos).
 INPUT_DEPTH = 5000
+
+
+def input_qos() -> QoSProfile:
+    """The input subscriptions' QoS: sensor-data reliability and durability, keep-last
+    :data:`INPUT_DEPTH`."""
+    return QoSProfile(
+        depth=INPUT_DEPTH,
+        reliability=qos_profile_sensor_data.reliability,
+        durability=qos_profile_sensor_data.durability,
+    )
+
+
 #: how often the end of a warm-up is looked for, and after how long it is announced, s
 WARMUP_POLL = 0.05
 WARMUP_NOTICE = 1.0
@@ -294,11 +313,7 @@ class EstimatorNode(Node):
         service_qos = QoSProfile(depth=SERVICE_DEPTH, reliability=ReliabilityPolicy.RELIABLE)
         self.create_service(Trigger, '~/reset', self._on_reset, qos_profile=service_qos)
         self.create_service(Trigger, '~/self_test', self._on_self_test, qos_profile=service_qos)
-        qos = QoSProfile(
-            depth=INPUT_DEPTH,
-            reliability=qos_profile_sensor_data.reliability,
-            durability=qos_profile_sensor_data.durability,
-        )
+        qos = input_qos()
         if self._aligner is None:
             callbacks = [self._on_stamped if has_header(self._input_type) else self._on_unstamped]
         else:
@@ -331,15 +346,21 @@ class EstimatorNode(Node):
         #: the parameters being set are the node's own decision (:meth:`_decide`)
         self._deciding = False
 
-    def _subscribe(self, index: int):
-        """The subscription to input topic ``index`` (with the middleware's own count of the
-        samples it lost before the queue)."""
+    def _subscribe(self, index: int, lost_events: bool = True):
+        """The subscription to input topic ``index`` (with ``lost_events``, the middleware's own
+        count of the samples it lost before the queue). A subscription the watchdog re-creates
+        has none: rclpy's EventsExecutor dispatches a QoS event of a subscription destroyed
+        meanwhile (InvalidHandle, or a segmentation fault; ros2/rclpy#1644) -- re-created every
+        20 ms under sim_node at speed 10 it died in 4 runs of 4 within 4-37 s, without the event
+        callback 0 in 2 runs of 2500 re-creations (benchmarks/resubscribe.py;
+        docs/nodes.md#never-deaf)."""
+        events = SubscriptionEventCallbacks(message_lost=self._on_message_lost)
         return self.create_subscription(
             message_class(self._input_type),
             self._topics[index],
             self._input_callbacks[index],
             self._input_qos,
-            event_callbacks=SubscriptionEventCallbacks(message_lost=self._on_message_lost),
+            event_callbacks=events if lost_events else None,
         )
 
     def _watch_inputs(self, now: float) -> None:
@@ -354,7 +375,7 @@ class EstimatorNode(Node):
                 continue
             topic = sub.topic_name
             self.destroy_subscription(sub)
-            self._subscriptions_in[i] = self._subscribe(i)
+            self._subscriptions_in[i] = self._subscribe(i, lost_events=False)
             self._stream.health.count('input_resubscribed')
             if watchdog.episode == 1:
                 self.get_logger().warn(

@@ -31,7 +31,7 @@ import warnings
 from typing import Callable, Optional, Sequence
 
 import rclpy
-from rclpy._rclpy_pybind11 import RCLError
+from rclpy._rclpy_pybind11 import InvalidHandle, RCLError
 from rclpy.exceptions import NameValidationException
 from rclpy.executors import ExternalShutdownException
 from rclpy.experimental import EventsExecutor
@@ -85,15 +85,60 @@ TRANSPORTS_VARIABLE = 'FASTDDS_BUILTIN_TRANSPORTS'
 #: and the node stays deaf to that writer for good (re-creating the subscription does not change
 #: the participant's port). Over UDP a stalled reader only loses what its socket could not hold.
 NODE_TRANSPORTS = 'UDPv4'
+#: the Fast DDS variables naming an XML profiles file (2.x reads the first, 3.x the second)
+PROFILES_VARIABLES = ('FASTRTPS_DEFAULT_PROFILES_FILE', 'FASTDDS_DEFAULT_PROFILES_FILE')
+#: ... and so a default participant profile whose participant listens on UDPv4 only (its unicast
+#: locators, any address). Needed besides :data:`NODE_TRANSPORTS`: with
+#: ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST (the soak's, the suite's, many users') rmw_fastrtps
+#: (Jazzy wheels) gives the participant shared memory whatever FASTDDS_BUILTIN_TRANSPORTS says --
+#: the soak's estimator_node listened on shared-memory ports and went deaf for good after a 2-s
+#: stop (docs/nodes.md#never-deaf). A UDPv4 locator list leaves it no shared-memory port to
+#: listen on; it still writes to a peer's shared-memory port (the peer's reader is the one at
+#: risk, not this node).
+UDP_PROFILE = """<?xml version="1.0" encoding="UTF-8" ?>
+<profiles xmlns="http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles">
+  <participant profile_name="vib_estimator_udp" is_default_profile="true">
+    <rtps>
+      <defaultUnicastLocatorList>
+        <locator><udpv4/></locator>
+      </defaultUnicastLocatorList>
+    </rtps>
+  </participant>
+</profiles>
+"""
+
+
+def udp_profile_file() -> str:
+    """:data:`UDP_PROFILE` in a file (the temporary directory, one per user; written atomically,
+    so nodes starting together never read half of it)."""
+    path = os.path.join(tempfile.gettempdir(), f'vib_estimator_udp_profile_{os.getuid()}.xml')
+    try:
+        with open(path) as f:
+            if f.read() == UDP_PROFILE:
+                return path
+    except OSError:
+        pass
+    fd, partial = tempfile.mkstemp(dir=os.path.dirname(path), suffix='.xml')
+    with os.fdopen(fd, 'w') as f:
+        f.write(UDP_PROFILE)
+    os.replace(partial, path)
+    return path
+
+
+#: at most this many InvalidHandle errors in a row from the executor are skipped (see :func:`run`)
+MAX_INVALID_HANDLES = 100
 
 
 def stall_safe_transports(environ=os.environ) -> bool:
-    """Set the nodes' transports (:data:`NODE_TRANSPORTS`) unless the user chose some
+    """Set the nodes' transports (:data:`NODE_TRANSPORTS`) and, unless the user names a profiles
+    file, the UDP-only profile (:data:`UDP_PROFILE`) -- all unless the user chose the transports
     (:data:`TRANSPORTS_VARIABLE` already set, e.g. ``DEFAULT`` for shared memory again); True when
-    set. Before ``rclpy.init``: the participant reads it when it is created."""
+    set. Before ``rclpy.init``: the participant reads them when it is created."""
     if environ.get(TRANSPORTS_VARIABLE):
         return False
     environ[TRANSPORTS_VARIABLE] = NODE_TRANSPORTS
+    if not any(environ.get(name) for name in PROFILES_VARIABLES):
+        environ[PROFILES_VARIABLES[0]] = udp_profile_file()
     return True
 
 
@@ -158,8 +203,18 @@ def run(
             node = factory()
         executor = make_executor()
         executor.add_node(node)
+        skipped = 0
         while rclpy.ok() and not stop.requested and not (done is not None and done(node)):
-            executor.spin_once(timeout_sec=0.1)
+            try:
+                executor.spin_once(timeout_sec=0.1)
+                skipped = 0
+            except InvalidHandle:
+                # a QoS event of an entity destroyed meanwhile (the watchdog's re-created
+                # subscription: rclpy's EventsExecutor, ros2/rclpy#1644): skipped, unless it
+                # never ends
+                skipped += 1
+                if skipped > MAX_INVALID_HANDLES:
+                    raise
     except StartupError as err:
         print(f'error: {err}', file=sys.stderr)
         code = 2
