@@ -141,6 +141,16 @@ def test_self_test_passes_with_the_defaults(model, modes):
     assert all('error' in line for line in lines[1:])
 
 
+@pytest.mark.parametrize('excitation', ['ambient', 'auto'])
+def test_self_test_passes_under_the_identifier(excitation):
+    """``excitation`` ambient (what the node's default decides for a driven input) or auto:
+    each tone a white-noise-driven mode over three windows (a pure sine of ten periods gave
+    "no estimate" on every tone)."""
+    ok, message = self_test(EstimatorConfig(excitation=excitation), 500.0)
+    lines = message.splitlines()
+    assert ok and len(lines) == 4 and all('error' in line for line in lines[1:]), message
+
+
 def test_self_test_tones_span_the_band():
     assert tone_frequencies((1.0, 16.0), 500.0) == pytest.approx([2.0, 4.0, 8.0])
     lo, hi = default_band(500.0)

@@ -3,11 +3,13 @@
 """The estimator node's self-test, with no rclpy: known tones through a fresh estimator.
 
 :func:`self_test` runs three seeded tones (a sine at 40 dB SNR each, one after the other, each
-through its own fresh estimator of the given configuration, batch path) and reports the median
-error of each tone's estimates. The tones sit across the configured ``band_hz`` (geometrically at
-1/4, 1/2 and 3/4 of it), or, without a band, across :func:`default_band` of the sampling rate. The
-node answers its ``~/self_test`` service with it, off the data path: the live estimator is not
-touched. (ArduPilot's GyroFFT has the same kind of check.)
+through its own fresh estimator of the given configuration, batch path; for ``excitation``
+ambient or auto a white-noise-driven mode at each tone, over three identifier windows) and
+reports the median error of each tone's estimates. The tones sit across the configured
+``band_hz`` (geometrically at 1/4, 1/2 and 3/4 of it), or, without a band, across
+:func:`default_band` of the sampling rate. The node answers its ``~/self_test`` service with
+it, off the data path: the live estimator is not touched. (ArduPilot's GyroFFT has the same
+kind of check.)
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ import numpy as np
 
 from ..core.config import EstimatorConfig
 from ..core.factory import create_estimator
+from ..sim.ambient import ambient_record
 
 #: sampling rate of the tones when the input's is not known yet, Hz
 DEFAULT_RATE_HZ = 500.0
@@ -32,6 +35,11 @@ PERIODS = 10.0
 #: at most this many samples per tone
 MAX_SAMPLES = 200_000
 SEED = 0
+#: ``excitation`` ambient or auto: each tone is a white-noise-driven mode at this damping ratio
+#: over this many identifier windows (the identifier publishes from its first full window on;
+#: a pure sine, undamped, is no mode it confirms)
+AMBIENT_ZETA = 0.01
+AMBIENT_WINDOWS = 3.0
 
 
 @dataclass(frozen=True)
@@ -92,13 +100,21 @@ def run_tone(
             math.nan,
             f'above the Nyquist frequency {sample_rate_hz / 2:.6g} Hz of the input',
         )
-    periods = max(PERIODS, 4 * (config.min_periods + 1))
-    n = min(MAX_SAMPLES, int(math.ceil(periods * sample_rate_hz / frequency_hz)))
-    rng = np.random.default_rng(seed)
     amplitude = max(1.0, 10 * config.min_amplitude)
-    t = np.arange(n) / sample_rate_hz
-    y = amplitude * np.sin(2 * np.pi * frequency_hz * t + rng.uniform(0, 2 * np.pi))
-    y += rng.normal(0.0, amplitude / math.sqrt(2) * 10 ** (-SNR_DB / 20), n)
+    if config.excitation in (
+        'ambient',
+        'auto',
+    ):  # a driven mode, over windows the identifier needs
+        seconds = min(AMBIENT_WINDOWS * config.ambient_window_s, MAX_SAMPLES / sample_rate_hz)
+        mode = [(frequency_hz, AMBIENT_ZETA, amplitude**2 / 2)]
+        t, y, _ = ambient_record(seconds, sample_rate_hz, mode, SNR_DB, seed)
+    else:
+        periods = max(PERIODS, 4 * (config.min_periods + 1))
+        n = min(MAX_SAMPLES, int(math.ceil(periods * sample_rate_hz / frequency_hz)))
+        rng = np.random.default_rng(seed)
+        t = np.arange(n) / sample_rate_hz
+        y = amplitude * np.sin(2 * np.pi * frequency_hz * t + rng.uniform(0, 2 * np.pi))
+        y += rng.normal(0.0, amplitude / math.sqrt(2) * 10 ** (-SNR_DB / 20), n)
     estimates = (create or create_estimator)(config).process(t, y)
     median = float(np.median(estimates.frequency_hz)) if len(estimates) else math.nan
     return ToneResult(frequency_hz, len(estimates), median)
