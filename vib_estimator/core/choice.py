@@ -314,18 +314,27 @@ def impurity(t: np.ndarray, y: np.ndarray, f: float, spec=None) -> float:
     return off / total if total > 0 else math.nan
 
 
+def decay_blocks(t: np.ndarray, y: np.ndarray, f: float) -> tuple[np.ndarray, float]:
+    """``y`` in consecutive blocks of :data:`DECAY_BLOCK_PERIODS` periods of ``f`` Hz (rows; the
+    samples beyond the last whole block left out) and the blocks' length in seconds; no rows
+    when a block would hold fewer than 4 samples."""
+    fs = (len(t) - 1) / float(t[-1] - t[0]) if len(t) > 1 else math.nan
+    n = int(round(DECAY_BLOCK_PERIODS * fs / f)) if f > 0 and math.isfinite(fs) else 0
+    m = len(y) // n if n >= 4 else 0
+    return np.reshape(y[: m * n], (m, max(n, 1))), (n / fs if m else math.nan)
+
+
 def decay_zeta(t: np.ndarray, y: np.ndarray, f: float) -> float:
     """The damping ratio of a free decay at ``f`` Hz from its envelope: the variance of blocks of
     :data:`DECAY_BLOCK_PERIODS` periods, from the block after the most energetic one on while
     they fall (none rising 1.5 x: a next pluck) and stand 10 x above the noise (the last quarter's
     median block, when flat: a decay that rang down), fitted by ``exp(-2 zeta 2 pi f t)`` over
     the noise; NaN with fewer than 3 such blocks."""
-    fs = (len(t) - 1) / float(t[-1] - t[0]) if len(t) > 1 else math.nan
-    n = int(round(DECAY_BLOCK_PERIODS * fs / f)) if f > 0 and math.isfinite(fs) else 0
-    m = len(y) // n if n >= 4 else 0
+    blocks, block_s = decay_blocks(t, y, f)
+    m = len(blocks)
     if m < 4:
         return math.nan
-    energy = y[: m * n].reshape(m, n).var(axis=1)
+    energy = blocks.var(axis=1)
     peak = int(np.argmax(energy))
     tail = energy[-max(2, m // 4) :]
     half = len(tail) // 2
@@ -339,7 +348,7 @@ def decay_zeta(t: np.ndarray, y: np.ndarray, f: float) -> float:
         k += 1
     if k - peak - 1 < 3:
         return math.nan
-    centres = (np.arange(peak + 1, k) + 0.5) * n / fs
+    centres = (np.arange(peak + 1, k) + 0.5) * block_s
     slope = np.polyfit(centres, np.log(energy[peak + 1 : k] - floor), 1)[0]
     return float(-slope / 2 / (2 * math.pi * f))
 
@@ -350,12 +359,9 @@ def snr_db(t: np.ndarray, y: np.ndarray, f: float) -> float:
     blocks' second differences' variance / 6 (white noise's; a sinusoid's second difference is
     ``(2 pi f / fs)^2`` of it, and the least block is where the decay has rung down); NaN when
     the record holds fewer than 2 blocks."""
-    fs = (len(t) - 1) / float(t[-1] - t[0]) if len(t) > 1 else math.nan
-    n = int(round(DECAY_BLOCK_PERIODS * fs / f)) if f > 0 and math.isfinite(fs) else 0
-    m = len(y) // n if n >= 4 else 0
-    if m < 2:
+    blocks, _ = decay_blocks(t, y, f)
+    if len(blocks) < 2:
         return math.nan
-    blocks = y[: m * n].reshape(m, n)
     noise = float(np.min(np.diff(blocks, 2, axis=1).var(axis=1))) / 6
     peak = float(np.max(blocks.var(axis=1)))
     return 10 * math.log10(peak / noise) if noise > 0 else math.inf
