@@ -567,8 +567,8 @@ class StreamChoice:
         self._share: Optional[float] = None
         self._estimated_at = -math.inf  # stream time of the last free estimate (follow)
         self._silent_retry = -math.inf
-        self._window_onset = 0  # the onset whose decay was last read for its window
-        self._window_reads = 0  # ... and how many times (several modes: read again)
+        self._window_onset = 0  # the onset whose decay is read for its window
+        self._window_reads = 0  # ... how many times (WINDOW_READS: done)
         #: ((onsets, driven blocks) of the stretch, free-decay tests passed running in it)
         self._passed: tuple = ((-1, -1), 0)
 
@@ -643,19 +643,17 @@ class StreamChoice:
         if it allows none (an impure or heavily damped decay) or not yet."""
         watch = self.watch
         f = watch.followed_hz
-        if watch.onsets == self._window_onset or not f > 0 or not watch.live():
+        if watch.onsets != self._window_onset:  # a new onset: its decay not read yet
+            self._window_onset, self._window_reads = watch.onsets, 0
+        if self._window_reads >= WINDOW_READS or not f > 0 or not watch.live():
             return None
         t, y = self.recent(now - watch.onset_t)
         if not decay_zeta(t, y, f) > 0:  # no decay seen yet (a driven response's wandering)
             return None
         chosen = decide(t, y)
-        self._window_reads = self._window_reads + 1 if self._window_onset == -watch.onsets else 1
         # several modes this early may be a pluck's higher modes not yet rung down (a beam's
         # 39 Hz beside its 6 Hz for 2 s): read again, a second later, up to WINDOW_READS times
-        if not chosen.modes or self._window_reads >= WINDOW_READS:
-            self._window_onset = watch.onsets
-        else:
-            self._window_onset = -watch.onsets  # (pending: read again)
+        self._window_reads = self._window_reads + 1 if chosen.modes else WINDOW_READS
         ok = chosen.excitation == 'free' and not chosen.modes
         return chosen if ok and math.isfinite(chosen.min_periods) else None
 
