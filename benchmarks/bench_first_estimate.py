@@ -26,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
+from vib_estimator.analysis.choosing import decided_config
 from vib_estimator.core import EstimatorConfig, estimate
 from vib_estimator.core.choice import decide
 from vib_estimator.io.csv_reader import read_csv_series
@@ -86,6 +87,14 @@ SWEEP = (
 )
 
 
+def decided(t: np.ndarray, y: np.ndarray):
+    """``analyze``'s decided configuration of ``(t, y)``, the samples it estimates (less the
+    decided offset) and the decision."""
+    d = decide(t, y)
+    config = decided_config(EstimatorConfig(), d, 'bench')[0]
+    return config, (y - d.offset if np.isfinite(d.offset) else y), d
+
+
 def sweep(seeds: int = 6) -> int:
     """The decided configuration (as ``analyze`` applies it) on each of :data:`SWEEP`, ringing
     six time constants at 50 samples a period, over ``seeds`` noise seeds: the least and mean
@@ -100,19 +109,19 @@ def sweep(seeds: int = 6) -> int:
             t = np.arange(0, min(30.0, 6.0 / (zeta * 2 * np.pi * f)), 1 / fs)
             y = np.exp(-zeta * 2 * np.pi * f * t) * np.sin(2 * np.pi * f * t + seed)
             y += 10 ** (-snr / 20) / np.sqrt(2) * rng.standard_normal(len(t))
-            d = decide(t, y)
-            config = EstimatorConfig()
-            if np.isfinite(d.min_periods):
-                config = config.replace(min_periods=d.min_periods, early_std_rel=d.early_std_rel)
-            e = estimate(t, y, config)
+            config, y_used, _ = decided(t, y)
+            e = estimate(t, y_used, config)
             err = np.abs(e.frequency_hz / f - 1)
             conv = np.median(e.convergence_time * f) if len(e) else np.nan
-            res.append((100 * np.mean(err <= 0.02) if len(e) else 0.0, conv, config.early_std_rel))
+            early = f'{config.early_std_rel:g}' + (
+                ' damped' if config.model == 'damped-sinusoid' else ''
+            )
+            res.append((100 * np.mean(err <= 0.02) if len(e) else 0.0, conv, early))
         within = [r[0] for r in res]
         conv = [r[1] for r in res]
         early = sorted({r[2] for r in res})
         print(
-            f'| {f:g} Hz, zeta {zeta:g}, {snr} dB | {", ".join(f"{x:g}" for x in early)} | '
+            f'| {f:g} Hz, zeta {zeta:g}, {snr} dB | {", ".join(early)} | '
             f'{min(within):.0f} %, {np.mean(within):.1f} % | '
             f'{np.nanmedian(conv):.2f}, {np.nanmax(conv):.2f} |'
         )
@@ -152,11 +161,12 @@ def main() -> int:
     print('|---|---|---|' + '---|' * len(args.periods))
     for name, t, y, f in records(real):
         cells = []
-        d = decide(t, y)
-        decided = d.min_periods if np.isfinite(d.min_periods) else EstimatorConfig().min_periods
-        for k, periods in enumerate([decided, *args.periods]):
-            early = d.early_std_rel if k == 0 else 0.0
-            e = estimate(t, y, EstimatorConfig(min_periods=periods, early_std_rel=early))
+        config, y_used, _ = decided(t, y)
+        for k, periods in enumerate([config.min_periods, *args.periods]):
+            if k == 0:
+                e = estimate(t, y_used, config)
+            else:
+                e = estimate(t, y, EstimatorConfig(min_periods=periods))
             if not len(e):
                 cells.append('none')
                 continue

@@ -2,12 +2,14 @@
 # SPDX-License-Identifier: Apache-2.0
 """``vib-estimator analyze`` on CSV files and bags, and its handling of bad input."""
 
+import argparse
 import json
 import re
 
 import numpy as np
 import pytest
 
+from vib_estimator.analysis.choosing import prepare
 from vib_estimator.cli import main
 from vib_estimator.core import EstimatorConfig, estimate
 from vib_estimator.core.choice import decide
@@ -16,13 +18,21 @@ from vib_estimator.io.fields import seconds_since
 
 
 def decided(t, y, config=None):
-    """What ``analyze`` with no ``--excitation`` estimates: ``config`` (default: the defaults)
-    with the free-decay window its decision gives (core.choice.fast_window)."""
-    config = config or EstimatorConfig()
-    d = decide(t, y)
-    if np.isfinite(d.min_periods):
-        config = config.replace(min_periods=d.min_periods, early_std_rel=d.early_std_rel)
-    return estimate(t, y, config)
+    """What ``analyze`` with no ``--excitation`` estimates (:func:`.choosing.prepare`):
+    ``config`` (default: the defaults; its model or band given as options) with the free-decay
+    window (and model) its decision gives (core.choice.fast_window), on the samples less the
+    offset it gives."""
+    given = config is not None
+    args = argparse.Namespace(
+        excitation=None,
+        paper=False,
+        min_periods=None,
+        ambient_window_s=None,
+        model=config.model if given else None,
+        band_hz=config.band_hz if given else None,
+    )
+    config, d, _ = prepare(args, config or EstimatorConfig(), t, y, 1, 'analyze')
+    return estimate(t, y - d.offset if np.isfinite(d.offset) else y, config)
 
 
 @pytest.fixture

@@ -95,14 +95,22 @@ def test_jsonl_is_strict_json_for_an_absurd_sample():
 
 
 def test_no_estimate_says_why():
-    """Issue 22 case 8: the default model on a clean damped sine gave 0 estimates, no word why."""
+    """Issue 22 case 8: the default model on a clean damped sine gave 0 estimates, no word why
+    (``--excitation free``: the configured model; the default now decides the damped model for
+    it, issue 37, and estimates it)."""
     t = np.arange(0, 10, 0.002)
     wn = 2 * np.pi * 3
     text = 't,y\n' + ''.join(
         f'{a!r},{b!r}\n'
         for a, b in zip(t.tolist(), (np.exp(-0.02 * wn * t) * np.sin(wn * t)).tolist())
     )
-    code, out, err = analyze(text.encode(), '--format', 'table')
+    code, out, err = analyze(text.encode(), '--format', 'jsonl')
+    rows = [json.loads(line) for line in out.splitlines()]
+    assert code == 0 and len(rows) > 5 and 'damped-sinusoid' in err
+    assert all(
+        abs(r['frequency_hz'] / 3 - 1) < 0.005 and abs(r['damping'] / 0.02 - 1) < 0.1 for r in rows
+    )
+    code, out, err = analyze(text.encode(), '--format', 'table', '--excitation', 'free')
     assert code == 0 and 'estimates=0' in err
     why = [line for line in err.splitlines() if line.startswith('analyze: no estimate: ')]
     assert len(why) == 1 and 'never fired' in why[0] and 'damped-sinusoid' in why[0]

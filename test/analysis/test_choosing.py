@@ -45,26 +45,37 @@ def driven(tmp_path):
     return write(tmp_path / 'driven.csv', t, y)
 
 
-def test_a_free_decay_gives_exactly_the_free_estimator_s_output(capsys, free_decay):
-    """A pure, clean decay: ``free`` with the decided window (0.9 periods where precise,
-    core.choice: ``FAST_STD_CLEAN``); every row of ``free`` with those options, none of
-    ``free``'s default window."""
-    from vib_estimator.core.choice import FAST_STD_CLEAN
+def test_a_free_decay_gives_exactly_the_free_estimator_s_output(capsys, free_decay, tmp_path):
+    """A pure, clean decay whose offset its tail gives: ``free`` with the decided window (0.9
+    periods where precise, core.choice: ``FAST_STD_CLEAN``) and model (the damped sinusoid) on
+    the record less that offset; every row of ``free`` with those options on that record, none
+    of ``free``'s default window."""
+    from vib_estimator.core.choice import FAST_STD_CLEAN, decide
 
     rows, err = analyze(capsys, free_decay)
     assert 'analyze: excitation free (the default decides from the record' in err
-    assert 'min_periods 0.9' in err
+    assert 'min_periods 0.9' in err and 'damped-sinusoid' in err
+    t, y = np.loadtxt(free_decay, delimiter=',', skiprows=1).T
+    d = decide(t, y)
+    assert d.model == 'damped-sinusoid' and abs(d.offset) < 1e-3
     free, err_free = analyze(
         capsys,
-        free_decay,
+        write(tmp_path / 'less_offset.csv', t, y - d.offset),
         '--excitation',
         'free',
+        '--model',
+        'damped-sinusoid',
         '--min-periods',
         '0.9',
         '--early-std-rel',
         str(FAST_STD_CLEAN),
     )
-    assert rows == free and len(rows) > 10
+    assert len(rows) == len(free) > 10  # the offset read back: equal to rounding
+    assert all(r.keys() == g.keys() and r['t'] == g['t'] for r, g in zip(rows, free))
+    for key in ('frequency_hz', 'damping', 'amplitude', 'frequency_std_hz'):
+        assert np.allclose([r[key] for r in rows], [g[key] for g in free], rtol=1e-9, atol=0)
+    assert np.mean([abs(r['frequency_hz'] / 5 - 1) < 0.02 for r in rows]) >= 0.95
+    assert abs(np.median([r['damping'] for r in rows]) / 0.01 - 1) < 0.1
     assert 'decides from the record' not in err_free
     assert analyze(capsys, free_decay, '--excitation', 'free')[0] != rows
 

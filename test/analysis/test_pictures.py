@@ -147,7 +147,7 @@ def test_analyze_summary_without_damping_designs_for_zero_and_no_estimate_no_sum
     t, y = sine()
     path = tmp_path / 's.csv'
     np.savetxt(path, np.column_stack([t, y]), delimiter=',', header='t,torque', comments='')
-    assert main(['analyze', str(path)]) == 0
+    assert main(['analyze', str(path), '--model', 'biased-sinusoid']) == 0
     summary = summary_of(capsys.readouterr().err)
     assert 'damping not estimated' in summary[1]
     assert summary[3].endswith('-p damping_ratio:=0.0')

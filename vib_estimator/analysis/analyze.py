@@ -223,10 +223,14 @@ class Run:
 
 
 def estimate_signal(
-    signal: Signal, config: EstimatorConfig, keep_samples: bool = False, blocks=None
+    signal: Signal,
+    config: EstimatorConfig,
+    keep_samples: bool = False,
+    blocks=None,
+    offset: float = 0.0,
 ) -> Run:
     """Stream ``signal`` (or its ``blocks``, when some were read ahead) through a fresh estimator
-    of ``config``, block by block.
+    of ``config``, block by block, less ``offset`` (the samples kept as read).
 
     Raises ValueError (no samples, time not increasing, band above Nyquist) and the readers'
     CsvError/BagError.
@@ -244,7 +248,7 @@ def estimate_signal(
             )
             nyquist_checked = True
         first_t = float(t[0]) if first_t is None else first_t
-        parts.append(run_batch(estimator, t, y, count))
+        parts.append(run_batch(estimator, t, y - offset if offset else y, count))
         count, previous = count + len(t), float(t[-1])
         if keep_samples:
             kept.append((t, y))
@@ -350,7 +354,8 @@ def run(args: argparse.Namespace) -> int:
         decision, notes = None, []
         if ahead is not None:
             config, decision, notes = prepare(args, config, *ahead, 1, 'analyze')
-        result = estimate_signal(signal, config, bool(args.plot or args.report), blocks)
+        offset = decision.offset if decision is not None and math.isfinite(decision.offset) else 0
+        result = estimate_signal(signal, config, bool(args.plot or args.report), blocks, offset)
     except (VibEstimatorError, ValueError) as err:
         return report(err, 'vib-estimator analyze')
     damage_warning(signal, 'vib-estimator analyze')

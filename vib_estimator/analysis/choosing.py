@@ -16,6 +16,7 @@ one ``error:`` line)."""
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 from typing import Iterable, Iterator, Optional, Tuple
@@ -44,6 +45,12 @@ def periods_given(args) -> bool:
     return getattr(args, 'min_periods', None) is not None
 
 
+def model_given(args) -> bool:
+    """Whether the command line sets the model or a band (``--model``, ``--band-hz``): the
+    decided model and offset are then not applied."""
+    return any(getattr(args, name, None) is not None for name in ('model', 'band_hz'))
+
+
 def decided_config(
     config: EstimatorConfig,
     d: Decision,
@@ -53,15 +60,16 @@ def decided_config(
 ) -> Tuple[EstimatorConfig, str]:
     """``config`` with the excitation, (unless ``keep_window``: ``--ambient-window-s`` was
     given) the ambient window, (unless ``config.modes`` is set) the modes to track and (unless
-    ``keep_periods``: ``--min-periods`` was given) the free-decay window of the decision ``d``,
-    and the line that says so."""
+    ``keep_periods``: ``--min-periods`` was given) the free-decay window and model of the
+    decision ``d``, and the line that says so."""
     window = config.ambient_window_s
     if not keep_window and d.excitation != 'free':
         window = d.window_s
     modes = config.modes or d.modes
-    periods, early = config.min_periods, config.early_std_rel
+    periods, early, model = config.min_periods, config.early_std_rel, config.model
     if not keep_periods and math.isfinite(d.min_periods):
         periods, early = d.min_periods, early or d.early_std_rel
+        model = d.model or model
     line = (
         f'{prog}: excitation {d.excitation} (the default decides from the record: {d.reason}; '
         '--excitation free, ambient or auto overrides'
@@ -75,6 +83,7 @@ def decided_config(
         modes=modes,
         min_periods=periods,
         early_std_rel=early,
+        model=model,
     )
     return changed, line
 
@@ -144,9 +153,12 @@ def prepare(
 ) -> Tuple[EstimatorConfig, Decision, list[str]]:
     """The configuration a command line and a record ``(t, y)`` give (the default decided from
     the record: :func:`decides`), the decision, and the lines to print once the record has been
-    estimated (what was decided, or a contradiction)."""
+    estimated (what was decided, or a contradiction). The decision's ``offset``, when finite, is
+    to be removed from the samples the configuration estimates (not otherwise)."""
     d = decide(t, y, channels, config.ambient_window_s)
     if decides(args):
+        if periods_given(args) or model_given(args):  # the decided model and offset not applied
+            d = dataclasses.replace(d, model='', offset=math.nan)
         config, line = decided_config(config, d, prog, window_given(args), periods_given(args))
         return config, d, [line]
     if getattr(args, 'paper', False):
