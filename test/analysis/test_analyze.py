@@ -259,3 +259,25 @@ def test_excitation_auto_equals_the_core_and_free_on_a_free_decay(tmp_path, caps
     assert len(rows) == len(ref) == len(free) > 0
     assert [r['frequency_hz'] for r in rows] == list(ref.frequency_hz) == list(free.frequency_hz)
     assert {r['mode'] for r in rows} == {1}
+
+
+def test_options_keep_the_record_as_read(tmp_path, capsys):
+    """The decided model and offset (a decay whose offset its tail gives) are the default's:
+    ``--paper``, ``--excitation free``, ``--model`` and ``--min-periods`` estimate the samples as
+    read, exactly as the core does with those options."""
+    t = np.arange(0, 20, 0.002)
+    y = 0.5 + np.exp(-0.01 * 2 * np.pi * 2 * t) * np.sin(2 * np.pi * 2 * t + 1)
+    y += 0.003 * np.random.default_rng(2).standard_normal(len(t))
+    assert decide(t, y).model == 'damped-sinusoid' and abs(decide(t, y).offset - 0.5) < 1e-3
+    path = tmp_path / 'decay.csv'
+    np.savetxt(path, np.column_stack([t, y]), delimiter=',', header='t,y', comments='')
+    for options, config in (
+        (['--paper'], EstimatorConfig.paper()),
+        (['--excitation', 'free'], EstimatorConfig()),
+        (['--model', 'damped-sinusoid'], EstimatorConfig(model='damped-sinusoid')),
+        (['--min-periods', '0.9'], EstimatorConfig(min_periods=0.9)),
+    ):
+        assert main(['analyze', str(path), '--format', 'jsonl', *options]) == 0
+        rows = jsonl(capsys.readouterr().out)
+        expected = estimate(t, y, config)
+        assert [r['frequency_hz'] for r in rows] == expected.frequency_hz.tolist(), options

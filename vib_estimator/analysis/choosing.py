@@ -156,9 +156,9 @@ def prepare(
     estimated (what was decided, or a contradiction). The decision's ``offset``, when finite, is
     to be removed from the samples the configuration estimates (not otherwise)."""
     d = decide(t, y, channels, config.ambient_window_s)
+    if not decides(args) or periods_given(args) or model_given(args):
+        d = dataclasses.replace(d, model='', offset=math.nan)  # not applied
     if decides(args):
-        if periods_given(args) or model_given(args):  # the decided model and offset not applied
-            d = dataclasses.replace(d, model='', offset=math.nan)
         config, line = decided_config(config, d, prog, window_given(args), periods_given(args))
         return config, d, [line]
     if getattr(args, 'paper', False):
