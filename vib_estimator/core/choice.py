@@ -307,33 +307,13 @@ def decide(
             + ', '.join(f'{f:.3g}' for f in sorted(separate))
             + f' Hz): the mode tracker, modes {modes}'
         )
-    periods, early, model, offset = math.nan, 0.0, '', math.nan
+    free = (math.nan, 0.0, '', math.nan)  # a free decay's window, precision, model, offset
     # a stream (the node) keeps its window
-    if (
-        excitation == 'free'
-        and not (modes or stream)
-        and channels == 1
-        and math.isfinite(dominant)
-    ):
-        periods, early, why, model, offset = fast_window(t, y, dominant, spec, offset_ok)
+    if excitation == 'free' and not (modes or stream) and channels == 1 and dominant > 0:
+        *free, why = fast_window(t, y, dominant, spec, offset_ok)
         seen += f'; {why}'
-    rate = (len(t) - 1) / span
-    return Decision(
-        excitation,
-        window,
-        share,
-        dominant,
-        fundamental,
-        tuple(peaks),
-        seen,
-        span,
-        rate,
-        modes,
-        periods,
-        early,
-        model,
-        offset,
-    )
+    seen_at = (tuple(peaks), seen, span, (len(t) - 1) / span)  # what was read, at what rate
+    return Decision(excitation, window, share, dominant, fundamental, *seen_at, modes, *free)
 
 
 def impurity(t: np.ndarray, y: np.ndarray, f: float, spec=None) -> float:
@@ -434,9 +414,9 @@ def known_offset(t: np.ndarray, y: np.ndarray, f: float) -> float:
 
 def fast_window(
     t: np.ndarray, y: np.ndarray, f: float, spec=None, offset_ok: bool = True
-) -> tuple[float, float, str, str, float]:
+) -> tuple[float, float, str, float, str]:
     """The window (``min_periods``), the precision its estimates need (``early_std_rel``), the
-    reason in words, the model ('': the configured) and the offset to remove (NaN: none) for a
+    model ('': the configured), the offset to remove (NaN: none) and the reason in words for a
     free decay of one mode at ``f`` Hz, when its spectrum is pure (:func:`impurity` below
     :data:`IMPURE`): :data:`FAST_PERIODS`, and :data:`FAST_STD` (:data:`FAST_STD_CLEAN` at
     :data:`CLEAN_SNR_DB` and above) -- with ``offset_ok``, the offset known
@@ -447,13 +427,13 @@ def fast_window(
     spread = impurity(t, y, f, spec)
     if not spread <= IMPURE:
         why = f'{100 * spread:.0f} % of the power near {f:.3g} Hz off its peak'
-        return math.nan, 0.0, why, '', math.nan
+        return math.nan, 0.0, '', math.nan, why
     snr = snr_db(t, y, f)
     zeta = decay_zeta(t, y, f)
     light = not zeta > FAST_ZETA
     offset = known_offset(t, y, f) if offset_ok and snr >= DAMPED_SNR_DB else math.nan
     if not (light or math.isfinite(offset)):
-        return math.nan, 0.0, f'a decay damped at {100 * zeta:.1f} % (its envelope)', '', math.nan
+        return math.nan, 0.0, '', math.nan, f'a decay damped at {100 * zeta:.1f} % (its envelope)'
     damped = math.isfinite(offset)
     precision = FAST_STD_CLEAN if light and (damped or snr >= CLEAN_SNR_DB) else FAST_STD
     what = (
@@ -462,16 +442,11 @@ def fast_window(
         if damped
         else f'a pure, lightly damped peak ({100 * spread:.1f} % off it, {snr:.0f} dB)'
     )
-    return (
-        FAST_PERIODS,
-        precision,
-        (
-            f'{what}, min_periods {FAST_PERIODS:g} where the estimate is within '
-            f'{100 * precision:.2g} % (1 std), else 1.25'
-        ),
-        'damped-sinusoid' if damped else '',
-        offset,
+    why = (
+        f'{what}, min_periods {FAST_PERIODS:g} where the estimate is within '
+        f'{100 * precision:.2g} % (1 std), else 1.25'
     )
+    return FAST_PERIODS, precision, 'damped-sinusoid' if damped else '', offset, why
 
 
 def window_advice(window_s: float, d: Optional[Decision], option: str) -> str:
