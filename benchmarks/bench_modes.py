@@ -27,14 +27,19 @@ Usage: ``.venv/bin/python benchmarks/bench_modes.py [--seeds N] [--real-data DIR
 """
 
 import argparse
+import contextlib
+import io
+import json
 import math
 import sys
+import tempfile
 from pathlib import Path
 
 import numpy as np
 from bench_estimator import best  # benchmarks/ is the script's folder
 from real_data import REFERENCE as REAL_F1
 
+from vib_estimator.cli import main as cli
 from vib_estimator.core import EstimatorConfig, FrequencyEstimator
 from vib_estimator.core.modes import ModeTracker
 from vib_estimator.io.csv_reader import read_csv_series
@@ -65,8 +70,9 @@ CASES = {
 REAL_F2 = {30: 107.6, 40: 61.54, 50: 39.63, 60: 27.35}
 
 
-def decay(freqs, amps, zetas, clip, seed, duration=11.0):
-    """Noise, then at T_EXCITE a sum of damped sines (SNR 30 dB for the weakest), maybe clipped."""
+def decay(freqs, amps, zetas, clip, seed, duration=11.0, snr_db=30.0):
+    """Noise, then at T_EXCITE a sum of damped sines (SNR ``snr_db`` for the weakest), maybe
+    clipped."""
     t = np.arange(0.0, duration, 1.0 / FS)
     tt = np.maximum(t - T_EXCITE, 0.0)
     rng = np.random.default_rng(seed)
@@ -77,7 +83,7 @@ def decay(freqs, amps, zetas, clip, seed, duration=11.0):
     y *= t >= T_EXCITE
     if clip is not None:
         y = np.clip(y, -clip, clip)
-    y += min(amps) / math.sqrt(2) * 10 ** (-30 / 20) * rng.standard_normal(len(t))
+    y += min(amps) / math.sqrt(2) * 10 ** (-snr_db / 20) * rng.standard_normal(len(t))
     return t, y
 
 
@@ -258,6 +264,121 @@ def cost():
     )
 
 
+#: the default's records (section 5): name -> (frequencies Hz, amplitudes, damping ratios, SNR dB
+#: of the weakest mode)
+DEFAULT_CASES = {
+    '10/13 Hz 1:0.5, 30 dB': ((10.0, 13.0), (1.0, 0.5), (0.003, 0.003), 30.0),
+    '10/13 Hz 1:0.5, 45 dB': ((10.0, 13.0), (1.0, 0.5), (0.003, 0.003), 45.0),
+    '8/21/55 Hz 1:0.3:0.05, 30 dB': (
+        (8.0, 21.0, 55.0),
+        (1.0, 0.3, 0.05),
+        (0.003, 0.002, 0.002),
+        30.0,
+    ),
+    '5/17 Hz 1:0.05, 40 dB': ((5.0, 17.3), (1.0, 0.05), (0.004, 0.002), 40.0),
+    '6/9/14 Hz 1:0.5:0.2, 35 dB': ((6.0, 9.0, 14.0), (1.0, 0.5, 0.2), (0.003, 0.003, 0.002), 35.0),
+    '12/40 Hz 1:1, 45 dB': ((12.0, 40.0), (1.0, 1.0), (0.002, 0.002), 45.0),
+    '20/26/97 Hz 1:0.5:0.3, 30 dB': (
+        (20.0, 26.0, 97.0),
+        (1.0, 0.5, 0.3),
+        (0.002, 0.002, 0.001),
+        30.0,
+    ),
+}
+
+
+def analyze_default(t, y, folder):
+    """``vib-estimator analyze FILE --format jsonl`` with no option (in process): the rows'
+    (t, frequency_hz, convergence_time_s) as arrays."""
+    path = Path(folder) / 'record.csv'
+    np.savetxt(
+        path, np.column_stack([t, y]), delimiter=',', header='time_s,y', comments='', fmt='%.9g'
+    )
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(io.StringIO()):
+        cli(['analyze', str(path), '--format', 'jsonl'])
+    rows = [json.loads(line) for line in out.getvalue().splitlines() if line.startswith('{')]
+    return tuple(
+        np.array([r[key] for r in rows], dtype=float)
+        for key in ('t', 'frequency_hz', 'convergence_time_s')
+    )
+
+
+def per_mode(est_t, est_f, conv, freqs):
+    """Per true mode (estimates attributed to the nearest): (estimates, median convergence in its
+    periods, ... in periods of the lowest mode, share within 2 %, first within 2 % after the
+    excitation in periods of the lowest); and the share of estimates farther than 3 % from every
+    true mode."""
+    freqs = np.asarray(freqs)
+    if not len(est_f):
+        return [(0, math.nan, math.nan, 0.0, math.inf)] * len(freqs), math.nan
+    rel = est_f[:, None] / freqs[None, :] - 1
+    nearest = np.argmin(np.abs(rel), axis=1)
+    err = np.abs(rel[np.arange(len(est_f)), nearest])
+    rows = []
+    for k, f in enumerate(freqs):
+        sel = nearest == k
+        ok = sel & (err < 0.02)
+        if not np.any(sel):
+            rows.append((0, math.nan, math.nan, 0.0, math.inf))
+            continue
+        rows.append(
+            (
+                int(np.sum(sel)),
+                float(np.median(conv[sel])) * f,
+                float(np.median(conv[sel])) * freqs.min(),
+                float(np.mean(err[sel] < 0.02)),
+                (est_t[ok][0] - T_EXCITE) * freqs.min() if np.any(ok) else math.inf,
+            )
+        )
+    return rows, float(np.mean(err > 0.03))
+
+
+def defaults(seeds):
+    print(
+        '\n5. the default: vib-estimator analyze FILE --format jsonl, no option (%d seeds; per '
+        'mode the median over seeds, worst seed in brackets)' % seeds
+    )
+    print(
+        '| case | mode Hz | estimates | median conv (own periods) | median conv (periods f1) '
+        '| within 2 % | first within 2 % (periods f1) | > 3 % from all (per record) '
+        '| pooled conv |'
+    )
+    print('|---|---|---|---|---|---|---|---|---|')
+    with tempfile.TemporaryDirectory() as folder:
+        for name, (freqs, amps, zetas, snr) in DEFAULT_CASES.items():
+            res = []
+            for seed in range(seeds):
+                t, y = decay(freqs, amps, zetas, None, seed, snr_db=snr)
+                et, ef, ec = analyze_default(t, y, folder)
+                rows, spur = per_mode(et, ef, ec, freqs)
+                rel = ef[:, None] / np.asarray(freqs)[None, :] - 1 if len(ef) else None
+                pooled = (
+                    float(np.median(ec * np.asarray(freqs)[np.argmin(np.abs(rel), axis=1)]))
+                    if len(ef)
+                    else math.nan
+                )
+                res.append((rows, spur, pooled))
+            for k, f in enumerate(freqs):
+                col = [[r[0][k][i] for r in res] for i in range(5)]
+                spur = [100 * r[1] for r in res]
+                pooled = [r[2] for r in res]
+                tail = (
+                    f'{np.median(spur):.2f} ({np.max(spur):.2f}) | '
+                    f'{np.median(pooled):.2f} ({np.max(pooled):.2f})'
+                    if k == 0
+                    else ' | '
+                )
+                print(
+                    f'| {name if k == 0 else ""} | {f:g} | {np.median(col[0]):.0f} '
+                    f'| {np.median(col[1]):.2f} ({np.max(col[1]):.2f}) '
+                    f'| {np.median(col[2]):.2f} ({np.max(col[2]):.2f}) '
+                    f'| {100 * np.median(col[3]):.1f} ({100 * np.min(col[3]):.1f}) % '
+                    f'| {np.median(col[4]):.2f} ({np.max(col[4]):.2f}) | {tail} |'
+                )
+                sys.stdout.flush()
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--seeds', type=int, default=5)
@@ -266,11 +387,18 @@ def main() -> int:
         type=Path,
         default=Path(__file__).resolve().parents[2] / 'shared' / 'real-data',
     )
+    parser.add_argument(
+        '--defaults-only', action='store_true', help='only section 5 (the default, per mode)'
+    )
     args = parser.parse_args()
+    if args.defaults_only:
+        defaults(args.seeds)
+        return 0
     synthetic(args.seeds)
     mass_change()
     real(args.real_data / 'aluminium_cantilever_adxl357')
     cost()
+    defaults(args.seeds)
     return 0
 
 

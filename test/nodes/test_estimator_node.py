@@ -1091,3 +1091,31 @@ def test_a_silent_decay_of_several_modes_sets_the_nodes_modes(make_probe):
     assert spin_until(p.executor, lambda: config_of(node).modes == 3, 10.0)
     assert node.get_parameter('modes').value == 3 and config_of(node).excitation == 'free'
     assert p.node._stream.decided
+
+
+def test_a_decay_whose_modes_ring_on_sets_the_nodes_modes_and_publishes_each(make_probe):
+    """``decide_excitation``: an 8 / 21 / 55 Hz pluck (1 : 0.3 : 0.05), whose one-mode estimator
+    follows 8 Hz alone, sets the node's own ``modes`` to 3 once the decay's last half still
+    shows its modes (test_stream.py has the rule); the pluck's next seconds are then published
+    on vibration/mode1..3/frequency, each mode within 2 % of its own."""
+    t = np.arange(0, 10, 1 / FS)
+    tau = np.maximum(t - 1.0, 0)
+    truth = ((8.0, 1.0, 0.003), (21.0, 0.3, 0.002), (55.0, 0.05, 0.002))
+    y = sum(
+        a * np.exp(-z * 2 * np.pi * f * tau) * np.sin(2 * np.pi * f * tau) for f, a, z in truth
+    )
+    y += 1e-3 * np.random.default_rng(0).standard_normal(len(t))
+    stamps = [EPOCH_NS + round(s * 1e9) for s in t]
+    p = make_probe(**{name: getattr(EstimatorConfig(), name) for name in PAPER})  # defaults
+    first = int(4 * FS)
+    p.feed(stamps[:first], y[:first])
+    node = p.node
+    assert spin_until(p.executor, lambda: config_of(node).modes == 3, 10.0)
+    assert node.get_parameter('modes').value == 3 and p.node._stream.decided
+    subs = [p._listen(f'mode{k}/{n}') for k in (1, 2, 3) for n in ('frequency', 'reset')]
+    assert spin_until(p.executor, lambda: all(s.get_publisher_count() >= 1 for s in subs), 10.0)
+    p.modes = 3  # (Probe.wait_outputs: each mode's resets)
+    p.publish([message(p.input_type, 'torque.z', s, v) for s, v in zip(stamps[first:], y[first:])])
+    for k, (f, _, _) in enumerate(truth, 1):
+        got = np.array(p.values(f'mode{k}/frequency'))
+        assert len(got) >= 5 and np.mean(np.abs(got / f - 1) <= 0.02) >= 0.95, (k, got)

@@ -494,6 +494,10 @@ MAX_KEPT = 2**18
 SILENT_S = 3.0
 #: the most times a decay's window is read (a decision a second) while it shows several modes
 WINDOW_READS = 5
+#: ... each read that shows several modes reads again this last share of the decay since its
+#: onset: several modes there too (they ring on) send the stream to the mode tracker
+#: (:meth:`StreamChoice._lasting_modes`)
+LASTING_SHARE = 0.5
 #: free-decay tests passed running in a stretch (no onset, no block read driven between) after
 #: which its later free estimates are trusted untested (:meth:`StreamChoice.free_decay`)
 TRUSTED_PASSES = 3
@@ -696,7 +700,8 @@ class StreamChoice:
         its free stretch has shown a decay at the last free estimate's frequency
         (:func:`decay_zeta`: at least 8 periods, three blocks of two falling; asked again until
         it has; and again, up to :data:`WINDOW_READS` times, while it shows several modes); None
-        if it allows none (an impure or heavily damped decay) or not yet."""
+        if it allows none (an impure or heavily damped decay) or not yet. A decay of several
+        modes that ring on (:meth:`_lasting_modes`) gets the mode tracker instead."""
         watch = self.watch
         f = watch.followed_hz
         if watch.onsets != self._window_onset:  # a new onset: its decay not read yet
@@ -707,11 +712,24 @@ class StreamChoice:
         if not decay_zeta(t, y, f) > 0:  # no decay seen yet (a driven response's wandering)
             return None
         chosen = decide(t, y, offset_ok=False)  # the node estimates the samples as they come
+        lasting = self._lasting_modes(t, y) if chosen.modes else None
+        if lasting is not None:
+            self._window_reads = WINDOW_READS
+            return lasting
         # several modes this early may be a pluck's higher modes not yet rung down (a beam's
         # 39 Hz beside its 6 Hz for 2 s): read again, a second later, up to WINDOW_READS times
         self._window_reads = self._window_reads + 1 if chosen.modes else WINDOW_READS
         ok = chosen.excitation == 'free' and not chosen.modes
         return chosen if ok and math.isfinite(chosen.min_periods) else None
+
+    def _lasting_modes(self, t: np.ndarray, y: np.ndarray) -> Optional[Decision]:
+        """:func:`decide`'s free decay of several modes over the last :data:`LASTING_SHARE` of
+        the decay ``(t, y)`` (since its onset), when that part still shows them: modes that
+        ring on (an 8 / 21 / 55 Hz decay, whose one-mode estimator follows 8 Hz alone), not a
+        pluck's higher modes rung down since (a beam's); else None."""
+        late = t >= t[-1] - LASTING_SHARE * (t[-1] - t[0])
+        chosen = decide(t[late], y[late], offset_ok=False)
+        return chosen if chosen.excitation == 'free' and chosen.modes else None
 
     def recent(self, seconds: float) -> tuple[np.ndarray, np.ndarray]:
         """``(t, y)`` of the kept samples of the last ``seconds`` s (at least; y: the first
@@ -765,8 +783,9 @@ class StreamChoice:
         ``free`` with ``modes`` 0 whose estimator has been silent for :data:`SILENT_S` s while the
         stream rings after an onset, a free decay of several modes (the mode tracker); from
         ``free`` on the default window (``windowed`` False), once per onset when it has shown
-        a decay, the window that decay allows (:func:`fast_window`, as ``analyze`` decides it);
-        from an
+        a decay, the window that decay allows (:func:`fast_window`, as ``analyze`` decides it),
+        or, when that decay and its last :data:`LASTING_SHARE` show several modes, the mode
+        tracker (:meth:`_lasting_modes`); from an
         ``ambient`` this choice ``decided``, ``free`` once the stream reads free.
         ``window_s``: the configured ambient window (the shortest the decision gives)."""
         self._flush()

@@ -401,7 +401,8 @@ class EstimatorStream:
         """What the input needs now, if not what runs (``decide_excitation``; after
         :meth:`status`, which watches the input): from ``free``, once the input looks driven
         throughout, analyze's decision over its last seconds (excitation and ambient window), or
-        when its estimator stays silent on a ringing input, a decay of several modes (``modes``);
+        when its estimator stays silent on a ringing input or a decay's modes ring on, a decay
+        of several modes (``modes``);
         from an ``ambient`` decided so, ``free`` once it looks free again
         (:class:`~vib_estimator.core.choice.StreamChoice`). The caller applies it (the node: as
         its parameters) and sets :attr:`decided`."""
