@@ -405,13 +405,17 @@ class Envelope:
         if not len(idx):
             driven[:] = self.state == DRIVEN
             return valid, driven
-        tv, yv = t[idx], y[idx]
+        tv, yv = (t, y) if len(idx) == n else (t[idx], y[idx])
         if self._t0 is None:
             self._t0 = float(tv[0])
         self._last = float(tv[-1])
         k = ((tv - self._t0) // self.block_s).astype(np.int64)
-        # the first valid sample of each new block closes the one before
-        starts = np.flatnonzero(np.diff(np.concatenate(([self._k], k))) != 0)
+        # the first valid sample of each new block closes the one before (k does not decrease:
+        # none when the last is in the block under way)
+        if k[-1] == self._k:
+            starts = idx[:0]
+        else:
+            starts = np.flatnonzero(np.diff(np.concatenate(([self._k], k))) != 0)
         ends = np.concatenate((starts, [len(k)]))
         changes = [(0, self.state == DRIVEN)]
         lo = 0
