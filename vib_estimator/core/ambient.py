@@ -160,6 +160,8 @@ class SlidingWindowIdentifier(Estimator):
         #: buffer at once when one is due (:meth:`_store`), not one numpy write each
         self._pending_t: list[float] = []
         self._pending_y: list = []
+        self._max_gap = config.max_gap
+        self._clear_window = self._clear  # (bound once: the data path's)
         #: while True, a window that is due only slides (counted ``analyses_idle``): nothing is
         #: identified or published, the tracked modes wait (``excitation = auto`` in a free
         #: stretch, where the identifier's estimates would not publish)
@@ -203,15 +205,15 @@ class SlidingWindowIdentifier(Estimator):
             finite = all(map(math.isfinite, value))
         t = float(t)
         # a gap or a long jump back clears the window
-        if not accept_sample(self._c, self._last, t, finite, self._config.max_gap, self._clear):
+        if not accept_sample(self._c, self._last, t, finite, self._max_gap, self._clear_window):
             return []
         self._last = t
         self._pending_t.append(t)
         self._pending_y.append(value)
-        if self._next == math.inf:  # the window's first sample
-            self._next = t + self._window
         if t >= self._next:
             return self._analysis()
+        if self._next == math.inf:  # the window's first sample
+            self._next = t + self._window
         return []
 
     def mode_counters(self) -> dict[int, dict[str, int]]:
