@@ -379,3 +379,25 @@ def test_memory_is_flat_over_a_long_stream(one_second_hop):
         tracemalloc.stop()
     analyses = 10 * block  # one a second, the last ten blocks
     assert used[-1] - used[9] < 32 * analyses, [u - used[9] for u in used]
+
+
+def test_samples_fed_one_at_a_time_between_batches_resets_and_gaps_are_the_streams():
+    # samples fed alone wait in a list until an analysis is due: a batch, a reset or a gap in
+    # between must see them where the buffer would have held them
+    t, y, _ = ambient_record(100.0, FS, [(5.0, 0.01, 1.0)], 26.0, 8)
+    t = np.where(t > 70.0, t + 5.0, t)  # a gap (in a batch): a new window
+    cut = np.searchsorted(t, [13.3, 31.7, 44.1, 66.9, 72.0])
+    streamed, mixed = AmbientEstimator(AMBIENT), AmbientEstimator(AMBIENT)
+    want, got = [], []
+    for k, (a, b) in enumerate(zip((0, *cut), (*cut, len(t)))):
+        if k == 3:  # a reset after samples fed alone
+            streamed.reset()
+            mixed.reset()
+        want += [e.frequency_hz for ti, yi in zip(t[a:b], y[a:b]) for e in streamed.update(ti, yi)]
+        if k % 2:
+            got += mixed.process(t[a:b], y[a:b]).frequency_hz.tolist()
+        else:
+            got += [e.frequency_hz for ti, yi in zip(t[a:b], y[a:b]) for e in mixed.update(ti, yi)]
+    assert len(want) >= 6
+    assert got == want
+    assert mixed.counters == streamed.counters

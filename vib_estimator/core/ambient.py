@@ -156,6 +156,12 @@ class SlidingWindowIdentifier(Estimator):
         self._y = np.empty((1 << 14, channels))
         self._register = ModeRegister(self._window, CONFIRM, CONFIRM_BESIDE, new=_Track)
         self._cascade = CorrelationCascade(2 * block_rows(channels), channels)
+        #: samples fed one at a time since the last analysis (stamps, values): appended to the
+        #: buffer at once when one is due (:meth:`_store`), not one numpy write each
+        self._pending_t: list[float] = []
+        self._pending_y: list = []
+        self._max_gap = config.max_gap
+        self._clear_window = self._clear  # (bound once: the data path's)
         #: while True, a window that is due only slides (counted ``analyses_idle``): nothing is
         #: identified or published, the tracked modes wait (``excitation = auto`` in a free
         #: stretch, where the identifier's estimates would not publish)
@@ -182,26 +188,32 @@ class SlidingWindowIdentifier(Estimator):
         self._n = 0  # samples in the buffer
         self._start = 0  # first sample of the current window
         self._fed = 0  # samples of the buffer in the cascade
+        self._pending_t.clear()
+        self._pending_y.clear()
         self._cascade.clear()
         self._next = math.inf
 
     def update(self, t: float, y) -> list:
         """Feed one sample (one value per channel); the estimates of an analysis it completes
         (ascending mode)."""
-        if isinstance(y, float):  # (a float or numpy float64: no array made)
-            values = [y]
+        if isinstance(y, float) and self._m == 1:  # (a float or numpy float64: no array made)
+            value, finite = y, math.isfinite(y)
         else:
-            values = np.asarray(y, dtype=np.float64).reshape(-1).tolist()
-        if len(values) != self._m:
-            raise ValueError(f'expected {self._m} channel values, got {len(values)}')
-        t, finite = float(t), all(map(math.isfinite, values))
+            value = np.asarray(y, dtype=np.float64).reshape(-1).tolist()
+            if len(value) != self._m:
+                raise ValueError(f'expected {self._m} channel values, got {len(value)}')
+            finite = all(map(math.isfinite, value))
+        t = float(t)
         # a gap or a long jump back clears the window
-        if not accept_sample(self._c, self._last, t, finite, self._config.max_gap, self._clear):
+        if not accept_sample(self._c, self._last, t, finite, self._max_gap, self._clear_window):
             return []
         self._last = t
-        self._append(t, values)
+        self._pending_t.append(t)
+        self._pending_y.append(value)
         if t >= self._next:
             return self._analysis()
+        if self._next == math.inf:  # the window's first sample
+            self._next = t + self._window
         return []
 
     def mode_counters(self) -> dict[int, dict[str, int]]:
@@ -209,10 +221,19 @@ class SlidingWindowIdentifier(Estimator):
         return self._register.counters()
 
     # ---- input --------------------------------------------------------------------------------
-    def _append(self, t, y) -> None:
-        """Append samples: stamps ``t`` (an array) and their rows ``y``, or one stamp (a float)
-        and its values."""
-        m = len(t) if isinstance(t, np.ndarray) else 1
+    def _store(self) -> None:
+        """Append the samples fed one at a time (:meth:`update`) to the buffer."""
+        if self._pending_t:
+            t = np.array(self._pending_t, dtype=np.float64)
+            y = np.array(self._pending_y, dtype=np.float64).reshape(len(t), self._m)
+            self._pending_t.clear()
+            self._pending_y.clear()
+            self._append(t, y)
+
+    def _append(self, t: np.ndarray, y: np.ndarray) -> None:
+        """Append samples: stamps ``t`` and their rows ``y`` (after those fed one at a time)."""
+        self._store()
+        m = len(t)
         if self._n + m > len(self._t):
             keep = self._n - self._start
             if keep + m > len(self._t) // 2:  # grow
@@ -226,12 +247,8 @@ class SlidingWindowIdentifier(Estimator):
                 self._y[:keep] = self._y[self._start : self._n]
             self._fed -= self._start
             self._n, self._start = keep, 0
-        if m == 1 and not isinstance(t, np.ndarray):
-            self._t[self._n] = t
-            self._y[self._n] = y
-        else:
-            self._t[self._n : self._n + m] = t
-            self._y[self._n : self._n + m] = y
+        self._t[self._n : self._n + m] = t
+        self._y[self._n : self._n + m] = y
         if self._n == 0:
             self._next = float(self._t[0]) + self._window
         self._n += m
@@ -239,6 +256,7 @@ class SlidingWindowIdentifier(Estimator):
     def _due(self) -> list:
         """The analysis due now (:func:`.ssi.identify` of the window, :meth:`_track`), or,
         :attr:`idle`, only the window's slide."""
+        self._store()
         if self.idle:
             self._slide()
             self._c['analyses_idle'] += 1
@@ -277,7 +295,7 @@ class SlidingWindowIdentifier(Estimator):
                 i += 1
                 continue
             while i < j:
-                if not self._n:
+                if self._next == math.inf:  # the window's first sample
                     self._next = float(t[i]) + self._window
                 k = min(j, int(np.searchsorted(t[i:j], self._next, 'left')) + i + 1)
                 self._c['received'] += k - i

@@ -530,8 +530,9 @@ class DrivenWatch:
         while start < n:
             end = start + 1  # the first sample is marked
             if self._marks:  # else up to the next sample to mark at
-                later = np.flatnonzero(t[start:] - self._marks[-1][0] >= WATCH_S / 100)
-                end = start + int(later[0]) + 1 if len(later) else n + 1
+                later = t[start:] - self._marks[-1][0] >= WATCH_S / 100
+                first = int(np.argmax(later))
+                end = start + first + 1 if later[first] else n + 1
             with np.errstate(over='ignore', invalid='ignore'):  # a huge sample: inf energy
                 self._envelope.feed(t[start:end], y[start:end])
             self._last_t = float(t[min(end, n) - 1])
