@@ -156,8 +156,9 @@ def prepare(
     estimated (what was decided, or a contradiction). The decision's ``offset``, when finite, is
     to be removed from the samples the configuration estimates (not otherwise)."""
     d = decide(t, y, channels, config.ambient_window_s)
-    if not decides(args) or periods_given(args) or model_given(args):
-        d = dataclasses.replace(d, model='', offset=math.nan)  # not applied
+    if d.model and (not decides(args) or periods_given(args) or model_given(args)):
+        kept = '; --model, --band-hz or --min-periods given: the record as read, their model'
+        d = dataclasses.replace(d, model='', offset=math.nan, reason=d.reason + kept)
     if decides(args):
         config, line = decided_config(config, d, prog, window_given(args), periods_given(args))
         return config, d, [line]
