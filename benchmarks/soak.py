@@ -61,12 +61,15 @@ import rclpy  # noqa: E402
 from diagnostic_msgs.msg import DiagnosticArray  # noqa: E402
 from geometry_msgs.msg import WrenchStamped  # noqa: E402
 from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue  # noqa: E402
-from rcl_interfaces.srv import SetParameters  # noqa: E402
+from rcl_interfaces.srv import GetParameters, SetParameters  # noqa: E402
 from rclpy.node import Node  # noqa: E402
 from rclpy.qos import QoSProfile, ReliabilityPolicy  # noqa: E402
-from std_msgs.msg import Float64  # noqa: E402
+from rosgraph_msgs.msg import Clock as ClockMsg  # noqa: E402
+from std_msgs.msg import Float64, Header  # noqa: E402
 from std_srvs.srv import Trigger  # noqa: E402
 
+from vib_estimator.core.ambient import hop_s  # noqa: E402
+from vib_estimator.io.fields import stamp_ns  # noqa: E402
 from vib_estimator.nodes.health import identities  # noqa: E402
 from vib_estimator.nodes.runner import make_executor  # noqa: E402
 from vib_estimator.nodes.sim_node import GROUND_TRUTH_QOS  # noqa: E402
@@ -93,6 +96,9 @@ RECOVERY_WINDOWS = 3.0
 #: after a stop of the node, an estimate within this many (one window of data when the stall
 #: restarted the estimator; a second for what was taken before the restart point)
 STALL_WINDOWS = 2.0
+#: the simulated seconds an estimate may come after the stream time it was given up at: the
+#: node's input queue (5000 samples, 10 s at 500 Hz) and an analysis in flight
+LAG_S = 20.0
 #: sim_node's sampling rate, Hz (the estimator's sample_rate_hz until its diagnostics say it)
 SAMPLE_RATE_HZ = 500.0
 #: the hidden soak's RSS limit (issue 40: 20 MB growth; 10 MB after the first 10 min of 8 h)
@@ -105,6 +111,8 @@ RSS_AFTER_SIM_S = 600.0
 #: that stops again for this long after it came back is deafness (a simulator started again on a
 #: loaded machine takes seconds to import and match: not a fault unrecovered)
 INPUT_WAIT_S = 24.0
+#: a recovery under way when the run ends is waited for this long (s) at most, then judged
+RECOVERY_WAIT_S = 180.0
 #: the soak's progress line (RSS, load, counters) every this many seconds
 PROGRESS_EVERY_S = 300.0
 
@@ -223,6 +231,26 @@ class Watch(Node):
         )
         self.estimates = {'/': [], '/replay': []}  # [(steady s, Hz)]
         self.truth = []  # [(steady s, Hz)]
+        #: each estimate's sample stamp (vibration/reset: the sample that completed it), the
+        #: stream time a recovery is measured in
+        self.resets = []  # [(steady s, stamp ns)]
+        self.create_subscription(
+            Header,
+            'vibration/reset',
+            lambda m: self.resets.append((time.monotonic(), stamp_ns(m))),
+            100,
+        )
+        #: the simulator's clock (sim_node publishes /clock with each batch of samples): the
+        #: latest, and the first received since :meth:`mark_clock` (or since it went back: a
+        #: simulator started again), from which a recovery is measured
+        self.clock_ns = None
+        self.clock_first = None
+        self.create_subscription(
+            ClockMsg,
+            '/clock',
+            self._on_clock,
+            QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT),
+        )
         for ns in self.estimates:
             self.create_subscription(
                 Float64,
@@ -241,10 +269,21 @@ class Watch(Node):
         self.set_params = self.create_client(
             SetParameters, '/estimator_node/set_parameters', qos_profile=deep
         )
+        self.get_params = self.create_client(GetParameters, '/estimator_node/get_parameters')
         self.triggers = {
             name: self.create_client(Trigger, f'/estimator_node/{name}', qos_profile=deep)
             for name in ('self_test', 'reset')
         }
+
+    def _on_clock(self, msg) -> None:
+        ns = msg.clock.sec * 10**9 + msg.clock.nanosec
+        if self.clock_first is None or (self.clock_ns is not None and ns < self.clock_ns - 10**9):
+            self.clock_first = ns  # (a clock gone back: the time base the node now estimates in)
+        self.clock_ns = ns
+
+    def mark_clock(self) -> None:
+        """Take the next /clock received as the reference (:attr:`clock_first`)."""
+        self.clock_first = None
 
     def _on_replayed(self, msg) -> None:
         r = self.replayed
@@ -318,10 +357,14 @@ class Soak:
             )
             self.procs += [self.replay_est, self.replayer]
         if args.shaper:
-            # on the estimator's vibration/frequency, the soak's reference; wall-clock ticks
-            self.shaper = Proc('shaper_node', ['shaper_node'], logs)
+            # on the estimator's vibration/frequency, the soak's reference; in the simulated time
+            # (on the wall clock its ZVD impulses, 0.38 s apart for 1.33 Hz, were 5 periods of the
+            # simulated arm: each reference move an unshaped step, every 30 simulated s)
+            self.shaper = Proc(
+                'shaper_node', ['shaper_node', '--ros-args', '-p', 'use_sim_time:=true'], logs
+            )
             self.procs.append(self.shaper)
-        rclpy.init()
+        rclpy.init(args=[])  # (not sys.argv: the soak's own -p would read as remap rules)
         self.watch = Watch()
         self.ex = make_executor()
         self.ex.add_node(self.watch)
@@ -597,7 +640,8 @@ class Soak:
         order = []
         end = self.t0 + self.args.minutes * 60
         next_at = time.monotonic() + self.args.fault_every
-        while time.monotonic() + 5 < end:
+        count = self.args.count
+        while len(self.faults) < count if count else time.monotonic() + 5 < end:
             if not order:
                 order = list(self.args.faults)
                 self.rng.shuffle(order)
@@ -607,12 +651,15 @@ class Soak:
             # it would not end (and a node restarted then stopped in its first second dies of
             # the KeyboardInterrupt)
             if time.monotonic() + FAULT_S[kind] + longer > end:
+                if count:
+                    self.problems.append(f'{len(self.faults)} faults of {count} within the run')
                 break
             f = {'kind': kind, 'start': time.monotonic()}
             taken0 = self.taken()
             getattr(self, f'fault_{kind}')(f)
             f['end'] = time.monotonic()
-            n_est = len(self.watch.estimates['/'])
+            n_est = len(self.watch.resets)
+            self.watch.mark_clock()  # the stream time the recovery is measured from
             next_at = f['end'] + self.args.fault_every
             # input waited for until the next fault, at least INPUT_WAIT_S (a dense schedule:
             # the next fault waits for it)
@@ -620,38 +667,54 @@ class Soak:
             limit = min(f['end'] + wait, end) - time.monotonic()
             got = self.spin(limit, lambda: self.taken() > taken0 + 100)
             f['input_s'] = time.monotonic() - f['end'] if got else math.nan
-            # then an estimate, waited for as long as the data of RECOVERY_WINDOWS estimator
-            # windows take to come (not a steady time: a loaded machine slows the simulator and
-            # the node alike)
-            taken_in, window = self.taken(), self.window_samples()
-            flowing = [taken_in, time.monotonic()]  # the last count taken, and when it grew
+            # then an estimate of the data after the fault, measured in the stream's time (the
+            # simulator's clock at the fault's end, or its new origin after a restart, to the
+            # stamp of the sample that completed the estimate): waited for until the simulator
+            # is RECOVERY_WINDOWS estimator windows (and LAG_S for the node's queue) past it,
+            # not a steady time nor a count of samples (a loaded machine slows the simulator
+            # and the node alike; the node drains a backlog after a stall)
+            f['window_s'] = self.node_window_s()
+            window_ns = f['window_s'] * 1e9
+            flowing = [self.taken(), time.monotonic()]  # the last count taken, and when it grew
 
-            def estimated():
-                return len(self.watch.estimates['/']) > n_est
+            def recovery():
+                """(steady s of its arrival, windows of stream) of the first estimate published
+                since the fault's end of the data after it, or None. An estimate stamped after
+                the simulator's clock is of an earlier time base (a restarted simulator)."""
+                w = self.watch
+                ref, now = w.clock_first, w.clock_ns
+                if ref is None:
+                    return None
+                for at, stamp in w.resets[n_est:]:
+                    if ref - window_ns <= stamp <= now + 1e9:
+                        return at, max(0.0, stamp - ref) / window_ns
+                return None
 
             def gave_up():
-                # enough data and no estimate, or the input gone again for a fault's spacing
-                # (deaf after a few messages)
-                taken = self.taken()
+                # the stream well past the windows without an estimate, or the input gone again
+                # for a fault's spacing (deaf after a few messages)
+                taken, w = self.taken(), self.watch
                 if taken > flowing[0]:
                     flowing[:] = [taken, time.monotonic()]
-                return (
-                    taken - taken_in > RECOVERY_WINDOWS * window
-                    or time.monotonic() - flowing[1] > wait
+                past = w.clock_first is not None and w.clock_ns - w.clock_first > (
+                    RECOVERY_WINDOWS * window_ns + LAG_S * 1e9
                 )
+                return past or time.monotonic() - flowing[1] > wait
 
+            # (the end of the run does not cut a recovery short: it is judged, within
+            # RECOVERY_WAIT_S at most)
             self.spin(
-                (end if got else min(next_at, end)) - time.monotonic(),
-                lambda: estimated() or gave_up(),
+                (max(end, f['end'] + RECOVERY_WAIT_S) if got else min(next_at, end))
+                - time.monotonic(),
+                lambda: recovery() is not None or gave_up(),
             )
-            got = estimated()
-            f['estimate_s'] = time.monotonic() - f['end'] if got else math.nan
-            # estimator windows of data taken from input taken again to an estimate (the
-            # diagnostics' count, up to a second old: lenient by a second's samples)
-            f['windows'] = (self.taken() - taken_in) / window if got else math.nan
+            found = recovery()
+            f['estimate_s'] = found[0] - f['end'] if found else math.nan
+            # estimator windows of stream from the fault's end to the estimate's sample
+            f['windows'] = found[1] if found else math.nan
             # a fault whose recovery the end of the run cut short is not judged (None)
-            if got:
-                f['recovered'] = True
+            if found:
+                f['recovered'] = found[1] <= RECOVERY_WINDOWS
             elif f['input_s'] != f['input_s']:
                 f['recovered'] = False if f['end'] + wait < end else None
             else:
@@ -662,7 +725,7 @@ class Soak:
             self.faults.append(f)
             print(
                 f'{f["start"] - self.t0:7.1f} s  {kind:8s} input after {f["input_s"]:5.2f} s, '
-                f'estimate after {f["estimate_s"]:5.2f} s ({f["windows"]:.2f} windows after input)'
+                f'estimate after {f["estimate_s"]:5.2f} s ({f["windows"]:.2f} windows of stream)'
                 + ''.join(
                     f', {k} {f[k]:.0f}' if isinstance(f[k], float) else f', {k} {f[k]}'
                     for k in f
@@ -670,7 +733,7 @@ class Soak:
                 ),
                 flush=True,
             )
-        self.spin(max(0.0, end - time.monotonic()))
+        self.spin(self.args.fault_every if count else max(0.0, end - time.monotonic()))
         return self.finish()
 
     def window_samples(self) -> float:
@@ -682,6 +745,18 @@ class Soak:
         except ValueError:
             rate = math.nan
         return self.window_s() * (rate if rate > 0 else SAMPLE_RATE_HZ)
+
+    def node_window_s(self) -> float:
+        """The window the estimator runs now: its ``ambient_window_s`` under ``excitation``
+        ambient or auto (the node's default decides them), else :meth:`window_s`."""
+        client = self.watch.get_params
+        future = client.call_async(GetParameters.Request(names=['excitation', 'ambient_window_s']))
+        if not self.spin(5.0, future.done):
+            return self.window_s()
+        excitation, window = future.result().values
+        if excitation.string_value in ('ambient', 'auto') and window.double_value > 0:
+            return window.double_value
+        return self.window_s()
 
     def window_s(self) -> float:
         """The estimator's analysis window, simulated s (``-p ambient_window_s:=``, else its
@@ -736,7 +811,8 @@ class Soak:
                 errors.append(abs(hz / truth - 1))
         errors.sort()
         # RSS after the first tenth
-        tenth = 0.1 * self.args.minutes * 60
+        length = time.monotonic() - self.t0
+        tenth = 0.1 * length
         after = [mb for t, mb in self.rss if t >= tenth and mb == mb]
         rss_growth = (max(after) - after[0]) if after else math.nan
         # (a node restarted by the faults, sim_node, has no long life to measure)
@@ -817,17 +893,19 @@ class Soak:
                         if f['input_s'] != f['input_s']
                         else 'input again, then none (deaf)'
                         if f.get('deaf')
-                        else f'no estimate within {RECOVERY_WINDOWS:g} estimator windows of input'
+                        else f'an estimate {f["windows"]:.1f} estimator windows of stream after it'
+                        if f['windows'] == f['windows']
+                        else f'no estimate within {RECOVERY_WINDOWS:g} estimator windows of stream'
                     )
                 )
             elif f['kind'] == 'stop' and f['windows'] > STALL_WINDOWS:
                 self.problems.append(
                     f'stop at {f["start"] - self.t0:.0f} s: an estimate {f["windows"]:.1f} '
-                    'estimator windows after input was taken again'
+                    'estimator windows of stream after it'
                 )
         for name, mb in growth.items():
             # (a shorter run's first tenth is the start-up, the estimator's buffer filling)
-            if mb > RSS_GROWTH_MB and self.args.minutes >= 5:
+            if mb > RSS_GROWTH_MB and length >= 300:
                 self.problems.append(f'{name}: RSS grew {mb} MB after the first tenth')
         for name, mb in long_growth.get('after_10_simulated_min', {}).items():
             if mb > RSS_GROWTH_LONG_MB:
@@ -851,7 +929,7 @@ class Soak:
 def report(fig: dict) -> None:
     print(
         '\nfault     n  recovered  input resumed (s, max)  estimate resumed (s, median / max)'
-        '  windows after input (max)'
+        '  windows of stream (max)'
     )
     for kind in FAULTS:
         rows = [f for f in fig['faults'] if f['kind'] == kind]
@@ -869,6 +947,14 @@ def report(fig: dict) -> None:
             f'{median:6.2f} / {max(est, default=math.nan):6.2f}'
             f'                 {max(windows, default=math.nan):5.2f}'
         )
+    judged = [f for f in fig['faults'] if f['windows'] == f['windows']]
+    print(
+        'recovery in windows of stream from the fault to the estimate (the window the estimator '
+        f'ran: {sorted({f["window_s"] for f in judged})} s): within one window and the '
+        "identifier's analysis hop "
+        f'{sum(f["windows"] <= 1 + hop_s(f["window_s"]) / f["window_s"] for f in judged)} of '
+        f'{len(fig["faults"])} faults, within 1.0 {sum(f["windows"] <= 1.0 for f in judged)}'
+    )
     c = fig['counters']
     print(
         f'\ncounters: received {c.get("received")}, used {c.get("used")}, samples_missing '
@@ -960,6 +1046,13 @@ def main(argv=None) -> int:
         'growth <= 10 MB after the first 10 simulated minutes',
     )
     parser.add_argument('--speed', type=float, default=10.0, help="sim_node's speed")
+    parser.add_argument(
+        '--count',
+        type=int,
+        default=0,
+        help='run this many faults, each judged, then end (--minutes is then a limit: a fault '
+        'that cannot start before it is a problem); default: faults until --minutes',
+    )
     parser.add_argument('--seed', type=int, default=0, help='seed of the fault schedule')
     parser.add_argument(
         '--stop-s', type=float, default=2.0, help="a stop's length: SIGSTOP to SIGCONT, s"

@@ -261,6 +261,28 @@ def test_the_stream_choice_feeds_the_watch_in_batches_with_the_same_answers():
     assert any(a is not None for a, *_ in answers) and any(c for *_, c, _ in answers)
 
 
+def test_a_stream_whose_stamps_go_back_is_judged_afresh():
+    """A source restarted (its stamps back to 1 s, within a batch of the node's): the watch and
+    the decision start again on the new stream, which reads driven after the watched span's half,
+    as the first did -- not once its time has passed the old stream's (its samples were all
+    'earlier' than the old ones: the watch was blind for the old stream's length, issue 40)."""
+    from vib_estimator.core.choice import StreamChoice
+
+    t, y, _ = ambient_record(300, 100, [(1.2, 0.015, 1.0)], 20, 1)
+    stream = StreamChoice()
+    said, decided = [], []
+    for k, (a, b) in enumerate(zip(t.tolist() + (1 + t[:12000]).tolist(), y.tolist() * 2)):
+        stream.update(a, b)
+        if k % 100 == 50:  # once a second, as the node asks; the jump inside a batch
+            said.append(stream.driven())
+            decided.append(stream.decision('free', False, 30.0))
+    before, after = said[:300], said[300:]
+    assert before[-1] is not None and after[0] is None  # the old stream's judgement forgotten
+    assert not any(after[:59]) and all(s is not None for s in after[80:])  # then the new one's
+    assert [d.excitation for d in decided[300:] if d is not None] == ['ambient']
+    assert stream.kept()[0][0] >= 1 and len(stream.kept()[0]) <= 12000
+
+
 @pytest.mark.parametrize('factor', [1e-3, 1e3])
 def test_the_stream_choice_keeps_at_most_max_kept_samples(monkeypatch, factor):
     """The node's decision reads the last WATCH_S s, bounded in memory: a 10 kHz stream keeps

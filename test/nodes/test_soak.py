@@ -1,16 +1,17 @@
 # Copyright 2026 vib_estimator developers
 # SPDX-License-Identifier: Apache-2.0
-"""The soak's short version (benchmarks/soak.py, one minute): sim_node at speed 10 and
-estimator_node as processes, bag_replayer looping a bag into a second estimator_node, shaper_node
-on the first's estimates; faults on a seeded schedule (a restart with time going back, a 5-s
-SIGSTOP of estimator_node second -- a stop first met the kernels' compile ending, a restart of its
-own --, a parameter storm with invalid values, a 5000-message burst when time is left): after the
-stop, input taken again and an estimate within two estimator windows of data (over shared memory
-the node went deaf for good after such a stop about one time in two: docs/nodes.md#never-deaf);
-every fault recovered (an estimate within 3 windows of data), every call answered, every burst
-message received or counted, the counters' identities, what the replay estimator and the shaper
-took of what was sent to them, no traceback, SIGINT exit 0 within 2 s for every node (issue
-40)."""
+"""The soak's short version (benchmarks/soak.py, four faults, about a minute and a half):
+sim_node at speed 10 and estimator_node as processes, bag_replayer looping a bag into a second
+estimator_node, shaper_node on the first's estimates; four faults from a seeded schedule, each
+waited for and judged before the next (``--count``: no wall-clock budget a loaded machine could
+cut short) -- a restart with time going back, a 5-s SIGSTOP of estimator_node second (a stop first
+met the kernels' compile ending, a restart of its own), a parameter storm with invalid values, a
+5000-message burst: after the stop, input taken again and an estimate within two estimator windows
+of stream (over shared memory the node went deaf for good after such a stop about one time in
+two: docs/nodes.md#never-deaf); every fault recovered (an estimate within 3 windows of stream,
+measured in the simulator's time, not in steady seconds), every call answered, every burst message
+received or counted, the counters' identities, what the replay estimator and the shaper took of
+what was sent to them, no traceback, SIGINT exit 0 within 2 s for every node (issue 40)."""
 
 from __future__ import annotations
 
@@ -24,13 +25,14 @@ SOAK = Path(__file__).resolve().parents[2] / 'benchmarks' / 'soak.py'
 
 def test_a_minute_of_faults(tmp_path):
     out = tmp_path / 'soak.json'
-    args = ['--minutes', '1', '--fault-every', '10', '--stop-s', '5']
+    # --minutes: a limit only (a fault that cannot start before it is a problem)
+    args = ['--count', '4', '--minutes', '5', '--fault-every', '10', '--stop-s', '5']
     args += ['--faults', 'stop,restart,storm,burst', '--seed', '15']
     run = subprocess.run(
         [sys.executable, str(SOAK), *args, '--json', str(out)],
         capture_output=True,
         text=True,
-        timeout=180,
+        timeout=600,
     )
     fig = json.loads(out.read_text())
     assert run.returncode in (0, 1), run.stdout + run.stderr
@@ -44,14 +46,14 @@ def test_a_minute_of_faults(tmp_path):
         'shaper_node',
     }
     kinds = [f['kind'] for f in fig['faults']]
-    assert kinds[:2] == ['restart', 'stop'] and set(kinds) <= {'restart', 'stop', 'storm'}, kinds
-    assert all(f['recovered'] is not False for f in fig['faults']), fig['faults']
+    assert kinds == ['restart', 'stop', 'storm', 'burst'], kinds
+    assert all(f['recovered'] is True for f in fig['faults']), fig['faults']
     # never deaf: after the node's own stall, input again and estimates within the windows
     stop = next(f for f in fig['faults'] if f['kind'] == 'stop')
     assert stop['input_s'] == stop['input_s'] and stop['recovered'] is True, run.stdout
     assert stop['windows'] <= 2.0, run.stdout
     assert fig['counters']['input_resubscribed'] == 0, run.stdout  # no silence it had to answer
-    for storm in (f for f in fig['faults'] if f['kind'] == 'storm'):  # (when time was left)
+    for storm in (f for f in fig['faults'] if f['kind'] == 'storm'):
         assert storm['answered'] == storm['calls'] == 200 and storm['wrong_verdicts'] == 0
     for burst in (f for f in fig['faults'] if f['kind'] == 'burst'):
         # every burst message received or counted; beyond it, only the simulator's samples in
@@ -59,9 +61,9 @@ def test_a_minute_of_faults(tmp_path):
         assert 5001 <= burst['received'] + burst['missing'] <= 5001 + 500, burst
     assert all(fig['identities'].values())
     assert not any(fig['tracebacks'].values())
-    # the estimates between faults are the arm's (a minute holds a few hundred, some of them
-    # still near a fault: the share within 2 % is the benchmark's figure, 77-100 % in such runs)
-    assert fig['accuracy_n'] > 50 and fig['accuracy_median'] < 0.01, fig
+    # the estimates between faults are the arm's (a run this short holds tens, some of them still
+    # near a fault: the share within 2 % is the benchmark's figure, 77-100 % in such runs)
+    assert fig['accuracy_n'] >= 20 and fig['accuracy_median'] < 0.01, fig
     # the replayed bag looped, its estimator took every message or counted it; the shaper took
     # every reference and estimate sent to it and kept commanding
     replay, shaper = fig['others']['replay'], fig['others']['shaper']
@@ -72,4 +74,6 @@ def test_a_minute_of_faults(tmp_path):
         shaper['frequency_estimates'] + shaper['estimates_ignored']
         == shaper['estimates_published']
     )
-    assert shaper['commands_published'] > 400 * 30, shaper  # 500 Hz, from the first reference
+    # one command a /clock of the simulator (use_sim_time: up to 1 kHz, fewer on a loaded
+    # machine, 4879 in 80 s at a load of 13), from the first reference on
+    assert shaper['commands_published'] > 1000, shaper

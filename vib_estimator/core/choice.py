@@ -646,12 +646,36 @@ class StreamChoice:
         t = np.array(self._pending_t, dtype=np.float64)
         y = np.array(self._pending_y, dtype=np.float64)
         self._pending_t, self._pending_y = [], []
+        # a stamp going back (within the batch too): what follows is a stream of its own
+        last, i = (self._kept[-1][0][-1] if self._kept else -math.inf), 0
+        while i < len(t):
+            ahead = np.maximum.accumulate(np.append(last, t[i:-1]))  # the latest before each
+            back = np.flatnonzero(t[i:] < ahead - WATCH_S / 100)
+            if len(back) and back[0] == 0:
+                self._afresh()
+                last = -math.inf
+                continue
+            j = i + int(back[0]) if len(back) else len(t)
+            self._keep(t[i:j], y[i:j])
+            last, i = (ahead[j - i] if j < len(t) else last), j
+
+    def _afresh(self) -> None:
+        """Forget the stream (its stamps went back: a source restarted, a bag looping): the
+        samples, the watch and the times kept in the old time base."""
+        self._kept.clear()
+        self._kept_n = 0
+        self._estimated_at = self._silent_retry = self._retry_at = -math.inf
+        self.watch = DrivenWatch()
+        self._share = None
+        self._window_onset = self._window_reads = 0
+        self._passed = ((-1, -1), 0)
+
+    def _keep(self, t: np.ndarray, y: np.ndarray) -> None:
+        """Feed samples of one time base to the watch (its first channel) and keep them."""
+        if not len(t):
+            return
         self.watch.feed(t, y if y.ndim == 1 else y[:, 0])
         kept = self._kept
-        if kept and t[0] < kept[-1][0][-1] - WATCH_S / 100:
-            kept.clear()
-            self._kept_n = 0
-            self._estimated_at = self._silent_retry = -math.inf
         kept.append((t, y))
         self._kept_n += len(t)
         while len(kept) > 1 and t[-1] - kept[1][0][0] >= WATCH_S:
