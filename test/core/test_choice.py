@@ -15,6 +15,13 @@ from vib_estimator.sim.ambient import ambient_record
 from vib_estimator.sim.frame import frame_record
 
 
+def holds_then_breaks(monkeypatch, name: str, factor: float, right) -> None:
+    """``right()`` holds, and no longer once :mod:`core.choice`'s ``name`` is ``factor`` x."""
+    assert right()
+    monkeypatch.setattr(choice, name, getattr(choice, name) * factor)
+    assert not right()
+
+
 def decay(f, zeta, seconds, fs=500.0, noise=0.002, seed=0, plucks=(0.0,)):
     t = np.arange(0, seconds, 1 / fs)
     y = np.zeros_like(t)
@@ -154,9 +161,7 @@ def test_the_constants_are_pinned_from_both_sides(monkeypatch, name, factor):
             and abs(d.fundamental_hz / 1.2 - 1) < 0.03
         )
 
-    assert right()
-    monkeypatch.setattr(choice, name, getattr(choice, name) * factor)
-    assert not right()
+    holds_then_breaks(monkeypatch, name, factor, right)
 
 
 def watch(t, y, step=100):
@@ -187,9 +192,7 @@ def test_the_stream_watch_tells_a_driven_input_and_its_constants_are_pinned(
         said = [s is not None for s in watch(t, y)]  # one answer a second
         return not any(said[:59]) and sum(said[200:]) >= 90 and not any(watch(ring_t, ring))
 
-    assert right()
-    monkeypatch.setattr(choice, name, getattr(choice, name) * factor)
-    assert not right()
+    holds_then_breaks(monkeypatch, name, factor, right)
 
 
 def several(freqs, amps, zetas, seconds=10.0, fs=1000.0, clip=None, seed=0):
@@ -376,9 +379,7 @@ def test_a_pure_free_decay_is_estimated_over_a_shorter_window_where_precise(
             and noisy_within >= 0.95
         )
 
-    assert right()
-    monkeypatch.setattr(choice, name, getattr(choice, name) * factor)
-    assert not right()
+    holds_then_breaks(monkeypatch, name, factor, right)
 
 
 @pytest.mark.parametrize('factor', [1e-3, 1e3])
@@ -405,9 +406,7 @@ def test_a_heavily_damped_decay_keeps_the_default_window(monkeypatch, name, fact
             and heavy[1] >= 0.95
         )
 
-    assert right()
-    monkeypatch.setattr(choice, name, getattr(choice, name) * factor)
-    assert not right()
+    holds_then_breaks(monkeypatch, name, factor, right)
 
 
 @pytest.mark.parametrize('factor', [1e-3, 1e3])
@@ -431,9 +430,7 @@ def test_a_clean_decay_is_published_sooner_than_a_noisy_one(monkeypatch, name, f
         noisy = decided_convergence(*pluck_with_a_move(0.0, 20.0, zeta=0.01), offset_ok=False)
         return clean[0] <= 1.0 and clean[1] >= 0.95 and noisy[0] >= 1.1 and noisy[1] >= 0.95
 
-    assert right()
-    monkeypatch.setattr(choice, name, getattr(choice, name) * factor)
-    assert not right()
+    holds_then_breaks(monkeypatch, name, factor, right)
 
 
 def beam_like(offset: float = 0.5, drift: float = 0.0, snr_db: float = 40.0, seed: int = 0):
@@ -490,6 +487,4 @@ def test_a_decay_whose_offset_is_known_is_estimated_by_the_damped_model(monkeypa
             and model(*pluck_with_a_move(0.3, 40.0, zeta=0.005)) == ''
         )
 
-    assert right()
-    monkeypatch.setattr(choice, name, getattr(choice, name) * factor)
-    assert not right()
+    holds_then_breaks(monkeypatch, name, factor, right)

@@ -365,16 +365,21 @@ def decay_zeta(t: np.ndarray, y: np.ndarray, f: float) -> float:
     return float(-slope / 2 / (2 * math.pi * f))
 
 
+def block_noise(blocks: np.ndarray) -> float:
+    """The white noise's variance in ``blocks`` (:func:`decay_blocks`): the least of the blocks'
+    second differences' variance / 6 (a sinusoid's second difference is ``(2 pi f / fs)^2`` of
+    it, and the least block is where the decay has rung down)."""
+    return float(np.min(np.diff(blocks, 2, axis=1).var(axis=1))) / 6
+
+
 def snr_db(t: np.ndarray, y: np.ndarray, f: float) -> float:
     """The signal-to-noise ratio of a free decay at ``f`` Hz, dB: its most energetic block of
-    :data:`DECAY_BLOCK_PERIODS` periods (variance) over the noise's variance, the least of the
-    blocks' second differences' variance / 6 (white noise's; a sinusoid's second difference is
-    ``(2 pi f / fs)^2`` of it, and the least block is where the decay has rung down); NaN when
-    the record holds fewer than 2 blocks."""
+    :data:`DECAY_BLOCK_PERIODS` periods (variance) over the noise's variance (:func:`block_noise`);
+    NaN when the record holds fewer than 2 blocks."""
     blocks, _ = decay_blocks(t, y, f)
     if len(blocks) < 2:
         return math.nan
-    noise = float(np.min(np.diff(blocks, 2, axis=1).var(axis=1))) / 6
+    noise = block_noise(blocks)
     peak = float(np.max(blocks.var(axis=1)))
     return 10 * math.log10(peak / noise) if noise > 0 else math.inf
 
@@ -385,7 +390,7 @@ def known_offset(t: np.ndarray, y: np.ndarray, f: float) -> float:
     periods is averaged with a triangle's weights (two one-period means convolved: a sinusoid,
     decaying or a little off ``f``, averages out to second order); the offset is the mean of the
     last quarter's blocks (at least two), known when its two halves agree within that tolerance
-    (no drift) and the noise (the blocks' second differences, as :func:`snr_db`) allows it, and
+    (no drift) and the noise (:func:`block_noise`) allows it, and
     every block lies within :data:`OFFSET_MOVE` of its amplitude of it (it never moved)."""
     blocks, _ = decay_blocks(t, y, f)
     m = len(blocks)
@@ -397,9 +402,7 @@ def known_offset(t: np.ndarray, y: np.ndarray, f: float) -> float:
     weights /= np.sum(weights)
     means = blocks @ weights
     amplitudes = np.sqrt(2 * blocks.var(axis=1))
-    # the noise of one block's mean
-    noise = math.sqrt(float(np.min(np.diff(blocks, 2, axis=1).var(axis=1))) / 6)
-    noise *= math.sqrt(float(np.sum(weights**2)))
+    noise = math.sqrt(block_noise(blocks) * float(np.sum(weights**2)))  # of one block's mean
     tol = OFFSET_TOL * float(np.max(amplitudes))
     tail = means[-k:]
     spread = 3 * noise * math.sqrt(1 / half + 1 / (k - half))
