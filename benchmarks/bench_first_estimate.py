@@ -16,6 +16,7 @@ around the mode, and a window of about one period reads that spread as a 2 % shi
 
     cd benchmarks && ../.venv/bin/python bench_first_estimate.py [--real-data DIR] [--periods P..]
     cd benchmarks && ../.venv/bin/python bench_first_estimate.py --sweep   # SWEEP, 6 seeds each
+    cd benchmarks && ../.venv/bin/python bench_first_estimate.py --noisy   # NOISY, beside free
 """
 
 from __future__ import annotations
@@ -95,38 +96,96 @@ def decided(t: np.ndarray, y: np.ndarray):
     return config, (y - d.offset if np.isfinite(d.offset) else y), d
 
 
-def sweep(seeds: int = 6) -> int:
-    """The decided configuration (as ``analyze`` applies it) on each of :data:`SWEEP`, ringing
-    six time constants at 50 samples a period, over ``seeds`` noise seeds: the least and mean
-    share within 2 %, the median and largest of the records' median convergence (periods)."""
-    print('| decay | early_std_rel decided | within 2 %: least, mean | conv: median, largest |')
-    print('|---|---|---|---|')
-    for f, zeta, snr in SWEEP:
-        res = []
+#: noisy decays (``--noisy``): frequency (Hz), damping ratio, SNR (dB, at the start), samples a
+#: period; each with an offset of 5 % of the amplitude
+NOISY = (
+    (5.0, 0.005, 20, 50),
+    (5.0, 0.005, 20, 200),
+    (5.0, 0.01, 20, 500),
+    (2.0, 0.01, 20, 2500),
+    (5.0, 0.005, 15, 1000),
+)
+
+
+def sweep(cases=SWEEP, seeds: int = 6, offset: float = 0.0, free: bool = False) -> int:
+    """The decided configuration (as ``analyze`` applies it) on each decay of ``cases`` ((f, zeta,
+    SNR) at 50 samples a period, or (f, zeta, SNR, samples a period)) plus ``offset``, ringing six
+    time constants, over ``seeds`` noise seeds: the least and mean share within 2 %, the median
+    and largest of the records' median convergence (periods); with ``free`` the RMS error (%)
+    and the same figures of ``--excitation free``'s configuration (biased sinusoid, 1.25
+    periods) beside them."""
+    extra = ' RMS error % | free: within 2 %, RMS error % | free: conv |' if free else ''
+    print(
+        '| decay | early_std_rel decided | within 2 %: least, mean | conv: median, largest |'
+        + extra
+    )
+    print('|---|---|---|---|' + ('---|---|---|' if free else ''))
+    for f, zeta, snr, *rest in cases:
+        per_period = rest[0] if rest else 50.0
+        res, ref = [], []
         for seed in range(seeds):
             rng = np.random.default_rng(300 + seed)
-            fs = max(100.0, 50.0 * f)
+            fs = max(100.0, per_period * f)
             t = np.arange(0, min(30.0, 6.0 / (zeta * 2 * np.pi * f)), 1 / fs)
-            y = np.exp(-zeta * 2 * np.pi * f * t) * np.sin(2 * np.pi * f * t + seed)
+            y = np.exp(-zeta * 2 * np.pi * f * t) * np.sin(2 * np.pi * f * t + seed) + offset
             y += 10 ** (-snr / 20) / np.sqrt(2) * rng.standard_normal(len(t))
             config, y_used, _ = decided(t, y)
-            e = estimate(t, y_used, config)
-            err = np.abs(e.frequency_hz / f - 1)
-            conv = np.median(e.convergence_time * f) if len(e) else np.nan
             early = f'{config.early_std_rel:g}' + (
                 ' damped' if config.model == 'damped-sinusoid' else ''
             )
-            res.append((100 * np.mean(err <= 0.02) if len(e) else 0.0, conv, early))
-        within = [r[0] for r in res]
-        conv = [r[1] for r in res]
-        early = sorted({r[2] for r in res})
-        print(
-            f'| {f:g} Hz, zeta {zeta:g}, {snr} dB | {", ".join(early)} | '
-            f'{min(within):.0f} %, {np.mean(within):.1f} % | '
-            f'{np.nanmedian(conv):.2f}, {np.nanmax(conv):.2f} |'
-        )
+            for out, e in (
+                (res, estimate(t, y_used, config)),
+                (ref, estimate(t, y, EstimatorConfig()) if free else None),
+            ):
+                if e is None:
+                    continue
+                err = np.abs(e.frequency_hz / f - 1)
+                conv = np.median(e.convergence_time * f) if len(e) else np.nan
+                rms = 100 * np.sqrt(np.mean(err**2)) if len(e) else np.nan
+                out.append((100 * np.mean(err <= 0.02) if len(e) else 0.0, conv, rms, early))
+        cells = [
+            f'{f:g} Hz, zeta {zeta:g}, {snr} dB' + (f', {per_period:g} a period' if rest else '')
+        ]
+        cells.append(', '.join(sorted({r[3] for r in res})))
+        for k, rows in enumerate((res, ref) if free else (res,)):
+            within = [r[0] for r in rows]
+            conv = [r[1] for r in rows]
+            rms = f'{np.nanmedian([r[2] for r in rows]):.2f}'
+            cells.append(
+                f'{min(within):.0f} %, {np.mean(within):.1f} %' + (f', {rms}' if k else '')
+            )
+            cells.append(f'{np.nanmedian(conv):.2f}, {np.nanmax(conv):.2f}')
+            if free and not k:
+                cells.append(rms)
+        print('| ' + ' | '.join(cells) + ' |')
         sys.stdout.flush()
     return 0
+
+
+def noisy_bound(snr: float = 20.0, per_period: int = 50, zeta: float = 0.005) -> None:
+    """The exact CRB of the frequency (relative std, %, over 24 phases) at a decay's start, with
+    the offset fitted (biased sinusoid) and known (damped sinusoid), over 0.9, 1 and 1.25
+    periods: what a window under 1.25 periods can hold in ``snr`` dB."""
+    from vib_estimator.analysis.bounds import model_crb
+
+    noise = 10 ** (-snr / 20) / np.sqrt(2)
+    phases = np.linspace(0, 2 * np.pi, 24, endpoint=False)
+    cells = []
+    for periods in (0.9, 1.0, 1.25):
+        t = np.arange(int(periods * per_period) + 1) / (5.0 * per_period)
+        stds = [
+            100
+            * np.sqrt(np.mean([model_crb(m, t, 1.0, 5.0, p, noise, zeta)[0] ** 2 for p in phases]))
+            / 5
+            for m in ('biased-sinusoid', 'damped-sinusoid')
+        ]
+        cells.append(
+            f'{periods:g} periods {stds[0]:.2f} % (offset fitted) / {stds[1]:.2f} % (known)'
+        )
+    print(
+        f'exact CRB at the start of a decay in {snr:g} dB, {per_period} samples a period: '
+        + '; '.join(cells)
+    )
 
 
 def impurity(t: np.ndarray, y: np.ndarray) -> float:
@@ -149,9 +208,17 @@ def main() -> int:
     parser.add_argument(
         '--sweep', action='store_true', help='the decided window on SWEEP, 6 seeds each'
     )
+    parser.add_argument(
+        '--noisy',
+        action='store_true',
+        help='the decided configuration beside free on NOISY, 6 seeds each; the CRB',
+    )
     args = parser.parse_args()
     if args.sweep:
         return sweep()
+    if args.noisy:
+        noisy_bound()
+        return sweep(NOISY, offset=0.05, free=True)
     real = Path(args.real_data)
     real = real if real.is_dir() else None
     head = ' | '.join(f'min_periods {p:g}: n, within 2 %, > 5 %, conv' for p in args.periods)

@@ -446,16 +446,16 @@ def beam_like(offset: float = 0.5, drift: float = 0.0, snr_db: float = 40.0, see
 
 
 @pytest.mark.parametrize('factor', [1e-3, 1e3])
-@pytest.mark.parametrize('name', ['DAMPED_SNR_DB', 'OFFSET_TOL', 'OFFSET_MOVE'])
+@pytest.mark.parametrize('name', ['OFFSET_TOL', 'OFFSET_MOVE'])
 def test_a_decay_whose_offset_is_known_is_estimated_by_the_damped_model(monkeypatch, name, factor):
     """A decay whose offset its rung-down tail gives (to 0.1 % of its amplitude, never moved)
     is estimated by the damped sinusoid less that offset: a beam-like pluck at 40 dB (its higher
     mode ringing out first) and a 2 Hz decay at 30 dB after 0.92 periods, >= 95 % within 2 %
-    (the biased sinusoid's 30 dB tail: 1.27 periods). Not: in 20 dB (the damped model's fifth
-    parameter costs more than the offset's), an offset drifting by 2 % of the amplitude (the
-    damped model then loses its accuracy), nor one that moved (an arm's step of 0.3 amplitudes
-    at 5 s: its first seconds' estimates would be off). Each constant at 0.001x and 1000x breaks
-    one of them."""
+    (the biased sinusoid's 30 dB tail: 1.27 periods), and a 2 Hz decay in 20 dB at 5 kHz (its
+    offset known there: RMS error 0.20-0.30 % against the biased sinusoid's 0.44-0.80 %). Not: an
+    offset drifting by 2 % of the amplitude (the damped model then loses its accuracy), nor one
+    that moved (an arm's step of 0.3 amplitudes at 5 s: its first seconds' estimates would be
+    off). Each constant at 0.001x and 1000x breaks one of them."""
     from vib_estimator.core import EstimatorConfig, estimate
 
     def model(t, y):
@@ -482,7 +482,7 @@ def test_a_decay_whose_offset_is_known_is_estimated_by_the_damped_model(monkeypa
             and beam_within >= 0.95
             and mid <= 0.95
             and mid_within >= 0.95
-            and model(*noisy) == ''
+            and model(*noisy) == 'damped-sinusoid'
             and (d.model == '' or drifting_within >= 0.95)
             and model(*pluck_with_a_move(0.3, 40.0, zeta=0.005)) == ''
         )

@@ -127,18 +127,18 @@ CLEAN_SNR_DB = 33.0
 FAST_ZETA = 0.015
 #: the envelope blocks of :func:`decay_zeta`, in periods
 DECAY_BLOCK_PERIODS = 2.0
-#: a free decay whose offset is known (:func:`known_offset`) and whose signal-to-noise ratio is at
-#: least this (dB) is estimated with that offset removed by the damped-sinusoid model, whose
-#: frequency holds the decay (no :data:`FAST_ZETA` limit) and, with no offset to fit, is more
-#: precise over a short window: 6 seeds each (5 Dec), 0.9 periods, ``early_std_rel`` 0.01 --
-#: 5 Hz at zeta 1 %, 30 dB: median 1.27 -> 0.92 periods, 94-100 % within 2 %; 2 Hz at 3 %, 40 dB:
-#: 1.28 -> 0.92, 60-100 % -> 94-100 %; the real beams' median error 0.22-0.37 -> 0.16-0.24 %.
-#: At 20 dB the model's fifth parameter costs more than the offset's (88 % within 2 % against 91 %)
-DAMPED_SNR_DB = 25.0
-#: the offset is known when the record's last quarter's halves (means over whole blocks of
-#: :data:`DECAY_BLOCK_PERIODS` periods, where a sinusoid averages out) agree within this share of
-#: the decay's amplitude and the noise allows that precision: the damped model is unhurt by an
-#: offset of 0.1-0.3 % of the amplitude and loses 10-35 % of its estimates within 2 % at 1 %
+#: a free decay whose offset is known (:func:`known_offset`) is estimated with that offset removed
+#: by the damped-sinusoid model, whose frequency holds the decay (no :data:`FAST_ZETA` limit) and,
+#: with no offset to fit, is more precise over a short window: 6 seeds each (5 Dec), 0.9 periods,
+#: ``early_std_rel`` 0.01 -- 5 Hz at zeta 1 %, 30 dB: median 1.27 -> 0.92 periods, 94-100 % within
+#: 2 %; 2 Hz at 3 %, 40 dB: 1.28 -> 0.92, 60-100 % -> 94-100 %; the real beams' median error
+#: 0.22-0.37 -> 0.16-0.24 %; in 20 dB at 200-2500 samples a period 1.23-1.25 -> 0.90-0.91 periods,
+#: RMS error 0.44-0.80 -> 0.20-0.61 %, and in 13-15 dB too (no signal-to-noise limit: where the
+#: noise hides the offset it is not known). The offset is known when the record's last
+#: quarter's halves (means over whole blocks of :data:`DECAY_BLOCK_PERIODS` periods, where a
+#: sinusoid averages out) agree within this share of the decay's amplitude and the noise allows
+#: that precision: the damped model is unhurt by an offset of 0.1-0.3 % of the amplitude and
+#: loses 10-35 % of its estimates within 2 % at 1 %
 OFFSET_TOL = 1e-3
 #: ... and every block's mean lies within this share of the block's own amplitude of it (a
 #: sinusoid decaying at zeta averages to ~zeta of its amplitude over whole periods): an offset
@@ -422,9 +422,9 @@ def fast_window(
     model ('': the configured), the offset to remove (NaN: none) and the reason in words for a
     free decay of one mode at ``f`` Hz, when its spectrum is pure (:func:`impurity` below
     :data:`IMPURE`): :data:`FAST_PERIODS`, and :data:`FAST_STD` (:data:`FAST_STD_CLEAN` at
-    :data:`CLEAN_SNR_DB` and above) -- with ``offset_ok``, the offset known
-    (:func:`known_offset`) and :data:`DAMPED_SNR_DB` or more, the damped-sinusoid model on the
-    record less its offset (:data:`FAST_STD_CLEAN` while lightly damped); else only when lightly
+    :data:`CLEAN_SNR_DB` and above) -- with ``offset_ok`` and the offset known
+    (:func:`known_offset`), the damped-sinusoid model on the record less its offset
+    (:data:`FAST_STD_CLEAN` while lightly damped); else only when lightly
     damped (:func:`decay_zeta` at most :data:`FAST_ZETA`, or unknown). Otherwise (NaN, 0: the
     configured window). ``spec``: the :func:`spectrum` of ``(t, y)``, if computed already."""
     spread = impurity(t, y, f, spec)
@@ -434,7 +434,7 @@ def fast_window(
     snr = snr_db(t, y, f)
     zeta = decay_zeta(t, y, f)
     light = not zeta > FAST_ZETA
-    offset = known_offset(t, y, f) if offset_ok and snr >= DAMPED_SNR_DB else math.nan
+    offset = known_offset(t, y, f) if offset_ok else math.nan
     if not (light or math.isfinite(offset)):
         return math.nan, 0.0, '', math.nan, f'a decay damped at {100 * zeta:.1f} % (its envelope)'
     damped = math.isfinite(offset)
