@@ -178,32 +178,69 @@ def _blocks(t: np.ndarray, y: np.ndarray, f: float, other: Optional[float] = Non
     ``other`` Hz (the residual's mean square over its degrees of freedom); None if a block holds
     fewer than 4 samples (beyond the fit's parameters)."""
     nb = int(math.floor((t[-1] - t[0]) * 2 * f)) - 1
-    ends = t[-1] - np.arange(nb)[::-1] / (2 * f)
-    a = np.searchsorted(t, ends - 1 / f, 'right')
-    b = np.searchsorted(t, ends, 'right')
-    p = 0 if other is None else 5
-    if nb < 1 or np.any(b - a < 4 + p):
+    if nb < 1:
         return None
+    # block k spans the half-period marks k to k + 2
+    cuts = np.searchsorted(t, t[-1] - np.arange(nb + 1, -1, -1) / (2 * f), 'right')
+    a, b = cuts[:-2], cuts[2:]
     n = b - a
-    idx = a[:, None] + np.arange(int(n.max()))[None, :]
-    inside = idx < b[:, None]
-    idx = np.minimum(idx, len(t) - 1)
-    tau = t[idx] - t[-1]
-    e = np.exp(-2j * math.pi * f * tau) * inside
-    yb = (y[idx] - (np.sum(y[idx] * inside, axis=1) / n)[:, None]) * inside
-    if other is None:
-        c = 2 * np.sum(yb * e, axis=1) / n
-        res = (yb - np.real(c[:, None] * np.conj(e))) * inside
-        return c, 4 * np.sum(res**2, axis=1) / (n * n)
-    cols = [inside.astype(np.float64), e.real, e.imag]
-    w2 = 2 * math.pi * other
-    cols += [np.cos(w2 * tau) * inside, np.sin(w2 * tau) * inside]
-    x = np.stack(cols, axis=-1)
-    gram = np.einsum('kni,knj->kij', x, x)
-    beta = np.linalg.solve(gram, np.einsum('kni,kn->ki', x, yb)[..., None])[..., 0]
-    res = yb - np.einsum('kni,ki->kn', x, beta)
+    if np.any(n < 4 + (0 if other is None else 5)):
+        return None
+    span = slice(cuts[0], cuts[-1])
+    fit = _projected if other is None else _fitted
+    return fit(t[span] - t[-1], y[span], f, cuts - cuts[0], other)
+
+
+def _block_sums(x: np.ndarray, cuts: np.ndarray) -> np.ndarray:
+    """The sums of each row of ``x`` over the blocks (columns), block ``k`` from ``cuts[k]`` to
+    ``cuts[k + 2]``: the half blocks' sums (``np.add.reduceat``, an empty one 0) added in pairs."""
+    halves = np.add.reduceat(np.pad(x, ((0, 0), (0, 1))), cuts[:-1], axis=1)
+    halves[:, cuts[:-1] == cuts[1:]] = 0.0
+    return halves[:, :-1] + halves[:, 1:]
+
+
+def _projected(tau, y, f, cuts, other=None):
+    """:func:`_blocks` without ``other``, the blocks of ``y`` between ``cuts``
+    (:func:`_block_sums`; ``tau``: time from the last sample) from sums: with ``u = y - mean`` and
+    ``e = exp(-2 pi i f tau)`` over a block of ``n`` samples, ``c = 2 sum(u e) / n`` and the
+    residual ``u - Re(c conj(e))`` has the sum of squares
+    ``sum(u^2) - n |c|^2 / 2 + Re(c^2 conj(sum(e^2))) / 2``."""
+    n = cuts[2:] - cuts[:-2]
+    u = y - np.mean(y)  # the record's offset out of the sums' rounding
+    e = np.exp(-2j * math.pi * f * tau)
+    sums = _block_sums(np.stack((u, u * u, e, u * e, e * e)), cuts)
+    mean = sums[0].real / n
+    c = 2 * (sums[3] - mean * sums[2]) / n
+    energy = sums[1].real - n * mean * mean
+    rss = energy - n * np.abs(c) ** 2 / 2 + np.real(c * c * np.conj(sums[4])) / 2
+    return c, 4 * _floored(rss, energy) / (n * n)
+
+
+def _fitted(tau, y, f, cuts, other):
+    """:func:`_blocks` with ``other``: each block's least squares (normal equations) of a
+    constant and the sinusoids at ``f`` and ``other`` Hz on ``y`` less the block's mean, from
+    sums of the columns' products; the residual's sum of squares ``sum(u^2) - beta . X'u``."""
+    n = cuts[2:] - cuts[:-2]
+    u = y - np.mean(y)
+    w1, w2 = 2 * math.pi * f * tau, 2 * math.pi * other * tau
+    x = np.stack((np.ones_like(u), np.cos(w1), -np.sin(w1), np.cos(w2), np.sin(w2)))
+    i, j = np.triu_indices(5)
+    sums = _block_sums(np.concatenate((x[i] * x[j], x * u, [u * u])), cuts)
+    gram = np.empty((len(n), 5, 5))
+    gram[:, i, j] = gram[:, j, i] = sums[: len(i)].T
+    mean = sums[len(i)] / n  # x[0] u: the block's sum of u
+    rhs = (sums[len(i) : len(i) + 5] - mean * sums[:5]).T  # X'(u - mean)
+    beta = np.linalg.solve(gram, rhs[..., None])[..., 0]
+    energy = sums[-1] - n * mean * mean
+    rss = energy - np.sum(beta * rhs, axis=1)
     # y - m = A cos(w tau) - B sin(w tau) + ... = Re(c exp(i w tau)): c = A + iB
-    return beta[:, 1] + 1j * beta[:, 2], 4 * np.sum(res**2, axis=1) / ((n - p) * n)
+    return beta[:, 1] + 1j * beta[:, 2], 4 * _floored(rss, energy) / ((n - 5) * n)
+
+
+def _floored(rss: np.ndarray, energy: np.ndarray) -> np.ndarray:
+    """A residual sum of squares by difference, at least the rounding of ``energy`` (a noiseless
+    block)."""
+    return np.maximum(rss, np.finfo(float).eps * energy)
 
 
 def _first_block(c: np.ndarray, periods: float) -> int:
