@@ -357,9 +357,10 @@ def test_a_pure_free_decay_is_estimated_over_a_shorter_window_where_precise(
     2.5 % of the power near the mode off its peak). A large move (the real arm's step: 22 % off
     the peak) keeps the default 1.25 periods. In 20 dB of noise, its offset not removed (as the
     node decides), the 0.9-period estimates of the decay's tail are held to 1.25 periods
-    (``early_std_rel``: 80 % within 2 % without, 100 % with); in 30 dB its head is published after 0.9 periods (a median of 0.97); a decay damped
-    at 3 % (its offset known: the damped model) after 0.92, those over ``FAST_STD`` held. Each
-    constant at 0.001x and 1000x breaks one of them."""
+    (``early_std_rel``: 80 % within 2 % without, 100 % with); in 30 dB its head is published
+    after 0.9 periods (a median of 0.97); a decay damped at 3 % (its offset known: the damped
+    model) after 0.92, those over ``FAST_STD`` held. Each constant at 0.001x and 1000x breaks one
+    of them."""
 
     def right():
         fast, fast_within = decided_convergence(*pluck_with_a_move(3.0))
