@@ -1,7 +1,8 @@
 # Copyright 2026 vib_estimator developers
 # SPDX-License-Identifier: Apache-2.0
 """A periodic motion: the simulated arm (Eqs. 19-23, 1.3306 Hz) moved back and forth without
-rest, ramps one after another (a pick-and-place cycle), 300 s at 500 Hz, its coupling torque;
+rest, ramps one after another (a pick-and-place cycle; the last two schedules ramp without a
+hold: the hub's angle a triangle wave), 300 s at 500 Hz, its coupling torque;
 ``vib-estimator analyze FILE`` with no option and with ``--excitation ambient``, in the same run.
 Per schedule and configuration, over two seeds: estimates, the share within 2 % of the mode,
 those beyond 5 %, and the frequencies the estimates beyond 5 % sit at (the move cycle's odd
@@ -28,6 +29,8 @@ SCHEDULES = (
     ('1.5 s a move, jittered 50 %', 1.5, 0.5, 1.0, 0.5),
     ('4 s a move, 1 rad', 4.0, 1.0, 1.0, 0.0),
     ('0.8 s a move, 0.3 rad', 0.8, 0.3, 1.0, 0.0),
+    ('ramps back to back, 1 s, 1 rad', 1.0, 0.5, 1.0, 0.0),
+    ('ramps back to back, 2 s, 2 rad', 2.0, 1.0, 1.0, 0.0),
 )
 
 
