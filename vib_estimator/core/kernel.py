@@ -1072,57 +1072,42 @@ def _missing_optional():
     raise ValueError('kernel: run/step need optional=optional_features(p) for this p')
 
 
+def _only_with_optional(python, missing=None):
+    """Compile ``python`` (a function whose first argument is ``optional``) only where its
+    caller passes ``optional`` (:func:`optional_features`): numba's overload of it is its own body,
+    or, with ``optional`` None, a function of the same arguments that raises
+    (:func:`_missing_optional`) and returns ``missing`` (its result's type); the optional
+    features' code is then not compiled. ``python`` runs as it is uncompiled
+    (:func:`core.jit.interpreted`)."""
+    code = python.__code__
+    names = ', '.join(code.co_varnames[: code.co_argcount])
+    scope = {'_missing_optional': _missing_optional, '_unused': _unused, 'python': python}
+    exec(
+        f'def absent({names}):\n    _missing_optional()\n    return {missing!r}\n\n'
+        f'def typed({names}):\n    return absent if _unused(optional) else python\n',
+        scope,
+    )
+    overload(python, inline='always')(scope['typed'])
+
+
 def _band_std_if(optional, p, s, seg, n, model, res):
-    """:func:`_band_std`, compiled (an overload chosen by the type of ``optional``) only for a
-    configuration with optional features (:func:`optional_features`). This body is what runs
-    uncompiled (:func:`core.jit.interpreted`)."""
+    """:func:`_band_std`, compiled only for a configuration with optional features."""
     _band_std(p, s, seg, n, model, res)
 
 
-@overload(_band_std_if, inline='always')
-def _band_std_if_typed(optional, p, s, seg, n, model, res):
-    if _unused(optional):
-        return lambda optional, p, s, seg, n, model, res: _missing_optional()
-    return lambda optional, p, s, seg, n, model, res: _band_std(p, s, seg, n, model, res)
-
-
 def _target_reached_if(optional, p, s, seg, n, model, f, damping):
-    """:func:`_target_reached`, compiled only with optional features (:func:`_band_std_if`)."""
+    """:func:`_target_reached`, compiled only with optional features."""
     return _target_reached(p, s, seg, n, model, f, damping, optional)
 
 
-@overload(_target_reached_if, inline='always')
-def _target_reached_if_typed(optional, p, s, seg, n, model, f, damping):
-    if _unused(optional):
-
-        def missing(optional, p, s, seg, n, model, f, damping):
-            _missing_optional()
-            return False
-
-        return missing
-    return lambda optional, p, s, seg, n, model, f, damping: _target_reached(
-        p, s, seg, n, model, f, damping, optional
-    )
-
-
 def _long_window_if(optional, p, s, c, m, one_sided, model, tau, f, damping):
-    """:func:`_long_window_spanned`, compiled only with optional features
-    (:func:`_band_std_if`)."""
+    """:func:`_long_window_spanned`, compiled only with optional features."""
     return _long_window_spanned(p, s, c, m, one_sided, model, tau, f, damping)
 
 
-@overload(_long_window_if, inline='always')
-def _long_window_if_typed(optional, p, s, c, m, one_sided, model, tau, f, damping):
-    if _unused(optional):
-
-        def missing(optional, p, s, c, m, one_sided, model, tau, f, damping):
-            _missing_optional()
-            return False
-
-        return missing
-    return lambda optional, p, s, c, m, one_sided, model, tau, f, damping: _long_window_spanned(
-        p, s, c, m, one_sided, model, tau, f, damping
-    )
+_only_with_optional(_band_std_if)
+_only_with_optional(_target_reached_if, False)
+_only_with_optional(_long_window_if, False)
 
 
 @jit(inline='always')
