@@ -6,12 +6,15 @@ sliding window of any number of channels: the streaming side.
 ``excitation = ambient``: the structure is driven by broadband, unmeasured forces (wind, traffic, a
 robot that never rests), so there is no free decay to fit. Its modes are identified from the
 correlation structure of the response over a sliding window, as operational modal analysis does.
-One channel is the case m = 1 of the several channels' identifier (one path, one set of fixes).
+With several channels (accelerometers, the three axes of an IMU, the joints of an arm) the modes
+are identified jointly from all channels' correlations, each with its **shape** -- how much, and
+in which phase, each channel moves in it (docs/channels.md). One channel is the case m = 1 (one
+path, one set of fixes).
 
-Interface (that of :class:`~vib_estimator.core.FrequencyEstimator` and the mode tracker, which the
-node stream and ``analyze`` use): :class:`AmbientEstimator` ``.update(t, y) -> List[Estimate]``,
-``.process(t, y) -> EstimateArrays``, ``.counters``, ``.reset()``, ``.restart()``, ``.config``;
-several channels: :class:`vib_estimator.core.multichannel.JointAmbientEstimator`.
+Interface (:class:`~vib_estimator.core.Estimator`): :class:`AmbientEstimator` ``(config,
+channels=())`` ``.update(t, y) -> list[Estimate]``, ``.process(t, y) -> EstimateArrays`` (one
+channel) or :class:`~.estimator.JointEstimates` (several named ``channels``, ``y``: samples x
+channels), ``.counters``, ``.reset()``, ``.restart()``, ``.config``, ``.channels``.
 
 Method, per analysis, once ``ambient_window_s`` of samples are in: every :data:`HOP_S` (1 s) of
 input while a mode is to be confirmed, every :func:`hop_s` (a fifth of the window, 1-5 s) once
@@ -38,9 +41,12 @@ every mode tracked is published:
 
 Each estimate: ``t`` = the window's last stamp, ``convergence_time`` = the window's span (the
 window used), ``samples`` = its samples, ``amplitude`` = RMS of the modal response (summed in
-quadrature over channels), ``fit`` = share of the window's (summed) variance the modes explain.
+quadrature over channels), ``fit`` = share of the window's (summed) variance the modes explain;
+with several channels its ``shape``, ``shape_std`` (the spread over the stable model orders) and
+``mac`` with the mode's previous shape (NaN for a mode's first window).
 
-Bad samples never raise: a sample with a non-finite value, duplicate and out-of-order stamps are
+Bad samples never raise: a sample with a non-finite value (on any channel), duplicate and
+out-of-order stamps are
 skipped and counted; a gap or a backward jump longer than ``max_gap`` starts a new window
 (``gap_resets``, ``time_jump_resets``); the tracked modes are kept.
 """
@@ -59,8 +65,10 @@ from .estimator import (
     Estimate,
     EstimateArrays,
     Estimator,
+    JointEstimates,
     accept_sample,
     as_series,
+    channel_names,
 )
 from .identity import CONFIRM, CONFIRM_BESIDE, Mode, ModeRegister
 from .ssi import BLOCK_ROWS, WindowModes, block_rows, identify
@@ -136,26 +144,27 @@ class _Track(Mode):
         return max(1.0, math.sqrt(float(np.mean(d * d))))
 
 
-class SlidingWindowIdentifier(Estimator):
-    """The output-only identifier of ``channels`` channels (see the module docstring): the
-    samples' buffer (a row of ``channels`` values a sample), their checks and counters, the runs
-    of clean samples of a batch, the window each analysis reads (:meth:`_next_window`), its
-    identification (:func:`.ssi.identify`) and the modes' identity over time (:meth:`_track`).
-    :class:`AmbientEstimator` (one channel) and
-    :class:`vib_estimator.core.multichannel.JointAmbientEstimator` (several, named
-    :attr:`channels`: its estimates carry their shapes) give out its estimates."""
+class AmbientEstimator(Estimator):
+    """The output-only identifier of one channel or of several named ``channels`` (at least
+    :data:`.estimator.MIN_CHANNELS`; their count is the number of columns fed; see the module
+    docstring): the samples' buffer (a row of values a sample), their checks and counters, the
+    runs of clean samples of a batch, the window each analysis reads (:meth:`_next_window`), its
+    identification (:func:`.ssi.identify`) and the modes' identity over time (:meth:`_track`)."""
 
-    def __init__(self, config: EstimatorConfig, channels: int = 1):
+    def __init__(self, config: EstimatorConfig, channels: Sequence[str] = ()):
         config.validate()
+        if channels:
+            hint = ' (one channel: excitation ambient, one column)'
+            self.channels = channel_names(channels, 'a joint identification', hint)
         self._config = config
         self._window = config.ambient_window_s
         self._band = config.band_hz or (0.0, math.inf)
         self._c = dict.fromkeys(COUNTER_NAMES, 0)
-        self._m = channels
+        self._m = m = max(len(self.channels), 1)
         self._t = np.empty(1 << 14)
-        self._y = np.empty((1 << 14, channels))
+        self._y = np.empty((1 << 14, m))
         self._register = ModeRegister(self._window, CONFIRM, CONFIRM_BESIDE, new=_Track)
-        self._cascade = CorrelationCascade(2 * block_rows(channels), channels)
+        self._cascade = CorrelationCascade(2 * block_rows(m), m)
         #: samples fed one at a time since the last analysis (stamps, values): appended to the
         #: buffer at once when one is due (:meth:`_store`), not one numpy write each
         self._pending_t: list[float] = []
@@ -192,6 +201,15 @@ class SlidingWindowIdentifier(Estimator):
         self._pending_y.clear()
         self._cascade.clear()
         self._next = math.inf
+
+    def process(self, t: Sequence[float], y):
+        """Feed arrays of samples (``y``: samples, or samples x channels; continuing the
+        stream); the estimates by time (:class:`~.estimator.JointEstimates` of several
+        channels)."""
+        t, y = as_series(t, y, self.channels)
+        y = y.reshape(len(t), self._m)
+        out = self._feed(t, y, np.isfinite(t) & np.isfinite(y).all(axis=1))
+        return JointEstimates.of(out, self.channels) if self.channels else EstimateArrays.of(out)
 
     def update(self, t: float, y) -> list:
         """Feed one sample (one value per channel); the estimates of an analysis it completes
@@ -379,16 +397,3 @@ class SlidingWindowIdentifier(Estimator):
             out.append(Estimate(*est, *shape))
         self._c['estimates'] += len(out)
         return out
-
-
-class AmbientEstimator(SlidingWindowIdentifier):
-    """Sliding-window output-only mode identification of one channel (the m = 1 case of
-    :class:`SlidingWindowIdentifier`); see the module docstring."""
-
-    def __init__(self, config: EstimatorConfig):
-        super().__init__(config, 1)
-
-    def process(self, t: Sequence[float], y: Sequence[float]) -> EstimateArrays:
-        """Feed arrays of samples (continuing the stream); the estimates as columns, by time."""
-        t, y = as_series(t, y)
-        return EstimateArrays.of(self._feed(t, y[:, None], np.isfinite(t) & np.isfinite(y)))

@@ -100,9 +100,12 @@ COUNTER_NAMES = INPUT_COUNTERS + (
 _BOUND = ('_feed', '_k', '_p', '_row', '_s', '_seg')
 
 
-def as_series(t: Sequence[float], y: Sequence[float]) -> Tuple[np.ndarray, np.ndarray]:
+def as_series(
+    t: Sequence[float], y: Sequence[float], channels: Sequence[str] = ()
+) -> Tuple[np.ndarray, np.ndarray]:
     """``t``, ``y`` as contiguous, writeable float64 arrays of one length (``ValueError``
-    otherwise); ``y`` may be samples x 1 (one channel, as a joint estimator's input).
+    otherwise): ``y`` samples, or samples x 1 (one channel, as a joint estimator's input);
+    with several named ``channels``, samples x that many.
 
     Writeable: numba compiles a kernel once more for a read-only array (another type), so a
     CSV's read-only time column (pyarrow's) cost ``analyze`` a compile of 10-20 s that
@@ -110,11 +113,27 @@ def as_series(t: Sequence[float], y: Sequence[float]) -> Tuple[np.ndarray, np.nd
     """
     t = np.require(t, np.float64, ('C', 'W'))
     y = np.require(y, np.float64, ('C', 'W'))
-    if y.ndim == 2 and y.shape[1:] == (1,):
+    m = len(channels)
+    if m and (y.ndim != 2 or y.shape[1] != m):
+        raise ValueError(f'y must be samples x {m} channels, got {y.shape}')
+    if not m and y.ndim == 2 and y.shape[1:] == (1,):
         y = y[:, 0]
-    if t.shape != y.shape or t.ndim != 1:
+    if t.shape != y.shape[: 1 if m else None] or t.ndim != 1:
         raise ValueError(f't and y must be 1-D arrays of one length, got {t.shape}, {y.shape}')
     return t, y
+
+
+#: the fewest channels of a joint estimator (one channel is a one-channel estimator's)
+MIN_CHANNELS = 2
+
+
+def channel_names(channels: Sequence[str], what: str, hint: str = '') -> Tuple[str, ...]:
+    """``channels`` as names; ValueError if they are fewer than :data:`MIN_CHANNELS` (``what``
+    needs them; ``hint``: what to do instead)."""
+    names = tuple(str(c) for c in channels)
+    if len(names) < MIN_CHANNELS:
+        raise ValueError(f'{what} needs at least {MIN_CHANNELS} channels, got {len(names)}{hint}')
+    return names
 
 
 @dataclass(frozen=True)
@@ -133,7 +152,7 @@ class Estimate:
         damping_std: predicted standard deviation of ``damping`` (NaN if not computed).
         mode: the mode it belongs to, 1 = the lowest (``modes`` >= 1); 0 with ``modes`` = 0.
         shape: a joint estimator's mode shape, normalised, complex, one entry per channel
-            (None with one channel; :mod:`.multichannel`).
+            (None with one channel; :mod:`.ambient`, :mod:`.multichannel_free`).
         shape_std: its uncertainty per channel (None with one channel).
         mac: the MAC of ``shape`` with the same mode's previous one (NaN at its first and with
             one channel).
@@ -184,7 +203,7 @@ class Estimator(Protocol):
       channel); the estimates it completes, a sequence (empty, usually).
     - ``process(t, y)``: arrays of samples (``y``: samples, or samples x channels), continuing
       the stream; the estimates as columns (:class:`EstimateArrays`; a joint estimator's
-      :class:`~.multichannel.JointEstimates` add the shapes). Streaming equals batch.
+      :class:`JointEstimates` add the shapes). Streaming equals batch.
     - ``reset()``: a new segment or window at the last sample; ``restart()``: forget the
       signal; both keep the counters.
     - ``config``; ``channels``: the channel names of a joint estimator, () for one channel.
@@ -286,6 +305,34 @@ class EstimateArrays:
             Estimate(*(int(v) if i in ints else float(v) for i, v in enumerate(row)))
             for row in zip(*columns)
         ]
+
+
+@dataclass
+class JointEstimates:
+    """Estimates of a joint (several channels) batch run: the columns of
+    :class:`EstimateArrays`, the shapes (estimates x channels, complex), their stds and the MACs,
+    in the estimates' order."""
+
+    estimates: EstimateArrays
+    shapes: np.ndarray
+    shape_std: np.ndarray
+    mac: np.ndarray
+    channels: Tuple[str, ...]
+
+    def __len__(self) -> int:
+        return len(self.estimates)
+
+    @classmethod
+    def of(cls, out: Sequence[Estimate], channels: Tuple[str, ...]) -> 'JointEstimates':
+        """The columns of the estimates ``out`` (with shapes) of ``channels``, in their order."""
+        m = len(channels)
+        return cls(
+            EstimateArrays.of(out),
+            np.array([e.shape for e in out], dtype=complex).reshape(-1, m),
+            np.array([e.shape_std for e in out]).reshape(-1, m),
+            np.array([e.mac for e in out]),
+            channels,
+        )
 
 
 class FrequencyEstimator(Estimator):

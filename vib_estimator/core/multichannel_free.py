@@ -7,8 +7,9 @@ accelerometers on a beam) after a pluck: each estimate is fitted to all channels
 mode's **shape** -- how much, and in which phase, each channel moves in it. One channel is not
 routed here: it stays the one-channel estimator of :func:`..factory.create_estimator`, bit for bit.
 
-Interface (that of :class:`..multichannel.JointAmbientEstimator`): :class:`JointFreeEstimator`
-``(config, channels, single)`` ``.process(t, Y) ->`` :class:`..multichannel.JointEstimates` (``Y``:
+Interface (that of :class:`..ambient.AmbientEstimator` of several channels):
+:class:`JointFreeEstimator` ``(config, channels, single)`` ``.process(t, Y) ->``
+:class:`..estimator.JointEstimates` (``Y``:
 samples x channels), ``.update(t, y) -> list[Estimate]``, ``.counters``, ``.reset()``,
 ``.restart()``, ``.config``, ``.channels``; :func:`..factory.create_estimator` picks it for
 ``excitation`` free and several channels.
@@ -74,9 +75,16 @@ from functools import partial
 import numpy as np
 
 from .config import EstimatorConfig
-from .estimator import INPUT_COUNTERS, Estimate, Estimator, accept_sample
+from .estimator import (
+    INPUT_COUNTERS,
+    Estimate,
+    Estimator,
+    JointEstimates,
+    accept_sample,
+    as_series,
+    channel_names,
+)
 from .identity import ModeRegister
-from .multichannel import JointEstimates, as_channels, channel_names
 from .shapes import normalise_shape
 from .threads import single_blas_thread
 
@@ -406,7 +414,7 @@ class JointFreeEstimator(Estimator):
     def process(self, t: Sequence[float], y: np.ndarray) -> JointEstimates:
         """Feed arrays (``y``: samples x channels; continuing the stream); the estimates by
         time."""
-        t, y = as_channels(t, y, len(self.channels))
+        t, y = as_series(t, y, self.channels)
         keep, restarts = self._keep(t, y)
         t, y = t[keep], y[keep]
         out: list[Estimate] = []
