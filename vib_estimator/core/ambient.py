@@ -66,6 +66,7 @@ from .estimator import (
     EstimateArrays,
     Estimator,
     JointEstimates,
+    accept_rows,
     accept_sample,
     as_series,
     channel_names,
@@ -296,31 +297,22 @@ class AmbientEstimator(Estimator):
 
     @single_blas_thread
     def _feed(self, t: np.ndarray, y: np.ndarray, finite: np.ndarray) -> list:
-        """Feed a batch (``finite``: per sample, its values are): each clean run (finite,
-        increasing, no gap) at once up to the next analysis, any other sample through
-        ``update``; the estimates of the analyses, in order."""
+        """Feed a batch (``finite``: per sample, its values are): its samples kept
+        (:func:`.estimator.accept_rows`, a restart clearing the window) appended at once up to
+        each analysis; the estimates of the analyses, in order."""
         out: list = []
-        gap = self._config.max_gap
-        i, n = 0, len(t)
-        while i < n:
-            j = i
-            if finite[i] and t[i] > self._last and t[i] - self._last <= gap:
-                d = np.diff(t[i : min(n, i + 65536)])
-                bad = ~((d > 0) & (d <= gap)) | ~finite[i + 1 : i + 1 + len(d)]
-                j = i + 1 + (int(np.argmax(bad)) if bad.any() else len(d))
-            if j == i:
-                out.extend(self.update(t[i], y[i]))
-                i += 1
-                continue
-            while i < j:
+        kept, restarts, _ = accept_rows(self._c, self._last, t, finite, self._max_gap)
+        t, y = t[kept], y[kept]
+        cuts = [0, *np.flatnonzero(restarts).tolist(), len(t)]
+        for a, b in zip(cuts[:-1], cuts[1:]):
+            if a < b and restarts[a]:
+                self._clear()
+            while a < b:
                 if self._next == math.inf:  # the window's first sample
-                    self._next = float(t[i]) + self._window
-                k = min(j, int(np.searchsorted(t[i:j], self._next, 'left')) + i + 1)
-                self._c['received'] += k - i
-                self._c['used'] += k - i
-                self._append(t[i:k], y[i:k])
-                self._last = float(t[k - 1])
-                i = k
+                    self._next = float(t[a]) + self._window
+                k = min(b, int(np.searchsorted(t[a:b], self._next, 'left')) + a + 1)
+                self._append(t[a:k], y[a:k])
+                self._last, a = float(t[k - 1]), k
                 if self._last >= self._next:
                     out.extend(self._due())
         return out

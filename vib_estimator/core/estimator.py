@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import partial
 from typing import Callable, Dict, List, Optional, Protocol, Sequence, Tuple
 
 import numpy as np
@@ -79,6 +80,33 @@ def accept_sample(
         c['time_jump_resets' if t <= last else 'gap_resets'] += 1
         restart()
     return True
+
+
+def accept_rows(
+    c: Dict[str, int], last: float, t: np.ndarray, finite: np.ndarray, max_gap: float
+) -> Tuple[np.ndarray, np.ndarray, float]:
+    """:func:`accept_sample` over a batch of stamps ``t`` (``finite``: per sample, its values
+    are): ``(kept: per sample, whether it is kept; restarts: per kept sample, whether it
+    restarts the signal (a gap or a jump back); the last kept stamp)``. A run of clean samples
+    (finite, increasing, no gap) is counted at once, any other sample by :func:`accept_sample`."""
+    n = len(t)
+    kept, restarts, restarted = np.zeros(n, bool), np.zeros(n, bool), []
+    mark = partial(restarted.append, True)  # accept_sample's restart
+    i = 0
+    while i < n:
+        if finite[i] and t[i] > last and t[i] - last <= max_gap:
+            d = np.diff(t[i : min(n, i + 65536)])
+            bad = ~((d > 0) & (d <= max_gap)) | ~finite[i + 1 : i + 1 + len(d)]
+            j = i + 1 + (int(np.argmax(bad)) if bad.any() else len(d))
+            c['received'] += j - i
+            c['used'] += j - i
+            kept[i:j], last, i = True, float(t[j - 1]), j
+            continue
+        restarted.clear()
+        if accept_sample(c, last, float(t[i]), bool(finite[i]), max_gap, mark):
+            kept[i], restarts[i], last = True, bool(restarted), float(t[i])
+        i += 1
+    return kept, restarts[kept], last
 
 
 #: counter names, in the order of :mod:`vib_estimator.core.kernel`'s counter array

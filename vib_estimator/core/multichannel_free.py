@@ -60,9 +60,9 @@ A fit is published only if it is finite, within :data:`MAX_MOVE` of its start an
 ``|zeta| <= max_damping``; else counted (``rejected_joint``). Bad samples never raise: a
 row with a non-finite stamp or channel is skipped (``skipped_non_finite``), a repeated or earlier
 stamp within ``max_gap`` too (``skipped_duplicate``, ``skipped_out_of_order``); a jump back or a
-gap beyond it restarts (``time_jump_resets``, ``gap_resets``: :func:`.estimator.accept_sample`,
-the input policy the identifier shares); the channels' estimators see only the rows kept, so
-their gaps and jumps are handled as with one channel.
+gap beyond it restarts (``time_jump_resets``, ``gap_resets``: :func:`.estimator.accept_rows`,
+the input policy every estimator written in Python shares); the channels' estimators see only the
+rows kept, so their gaps and jumps are handled as with one channel.
 """
 
 from __future__ import annotations
@@ -70,7 +70,6 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from functools import partial
 
 import numpy as np
 
@@ -80,7 +79,7 @@ from .estimator import (
     Estimate,
     Estimator,
     JointEstimates,
-    accept_sample,
+    accept_rows,
     as_series,
     channel_names,
 )
@@ -341,21 +340,12 @@ class JointFreeEstimator(Estimator):
     # ---- input --------------------------------------------------------------------------------
     def _keep(self, t: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The rows to keep and the kept rows that restart (a jump back or a gap beyond
-        ``max_gap``), counted (:func:`.estimator.accept_sample`)."""
+        ``max_gap``), counted (:func:`.estimator.accept_rows`)."""
         finite = np.isfinite(t) & np.all(np.isfinite(y), axis=1)
-        kept = np.zeros(len(t), bool)
-        restarts = np.zeros(len(t), bool)
-        last, gap = self._last, self._config.max_gap
-        restarted: list = []
-        mark = partial(restarted.append, None)  # accept_sample's restart
-        for i, (ti, ok) in enumerate(zip(t.tolist(), finite.tolist())):
-            if accept_sample(self._c, last, ti, ok, gap, mark):
-                kept[i], last = True, ti
-                if restarted:
-                    restarts[i] = True
-                    restarted.clear()
-        self._last = last
-        return kept, restarts[kept]
+        kept, restarts, self._last = accept_rows(
+            self._c, self._last, t, finite, self._config.max_gap
+        )
+        return kept, restarts
 
     def _forget_signal(self) -> None:
         """After a restart (:meth:`_keep`): the row store emptied, the channels' recent
