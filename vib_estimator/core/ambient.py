@@ -70,6 +70,7 @@ from .estimator import (
     accept_sample,
     as_series,
     channel_names,
+    make_room,
 )
 from .identity import CONFIRM, CONFIRM_BESIDE, Mode, ModeRegister
 from .ssi import BLOCK_ROWS, WindowModes, block_rows, identify
@@ -162,8 +163,7 @@ class AmbientEstimator(Estimator):
         self._band = config.band_hz or (0.0, math.inf)
         self._c = dict.fromkeys(COUNTER_NAMES, 0)
         self._m = m = max(len(self.channels), 1)
-        self._t = np.empty(1 << 14)
-        self._y = np.empty((1 << 14, m))
+        self._t = np.empty(1 << 14)  # the window's stamps (its values: in the cascade)
         self._register = ModeRegister(self._window, CONFIRM, CONFIRM_BESIDE, new=_Track)
         self._cascade = CorrelationCascade(2 * block_rows(m), m)
         #: samples fed one at a time since the last analysis (stamps, values): appended to the
@@ -197,7 +197,6 @@ class AmbientEstimator(Estimator):
     def _clear(self) -> None:
         self._n = 0  # samples in the buffer
         self._start = 0  # first sample of the current window
-        self._fed = 0  # samples of the buffer in the cascade
         self._pending_t.clear()
         self._pending_y.clear()
         self._cascade.clear()
@@ -254,20 +253,10 @@ class AmbientEstimator(Estimator):
         self._store()
         m = len(t)
         if self._n + m > len(self._t):
-            keep = self._n - self._start
-            if keep + m > len(self._t) // 2:  # grow
-                size = 1 << math.ceil(math.log2(2 * (keep + m)))
-                self._t = np.concatenate((self._t[self._start : self._n], np.empty(size - keep)))
-                self._y = np.concatenate(
-                    (self._y[self._start : self._n], np.empty((size - keep, self._m)))
-                )
-            else:  # compact
-                self._t[:keep] = self._t[self._start : self._n]
-                self._y[:keep] = self._y[self._start : self._n]
-            self._fed -= self._start
-            self._n, self._start = keep, 0
+            self._t = make_room(self._t, self._start, self._n, m)
+            self._n, self._start = self._n - self._start, 0
         self._t[self._n : self._n + m] = t
-        self._y[self._n : self._n + m] = y
+        self._cascade.push(y)
         if self._n == 0:
             self._next = float(self._t[0]) + self._window
         self._n += m
@@ -355,8 +344,6 @@ class AmbientEstimator(Estimator):
         )
         self._start = first
         ts = self._t[first : self._n]
-        self._cascade.push(self._y[self._fed : self._n])
-        self._fed = self._n
         self._cascade.keep_last(len(ts))
         return ts
 

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .estimator import make_room
 from .jit import jit
 
 #: a window whose RMS is at most this fraction of its mean's magnitude is constant to rounding
@@ -191,12 +192,9 @@ class LagProducts:
         if not m:
             return
         if self._n + m > len(self._buf):
-            keep = self._n - self._start
-            size = max(len(self._buf), 1 << math.ceil(math.log2(2 * (keep + m))))
-            buf = np.empty((size, self.channels)) if size > len(self._buf) else self._buf
-            buf[:keep] = self._buf[self._start : self._n]
             shift = self._start
-            self._buf, self._n = buf, keep
+            self._buf = make_room(self._buf, shift, self._n, m)
+            self._n -= shift
             self._start, self._want, self._done = 0, self._want - shift, self._done - shift
         if self._n == self._want:
             self._offset = np.array(x[0], dtype=np.float64)  # keeps the products' rounding small

@@ -109,6 +109,17 @@ def accept_rows(
     return kept, restarts[kept], last
 
 
+def make_room(buf: np.ndarray, start: int, n: int, more: int) -> np.ndarray:
+    """``buf`` (a buffer of rows) with its rows ``start .. n`` moved to its front and room after
+    them for ``more`` rows: in place, or in a new buffer of twice their count rounded up to a
+    power of two (the sample buffers of the estimators written in Python)."""
+    keep = n - start
+    size = 1 << math.ceil(math.log2(2 * (keep + more)))
+    out = buf if size <= len(buf) else np.empty((size, *buf.shape[1:]))
+    out[:keep] = buf[start:n]
+    return out
+
+
 #: counter names, in the order of :mod:`vib_estimator.core.kernel`'s counter array
 COUNTER_NAMES = INPUT_COUNTERS + (
     'rejected_at_rest',

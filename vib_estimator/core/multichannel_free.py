@@ -82,6 +82,7 @@ from .estimator import (
     accept_rows,
     as_series,
     channel_names,
+    make_room,
 )
 from .identity import ModeRegister
 from .shapes import normalise_shape
@@ -367,19 +368,12 @@ class JointFreeEstimator(Estimator):
 
     def _append(self, t: np.ndarray, y: np.ndarray) -> None:
         """Append kept rows to the row store (the last ``buffer_samples`` rows are held)."""
-        rows, room = self._rows, self._room
-        if self._n + len(t) > len(rows):  # keep the last `room` rows (and make space)
-            keep = min(self._n, room)
-            if keep + len(t) > len(rows):
-                rows = np.empty((keep + len(t), rows.shape[1]))
-                rows[:keep] = self._rows[self._n - keep : self._n]
-                self._rows = rows
-            else:
-                rows[:keep] = rows[self._n - keep : self._n]
+        if self._n + len(t) > len(self._rows):  # keep the last `room` rows (and make space)
+            keep = min(self._n, self._room)
+            self._rows = make_room(self._rows, self._n - keep, self._n, len(t))
             self._n = keep
-        start = self._n
-        rows[start : start + len(t), 0] = t
-        rows[start : start + len(t), 1:] = y
+        self._rows[self._n : self._n + len(t), 0] = t
+        self._rows[self._n : self._n + len(t), 1:] = y
         self._n += len(t)
 
     # ---- streaming and batch ------------------------------------------------------------------
