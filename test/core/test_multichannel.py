@@ -9,10 +9,11 @@ import pytest
 
 from vib_estimator.core import EstimatorConfig
 from vib_estimator.core.ambient import AmbientEstimator
-from vib_estimator.core.correlations import correlation_matrices
 from vib_estimator.core.shapes import mac
 from vib_estimator.sim.arm_model import simulate_driven
 from vib_estimator.sim.frame import frame_record, modal_record, shear_frame
+
+from .test_ambient_incremental import correlation_matrices
 
 #: 6 Hz at 0.3 of the rate: the frame's modes without decimation (a short test)
 FS = 20.0
