@@ -219,6 +219,13 @@ class Estimate:
         """Estimated angular frequency, rad/s."""
         return 2 * math.pi * self.frequency_hz
 
+    @classmethod
+    def of_row(cls, row: np.ndarray) -> 'Estimate':
+        """An estimate from a kernel's row: the fields in order (:mod:`.kernel`'s ``O_*``), a
+        mode after them (the mode tracker's) or none (0)."""
+        ints = (K.O_SAMPLES, K.N_OUT)
+        return cls(*(int(v) if i in ints else float(v) for i, v in enumerate(row)))
+
     def as_dict(self) -> Dict[str, float]:
         return {
             't': self.t,
@@ -299,14 +306,15 @@ class EstimateArrays:
     mode: np.ndarray
 
     @classmethod
-    def from_rows(cls, rows: np.ndarray, mode: int = 0) -> 'EstimateArrays':
-        """Columns of the kernel's estimate rows, all of one ``mode``."""
+    def from_rows(cls, rows: np.ndarray) -> 'EstimateArrays':
+        """Columns of a kernel's estimate rows (:meth:`Estimate.of_row`)."""
+        mode = rows[:, K.N_OUT] if rows.shape[1] > K.N_OUT else np.zeros(len(rows))
         return cls(
             *(
                 rows[:, i].astype(np.int64) if i == K.O_SAMPLES else rows[:, i].copy()
                 for i in range(K.N_OUT)
             ),
-            np.full(len(rows), mode, dtype=np.int64),
+            mode.astype(np.int64),
         )
 
     @classmethod
@@ -479,11 +487,7 @@ class FrequencyEstimator(Estimator):
                 else entry(K.feed, (self._f, self._c, self._n_state, 0.0, 0.0, self._optional))
             )
         if feed(self._f, self._c, self._n_state, t, y, self._optional):
-            return (
-                Estimate(
-                    *(int(v) if i == K.O_SAMPLES else float(v) for i, v in enumerate(self._row[0]))
-                ),
-            )
+            return (Estimate.of_row(self._row[0]),)
         return ()
 
     def process(self, t: Sequence[float], y: Sequence[float]) -> EstimateArrays:

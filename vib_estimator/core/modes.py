@@ -823,13 +823,7 @@ class ModeTracker(Estimator):
             raise ValueError('ModeTracker needs modes >= 1 (FrequencyEstimator for modes = 0)')
         self._config = config
         self._fs = np.zeros(N_F)
-        self._b, self._sl, self._pd, self._lams, pa = (
-            self._fs[:N_B],
-            self._fs[F_SL:F_PD].reshape((KMAX, N_SL)),
-            self._fs[F_PD:F_LAM].reshape((NPEND, 3)),
-            self._fs[F_LAM:F_PA].reshape((NS, 3, PCOL)),
-            self._fs[F_PA:N_F],
-        )
+        self._b, self._sl, self._pd, self._lams, pa = _unpack.py_func(self._fs)
         self._ic = np.zeros(N_I, dtype=np.int64)
         self._qs = np.zeros((NS, NQ, PCOL))
         band = config.band_hz or (0.0, math.inf)
@@ -881,12 +875,7 @@ class ModeTracker(Estimator):
         if n == 0:
             return []
         rows = self._out[:n]
-        return [
-            Estimate(
-                *row[:O_SAMPLES], int(row[O_SAMPLES]), *row[O_FIT:O_MODE], mode=int(row[O_MODE])
-            )
-            for row in rows[np.lexsort((rows[:, O_MODE], rows[:, O_T]))]
-        ]
+        return [Estimate.of_row(row) for row in rows[np.lexsort((rows[:, O_MODE], rows[:, O_T]))]]
 
     def process(self, t: Sequence[float], y: Sequence[float]) -> EstimateArrays:
         """Feed arrays of samples (continuing the stream); the estimates as columns, by time."""
@@ -898,12 +887,7 @@ class ModeTracker(Estimator):
             i = self._m._run(self._fs, self._ic, self._qs, t, y, out, i)
             parts.append(out[: self._ic[I_NOUT]].copy())
         rows = np.concatenate(parts) if parts else np.empty((0, N_O))
-        rows = rows[np.lexsort((rows[:, O_MODE], rows[:, O_T]))]
-        cols = [
-            rows[:, j].astype(np.int64) if j in (O_SAMPLES, O_MODE) else rows[:, j].copy()
-            for j in range(N_O)
-        ]
-        return EstimateArrays(*cols)
+        return EstimateArrays.from_rows(rows[np.lexsort((rows[:, O_MODE], rows[:, O_T]))])
 
     # ---- what it knows -----------------------------------------------------------------------
     def _active(self) -> List[int]:
