@@ -136,7 +136,7 @@ COUNTER_NAMES = INPUT_COUNTERS + (
 
 
 #: the attributes :meth:`FrequencyEstimator._bind` derives (not pickled: compiled code, views)
-_BOUND = ('_feed', '_k', '_p', '_row', '_s', '_seg')
+_BOUND = ('_feed', '_p', '_row', '_s', '_seg')
 
 
 def as_series(
@@ -263,17 +263,33 @@ class Estimator(Protocol):
       back and why; the others are named in the estimator's module.
 
     The estimators subclass it, for the defaults of ``channels``, ``segment_samples``,
-    ``interpreted`` and ``mode_counters``.
+    ``interpreted`` and ``mode_counters``, and an estimator whose step is a module's compiled
+    functions (:attr:`_module`) for :attr:`_k` and :meth:`compiled`.
     """
 
     channels: Tuple[str, ...] = ()
     segment_samples: Optional[int] = None
     #: True while it runs its kernels uncompiled (:func:`.factory.create_uncompiled`)
     interpreted: bool = False
+    #: the module whose compiled functions are its step (None: none)
+    _module = None
 
     @property
     def config(self) -> EstimatorConfig:
         return self._config
+
+    @property
+    def _k(self):
+        """:attr:`_module`'s compiled functions, or while :attr:`interpreted` their uncompiled
+        code (:func:`.jit.interpreted`: the same state, the same floats, estimating at once while
+        they compile)."""
+        return interpreted(self._module) if self.interpreted else self._module
+
+    def compiled(self) -> None:
+        """Run the compiled functions from the next sample on (the state is in the arrays both
+        read). Their first call compiles them, unless compiled already (the node compiles them in
+        the background: :mod:`vib_estimator.nodes.stream`)."""
+        self.interpreted = False
 
     @property
     def counters(self) -> Dict[str, int]: ...
@@ -393,11 +409,12 @@ class FrequencyEstimator(Estimator):
     ``counters`` tells how many samples went where and why estimates were held back.
     """
 
+    _module = K
+
     def __init__(self, config: EstimatorConfig = EstimatorConfig(), interpret: bool = False):
         config.validate()
         self._config = config
-        #: the kernel's functions: compiled, or uncompiled while ``interpret`` (:meth:`compiled`)
-        self._k = interpreted(K) if interpret else K
+        self.interpreted = interpret  # (:meth:`~Estimator.compiled`)
         self._n_state = K.N_STATE_FIXED + 2 * config.window + 1
         self._f = K.feed_buffer(config.as_params(), self._n_state, config.buffer_samples)
         self._c = np.zeros(K.N_COUNTERS, dtype=np.int64)
@@ -410,20 +427,6 @@ class FrequencyEstimator(Estimator):
         ``_s``, ``_seg`` (:func:`core.kernel.feed_buffer`'s layout) and the streaming path's
         compiled code, looked up at the first :meth:`update`."""
         self._p, self._row, self._s, self._seg = K.feed_views.py_func(self._f, self._n_state)
-        self._feed = None
-        self.__dict__.setdefault('_k', K)  # unpickled: compiled (the kernel is not pickled)
-
-    @property
-    def interpreted(self) -> bool:
-        """True while the estimator runs its kernel uncompiled (``interpret``)."""
-        return self._k is not K
-
-    def compiled(self) -> None:
-        """Run the compiled kernel from the next sample on (same state, same floats: the
-        uncompiled one computes what it computes, :func:`core.jit.interpreted`). Its first call
-        compiles it, unless it is compiled already (the node compiles it in the background:
-        :mod:`vib_estimator.nodes.stream`)."""
-        self._k = K
         self._feed = None
 
     def kernels_available(self) -> bool:
@@ -481,11 +484,11 @@ class FrequencyEstimator(Estimator):
         """
         feed = self._feed
         if feed is None:
-            feed = self._feed = (
-                self._k.feed
-                if self.interpreted
-                else entry(K.feed, (self._f, self._c, self._n_state, 0.0, 0.0, self._optional))
-            )
+            if self.interpreted:  # (not kept: compiled() switches)
+                feed = self._k.feed
+            else:
+                args = (self._f, self._c, self._n_state, 0.0, 0.0, self._optional)
+                feed = self._feed = entry(K.feed, args)
         if feed(self._f, self._c, self._n_state, t, y, self._optional):
             return (Estimate.of_row(self._row[0]),)
         return ()

@@ -79,7 +79,7 @@ import numpy as np
 
 from .config import EstimatorConfig
 from .estimator import COUNTER_NAMES, Estimate, EstimateArrays, Estimator, as_series
-from .jit import available, borrowed, interpreted, jit
+from .jit import available, borrowed, jit
 from .kernel import BAND_DAMPING, advance, discretise
 from .subspace import (
     N_R,
@@ -88,7 +88,7 @@ from .subspace import (
     R_NU,
     R_ZETA,
     analyse,
-    init_subspace,  # noqa: F401 (ModeTracker.restart: self._m.init_subspace)
+    init_subspace,  # noqa: F401 (ModeTracker.restart: self._k.init_subspace)
 )
 
 KMAX = 8  # most modes a tracker follows (the range of ``modes``)
@@ -816,9 +816,11 @@ class ModeTracker(Estimator):
     as the compiled tracker does from one CPU to another (test/core/test_kernel_reference.py).
     """
 
+    _module = sys.modules[__name__]  # (:attr:`~.estimator.Estimator._k`)
+
     def __init__(self, config: EstimatorConfig, fast: bool = True, interpret: bool = False):
         config.validate()
-        self._interpret = interpret
+        self.interpreted = interpret
         if config.modes < 1:
             raise ValueError('ModeTracker needs modes >= 1 (FrequencyEstimator for modes = 0)')
         self._config = config
@@ -842,23 +844,8 @@ class ModeTracker(Estimator):
         self._out = np.empty((ROOM, N_O))
         self._t1 = np.zeros(1)  # the streaming path's sample, fed to the batch kernel
         self._y1 = np.zeros(1)
-        self._m._levels_init(self._b)
+        self._k._levels_init(self._b)
         self.restart()
-
-    @property
-    def _m(self):
-        """This module's compiled functions, or their uncompiled namespace while ``interpret``."""
-        return interpreted(_MODULE) if self._interpret else _MODULE
-
-    @property
-    def interpreted(self) -> bool:
-        """True while the tracker runs uncompiled (``interpret``)."""
-        return self._interpret
-
-    def compiled(self) -> None:
-        """Run compiled from the next sample on (the state lives in the arrays both read). Its
-        first call compiles, unless compiled already (the node compiles in the background)."""
-        self._interpret = False
 
     def kernels_available(self) -> bool:
         """Whether the compiled batch step is in memory or numba's cache
@@ -870,7 +857,7 @@ class ModeTracker(Estimator):
         """Feed one sample; return the estimates published at it (ascending mode)."""
         self._t1[0] = t
         self._y1[0] = y
-        self._m._run(self._fs, self._ic, self._qs, self._t1, self._y1, self._out, 0)
+        self._k._run(self._fs, self._ic, self._qs, self._t1, self._y1, self._out, 0)
         n = self._ic[I_NOUT]
         if n == 0:
             return []
@@ -884,7 +871,7 @@ class ModeTracker(Estimator):
         parts = []
         i = 0
         while i < len(t):
-            i = self._m._run(self._fs, self._ic, self._qs, t, y, out, i)
+            i = self._k._run(self._fs, self._ic, self._qs, t, y, out, i)
             parts.append(out[: self._ic[I_NOUT]].copy())
         rows = np.concatenate(parts) if parts else np.empty((0, N_O))
         return EstimateArrays.from_rows(rows[np.lexsort((rows[:, O_MODE], rows[:, O_T]))])
@@ -941,7 +928,7 @@ class ModeTracker(Estimator):
         """Forget the signal entirely (levels, modes, candidates); counters are kept."""
         for k in range(KMAX):
             if self._sl[k, SL_ACTIVE]:
-                self._m._remove(self._ic, self._sl, k)
+                self._k._remove(self._ic, self._sl, k)
                 self._ic[I_LOST] -= 1
         keep = {
             i: self._ic[i]
@@ -953,13 +940,9 @@ class ModeTracker(Estimator):
         self._sl[:] = 0.0
         self._pd[:] = 0.0
         self._b[B_RING:] = 0.0
-        self._m._levels_settle(self._b, self._ic, 0.0)
+        self._k._levels_settle(self._b, self._ic, 0.0)
         for s in range(NS):
             m = M_A if s % 2 == 0 else M_B
-            self._m.init_subspace(self._qs[s, : m // 3 + 1, : self._npc])
+            self._k.init_subspace(self._qs[s, : m // 3 + 1, : self._npc])
         self._lams[:, 0] = 0.0
         self._lams[:, 1:] = math.nan
-
-
-#: this module (:meth:`ModeTracker._m`: its compiled functions, or :func:`core.jit.interpreted`'s)
-_MODULE = sys.modules[__name__]
