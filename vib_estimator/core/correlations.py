@@ -144,7 +144,8 @@ class LagProducts:
         self._want = 0  # the window's first sample
         self._start = 0  # the first sample of the stretch [start, done) the sums cover
         self._done = 0
-        self._offset = np.zeros(self.channels)
+        #: the value subtracted from the samples before their products are summed
+        self.offset = np.zeros(self.channels)
         self._sums = np.zeros((self.lags + 1, self.channels, self.channels))
         self._total = np.zeros(self.channels)
         self._slides = 0
@@ -158,15 +159,10 @@ class LagProducts:
         """The window's samples (a view)."""
         return self._buf[self._want : self._n]
 
-    @property
-    def offset(self) -> np.ndarray:
-        """The value subtracted from the samples before their products are summed."""
-        return self._offset
-
     def mean(self) -> np.ndarray:
         """The window's mean, from the sums kept."""
         self._sync()
-        return self._offset + self._total / len(self)
+        return self.offset + self._total / len(self)
 
     def push(self, x: np.ndarray) -> None:
         """Append samples ``x`` (rows) to the window."""
@@ -179,7 +175,7 @@ class LagProducts:
             self._n -= shift
             self._start, self._want, self._done = 0, self._want - shift, self._done - shift
         if self._n == self._want:
-            self._offset = np.array(x[0], dtype=np.float64)  # keeps the products' rounding small
+            self.offset = np.array(x[0], dtype=np.float64)  # keeps the products' rounding small
             self._restart()
         self._buf[self._n : self._n + m] = x
         self._n += m
@@ -198,33 +194,25 @@ class LagProducts:
         self._slides = 0
 
     def _sync(self) -> None:
-        """Bring the sums to the window."""
+        """Bring the sums to the window: subtract the products ``y[u + k] y[u]^T`` of the samples
+        that left, add the products ``y[t] y[t - k]^T`` of those pushed with the window's."""
+        args = (self.offset, self._sums, self._total)  # (updated in place)
         if self._want > self._start:
             if self._want >= self._done or self._slides >= REFRESH_SLIDES:
                 self._restart()
             else:
-                self._sub(self._start, self._want)
+                lag_products(self._buf, self._start, self._want, self._done, *args, False, True)
                 self._start = self._want
                 self._slides += 1
         if self._done < self._n:
-            self._add(self._done, self._n)
+            lag_products(self._buf, self._done, self._n, self._start, *args)
             self._done = self._n
-
-    def _add(self, a: int, b: int) -> None:
-        """Add the products ``y[t] y[t - k]^T`` of the samples a <= t < b with the window's."""
-        lag_products(self._buf, a, b, self._start, self._offset, self._sums, self._total)
-
-    def _sub(self, c: int, d: int) -> None:
-        """Subtract the products ``y[u + k] y[u]^T`` of the samples c <= u < d leaving."""
-        lag_products(
-            self._buf, c, d, self._done, self._offset, self._sums, self._total, False, True
-        )
 
     def correlations(self) -> np.ndarray:
         """The window's unbiased correlation matrices of its mean-removed channels, ``R_k[a, b]
         = sum_t y_a,t+k y_b,t / (N - k)``, k = 0 .. ``lags``: (lags + 1, channels, channels)."""
         self._sync()
-        return centred_correlations(self._sums, self._total, self.window, self._offset)
+        return centred_correlations(self._sums, self._total, self.window, self.offset)
 
 
 class EditedProducts:

@@ -78,7 +78,14 @@ from typing import Dict, List, Sequence
 import numpy as np
 
 from .config import EstimatorConfig
-from .estimator import COUNTER_NAMES, Estimate, EstimateArrays, Estimator, as_series
+from .estimator import (
+    COUNTER_NAMES,
+    INPUT_COUNTERS,
+    Estimate,
+    EstimateArrays,
+    Estimator,
+    as_series,
+)
 from .jit import available, borrowed, jit
 from .kernel import BAND_DAMPING, advance, discretise
 from .subspace import (
@@ -176,15 +183,7 @@ I_BUSY = I_RET + 4  # NS flags: a mode publishes from the scale (or soon will)
 I_WAKE = I_BUSY + NS  # input samples of fast analyses left (a change in the signal)
 N_I = I_WAKE + 1
 #: input counters, named as the estimator's
-STAGE_COUNTERS = {
-    'received': I_RECEIVED,
-    'used': I_USED,
-    'skipped_non_finite': I_NONFINITE,
-    'skipped_duplicate': I_DUPLICATE,
-    'skipped_out_of_order': I_OUT_OF_ORDER,
-    'time_jump_resets': I_TIME_JUMP,
-    'gap_resets': I_GAP,
-}
+STAGE_COUNTERS = dict(zip(INPUT_COUNTERS, range(I_RECEIVED, I_GAP + 1)))
 #: the finder's counters (the candidates' rules)
 FINDER_COUNTERS = {
     'modes_found': I_FOUND,
