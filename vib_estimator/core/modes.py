@@ -95,6 +95,7 @@ from .subspace import (
     R_NU,
     R_ZETA,
     analyse,
+    descending,
     init_subspace,  # noqa: F401 (ModeTracker.restart: self._k.init_subspace)
 )
 
@@ -697,21 +698,6 @@ def _feed(b, ic, sl, pd, qs, lams, pa, t, y, out):
                 _analysis(b, ic, sl, pd, qs, lams, pa, 2 * d + half, t, out)
 
 
-@jit
-def _median_step(b):
-    """The median of the first N_STEP intervals (N_STEP odd: the middle one once sorted), by
-    insertion sort (np.median's sort machinery costs more to compile than this runs)."""
-    x = np.empty(N_STEP)
-    for i in range(N_STEP):
-        v = b[B_HBUF + i]
-        j = i
-        while j > 0 and x[j - 1] > v:
-            x[j] = x[j - 1]
-            j -= 1
-        x[j] = v
-    return x[N_STEP // 2]
-
-
 @jit(inline='always')
 def _step(b, ic, sl, pd, qs, lams, pa, t, y, out):
     """One input sample (counted; restarting the levels, or resampled onto the uniform grid by
@@ -723,8 +709,10 @@ def _step(b, ic, sl, pd, qs, lams, pa, t, y, out):
     if kind == 2:
         ic[I_NDT] = 0
     elif ic[I_NDT] == N_STEP and b[B_DT] == 0.0:
-        # the grid: the median of the first intervals as its step, from this sample on
-        b[B_DT] = _median_step(b)
+        # the grid: the median of the first intervals (N_STEP, odd) as its step, from this
+        # sample on (an insertion sort: np.median's costs more to compile than this runs)
+        h = b[B_HBUF : B_HBUF + N_STEP]
+        b[B_DT] = h[descending(h)[N_STEP // 2]]
         _levels_settle(b, ic, y)
         b[B_TG] = t
         _feed(b, ic, sl, pd, qs, lams, pa, t, y, out)
