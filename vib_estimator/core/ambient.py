@@ -290,11 +290,10 @@ class AmbientEstimator(Estimator):
         (:func:`.estimator.accept_rows`, a restart clearing the window) appended at once up to
         each analysis; the estimates of the analyses, in order."""
         out: list = []
-        kept, restarts, _ = accept_rows(self._c, self._last, t, finite, self._max_gap)
+        kept, runs, _ = accept_rows(self._c, self._last, t, finite, self._max_gap)
         t, y = t[kept], y[kept]
-        cuts = [0, *np.flatnonzero(restarts).tolist(), len(t)]
-        for a, b in zip(cuts[:-1], cuts[1:]):
-            if a < b and restarts[a]:
+        for a, b, restart in runs:
+            if restart:
                 self._clear()
             while a < b:
                 if self._next == math.inf:  # the window's first sample

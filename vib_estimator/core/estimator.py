@@ -84,11 +84,12 @@ def accept_sample(
 
 def accept_rows(
     c: Dict[str, int], last: float, t: np.ndarray, finite: np.ndarray, max_gap: float
-) -> Tuple[np.ndarray, np.ndarray, float]:
+) -> Tuple[np.ndarray, List[Tuple[int, int, bool]], float]:
     """:func:`accept_sample` over a batch of stamps ``t`` (``finite``: per sample, its values
-    are): ``(kept: per sample, whether it is kept; restarts: per kept sample, whether it
-    restarts the signal (a gap or a jump back); the last kept stamp)``. A run of clean samples
-    (finite, increasing, no gap) is counted at once, any other sample by :func:`accept_sample`."""
+    are): ``(kept: per sample, whether it is kept; the kept samples' runs [a, b) between
+    restarts (a gap or a jump back), with whether each begins with one; the last kept stamp)``.
+    A run of clean samples (finite, increasing, no gap) is counted at once, any other sample by
+    :func:`accept_sample`."""
     n = len(t)
     kept, restarts, restarted = np.zeros(n, bool), np.zeros(n, bool), []
     mark = partial(restarted.append, True)  # accept_sample's restart
@@ -106,7 +107,10 @@ def accept_rows(
         if accept_sample(c, last, float(t[i]), bool(finite[i]), max_gap, mark):
             kept[i], restarts[i], last = True, bool(restarted), float(t[i])
         i += 1
-    return kept, restarts[kept], last
+    restarts = restarts[kept]
+    cuts = [0, *np.flatnonzero(restarts).tolist(), len(restarts)]
+    runs = [(a, b, bool(restarts[a])) for a, b in zip(cuts[:-1], cuts[1:]) if a < b]
+    return kept, runs, last
 
 
 def make_room(buf: np.ndarray, start: int, n: int, more: int) -> np.ndarray:

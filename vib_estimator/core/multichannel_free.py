@@ -339,14 +339,12 @@ class JointFreeEstimator(Estimator):
             est.reset()
 
     # ---- input --------------------------------------------------------------------------------
-    def _keep(self, t: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The rows to keep and the kept rows that restart (a jump back or a gap beyond
+    def _keep(self, t: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, list]:
+        """The rows to keep and the kept rows' runs between restarts (a jump back or a gap beyond
         ``max_gap``), counted (:func:`.estimator.accept_rows`)."""
         finite = np.isfinite(t) & np.all(np.isfinite(y), axis=1)
-        kept, restarts, self._last = accept_rows(
-            self._c, self._last, t, finite, self._config.max_gap
-        )
-        return kept, restarts
+        kept, runs, self._last = accept_rows(self._c, self._last, t, finite, self._config.max_gap)
+        return kept, runs
 
     def _forget_signal(self) -> None:
         """After a restart (:meth:`_keep`): the row store emptied, the channels' recent
@@ -383,10 +381,10 @@ class JointFreeEstimator(Estimator):
         if len(values) != len(self.channels):
             raise ValueError(f'expected {len(self.channels)} channel values, got {len(values)}')
         t, row = float(t), np.array((values,))
-        kept, restart = self._keep(np.array((t,)), row)
+        kept, runs = self._keep(np.array((t,)), row)
         if not kept[0]:
             return []
-        if restart[0]:
+        if runs[0][2]:
             self._forget_signal()
         self._append(np.array((t,)), row)
         events = []
@@ -399,13 +397,11 @@ class JointFreeEstimator(Estimator):
         """Feed arrays (``y``: samples x channels; continuing the stream); the estimates by
         time."""
         t, y = as_series(t, y, self.channels)
-        keep, restarts = self._keep(t, y)
+        keep, runs = self._keep(t, y)
         t, y = t[keep], y[keep]
         out: list[Estimate] = []
-        # a restart empties the row store: each piece from one is appended alone
-        cuts = [0, *np.flatnonzero(restarts).tolist(), len(t)]
-        for a, b in zip(cuts[:-1], cuts[1:]):
-            if a < b and restarts[a]:
+        for a, b, restart in runs:  # a restart empties the row store: each run appended alone
+            if restart:
                 self._forget_signal()
             out += self._process_rows(t[a:b], y[a:b])
         return JointEstimates.of(out, self.channels)
