@@ -60,7 +60,7 @@ A fit is published only if it is finite, within :data:`MAX_MOVE` of its start an
 ``|zeta| <= max_damping``; else counted (``rejected_joint``). Bad samples never raise: a
 row with a non-finite stamp or channel is skipped (``skipped_non_finite``), a repeated or earlier
 stamp within ``max_gap`` too (``skipped_duplicate``, ``skipped_out_of_order``); a jump back or a
-gap beyond it restarts (``time_jump_resets``, ``gap_resets``: :func:`.estimator.accept_rows`,
+gap beyond it restarts (``time_jump_resets``, ``gap_resets``: :func:`.estimator.accept_sample`,
 the input policy every estimator written in Python shares); the channels' estimators see only the
 rows kept, so their gaps and jumps are handled as with one channel.
 """
@@ -80,6 +80,7 @@ from .estimator import (
     Estimator,
     JointEstimates,
     accept_rows,
+    accept_sample,
     as_series,
     channel_names,
     make_room,
@@ -339,17 +340,10 @@ class JointFreeEstimator(Estimator):
             est.reset()
 
     # ---- input --------------------------------------------------------------------------------
-    def _keep(self, t: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, list]:
-        """The rows to keep and the kept rows' runs between restarts (a jump back or a gap beyond
-        ``max_gap``), counted (:func:`.estimator.accept_rows`)."""
-        finite = np.isfinite(t) & np.all(np.isfinite(y), axis=1)
-        kept, runs, self._last = accept_rows(self._c, self._last, t, finite, self._config.max_gap)
-        return kept, runs
-
     def _forget_signal(self) -> None:
-        """After a restart (:meth:`_keep`): the row store emptied, the channels' recent
-        estimates forgotten, the known modes kept by frequency and shape but not by time (a
-        stream whose time went back would otherwise merge every event into them)."""
+        """After a restart (a jump back or a gap beyond ``max_gap``): the row store emptied, the
+        channels' recent estimates forgotten, the known modes kept by frequency and shape but not
+        by time (a stream whose time went back would otherwise merge every event into them)."""
         self._n = 0
         self._recent.clear()
         for mode in self._modes.modes:
@@ -380,13 +374,12 @@ class JointFreeEstimator(Estimator):
         values = [float(v) for v in y]
         if len(values) != len(self.channels):
             raise ValueError(f'expected {len(self.channels)} channel values, got {len(values)}')
-        t, row = float(t), np.array((values,))
-        kept, runs = self._keep(np.array((t,)), row)
-        if not kept[0]:
+        t, finite = float(t), all(map(math.isfinite, values))
+        gap = self._config.max_gap
+        if not accept_sample(self._c, self._last, t, finite, gap, self._forget_signal):
             return []
-        if runs[0][2]:
-            self._forget_signal()
-        self._append(np.array((t,)), row)
+        self._last = t
+        self._append(np.array((t,)), np.array((values,)))
         events = []
         for c, est in enumerate(self._estimators):
             for e in est.update(t, values[c]):
@@ -397,7 +390,8 @@ class JointFreeEstimator(Estimator):
         """Feed arrays (``y``: samples x channels; continuing the stream); the estimates by
         time."""
         t, y = as_series(t, y, self.channels)
-        keep, runs = self._keep(t, y)
+        finite = np.isfinite(t) & np.all(np.isfinite(y), axis=1)
+        keep, runs, self._last = accept_rows(self._c, self._last, t, finite, self._config.max_gap)
         t, y = t[keep], y[keep]
         out: list[Estimate] = []
         for a, b, restart in runs:  # a restart empties the row store: each run appended alone
