@@ -11,7 +11,10 @@ floats.
 
 The arithmetic lives in :mod:`vib_estimator.core.kernel` (its docstring derives Eqs. 7-12 and the
 corrected sign of Eq. 8). The configuration and its validation are in
-:mod:`vib_estimator.core.config`; this module holds the Python API.
+:mod:`vib_estimator.core.config`; this module holds the Python API, and what every estimator
+shares: the :class:`Estimator` interface, :class:`Estimate`, :class:`EstimateArrays`,
+:class:`JointEstimates`, the input policy (:func:`accept_sample`, :func:`accept_rows`) and sample
+buffer (:func:`make_room`) of those written in Python.
 
 Error budget behind the defaults (the integration rule and eps). The numerator ``n`` is a
 difference of terms of order A t^2 that cancel to w^2 A t^4 / 12, so an integration error e in the
