@@ -171,7 +171,7 @@ class AmbientEstimator(Estimator):
         self._pending_t: list[float] = []
         self._pending_y: list = []
         self._max_gap = config.max_gap
-        self._clear_window = self._clear  # (bound once: the data path's)
+        self._clear_window = self.reset  # (bound once: the data path's)
         #: while True, a window that is due only slides (counted ``analyses_idle``): nothing is
         #: identified or published, the tracked modes wait (``excitation = auto`` in a free
         #: stretch, where the identifier's estimates would not publish)
@@ -187,14 +187,11 @@ class AmbientEstimator(Estimator):
         self._register.clear()
         self._last = -math.inf
         self._since_search = math.inf  # analyses since the last search (the first searches)
-        self._clear()
+        self.reset()
 
     def reset(self) -> None:
         """Start a new window at the next sample (the tracked modes are kept): the next estimates
-        come from samples after this call."""
-        self._clear()
-
-    def _clear(self) -> None:
+        come from samples after this call (and after a gap or a jump back)."""
         self._n = 0  # samples in the buffer
         self._start = 0  # first sample of the current window
         self._pending_t.clear()
@@ -294,7 +291,7 @@ class AmbientEstimator(Estimator):
         t, y = t[kept], y[kept]
         for a, b, restart in runs:
             if restart:
-                self._clear()
+                self.reset()
             while a < b:
                 if self._next == math.inf:  # the window's first sample
                     self._next = float(t[a]) + self._window
