@@ -403,12 +403,6 @@ def _close_pairs(poles, m):
     return close[:nc]
 
 
-@jit(fastmath=FAST)
-def _gauss_newton_step(jac, res):
-    """The step d minimising |res + jac^T d| (``jac``: one row per parameter)."""
-    return -_normal_solve(jac, res)
-
-
 @jit(inline='always')
 def refine_undamped(x, poles):
     """The close pairs of poles (:func:`_close_pairs`) moved onto the unit circle, their angles
@@ -437,7 +431,7 @@ def refine_undamped(x, poles):
             if len(ru) == 0:
                 return poles
             jac[i, :] = (ru - res) / REFINE_STEP
-        step = _gauss_newton_step(jac, res)
+        step = -_normal_solve(jac, res)  # minimises |res + jac^T step|
         trial = theta + step
         rt = _circle_residual(x, poles, idx, trial)
         if len(rt) == 0 or not np.sum(rt * rt) < rss:
