@@ -1,7 +1,7 @@
 # Copyright 2026 vib_estimator developers
 # SPDX-License-Identifier: Apache-2.0
 """Several channels, one set of modes: the joint identifier (``analyze --columns``,
-``core.multichannel``) vs pyOMA2's multi-channel SSI-cov vs each channel alone.
+``core.ambient`` of several channels) vs pyOMA2's multi-channel SSI-cov vs each channel alone.
 
     .venv/bin/python benchmarks/bench_channels.py [--seeds 3] [--no-peer]
         [--real-data ../shared/real-data] [--ref REV] [--cost-only] [--free-only]
@@ -43,7 +43,6 @@ from bench_operation import HCT_FILE, HCT_MODES, REAL_DATA, ssi_cov_window  # be
 
 from vib_estimator.core import EstimatorConfig, ambient, create_estimator
 from vib_estimator.core.ambient import HOP_S, AmbientEstimator
-from vib_estimator.core.multichannel import JointAmbientEstimator
 from vib_estimator.core.shapes import mac
 from vib_estimator.core.ssi import block_rows
 from vib_estimator.extras import optional
@@ -96,7 +95,7 @@ def joint_every_second(config, names, t, y):
     window."""
     share, ambient.HOP_SHARE = ambient.HOP_SHARE, 0.0
     try:
-        return JointAmbientEstimator(config, names).process(t, y)
+        return AmbientEstimator(config, names).process(t, y)
     finally:
         ambient.HOP_SHARE = share
 
@@ -193,7 +192,7 @@ def invisible():
     modes = [(1.0, 0.02, 1.0), (2.5, 0.02, 0.3), (4.0, 0.02, 1.0)]
     shapes = np.array([[1.0, 0.0, 0.6], [0.8, 0.0, -0.7], [0.5, 1.0, 0.9]])
     t, y = modal_record(400.0, 20.0, modes, shapes, 20.0, 3)
-    r = JointAmbientEstimator(config, ['a', 'b', 'c']).process(t, y)
+    r = AmbientEstimator(config, ['a', 'b', 'c']).process(t, y)
     print('\n## A mode invisible on channels a and b (2.5 Hz on c only), 3 channels, 20 Hz, 400 s')
     for (f, _, _), err in zip(modes, per_mode(r.estimates.frequency_hz, [m[0] for m in modes])):
         print(
@@ -211,7 +210,7 @@ def real_hct(real_data):
     t, y = data[:, 0], data[:, 1:]
     config = EstimatorConfig(excitation='ambient', ambient_window_s=120.0, band_hz=(0.5, 6.0))
     start = time.perf_counter()
-    r = JointAmbientEstimator(config, [f'ch{i}' for i in range(1, 7)]).process(t, y)
+    r = AmbientEstimator(config, [f'ch{i}' for i in range(1, 7)]).process(t, y)
     elapsed = time.perf_counter() - start
     f = r.estimates.frequency_hz
     rel = np.abs(f[:, None] / np.array(HCT_MODES)[None, :] - 1)
@@ -250,9 +249,9 @@ def cost(ref=None):
     names = [f'c{i}' for i in range(channels)]
     # warmed up and made before the clock starts, as reference_cost's probe does for --ref
     # (the first use designs the decimation filter, a few tenths of a second)
-    JointAmbientEstimator(config, names).process(t[:2000], y[:2000])
+    AmbientEstimator(config, names).process(t[:2000], y[:2000])
     AmbientEstimator(config).process(t[:2000], y[:2000, 0])
-    joint_est, one_est = JointAmbientEstimator(config, names), AmbientEstimator(config)
+    joint_est, one_est = AmbientEstimator(config, names), AmbientEstimator(config)
     start = time.process_time()  # CPU seconds: the steadier figure on a shared machine
     r = joint_est.process(t, y)
     joint = time.process_time() - start
@@ -280,7 +279,7 @@ def stream(config, fs=1000.0, duration=60.0, channels=6):
     print(
         f'\n## {channels} channels at {fs:g} Hz, {duration:g} s, window 30 s, as a node feeds them'
     )
-    est = JointAmbientEstimator(config, names)
+    est = AmbientEstimator(config, names)
     block = int(fs)
     worst, total = 0.0, 0.0
     for i in range(0, len(t), block):
@@ -292,7 +291,7 @@ def stream(config, fs=1000.0, duration=60.0, channels=6):
         f'1 s blocks (process): {duration / total:.0f}x real time, '
         f'slowest block {1e3 * worst:.1f} ms'
     )
-    est = JointAmbientEstimator(config, names)
+    est = AmbientEstimator(config, names)
     worst, total = 0.0, 0.0
     rows = y.tolist()
     for ti, yi in zip(t.tolist(), rows):

@@ -35,8 +35,8 @@ if y.ndim == 1:
     from vib_estimator.core import create_estimator
     make = lambda: create_estimator(config)
 else:
-    from vib_estimator.core.multichannel import JointAmbientEstimator
-    make = lambda: JointAmbientEstimator(config, [f'c{i}' for i in range(y.shape[1])])
+    from vib_estimator.core.ambient import AmbientEstimator
+    make = lambda: AmbientEstimator(config, [f'c{i}' for i in range(y.shape[1])])
 make().process(t[:2000], y[:2000])
 est = make()
 start = time.process_time()

@@ -58,7 +58,6 @@ MODULES = tuple(
         'identity',
         'kernel',
         'modes',
-        'multichannel',
         'multichannel_free',
         'ssi',
         'subspace',
@@ -82,7 +81,12 @@ TESTS = {
     ],
     'config': ['test/core/test_estimator.py'],
     'correlations': ['test/core/test_ambient_incremental.py', 'test/core/test_ambient.py'],
-    'estimator': ['test/core/test_estimator.py', 'test/core/test_bad_input.py'],
+    'estimator': [
+        'test/core/test_estimator.py',
+        'test/core/test_bad_input.py',
+        'test/core/test_multichannel.py',
+        'test/analysis/test_channels.py',
+    ],
     'health_model': ['test/core/test_health_model.py'],
     'identity': [
         'test/core/test_identity.py',
@@ -98,10 +102,6 @@ TESTS = {
     'modes': [
         'test/core/test_modes.py',
         'test/core/test_subspace.py',
-    ],
-    'multichannel': [
-        'test/core/test_multichannel.py',
-        'test/analysis/test_channels.py',
     ],
     'multichannel_free': [
         'test/core/test_multichannel_free.py',

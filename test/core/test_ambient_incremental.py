@@ -8,14 +8,36 @@ import numpy as np
 import pytest
 from scipy.signal import sosfiltfilt
 
-from vib_estimator.core.correlations import (
-    CorrelationCascade,
-    correlation_matrices,
-    decimation_filter,
-    halve,
-)
+from vib_estimator.core.correlations import CorrelationCascade, decimation_filter, zero_phase
 from vib_estimator.core.ssi import ORDERS, hankel_svd, state_matrices
-from vib_estimator.core.whittle import sdof_psd
+from vib_estimator.core.whittle import sdof_density
+
+
+# ---- the direct computations the buffers are checked against
+def correlation_matrices(y: np.ndarray, lags: int) -> np.ndarray:
+    """Unbiased correlation matrices ``R_k[a, b] = sum_t y_a,t+k y_b,t / (N - k)``, k = 0 ..
+    ``lags``, of the mean-removed columns of ``y`` (samples x channels), by FFT: (lags + 1,
+    channels, channels)."""
+    n = len(y)
+    y = y - y.mean(axis=0)
+    size = 1 << math.ceil(math.log2(n + lags + 1))
+    spec = np.fft.rfft(y, size, axis=0).T  # channels x bins
+    m = y.shape[1]
+    a, b = np.triu_indices(m)
+    # one inverse transform per pair a <= b: its start holds R_k[a, b], its end R_k[b, a]
+    circ = np.fft.irfft(spec[a] * np.conj(spec[b]), size, axis=-1)
+    r = np.empty((lags + 1, m, m))
+    r[:, a, b] = circ[:, : lags + 1].T
+    r[0, b, a] = circ[:, 0]
+    r[1:, b, a] = circ[:, : -lags - 1 : -1].T
+    return r / np.arange(n, n - lags - 1, -1)[:, None, None]
+
+
+def halve(y: np.ndarray) -> np.ndarray:
+    """``y`` (samples, or samples x channels) at half its rate: every second sample of its
+    zero-phase (forwards and backwards) anti-alias filtering by ``decimation_filter``
+    (``zero_phase``)."""
+    return zero_phase(y)[::2]
 
 
 @pytest.mark.parametrize('channels', [1, 3])
@@ -83,7 +105,9 @@ def test_sdof_density_in_real_arithmetic_is_the_complex_closed_form():
         e = np.exp(-1j * w)
         total = a * (1 / (1 - z * e) + 1 / (1 - z / e) - 1)
         total += a.conjugate() * (1 / (1 - z.conjugate() * e) + 1 / (1 - z.conjugate() / e) - 1)
-        np.testing.assert_allclose(sdof_psd(w, f, zeta, var, dt), 0.5 * total.real, rtol=1e-7)
+        np.testing.assert_allclose(
+            sdof_density(np.cos(w), f, zeta, var, dt), 0.5 * total.real, rtol=1e-7
+        )
 
 
 @pytest.mark.parametrize('channels', [1, 2])

@@ -8,11 +8,12 @@ import numpy as np
 import pytest
 
 from vib_estimator.core import EstimatorConfig
-from vib_estimator.core.correlations import correlation_matrices
-from vib_estimator.core.multichannel import JointAmbientEstimator
+from vib_estimator.core.ambient import AmbientEstimator
 from vib_estimator.core.shapes import mac
 from vib_estimator.sim.arm_model import simulate_driven
 from vib_estimator.sim.frame import frame_record, modal_record, shear_frame
+
+from .test_ambient_incremental import correlation_matrices
 
 #: 6 Hz at 0.3 of the rate: the frame's modes without decimation (a short test)
 FS = 20.0
@@ -49,7 +50,7 @@ def test_shear_frame_modes():
 @pytest.mark.parametrize('seed', [1, 2])
 def test_five_storey_frame_five_modes_with_shapes(seed):
     t, y, freqs, shapes = frame_record(600.0, FS, zeta=0.02, snr_db=20.0, seed=seed)
-    result = JointAmbientEstimator(CONFIG, [f'storey{i}' for i in range(1, 6)]).process(t, y)
+    result = AmbientEstimator(CONFIG, [f'storey{i}' for i in range(1, 6)]).process(t, y)
     assert len(result) > 100
     for err, zeta, similarity in _per_mode(result, freqs, shapes):
         assert err <= 0.01
@@ -65,7 +66,7 @@ def test_a_mode_invisible_on_some_channels_is_found():
     modes = [(1.0, 0.02, 1.0), (2.5, 0.02, 0.3), (4.0, 0.02, 1.0)]
     shapes = np.array([[1.0, 0.0, 0.6], [0.8, 0.0, -0.7], [0.5, 1.0, 0.9]])
     t, y = modal_record(400.0, FS, modes, shapes, snr_db=20.0, seed=3)
-    result = JointAmbientEstimator(CONFIG, ['a', 'b', 'c']).process(t, y)
+    result = AmbientEstimator(CONFIG, ['a', 'b', 'c']).process(t, y)
     freqs = np.array([f for f, _, _ in modes])
     per = _per_mode(result, freqs, shapes / np.linalg.norm(shapes, axis=0))
     for err, _, similarity in per:
@@ -85,7 +86,7 @@ def test_the_simulated_arm_tip_imu_axes_combine_without_a_spurious_mode():
     z = rec.torque  # the measured output: here the tip acceleration
     y = 9.81 + 0.01 * np.std(z) * np.random.default_rng(2).standard_normal(len(z))
     config = EstimatorConfig(excitation='ambient', ambient_window_s=30.0)
-    estimator = JointAmbientEstimator(config, ['x', 'y', 'z'])
+    estimator = AmbientEstimator(config, ['x', 'y', 'z'])
     with np.errstate(divide='raise', invalid='raise'):
         result = estimator.process(rec.t, np.column_stack([np.zeros_like(z), y, z]))
     err = result.estimates.frequency_hz / rec.f_true[0] - 1
@@ -109,8 +110,8 @@ def test_correlation_matrices_are_the_direct_sums():
 
 def test_one_channel_is_refused_and_bad_samples_are_counted():
     with pytest.raises(ValueError, match='at least 2 channels'):
-        JointAmbientEstimator(CONFIG, ['a'])
-    est = JointAmbientEstimator(CONFIG, ['a', 'b'])
+        AmbientEstimator(CONFIG, ['a'])
+    est = AmbientEstimator(CONFIG, ['a', 'b'])
     t = np.arange(10) / FS
     y = np.ones((10, 2))
     y[3, 1] = np.nan
@@ -130,7 +131,7 @@ def test_close_modes_with_different_shapes_stay_two():
     modes = [(2.0, 0.005, 1.0), (2.02, 0.005, 1.0)]
     shapes = np.array([[1.0, 0.0], [0.0, 1.0], [0.5, -0.5]])
     t, y = modal_record(200.0, FS, modes, shapes, snr_db=20.0, seed=0)
-    e = JointAmbientEstimator(CONFIG, ['a', 'b', 'c']).process(t, y).estimates
+    e = AmbientEstimator(CONFIG, ['a', 'b', 'c']).process(t, y).estimates
     late = e.t > 100.0
     assert set(e.mode[late].tolist()) == {1, 2}
     for mode, (f, _, _) in enumerate(modes, 1):

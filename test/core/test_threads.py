@@ -7,7 +7,6 @@ import pytest
 
 from vib_estimator.core import EstimatorConfig
 from vib_estimator.core.ambient import AmbientEstimator
-from vib_estimator.core.multichannel import JointAmbientEstimator
 from vib_estimator.core.threads import blas_controller, one_blas_thread
 from vib_estimator.sim.ambient import ambient_record
 
@@ -60,7 +59,7 @@ def test_ambient_batch_and_streaming_run_on_one_blas_thread(record, eig_threads)
 def test_joint_identifier_runs_on_one_blas_thread(record, eig_threads):
     t, y = record
     columns = np.column_stack([y, -0.5 * y + 0.01 * np.sin(t)])
-    estimates = JointAmbientEstimator(CONFIG, ('a', 'b')).process(t, columns)
+    estimates = AmbientEstimator(CONFIG, ('a', 'b')).process(t, columns)
     assert eig_threads and set(eig_threads) == {1}
     assert len(estimates) and np.all(np.abs(estimates.estimates.frequency_hz / 5.0 - 1) < 0.05)
 

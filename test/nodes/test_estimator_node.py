@@ -29,8 +29,8 @@ from std_msgs.msg import Float64, Float64MultiArray, Header
 from std_srvs.srv import Trigger
 
 from vib_estimator.core import Estimate, EstimatorConfig, FrequencyEstimator
+from vib_estimator.core.ambient import AmbientEstimator
 from vib_estimator.core.config import PAPER
-from vib_estimator.core.multichannel import JointAmbientEstimator
 from vib_estimator.core.shapes import SHAPE_ROWS
 from vib_estimator.io import fields
 from vib_estimator.io.fields import seconds_since
@@ -939,7 +939,7 @@ def check_modes_and_shapes(p, stamps, y, skip=()):
     keep = np.setdiff1d(np.arange(len(stamps)), list(skip))
     kept = np.asarray(stamps, dtype=np.int64)[keep]
     names = p.node.get_parameter('components').value
-    expected = JointAmbientEstimator(config_of(p.node), names).process(
+    expected = AmbientEstimator(config_of(p.node), names).process(
         seconds_since(kept, kept[0]), y[keep]
     )
     e = expected.estimates

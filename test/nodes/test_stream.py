@@ -148,7 +148,7 @@ def test_a_burst_of_self_tests_runs_the_tones_once(monkeypatch):
 
 # ---- several channels (the node's components) ---------------------------------------------------
 def test_channels_one_is_the_single_channel_stream_several_the_joint_identifier():
-    from vib_estimator.core.multichannel import JointAmbientEstimator
+    from vib_estimator.core.ambient import AmbientEstimator
     from vib_estimator.nodes.stream import check_channels
     from vib_estimator.sim.frame import modal_record
 
@@ -171,7 +171,7 @@ def test_channels_one_is_the_single_channel_stream_several_the_joint_identifier(
     stamps = EPOCH_NS + np.round(t * 1e9).astype(np.int64)
     stream = EstimatorStream(config, now=0.0, channels=names)
     got = [e for s, row in zip(stamps, y.tolist()) for e in stream.feed(int(s), tuple(row))]
-    expected = JointAmbientEstimator(config, names).process((stamps - stamps[0]) * 1e-9, y)
+    expected = AmbientEstimator(config, names).process((stamps - stamps[0]) * 1e-9, y)
     assert all(e.shape is not None for e in got) and len(got) == len(expected) > 6
     assert [e.frequency_hz for e in got] == expected.estimates.frequency_hz.tolist()
     for e in got:

@@ -24,8 +24,8 @@ import sys
 import numpy as np
 
 from ..core import EstimatorConfig, create_estimator
+from ..core.estimator import JointEstimates
 from ..core.factory import kind_of
-from ..core.multichannel import JointEstimates
 from ..core.shapes import SHAPE_ROWS, phases_deg, signed_amplitudes
 from ..errors import BagError, CsvError
 from ..io.csv_reader import column_names, read_csv_columns

@@ -10,7 +10,7 @@ modes (frequency and damping with their robust stds, the recommended input shape
 the singular values of the cross-spectral matrix -- with each mode marked; for ``excitation
 ambient`` a stabilisation diagram (the SSI-cov poles of the record's last window over the model
 orders, those of the estimator's stable clusters coloured: :mod:`..core.ambient`,
-:mod:`..core.multichannel`); frequency and damping over time with their stds; each mode's shape,
+:mod:`..core.ssi`); frequency and damping over time with their stds; each mode's shape,
 on the geometry (deformed over undeformed, animated) or as a bar plot of the channels' signed
 amplitudes and phases; the MAC matrix between the modes; the counters and, when nothing was
 estimated, why. Everything shown comes from the run's estimates: nothing is estimated again.

@@ -387,7 +387,7 @@ def _stat_rows(
     recording: Path, signal, result, modes: int, summary: str, joint=None, component=None
 ) -> List[Dict]:
     """The rows of one streamed signal: one, or one per mode. ``joint``: the
-    :class:`..core.multichannel.JointEstimates` of a joint run (``signal`` None for CSV
+    :class:`..core.estimator.JointEstimates` of a joint run (``signal`` None for CSV
     columns), whose rows gain the shape fields (:func:`mode_shape_fields`) and are named
     ``component`` (the channels, comma-separated)."""
     est = result.estimates

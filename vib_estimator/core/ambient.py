@@ -6,12 +6,15 @@ sliding window of any number of channels: the streaming side.
 ``excitation = ambient``: the structure is driven by broadband, unmeasured forces (wind, traffic, a
 robot that never rests), so there is no free decay to fit. Its modes are identified from the
 correlation structure of the response over a sliding window, as operational modal analysis does.
-One channel is the case m = 1 of the several channels' identifier (one path, one set of fixes).
+With several channels (accelerometers, the three axes of an IMU, the joints of an arm) the modes
+are identified jointly from all channels' correlations, each with its **shape** -- how much, and
+in which phase, each channel moves in it (docs/channels.md). One channel is the case m = 1 (one
+path, one set of fixes).
 
-Interface (that of :class:`~vib_estimator.core.FrequencyEstimator` and the mode tracker, which the
-node stream and ``analyze`` use): :class:`AmbientEstimator` ``.update(t, y) -> List[Estimate]``,
-``.process(t, y) -> EstimateArrays``, ``.counters``, ``.reset()``, ``.restart()``, ``.config``;
-several channels: :class:`vib_estimator.core.multichannel.JointAmbientEstimator`.
+Interface (:class:`~vib_estimator.core.Estimator`): :class:`AmbientEstimator` ``(config,
+channels=())`` ``.update(t, y) -> list[Estimate]``, ``.process(t, y) -> EstimateArrays`` (one
+channel) or :class:`~.estimator.JointEstimates` (several named ``channels``, ``y``: samples x
+channels), ``.counters``, ``.reset()``, ``.restart()``, ``.config``, ``.channels``.
 
 Method, per analysis, once ``ambient_window_s`` of samples are in: every :data:`HOP_S` (1 s) of
 input while a mode is to be confirmed, every :func:`hop_s` (a fifth of the window, 1-5 s) once
@@ -38,9 +41,12 @@ every mode tracked is published:
 
 Each estimate: ``t`` = the window's last stamp, ``convergence_time`` = the window's span (the
 window used), ``samples`` = its samples, ``amplitude`` = RMS of the modal response (summed in
-quadrature over channels), ``fit`` = share of the window's (summed) variance the modes explain.
+quadrature over channels), ``fit`` = share of the window's (summed) variance the modes explain;
+with several channels its ``shape``, ``shape_std`` (the spread over the stable model orders) and
+``mac`` with the mode's previous shape (NaN for a mode's first window).
 
-Bad samples never raise: a sample with a non-finite value, duplicate and out-of-order stamps are
+Bad samples never raise: a sample with a non-finite value (on any channel), duplicate and
+out-of-order stamps are
 skipped and counted; a gap or a backward jump longer than ``max_gap`` starts a new window
 (``gap_resets``, ``time_jump_resets``); the tracked modes are kept.
 """
@@ -59,8 +65,12 @@ from .estimator import (
     Estimate,
     EstimateArrays,
     Estimator,
+    JointEstimates,
+    accept_rows,
     accept_sample,
     as_series,
+    channel_names,
+    make_room,
 )
 from .identity import CONFIRM, CONFIRM_BESIDE, Mode, ModeRegister
 from .ssi import BLOCK_ROWS, WindowModes, block_rows, identify
@@ -136,32 +146,32 @@ class _Track(Mode):
         return max(1.0, math.sqrt(float(np.mean(d * d))))
 
 
-class SlidingWindowIdentifier(Estimator):
-    """The output-only identifier of ``channels`` channels (see the module docstring): the
-    samples' buffer (a row of ``channels`` values a sample), their checks and counters, the runs
-    of clean samples of a batch, the window each analysis reads (:meth:`_next_window`), its
-    identification (:func:`.ssi.identify`) and the modes' identity over time (:meth:`_track`).
-    :class:`AmbientEstimator` (one channel) and
-    :class:`vib_estimator.core.multichannel.JointAmbientEstimator` (several, named
-    :attr:`channels`: its estimates carry their shapes) give out its estimates."""
+class AmbientEstimator(Estimator):
+    """The output-only identifier of one channel or of several named ``channels`` (at least
+    :data:`.estimator.MIN_CHANNELS`; their count is the number of columns fed; see the module
+    docstring): the samples' buffer (a row of values a sample), their checks and counters, the
+    runs of clean samples of a batch, the window each analysis reads (:meth:`_next_window`), its
+    identification (:func:`.ssi.identify`) and the modes' identity over time (:meth:`_track`)."""
 
-    def __init__(self, config: EstimatorConfig, channels: int = 1):
+    def __init__(self, config: EstimatorConfig, channels: Sequence[str] = ()):
         config.validate()
+        if channels:
+            hint = ' (one channel: excitation ambient, one column)'
+            self.channels = channel_names(channels, 'a joint identification', hint)
         self._config = config
         self._window = config.ambient_window_s
         self._band = config.band_hz or (0.0, math.inf)
         self._c = dict.fromkeys(COUNTER_NAMES, 0)
-        self._m = channels
-        self._t = np.empty(1 << 14)
-        self._y = np.empty((1 << 14, channels))
+        self._m = m = max(len(self.channels), 1)
+        self._t = np.empty(1 << 14)  # the window's stamps (its values: in the cascade)
         self._register = ModeRegister(self._window, CONFIRM, CONFIRM_BESIDE, new=_Track)
-        self._cascade = CorrelationCascade(2 * block_rows(channels), channels)
+        self._cascade = CorrelationCascade(2 * block_rows(m), m)
         #: samples fed one at a time since the last analysis (stamps, values): appended to the
         #: buffer at once when one is due (:meth:`_store`), not one numpy write each
         self._pending_t: list[float] = []
         self._pending_y: list = []
         self._max_gap = config.max_gap
-        self._clear_window = self._clear  # (bound once: the data path's)
+        self._clear_window = self.reset  # (bound once: the data path's)
         #: while True, a window that is due only slides (counted ``analyses_idle``): nothing is
         #: identified or published, the tracked modes wait (``excitation = auto`` in a free
         #: stretch, where the identifier's estimates would not publish)
@@ -177,21 +187,26 @@ class SlidingWindowIdentifier(Estimator):
         self._register.clear()
         self._last = -math.inf
         self._since_search = math.inf  # analyses since the last search (the first searches)
-        self._clear()
+        self.reset()
 
     def reset(self) -> None:
         """Start a new window at the next sample (the tracked modes are kept): the next estimates
-        come from samples after this call."""
-        self._clear()
-
-    def _clear(self) -> None:
+        come from samples after this call (and after a gap or a jump back)."""
         self._n = 0  # samples in the buffer
         self._start = 0  # first sample of the current window
-        self._fed = 0  # samples of the buffer in the cascade
         self._pending_t.clear()
         self._pending_y.clear()
         self._cascade.clear()
         self._next = math.inf
+
+    def process(self, t: Sequence[float], y):
+        """Feed arrays of samples (``y``: samples, or samples x channels; continuing the
+        stream); the estimates by time (:class:`~.estimator.JointEstimates` of several
+        channels)."""
+        t, y = as_series(t, y, self.channels)
+        y = y.reshape(len(t), self._m)
+        out = self._feed(t, y, np.isfinite(t) & np.isfinite(y).all(axis=1))
+        return JointEstimates.of(out, self.channels) if self.channels else EstimateArrays.of(out)
 
     def update(self, t: float, y) -> list:
         """Feed one sample (one value per channel); the estimates of an analysis it completes
@@ -235,20 +250,10 @@ class SlidingWindowIdentifier(Estimator):
         self._store()
         m = len(t)
         if self._n + m > len(self._t):
-            keep = self._n - self._start
-            if keep + m > len(self._t) // 2:  # grow
-                size = 1 << math.ceil(math.log2(2 * (keep + m)))
-                self._t = np.concatenate((self._t[self._start : self._n], np.empty(size - keep)))
-                self._y = np.concatenate(
-                    (self._y[self._start : self._n], np.empty((size - keep, self._m)))
-                )
-            else:  # compact
-                self._t[:keep] = self._t[self._start : self._n]
-                self._y[:keep] = self._y[self._start : self._n]
-            self._fed -= self._start
-            self._n, self._start = keep, 0
+            self._t = make_room(self._t, self._start, self._n, m)
+            self._n, self._start = self._n - self._start, 0
         self._t[self._n : self._n + m] = t
-        self._y[self._n : self._n + m] = y
+        self._cascade.push(y)
         if self._n == 0:
             self._next = float(self._t[0]) + self._window
         self._n += m
@@ -278,31 +283,21 @@ class SlidingWindowIdentifier(Estimator):
 
     @single_blas_thread
     def _feed(self, t: np.ndarray, y: np.ndarray, finite: np.ndarray) -> list:
-        """Feed a batch (``finite``: per sample, its values are): each clean run (finite,
-        increasing, no gap) at once up to the next analysis, any other sample through
-        ``update``; the estimates of the analyses, in order."""
+        """Feed a batch (``finite``: per sample, its values are): its samples kept
+        (:func:`.estimator.accept_rows`, a restart clearing the window) appended at once up to
+        each analysis; the estimates of the analyses, in order."""
         out: list = []
-        gap = self._config.max_gap
-        i, n = 0, len(t)
-        while i < n:
-            j = i
-            if finite[i] and t[i] > self._last and t[i] - self._last <= gap:
-                d = np.diff(t[i : min(n, i + 65536)])
-                bad = ~((d > 0) & (d <= gap)) | ~finite[i + 1 : i + 1 + len(d)]
-                j = i + 1 + (int(np.argmax(bad)) if bad.any() else len(d))
-            if j == i:
-                out.extend(self.update(t[i], y[i]))
-                i += 1
-                continue
-            while i < j:
+        kept, runs, _ = accept_rows(self._c, self._last, t, finite, self._max_gap)
+        t, y = t[kept], y[kept]
+        for a, b, restart in runs:
+            if restart:
+                self.reset()
+            while a < b:
                 if self._next == math.inf:  # the window's first sample
-                    self._next = float(t[i]) + self._window
-                k = min(j, int(np.searchsorted(t[i:j], self._next, 'left')) + i + 1)
-                self._c['received'] += k - i
-                self._c['used'] += k - i
-                self._append(t[i:k], y[i:k])
-                self._last = float(t[k - 1])
-                i = k
+                    self._next = float(t[a]) + self._window
+                k = min(b, int(np.searchsorted(t[a:b], self._next, 'left')) + a + 1)
+                self._append(t[a:k], y[a:k])
+                self._last, a = float(t[k - 1]), k
                 if self._last >= self._next:
                     out.extend(self._due())
         return out
@@ -345,8 +340,6 @@ class SlidingWindowIdentifier(Estimator):
         )
         self._start = first
         ts = self._t[first : self._n]
-        self._cascade.push(self._y[self._fed : self._n])
-        self._fed = self._n
         self._cascade.keep_last(len(ts))
         return ts
 
@@ -379,16 +372,3 @@ class SlidingWindowIdentifier(Estimator):
             out.append(Estimate(*est, *shape))
         self._c['estimates'] += len(out)
         return out
-
-
-class AmbientEstimator(SlidingWindowIdentifier):
-    """Sliding-window output-only mode identification of one channel (the m = 1 case of
-    :class:`SlidingWindowIdentifier`); see the module docstring."""
-
-    def __init__(self, config: EstimatorConfig):
-        super().__init__(config, 1)
-
-    def process(self, t: Sequence[float], y: Sequence[float]) -> EstimateArrays:
-        """Feed arrays of samples (continuing the stream); the estimates as columns, by time."""
-        t, y = as_series(t, y)
-        return EstimateArrays.of(self._feed(t, y[:, None], np.isfinite(t) & np.isfinite(y)))

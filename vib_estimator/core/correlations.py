@@ -5,12 +5,14 @@ rate and at that rate halved 1, 2, ... times: the buffers the output-only identi
 (:mod:`.ambient`) reads its subspace identification (:mod:`.ssi`) from, for any number of
 channels (one is a 1 x 1 matrix).
 
-- :func:`correlation_matrices`: the unbiased correlation matrices ``R_k`` of a window (by FFT),
-  what every buffer below equals (``test/core/test_ambient_incremental.py``);
+Each buffer gives the unbiased correlation matrices ``R_k[a, b] = sum_t y_a,t+k y_b,t / (N - k)``,
+k = 0 .. lags, of the window's mean-removed channels, what the direct computation from the window
+gives (by FFT: ``test/core/test_ambient_incremental.py``):
+
 - :class:`LagProducts`: the input rate's, exact, without re-reading the window;
 - :class:`EditedProducts`: a halved window's, across analyses (only its ends change);
-- :func:`halve`: the zero-phase anti-alias filtering and halving of the rate
-  (:func:`decimation_filter`);
+- :func:`zero_phase`: the zero-phase anti-alias filtering (:func:`decimation_filter`) before each
+  halving of the rate;
 - :class:`CorrelationCascade`: the levels together, as one analysis reads them.
 """
 
@@ -22,6 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .estimator import make_room
 from .jit import jit
 
 #: a window whose RMS is at most this fraction of its mean's magnitude is constant to rounding
@@ -73,25 +76,6 @@ def decimation_filter() -> DecimationFilter:
     radius = float(np.max(np.abs(sos2zpk(sos)[1])))
     settle = math.ceil(-20.0 / math.log10(radius)) + pad
     return DecimationFilter(sos, sosfilt_zi(sos), pad, settle)
-
-
-def correlation_matrices(y: np.ndarray, lags: int) -> np.ndarray:
-    """Unbiased correlation matrices ``R_k[a, b] = sum_t y_a,t+k y_b,t / (N - k)``, k = 0 ..
-    ``lags``, of the mean-removed columns of ``y`` (samples x channels), by FFT: (lags + 1,
-    channels, channels)."""
-    n = len(y)
-    y = y - y.mean(axis=0)
-    size = 1 << math.ceil(math.log2(n + lags + 1))
-    spec = np.fft.rfft(y, size, axis=0).T  # channels x bins
-    m = y.shape[1]
-    a, b = np.triu_indices(m)
-    # one inverse transform per pair a <= b: its start holds R_k[a, b], its end R_k[b, a]
-    circ = np.fft.irfft(spec[a] * np.conj(spec[b]), size, axis=-1)
-    r = np.empty((lags + 1, m, m))
-    r[:, a, b] = circ[:, : lags + 1].T
-    r[0, b, a] = circ[:, 0]
-    r[1:, b, a] = circ[:, : -lags - 1 : -1].T
-    return r / np.arange(n, n - lags - 1, -1)[:, None, None]
 
 
 def lag_products(y, a, b, bound, off, sums, total, later=True, subtract=False) -> None:
@@ -148,8 +132,7 @@ class LagProducts:
     ``channels`` values each), kept exactly: when the correlations are read, the products of
     the samples pushed since are added, those of the samples that left are subtracted (or, after
     :data:`REFRESH_SLIDES` such slides or a slide longer than what stays, all recomputed from the
-    window). :meth:`correlations` gives what :func:`correlation_matrices` computes from the
-    window."""
+    window). :meth:`correlations` gives the window's correlation matrices."""
 
     def __init__(self, lags: int, channels: int):
         self.lags, self.channels = lags, channels
@@ -161,7 +144,8 @@ class LagProducts:
         self._want = 0  # the window's first sample
         self._start = 0  # the first sample of the stretch [start, done) the sums cover
         self._done = 0
-        self._offset = np.zeros(self.channels)
+        #: the value subtracted from the samples before their products are summed
+        self.offset = np.zeros(self.channels)
         self._sums = np.zeros((self.lags + 1, self.channels, self.channels))
         self._total = np.zeros(self.channels)
         self._slides = 0
@@ -175,15 +159,10 @@ class LagProducts:
         """The window's samples (a view)."""
         return self._buf[self._want : self._n]
 
-    @property
-    def offset(self) -> np.ndarray:
-        """The value subtracted from the samples before their products are summed."""
-        return self._offset
-
     def mean(self) -> np.ndarray:
         """The window's mean, from the sums kept."""
         self._sync()
-        return self._offset + self._total / len(self)
+        return self.offset + self._total / len(self)
 
     def push(self, x: np.ndarray) -> None:
         """Append samples ``x`` (rows) to the window."""
@@ -191,15 +170,12 @@ class LagProducts:
         if not m:
             return
         if self._n + m > len(self._buf):
-            keep = self._n - self._start
-            size = max(len(self._buf), 1 << math.ceil(math.log2(2 * (keep + m))))
-            buf = np.empty((size, self.channels)) if size > len(self._buf) else self._buf
-            buf[:keep] = self._buf[self._start : self._n]
             shift = self._start
-            self._buf, self._n = buf, keep
+            self._buf = make_room(self._buf, shift, self._n, m)
+            self._n -= shift
             self._start, self._want, self._done = 0, self._want - shift, self._done - shift
         if self._n == self._want:
-            self._offset = np.array(x[0], dtype=np.float64)  # keeps the products' rounding small
+            self.offset = np.array(x[0], dtype=np.float64)  # keeps the products' rounding small
             self._restart()
         self._buf[self._n : self._n + m] = x
         self._n += m
@@ -218,33 +194,25 @@ class LagProducts:
         self._slides = 0
 
     def _sync(self) -> None:
-        """Bring the sums to the window."""
+        """Bring the sums to the window: subtract the products ``y[u + k] y[u]^T`` of the samples
+        that left, add the products ``y[t] y[t - k]^T`` of those pushed with the window's."""
+        args = (self.offset, self._sums, self._total)  # (updated in place)
         if self._want > self._start:
             if self._want >= self._done or self._slides >= REFRESH_SLIDES:
                 self._restart()
             else:
-                self._sub(self._start, self._want)
+                lag_products(self._buf, self._start, self._want, self._done, *args, False, True)
                 self._start = self._want
                 self._slides += 1
         if self._done < self._n:
-            self._add(self._done, self._n)
+            lag_products(self._buf, self._done, self._n, self._start, *args)
             self._done = self._n
-
-    def _add(self, a: int, b: int) -> None:
-        """Add the products ``y[t] y[t - k]^T`` of the samples a <= t < b with the window's."""
-        lag_products(self._buf, a, b, self._start, self._offset, self._sums, self._total)
-
-    def _sub(self, c: int, d: int) -> None:
-        """Subtract the products ``y[u + k] y[u]^T`` of the samples c <= u < d leaving."""
-        lag_products(
-            self._buf, c, d, self._done, self._offset, self._sums, self._total, False, True
-        )
 
     def correlations(self) -> np.ndarray:
         """The window's unbiased correlation matrices of its mean-removed channels, ``R_k[a, b]
         = sum_t y_a,t+k y_b,t / (N - k)``, k = 0 .. ``lags``: (lags + 1, channels, channels)."""
         self._sync()
-        return centred_correlations(self._sums, self._total, self.window, self._offset)
+        return centred_correlations(self._sums, self._total, self.window, self.offset)
 
 
 class EditedProducts:
@@ -253,7 +221,7 @@ class EditedProducts:
     only its first and last samples differ; the products of the pairs that involve them are
     subtracted (the previous window's) and added (this one's) instead of all recomputed (all,
     after :data:`REFRESH_SLIDES` such updates, or when the middle is not the previous one's).
-    :meth:`correlations` gives what :func:`correlation_matrices` computes from the window."""
+    :meth:`correlations` gives the window's correlation matrices."""
 
     def __init__(self, lags: int, channels: int):
         self._sums = np.zeros((lags + 1, channels, channels))
@@ -333,24 +301,17 @@ def zero_phase(x: np.ndarray) -> np.ndarray:
     return work[::-1][pad:-pad].reshape((-1,) + x.shape[1:])
 
 
-def halve(y: np.ndarray) -> np.ndarray:
-    """``y`` (samples, or samples x channels) at half its rate: every second sample of its
-    zero-phase (forwards and backwards) anti-alias filtering by :func:`decimation_filter`
-    (:func:`zero_phase`)."""
-    return zero_phase(y)[::2]
-
-
 class CorrelationCascade:
     """A sliding window's correlations at the input rate and at that rate halved 1, 2, ...
-    times (level j: :func:`halve` applied j times to the window). The input rate's are kept up to
-    date as samples arrive (:class:`LagProducts`: exact, without re-reading the window). A
-    halved rate's window is made when first read after the window moved: the zero-phase
-    filtering of a window depends on its ends only within ``decimation_filter().settle``
-    samples of them, so
-    its middle is kept from the previous analysis and only the stretches near the ends that
-    moved are filtered again (the same numbers, to rounding, as :func:`halve` of the whole
-    window: ``test/core/test_ambient_incremental.py``). A halved window's correlations come from
-    its lag products, kept across analyses (:class:`EditedProducts`), and the window's variance
+    times (level j: every second sample of the window's :func:`zero_phase` filtering, j times).
+    The input rate's are kept up to date as samples arrive (:class:`LagProducts`: exact,
+    without re-reading the window). A halved rate's window is made when first read after the
+    window moved: the zero-phase filtering of a window depends on its ends only within
+    ``decimation_filter().settle`` samples of them, so its middle is kept from the previous
+    analysis and only the stretches near the ends that moved are filtered again (the same
+    numbers, to rounding, as the filtering of the whole window:
+    ``test/core/test_ambient_incremental.py``). A halved window's correlations come from its
+    lag products, kept across analyses (:class:`EditedProducts`), and the window's variance
     from the input rate's (``R_0``)."""
 
     def __init__(self, lags: int, channels: int):
@@ -445,7 +406,7 @@ class CorrelationCascade:
         return self._level(level)[0]
 
     def correlations(self, level: int) -> np.ndarray:
-        """Level ``level``'s correlation matrices (as :func:`correlation_matrices`)."""
+        """Level ``level``'s correlation matrices (lags 0 .. ``lags``)."""
         if level not in self._corr:
             if level == 0:
                 r = self.levels[0].correlations()

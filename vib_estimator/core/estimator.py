@@ -11,7 +11,10 @@ floats.
 
 The arithmetic lives in :mod:`vib_estimator.core.kernel` (its docstring derives Eqs. 7-12 and the
 corrected sign of Eq. 8). The configuration and its validation are in
-:mod:`vib_estimator.core.config`; this module holds the Python API.
+:mod:`vib_estimator.core.config`; this module holds the Python API, and what every estimator
+shares: the :class:`Estimator` interface, :class:`Estimate`, :class:`EstimateArrays`,
+:class:`JointEstimates`, the input policy (:func:`accept_sample`, :func:`accept_rows`) and sample
+buffer (:func:`make_room`) of those written in Python.
 
 Error budget behind the defaults (the integration rule and eps). The numerator ``n`` is a
 difference of terms of order A t^2 that cancel to w^2 A t^4 / 12, so an integration error e in the
@@ -31,6 +34,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import partial
 from typing import Callable, Dict, List, Optional, Protocol, Sequence, Tuple
 
 import numpy as np
@@ -81,6 +85,48 @@ def accept_sample(
     return True
 
 
+def accept_rows(
+    c: Dict[str, int], last: float, t: np.ndarray, finite: np.ndarray, max_gap: float
+) -> Tuple[np.ndarray, List[Tuple[int, int, bool]], float]:
+    """:func:`accept_sample` over a batch of stamps ``t`` (``finite``: per sample, its values
+    are): ``(kept: per sample, whether it is kept; the kept samples' runs [a, b) between
+    restarts (a gap or a jump back), with whether each begins with one; the last kept stamp)``.
+    A run of clean samples (finite, increasing, no gap) is counted at once, any other sample by
+    :func:`accept_sample`."""
+    n = len(t)
+    kept, restarts, restarted = np.zeros(n, bool), np.zeros(n, bool), []
+    mark = partial(restarted.append, True)  # accept_sample's restart
+    i = 0
+    while i < n:
+        if finite[i] and t[i] > last and t[i] - last <= max_gap:
+            d = np.diff(t[i : min(n, i + 65536)])
+            bad = ~((d > 0) & (d <= max_gap)) | ~finite[i + 1 : i + 1 + len(d)]
+            j = i + 1 + (int(np.argmax(bad)) if bad.any() else len(d))
+            c['received'] += j - i
+            c['used'] += j - i
+            kept[i:j], last, i = True, float(t[j - 1]), j
+            continue
+        restarted.clear()
+        if accept_sample(c, last, float(t[i]), bool(finite[i]), max_gap, mark):
+            kept[i], restarts[i], last = True, bool(restarted), float(t[i])
+        i += 1
+    restarts = restarts[kept]
+    cuts = [0, *np.flatnonzero(restarts).tolist(), len(restarts)]
+    runs = [(a, b, bool(restarts[a])) for a, b in zip(cuts[:-1], cuts[1:]) if a < b]
+    return kept, runs, last
+
+
+def make_room(buf: np.ndarray, start: int, n: int, more: int) -> np.ndarray:
+    """``buf`` (a buffer of rows) with its rows ``start .. n`` moved to its front and room after
+    them for ``more`` rows: in place, or in a new buffer of twice their count rounded up to a
+    power of two (the sample buffers of the estimators written in Python)."""
+    keep = n - start
+    size = 1 << math.ceil(math.log2(2 * (keep + more)))
+    out = buf if size <= len(buf) else np.empty((size, *buf.shape[1:]))
+    out[:keep] = buf[start:n]
+    return out
+
+
 #: counter names, in the order of :mod:`vib_estimator.core.kernel`'s counter array
 COUNTER_NAMES = INPUT_COUNTERS + (
     'rejected_at_rest',
@@ -97,12 +143,15 @@ COUNTER_NAMES = INPUT_COUNTERS + (
 
 
 #: the attributes :meth:`FrequencyEstimator._bind` derives (not pickled: compiled code, views)
-_BOUND = ('_feed', '_k', '_p', '_row', '_s', '_seg')
+_BOUND = ('_feed', '_p', '_row', '_s', '_seg')
 
 
-def as_series(t: Sequence[float], y: Sequence[float]) -> Tuple[np.ndarray, np.ndarray]:
+def as_series(
+    t: Sequence[float], y: Sequence[float], channels: Sequence[str] = ()
+) -> Tuple[np.ndarray, np.ndarray]:
     """``t``, ``y`` as contiguous, writeable float64 arrays of one length (``ValueError``
-    otherwise); ``y`` may be samples x 1 (one channel, as a joint estimator's input).
+    otherwise): ``y`` samples, or samples x 1 (one channel, as a joint estimator's input);
+    with several named ``channels``, samples x that many.
 
     Writeable: numba compiles a kernel once more for a read-only array (another type), so a
     CSV's read-only time column (pyarrow's) cost ``analyze`` a compile of 10-20 s that
@@ -110,11 +159,27 @@ def as_series(t: Sequence[float], y: Sequence[float]) -> Tuple[np.ndarray, np.nd
     """
     t = np.require(t, np.float64, ('C', 'W'))
     y = np.require(y, np.float64, ('C', 'W'))
-    if y.ndim == 2 and y.shape[1:] == (1,):
+    m = len(channels)
+    if m and (y.ndim != 2 or y.shape[1] != m):
+        raise ValueError(f'y must be samples x {m} channels, got {y.shape}')
+    if not m and y.ndim == 2 and y.shape[1:] == (1,):
         y = y[:, 0]
-    if t.shape != y.shape or t.ndim != 1:
+    if t.shape != y.shape[: 1 if m else None] or t.ndim != 1:
         raise ValueError(f't and y must be 1-D arrays of one length, got {t.shape}, {y.shape}')
     return t, y
+
+
+#: the fewest channels of a joint estimator (one channel is a one-channel estimator's)
+MIN_CHANNELS = 2
+
+
+def channel_names(channels: Sequence[str], what: str, hint: str = '') -> Tuple[str, ...]:
+    """``channels`` as names; ValueError if they are fewer than :data:`MIN_CHANNELS` (``what``
+    needs them; ``hint``: what to do instead)."""
+    names = tuple(str(c) for c in channels)
+    if len(names) < MIN_CHANNELS:
+        raise ValueError(f'{what} needs at least {MIN_CHANNELS} channels, got {len(names)}{hint}')
+    return names
 
 
 @dataclass(frozen=True)
@@ -133,7 +198,7 @@ class Estimate:
         damping_std: predicted standard deviation of ``damping`` (NaN if not computed).
         mode: the mode it belongs to, 1 = the lowest (``modes`` >= 1); 0 with ``modes`` = 0.
         shape: a joint estimator's mode shape, normalised, complex, one entry per channel
-            (None with one channel; :mod:`.multichannel`).
+            (None with one channel; :mod:`.ambient`, :mod:`.multichannel_free`).
         shape_std: its uncertainty per channel (None with one channel).
         mac: the MAC of ``shape`` with the same mode's previous one (NaN at its first and with
             one channel).
@@ -161,6 +226,13 @@ class Estimate:
         """Estimated angular frequency, rad/s."""
         return 2 * math.pi * self.frequency_hz
 
+    @classmethod
+    def of_row(cls, row: np.ndarray) -> 'Estimate':
+        """An estimate from a kernel's row: the fields in order (:mod:`.kernel`'s ``O_*``), a
+        mode after them (the mode tracker's) or none (0)."""
+        ints = (K.O_SAMPLES, K.N_OUT)
+        return cls(*(int(v) if i in ints else float(v) for i, v in enumerate(row)))
+
     def as_dict(self) -> Dict[str, float]:
         return {
             't': self.t,
@@ -184,7 +256,7 @@ class Estimator(Protocol):
       channel); the estimates it completes, a sequence (empty, usually).
     - ``process(t, y)``: arrays of samples (``y``: samples, or samples x channels), continuing
       the stream; the estimates as columns (:class:`EstimateArrays`; a joint estimator's
-      :class:`~.multichannel.JointEstimates` add the shapes). Streaming equals batch.
+      :class:`JointEstimates` add the shapes). Streaming equals batch.
     - ``reset()``: a new segment or window at the last sample; ``restart()``: forget the
       signal; both keep the counters.
     - ``config``; ``channels``: the channel names of a joint estimator, () for one channel.
@@ -198,17 +270,33 @@ class Estimator(Protocol):
       back and why; the others are named in the estimator's module.
 
     The estimators subclass it, for the defaults of ``channels``, ``segment_samples``,
-    ``interpreted`` and ``mode_counters``.
+    ``interpreted`` and ``mode_counters``, and an estimator whose step is a module's compiled
+    functions (:attr:`_module`) for :attr:`_k` and :meth:`compiled`.
     """
 
     channels: Tuple[str, ...] = ()
     segment_samples: Optional[int] = None
     #: True while it runs its kernels uncompiled (:func:`.factory.create_uncompiled`)
     interpreted: bool = False
+    #: the module whose compiled functions are its step (None: none)
+    _module = None
 
     @property
     def config(self) -> EstimatorConfig:
         return self._config
+
+    @property
+    def _k(self):
+        """:attr:`_module`'s compiled functions, or while :attr:`interpreted` their uncompiled
+        code (:func:`.jit.interpreted`: the same state, the same floats, estimating at once while
+        they compile)."""
+        return interpreted(self._module) if self.interpreted else self._module
+
+    def compiled(self) -> None:
+        """Run the compiled functions from the next sample on (the state is in the arrays both
+        read). Their first call compiles them, unless compiled already (the node compiles them in
+        the background: :mod:`vib_estimator.nodes.stream`)."""
+        self.interpreted = False
 
     @property
     def counters(self) -> Dict[str, int]: ...
@@ -241,14 +329,15 @@ class EstimateArrays:
     mode: np.ndarray
 
     @classmethod
-    def from_rows(cls, rows: np.ndarray, mode: int = 0) -> 'EstimateArrays':
-        """Columns of the kernel's estimate rows, all of one ``mode``."""
+    def from_rows(cls, rows: np.ndarray) -> 'EstimateArrays':
+        """Columns of a kernel's estimate rows (:meth:`Estimate.of_row`)."""
+        mode = rows[:, K.N_OUT] if rows.shape[1] > K.N_OUT else np.zeros(len(rows))
         return cls(
             *(
                 rows[:, i].astype(np.int64) if i == K.O_SAMPLES else rows[:, i].copy()
                 for i in range(K.N_OUT)
             ),
-            np.full(len(rows), mode, dtype=np.int64),
+            mode.astype(np.int64),
         )
 
     @classmethod
@@ -288,6 +377,34 @@ class EstimateArrays:
         ]
 
 
+@dataclass
+class JointEstimates:
+    """Estimates of a joint (several channels) batch run: the columns of
+    :class:`EstimateArrays`, the shapes (estimates x channels, complex), their stds and the MACs,
+    in the estimates' order."""
+
+    estimates: EstimateArrays
+    shapes: np.ndarray
+    shape_std: np.ndarray
+    mac: np.ndarray
+    channels: Tuple[str, ...]
+
+    def __len__(self) -> int:
+        return len(self.estimates)
+
+    @classmethod
+    def of(cls, out: Sequence[Estimate], channels: Tuple[str, ...]) -> 'JointEstimates':
+        """The columns of the estimates ``out`` (with shapes) of ``channels``, in their order."""
+        m = len(channels)
+        return cls(
+            EstimateArrays.of(out),
+            np.array([e.shape for e in out], dtype=complex).reshape(-1, m),
+            np.array([e.shape_std for e in out]).reshape(-1, m),
+            np.array([e.mac for e in out]),
+            channels,
+        )
+
+
 class FrequencyEstimator(Estimator):
     """Streaming algebraic frequency estimator; see the module docstring.
 
@@ -299,11 +416,12 @@ class FrequencyEstimator(Estimator):
     ``counters`` tells how many samples went where and why estimates were held back.
     """
 
+    _module = K
+
     def __init__(self, config: EstimatorConfig = EstimatorConfig(), interpret: bool = False):
         config.validate()
         self._config = config
-        #: the kernel's functions: compiled, or uncompiled while ``interpret`` (:meth:`compiled`)
-        self._k = interpreted(K) if interpret else K
+        self.interpreted = interpret  # (:meth:`~Estimator.compiled`)
         self._n_state = K.N_STATE_FIXED + 2 * config.window + 1
         self._f = K.feed_buffer(config.as_params(), self._n_state, config.buffer_samples)
         self._c = np.zeros(K.N_COUNTERS, dtype=np.int64)
@@ -316,20 +434,6 @@ class FrequencyEstimator(Estimator):
         ``_s``, ``_seg`` (:func:`core.kernel.feed_buffer`'s layout) and the streaming path's
         compiled code, looked up at the first :meth:`update`."""
         self._p, self._row, self._s, self._seg = K.feed_views.py_func(self._f, self._n_state)
-        self._feed = None
-        self.__dict__.setdefault('_k', K)  # unpickled: compiled (the kernel is not pickled)
-
-    @property
-    def interpreted(self) -> bool:
-        """True while the estimator runs its kernel uncompiled (``interpret``)."""
-        return self._k is not K
-
-    def compiled(self) -> None:
-        """Run the compiled kernel from the next sample on (same state, same floats: the
-        uncompiled one computes what it computes, :func:`core.jit.interpreted`). Its first call
-        compiles it, unless it is compiled already (the node compiles it in the background:
-        :mod:`vib_estimator.nodes.stream`)."""
-        self._k = K
         self._feed = None
 
     def kernels_available(self) -> bool:
@@ -387,17 +491,13 @@ class FrequencyEstimator(Estimator):
         """
         feed = self._feed
         if feed is None:
-            feed = self._feed = (
-                self._k.feed
-                if self.interpreted
-                else entry(K.feed, (self._f, self._c, self._n_state, 0.0, 0.0, self._optional))
-            )
+            if self.interpreted:  # (not kept: compiled() switches)
+                feed = self._k.feed
+            else:
+                args = (self._f, self._c, self._n_state, 0.0, 0.0, self._optional)
+                feed = self._feed = entry(K.feed, args)
         if feed(self._f, self._c, self._n_state, t, y, self._optional):
-            return (
-                Estimate(
-                    *(int(v) if i == K.O_SAMPLES else float(v) for i, v in enumerate(self._row[0]))
-                ),
-            )
+            return (Estimate.of_row(self._row[0]),)
         return ()
 
     def process(self, t: Sequence[float], y: Sequence[float]) -> EstimateArrays:

@@ -23,9 +23,8 @@ from typing import Callable, Optional, Sequence
 from .ambient import AmbientEstimator
 from .auto import AutoEstimator
 from .config import EstimatorConfig
-from .estimator import Estimator, FrequencyEstimator, batch_start
+from .estimator import MIN_CHANNELS, Estimator, FrequencyEstimator, batch_start
 from .modes import ModeTracker
-from .multichannel import MIN_CHANNELS, JointAmbientEstimator
 from .multichannel_free import JointFreeEstimator
 
 
@@ -87,7 +86,7 @@ KINDS = (
             partial(ModeTracker, c, fast=False) if c.modes else partial(create_estimator, c),
         ),
     ),
-    Kind('joint ambient', 'ambient', True, JointAmbientEstimator),
+    Kind('joint ambient', 'ambient', True, AmbientEstimator),
 )
 
 

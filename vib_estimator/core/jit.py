@@ -92,22 +92,23 @@ def available(dispatcher, args) -> bool:
     return True
 
 
+def _unreferenced(context, builder, signature, args):
+    """:func:`borrowed`'s code: its array argument with a null meminfo and parent."""
+    view = context.make_array(signature.args[0])(context, builder, value=args[0])
+    view.meminfo = cgutils.get_null_value(view.meminfo.type)
+    view.parent = cgutils.get_null_value(view.parent.type)
+    return view._getvalue()
+
+
 @intrinsic
 def borrowed(typingctx, array):
     """``array`` without its reference count (a null meminfo): numba's increments and decrements
-    of it, and of every view of it, become a test of a null pointer.
+    of it, and of every view of it, become a test of a null pointer (:func:`_unreferenced`).
 
     For the compiled loops' own arguments only (:func:`core.kernel.run`, :func:`core.modes._run`):
     the caller holds the arrays for the whole call, and no view of them outlives it.
     """
-
-    def codegen(context, builder, signature, args):
-        view = context.make_array(signature.args[0])(context, builder, value=args[0])
-        view.meminfo = cgutils.get_null_value(view.meminfo.type)
-        view.parent = cgutils.get_null_value(view.parent.type)
-        return view._getvalue()
-
-    return array(array), codegen
+    return array(array), _unreferenced
 
 
 def _identity(array):

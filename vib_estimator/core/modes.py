@@ -78,8 +78,15 @@ from typing import Dict, List, Sequence
 import numpy as np
 
 from .config import EstimatorConfig
-from .estimator import COUNTER_NAMES, Estimate, EstimateArrays, Estimator, as_series
-from .jit import available, borrowed, interpreted, jit
+from .estimator import (
+    COUNTER_NAMES,
+    INPUT_COUNTERS,
+    Estimate,
+    EstimateArrays,
+    Estimator,
+    as_series,
+)
+from .jit import available, borrowed, jit
 from .kernel import BAND_DAMPING, advance, discretise
 from .subspace import (
     N_R,
@@ -88,7 +95,8 @@ from .subspace import (
     R_NU,
     R_ZETA,
     analyse,
-    init_subspace,  # noqa: F401 (ModeTracker.restart: self._m.init_subspace)
+    descending,
+    init_subspace,  # noqa: F401 (ModeTracker.restart: self._k.init_subspace)
 )
 
 KMAX = 8  # most modes a tracker follows (the range of ``modes``)
@@ -176,15 +184,7 @@ I_BUSY = I_RET + 4  # NS flags: a mode publishes from the scale (or soon will)
 I_WAKE = I_BUSY + NS  # input samples of fast analyses left (a change in the signal)
 N_I = I_WAKE + 1
 #: input counters, named as the estimator's
-STAGE_COUNTERS = {
-    'received': I_RECEIVED,
-    'used': I_USED,
-    'skipped_non_finite': I_NONFINITE,
-    'skipped_duplicate': I_DUPLICATE,
-    'skipped_out_of_order': I_OUT_OF_ORDER,
-    'time_jump_resets': I_TIME_JUMP,
-    'gap_resets': I_GAP,
-}
+STAGE_COUNTERS = dict(zip(INPUT_COUNTERS, range(I_RECEIVED, I_GAP + 1)))
 #: the finder's counters (the candidates' rules)
 FINDER_COUNTERS = {
     'modes_found': I_FOUND,
@@ -698,21 +698,6 @@ def _feed(b, ic, sl, pd, qs, lams, pa, t, y, out):
                 _analysis(b, ic, sl, pd, qs, lams, pa, 2 * d + half, t, out)
 
 
-@jit
-def _median_step(b):
-    """The median of the first N_STEP intervals (N_STEP odd: the middle one once sorted), by
-    insertion sort (np.median's sort machinery costs more to compile than this runs)."""
-    x = np.empty(N_STEP)
-    for i in range(N_STEP):
-        v = b[B_HBUF + i]
-        j = i
-        while j > 0 and x[j - 1] > v:
-            x[j] = x[j - 1]
-            j -= 1
-        x[j] = v
-    return x[N_STEP // 2]
-
-
 @jit(inline='always')
 def _step(b, ic, sl, pd, qs, lams, pa, t, y, out):
     """One input sample (counted; restarting the levels, or resampled onto the uniform grid by
@@ -724,8 +709,10 @@ def _step(b, ic, sl, pd, qs, lams, pa, t, y, out):
     if kind == 2:
         ic[I_NDT] = 0
     elif ic[I_NDT] == N_STEP and b[B_DT] == 0.0:
-        # the grid: the median of the first intervals as its step, from this sample on
-        b[B_DT] = _median_step(b)
+        # the grid: the median of the first intervals (N_STEP, odd) as its step, from this
+        # sample on (an insertion sort: np.median's costs more to compile than this runs)
+        h = b[B_HBUF : B_HBUF + N_STEP]
+        b[B_DT] = h[descending(h)[N_STEP // 2]]
         _levels_settle(b, ic, y)
         b[B_TG] = t
         _feed(b, ic, sl, pd, qs, lams, pa, t, y, out)
@@ -816,20 +803,16 @@ class ModeTracker(Estimator):
     as the compiled tracker does from one CPU to another (test/core/test_kernel_reference.py).
     """
 
+    _module = sys.modules[__name__]  # (:attr:`~.estimator.Estimator._k`)
+
     def __init__(self, config: EstimatorConfig, fast: bool = True, interpret: bool = False):
         config.validate()
-        self._interpret = interpret
+        self.interpreted = interpret
         if config.modes < 1:
             raise ValueError('ModeTracker needs modes >= 1 (FrequencyEstimator for modes = 0)')
         self._config = config
         self._fs = np.zeros(N_F)
-        self._b, self._sl, self._pd, self._lams, pa = (
-            self._fs[:N_B],
-            self._fs[F_SL:F_PD].reshape((KMAX, N_SL)),
-            self._fs[F_PD:F_LAM].reshape((NPEND, 3)),
-            self._fs[F_LAM:F_PA].reshape((NS, 3, PCOL)),
-            self._fs[F_PA:N_F],
-        )
+        self._b, self._sl, self._pd, self._lams, pa = _unpack.py_func(self._fs)
         self._ic = np.zeros(N_I, dtype=np.int64)
         self._qs = np.zeros((NS, NQ, PCOL))
         band = config.band_hz or (0.0, math.inf)
@@ -848,23 +831,8 @@ class ModeTracker(Estimator):
         self._out = np.empty((ROOM, N_O))
         self._t1 = np.zeros(1)  # the streaming path's sample, fed to the batch kernel
         self._y1 = np.zeros(1)
-        self._m._levels_init(self._b)
+        self._k._levels_init(self._b)
         self.restart()
-
-    @property
-    def _m(self):
-        """This module's compiled functions, or their uncompiled namespace while ``interpret``."""
-        return interpreted(_MODULE) if self._interpret else _MODULE
-
-    @property
-    def interpreted(self) -> bool:
-        """True while the tracker runs uncompiled (``interpret``)."""
-        return self._interpret
-
-    def compiled(self) -> None:
-        """Run compiled from the next sample on (the state lives in the arrays both read). Its
-        first call compiles, unless compiled already (the node compiles in the background)."""
-        self._interpret = False
 
     def kernels_available(self) -> bool:
         """Whether the compiled batch step is in memory or numba's cache
@@ -876,17 +844,12 @@ class ModeTracker(Estimator):
         """Feed one sample; return the estimates published at it (ascending mode)."""
         self._t1[0] = t
         self._y1[0] = y
-        self._m._run(self._fs, self._ic, self._qs, self._t1, self._y1, self._out, 0)
+        self._k._run(self._fs, self._ic, self._qs, self._t1, self._y1, self._out, 0)
         n = self._ic[I_NOUT]
         if n == 0:
             return []
         rows = self._out[:n]
-        return [
-            Estimate(
-                *row[:O_SAMPLES], int(row[O_SAMPLES]), *row[O_FIT:O_MODE], mode=int(row[O_MODE])
-            )
-            for row in rows[np.lexsort((rows[:, O_MODE], rows[:, O_T]))]
-        ]
+        return [Estimate.of_row(row) for row in rows[np.lexsort((rows[:, O_MODE], rows[:, O_T]))]]
 
     def process(self, t: Sequence[float], y: Sequence[float]) -> EstimateArrays:
         """Feed arrays of samples (continuing the stream); the estimates as columns, by time."""
@@ -895,15 +858,10 @@ class ModeTracker(Estimator):
         parts = []
         i = 0
         while i < len(t):
-            i = self._m._run(self._fs, self._ic, self._qs, t, y, out, i)
+            i = self._k._run(self._fs, self._ic, self._qs, t, y, out, i)
             parts.append(out[: self._ic[I_NOUT]].copy())
         rows = np.concatenate(parts) if parts else np.empty((0, N_O))
-        rows = rows[np.lexsort((rows[:, O_MODE], rows[:, O_T]))]
-        cols = [
-            rows[:, j].astype(np.int64) if j in (O_SAMPLES, O_MODE) else rows[:, j].copy()
-            for j in range(N_O)
-        ]
-        return EstimateArrays(*cols)
+        return EstimateArrays.from_rows(rows[np.lexsort((rows[:, O_MODE], rows[:, O_T]))])
 
     # ---- what it knows -----------------------------------------------------------------------
     def _active(self) -> List[int]:
@@ -957,7 +915,7 @@ class ModeTracker(Estimator):
         """Forget the signal entirely (levels, modes, candidates); counters are kept."""
         for k in range(KMAX):
             if self._sl[k, SL_ACTIVE]:
-                self._m._remove(self._ic, self._sl, k)
+                self._k._remove(self._ic, self._sl, k)
                 self._ic[I_LOST] -= 1
         keep = {
             i: self._ic[i]
@@ -969,13 +927,9 @@ class ModeTracker(Estimator):
         self._sl[:] = 0.0
         self._pd[:] = 0.0
         self._b[B_RING:] = 0.0
-        self._m._levels_settle(self._b, self._ic, 0.0)
+        self._k._levels_settle(self._b, self._ic, 0.0)
         for s in range(NS):
             m = M_A if s % 2 == 0 else M_B
-            self._m.init_subspace(self._qs[s, : m // 3 + 1, : self._npc])
+            self._k.init_subspace(self._qs[s, : m // 3 + 1, : self._npc])
         self._lams[:, 0] = 0.0
         self._lams[:, 1:] = math.nan
-
-
-#: this module (:meth:`ModeTracker._m`: its compiled functions, or :func:`core.jit.interpreted`'s)
-_MODULE = sys.modules[__name__]

@@ -7,8 +7,9 @@ accelerometers on a beam) after a pluck: each estimate is fitted to all channels
 mode's **shape** -- how much, and in which phase, each channel moves in it. One channel is not
 routed here: it stays the one-channel estimator of :func:`..factory.create_estimator`, bit for bit.
 
-Interface (that of :class:`..multichannel.JointAmbientEstimator`): :class:`JointFreeEstimator`
-``(config, channels, single)`` ``.process(t, Y) ->`` :class:`..multichannel.JointEstimates` (``Y``:
+Interface (that of :class:`..ambient.AmbientEstimator` of several channels):
+:class:`JointFreeEstimator` ``(config, channels, single)`` ``.process(t, Y) ->``
+:class:`..estimator.JointEstimates` (``Y``:
 samples x channels), ``.update(t, y) -> list[Estimate]``, ``.counters``, ``.reset()``,
 ``.restart()``, ``.config``, ``.channels``; :func:`..factory.create_estimator` picks it for
 ``excitation`` free and several channels.
@@ -60,8 +61,8 @@ A fit is published only if it is finite, within :data:`MAX_MOVE` of its start an
 row with a non-finite stamp or channel is skipped (``skipped_non_finite``), a repeated or earlier
 stamp within ``max_gap`` too (``skipped_duplicate``, ``skipped_out_of_order``); a jump back or a
 gap beyond it restarts (``time_jump_resets``, ``gap_resets``: :func:`.estimator.accept_sample`,
-the input policy the identifier shares); the channels' estimators see only the rows kept, so
-their gaps and jumps are handled as with one channel.
+the input policy every estimator written in Python shares); the channels' estimators see only the
+rows kept, so their gaps and jumps are handled as with one channel.
 """
 
 from __future__ import annotations
@@ -69,14 +70,22 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from functools import partial
 
 import numpy as np
 
 from .config import EstimatorConfig
-from .estimator import INPUT_COUNTERS, Estimate, Estimator, accept_sample
+from .estimator import (
+    INPUT_COUNTERS,
+    Estimate,
+    Estimator,
+    JointEstimates,
+    accept_rows,
+    accept_sample,
+    as_series,
+    channel_names,
+    make_room,
+)
 from .identity import ModeRegister
-from .multichannel import JointEstimates, as_channels, channel_names
 from .shapes import normalise_shape
 from .threads import single_blas_thread
 
@@ -331,28 +340,10 @@ class JointFreeEstimator(Estimator):
             est.reset()
 
     # ---- input --------------------------------------------------------------------------------
-    def _keep(self, t: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The rows to keep and the kept rows that restart (a jump back or a gap beyond
-        ``max_gap``), counted (:func:`.estimator.accept_sample`)."""
-        finite = np.isfinite(t) & np.all(np.isfinite(y), axis=1)
-        kept = np.zeros(len(t), bool)
-        restarts = np.zeros(len(t), bool)
-        last, gap = self._last, self._config.max_gap
-        restarted: list = []
-        mark = partial(restarted.append, None)  # accept_sample's restart
-        for i, (ti, ok) in enumerate(zip(t.tolist(), finite.tolist())):
-            if accept_sample(self._c, last, ti, ok, gap, mark):
-                kept[i], last = True, ti
-                if restarted:
-                    restarts[i] = True
-                    restarted.clear()
-        self._last = last
-        return kept, restarts[kept]
-
     def _forget_signal(self) -> None:
-        """After a restart (:meth:`_keep`): the row store emptied, the channels' recent
-        estimates forgotten, the known modes kept by frequency and shape but not by time (a
-        stream whose time went back would otherwise merge every event into them)."""
+        """After a restart (a jump back or a gap beyond ``max_gap``): the row store emptied, the
+        channels' recent estimates forgotten, the known modes kept by frequency and shape but not
+        by time (a stream whose time went back would otherwise merge every event into them)."""
         self._n = 0
         self._recent.clear()
         for mode in self._modes.modes:
@@ -369,19 +360,12 @@ class JointFreeEstimator(Estimator):
 
     def _append(self, t: np.ndarray, y: np.ndarray) -> None:
         """Append kept rows to the row store (the last ``buffer_samples`` rows are held)."""
-        rows, room = self._rows, self._room
-        if self._n + len(t) > len(rows):  # keep the last `room` rows (and make space)
-            keep = min(self._n, room)
-            if keep + len(t) > len(rows):
-                rows = np.empty((keep + len(t), rows.shape[1]))
-                rows[:keep] = self._rows[self._n - keep : self._n]
-                self._rows = rows
-            else:
-                rows[:keep] = rows[self._n - keep : self._n]
+        if self._n + len(t) > len(self._rows):  # keep the last `room` rows (and make space)
+            keep = min(self._n, self._room)
+            self._rows = make_room(self._rows, self._n - keep, self._n, len(t))
             self._n = keep
-        start = self._n
-        rows[start : start + len(t), 0] = t
-        rows[start : start + len(t), 1:] = y
+        self._rows[self._n : self._n + len(t), 0] = t
+        self._rows[self._n : self._n + len(t), 1:] = y
         self._n += len(t)
 
     # ---- streaming and batch ------------------------------------------------------------------
@@ -390,13 +374,12 @@ class JointFreeEstimator(Estimator):
         values = [float(v) for v in y]
         if len(values) != len(self.channels):
             raise ValueError(f'expected {len(self.channels)} channel values, got {len(values)}')
-        t, row = float(t), np.array((values,))
-        kept, restart = self._keep(np.array((t,)), row)
-        if not kept[0]:
+        t, finite = float(t), all(map(math.isfinite, values))
+        gap = self._config.max_gap
+        if not accept_sample(self._c, self._last, t, finite, gap, self._forget_signal):
             return []
-        if restart[0]:
-            self._forget_signal()
-        self._append(np.array((t,)), row)
+        self._last = t
+        self._append(np.array((t,)), np.array((values,)))
         events = []
         for c, est in enumerate(self._estimators):
             for e in est.update(t, values[c]):
@@ -406,14 +389,13 @@ class JointFreeEstimator(Estimator):
     def process(self, t: Sequence[float], y: np.ndarray) -> JointEstimates:
         """Feed arrays (``y``: samples x channels; continuing the stream); the estimates by
         time."""
-        t, y = as_channels(t, y, len(self.channels))
-        keep, restarts = self._keep(t, y)
+        t, y = as_series(t, y, self.channels)
+        finite = np.isfinite(t) & np.all(np.isfinite(y), axis=1)
+        keep, runs, self._last = accept_rows(self._c, self._last, t, finite, self._config.max_gap)
         t, y = t[keep], y[keep]
         out: list[Estimate] = []
-        # a restart empties the row store: each piece from one is appended alone
-        cuts = [0, *np.flatnonzero(restarts).tolist(), len(t)]
-        for a, b in zip(cuts[:-1], cuts[1:]):
-            if a < b and restarts[a]:
+        for a, b, restart in runs:  # a restart empties the row store: each run appended alone
+            if restart:
                 self._forget_signal()
             out += self._process_rows(t[a:b], y[a:b])
         return JointEstimates.of(out, self.channels)

@@ -146,7 +146,7 @@ def state_matrices(u: np.ndarray, s: np.ndarray, m: int, orders: Sequence[int]) 
 
 
 def ssi_poles(r: np.ndarray, fs: float, orders: Sequence[int] = ORDERS) -> list[np.ndarray]:
-    """SSI-cov poles of correlation matrices ``r`` (:func:`.correlations.correlation_matrices`,
+    """SSI-cov poles of correlation matrices ``r`` (:mod:`.correlations`,
     lags 0 .. 2 p: p block rows) at each model order: per order an array with a row per complex
     pair (upper half plane): frequency Hz, damping ratio, variance summed over channels, each
     channel's variance, the real then the imaginary parts of the (unnormalised) shape."""

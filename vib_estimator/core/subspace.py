@@ -78,10 +78,11 @@ def hankel_cov(x, lag, r):
 
 
 @jit
-def _descending(lam):
-    """The order of lam's values, descending, NaN last, ties in place (what np.argsort(-lam)
-    gives for the fewer than 15 columns here: numba's quicksort is an insertion sort below 15
-    elements; this one costs less to compile than numpy's sort machinery)."""
+def descending(lam):
+    """The order of lam's values, descending, NaN last, ties in place (an insertion sort: what
+    np.argsort(-lam) gives for the fewer than 15 columns here, numba's quicksort being an
+    insertion sort below 15 elements; this one costs less to compile than numpy's sort
+    machinery). The mode tracker's median interval is read from it too."""
     n = lam.shape[0]
     order = np.empty(n, dtype=np.int64)
     for i in range(n):
@@ -130,7 +131,7 @@ def orthogonal_iteration(r, n, q, lam):
         else:
             w[k, :] = 0.0
             w[k, k % n] = 1.0
-    order = _descending(lam)
+    order = descending(lam)
     ranked = np.empty(npc)
     for k in range(npc):
         ranked[k] = lam[order[k]]
@@ -402,12 +403,6 @@ def _close_pairs(poles, m):
     return close[:nc]
 
 
-@jit(fastmath=FAST)
-def _gauss_newton_step(jac, res):
-    """The step d minimising |res + jac^T d| (``jac``: one row per parameter)."""
-    return -_normal_solve(jac, res)
-
-
 @jit(inline='always')
 def refine_undamped(x, poles):
     """The close pairs of poles (:func:`_close_pairs`) moved onto the unit circle, their angles
@@ -436,7 +431,7 @@ def refine_undamped(x, poles):
             if len(ru) == 0:
                 return poles
             jac[i, :] = (ru - res) / REFINE_STEP
-        step = _gauss_newton_step(jac, res)
+        step = -_normal_solve(jac, res)  # minimises |res + jac^T step|
         trial = theta + step
         rt = _circle_residual(x, poles, idx, trial)
         if len(rt) == 0 or not np.sum(rt * rt) < rss:

@@ -16,7 +16,7 @@ section 10.8).
 
 In this module's order:
 
-1. **The model density**: :func:`sdof_psd`, each mode's in closed form; :func:`peak_ratio`, a
+1. **The model density**: :func:`sdof_density`, each mode's in closed form; :func:`peak_ratio`, a
    mode's peak over the noise.
 2. **The frequency refinement** (:func:`whittle_frequencies`): each identified mode's frequency
    moved to the likelihood's maximum near it, the other parameters kept (SSI-cov's frequencies are
@@ -62,21 +62,15 @@ ACTIVE = 1e-2
 
 
 # ---- 1. the model density -----------------------------------------------------------------------
-def sdof_psd(
-    w: np.ndarray, frequency_hz: float, zeta: float, variance: float, dt: float
-) -> np.ndarray:
-    """Spectral density at ``w`` (rad/sample; normalised so that its mean over a period is the
-    variance) of a white-noise-driven SDOF's response sampled every ``dt``: the DTFT of its
-    autocovariance ``c_k = variance e^(-zeta wn |k| dt) (cos wd k dt + zeta / sqrt(1 - zeta^2)
-    sin wd |k| dt)``, summed in closed form (``c_k = Re(a z^|k|)``, ``z = e^((-zeta wn + i wd)
-    dt)``: ``Re(a (1 - z^2) / (1 - 2 z cos w + z^2))``)."""
-    return sdof_density(np.cos(np.asarray(w, dtype=np.float64)), frequency_hz, zeta, variance, dt)
-
-
 def sdof_density(
     c: np.ndarray, frequency_hz: float, zeta: float, variance: float, dt: float
 ) -> np.ndarray:
-    """:func:`sdof_psd` at ``c = cos w``, in real arithmetic."""
+    """Spectral density at ``w`` (rad/sample; normalised so that its mean over a period is the
+    variance), given as ``c = cos w``, of a white-noise-driven SDOF's response sampled every
+    ``dt``: the DTFT of its autocovariance ``c_k = variance e^(-zeta wn |k| dt) (cos wd k dt +
+    zeta / sqrt(1 - zeta^2) sin wd |k| dt)``, summed in closed form (``c_k = Re(a z^|k|)``, ``z =
+    e^((-zeta wn + i wd) dt)``: ``Re(a (1 - z^2) / (1 - 2 z cos w + z^2))``), in real
+    arithmetic."""
     wn = 2 * math.pi * frequency_hz * dt
     root = math.sqrt(max(1.0 - zeta * zeta, 1e-12))
     decay = math.exp(-zeta * wn)
@@ -91,9 +85,9 @@ def sdof_density(
 def peak_ratio(
     frequency_hz: float, zeta: float, variance: float, noise_var: float, dt: float
 ) -> float:
-    """A mode's spectral density at its frequency over the white noise's (:func:`sdof_psd`)."""
-    w = 2 * math.pi * frequency_hz * dt
-    return float(sdof_psd(np.array([w]), frequency_hz, zeta, variance, dt)[0]) / noise_var
+    """A mode's spectral density at its frequency over the white noise's (:func:`sdof_density`)."""
+    c = np.cos(np.array([2 * math.pi * frequency_hz * dt]))
+    return float(sdof_density(c, frequency_hz, zeta, variance, dt)[0]) / noise_var
 
 
 # ---- 2. the frequency refinement ---------------------------------------------------------------
@@ -132,18 +126,18 @@ def whittle_frequencies(
     frequencies' stds, Hz; ``shapes``: each mode's real unit shape, modes x channels, one channel:
     1).
 
-    The Whittle log-likelihood of a stationary Gaussian vector series over the Fourier
-    frequencies ``w_j = 2 pi j / N`` is ``-sum_j (ln det S(w_j) + tr(S(w_j)^-1 I(w_j)))``, ``I``
-    the periodogram matrix ``X_j X_j^H / N`` (``X_j = sum_t (x_t - mean) e^(-i w_j t)``) and ``S``
-    the model's spectral matrix: each mode's SDOF density (:func:`sdof_psd`) times ``phi phi^T``,
+    The Whittle log-likelihood of a stationary Gaussian vector series over the Fourier frequencies
+    ``w_j = 2 pi j / N`` is ``-sum_j (ln det S(w_j) + tr(S(w_j)^-1 I(w_j)))``, ``I`` the
+    periodogram matrix ``X_j X_j^H / N`` (``X_j = sum_t (x_t - mean) e^(-i w_j t)``) and ``S`` the
+    model's spectral matrix: each mode's SDOF density (:func:`sdof_density`) times ``phi phi^T``,
     plus the noise's diagonal (one channel: ``-sum_j (ln S + I / S)``). Maximised over one mode's
-    frequency at a time, the bins within :data:`WHITTLE_SPAN` half-power half-widths
-    (``zeta f``) of it and at most :data:`WHITTLE_GAP` of the way to the nearest other mode, the
-    others at their SSI values, within :data:`WHITTLE_REACH` of the mode's std of the SSI
-    frequency. With ``R`` the rest of ``S`` and ``psi`` the mode's density, ``S = R + psi phi
-    phi^T`` is a rank-one update: ``ln det S = ln det R + ln(1 + psi a)`` and ``tr(S^-1 I) =
-    tr(R^-1 I) - psi b / (1 + psi a)`` (``a = phi^T R^-1 phi``, ``b = |(R^-1 phi)^T X|^2 / N``),
-    so the search costs per bin what one channel's does.
+    frequency at a time, the bins within :data:`WHITTLE_SPAN` half-power half-widths (``zeta f``)
+    of it and at most :data:`WHITTLE_GAP` of the way to the nearest other mode, the others at their
+    SSI values, within :data:`WHITTLE_REACH` of the mode's std of the SSI frequency. With ``R`` the
+    rest of ``S`` and ``psi`` the mode's density, ``S = R + psi phi phi^T`` is a rank-one update:
+    ``ln det S = ln det R + ln(1 + psi a)`` and ``tr(S^-1 I) = tr(R^-1 I) - psi b / (1 + psi a)``
+    (``a = phi^T R^-1 phi``, ``b = |(R^-1 phi)^T X|^2 / N``), so the search costs per bin what one
+    channel's does.
     SSI-cov's frequencies are consistent but not efficient (1.1-1.9x the Whittle bound,
     ``benchmarks/bench_operation.py``); the likelihood's maximum is (asymptotically) at the
     bound. The damping is left to SSI: the periodogram's leakage (the window's Fejer kernel)

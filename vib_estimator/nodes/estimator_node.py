@@ -64,8 +64,7 @@ from std_msgs.msg import Float64, Float64MultiArray, Header, MultiArrayDimension
 from std_srvs.srv import Trigger
 
 from ..core.config import EstimatorConfig
-from ..core.estimator import Estimate
-from ..core.multichannel import MIN_CHANNELS
+from ..core.estimator import MIN_CHANNELS, Estimate
 from ..core.shapes import SHAPE_ROWS, phases_deg, signed_amplitudes
 from ..errors import StartupError
 from ..io.align import StampAligner

@@ -45,9 +45,8 @@ import numpy as np
 
 from ..core.choice import WATCH_S, Decision, StreamChoice, decide, window_advice
 from ..core.config import EstimatorConfig
-from ..core.estimator import COUNTER_NAMES, Estimate
+from ..core.estimator import COUNTER_NAMES, MIN_CHANNELS, Estimate
 from ..core.factory import create_estimator, create_uncompiled, kind_of
-from ..core.multichannel import MIN_CHANNELS
 from ..core.warmup import is_warm, warm
 from ..io.fields import seconds_since
 from .health import WARN, Health, Status
