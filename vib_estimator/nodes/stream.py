@@ -35,6 +35,7 @@ start after an install). Meanwhile the node stays live (services, diagnostics), 
 
 from __future__ import annotations
 
+import ctypes
 import math
 import threading
 import time
@@ -472,4 +473,16 @@ class _SelfTestRun:
             self.result = self_test(*self.key, self._create)
         except Exception as err:  # answered, never lost in a thread
             self.result = (False, f'FAILED: the self test raised {err!r}')
+        release_memory()
         self.finished.set()
+
+
+def release_memory() -> None:
+    """Give the C heap's free pages back to the system (glibc's ``malloc_trim``; elsewhere
+    nothing). A thread's allocations come from a heap of its own, which kept its peak: six
+    self-tests of the identifier, each in a thread, left RSS 23-28 MB above the start in one
+    process (18 MB in the caller's thread), 0-8 MB with this after each."""
+    try:
+        ctypes.CDLL(None).malloc_trim(0)
+    except (OSError, AttributeError):
+        pass
