@@ -21,14 +21,13 @@ import threading
 import time
 
 import numpy as np
-from rclpy.qos import QoSProfile, ReliabilityPolicy
 from std_srvs.srv import Trigger
 
 from vib_estimator.nodes import estimator_node as E
 from vib_estimator.nodes import stream as S
 from vib_estimator.nodes.runner import spin_until
 
-from .test_estimator_node import make_probe, message, sine_stamps
+from .test_estimator_node import make_probe, message, sine_stamps, values_of
 
 __all__ = ['make_probe']  # the fixture, used by name
 
@@ -128,24 +127,22 @@ def test_a_burst_of_self_tests_holds_neither_diagnostics_nor_input_nor_other_cal
 
     monkeypatch.setattr(S, 'self_test', held)
     p = make_probe(excitation='ambient')
-    qos = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
-    clients = {
-        name: p.probe.create_client(Trigger, f'/estimator_node/{name}', qos_profile=qos)
-        for name in ('reset', 'self_test')
-    }
-    for client in clients.values():
-        assert spin_until(p.executor, client.service_is_ready, 60.0)
+    clients = p.trigger_clients()
+    # input first: the tones are made for its rate (a rate measured meanwhile is another run)
+    stamps = sine_stamps(1000)
+    values = np.sin(2 * np.pi * 1.33 * np.arange(1000) / 500.0)
+    p.feed(stamps[:500], values[:500])
+    p.wait_status(lambda status: values_of(status).get('sample_rate_hz', 'nan') != 'nan')
     tests = [clients['self_test'].call_async(Trigger.Request()) for _ in range(20)]
     assert spin_until(p.executor, lambda: len(runs) == 1, 10.0)
     # while it runs: diagnostics, input taken, another service answered
     arrived = len(p.diagnostics)
     assert spin_until(p.executor, lambda: len(p.diagnostics) >= arrived + 3, 8.0)
     assert not expired, 'the self-test held the executor thread'
-    stamps = sine_stamps(500)
-    p.feed(stamps, np.sin(2 * np.pi * 1.33 * np.arange(500) / 500.0))
+    p.feed(stamps[500:], values[500:])
     reset = clients['reset'].call_async(Trigger.Request())
     assert spin_until(p.executor, reset.done, 10.0) and reset.result().success
-    assert not any(f.done() for f in tests) and p.node.counters['received'] == 500
+    assert not any(f.done() for f in tests) and p.node.counters['received'] == 1000
     release.set()
     assert spin_until(p.executor, lambda: all(f.done() for f in tests), 60.0)
     answers = {(f.result().success, f.result().message) for f in tests}

@@ -479,9 +479,9 @@ class _SelfTestRun:
 
 def release_memory() -> None:
     """Give the C heap's free pages back to the system (glibc's ``malloc_trim``; elsewhere
-    nothing). A thread's allocations come from a heap of its own, which kept its peak: six
-    self-tests of the identifier, each in a thread, left RSS 23-28 MB above the start in one
-    process (18 MB in the caller's thread), 0-8 MB with this after each."""
+    nothing). The heaps keep their peaks: the identifier's self-tests of four configurations in
+    one stream left RSS about 200 MB above the start on the caller's thread, 9-20 MB each in a
+    thread followed by this (docs/soak.md)."""
     try:
         ctypes.CDLL(None).malloc_trim(0)
     except (OSError, AttributeError):
