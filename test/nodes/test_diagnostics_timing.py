@@ -7,7 +7,10 @@ EventsExecutor thread runs the 1-s timer's event after every event queued before
 * the samples held during a warm-up are fed in slices (``DRAIN_SLICE_S`` a turn), the timer's
   event between them (fed at once they were one long callback);
 * a node behind its input (a backlog: here each sample made to cost 2 ms, as on a starved CPU)
-  publishes its diagnostics from the data path once the timer's are ``DIAGNOSTICS_OVERDUE`` late.
+  publishes its diagnostics from the data path once the timer's are ``DIAGNOSTICS_OVERDUE`` late;
+* a ``~/self_test`` of a configuration not tested yet runs in a thread, its calls answered once it
+  is done (run in the executor's callback, under the identifier, it held /diagnostics silent for
+  3.8-5.2 s in soaks on a loaded machine).
 
 In process, through the node's topic; the publication times of /diagnostics are recorded at the
 node's publisher (a subscriber in the same executor would wait behind the same queue)."""
@@ -18,12 +21,13 @@ import threading
 import time
 
 import numpy as np
+from std_srvs.srv import Trigger
 
 from vib_estimator.nodes import estimator_node as E
 from vib_estimator.nodes import stream as S
 from vib_estimator.nodes.runner import spin_until
 
-from .test_estimator_node import make_probe, message, sine_stamps
+from .test_estimator_node import make_probe, message, sine_stamps, values_of
 
 __all__ = ['make_probe']  # the fixture, used by name
 
@@ -104,3 +108,48 @@ def test_a_node_behind_its_work_publishes_its_diagnostics_every_second(make_prob
     # and not more often than the timer's period (one from the data path per late turn)
     assert len(between) - 1 <= seconds / E.H.DIAGNOSTICS_PERIOD + 2, (between, seconds)
     assert node.counters['received'] == 2 * SAMPLES and node.counters['samples_missing'] == 0
+
+
+def test_a_burst_of_self_tests_holds_neither_diagnostics_nor_input_nor_other_calls(
+    make_probe, monkeypatch
+):
+    # the self-test's run held until the test lets it go on (then the real one: the identifier's
+    # tones, a configuration not tested yet)
+    release = threading.Event()
+    runs, expired = [], []
+    real = S.self_test
+
+    def held(*args):
+        runs.append(args)
+        if not release.wait(10.0):  # (in the executor's thread: it held everything that long)
+            expired.append(args)
+        return real(*args)
+
+    monkeypatch.setattr(S, 'self_test', held)
+    p = make_probe(excitation='ambient')
+    clients = p.trigger_clients()
+    # input first: the tones are made for its rate (a rate measured meanwhile is another run)
+    stamps = sine_stamps(1000)
+    values = np.sin(2 * np.pi * 1.33 * np.arange(1000) / 500.0)
+    p.feed(stamps[:500], values[:500])
+    p.wait_status(lambda status: values_of(status).get('sample_rate_hz', 'nan') != 'nan')
+    tests = [clients['self_test'].call_async(Trigger.Request()) for _ in range(20)]
+    assert spin_until(p.executor, lambda: len(runs) == 1, 10.0)
+    # while it runs: diagnostics, input taken, another service answered
+    arrived = len(p.diagnostics)
+    assert spin_until(p.executor, lambda: len(p.diagnostics) >= arrived + 3, 8.0)
+    assert not expired, 'the self-test held the executor thread'
+    p.feed(stamps[500:], values[500:])
+    reset = clients['reset'].call_async(Trigger.Request())
+    assert spin_until(p.executor, reset.done, 10.0) and reset.result().success
+    assert not any(f.done() for f in tests) and p.node.counters['received'] == 1000
+    release.set()
+    assert spin_until(p.executor, lambda: all(f.done() for f in tests), 60.0)
+    answers = {(f.result().success, f.result().message) for f in tests}
+    assert len(runs) == 1 and len(answers) == 1, answers  # one run answers the burst
+    ok, message = answers.pop()
+    assert ok and message.startswith('passed: 3 tones at 500 Hz'), message
+    # a call now finds the result kept
+    again = clients['self_test'].call_async(Trigger.Request())
+    assert spin_until(p.executor, again.done, 10.0) and again.result().message == message
+    assert len(runs) == 1

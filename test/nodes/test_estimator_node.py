@@ -180,6 +180,20 @@ class Probe:
         self.probe.destroy_client(client)
         return future.result()
 
+    def trigger_clients(self) -> dict:
+        """Clients of the node's Trigger services (``reset``, ``self_test``), each with a deep
+        reliable history (a burst of calls is answered whole), their services ready."""
+        from rclpy.qos import QoSProfile, ReliabilityPolicy
+
+        qos = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
+        clients = {
+            name: self.probe.create_client(Trigger, f'/estimator_node/{name}', qos_profile=qos)
+            for name in ('reset', 'self_test')
+        }
+        for client in clients.values():
+            assert spin_until(self.executor, client.service_is_ready, 60.0)
+        return clients
+
     def wait_status(self, predicate, timeout=5.0) -> DiagnosticStatus:
         """Spin until a /diagnostics status satisfies ``predicate``; return it."""
         array = spin_until_arrival(
@@ -877,16 +891,8 @@ def test_simultaneous_service_calls_are_all_answered_while_estimating(make_probe
     """Issue 22 case 7: 50 resets and 50 self-tests sent together while streaming were 21 answered.
     Now every call is answered (in turn) and the samples streamed meanwhile are all taken and
     estimated on."""
-    from rclpy.qos import QoSProfile, ReliabilityPolicy
-
     p = make_probe()
-    qos = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
-    clients = {
-        name: p.probe.create_client(Trigger, f'/estimator_node/{name}', qos_profile=qos)
-        for name in ('reset', 'self_test')
-    }
-    for client in clients.values():
-        assert spin_until(p.executor, client.service_is_ready, 60.0)
+    clients = p.trigger_clients()
     assert p.call('self_test').success  # compiled before the burst
     stamps = sine_stamps(5000)
     values = np.sin(2 * np.pi * 1.33 * np.arange(5000) / FS)

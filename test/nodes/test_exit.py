@@ -45,7 +45,7 @@ def fresh_domain() -> int:
 class Node:
     """A node's process in domain ``domain``, its output (stdout and stderr) in a pipe."""
 
-    def __init__(self, domain: int, name: str, *ros_args: str, env=None):
+    def __init__(self, domain: int, name: str, *ros_args: str, env=None, sigint_ignored=False):
         self.name = name
         exe = Path(sys.executable).parent / name
         self.proc = subprocess.Popen(
@@ -54,6 +54,8 @@ class Node:
             stderr=subprocess.STDOUT,
             text=True,
             env=dict(os.environ, ROS_DOMAIN_ID=str(domain), **(env or {})),
+            # as a shell starts a job in the background: SIGINT ignored, inherited
+            preexec_fn=ignore_sigint if sigint_ignored else None,
         )
         self.read = []  # lines read before the SIGINT
 
@@ -148,12 +150,28 @@ def test_the_list_of_executables_is_setup_py_s():
     assert names == set(EXECUTABLES)
 
 
-@pytest.mark.parametrize('name', ['estimator_node', 'sim_node', 'shaper_node', 'bag_replayer'])
-def test_sigint_while_the_modules_load(name):
+def ignore_sigint() -> None:
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+@pytest.mark.parametrize(
+    'name, sigint_ignored',
+    [
+        ('estimator_node', False),
+        ('sim_node', False),
+        ('shaper_node', False),
+        ('bag_replayer', False),
+        ('estimator_node', True),
+    ],
+)
+def test_sigint_while_the_modules_load(name, sigint_ignored):
     """SIGINT while the node's module imports rclpy, numba and scipy: once nodes.stopping is
     loaded and its handler in place (Python reports each import as it ends, -X importtime: the
-    first import reported after it ended after the handler was installed)."""
-    node = Node(fresh_domain(), name, env={'PYTHONPROFILEIMPORTTIME': '1'})
+    first import reported after it ended after the handler was installed). Also in a process
+    started with SIGINT ignored, as a shell's background job (before, that one missed it and ran
+    on)."""
+    env = {'PYTHONPROFILEIMPORTTIME': '1'}
+    node = Node(fresh_domain(), name, env=env, sigint_ignored=sigint_ignored)
     guard = threading.Timer(READY_S, node.kill)  # never a hang, whatever it prints
     guard.start()
     try:

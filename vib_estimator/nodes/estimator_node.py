@@ -25,8 +25,9 @@ and the diagnostics bookkeeping, all without rclpy) and publishes what comes bac
   ``vibration/mode<k>/shape`` (std_msgs/Float64MultiArray, :meth:`Outputs.publish_shape`).
 * Services ``~/reset`` (a new segment now) and ``~/self_test`` (:mod:`.self_test`),
   std_srvs/Trigger, with a request history of :data:`SERVICE_DEPTH`: a burst of calls is queued and
-  every call answered, in turn (a self-test takes ~8 ms at the defaults; the input history
-  covers 2 s).
+  every call answered, in turn; a self-test runs in a thread, once per configuration and rate,
+  its calls answered when it is done (under the identifier it takes about a CPU second: the
+  executor thread goes on meanwhile).
 * ``/diagnostics`` at 1 Hz (steady clock): one status named after the node (:mod:`.health`).
 * ``decide_excitation`` (default true): while ``excitation`` is ``free`` (the default), once the
   input looks driven throughout its last two minutes, the node sets its own ``excitation`` (and
@@ -135,6 +136,8 @@ DRAIN_SLICE_S = 0.1
 #: queued before it, and a node behind its input (a backlog after a stall, a starved CPU) once
 #: left /diagnostics silent for 2.4-3.2 s in a soak
 DIAGNOSTICS_OVERDUE = 1.5 * H.DIAGNOSTICS_PERIOD
+#: how often (s) a self-test run is looked at while calls wait for it (their answer's delay)
+SELF_TEST_POLL = 0.02
 #: request history of the services: a burst of calls queues instead of being dropped (rclpy's
 #: default, 10, answered 21 of 100 simultaneous calls)
 SERVICE_DEPTH = 1000
@@ -311,7 +314,7 @@ class EstimatorNode(Node):
         # request history, so that a burst of calls queues instead of being dropped
         service_qos = QoSProfile(depth=SERVICE_DEPTH, reliability=ReliabilityPolicy.RELIABLE)
         self.create_service(Trigger, '~/reset', self._on_reset, qos_profile=service_qos)
-        self.create_service(Trigger, '~/self_test', self._on_self_test, qos_profile=service_qos)
+        self._create_self_test(service_qos)
         qos = input_qos()
         if self._aligner is None:
             callbacks = [self._on_stamped if has_header(self._input_type) else self._on_unstamped]
@@ -344,6 +347,28 @@ class EstimatorNode(Node):
         self._warmup_logged = False
         #: the parameters being set are the node's own decision (:meth:`_decide`)
         self._deciding = False
+
+    def _create_self_test(self, qos: QoSProfile) -> None:
+        """``~/self_test``, answered when its run (a thread: :meth:`.stream.EstimatorStream.
+        self_test`) is done, never holding the executor thread: a call that finds it running is
+        answered later, by :meth:`_answer_self_tests`. rclpy's executors (the EventsExecutor and
+        the single-threaded one) send the callback's response through the service's
+        ``send_response(response, header)``; the service's own is replaced by
+        :meth:`_send_or_defer`, which keeps such a response and its request's header until then.
+        (The Jazzy wheels' EventsExecutor cannot take an ``async`` service callback: a
+        ``TypeError`` in ``send_response``, fixed by ros2/rclpy#1613, not in 7.1.6.)"""
+        service = self.create_service(Trigger, '~/self_test', self._on_self_test, qos_profile=qos)
+        self._send_self_test = service.send_response
+        service.send_response = self._send_or_defer
+        #: the response a self-test call returned while the run goes on (sent later)
+        self._deferred = None
+        #: (response, request header) of the calls waiting for the running self-test
+        self._self_test_waiting = []
+        steady = Clock(clock_type=ClockType.STEADY_TIME)
+        self._self_test_timer = self.create_timer(
+            SELF_TEST_POLL, self._answer_self_tests, clock=steady
+        )
+        self._self_test_timer.cancel()
 
     def _subscribe(self, index: int, lost_events: bool = True):
         """The subscription to input topic ``index`` (with ``lost_events``, the middleware's own
@@ -615,14 +640,45 @@ class EstimatorNode(Node):
         return response
 
     def _on_self_test(self, request, response):
-        """``~/self_test``: three tones through a fresh estimator of the live configuration."""
-        response.success, response.message = self._stream.self_test()
+        """``~/self_test``: three tones through a fresh estimator of the live configuration (its
+        run in a thread: a call that finds it running is answered when it is done)."""
+        result = self._stream.self_test(wait=False)
+        if result is None:
+            self._deferred = response  # kept by _send_or_defer, answered by _answer_self_tests
+            if self._self_test_timer.is_canceled():
+                self._self_test_timer.reset()
+            return response
+        return self._self_tested(response, result)
+
+    def _self_tested(self, response, result):
+        """``response`` filled with the self-test's ``result``, logged."""
+        response.success, response.message = result
         text = 'self test ' + response.message.replace('\n', '; ')
         if response.success:  # one call site per severity (rclpy refuses a change)
             self.get_logger().info(text)
         else:
             self.get_logger().warn(text)
         return response
+
+    def _send_or_defer(self, response, header) -> None:
+        """The self-test service's ``send_response``: a response :meth:`_on_self_test` deferred is
+        kept with its request's header; any other is sent."""
+        if response is self._deferred:
+            self._deferred = None
+            self._self_test_waiting.append((response, header))
+            return
+        self._send_self_test(response, header)
+
+    def _answer_self_tests(self) -> None:
+        """Every :data:`SELF_TEST_POLL` s while calls wait: once the self-test's run is done,
+        answer them all."""
+        result = self._stream.self_test(wait=False)
+        if result is None:
+            return
+        self._self_test_timer.cancel()
+        waiting, self._self_test_waiting = self._self_test_waiting, []
+        for response, header in waiting:
+            self._send_self_test(self._self_tested(response, result), header)
 
     # ---- diagnostics -----------------------------------------------------------------------
     @property
