@@ -8,6 +8,7 @@ import re
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from vib_estimator.analysis.summary import (
     MIN_ESTIMATES,
@@ -132,3 +133,35 @@ def test_the_default_column_is_named_and_the_others_listed_when_it_gives_nothing
     assert main(['analyze', str(path), '--column', 'tip_g', '--format', 'csv']) == 0
     out = capsys.readouterr().out.splitlines()
     assert len(out) > 2 and abs(float(out[1].split(',')[1]) / 1.8 - 1) < 0.01
+
+
+@pytest.mark.parametrize('factor', [1e-3, 1e3])
+def test_an_identifier_s_undamped_line_is_named_and_never_shaped_for(monkeypatch, factor):
+    """The simulated arm moved every 4 s (benchmarks/bench_periodic.py): the identifier's modes
+    were its cycle's 5th harmonic, 0.625 Hz, and 11th, 1.375 Hz, at damping ratios of ~1e-5, and
+    the arm's mode, 1.331 Hz at 0.36 %: the shaper is designed for 1.331 Hz, the two lines are
+    named as such. A free decay's modes (``identified`` False) are summarised as before. At
+    ``UNDAMPED`` x 0.001 the 0.625 Hz line is shaped for; x 1000 the mode is a line too."""
+    from vib_estimator.analysis import summary
+
+    f = np.repeat([0.625, 1.331, 1.375], [11, 29, 16])
+    zeta = np.repeat([1.5e-5, 3.6e-3, 1e-5], [11, 29, 16])
+    mode = np.repeat([1, 2, 3], [11, 29, 16])
+
+    def right():
+        modes = summarise_modes(f, zeta, mode)
+        lines = summary_lines(modes, identified=True)
+        free = summary_lines(modes)
+        low = shaped_mode(modes, identified=True)
+        return (
+            low is not None
+            and low.frequency_hz == 1.331
+            and 'initial_frequency_hz:=1.331' in lines[-1]
+            and sum('undamped, a line of the drive' in line for line in lines) == 2
+            and 'initial_frequency_hz:=0.625' in free[-1]
+            and not any('undamped' in line for line in free)
+        )
+
+    assert right()
+    monkeypatch.setattr(summary, 'UNDAMPED', summary.UNDAMPED * factor)
+    assert not right()

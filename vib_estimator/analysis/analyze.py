@@ -393,7 +393,8 @@ def run(args: argparse.Namespace) -> int:
                 file=sys.stderr,
             )
     for line in summary_lines(
-        summarise_modes(estimates.frequency_hz, estimates.damping, mode, estimates.t)
+        summarise_modes(estimates.frequency_hz, estimates.damping, mode, estimates.t),
+        config.excitation != 'free',
     ):
         print('analyze: ' + line, file=sys.stderr)
     pictures(args, config, signal, result, mode, geometry, why)

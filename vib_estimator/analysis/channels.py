@@ -299,7 +299,8 @@ def run_joint(args, config: EstimatorConfig, names, json_row, prog: str, warn=No
     why = '' if len(e) else explain_no_estimate(estimator.counters, None, config, decision)
     if why:
         print(f'{prog}: no estimate: {why}', file=sys.stderr)
-    for line in summary_lines(summarise_modes(e.frequency_hz, e.damping, e.mode, e.t)):
+    modes = summarise_modes(e.frequency_hz, e.damping, e.mode, e.t)
+    for line in summary_lines(modes, config.excitation != 'free'):
         print(f'{prog}: ' + line, file=sys.stderr)
     for k, (f, amp, _) in mode_shapes(result).items():
         shape = ', '.join(f'{n} {a:+.2f}' for n, a in zip(names, amp))

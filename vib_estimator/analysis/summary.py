@@ -25,6 +25,10 @@ Never a confident wrong answer:
 - **A mode on too few estimates** (fewer than :data:`MIN_ESTIMATES`) is listed as tentative and no
   shaper is designed for it: the lowest mode that is not tentative gets the recommendation, or the
   summary says why there is none.
+- **An undamped line** among an identifier's modes (``identified``: its median damping ratio under
+  :data:`UNDAMPED`): a periodic drive's harmonic, which output-only identification takes for a
+  mode of damping ~0 (docs/known_limits.md, *A periodic motion*), is listed as such and never
+  shaped for.
 """
 
 from __future__ import annotations
@@ -52,6 +56,11 @@ STRETCH_REL = 0.05
 STRETCH_RUN = 2
 #: a mode with fewer estimates than this is tentative: listed, but no shaper is designed for it
 MIN_ESTIMATES = 3
+#: an identifier's mode whose median damping ratio is under this is an undamped line, not a
+#: structural mode: the harmonics of the simulated arm's periodic moves read 4e-6 to 1.5e-4
+#: (benchmarks/bench_periodic.py), driven modes at zeta 0.2 % medians of 1.2e-3 to 5.9e-3 over
+#: 60-180 s windows, the Heritage Court Tower's 0.7-2 %
+UNDAMPED = 3e-4
 
 
 @dataclass(frozen=True)
@@ -79,6 +88,11 @@ class ModeSummary:
     def tentative(self) -> bool:
         """Fewer than :data:`MIN_ESTIMATES` estimates: listed, never shaped for."""
         return self.count < MIN_ESTIMATES
+
+    @property
+    def undamped(self) -> bool:
+        """A median damping ratio under :data:`UNDAMPED` (an identifier's: a line, module doc)."""
+        return math.isfinite(self.damping) and self.damping < UNDAMPED
 
 
 def stretches(f: np.ndarray) -> List[np.ndarray]:
@@ -191,18 +205,20 @@ def _mode_line(m: ModeSummary) -> str:
     )
 
 
-def shaped_mode(modes: List[ModeSummary]) -> Optional[ModeSummary]:
+def shaped_mode(modes: List[ModeSummary], identified: bool = False) -> Optional[ModeSummary]:
     """The summary a shaper is designed for: the last stretch of the lowest mode whose last
-    stretch is not tentative; None if every mode is."""
+    stretch is not tentative (nor, ``identified``, an undamped line); None if every mode is."""
     last = {}
     for m in modes:  # per mode in ascending frequency, its stretches in time order
         last[m.mode] = m
-    return next((m for m in last.values() if not m.tentative), None)
+    usable = (m for m in last.values() if not (m.tentative or (identified and m.undamped)))
+    return next(usable, None)
 
 
-def summary_lines(modes: List[ModeSummary]) -> List[str]:
+def summary_lines(modes: List[ModeSummary], identified: bool = False) -> List[str]:
     """The lines of the summary: one per mode (per stretch of a mode whose frequency moved), then
-    the recommended shaper and its command, or why there is none."""
+    the recommended shaper and its command, or why there is none. ``identified``: the modes are
+    an output-only identifier's (an undamped one is a line, module doc)."""
     if not modes:
         return []
     lines = ['modes found:']
@@ -213,12 +229,19 @@ def summary_lines(modes: List[ModeSummary]) -> List[str]:
                 f'  {name}: the frequency moved during the record ({m.stretches} stretches, each '
                 f'more than {100 * STRETCH_REL:g} % from the one before): summarised per stretch'
             )
-        lines.append(f'  {"  " if m.stretches > 1 else name + ": "}{_mode_line(m)}')
-    low = shaped_mode(modes)
+        line = f'  {"  " if m.stretches > 1 else name + ": "}{_mode_line(m)}'
+        if identified and m.undamped:
+            line += (
+                ": undamped, a line of the drive (a periodic motion's harmonic), not a mode of "
+                'the structure; no shaper is designed for it'
+            )
+        lines.append(line)
+    low = shaped_mode(modes, identified)
     if low is None:
         lines.append(
             f'no input shaper recommended: every mode rests on fewer than {MIN_ESTIMATES} '
             'estimates (a longer record, or the options the lines above suggest, give more)'
+            + (' or is an undamped line' if identified else '')
         )
         return lines
     shaper = recommend_shaper(low)
@@ -234,7 +257,11 @@ def summary_lines(modes: List[ModeSummary]) -> List[str]:
     if low.stretches > 1:
         notes.append(f'for the last stretch, from t = {low.t_first:.4g} s')
     if low.mode != modes[0].mode:
-        notes.append('the modes below it are tentative; shaper_node shapes one mode')
+        notes.append(
+            'the modes below it are tentative'
+            + (' or undamped lines' if identified else '')
+            + '; shaper_node shapes one mode'
+        )
     elif len({m.mode for m in modes}) > 1:
         notes.append('shaper_node shapes one mode: the lowest')
     lines.append(
