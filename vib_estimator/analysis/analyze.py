@@ -392,10 +392,8 @@ def run(args: argparse.Namespace) -> int:
                 + ' (--column NAME, or --columns all for a joint estimation)',
                 file=sys.stderr,
             )
-    for line in summary_lines(
-        summarise_modes(estimates.frequency_hz, estimates.damping, mode, estimates.t),
-        config.excitation != 'free',
-    ):
+    modes = summarise_modes(estimates.frequency_hz, estimates.damping, mode, estimates.t)
+    for line in summary_lines(modes, config.excitation != 'free'):
         print('analyze: ' + line, file=sys.stderr)
     pictures(args, config, signal, result, mode, geometry, why)
     return 0
