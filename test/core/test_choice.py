@@ -126,7 +126,9 @@ def test_decide_s_limits_what_is_read(monkeypatch):
 
 
 def test_a_record_driven_only_after_decide_s_is_decided_on_its_start():
-    t, y = mixed(choice.DECIDE_S - 20, 3 * choice.DECIDE_S, fs=20.0)
+    """The decision reads the first ten minutes (its cost, and the samples a stream holds back
+    for it, bounded): a pluck ringing 580 s, then 30 min driven, is decided free."""
+    t, y = mixed(580.0, 1800.0, fs=20.0)
     assert decide(t, y).excitation == 'free'
 
 
