@@ -109,6 +109,11 @@ def test_spectral_peaks_need_prominence_and_share():
     f, p = spectral_peaks(t, y)
     assert abs(f[0] - 3) < 0.06 and any(abs(f - 7) < 0.06)
     assert p[0] == max(p)
+    # a faint line (1 % of the amplitude, 1e-4 of the power: a hum, a sensor's artefact) stands
+    # far above the noise but is no peak of the structure: not the record's fundamental
+    y += 0.01 * np.sin(2 * np.pi * 1.3 * t)
+    f, _ = spectral_peaks(t, y)
+    assert not any(abs(f - 1.3) < 0.06) and min(f) > 2.9
 
 
 def mixed(free_s=60.0, driven_s=60.0, fs=200.0):
