@@ -38,8 +38,12 @@ def test_whittle_bound_matches_the_issue_figures():
     assert rel[1] == pytest.approx(0.0023, rel=0.03)
 
 
-def test_fisher_over_active_bins_equals_the_full_sum():
-    modes, noise, n = [(8.0, 0.01, 1.0), (8.8, 0.02, 0.5)], 1e-3, 6000
+@pytest.mark.parametrize('noise', [1e-3, 0.1])
+def test_fisher_over_active_bins_equals_the_full_sum(noise):
+    """The bins left out carry no information on the modes (a pair far above the noise, and one
+    whose skirts sink into it within a few half-widths: counting only the bins 10 x above the
+    noise, its dampings' bounds were 13-28 % too large)."""
+    modes, n = [(8.0, 0.01, 1.0), (8.8, 0.02, 0.5)], 6000
     w = 2 * math.pi * np.arange(1, (n + 1) // 2) / n
     theta = [x for m in modes for x in m] + [noise]
 
