@@ -407,3 +407,13 @@ def test_samples_fed_one_at_a_time_between_batches_resets_and_gaps_are_the_strea
     assert len(want) >= 6
     assert got == want
     assert mixed.counters == streamed.counters
+
+
+def test_a_mode_too_weak_to_tell_within_2_percent_is_not_published():
+    """A 1 Hz mode at zeta 3 % over 10 s windows (10 periods, 2 correlation times) in 10 dB of
+    noise: its predicted frequency std is 2.4-3.3 %, its estimates would err by up to 3 %: none
+    is published, each counted ``rejected_uncertain``."""
+    t, y, _ = ambient_record(60.0, 50.0, [(1.0, 0.03, 1.0)], 10.0, 0)
+    est = AmbientEstimator(EstimatorConfig(excitation='ambient', ambient_window_s=10.0))
+    assert len(est.process(t, y)) == 0
+    assert est.counters['rejected_uncertain'] > 10
