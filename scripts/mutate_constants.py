@@ -34,6 +34,7 @@ import os
 import random
 import re
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -255,11 +256,22 @@ def run_tests(root: Path, tests: list[str], timeout: float) -> tuple[str, str]:
     env.pop('NUMBA_CACHE_DIR', None)  # the copy's own __pycache__
     tests = [t for t in tests if (root / t).exists()]
     cmd = [sys.executable, '-m', 'pytest', '-x', '-q', '-rfE', '-p', 'no:cacheprovider', *tests]
+    # its own process group: a timeout ends the processes its tests started too (a test's
+    # subprocess outlived a killed pytest, its folder deleted under it)
+    proc = subprocess.Popen(
+        cmd,
+        cwd=root,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        text=True,
+        start_new_session=True,
+    )
     try:
-        out = subprocess.run(
-            cmd, cwd=root, env=env, capture_output=True, text=True, timeout=timeout
-        ).stdout
+        out = proc.communicate(timeout=timeout)[0]
     except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.communicate()
         return 'timeout', ''
     hit = re.search(r'^(?:FAILED|ERROR) (\S+)', out, re.M)
     if hit:
