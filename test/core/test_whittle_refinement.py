@@ -38,18 +38,26 @@ def test_the_refined_frequency_is_at_the_whittle_bound_from_a_start_two_stds_off
     assert abs(np.mean(errors)) < 0.5 * bound  # no bias toward the start
 
 
-def test_a_close_neighbour_keeps_each_frequency_near_its_own_peak():
-    pair = [(8.0, 0.01, 1.0), (8.8, 0.01, 0.8)]
+def pair_rms(pair, start):
+    """Each mode's RMS error over 20 seeded windows of ``pair`` refined from the rows
+    ``start(sign, bounds)`` (``sign`` alternating from window to window), and their bounds."""
     n = round(SECONDS * FS)
     noise_var = next(windows(1, pair))[1]
-    bounds = [b[0] for b in whittle_std(pair, noise_var, FS, n)]
+    bounds = np.array([b[0] for b in whittle_std(pair, noise_var, FS, n)])
     errors = []
     for k, (y, noise) in enumerate(windows(20, pair)):
-        sign = 1 if k % 2 else -1  # starts 2 bound-stds off, toward and away from the neighbour
-        rows = np.array([(f + sign * 2 * b, z, v) for (f, z, v), b in zip(pair, bounds)])
-        errors.append(whittle_frequencies(y, FS, rows, noise, np.array(bounds)) - [8.0, 8.8])
-    rms = np.sqrt(np.mean(np.square(errors), axis=0))
-    assert np.all(rms < 1.5 * np.array(bounds)), (rms, bounds)
+        rows = np.array(start(1 if k % 2 else -1, bounds))
+        errors.append(whittle_frequencies(y, FS, rows, noise, bounds) - [m[0] for m in pair])
+    return np.sqrt(np.mean(np.square(errors), axis=0)), bounds
+
+
+def test_a_close_neighbour_keeps_each_frequency_near_its_own_peak():
+    pair = [(8.0, 0.01, 1.0), (8.8, 0.01, 0.8)]
+    # starts 2 bound-stds off, toward and away from the neighbour
+    rms, bounds = pair_rms(
+        pair, lambda sign, b: [(f + sign * 2 * s, z, v) for (f, z, v), s in zip(pair, b)]
+    )
+    assert np.all(rms < 1.5 * bounds), (rms, bounds)
 
 
 def test_what_it_leaves_alone_and_how_far_it_moves():
@@ -105,15 +113,8 @@ def test_a_weak_mode_beside_a_strong_one_reads_its_own_peak():
     unexplained) keeps its RMS error within 1.3x its bound over 20 windows (1.07x; a band
     reaching into the neighbour's peak: 1.79x)."""
     pair = [(8.0, 0.01, 0.1), (8.5, 0.01, 1.0)]
-    n = round(SECONDS * FS)
-    noise_var = next(windows(1, pair))[1]
-    bounds = [b[0] for b in whittle_std(pair, noise_var, FS, n)]
-    errors = []
-    for k, (y, noise) in enumerate(windows(20, pair)):
-        sign = 1 if k % 2 else -1
-        rows = np.array(
-            [(8.0 + sign * 2 * bounds[0], 0.01, 0.1), (8.5 - sign * 2 * bounds[1], 0.02, 1.0)]
-        )
-        errors.append(whittle_frequencies(y, FS, rows, noise, np.array(bounds))[0] - 8.0)
-    rms = math.sqrt(np.mean(np.square(errors)))
-    assert rms < 1.3 * bounds[0], (rms, bounds[0])
+    rms, bounds = pair_rms(
+        pair,
+        lambda sign, b: [(8.0 + sign * 2 * b[0], 0.01, 0.1), (8.5 - sign * 2 * b[1], 0.02, 1.0)],
+    )
+    assert rms[0] < 1.3 * bounds[0], (rms, bounds)
