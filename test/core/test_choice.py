@@ -515,3 +515,42 @@ def test_a_pluck_in_a_quiet_record_is_read_and_a_glitch_is_not():
     d = decide(t, y)
     assert d.excitation == 'ambient' and abs(d.fundamental_hz / 1.2 - 1) < 0.03
     assert 90 <= d.window_s <= 110
+
+
+def _streamed(freqs, amps, zetas, follow_hz=None, seed=0):
+    """A free decay of ``freqs`` plucked at 2 s (12 s at 500 Hz) fed to a StreamChoice 50 ms at
+    a time, asked each time as a node on ``free``, ``modes`` 0, would ask, its estimator
+    publishing ``follow_hz`` once a period from 1.25 periods after the pluck (None: silent):
+    the seconds from the pluck to the first decision and its ``modes``, or None."""
+    from vib_estimator.core.choice import StreamChoice
+
+    t = np.arange(0, 12, 1 / 500)
+    tau = np.maximum(t - 2.0, 0)
+    y = sum(
+        a * np.exp(-z * 2 * np.pi * f * tau) * np.sin(2 * np.pi * f * tau)
+        for f, a, z in zip(freqs, amps, zetas)
+    )
+    y = y + 1e-3 * np.random.default_rng(seed).standard_normal(len(t))
+    stream = StreamChoice()
+    nxt = 2.0 + 1.25 / follow_hz if follow_hz else np.inf
+    for k in range(0, len(t), 25):
+        for i in range(k, min(k + 25, len(t))):
+            stream.update(t[i], y[i])
+        now = t[min(k + 25, len(t)) - 1]
+        if now >= nxt:
+            stream.follow(follow_hz)
+            nxt += 1 / follow_hz
+        d = stream.decision('free', False, 30.0, 0, windowed=True)
+        if d is not None:
+            return now - 2.0, d.modes
+    return None
+
+
+def test_a_silent_estimator_on_several_modes_goes_to_the_tracker_and_a_publishing_one_not():
+    """A 10 / 13 Hz decay (their beating fails every one-mode fit: the estimator stays silent)
+    is sent to the mode tracker within 2 s of the pluck (1.05 s); a beam's pluck, 6 Hz with its
+    39 Hz ringing beside it for 2 s, whose estimator publishes each period, is not (asked as
+    soon as the estimator paused between estimates, it went at 1.1 s)."""
+    went = _streamed((10.0, 13.0), (1.0, 0.5), (0.003, 0.003))
+    assert went is not None and went[0] < 2.0 and went[1] == 3
+    assert _streamed((6.0, 39.0), (1.0, 0.5), (0.005, 0.01), follow_hz=6.0) is None
