@@ -417,3 +417,14 @@ def test_a_mode_too_weak_to_tell_within_2_percent_is_not_published():
     est = AmbientEstimator(EstimatorConfig(excitation='ambient', ambient_window_s=10.0))
     assert len(est.process(t, y)) == 0
     assert est.counters['rejected_uncertain'] > 10
+
+
+def test_a_mode_on_a_large_offset_is_no_flat_window():
+    """A position in a world frame: a 2 Hz mode of 1 mm RMS on an offset of 1e7 m (RMS 1e-10 of
+    the mean, 7 digits above float64's rounding) is identified; a window is constant only to
+    rounding (its RMS within 1e-12 of its mean: at 1e-9 every window here read flat)."""
+    t, y, _ = ambient_record(60.0, 50.0, [(2.0, 0.01, 1.0)], 26.0, 0)
+    est = AmbientEstimator(EstimatorConfig(excitation='ambient', ambient_window_s=20.0))
+    e = est.process(t, 1e7 + 1e-3 * y)
+    assert len(e) >= 5 and abs(np.median(e.frequency_hz) / 2.0 - 1) < 0.02
+    assert est.counters['flat_windows'] == 0
