@@ -1080,6 +1080,21 @@ def test_a_driven_input_switches_the_default_to_the_identifier(make_probe, decid
         assert config_of(p.node).excitation == 'free'
 
 
+def test_a_periodic_drive_sets_the_nodes_lines(make_probe):
+    """``decide_excitation``: a mode driven by noise beside a cycle's lines (odd harmonics of
+    0.8 Hz) sets the node's own ``lines_hz`` (a double array) with the identifier."""
+    from vib_estimator.sim.ambient import ambient_record
+
+    p = make_probe()
+    t, y, _ = ambient_record(75, 40, [(5.0, 0.01, 1.0)], 30, 1)
+    y = y + sum(1.5 / k * np.sin(2 * np.pi * k * 0.8 * t + k) for k in (1, 3, 5, 7, 9))
+    p.feed([EPOCH_NS + round(s * 1e9) for s in t], y)
+    node = p.node
+    assert spin_until(p.executor, lambda: config_of(node).excitation == 'ambient', 5.0)
+    lines = node.get_parameter('lines_hz').value
+    assert len(lines) >= 5 and lines[0] == pytest.approx(0.8, rel=1e-3)
+
+
 def test_a_silent_decay_of_several_modes_sets_the_nodes_modes(make_probe):
     """``decide_excitation``: a pluck of two beating modes, which the one-mode estimator cannot
     fit, sets the node's own ``modes`` to 3 (the mode tracker, primed with the decay so far):

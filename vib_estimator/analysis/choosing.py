@@ -84,6 +84,7 @@ def decided_config(
         min_periods=periods,
         early_std_rel=early,
         model=model,
+        lines_hz=config.lines_hz or d.lines_hz or None,
     )
     return changed, line
 

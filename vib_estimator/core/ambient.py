@@ -94,6 +94,12 @@ SEARCH_EVERY = 5
 #: a mode's estimates over this many windows calibrate its stds (:meth:`_Track.calibration`)
 HISTORY_WINDOWS = 4
 
+#: a mode within this (relative) of one of ``lines_hz`` is the periodic drive's line
+#: (``rejected_line``): the identifier reads a line to ~1e-5, the decision refines it to ~1e-4
+#: (core.choice.peak_kurtosis), and a mode 3 % from a harmonic (the arm's 1.331 Hz beside its
+#: 4-s cycle's 1.375 Hz) stays apart
+LINE_TOL = 0.01
+
 COUNTER_NAMES = INPUT_COUNTERS + (
     'analyses',
     'analyses_idle',
@@ -101,6 +107,7 @@ COUNTER_NAMES = INPUT_COUNTERS + (
     'rejected_unstable',
     'rejected_weak',
     'rejected_uncertain',
+    'rejected_line',
     'flat_windows',
     'modes_found',
     'modes_lost',
@@ -344,10 +351,22 @@ class AmbientEstimator(Estimator):
         return ts
 
     # ---- analysis -----------------------------------------------------------------------------
+    def _off_lines(self, modes: WindowModes) -> WindowModes:
+        """The window's modes less those within :data:`LINE_TOL` of a line of the drive
+        (``lines_hz``; counted ``rejected_line``)."""
+        lines = self._config.lines_hz
+        if not lines or not len(modes):
+            return modes
+        ratio = modes.frequency[:, None] / np.asarray(lines, dtype=np.float64)[None, :]
+        at = np.any(np.abs(ratio - 1) <= LINE_TOL, axis=1)
+        self._c['rejected_line'] += int(np.count_nonzero(at))
+        return modes.take(~at)
+
     def _track(self, modes: WindowModes, total: float, t: float, span: float, n: int) -> list:
         """Match the window's modes to the tracked ones (:class:`.identity.ModeRegister`),
         publish the confirmed ones."""
         register = self._register
+        modes = self._off_lines(modes)
         match = register.match(modes.frequency.tolist(), modes.shapes)
         seen: dict = {}
         for i in range(len(modes)):

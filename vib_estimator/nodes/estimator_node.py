@@ -697,7 +697,12 @@ class EstimatorNode(Node):
         decision = self._stream.decision()
         if decision is None:
             return
-        changes = [Parameter(name, value=value) for name, value in decision.changes().items()]
+        changes = [
+            Parameter(name, Parameter.Type.DOUBLE_ARRAY, [float(v) for v in value])
+            if isinstance(value, list)  # (an empty list has no type rclpy can infer)
+            else Parameter(name, value=value)
+            for name, value in decision.changes().items()
+        ]
         config = self._stream.config
         what = f'excitation {config.excitation} -> {decision.excitation}'
         if decision.changes().get('modes', config.modes) != config.modes:
