@@ -179,6 +179,8 @@ class AmbientEstimator(Estimator):
         self._pending_y: list = []
         self._max_gap = config.max_gap
         self._clear_window = self.reset  # (bound once: the data path's)
+        self._clean = 0  # samples taken by update's fast path (counted received and used)
+        self._one_gap = config.max_gap if m == 1 else -math.inf  # (the fast path: one channel)
         #: while True, a window that is due only slides (counted ``analyses_idle``): nothing is
         #: identified or published, the tracked modes wait (``excitation = auto`` in a free
         #: stretch, where the identifier's estimates would not publish)
@@ -187,7 +189,10 @@ class AmbientEstimator(Estimator):
 
     @property
     def counters(self) -> dict[str, int]:
-        return dict(self._c)
+        c = dict(self._c)
+        c['received'] += self._clean  # (the samples :meth:`update` took by its fast path)
+        c['used'] += self._clean
+        return c
 
     def restart(self) -> None:
         """Forget the signal and the tracked modes; counters are kept."""
@@ -218,6 +223,19 @@ class AmbientEstimator(Estimator):
     def update(self, t: float, y) -> list:
         """Feed one sample (one value per channel); the estimates of an analysis it completes
         (ascending mode)."""
+        last = self._last
+        if y.__class__ is float and last < t <= last + self._one_gap and y - y == 0.0:
+            # the data path's sample (one channel's finite float, after the last, no gap: what
+            # accept_sample keeps without a restart), counted at once (``_clean``)
+            self._clean += 1
+            self._last = t
+            self._pending_t.append(t)
+            self._pending_y.append(y)
+            if t >= self._next:
+                return self._analysis()
+            if self._next == math.inf:  # the window's first sample (after a reset)
+                self._next = t + self._window
+            return []
         if isinstance(y, float) and self._m == 1:  # (a float or numpy float64: no array made)
             value, finite = y, math.isfinite(y)
         else:
