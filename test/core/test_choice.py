@@ -567,3 +567,35 @@ def test_the_periodic_drive_s_constants_are_pinned_from_both_sides(monkeypatch, 
         )
 
     holds_then_breaks(monkeypatch, name, factor, right)
+
+
+def slow_drive(variance):
+    """A 5 Hz mode driven by noise and, an octave and more below it, a broad bump of the drive's
+    slow motion (1 Hz, zeta 5 %) of ``variance``."""
+    t, y, _ = ambient_record(240, 100.0, [(5.0, 0.01, 1.0), (1.0, 0.05, variance)], 30, 3)
+    return t, y
+
+
+@pytest.mark.parametrize(
+    'name, factor',
+    [('LOW_SHARE', 0.001), ('LOW_SHARE', 1000), ('LOW_GAP', 0.001), ('LOW_GAP', 1000)],
+)
+def test_a_driven_record_s_weak_slow_content_is_left_out_of_its_band(monkeypatch, name, factor):
+    """A peak under LOW_SHARE of the strongest's power, below LOW_GAP x the lowest strong one,
+    is the drive's slow content: the identifier's band starts an octave below the mode and the
+    window is sized for the mode (not for 1 Hz: 120 s); a stronger one is a mode, kept."""
+
+    def right():
+        weak, strong = decide(*slow_drive(0.01)), decide(*slow_drive(0.3))
+        return (
+            weak.excitation == 'ambient'
+            and weak.band_hz
+            and weak.band_hz[0] == pytest.approx(2.5, rel=0.02)
+            and weak.band_hz[1] == pytest.approx(45.0)  # NU_MAX x the rate
+            and weak.window_s == 30.0
+            and weak.changes()['band_hz'] == list(weak.band_hz)
+            and strong.band_hz == ()
+            and strong.window_s == 120.0
+        )
+
+    holds_then_breaks(monkeypatch, name, factor, right)

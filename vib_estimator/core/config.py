@@ -322,10 +322,9 @@ class EstimatorConfig:
         """A validated copy with ``changes`` applied."""
         data = asdict(self)
         data.update(changes)
-        if data.get('band_hz') is not None:
-            data['band_hz'] = tuple(data['band_hz'])
-        if data.get('lines_hz') is not None:  # (none: [] or ())
-            data['lines_hz'] = tuple(data['lines_hz']) or None
+        for name in ('band_hz', 'lines_hz'):
+            if data.get(name) is not None:  # (none: [] or ())
+                data[name] = tuple(data[name]) or None
         cfg = EstimatorConfig(**data)
         cfg.validate()
         return cfg
