@@ -567,3 +567,10 @@ def test_a_periodic_drive_s_lines_go_to_the_identifier_and_leave_with_the_next_d
     assert stream.counters['rejected_line'] > 0
     stream.configure(stream.config.replace(**decide(t, y).changes()))
     assert stream.config.lines_hz is None and stream.config.excitation == 'ambient'
+    # back to free decays (the choice's own way back): what the driven decisions set goes
+    from vib_estimator.core.choice import Decision
+
+    stream.configure(stream.config.replace(lines_hz=[0.8], band_hz=[0.5, 45.0]))
+    back = Decision('free', 30.0, 0.0, np.nan, np.nan, (), 'freed', clears=True)
+    stream.configure(stream.config.replace(**back.changes()))
+    assert stream.config.lines_hz is None and stream.config.band_hz is None

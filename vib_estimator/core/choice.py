@@ -222,6 +222,8 @@ class Decision:
     lines_hz: tuple = ()
     #: a driven record's band, Hz (:func:`low_edge`; (): none)
     band_hz: tuple = ()
+    #: a stream's way back to free decays: the lines and the band its driven decision set go
+    clears: bool = False
 
     def changes(self) -> dict:
         """The configuration fields a stream switching to this decision sets (the node's
@@ -229,17 +231,21 @@ class Decision:
         several) or window (when decided)."""
         if self.excitation == 'free':
             out: dict = {'excitation': 'free'}
+            if self.clears:
+                out.update(lines_hz=[], band_hz=[])
             if self.modes:
                 out['modes'] = self.modes
             if math.isfinite(self.min_periods):
                 out.update(min_periods=self.min_periods, early_std_rel=self.early_std_rel)
             return out
-        return {
+        out = {
             'excitation': self.excitation,
             'ambient_window_s': float(self.window_s),
             'lines_hz': list(self.lines_hz),  # ([]: none, those of an earlier decision gone)
-            'band_hz': list(self.band_hz),
         }
+        if self.band_hz:  # (else the configured band stays)
+            out['band_hz'] = list(self.band_hz)
+        return out
 
 
 def principal_component(y: np.ndarray) -> np.ndarray:
@@ -1028,7 +1034,7 @@ class StreamChoice:
                 f'under {100 * FREE_BELOW:.0f} % of the energy of the last {WATCH_S:g} s read '
                 'driven by the envelope'
             )
-            return Decision('free', window_s, 0.0, math.nan, math.nan, (), reason)
+            return Decision('free', window_s, 0.0, math.nan, math.nan, (), reason, clears=True)
         if excitation != 'free' or self._share is None or now < self._retry_at:
             return None
         self._retry_at = now + WATCH_S / 2
