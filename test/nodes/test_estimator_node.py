@@ -1067,6 +1067,9 @@ def test_a_driven_input_switches_the_default_to_the_identifier(make_probe, decid
     from vib_estimator.sim.ambient import ambient_record
 
     p = make_probe(decide_excitation=deciding)
+    stream, primed = p.node._stream, []
+    configure = stream.configure
+    stream.configure = lambda *a, **k: primed.append(k.get('prime')) or configure(*a, **k)
     t, y, _ = ambient_record(75, 40, [(1.2, 0.015, 1.0)], 20, 1)
     p.feed([EPOCH_NS + round(s * 1e9) for s in t], y)
     if deciding:
@@ -1074,6 +1077,8 @@ def test_a_driven_input_switches_the_default_to_the_identifier(make_probe, decid
         assert spin_until(p.executor, lambda: config_of(node).excitation == 'ambient', 5.0)
         assert 90 <= node.get_parameter('ambient_window_s').value <= 110
         assert p.node._stream.decided
+        # excitation and window at once: one identifier built and primed, not one a parameter
+        assert primed == [True]
     else:
         status = p.wait_status(lambda s: 'looks driven' in s.message)
         assert 'excitation:=ambient' in status.message
