@@ -19,7 +19,7 @@ from vib_estimator.nodes import stream as S
 _CHURN = """
 import ctypes, sys
 import numpy as np
-from vib_estimator.nodes.stream import fix_allocator
+from vib_estimator.io.heap import fix_allocator
 if not hasattr(ctypes.CDLL(None), 'mallinfo2') or sys.argv[1] == 'fixed' and not fix_allocator():
     print('unfixable'); sys.exit()  # not glibc 2.33 or later
 def rss():

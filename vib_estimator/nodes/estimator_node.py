@@ -79,6 +79,7 @@ from ..io.fields import (
     stamp_ns,
     topic_channels,
 )
+from ..io.heap import fix_allocator, release_memory
 from . import health as H
 from .baseline_monitor import BaselineMonitor
 from .cadence import Cadence, Watchdog
@@ -98,8 +99,6 @@ from .stream import (
     WARMUP_MESSAGE,
     EstimatorStream,
     check_channels,
-    fix_allocator,
-    release_memory,
 )
 
 #: input history: sensor-data QoS (best effort: it matches best-effort and reliable publishers

@@ -35,7 +35,6 @@ start after an install). Meanwhile the node stays live (services, diagnostics), 
 
 from __future__ import annotations
 
-import ctypes
 import math
 import threading
 import time
@@ -50,6 +49,7 @@ from ..core.estimator import COUNTER_NAMES, MIN_CHANNELS, Estimate
 from ..core.factory import create_estimator, create_uncompiled, kind_of
 from ..core.warmup import is_warm, warm
 from ..io.fields import seconds_since
+from ..io.heap import release_memory
 from .health import WARN, Health, Status
 from .self_test import self_test
 
@@ -495,34 +495,3 @@ class _SelfTestRun:
             self.result = (False, f'FAILED: the self test raised {err!r}')
         release_memory()
         self.finished.set()
-
-
-#: glibc's ``mallopt`` parameter of the mmap threshold, and the threshold :func:`fix_allocator`
-#: sets (glibc's initial one)
-M_MMAP_THRESHOLD = -3
-MMAP_THRESHOLD = 128 * 1024
-
-
-def fix_allocator() -> bool:
-    """Fix glibc's mmap threshold at :data:`MMAP_THRESHOLD` (True when set; elsewhere nothing):
-    a block at least that large is mapped for itself and unmapped when freed. glibc otherwise
-    raises the threshold to the largest such block freed (32 MB at most), after which blocks of
-    that size come from the heap, whose freed pages stay resident: the identifier's windows and
-    self-tests (arrays of 0.1-10 MB, freed each analysis) grew the estimator's RSS by 21 MB
-    over 24 simulated minutes after its start, its traced heap by 0.5 MB (tracemalloc; by 10 MB
-    so, docs/soak.md)."""
-    try:
-        return ctypes.CDLL(None).mallopt(M_MMAP_THRESHOLD, MMAP_THRESHOLD) == 1
-    except (OSError, AttributeError):
-        return False
-
-
-def release_memory() -> None:
-    """Give the C heap's free pages back to the system (glibc's ``malloc_trim``; elsewhere
-    nothing). The heaps keep their peaks: the identifier's self-tests of four configurations in
-    one stream left RSS about 200 MB above the start on the caller's thread, 9-20 MB each in a
-    thread followed by this (docs/soak.md)."""
-    try:
-        ctypes.CDLL(None).malloc_trim(0)
-    except (OSError, AttributeError):
-        pass
