@@ -113,6 +113,14 @@ def records(folder: Path, real: Path | None):
                 ['--excitation', 'ambient'],
             )
         )
+    for name, every, jitter in (
+        ('moved at random times', 1.5, 0.5),
+        ('moved every 0.8 s', 0.8, 0),
+    ):
+        rec = arm_model.back_and_forth(300, every, 0.5 if jitter else 0.3, 1.0, jitter)
+        path = write_csv(folder, f'arm_moves_{every:g}', rec.t, rec.torque)
+        tuned = ['--excitation', 'ambient']
+        out.append((f'arm {name}', 'driven', path, [], [float(rec.f_true[0])], tuned))
     t, y, freqs, shapes = frame_record(300, 50, seed=0)
     path = write_csv(folder, 'frame', t, y)
     tuned = ['--excitation', 'ambient', '--ambient-window-s', '60']

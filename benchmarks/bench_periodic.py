@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 from bench_defaults import run
 
-from vib_estimator.sim.arm_model import DrivenArmSimulator, Move
+from vib_estimator.sim.arm_model import back_and_forth
 
 #: (name, seconds a move, its angle (rad, alternately + and -), its ramp's slope (rad/s),
 #: relative jitter of the angle and of the time between moves)
@@ -35,16 +35,10 @@ SCHEDULES = (
 
 
 def record(seed: int, every: float, angle: float, slope: float, jitter: float, seconds=300.0):
-    """``(t, torque, f)``: the arm moved every ``every`` s to +-``angle`` rad."""
-    rng = np.random.default_rng(seed + 100)
-    moves, t, k = [], 0.0, 0
-    while t < seconds:
-        moves.append(Move(t, angle * (-1) ** k * (1 + jitter * rng.uniform(-1, 1)), slope))
-        t += every * (1 + jitter * rng.uniform(-0.5, 0.5))
-        k += 1
-    sim = DrivenArmSimulator(rate_hz=500.0, seed=seed, schedule=tuple(moves), excitation='moves')
-    rows = np.array([sim.step() for _ in range(int(seconds * 500.0))])
-    return rows[:, 0], rows[:, 1], float(rows[0, 2])
+    """``(t, torque, f)``: the arm moved every ``every`` s to +-``angle`` rad
+    (:func:`vib_estimator.sim.arm_model.back_and_forth`)."""
+    rec = back_and_forth(seconds, every, angle, slope, jitter, seed)
+    return rec.t, rec.torque, float(rec.f_true[0])
 
 
 def main() -> int:

@@ -859,6 +859,8 @@ class Soak:
             rss_growth_after_first_tenth_mb=rss_growth,
             rss_growth_mb=growth,
             rss_growth_long_mb=long_growth,
+            # estimator_node's RSS every 10 s (steady s since the start, MB): when it grew
+            rss_every_10s=[(round(t), round(mb, 1)) for t, mb in self.rss[::10]],
             load=dict(
                 min=loads[0] if loads else math.nan,
                 median=loads[len(loads) // 2] if loads else math.nan,

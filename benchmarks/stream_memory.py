@@ -13,7 +13,9 @@ the simulator restarted (its stamps back to 1 s), a stall (10 s of samples lost:
 parameter storm (100 estimators built), 50 resets and self-tests, a publisher gone (restarted),
 and the decisions applied once a second of the soak's wall time (5000 samples), as the node does.
 Prints RSS every 5 simulated minutes (after a garbage collection); ``--trace``: tracemalloc's
-growth from the 5th minute to the end, by line, and the object counts that grew.
+growth from the 5th minute to the end, by line, and the object counts that grew. glibc's mmap
+threshold is fixed first, as ``estimator_node`` fixes it (``fix_allocator``);
+``--keep-allocator`` leaves glibc's dynamic threshold (the node before 5 Dec 2026).
 """
 
 from __future__ import annotations
@@ -26,7 +28,7 @@ import tracemalloc
 
 from vib_estimator.core.config import EstimatorConfig
 from vib_estimator.nodes.sim_node import PARAMETERS, make_simulator, schedule_from_array
-from vib_estimator.nodes.stream import EstimatorStream
+from vib_estimator.nodes.stream import EstimatorStream, fix_allocator
 
 RATE_HZ = 500.0
 #: samples between two of the node's status/decision calls (a wall second at speed 10)
@@ -53,7 +55,12 @@ def main(argv=None) -> None:
     parser.add_argument('--minutes', type=float, default=30.0, help='simulated minutes')
     parser.add_argument('--excitation', default='ambient', help="the estimator's excitation")
     parser.add_argument('--trace', action='store_true', help='tracemalloc from the 5th minute')
+    parser.add_argument(
+        '--keep-allocator', action='store_true', help="glibc's dynamic mmap threshold (not fixed)"
+    )
     args = parser.parse_args(argv)
+    if not args.keep_allocator:
+        fix_allocator()  # as estimator_node does
     stream = EstimatorStream(EstimatorConfig(excitation=args.excitation), 0.0, deciding=True)
     sim, runs, k, n, faults = simulator(0), 0, 0, 0, 0
     total = int(args.minutes * 60 * RATE_HZ)

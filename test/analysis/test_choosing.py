@@ -6,6 +6,7 @@ free``'s output, a driven record the identifier's modes; ``--paper`` and ``--exc
 never overridden."""
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -174,3 +175,23 @@ def test_a_free_decay_of_two_modes_reports_both(capsys, tmp_path):
     # --modes keeps the user's count
     _, err = analyze(capsys, write(tmp_path / 'two.csv', t, y), '--modes', '2')
     assert 'separate modes' in err
+
+
+def test_a_periodic_drive_s_lines_are_never_published(capsys, tmp_path):
+    """A 5 Hz mode driven by noise beside a cycle's odd harmonics at 0.8 Hz (strong: the cycle
+    dominates): the default reads a periodic drive, says so, gives the identifier the lines and
+    publishes the mode alone; ``--lines-hz`` is the expert's override (here: nothing dropped
+    but the 3 Hz it names, so the cycle's lines come back)."""
+    t, y, _ = ambient_record(180, 200.0, [(5.0, 0.01, 1.0)], 30, 0)
+    for k in (1, 3, 5, 7, 9):
+        y = y + 1.5 / k * np.sin(2 * np.pi * k * 0.8 * t + k)
+    path = write(tmp_path / 'periodic.csv', t, y)
+    rows, err = analyze(capsys, path)
+    assert 'a periodic drive: 4 lines at the harmonics of 0.8 Hz' in err
+    assert 'lines_hz' in err and 'rejected_line=' in err
+    f = np.array([r['frequency_hz'] for r in rows])
+    assert len(f) >= 20 and np.all(np.abs(f / 5.0 - 1) < 0.02)
+    assert re.search(r'rejected_line=[1-9]', err)
+    rows, err = analyze(capsys, path, '--excitation', 'ambient', '--lines-hz', '3')
+    f = np.array([r['frequency_hz'] for r in rows])
+    assert np.any(np.abs(f / 5.0 - 1) > 0.05)  # without the lines: the cycle's, published

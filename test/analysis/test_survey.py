@@ -257,7 +257,9 @@ def test_a_worker_started_with_a_malloc_trim_threshold_streams_without_remapping
 
 def test_malloc_is_left_alone_in_a_plain_process(monkeypatch):
     monkeypatch.delenv('MALLOC_TRIM_THRESHOLD_', raising=False)
-    monkeypatch.setattr(S.ctypes, 'CDLL', lambda *a: pytest.fail('mallopt called'))
+    from vib_estimator.io import heap
+
+    monkeypatch.setattr(heap.ctypes, 'CDLL', lambda *a: pytest.fail('mallopt called'))
     with S.streaming_malloc():
         pass
 

@@ -554,3 +554,112 @@ def test_a_silent_estimator_on_several_modes_goes_to_the_tracker_and_a_publishin
     went = _streamed((10.0, 13.0), (1.0, 0.5), (0.003, 0.003))
     assert went is not None and went[0] < 2.0 and went[1] == 3
     assert _streamed((6.0, 39.0), (1.0, 0.5), (0.005, 0.01), follow_hz=6.0) is None
+
+
+def periodic_drive(f0=0.8, harmonics=(1, 3, 5, 7, 9), mode=(5.0, 0.01, 1.0), seconds=180.0):
+    """A 5 Hz mode driven by noise beside a cycle's lines (a square wave's odd harmonics at
+    ``f0``, the fundamental's amplitude 1.5 the mode's standard deviation): a machine moved
+    without rest."""
+    t, y, _ = ambient_record(seconds, 200.0, [mode], 30, 0)
+    for k in harmonics:
+        y = y + 1.5 / k * np.sin(2 * np.pi * k * f0 * t + k)
+    return t, y
+
+
+def lines_of(t, y):
+    peaks, _ = spectral_peaks(t, y)
+    is_line, lines = choice.drive_lines(t, principal_component(y), peaks)
+    return peaks[is_line], lines
+
+
+def test_a_periodic_drive_s_lines_are_told_from_the_modes_beside_them():
+    """Brincker's indicator: a cycle's harmonics (sinusoids: kurtosis 1.5) are lines, the mode
+    driven by noise beside them (kurtosis 3) is not; the decision goes to the identifier, sizes
+    its window from the mode, not from the cycle, and lists the lines it is to drop."""
+    t, y = periodic_drive()
+    seen, lines = lines_of(t, y)
+    assert len(seen) >= 4 and np.all(np.abs(seen / 0.8 - np.round(seen / 0.8)) < 0.1)
+    assert np.allclose(lines[:5], [0.8, 2.4, 4.0, 5.6, 7.2], rtol=1e-3)  # refined to 0.1 %
+    assert lines[1] - lines[0] == pytest.approx(1.6, rel=1e-3)  # odd harmonics only
+    d = decide(t, y)
+    assert d.excitation == 'ambient' and d.lines_hz == tuple(lines)
+    assert d.fundamental_hz == pytest.approx(5.0, rel=0.02)  # the mode's, not the cycle's
+    assert d.window_s == 30.0 and 'periodic drive' in d.reason
+    assert d.changes()['lines_hz'] == list(lines)
+    assert not any(abs(f / 5.0 - 1) < 0.05 for f in d.lines_hz)
+
+
+@pytest.mark.parametrize(
+    'modes',
+    [
+        [(2.0, 0.01, 1.0), (4.0, 0.01, 1.0), (6.0, 0.01, 1.0)],  # modes on a harmonic series
+        [(2.0, 0.002, 1.0), (4.0, 0.002, 0.5), (6.0, 0.002, 0.5)],  # lightly damped too
+    ],
+)
+def test_modes_driven_by_noise_are_never_lines(modes):
+    t, y, _ = ambient_record(180, 200.0, modes, 20, 1)
+    assert len(lines_of(t, y)[0]) == 0
+    assert decide(t, y).lines_hz == ()
+
+
+@pytest.mark.parametrize(
+    'name, factor',
+    [
+        ('LINE_KURTOSIS', 0.001),
+        ('LINE_KURTOSIS', 1000),
+        ('LINE_BAND', 0.001),
+        ('LINE_BAND', 1000),
+        ('PERIODIC_LINES', 0.001),
+        ('PERIODIC_LINES', 1000),
+    ],
+)
+def test_the_periodic_drive_s_constants_are_pinned_from_both_sides(monkeypatch, name, factor):
+    """Each constant's behaviour: a cycle's lines found beside a mode, modes on a harmonic
+    series never lines, and one line beside a mode (an undamped ringing, a limit cycle) no
+    periodic drive."""
+    periodic = periodic_drive()
+    harmonic_modes = ambient_record(
+        180, 200.0, [(2.0, 0.01, 1), (4.0, 0.01, 1), (6.0, 0.01, 1)], 20, 1
+    )
+    one_line = periodic_drive(harmonics=(3,))
+
+    def right():
+        return (
+            len(lines_of(*periodic)[1]) > 0
+            and len(lines_of(*harmonic_modes[:2])[0]) == 0
+            and len(lines_of(*one_line)[0]) == 0
+        )
+
+    holds_then_breaks(monkeypatch, name, factor, right)
+
+
+def slow_drive(variance):
+    """A 5 Hz mode driven by noise and, an octave and more below it, a broad bump of the drive's
+    slow motion (1 Hz, zeta 5 %) of ``variance``."""
+    t, y, _ = ambient_record(240, 100.0, [(5.0, 0.01, 1.0), (1.0, 0.05, variance)], 30, 3)
+    return t, y
+
+
+@pytest.mark.parametrize(
+    'name, factor',
+    [('LOW_SHARE', 0.001), ('LOW_SHARE', 1000), ('LOW_GAP', 0.001), ('LOW_GAP', 1000)],
+)
+def test_a_driven_record_s_weak_slow_content_is_left_out_of_its_band(monkeypatch, name, factor):
+    """A peak under LOW_SHARE of the strongest's power, below LOW_GAP x the lowest strong one,
+    is the drive's slow content: the identifier's band starts an octave below the mode and the
+    window is sized for the mode (not for 1 Hz: 120 s); a stronger one is a mode, kept."""
+
+    def right():
+        weak, strong = decide(*slow_drive(0.01)), decide(*slow_drive(0.3))
+        return (
+            weak.excitation == 'ambient'
+            and weak.band_hz
+            and weak.band_hz[0] == pytest.approx(2.5, rel=0.02)
+            and weak.band_hz[1] == pytest.approx(45.0)  # NU_MAX x the rate
+            and weak.window_s == 30.0
+            and weak.changes()['band_hz'] == list(weak.band_hz)
+            and strong.band_hz == ()
+            and strong.window_s == 120.0
+        )
+
+    holds_then_breaks(monkeypatch, name, factor, right)

@@ -1067,6 +1067,9 @@ def test_a_driven_input_switches_the_default_to_the_identifier(make_probe, decid
     from vib_estimator.sim.ambient import ambient_record
 
     p = make_probe(decide_excitation=deciding)
+    stream, primed = p.node._stream, []
+    configure = stream.configure
+    stream.configure = lambda *a, **k: primed.append(k.get('prime')) or configure(*a, **k)
     t, y, _ = ambient_record(75, 40, [(1.2, 0.015, 1.0)], 20, 1)
     p.feed([EPOCH_NS + round(s * 1e9) for s in t], y)
     if deciding:
@@ -1074,10 +1077,27 @@ def test_a_driven_input_switches_the_default_to_the_identifier(make_probe, decid
         assert spin_until(p.executor, lambda: config_of(node).excitation == 'ambient', 5.0)
         assert 90 <= node.get_parameter('ambient_window_s').value <= 110
         assert p.node._stream.decided
+        # excitation and window at once: one identifier built and primed, not one a parameter
+        assert primed == [True]
     else:
         status = p.wait_status(lambda s: 'looks driven' in s.message)
         assert 'excitation:=ambient' in status.message
         assert config_of(p.node).excitation == 'free'
+
+
+def test_a_periodic_drive_sets_the_nodes_lines(make_probe):
+    """``decide_excitation``: a mode driven by noise beside a cycle's lines (odd harmonics of
+    0.8 Hz) sets the node's own ``lines_hz`` (a double array) with the identifier."""
+    from vib_estimator.sim.ambient import ambient_record
+
+    p = make_probe()
+    t, y, _ = ambient_record(75, 40, [(5.0, 0.01, 1.0)], 30, 1)
+    y = y + sum(1.5 / k * np.sin(2 * np.pi * k * 0.8 * t + k) for k in (1, 3, 5, 7, 9))
+    p.feed([EPOCH_NS + round(s * 1e9) for s in t], y)
+    node = p.node
+    assert spin_until(p.executor, lambda: config_of(node).excitation == 'ambient', 5.0)
+    lines = node.get_parameter('lines_hz').value
+    assert len(lines) >= 5 and lines[0] == pytest.approx(0.8, rel=1e-3)
 
 
 def test_a_silent_decay_of_several_modes_sets_the_nodes_modes(make_probe):

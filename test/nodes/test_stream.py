@@ -13,6 +13,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from vib_estimator.core import EstimatorConfig, FrequencyEstimator
+from vib_estimator.core.choice import decide
 from vib_estimator.nodes import health as H
 from vib_estimator.nodes.stream import EstimatorStream
 
@@ -546,3 +547,30 @@ def test_an_identifier_that_finds_no_mode_says_which_window_helps():
     assert said and said[0] == 60 and said == list(range(60, len(statuses)))
     assert '1.1 correlation times of the 0.3 Hz peak' in statuses[-1].message
     assert sum('ambient_window_s:=' in (s.log or '') for s in statuses) == 1
+
+
+def test_a_periodic_drive_s_lines_go_to_the_identifier_and_leave_with_the_next_decision():
+    """The stream decides as ``analyze`` does: a cycle's lines beside a driven mode set
+    ``lines_hz`` with the identifier (its estimates the mode's alone); a later decision without
+    a periodic drive clears them."""
+    from vib_estimator.sim.ambient import ambient_record
+
+    t, y, _ = ambient_record(150, 100, [(5.0, 0.01, 1.0)], 30, 0)
+    cycle = sum(1.5 / k * np.sin(2 * np.pi * k * 0.8 * t + k) for k in (1, 3, 5, 7, 9))
+    stream = EstimatorStream(EstimatorConfig(), now=0.0, deciding=True)
+    estimates = []
+    got = decisions(stream, t, y + cycle, estimates=estimates)
+    assert got and got[0][1].excitation == 'ambient'
+    assert stream.config.lines_hz and stream.config.lines_hz[0] == pytest.approx(0.8, rel=1e-3)
+    driven = [e.frequency_hz for _, x, e in estimates if x == 'ambient']
+    assert driven and all(abs(f / 5.0 - 1) < 0.02 for f in driven)
+    assert stream.counters['rejected_line'] > 0
+    stream.configure(stream.config.replace(**decide(t, y).changes()))
+    assert stream.config.lines_hz is None and stream.config.excitation == 'ambient'
+    # back to free decays (the choice's own way back): what the driven decisions set goes
+    from vib_estimator.core.choice import Decision
+
+    stream.configure(stream.config.replace(lines_hz=[0.8], band_hz=[0.5, 45.0]))
+    back = Decision('free', 30.0, 0.0, np.nan, np.nan, (), 'freed', clears=True)
+    stream.configure(stream.config.replace(**back.changes()))
+    assert stream.config.lines_hz is None and stream.config.band_hz is None

@@ -164,6 +164,14 @@ def add_config_arguments(parser: argparse.ArgumentParser, model: Optional[str] =
         metavar=('LO', 'HI'),
         help='band-pass prefilter [LO, HI] Hz (default off)',
     )
+    parser.add_argument(
+        '--lines-hz',
+        nargs='+',
+        type=float,
+        metavar='F',
+        help="a periodic drive's lines, Hz: the identifier drops its modes within 1 %% of one "
+        '(default: those the record shows, where the default reads a periodic drive)',
+    )
     for name, kind in _CONFIG_OPTIONS.items():
         value, paper_value = getattr(defaults, name), getattr(paper, name)
         parser.add_argument(
@@ -183,7 +191,10 @@ def make_config(args: argparse.Namespace) -> EstimatorConfig:
         for name in ('model', 'excitation', *_CONFIG_OPTIONS)
         if getattr(args, name) is not None
     }
-    return base.replace(band_hz=tuple(args.band_hz) if args.band_hz else None, **given)
+    lines = getattr(args, 'lines_hz', None)
+    return base.replace(
+        band_hz=tuple(args.band_hz) if args.band_hz else None, lines_hz=lines or None, **given
+    )
 
 
 def _check_times(t: np.ndarray, previous: float, count: int, name: str) -> None:

@@ -84,6 +84,8 @@ def decided_config(
         min_periods=periods,
         early_std_rel=early,
         model=model,
+        lines_hz=config.lines_hz or d.lines_hz or None,
+        band_hz=config.band_hz or d.band_hz or None,
     )
     return changed, line
 

@@ -39,8 +39,6 @@ from __future__ import annotations
 import argparse
 import atexit
 import contextlib
-import ctypes
-import ctypes.util
 import glob
 import json
 import math
@@ -64,6 +62,7 @@ from ..errors import VibEstimatorError, report
 from ..extras import optional
 from ..io.csv_reader import column_names
 from ..io.fields import DEFAULT_COMPONENT, check_component
+from ..io.heap import M_MMAP_THRESHOLD, M_TRIM_THRESHOLD, MMAP_THRESHOLD, glibc, mallopt
 from ..io.streaming import BagInfo, bag_info, is_csv, open_signal, supported_topics
 from . import health
 from .analyze import Run, add_config_arguments, estimate_signal, make_config
@@ -509,8 +508,6 @@ def _valid(component: str, kind: str) -> bool:
         return False
 
 
-_M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD = -1, -3  # glibc's mallopt parameters
-_GLIBC_DEFAULT_MMAP = 128 * 1024
 _tuned_tasks = 0  # survey tasks running with raised thresholds
 _tuned_lock = threading.Lock()
 
@@ -524,16 +521,14 @@ def streaming_malloc():
     raised (32 MiB mmap, 64 MiB trim) for the task and put back to the environment's values when
     the worker's last running task ends; elsewhere (not glibc, or no such variable) a no-op."""
     trim = os.environ.get('MALLOC_TRIM_THRESHOLD_')
-    libc = ctypes.util.find_library('c') if trim is not None and trim.isdigit() else None
-    mallopt = getattr(ctypes.CDLL(libc), 'mallopt', None) if libc else None
-    if mallopt is None:
+    if trim is None or not trim.isdigit() or not glibc():
         yield
         return
     global _tuned_tasks
     with _tuned_lock:
         _tuned_tasks += 1
-        mallopt(_M_MMAP_THRESHOLD, 32 << 20)
-        mallopt(_M_TRIM_THRESHOLD, 64 << 20)
+        mallopt(M_MMAP_THRESHOLD, 32 << 20)
+        mallopt(M_TRIM_THRESHOLD, 64 << 20)
     try:
         yield
     finally:
@@ -541,10 +536,10 @@ def streaming_malloc():
             _tuned_tasks -= 1
             if _tuned_tasks == 0:
                 mallopt(
-                    _M_MMAP_THRESHOLD,
-                    int(os.environ.get('MALLOC_MMAP_THRESHOLD_', _GLIBC_DEFAULT_MMAP)),
+                    M_MMAP_THRESHOLD,
+                    int(os.environ.get('MALLOC_MMAP_THRESHOLD_', MMAP_THRESHOLD)),
                 )
-                mallopt(_M_TRIM_THRESHOLD, int(trim))
+                mallopt(M_TRIM_THRESHOLD, int(trim))
 
 
 def survey_recording(path: Path, options: Options) -> List[Dict]:

@@ -94,6 +94,12 @@ SEARCH_EVERY = 5
 #: a mode's estimates over this many windows calibrate its stds (:meth:`_Track.calibration`)
 HISTORY_WINDOWS = 4
 
+#: a mode within this (relative) of one of ``lines_hz`` is the periodic drive's line
+#: (``rejected_line``): the identifier reads a line to ~1e-5, the decision refines it to ~1e-4
+#: (core.choice.peak_kurtosis), and a mode 3 % from a harmonic (the arm's 1.331 Hz beside its
+#: 4-s cycle's 1.375 Hz) stays apart
+LINE_TOL = 0.01
+
 COUNTER_NAMES = INPUT_COUNTERS + (
     'analyses',
     'analyses_idle',
@@ -101,6 +107,7 @@ COUNTER_NAMES = INPUT_COUNTERS + (
     'rejected_unstable',
     'rejected_weak',
     'rejected_uncertain',
+    'rejected_line',
     'flat_windows',
     'modes_found',
     'modes_lost',
@@ -172,6 +179,8 @@ class AmbientEstimator(Estimator):
         self._pending_y: list = []
         self._max_gap = config.max_gap
         self._clear_window = self.reset  # (bound once: the data path's)
+        self._clean = 0  # samples taken by update's fast path (counted received and used)
+        self._one_gap = config.max_gap if m == 1 else -math.inf  # (the fast path: one channel)
         #: while True, a window that is due only slides (counted ``analyses_idle``): nothing is
         #: identified or published, the tracked modes wait (``excitation = auto`` in a free
         #: stretch, where the identifier's estimates would not publish)
@@ -180,7 +189,10 @@ class AmbientEstimator(Estimator):
 
     @property
     def counters(self) -> dict[str, int]:
-        return dict(self._c)
+        c = dict(self._c)
+        c['received'] += self._clean  # (the samples :meth:`update` took by its fast path)
+        c['used'] += self._clean
+        return c
 
     def restart(self) -> None:
         """Forget the signal and the tracked modes; counters are kept."""
@@ -211,6 +223,19 @@ class AmbientEstimator(Estimator):
     def update(self, t: float, y) -> list:
         """Feed one sample (one value per channel); the estimates of an analysis it completes
         (ascending mode)."""
+        last = self._last
+        if y.__class__ is float and last < t <= last + self._one_gap and y - y == 0.0:
+            # the data path's sample (one channel's finite float, after the last, no gap: what
+            # accept_sample keeps without a restart), counted at once (``_clean``)
+            self._clean += 1
+            self._last = t
+            self._pending_t.append(t)
+            self._pending_y.append(y)
+            if t >= self._next:
+                return self._analysis()
+            if self._next == math.inf:  # the window's first sample (after a reset)
+                self._next = t + self._window
+            return []
         if isinstance(y, float) and self._m == 1:  # (a float or numpy float64: no array made)
             value, finite = y, math.isfinite(y)
         else:
@@ -344,10 +369,22 @@ class AmbientEstimator(Estimator):
         return ts
 
     # ---- analysis -----------------------------------------------------------------------------
+    def _off_lines(self, modes: WindowModes) -> WindowModes:
+        """The window's modes less those within :data:`LINE_TOL` of a line of the drive
+        (``lines_hz``; counted ``rejected_line``)."""
+        lines = self._config.lines_hz
+        if not lines or not len(modes):
+            return modes
+        ratio = modes.frequency[:, None] / np.asarray(lines, dtype=np.float64)[None, :]
+        at = np.any(np.abs(ratio - 1) <= LINE_TOL, axis=1)
+        self._c['rejected_line'] += int(np.count_nonzero(at))
+        return modes.take(~at)
+
     def _track(self, modes: WindowModes, total: float, t: float, span: float, n: int) -> list:
         """Match the window's modes to the tracked ones (:class:`.identity.ModeRegister`),
         publish the confirmed ones."""
         register = self._register
+        modes = self._off_lines(modes)
         match = register.match(modes.frequency.tolist(), modes.shapes)
         seen: dict = {}
         for i in range(len(modes)):

@@ -238,6 +238,13 @@ class EstimatorConfig:
     buffer_samples: int = _param(
         200_000, 'segment buffer of the quality gate; a longer segment resets', 1, 10**8
     )
+    lines_hz: Optional[Tuple[float, ...]] = _param(
+        None,
+        'excitation ambient or auto: the lines of a periodic drive, Hz (a '
+        "cycle's harmonics, sinusoids, not modes): the identifier drops a mode "
+        'within 1 % of one (the default sets them where it reads a periodic '
+        'drive); none = off',
+    )
 
     @classmethod
     def paper(cls, **changes) -> 'EstimatorConfig':
@@ -306,13 +313,18 @@ class EstimatorConfig:
                 raise ValueError(
                     f'band_hz must be [f_lo, f_hi] with 0 < f_lo < f_hi, got {self.band_hz!r}'
                 )
+        if self.lines_hz is not None and not all(
+            isinstance(f, (int, float)) and math.isfinite(f) and f > 0 for f in self.lines_hz
+        ):
+            raise ValueError(f'lines_hz must hold frequencies > 0 Hz, got {self.lines_hz!r}')
 
     def replace(self, **changes) -> 'EstimatorConfig':
         """A validated copy with ``changes`` applied."""
         data = asdict(self)
         data.update(changes)
-        if data.get('band_hz') is not None:
-            data['band_hz'] = tuple(data['band_hz'])
+        for name in ('band_hz', 'lines_hz'):
+            if data.get(name) is not None:  # (none: [] or ())
+                data[name] = tuple(data[name]) or None
         cfg = EstimatorConfig(**data)
         cfg.validate()
         return cfg

@@ -79,6 +79,7 @@ from ..io.fields import (
     stamp_ns,
     topic_channels,
 )
+from ..io.heap import fix_allocator, release_memory
 from . import health as H
 from .baseline_monitor import BaselineMonitor
 from .cadence import Cadence, Watchdog
@@ -93,7 +94,12 @@ from .parameters import (
     warn_unused_params_files,
 )
 from .runner import run
-from .stream import WARMUP_BUFFER, WARMUP_MESSAGE, EstimatorStream, check_channels
+from .stream import (
+    WARMUP_BUFFER,
+    WARMUP_MESSAGE,
+    EstimatorStream,
+    check_channels,
+)
 
 #: input history: sensor-data QoS (best effort: it matches best-effort and reliable publishers
 #: alike) but 5000 deep instead of 5, so that a burst of 5000 messages at full publisher speed, a
@@ -261,6 +267,7 @@ class EstimatorNode(Node):
     """Publishes the natural frequency of the vibration in one field of a sensor stream."""
 
     def __init__(self, **kwargs):
+        fix_allocator()  # freed arrays given back, not kept resident (docs/soak.md)
         super().__init__('estimator_node', **kwargs)
         self._input_type, topics, tolerance = declare_input(self)
         #: the input topics (several: resolved, their channels are named after them)
@@ -697,7 +704,12 @@ class EstimatorNode(Node):
         decision = self._stream.decision()
         if decision is None:
             return
-        changes = [Parameter(name, value=value) for name, value in decision.changes().items()]
+        changes = [
+            Parameter(name, Parameter.Type.DOUBLE_ARRAY, [float(v) for v in value])
+            if isinstance(value, list)  # (an empty list has no type rclpy can infer)
+            else Parameter(name, value=value)
+            for name, value in decision.changes().items()
+        ]
         config = self._stream.config
         what = f'excitation {config.excitation} -> {decision.excitation}'
         if decision.changes().get('modes', config.modes) != config.modes:
@@ -706,8 +718,8 @@ class EstimatorNode(Node):
             f'{what}: {decision.reason} (decide_excitation:=false keeps the configured excitation)'
         )
         self._deciding = True
-        try:
-            results = self.set_parameters(changes)
+        try:  # at once: one estimator built and primed, not one per parameter (docs/soak.md)
+            results = [self.set_parameters_atomically(changes)]
         finally:
             self._deciding = False
         refused = [r.reason for r in results if not r.successful]
@@ -725,6 +737,9 @@ class EstimatorNode(Node):
         status = self._stream.status(now)
         if timer:
             self._watch_inputs(now)
+            if self._stream.trim_due:  # an estimator (re)built since: its freed pages back
+                self._stream.trim_due = False
+                release_memory()
         if self._aligner is not None:
             counters = self._stream.health.node_counters
             lagging = self._aligner.lagging(round(H.STALE_AFTER * 1e9))

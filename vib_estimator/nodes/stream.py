@@ -35,7 +35,6 @@ start after an install). Meanwhile the node stays live (services, diagnostics), 
 
 from __future__ import annotations
 
-import ctypes
 import math
 import threading
 import time
@@ -50,6 +49,7 @@ from ..core.estimator import COUNTER_NAMES, MIN_CHANNELS, Estimate
 from ..core.factory import create_estimator, create_uncompiled, kind_of
 from ..core.warmup import is_warm, warm
 from ..io.fields import seconds_since
+from ..io.heap import release_memory
 from .health import WARN, Health, Status
 from .self_test import self_test
 
@@ -87,9 +87,15 @@ class _Build:
     compiled first; only compiled when ``channels`` is None: the stream estimates uncompiled
     meanwhile)."""
 
-    def __init__(self, config: EstimatorConfig, channels: Optional[Tuple[str, ...]]):
+    def __init__(
+        self,
+        config: EstimatorConfig,
+        channels: Optional[Tuple[str, ...]],
+        also: Tuple[EstimatorConfig, ...] = (),
+    ):
         self.config = config
         self._channels = channels
+        self._also = also  # configurations warmed after it (the estimator is built first)
         self.started = time.monotonic()
         self.seconds = 0.0
         self.estimator = None
@@ -104,6 +110,8 @@ class _Build:
             warm(self.config)
             if self._channels is not None:
                 self.estimator = create_estimator(self.config, self._channels)
+            for config in self._also:
+                warm(config)
         except Exception as err:  # reported by the node, never lost in a thread
             self.error = err
         self.seconds = time.monotonic() - self.started
@@ -162,6 +170,10 @@ class EstimatorStream:
         self._primer: Tuple[np.ndarray, np.ndarray] = NO_PRIMER
         #: :meth:`decision` is asked (the node's ``decide_excitation``): no hint, a switch
         self.deciding = deciding
+        #: a configuration was built since the last :func:`release_memory` (the node's 1-s
+        #: diagnostics give the C heap's free pages back then: an estimator built and primed, a
+        #: storm of them, leave freed pages behind)
+        self.trim_due = False
         self.configure(config)
 
     @property
@@ -204,6 +216,7 @@ class EstimatorStream:
         )
         self._primer = self._choice.kept() if primes else NO_PRIMER
         self.channels = channels
+        self.trim_due = True
         if self.estimator is not None:
             self.health.absorb(self.estimator.counters)
             self.estimator = None
@@ -213,11 +226,19 @@ class EstimatorStream:
         if self._background and not is_warm(config):
             if interpretable(config, channels):
                 self._install(create_uncompiled(config, channels))
-                self._build = _Build(config, None)
+                self._build = _Build(config, None, self._decidable(config, channels))
             else:
                 self._build = _Build(config, channels)
         else:
             self._install(create_estimator(config, channels))
+
+    def _decidable(self, config: EstimatorConfig, channels: Tuple[str, ...]) -> tuple:
+        """The identifier a deciding stream on one channel may switch to (``auto``), to be
+        warmed in the start's build: its code (the correlations' kernel, ``scipy.signal``'s
+        filter design) then loads before the first estimate, not at the first switch, in the
+        data path, minutes into a run (3.5 MB of RSS, docs/soak.md)."""
+        one = len(channels) < MIN_CHANNELS and config.excitation == 'free'
+        return (config.replace(excitation='auto'),) if self.deciding and one else ()
 
     def _install(self, estimator) -> None:
         self.estimator = estimator
@@ -474,14 +495,3 @@ class _SelfTestRun:
             self.result = (False, f'FAILED: the self test raised {err!r}')
         release_memory()
         self.finished.set()
-
-
-def release_memory() -> None:
-    """Give the C heap's free pages back to the system (glibc's ``malloc_trim``; elsewhere
-    nothing). The heaps keep their peaks: the identifier's self-tests of four configurations in
-    one stream left RSS about 200 MB above the start on the caller's thread, 9-20 MB each in a
-    thread followed by this (docs/soak.md)."""
-    try:
-        ctypes.CDLL(None).malloc_trim(0)
-    except (OSError, AttributeError):
-        pass

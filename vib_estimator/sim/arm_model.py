@@ -475,3 +475,20 @@ def simulate_driven(
     )
     rows = np.array([sim.step() for _ in range(int(round(duration * rate_hz)))]).reshape(-1, 3)
     return Recording(rows[:, 0].copy(), rows[:, 1].copy(), rows[:, 2].copy())
+
+
+def back_and_forth(
+    seconds: float, every: float, angle: float, slope: float, jitter: float, seed: int = 0
+) -> Recording:
+    """``seconds`` s at 500 Hz of the arm moved without rest (a pick-and-place cycle): a ramp of
+    ``slope`` rad/s every ``every`` s to +-``angle`` rad in turn, the angle and the time between
+    moves each jittered by up to ``jitter`` (relative; 0: a strictly periodic cycle), seeded."""
+    rng = np.random.default_rng(seed + 100)
+    moves, t, k = [], 0.0, 0
+    while t < seconds:
+        moves.append(Move(t, angle * (-1) ** k * (1 + jitter * rng.uniform(-1, 1)), slope))
+        t += every * (1 + jitter * rng.uniform(-0.5, 0.5))
+        k += 1
+    sim = DrivenArmSimulator(rate_hz=500.0, seed=seed, schedule=tuple(moves), excitation='moves')
+    rows = np.array([sim.step() for _ in range(int(seconds * 500.0))])
+    return Recording(rows[:, 0].copy(), rows[:, 1].copy(), rows[:, 2].copy())
