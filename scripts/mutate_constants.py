@@ -4,7 +4,7 @@
 """Are the tuning constants pinned? Mutate each to 0.001x and 1000x, see whether a test fails.
 
     python scripts/mutate_constants.py [--sample N] [--seed S] [--only NAME ...] [--list]
-                                       [--full] [--timeout SECONDS]
+                                       [--full] [--tests FILE ...] [--timeout SECONDS]
 
 A tuning constant is pinned when setting it to 0.001x makes a test fail and setting it to 1000x
 makes a test fail (docs/testing.md, issue 38). The population is every module-level UPPER_CASE
@@ -34,6 +34,7 @@ import os
 import random
 import re
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -74,7 +75,7 @@ TESTS = {
         'test/core/test_ambient_incremental.py',
         'test/core/test_whittle_refinement.py',
     ],
-    'auto': ['test/core/test_auto.py'],
+    'auto': ['test/core/test_auto.py', 'test/core/test_choice.py'],  # choice reads its envelope
     'choice': [
         'test/core/test_choice.py',
         'test/analysis/test_choosing.py',
@@ -123,7 +124,9 @@ TESTS = {
 STRUCTURAL = {
     r'[SBIFR]_[A-Z0-9_]+|N_[A-Z]+|N_STATE_FIXED|DEC_N|ROOM': 'array layout (offsets, slot counts)',
     r'NH|NBJ|NS|NQ|NLEV|KMAX|PCOL|NPEND': 'array sizes fixed by the method or a parameter range',
-    r'BINOMIAL|BAND_DAMPING|TWO_PI|INF': 'mathematical constants (Butterworth poles, binomials)',
+    r'BINOMIAL|BAND_DAMPING|TWO_PI|INF|MAD_TO_STD': (
+        "mathematical constants (Butterworth poles, binomials, a normal sample's std per MAD)"
+    ),
     r'VERSION': 'file-format version',
     r'MODEL_[A-Z]+': 'enumeration',
     r'RATE_HZ|TONE_HZ|SAMPLES': 'warm-up signal: compiles the kernels, its output is discarded',
@@ -253,11 +256,22 @@ def run_tests(root: Path, tests: list[str], timeout: float) -> tuple[str, str]:
     env.pop('NUMBA_CACHE_DIR', None)  # the copy's own __pycache__
     tests = [t for t in tests if (root / t).exists()]
     cmd = [sys.executable, '-m', 'pytest', '-x', '-q', '-rfE', '-p', 'no:cacheprovider', *tests]
+    # its own process group: a timeout ends the processes its tests started too (a test's
+    # subprocess outlived a killed pytest, its folder deleted under it)
+    proc = subprocess.Popen(
+        cmd,
+        cwd=root,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        text=True,
+        start_new_session=True,
+    )
     try:
-        out = subprocess.run(
-            cmd, cwd=root, env=env, capture_output=True, text=True, timeout=timeout
-        ).stdout
+        out = proc.communicate(timeout=timeout)[0]
     except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.communicate()
         return 'timeout', ''
     hit = re.search(r'^(?:FAILED|ERROR) (\S+)', out, re.M)
     if hit:
@@ -295,6 +309,7 @@ def main(argv=None) -> int:
     parser.add_argument('--only', nargs='*', default=[], help='MODULE.NAME or NAME')
     parser.add_argument('--list', action='store_true', help='print the population and exit')
     parser.add_argument('--full', action='store_true', help='run test/core and test/analysis')
+    parser.add_argument('--tests', nargs='*', default=[], help='run these test files instead')
     parser.add_argument('--timeout', type=float, default=900.0, help='s per mutant run')
     parser.add_argument(
         '--no-baseline', action='store_true', help='skip the unmutated run (it warms the cache)'
@@ -316,18 +331,20 @@ def main(argv=None) -> int:
         chosen = sorted(random.Random(args.seed).sample(tuning, args.sample), key=lambda c: c.key)
     for line in tautologies(ROOT, {c.name for c in chosen}):
         print(f'warning: a test asserts a constant, not a behaviour: {line}')
+    which = (
+        'test/core test/analysis' if args.full else ' '.join(args.tests) or 'per module (TESTS)'
+    )
     print(
-        f'{len(chosen)} of {len(tuning)} tuning constants (seed {args.seed}); '
-        f'tests: {"test/core test/analysis" if args.full else "per module (TESTS)"}',
+        f'{len(chosen)} of {len(tuning)} tuning constants (seed {args.seed}); tests: {which}',
         flush=True,
     )
     with tempfile.TemporaryDirectory(prefix='mutate-') as tmp:
         base = Path(tmp) / 'base'
         copy_tree(ROOT, base)
         if not args.no_baseline:  # the selection passes unmutated; the copy's cache is warm
-            tests = ['test/core', 'test/analysis'] if args.full else []
+            tests = ['test/core', 'test/analysis'] if args.full else list(args.tests)
             for stem in dict.fromkeys(Path(c.module).stem for c in chosen):
-                tests += [] if args.full else TESTS[stem]
+                tests += [] if args.full or args.tests else TESTS[stem]
             outcome, test = run_tests(base, list(dict.fromkeys(tests)), args.timeout)
             if outcome != 'pass':
                 print(f'error: the unmutated tests do not pass ({outcome} {test})')
@@ -337,7 +354,7 @@ def main(argv=None) -> int:
         print('|---|---|---|---|---|---|', flush=True)
         for c in chosen:
             stem = Path(c.module).stem
-            tests = ['test/core', 'test/analysis'] if args.full else TESTS[stem]
+            tests = ['test/core', 'test/analysis'] if args.full else args.tests or TESTS[stem]
             cells = []
             for factor in (1e-3, 1e3):
                 work = Path(tmp) / 'mutant'

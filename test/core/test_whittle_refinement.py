@@ -7,13 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from vib_estimator.core.whittle import (
-    WHITTLE_MAX_DAMPING,
-    WHITTLE_MIN_BINS,
-    WHITTLE_REACH,
-    whittle_frequencies,
-    whittle_std,
-)
+from vib_estimator.core.whittle import whittle_frequencies, whittle_std
 from vib_estimator.sim.ambient import ambient_record
 
 FS = 25.0  # the decimated rate: a 5 Hz mode at 0.2 of it, as the identifier's second pass
@@ -44,33 +38,43 @@ def test_the_refined_frequency_is_at_the_whittle_bound_from_a_start_two_stds_off
     assert abs(np.mean(errors)) < 0.5 * bound  # no bias toward the start
 
 
-def test_a_close_neighbour_keeps_each_frequency_near_its_own_peak():
-    pair = [(8.0, 0.01, 1.0), (8.8, 0.01, 0.8)]
+def pair_rms(pair, start):
+    """Each mode's RMS error over 20 seeded windows of ``pair`` refined from the rows
+    ``start(sign, bounds)`` (``sign`` alternating from window to window), and their bounds."""
     n = round(SECONDS * FS)
     noise_var = next(windows(1, pair))[1]
-    bounds = [b[0] for b in whittle_std(pair, noise_var, FS, n)]
+    bounds = np.array([b[0] for b in whittle_std(pair, noise_var, FS, n)])
     errors = []
     for k, (y, noise) in enumerate(windows(20, pair)):
-        sign = 1 if k % 2 else -1  # starts 2 bound-stds off, toward and away from the neighbour
-        rows = np.array([(f + sign * 2 * b, z, v) for (f, z, v), b in zip(pair, bounds)])
-        errors.append(whittle_frequencies(y, FS, rows, noise, np.array(bounds)) - [8.0, 8.8])
-    rms = np.sqrt(np.mean(np.square(errors), axis=0))
-    assert np.all(rms < 1.5 * np.array(bounds)), (rms, bounds)
+        rows = np.array(start(1 if k % 2 else -1, bounds))
+        errors.append(whittle_frequencies(y, FS, rows, noise, bounds) - [m[0] for m in pair])
+    return np.sqrt(np.mean(np.square(errors), axis=0)), bounds
+
+
+def test_a_close_neighbour_keeps_each_frequency_near_its_own_peak():
+    pair = [(8.0, 0.01, 1.0), (8.8, 0.01, 0.8)]
+    # starts 2 bound-stds off, toward and away from the neighbour
+    rms, bounds = pair_rms(
+        pair, lambda sign, b: [(f + sign * 2 * s, z, v) for (f, z, v), s in zip(pair, b)]
+    )
+    assert np.all(rms < 1.5 * bounds), (rms, bounds)
 
 
 def test_what_it_leaves_alone_and_how_far_it_moves():
+    """A peak narrower than the bins (the driven arm's 1.33 Hz at zeta 0.6 % over 30 s: 0.24 of a
+    bin, where the window's leakage shapes it) and a mode whose SSI damping reads 3 % (the arm's
+    coloured excitation over a wide band) are left alone; a start far from the peak moves toward
+    it by a few of its stds, not to it (a coloured density could pull it anywhere)."""
     y, noise = next(windows(1))
     bins = SECONDS  # a frequency of 1 Hz spans SECONDS bins: zeta f T bins for the half-width
-    narrow = WHITTLE_MIN_BINS / bins / MODE[0] * 0.9  # a peak narrower than the bins
-    wide = WHITTLE_MAX_DAMPING * 1.2
-    rows = np.array([(5.01, narrow, 1.0)])
-    assert whittle_frequencies(y, FS, rows, noise, np.array([0.01]))[0] == 5.01
-    rows = np.array([(5.01, wide, 1.0)])
-    assert whittle_frequencies(y, FS, rows, noise, np.array([0.01]))[0] == 5.01
-    std = 1e-4  # the reach: at most WHITTLE_REACH stds from the start
+    narrow = 0.25 / bins / MODE[0]  # a quarter of a bin
+    for zeta in (narrow, 0.03):
+        rows = np.array([(5.01, zeta, 1.0)])
+        assert whittle_frequencies(y, FS, rows, noise, np.array([0.01]))[0] == 5.01
+    std = 1e-4  # the start 500 stds above the peak
     rows = np.array([(5.05, MODE[1], 1.0)])
-    moved = whittle_frequencies(y, FS, rows, noise, np.array([std]))[0]
-    assert 0 < 5.05 - moved <= WHITTLE_REACH * std * (1 + 1e-6)
+    moved = 5.05 - whittle_frequencies(y, FS, rows, noise, np.array([std]))[0]
+    assert std < moved <= 5 * std
 
 
 def test_several_channels_refine_with_every_channel_and_one_column_is_one_channel():
@@ -100,3 +104,17 @@ def test_several_channels_refine_with_every_channel_and_one_column_is_one_channe
         assert column[0] == pytest.approx(alone[-1] + 5, abs=1e-6 * bound)
     rms = [math.sqrt(np.mean(np.square(e))) for e in (joint, alone)]
     assert rms[0] < 0.9 * rms[1], rms  # 0.0256 against 0.0320 Hz
+
+
+def test_a_weak_mode_beside_a_strong_one_reads_its_own_peak():
+    """The band read stops halfway to the nearest other mode: a weak mode (a tenth of the
+    variance) 6 % below a strong one whose SSI damping is twice the truth (SSI's damping errs by
+    tens of per cent over a window, so the neighbour's modelled density leaves part of its peak
+    unexplained) keeps its RMS error within 1.3x its bound over 20 windows (1.07x; a band
+    reaching into the neighbour's peak: 1.79x)."""
+    pair = [(8.0, 0.01, 0.1), (8.5, 0.01, 1.0)]
+    rms, bounds = pair_rms(
+        pair,
+        lambda sign, b: [(8.0 + sign * 2 * b[0], 0.01, 0.1), (8.5 - sign * 2 * b[1], 0.02, 1.0)],
+    )
+    assert rms[0] < 1.3 * bounds[0], (rms, bounds)
