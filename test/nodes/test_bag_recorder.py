@@ -43,7 +43,10 @@ def recording(ros_context, executor, output, topic, msg_type, *params, **popen):
     """The recorder executable on ``topic`` and a publisher of it: ``(process, publisher)``."""
     recorder = recorder_process(output, topic, *params, **popen)
     node = Node('test_publisher', context=ros_context)
-    publisher = node.create_publisher(msg_type, topic, QoSProfile(depth=1000))
+    # (a history as deep as the tests' bursts: a reliable keep-last writer may drop a sample its
+    # reader, slowed by the machine's load, has not acknowledged yet; test_records_every_message_
+    # exactly timed out once, its recorder short of the 10000, in a CI run on 5 Dec)
+    publisher = node.create_publisher(msg_type, topic, QoSProfile(depth=10_000))
     executor.add_node(node)
     return recorder, publisher
 

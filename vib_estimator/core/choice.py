@@ -317,7 +317,7 @@ def peak_kurtosis(t: np.ndarray, signal: np.ndarray, peaks) -> tuple[np.ndarray,
     magnitude = np.abs(spec)
     for f in peaks:
         f = strongest_bin(freq, magnitude * (np.abs(freq - f) <= 1.0 / SEGMENT_S))  # Welch's bin
-        band = np.abs(freq / f - 1) <= LINE_BAND
+        band = np.abs(freq - f) <= LINE_BAND * f  # (none at 0 Hz)
         x = np.fft.irfft(np.where(band, spec, 0), size)[edge : n - edge]
         power = float(np.mean(x * x))
         kurtosis.append(float(np.mean(x**4)) / power**2 if power > 0 else math.nan)
