@@ -228,31 +228,25 @@ class AmbientEstimator(Estimator):
             # the data path's sample (one channel's finite float, after the last, no gap: what
             # accept_sample keeps without a restart), counted at once (``_clean``)
             self._clean += 1
-            self._last = t
-            self._pending_t.append(t)
-            self._pending_y.append(y)
-            if t >= self._next:
-                return self._analysis()
-            if self._next == math.inf:  # the window's first sample (after a reset)
-                self._next = t + self._window
-            return []
-        if isinstance(y, float) and self._m == 1:  # (a float or numpy float64: no array made)
-            value, finite = y, math.isfinite(y)
+            value = y
         else:
-            value = np.asarray(y, dtype=np.float64).reshape(-1).tolist()
-            if len(value) != self._m:
-                raise ValueError(f'expected {self._m} channel values, got {len(value)}')
-            finite = all(map(math.isfinite, value))
-        t = float(t)
-        # a gap or a long jump back clears the window
-        if not accept_sample(self._c, self._last, t, finite, self._max_gap, self._clear_window):
-            return []
+            if isinstance(y, float) and self._m == 1:  # (a float or numpy float64: no array)
+                value, finite = y, math.isfinite(y)
+            else:
+                value = np.asarray(y, dtype=np.float64).reshape(-1).tolist()
+                if len(value) != self._m:
+                    raise ValueError(f'expected {self._m} channel values, got {len(value)}')
+                finite = all(map(math.isfinite, value))
+            t = float(t)
+            # a gap or a long jump back clears the window
+            if not accept_sample(self._c, last, t, finite, self._max_gap, self._clear_window):
+                return []
         self._last = t
         self._pending_t.append(t)
         self._pending_y.append(value)
         if t >= self._next:
             return self._analysis()
-        if self._next == math.inf:  # the window's first sample
+        if self._next == math.inf:  # the window's first sample (after a reset)
             self._next = t + self._window
         return []
 
