@@ -178,7 +178,7 @@ LINE_KURTOSIS = 1.8
 LINE_BAND = 0.03
 #: a driven record's peaks under this share of the strongest's power that lie below
 #: :data:`LOW_GAP` x the lowest peak holding more are the drive's slow content, not a mode: the
-#: identifier's band starts there (:func:`low_edge`). The arm moved back and forth at random
+#: identifier's band starts there (:func:`slow_content`). The arm moved back and forth at random
 #: times (bench_periodic's jittered 1.5 s): its motion's 0.32-0.35 Hz bump holds 0.4 % of the
 #: mode's power, sized a 240 s window and was published as a mode of zeta 3.5 % (73.7 % within
 #: 2 %); the lowest peaks of bench_defaults' driven records, the frame and the Heritage Court
@@ -220,7 +220,7 @@ class Decision:
     #: a periodic drive's lines (Hz, :func:`drive_lines`) beside a mode of the structure: the
     #: identifier drops its modes there (``lines_hz``)
     lines_hz: tuple = ()
-    #: a driven record's band, Hz (:func:`low_edge`; (): none)
+    #: a driven record's band, Hz (:func:`slow_content`; (): none)
     band_hz: tuple = ()
     #: a stream's way back to free decays: the lines and the band its driven decision set go
     clears: bool = False
@@ -379,21 +379,14 @@ def drive_lines(t: np.ndarray, signal: np.ndarray, peaks: np.ndarray) -> tuple[n
     return is_line, [n * f0 for n in range(1, top + 1, step)]
 
 
-def low_edge(peaks: np.ndarray, powers: np.ndarray) -> float:
-    """The lower edge of a driven record's band: :data:`LOW_GAP` x the lowest of the spectral
-    ``peaks`` holding at least :data:`LOW_SHARE` of the strongest's power, when a weaker one
-    lies below it (the drive's slow content), else 0."""
+def slow_content(peaks: np.ndarray, powers: np.ndarray, rate_hz: float) -> tuple:
+    """``(band, the lowest peak in it, in words)`` of a driven record whose spectral ``peaks``
+    under :data:`LOW_SHARE` of the strongest's power lie below :data:`LOW_GAP` x the lowest
+    stronger one (the drive's slow content): the band from that edge to :data:`.ssi.NU_MAX` x
+    ``rate_hz``; ``((), nan, '')`` for none."""
     strong = peaks[powers >= LOW_SHARE * np.max(powers)] if len(peaks) else peaks
     edge = LOW_GAP * float(np.min(strong)) if len(strong) else 0.0
-    return edge if np.any(peaks < edge) else 0.0
-
-
-def slow_content(peaks: np.ndarray, powers: np.ndarray, rate_hz: float) -> tuple:
-    """``(band, the lowest peak in it, in words)`` of a driven record whose weak spectral
-    ``peaks`` lie below its strong ones (:func:`low_edge`; ``((), nan, '')`` for none): the band
-    from the edge to :data:`.ssi.NU_MAX` x ``rate_hz``."""
-    edge = low_edge(peaks, powers)
-    if edge <= 0:
+    if not np.any(peaks < edge):
         return (), math.nan, ''
     above = peaks[peaks >= edge]
     said = (
