@@ -704,15 +704,16 @@ class EstimatorNode(Node):
         decision = self._stream.decision()
         if decision is None:
             return
+        wanted = decision.changes()
         changes = [
             Parameter(name, Parameter.Type.DOUBLE_ARRAY, [float(v) for v in value])
             if isinstance(value, list)  # (an empty list has no type rclpy can infer)
             else Parameter(name, value=value)
-            for name, value in decision.changes().items()
+            for name, value in wanted.items()
         ]
         config = self._stream.config
         what = f'excitation {config.excitation} -> {decision.excitation}'
-        if decision.changes().get('modes', config.modes) != config.modes:
+        if wanted.get('modes', config.modes) != config.modes:
             what += f', modes {config.modes} -> {decision.modes}'
         self.get_logger().info(
             f'{what}: {decision.reason} (decide_excitation:=false keeps the configured excitation)'
