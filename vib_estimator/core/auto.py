@@ -432,6 +432,11 @@ class Envelope:
         self._s1 += y
         self._s2 += y * y
 
+    @property
+    def last(self) -> float:
+        """The stamp of the last sample kept (-inf: none since the start or a restart)."""
+        return self._last
+
     def valid(self, t: np.ndarray, y: np.ndarray) -> np.ndarray:
         """The samples of arrays ``(t, y)`` that :meth:`update` keeps: finite and later than every
         finite stamp before them (the state unchanged)."""
@@ -592,6 +597,19 @@ class AutoEstimator(Estimator):
         self._free.reset()
         self._ambient.reset()
 
+    def _jumped_back(self, t: float) -> bool:
+        """Whether a sample of stamp ``t`` jumps back beyond ``max_gap`` from the last kept (a
+        source restarted, a bag looping); the envelope, the free-decay test's samples and the
+        known modes then start afresh, as the two estimators do by themselves
+        (:func:`~.estimator.accept_sample`): else the envelope skipped every sample until the
+        stamps passed the old ones (a restarted simulator: nothing published for minutes)."""
+        if not self._envelope.last - t > self._config.max_gap:
+            return False
+        self._envelope.restart()
+        self._modes.clear()
+        self._filled = 0
+        return True
+
     # ---- streaming ----------------------------------------------------------------------------
     def _remember(self, t: float, y: float) -> None:
         """Keep a valid sample (the envelope's rule) for the free-decay test."""
@@ -617,6 +635,7 @@ class AutoEstimator(Estimator):
 
     def update(self, t: float, y: float) -> list[Estimate]:
         """Feed one sample; the estimates it completes that belong to the current stretch."""
+        self._jumped_back(float(t))
         self._envelope.update(float(t), float(y))
         self._remember(float(t), float(y))
         free = self._free.update(t, y)
@@ -635,8 +654,27 @@ class AutoEstimator(Estimator):
         ]
 
     def process(self, t: Sequence[float], y: Sequence[float]) -> EstimateArrays:
-        """Feed arrays (continuing the stream); the same estimates as :meth:`update`, by time."""
+        """Feed arrays (continuing the stream); the same estimates as :meth:`update`, by time
+        (a batch is cut where its stamps jump back beyond ``max_gap``: :meth:`_jumped_back`)."""
         t, y = as_series(t, y)
+        parts = []
+        while True:
+            last = self._envelope.last
+            finite = np.where(np.isfinite(t) & np.isfinite(y), t, -math.inf)
+            ahead = np.maximum.accumulate(np.concatenate(([last], finite)))[:-1]
+            back = np.flatnonzero(ahead - t > self._config.max_gap)
+            if len(back) and back[0] == 0:
+                self._jumped_back(float(t[0]))
+                continue
+            if not len(back):
+                break
+            parts.append(self._process_run(t[: back[0]], y[: back[0]]))
+            t, y = t[back[0] :], y[back[0] :]
+        parts.append(self._process_run(t, y))
+        return parts[0] if len(parts) == 1 else EstimateArrays.concatenate(parts, False)
+
+    def _process_run(self, t: np.ndarray, y: np.ndarray) -> EstimateArrays:
+        """:meth:`process` of a batch whose stamps do not jump back beyond ``max_gap``."""
         free = self._free.process(t, y)
         # the history before this call, then this call's valid samples (the envelope's rule)
         valid = self._envelope.valid(t, y)

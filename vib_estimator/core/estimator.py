@@ -341,12 +341,17 @@ class EstimateArrays:
         )
 
     @classmethod
-    def concatenate(cls, parts: Sequence['EstimateArrays']) -> 'EstimateArrays':
-        """One set of columns from several, sorted by time (stable: ties keep their order)."""
+    def concatenate(
+        cls, parts: Sequence['EstimateArrays'], by_time: bool = True
+    ) -> 'EstimateArrays':
+        """One set of columns from several, sorted by time (stable: ties keep their order), or
+        with ``by_time`` False in the order of the parts (a stream whose time went back)."""
         names = list(cls.__dataclass_fields__)
         if not parts:
             return cls.from_rows(np.empty((0, K.N_OUT)))
         cols = {n: np.concatenate([getattr(p, n) for p in parts]) for n in names}
+        if not by_time:
+            return cls(**cols)
         order = np.argsort(cols['t'], kind='stable')
         return cls(**{n: c[order] for n, c in cols.items()})
 
