@@ -260,8 +260,9 @@ def test_the_deciding_stream_goes_to_the_identifier_when_driven_and_back_when_fr
     identifier (analyze's decision over the last seconds: its window for the 1.2 Hz
     fundamental) once half the watched span is in, without a hint, primed with those seconds
     (its first estimate once a window is in since the start, not since the switch; the primer
-    uncounted); a pluck later brings it back to free decays; a decay ringing down into noise
-    never leaves free."""
+    uncounted); a pluck later sends it to ``auto`` (its free stretches' estimates those of
+    the free-decay estimator, the identifier's again in a driven one: no second wait for the
+    watch); a decay ringing down into noise never leaves free."""
     from vib_estimator.core.choice import WATCH_S
     from vib_estimator.sim.ambient import ambient_record
 
@@ -277,12 +278,23 @@ def test_the_deciding_stream_goes_to_the_identifier_when_driven_and_back_when_fr
         np.concatenate([y, ring]),
         estimates=got_estimates,
     )
-    # (then the ring's window, as analyze decides it: a decay's, not an excitation)
-    assert [d.excitation for _, d in got][:2] == ['ambient', 'free']
-    assert all(d.excitation == 'free' and d.min_periods == 0.9 for _, d in got[2:])
-    (went, driven), (back, _) = got[:2]
+    assert [d.excitation for _, d in got] == ['ambient', 'auto']
+    (went, driven), (back, _) = got
     assert WATCH_S / 2 <= went <= WATCH_S / 2 + 5 and 90 <= driven.window_s <= 110
-    assert 150 <= back < 150 + WATCH_S and stream.config.excitation == 'free'
+    assert 150 <= back < 150 + WATCH_S and stream.config.excitation == 'auto'
+    assert stream.config.ambient_window_s == driven.window_s  # (the driven decision's stays)
+    # under auto: the ring's free estimates, and (its first seconds, before its envelope
+    # closed the pluck's block) the driven mode of the window before the pluck
+    off = [
+        min(abs(e.frequency_hz / f - 1) for f in (1.2, 2.0))
+        for _, x, e in got_estimates
+        if x == 'auto'
+    ]
+    assert max(off) < 0.05 and np.mean(np.array(off) < 0.02) >= 0.95
+    of_ring = [
+        e for _, x, e in got_estimates if x == 'auto' and abs(e.frequency_hz / 2 - 1) < 0.02
+    ]
+    assert len(of_ring) >= 20
     assert not any('looks driven' in m for m in stream.status(now=1e3).message.split(';'))
     driven_estimates = [(k, e) for k, x, e in got_estimates if x == 'ambient']
     assert driven_estimates[0][0] <= driven.window_s + 5  # primed: not went + window
@@ -567,10 +579,13 @@ def test_a_periodic_drive_s_lines_go_to_the_identifier_and_leave_with_the_next_d
     assert stream.counters['rejected_line'] > 0
     stream.configure(stream.config.replace(**decide(t, y).changes()))
     assert stream.config.lines_hz is None and stream.config.excitation == 'ambient'
-    # back to free decays (the choice's own way back): what the driven decisions set goes
+    # from the identifier to auto (the choice's way out of a driven decision, when the stream
+    # reads free): what the driven decisions set stays, for the next driven stretch
     from vib_estimator.core.choice import Decision
 
     stream.configure(stream.config.replace(lines_hz=[0.8], band_hz=[0.5, 45.0]))
-    back = Decision('free', 30.0, 0.0, np.nan, np.nan, (), 'freed', clears=True)
-    stream.configure(stream.config.replace(**back.changes()))
-    assert stream.config.lines_hz is None and stream.config.band_hz is None
+    window = stream.config.ambient_window_s
+    out = Decision('auto', 12.0, 0.0, np.nan, np.nan, (), 'freed', keeps=True)
+    stream.configure(stream.config.replace(**out.changes()))
+    assert stream.config.excitation == 'auto' and stream.config.lines_hz == (0.8,)
+    assert stream.config.band_hz == (0.5, 45.0) and stream.config.ambient_window_s == window

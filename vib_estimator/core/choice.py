@@ -222,8 +222,9 @@ class Decision:
     lines_hz: tuple = ()
     #: a driven record's band, Hz (:func:`slow_content`; (): none)
     band_hz: tuple = ()
-    #: a stream's way back to free decays: the lines and the band its driven decision set go
-    clears: bool = False
+    #: a stream's way from the identifier to ``auto``: only the excitation changes (the window,
+    #: the lines and the band its driven decision set stay)
+    keeps: bool = False
 
     def changes(self) -> dict:
         """The configuration fields a stream switching to this decision sets (the node's
@@ -231,13 +232,13 @@ class Decision:
         several) or window (when decided)."""
         if self.excitation == 'free':
             out: dict = {'excitation': 'free'}
-            if self.clears:
-                out.update(lines_hz=[], band_hz=[])
             if self.modes:
                 out['modes'] = self.modes
             if math.isfinite(self.min_periods):
                 out.update(min_periods=self.min_periods, early_std_rel=self.early_std_rel)
             return out
+        if self.keeps:
+            return {'excitation': self.excitation}
         out = {
             'excitation': self.excitation,
             'ambient_window_s': float(self.window_s),
@@ -1025,9 +1026,11 @@ class StreamChoice:
                 return None
             reason = (
                 f'under {100 * FREE_BELOW:.0f} % of the energy of the last {WATCH_S:g} s read '
-                'driven by the envelope'
+                'driven by the envelope: free decays now, a structure that was driven (auto: '
+                "the free-decay estimator's estimates in its free stretches, the identifier's in "
+                'driven ones, without waiting for the watch)'
             )
-            return Decision('free', window_s, 0.0, math.nan, math.nan, (), reason, clears=True)
+            return Decision('auto', window_s, 0.0, math.nan, math.nan, (), reason, keeps=True)
         if excitation != 'free' or self._share is None or now < self._retry_at:
             return None
         self._retry_at = now + WATCH_S / 2

@@ -451,8 +451,11 @@ class EstimatorNode(Node):
             self._stream.deciding = self.get_parameter('decide_excitation').value
         if not names & (CORE_NAMES | FIELD_NAMES):
             return
+        fields = self._read_fields()
+        if fields == self._fields and config_of(self) == self._stream.config:
+            return  # set to the values in force: the estimator goes on (its window kept)
         self._stream.decided = self._deciding  # a change of the user's is the user's
-        self._fields = self._read_fields()
+        self._fields = fields
         self._channels = topic_channels(self._topics, self._fields)
         self._value = channels_getter(self._fields, self._input_type)
         if self._aligner is not None:  # the queued samples may carry other fields
