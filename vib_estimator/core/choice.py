@@ -804,8 +804,8 @@ class DrivenWatch:
 class StreamChoice:
     """``estimator_node``'s default (``decide_excitation``): :func:`decide` over the last
     :data:`WATCH_S` s of the stream (all channels), taken once :class:`DrivenWatch` reads them
-    driven throughout while the estimator is the free-decay one; and back to ``free`` once a
-    stream it sent to ``ambient`` reads free (``auto`` follows free stretches itself).
+    driven throughout while the estimator is the free-decay one; and, once a stream it sent to
+    ``ambient`` reads free, ``auto`` (which follows free and driven stretches itself).
 
     Fed sample by sample (:meth:`update`, a value or a tuple of the channels' values: two list
     appends; the watch is fed in numpy batches when asked, or every :data:`MAX_KEPT`), asked at
@@ -1010,7 +1010,7 @@ class StreamChoice:
         a decay, the window that decay allows (:func:`fast_window`, as ``analyze`` decides it),
         or, when that decay and its last :data:`LASTING_SHARE` show several modes, the mode
         tracker (:meth:`_lasting_modes`); from an
-        ``ambient`` this choice ``decided``, ``free`` once the stream reads free.
+        ``ambient`` this choice ``decided``, ``auto`` once the stream reads free.
         ``window_s``: the configured ambient window (the shortest the decision gives)."""
         self._flush()
         if not self._kept:

@@ -155,7 +155,7 @@ FIELD_NAMES = frozenset(('component', 'components'))
 DECIDE_DESCRIPTION = (
     "while excitation is free, switch to what the input needs (analyze's decision over its "
     'last 120 s: ambient or auto, and the ambient window) once it looks driven throughout, and '
-    'back to free once it looks free again; false keeps the configured excitation'
+    'from ambient to auto once it looks free again; false keeps the configured excitation'
 )
 #: the Float64 outputs of each estimate, in publication order: (topic under vibration/, field)
 FLOAT_OUTPUTS = (

@@ -426,7 +426,7 @@ class EstimatorStream:
         throughout, analyze's decision over its last seconds (excitation and ambient window), or
         when its estimator stays silent on a ringing input or a decay's modes ring on, a decay
         of several modes (``modes``);
-        from an ``ambient`` decided so, ``free`` once it looks free again
+        from an ``ambient`` decided so, ``auto`` once it looks free again
         (:class:`~vib_estimator.core.choice.StreamChoice`). The caller applies it (the node: as
         its parameters) and sets :attr:`decided`."""
         if not self.ready:
