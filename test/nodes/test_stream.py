@@ -304,6 +304,36 @@ def test_the_deciding_stream_goes_to_the_identifier_when_driven_and_back_when_fr
     assert all(d.excitation == 'free' for _, d in decisions(quiet, ring_t, ring))
 
 
+def test_a_stream_driven_now_and_in_part_is_decided_without_waiting_for_the_ring_to_leave(
+    monkeypatch,
+):
+    """A mode driven throughout under a start's ring 25 x its driven level (an arm driven at
+    its tip after its ramp): once its envelope reads it driven, the deciding stream asks
+    ``decide`` as soon as the watched seconds' driven share is above ``FREE_BELOW`` (decide then
+    says ``auto``: the ring is still in them), not once the ring has left them (``ambient``, 20 s
+    later); what runs meanwhile (free) publishes nothing of the driven mode."""
+    import vib_estimator.nodes.stream as stream_module
+    from vib_estimator.core.choice import DRIVEN_ABOVE
+    from vib_estimator.sim.ambient import sdof_response
+
+    fs, f, zeta = 100.0, 1.3, 0.01
+    rng = np.random.default_rng(0)
+    t = np.arange(0, 200, 1 / fs)
+    y = sdof_response(len(t), fs, f, zeta, 1.0, rng)
+    w = 2 * np.pi * f
+    y += 25 * np.std(y) * np.exp(-zeta * w * t) * np.sin(w * t)
+    y += 0.05 * np.std(y) * rng.standard_normal(len(t))
+
+    def first_driven():
+        got = decisions(EstimatorStream(EstimatorConfig(), now=0.0, deciding=True), t, y)
+        return next((k, d.excitation) for k, d in got if d.excitation != 'free')
+
+    second, excitation = first_driven()
+    assert second <= 130 and excitation == 'auto'
+    monkeypatch.setattr(stream_module, 'FREE_BELOW', DRIVEN_ABOVE)  # driven throughout only
+    assert first_driven()[0] >= second + 15
+
+
 def test_the_deciding_stream_publishes_no_free_estimate_of_a_driven_input_before_it_decides():
     """Before it decides (its first minute), the deciding stream's free-decay estimator publishes
     only estimates whose signal passes the free-decay test (as ``auto``'s free stretches): a

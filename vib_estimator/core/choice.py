@@ -754,13 +754,14 @@ class DrivenWatch:
         self._envelope.follow(f)
         self.followed_hz = f
 
-    def driven(self) -> Optional[float]:
+    def driven(self, above: float = DRIVEN_ABOVE) -> Optional[float]:
         """The driven share of the last :data:`WATCH_S` s' energy when they look driven
-        throughout (see the class doc), else None."""
+        throughout (see the class doc; ``above``: the least share, :data:`FREE_BELOW` for
+        driven in part: a mixed stream), else None."""
         share, live = self._watched_share()
         if share is None or self._envelope.state != DRIVEN:
             return None
-        return share if share > DRIVEN_ABOVE and live else None
+        return share if share > above and live else None
 
     @property
     def driven_blocks(self) -> int:
@@ -803,9 +804,10 @@ class DrivenWatch:
 
 class StreamChoice:
     """``estimator_node``'s default (``decide_excitation``): :func:`decide` over the last
-    :data:`WATCH_S` s of the stream (all channels), taken once :class:`DrivenWatch` reads them
-    driven throughout while the estimator is the free-decay one; and, once a stream it sent to
-    ``ambient`` reads free, ``auto`` (which follows free and driven stretches itself).
+    :data:`WATCH_S` s of the stream (all channels), taken once :class:`DrivenWatch` reads the
+    stream driven now and in part of them (:meth:`driven` above :data:`FREE_BELOW`: ``decide``
+    tells ambient from auto) while the estimator is the free-decay one; and, once a stream it
+    sent to ``ambient`` reads free, ``auto`` (which follows free and driven stretches itself).
 
     Fed sample by sample (:meth:`update`, a value or a tuple of the channels' values: two list
     appends; the watch is fed in numpy batches when asked, or every :data:`MAX_KEPT`), asked at
@@ -988,10 +990,11 @@ class StreamChoice:
         self._passed = (stretch, passes + 1 if verdict is True else 0)
         return verdict
 
-    def driven(self) -> Optional[float]:
-        """:meth:`DrivenWatch.driven`, kept for :meth:`decision`."""
+    def driven(self, above: float = DRIVEN_ABOVE) -> Optional[float]:
+        """:meth:`DrivenWatch.driven`, kept for :meth:`decision` (which :func:`decide` then
+        tells ``ambient`` from ``auto``)."""
         self._flush()
-        self._share = self.watch.driven()
+        self._share = self.watch.driven(above)
         return self._share
 
     def decision(

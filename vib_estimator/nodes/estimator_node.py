@@ -30,12 +30,12 @@ and the diagnostics bookkeeping, all without rclpy) and publishes what comes bac
   executor thread goes on meanwhile).
 * ``/diagnostics`` at 1 Hz (steady clock): one status named after the node (:mod:`.health`).
 * ``decide_excitation`` (default true): while ``excitation`` is ``free`` (the default), once the
-  input looks driven throughout its last two minutes, the node sets its own ``excitation`` (and
-  ``ambient_window_s``) to what ``vib-estimator analyze`` decides on those seconds
-  (:meth:`~.stream.EstimatorStream.decision`: a building under wind, a machine driven without
-  rest), with one log line; from an ``ambient`` it set so, back to ``free`` once the input looks
-  free again. False keeps the configured excitation and says on ``/diagnostics`` when the input
-  looks driven.
+  input looks driven (now, and in part of its last two minutes), the node sets its own
+  ``excitation`` (and ``ambient_window_s``) to what ``vib-estimator analyze`` decides on those
+  seconds (:meth:`~.stream.EstimatorStream.decision`: a building under wind, a machine driven
+  without rest), with one log line; from an ``ambient`` it set so, to ``auto`` once the input
+  looks free again. False keeps the configured excitation and says on ``/diagnostics`` when the
+  input looks driven.
 
 Time base: the header stamps (``t`` = stamp - first stamp, as the offline ``vib-estimator
 analyze``, so both give the same floats). A zero stamp, and every sample of a type without a header
@@ -154,7 +154,7 @@ FIELD_NAMES = frozenset(('component', 'components'))
 #: the node's own choice of excitation (module doc)
 DECIDE_DESCRIPTION = (
     "while excitation is free, switch to what the input needs (analyze's decision over its "
-    'last 120 s: ambient or auto, and the ambient window) once it looks driven throughout, and '
+    'last 120 s: ambient or auto, and the ambient window) once it looks driven, and '
     'from ambient to auto once it looks free again; false keeps the configured excitation'
 )
 #: the Float64 outputs of each estimate, in publication order: (topic under vibration/, field)

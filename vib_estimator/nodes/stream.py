@@ -43,7 +43,15 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from ..core.choice import WATCH_S, Decision, StreamChoice, decide, window_advice
+from ..core.choice import (
+    DRIVEN_ABOVE,
+    FREE_BELOW,
+    WATCH_S,
+    Decision,
+    StreamChoice,
+    decide,
+    window_advice,
+)
 from ..core.config import EstimatorConfig
 from ..core.estimator import COUNTER_NAMES, MIN_CHANNELS, Estimate
 from ..core.factory import create_estimator, create_uncompiled, kind_of
@@ -388,7 +396,9 @@ class EstimatorStream:
     def _driven_hint(self) -> Optional[str]:
         """With the free-decay estimator, what to say when the input looks driven throughout
         (:class:`~vib_estimator.core.choice.DrivenWatch`); else None."""
-        share = self._choice.driven()
+        # deciding: driven now and in part (a structure moved between driven stretches), and
+        # decide() tells ambient from auto; else driven throughout is what the hint says
+        share = self._choice.driven(FREE_BELOW if self.deciding else DRIVEN_ABOVE)
         if share is None or self.config.excitation != 'free' or self.deciding:
             return None
         return (
