@@ -597,18 +597,16 @@ class AutoEstimator(Estimator):
         self._free.reset()
         self._ambient.reset()
 
-    def _jumped_back(self, t: float) -> bool:
-        """Whether a sample of stamp ``t`` jumps back beyond ``max_gap`` from the last kept (a
-        source restarted, a bag looping); the envelope, the free-decay test's samples and the
-        known modes then start afresh, as the two estimators do by themselves
+    def _jumped_back(self, t: float) -> None:
+        """When a sample of stamp ``t`` jumps back beyond ``max_gap`` from the last kept (a
+        source restarted, a bag looping), the envelope, the free-decay test's samples and the
+        known modes start afresh, as the two estimators do by themselves
         (:func:`~.estimator.accept_sample`): else the envelope skipped every sample until the
         stamps passed the old ones (a restarted simulator: nothing published for minutes)."""
-        if not self._envelope.last - t > self._config.max_gap:
-            return False
-        self._envelope.restart()
-        self._modes.clear()
-        self._filled = 0
-        return True
+        if self._envelope.last - t > self._config.max_gap:
+            self._envelope.restart()
+            self._modes.clear()
+            self._filled = 0
 
     # ---- streaming ----------------------------------------------------------------------------
     def _remember(self, t: float, y: float) -> None:
