@@ -843,6 +843,9 @@ class StreamChoice:
         self._pending_t, self._pending_y = [], []
         # a stamp going back (within the batch too): what follows is a stream of its own
         last, i = (self._kept[-1][0][-1] if self._kept else -math.inf), 0
+        if t[0] >= last and (t[1:] >= t[:-1]).all():  # none goes back (nor is NaN): one batch
+            self._keep(t, y)
+            return
         while i < len(t):
             ahead = np.maximum.accumulate(np.append(last, t[i:-1]))  # the latest before each
             back = np.flatnonzero(t[i:] < ahead - WATCH_S / 100)
