@@ -123,6 +123,8 @@ def state_matrices(u: np.ndarray, s: np.ndarray, m: int, orders: Sequence[int]) 
     top = max(orders)
     shift = u[:-m, :top].T @ u[m:, :top]
     eye = np.eye(m)
+    root = np.sqrt(s[:top])
+    scale = root[None, :] / root[:, None]  # (each order's: its leading block)
     out = []
     for order in orders:
         w = u[-m:, :order]
@@ -140,8 +142,7 @@ def state_matrices(u: np.ndarray, s: np.ndarray, m: int, orders: Sequence[int]) 
             except np.linalg.LinAlgError:
                 out.append(None)
                 continue
-        root = np.sqrt(s[:order])
-        out.append(b * (root[None, :] / root[:, None]))
+        out.append(b * scale[:order, :order])
     return out
 
 
@@ -156,8 +157,9 @@ def ssi_poles(r: np.ndarray, fs: float, orders: Sequence[int] = ORDERS) -> list[
     u, s, vt = hankel_svd(hankel, max(orders), m)
     width = 3 + 3 * m
     out = []
+    roots = np.sqrt(s)
     for order, a in zip(orders, state_matrices(u, s, m, orders)):
-        root = np.sqrt(s[:order])
+        root = roots[:order]
         obs = u[:m, :order] * root  # C, the first block row of O
         try:
             if a is None:
@@ -172,9 +174,10 @@ def ssi_poles(r: np.ndarray, fs: float, orders: Sequence[int] = ORDERS) -> list[
         phi = obs @ vec[:, keep]  # channels x poles
         share = 2.0 * (phi * g_modal[keep].T / lam_k).real  # each channel's variance
         pole = np.log(lam_k) * fs
+        size = np.abs(pole)
         row = np.empty((len(lam_k), width))
-        row[:, 0] = np.abs(pole) / (2 * math.pi)
-        row[:, 1] = -pole.real / np.abs(pole)
+        row[:, 0] = size / (2 * math.pi)
+        row[:, 1] = -pole.real / size
         row[:, 2] = share.sum(axis=0)
         row[:, 3 : 3 + m] = share.T
         row[:, 3 + m : 3 + 2 * m] = phi.real.T
