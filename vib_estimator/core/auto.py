@@ -194,7 +194,9 @@ def _blocks(t: np.ndarray, y: np.ndarray, f: float, other: Optional[float] = Non
 def _block_sums(x: np.ndarray, cuts: np.ndarray) -> np.ndarray:
     """The sums of each row of ``x`` over the blocks (columns), block ``k`` from ``cuts[k]`` to
     ``cuts[k + 2]``: the half blocks' sums (``np.add.reduceat``, an empty one 0) added in pairs."""
-    halves = np.add.reduceat(np.pad(x, ((0, 0), (0, 1))), cuts[:-1], axis=1)
+    padded = np.zeros((len(x), x.shape[1] + 1), dtype=x.dtype)  # (numpy.pad's zero, cheaper)
+    padded[:, :-1] = x
+    halves = np.add.reduceat(padded, cuts[:-1], axis=1)
     halves[:, cuts[:-1] == cuts[1:]] = 0.0
     return halves[:, :-1] + halves[:, 1:]
 
@@ -451,10 +453,14 @@ class Envelope:
             and np.isfinite(y).all()
         )
 
-    def feed(self, t: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def feed(
+        self, t: np.ndarray, y: np.ndarray, closes: Optional[list] = None
+    ) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`update` for arrays, block by block: ``(valid, driven)`` per sample (kept by
         the envelope's rule; the state after it). The same states as sample by sample: each
-        block's sums are sequential (``cumsum``, from the sums carried in), as ``update``'s."""
+        block's sums are sequential (``cumsum``, from the sums carried in), as ``update``'s.
+        ``closes``: a list to append, at each block closed, ``(sample, free energy, driven
+        energy, onsets)`` (the sample whose arrival closed it; the totals after it)."""
         n = len(t)
         if n and self.all_kept(t, y):
             valid, idx, tv, yv = np.ones(n, dtype=bool), None, t, y
@@ -482,7 +488,10 @@ class Envelope:
                 break
             self._close()
             self._k = int(k[j])
-            changes.append((j if idx is None else int(idx[j]), self.state == DRIVEN))
+            at = j if idx is None else int(idx[j])
+            changes.append((at, self.state == DRIVEN))
+            if closes is not None:
+                closes.append((at, self.energy[FREE], self.energy[DRIVEN], self.changes['onsets']))
             lo = j
         driven = np.empty(n, dtype=bool)
         for (a, state), (b, _) in zip(changes, changes[1:] + [(n, None)]):
