@@ -502,8 +502,11 @@ class Envelope:
         """Add the samples ``part`` of the block under way to its sums, in sequence."""
         if len(part):
             self._n += len(part)
-            self._s1 = float(np.cumsum(np.concatenate(([self._s1], part)))[-1])
-            self._s2 = float(np.cumsum(np.concatenate(([self._s2], part * part)))[-1])
+            sums = np.empty((2, len(part) + 1))  # the sums carried in, then the samples, squared
+            sums[:, 0] = self._s1, self._s2
+            sums[0, 1:] = part
+            np.multiply(part, part, out=sums[1, 1:])
+            self._s1, self._s2 = np.cumsum(sums, axis=1)[:, -1].tolist()  # (each row in turn)
 
     def _close(self) -> None:
         n = self._n
