@@ -463,3 +463,19 @@ def test_lines_hz_is_validated():
     for bad in ([0.0], [math.nan], [-1.0]):
         with pytest.raises(ValueError, match='lines_hz'):
             EstimatorConfig().replace(lines_hz=bad)
+
+
+def test_cluster_medians_are_numpy_s():
+    """ssi.medians: numpy.median's floats over the rows (odd and even counts, NaN, ties)."""
+    from vib_estimator.core.ssi import medians
+
+    rng = np.random.default_rng(3)
+    for rows in range(1, 12):
+        a = rng.standard_normal((rows, 5))
+        a[:, 1] = np.round(a[:, 1])
+        a[rng.integers(0, rows), 2] = np.nan
+        a[:, 3] = [math.inf, -math.inf, 1.0, 0.0][rows % 4]
+        want = np.median(a, axis=0)
+        got = medians(a)
+        assert np.array_equal(got, want, equal_nan=True)
+        assert np.all(np.signbit(got[~np.isnan(got)]) == np.signbit(want[~np.isnan(want)]))

@@ -261,14 +261,16 @@ def test_the_stream_choice_feeds_the_watch_in_batches_with_the_same_answers():
     y = np.concatenate([y, 30 * np.exp(-0.3 * (tail - 200)) * np.sin(2 * np.pi * tail)])
     t = np.concatenate([t, tail])
     one, batched = DrivenWatch(), StreamChoice()
-    answers = []
+    answers, onsets = [], []
     for k, (a, b) in enumerate(zip(t.tolist(), y.tolist())):
         one.feed(np.array([a]), np.array([b]))
         batched.update(a, b)
         if k % 337 == 0:
             answers.append((one.driven(), batched.driven(), one.freed(), batched.watch.freed()))
+            onsets.append((one.onsets, batched.watch.onsets))  # (when seen: the batch's end)
     assert all(a == b and c == d for a, b, c, d in answers)
     assert any(a is not None for a, *_ in answers) and any(c for *_, c, _ in answers)
+    assert all(a == b for a, b in onsets) and onsets[-1][0] > 1
 
 
 def test_a_stream_whose_stamps_go_back_is_judged_afresh():

@@ -44,3 +44,70 @@ def test_choice_no_longer_imports_scipy_signal():
         'sys.exit("scipy.signal" in sys.modules)'
     )
     assert subprocess.run([sys.executable, '-c', code]).returncode == 0
+
+
+def numpy_peaks(x, minimum):
+    """The peaks by prominence with numpy's minima over each peak's whole range (scipy's
+    find_peaks refuses NaN)."""
+    n, found, i = len(x), [], 1
+    while i < n - 1:
+        if x[i - 1] < x[i]:
+            ahead = i + 1
+            while ahead < n - 1 and x[ahead] == x[i]:
+                ahead += 1
+            if x[ahead] < x[i]:
+                found.append((i + ahead - 1) // 2)
+                i = ahead
+        i += 1
+    keep = []
+    for p in found:
+        higher = np.flatnonzero(x[:p] > x[p])
+        left = float(np.min(x[(higher[-1] + 1 if len(higher) else 0) : p + 1]))
+        higher = np.flatnonzero(x[p + 1 :] > x[p])
+        right = float(np.min(x[p : (p + 1 + higher[0] if len(higher) else n)]))
+        if x[p] - max(left, right) >= minimum:
+            keep.append(p)
+    return keep
+
+
+@pytest.mark.parametrize('scan', [0, 1, 3, 10**6])
+def test_the_peaks_are_scipy_s_whichever_way_the_higher_sample_is_found(monkeypatch, scan):
+    """The prominence's search in Python floats, then with numpy beyond ``SCAN`` samples: the same
+    peaks with either alone (NaN and infinities between included)."""
+    from vib_estimator.core import spectra
+
+    monkeypatch.setattr(spectra, 'SCAN', scan)
+    rng = np.random.default_rng(scan % 7)
+    for n in (1, 2, 3, 50, 400, 3000):
+        for x in (np.cumsum(rng.standard_normal(n)), np.round(rng.standard_normal(n), 1)):
+            for minimum in (0.0, 1.0):
+                want = list(find_peaks(x, prominence=minimum)[0])
+                assert list(peaks_by_prominence(x, minimum)) == want
+        x = rng.standard_normal(n)
+        x[rng.integers(0, n, 2)] = (np.nan, np.inf)
+        assert list(peaks_by_prominence(x, 0.5)) == numpy_peaks(x, 0.5)
+
+
+def test_a_spectrum_s_peaks_search_in_python_floats_and_numpy_beyond_the_scan(monkeypatch):
+    """A decision's spectrum (5001 bins of noise and a tone, ~1300 local maxima): most searches
+    for a higher sample end within ``SCAN`` samples, in Python floats (at 0, every one goes to
+    numpy); a tall peak's goes on with numpy (not in Python floats to the spectrum's ends)."""
+    from vib_estimator.core import spectra
+
+    y = np.random.default_rng(0).standard_normal(30000) + np.sin(np.arange(30000) * 0.3)
+    _, psd = scipy_welch(y, 500.0, nperseg=10000)
+    calls = []
+
+    class Counted:
+        def __getattr__(self, name):
+            return getattr(np, name)
+
+        @staticmethod
+        def flatnonzero(a):
+            calls.append(len(a))
+            return np.flatnonzero(a)
+
+    monkeypatch.setattr(spectra, 'np', Counted())
+    peaks = peaks_by_prominence(10 * np.log10(psd), 0.0)
+    assert len(peaks) > 1000
+    assert 0 < len(calls) < len(peaks) / 4

@@ -194,7 +194,9 @@ def _blocks(t: np.ndarray, y: np.ndarray, f: float, other: Optional[float] = Non
 def _block_sums(x: np.ndarray, cuts: np.ndarray) -> np.ndarray:
     """The sums of each row of ``x`` over the blocks (columns), block ``k`` from ``cuts[k]`` to
     ``cuts[k + 2]``: the half blocks' sums (``np.add.reduceat``, an empty one 0) added in pairs."""
-    halves = np.add.reduceat(np.pad(x, ((0, 0), (0, 1))), cuts[:-1], axis=1)
+    padded = np.zeros((len(x), x.shape[1] + 1), dtype=x.dtype)  # (numpy.pad's zero, cheaper)
+    padded[:, :-1] = x
+    halves = np.add.reduceat(padded, cuts[:-1], axis=1)
     halves[:, cuts[:-1] == cuts[1:]] = 0.0
     return halves[:, :-1] + halves[:, 1:]
 
@@ -444,46 +446,72 @@ class Envelope:
         stamps = np.concatenate(([self._last], np.where(finite, t, -math.inf)))
         return finite & (t > np.maximum.accumulate(stamps)[:-1])
 
-    def feed(self, t: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def all_kept(self, t: np.ndarray, y: np.ndarray) -> bool:
+        """Whether :meth:`valid` keeps every sample of arrays ``(t, y)`` (none of them empty):
+        the stamps rise strictly from after the last to a finite one (so none is NaN or
+        infinite) and the values are finite. A few array calls, where :meth:`valid` takes a
+        dozen (the watch's batches each second: all kept)."""
+        return bool(
+            t[0] > self._last
+            and math.isfinite(t[-1])
+            and (t[1:] > t[:-1]).all()
+            and np.isfinite(y).all()
+        )
+
+    def feed(
+        self, t: np.ndarray, y: np.ndarray, closes: Optional[list] = None
+    ) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`update` for arrays, block by block: ``(valid, driven)`` per sample (kept by
         the envelope's rule; the state after it). The same states as sample by sample: each
-        block's sums are sequential (``cumsum``, from the sums carried in), as ``update``'s."""
+        block's sums are sequential (``cumsum``, from the sums carried in), as ``update``'s.
+        ``closes``: a list to append, at each block closed, ``(sample, free energy, driven
+        energy, onsets)`` (the sample whose arrival closed it; the totals after it)."""
         n = len(t)
-        valid = self.valid(t, y)
-        driven = np.zeros(n, dtype=bool)
-        idx = np.flatnonzero(valid)
-        if not len(idx):
-            driven[:] = self.state == DRIVEN
-            return valid, driven
-        tv, yv = (t, y) if len(idx) == n else (t[idx], y[idx])
+        if n and self.all_kept(t, y):
+            valid, idx, tv, yv = np.ones(n, dtype=bool), None, t, y
+        else:
+            valid = self.valid(t, y)
+            idx = np.flatnonzero(valid)
+            if not len(idx):
+                return valid, np.full(n, self.state == DRIVEN)
+            tv, yv = (t, y) if len(idx) == n else (t[idx], y[idx])
         if self._t0 is None:
             self._t0 = float(tv[0])
         self._last = float(tv[-1])
-        k = ((tv - self._t0) // self.block_s).astype(np.int64)
         # the first valid sample of each new block closes the one before (k does not decrease:
         # none when the last is in the block under way)
-        if k[-1] == self._k:
-            starts = idx[:0]
+        if ((tv[-1:] - self._t0) // self.block_s).astype(np.int64)[0] == self._k:
+            k, starts = None, []
         else:
-            starts = np.flatnonzero(np.diff(np.concatenate(([self._k], k))) != 0)
-        ends = np.concatenate((starts, [len(k)]))
+            k = ((tv - self._t0) // self.block_s).astype(np.int64)
+            starts = np.flatnonzero(np.diff(np.concatenate(([self._k], k))) != 0).tolist()
         changes = [(0, self.state == DRIVEN)]
         lo = 0
-        for j, hi in zip(starts.tolist() + [None], ends.tolist()):
-            part = yv[lo:hi]
-            if len(part):
-                self._n += len(part)
-                self._s1 = float(np.cumsum(np.concatenate(([self._s1], part)))[-1])
-                self._s2 = float(np.cumsum(np.concatenate(([self._s2], part * part)))[-1])
+        for j, hi in zip(starts + [None], starts + [len(tv)]):
+            self._add(yv[lo:hi])
             if j is None:
                 break
             self._close()
             self._k = int(k[j])
-            changes.append((int(idx[j]), self.state == DRIVEN))
+            at = j if idx is None else int(idx[j])
+            changes.append((at, self.state == DRIVEN))
+            if closes is not None:
+                closes.append((at, self.energy[FREE], self.energy[DRIVEN], self.changes['onsets']))
             lo = j
+        driven = np.empty(n, dtype=bool)
         for (a, state), (b, _) in zip(changes, changes[1:] + [(n, None)]):
             driven[a:b] = state
         return valid, driven
+
+    def _add(self, part: np.ndarray) -> None:
+        """Add the samples ``part`` of the block under way to its sums, in sequence."""
+        if len(part):
+            self._n += len(part)
+            sums = np.empty((2, len(part) + 1))  # the sums carried in, then the samples, squared
+            sums[:, 0] = self._s1, self._s2
+            sums[0, 1:] = part
+            np.multiply(part, part, out=sums[1, 1:])
+            self._s1, self._s2 = np.cumsum(sums, axis=1)[:, -1].tolist()  # (each row in turn)
 
     def _close(self) -> None:
         n = self._n

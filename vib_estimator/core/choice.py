@@ -724,28 +724,51 @@ class DrivenWatch:
     def feed(self, t: np.ndarray, y: np.ndarray) -> None:
         """Samples ``(t, y)`` (arrays), in a few numpy passes: the energies are marked at the
         first sample and then every 1 % of :data:`WATCH_S` of stream time, however fast the
-        stream is fed, so any batching gives the same marks."""
-        start, n = 0, len(t)
-        while start < n:
-            end = start + 1  # the first sample is marked
-            if self._marks:  # else up to the next sample to mark at
-                later = t[start:] - self._marks[-1][0] >= WATCH_S / 100
-                first = int(np.argmax(later))
-                end = start + first + 1 if later[first] else n + 1
-            with np.errstate(over='ignore', invalid='ignore'):  # a huge sample: inf energy
-                self._envelope.feed(t[start:end], y[start:end])
+        stream is fed, so any batching gives the same marks. The envelope is fed the batch at
+        once; each mark takes the energies after the blocks closed before it (those its part of
+        the batch fed alone would leave: the same marks and onsets, one envelope pass a batch)."""
+        n = len(t)
+        if not n:
+            return
+        env = self._envelope
+        state = (env.energy[FREE], env.energy[DRIVEN], env.changes['onsets'])
+        closes: list = []
+        with np.errstate(over='ignore', invalid='ignore'):  # a huge sample: inf energy
+            env.feed(t, y, closes)
+        k = 0
+        for end in self._mark_ends(t):
+            while k < len(closes) and closes[k][0] < end:  # the blocks closed before it
+                state = closes[k][1:]
+                k += 1
             self._last_t = float(t[min(end, n) - 1])
-            if self._envelope.changes['onsets'] + 1 != self.onsets:
-                self.onsets = self._envelope.changes['onsets'] + 1
+            if state[2] + 1 != self.onsets:
+                self.onsets = state[2] + 1
                 self.onset_t = self._last_t if self.onsets > 1 else float(t[0])
             if end <= n:
-                self._mark(self._last_t)
-            start = end
+                self._mark(self._last_t, state[0], state[1])
 
-    def _mark(self, t: float) -> None:
-        """Mark the envelope's energies at stream time ``t``; forget marks beyond the span."""
-        env, marks = self._envelope, self._marks
-        marks.append((t, env.energy[FREE], env.energy[DRIVEN]))
+    def _mark_ends(self, t: np.ndarray) -> list[int]:
+        """The parts of a batch ``t`` (their ends, exclusive) each ending at a sample to mark
+        (:meth:`feed`); the last ends at ``len(t) + 1`` when no mark ends it."""
+        ends, start, n = [], 0, len(t)
+        at = self._marks[-1][0] if self._marks else None
+        while start < n:
+            end = start + 1  # the first sample is marked
+            if at is not None:  # else up to the next sample to mark at
+                later = t[start:] - at >= WATCH_S / 100
+                first = int(np.argmax(later))
+                end = start + first + 1 if later[first] else n + 1
+            if end <= n:
+                at = float(t[end - 1])
+            ends.append(end)
+            start = end
+        return ends
+
+    def _mark(self, t: float, free: float, driven: float) -> None:
+        """Mark the energies ``free`` and ``driven`` at stream time ``t``; forget marks beyond
+        the span."""
+        marks = self._marks
+        marks.append((t, free, driven))
         while len(marks) > 2 and t - marks[1][0] >= WATCH_S:
             marks.popleft()
 
@@ -849,6 +872,9 @@ class StreamChoice:
         self._pending_t, self._pending_y = [], []
         # a stamp going back (within the batch too): what follows is a stream of its own
         last, i = (self._kept[-1][0][-1] if self._kept else -math.inf), 0
+        if t[0] >= last and (t[1:] >= t[:-1]).all():  # none goes back (nor is NaN): one batch
+            self._keep(t, y)
+            return
         while i < len(t):
             ahead = np.maximum.accumulate(np.append(last, t[i:-1]))  # the latest before each
             back = np.flatnonzero(t[i:] < ahead - WATCH_S / 100)

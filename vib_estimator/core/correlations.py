@@ -78,6 +78,14 @@ def decimation_filter() -> DecimationFilter:
     return DecimationFilter(sos, sosfilt_zi(sos), pad, settle)
 
 
+def lag_windows(ext: np.ndarray, lags: int) -> np.ndarray:
+    """``numpy.lib.stride_tricks.sliding_window_view(ext, lags + 1, axis=0)`` (rows x channels
+    x lags + 1, read-only), the same view without its checks (~6 us a call)."""
+    step, across = ext.strides
+    shape = (len(ext) - lags, ext.shape[1], lags + 1)
+    return np.lib.stride_tricks.as_strided(ext, shape, (step, across, step), writeable=False)
+
+
 def lag_products(y, a, b, bound, off, sums, total, later=True, subtract=False) -> None:
     """Add to ``sums`` (lag k, channel i, channel j; k = 0 .. ``len(sums) - 1``) the products of
     the rows ``x = y - off`` that pair a row a <= t < b with another: ``later``, the products
@@ -92,14 +100,14 @@ def lag_products(y, a, b, bound, off, sums, total, later=True, subtract=False) -
             lo0 = max(bound, a0 - lags)
             ext[lags - (a0 - lo0) :] = y[lo0:b0] - off
             own = ext[lags:]
-            view = np.lib.stride_tricks.sliding_window_view(ext, lags + 1, axis=0)
+            view = lag_windows(ext, lags)
             # view[i, :, q] = ext[i + q] = y[a0 + i - (lags - q)]: lag k = lags - q
             prod = np.tensordot(own, view, axes=(0, 0))[:, :, ::-1].transpose(2, 0, 1)
         else:
             hi0 = min(bound, b0 + lags)
             ext[: hi0 - a0] = y[a0:hi0] - off
             own = ext[: b0 - a0]
-            view = np.lib.stride_tricks.sliding_window_view(ext, lags + 1, axis=0)[: b0 - a0]
+            view = lag_windows(ext, lags)[: b0 - a0]
             # view[i, :, k] = y[a0 + i + k]
             prod = np.tensordot(own, view, axes=(0, 0)).transpose(2, 1, 0)
         if subtract:
