@@ -964,7 +964,7 @@ class StreamChoice:
         if not decay_zeta(t, y, f) > 0:  # no decay seen yet (a driven response's wandering)
             return None
         chosen = decide(t, y, offset_ok=False)  # the node estimates the samples as they come
-        lasting = self._lasting_modes(t, y) if chosen.modes else None
+        lasting = self._lasting_modes(t, y, f) if chosen.modes else None
         if lasting is not None:
             self._window_reads = WINDOW_READS
             return lasting
@@ -974,12 +974,18 @@ class StreamChoice:
         ok = chosen.excitation == 'free' and not chosen.modes
         return chosen if ok and math.isfinite(chosen.min_periods) else None
 
-    def _lasting_modes(self, t: np.ndarray, y: np.ndarray) -> Optional[Decision]:
+    def _lasting_modes(self, t: np.ndarray, y: np.ndarray, f: float) -> Optional[Decision]:
         """:func:`decide`'s free decay of several modes over the last :data:`LASTING_SHARE` of
-        the decay ``(t, y)`` (since its onset), when that part still shows them: modes that
-        ring on (an 8 / 21 / 55 Hz decay, whose one-mode estimator follows 8 Hz alone), not a
-        pluck's higher modes rung down since (a beam's); else None."""
+        the decay ``(t, y)`` (since its onset), when that part still shows them and is a free
+        decay at the followed ``f`` Hz (:func:`.auto.is_free_decay`, which fits the strongest
+        other mode too): modes that ring on (an 8 / 21 / 55 Hz decay, whose one-mode estimator
+        follows 8 Hz alone), not a pluck's higher modes rung down since (a beam's), nor a
+        structure moved again meanwhile (the arm moved at random times, its moves' content
+        read as a 2.33 Hz mode beside its 1.33 Hz: the mode tracker published estimates up to
+        24 % off); else None."""
         late = t >= t[-1] - LASTING_SHARE * (t[-1] - t[0])
+        if is_free_decay(t[late], y[late], f) is False:
+            return None
         chosen = decide(t[late], y[late], offset_ok=False)
         return chosen if chosen.excitation == 'free' and chosen.modes else None
 
