@@ -369,7 +369,7 @@ def test_parameter_changes(make_probe):
     restarts it with the new configuration on the same time origin: the published estimates are
     those of the offline estimator of each configuration over its samples."""
     p = make_probe()
-    parts = np.cumsum([0, 1500, 750, 1500, 1500, 750])
+    parts = np.cumsum([0, 1500, 750, 1500, 1500, 750, 1500])
     stamps = sine_stamps(parts[-1])
     values = np.sin(2 * np.pi * 1.33 * np.arange(parts[-1]) / FS)
 
@@ -426,6 +426,16 @@ def test_parameter_changes(make_probe):
         0
     ].successful
     feed(4, PAPER_CONFIG.replace(window=5))
+    # set to the value in force (a storm of the same valid value): nothing restarts, the segment
+    # of part 4 goes on through part 5 (a rebuild would start one at part 5)
+    assert p.node.set_parameters([Parameter('window', value=5)])[0].successful
+    before = len(p.frequencies())
+    p.feed(stamps[parts[5] : parts[6]], values[parts[5] : parts[6]])
+    five = PAPER_CONFIG.replace(window=5)
+    went_on = offline(stamps[parts[4] : parts[6]], values[parts[4] : parts[6]], five, stamps[0])
+    went_on = went_on.frequency_hz[went_on.t >= seconds_since(stamps[parts[5]], stamps[0])]
+    restarted = offline(stamps[parts[5] : parts[6]], values[parts[5] : parts[6]], five, stamps[0])
+    assert p.frequencies()[before:] == went_on.tolist() != restarted.frequency_hz.tolist()
 
 
 def test_sigint_shuts_down_cleanly(ros_context):
