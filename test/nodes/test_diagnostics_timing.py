@@ -117,7 +117,7 @@ def test_a_burst_of_self_tests_holds_neither_diagnostics_nor_input_nor_other_cal
     # tones, a configuration not tested yet)
     release = threading.Event()
     runs, expired = [], []
-    real = S.self_test
+    real = S.in_process  # (the tones' own process)
 
     def held(*args):
         runs.append(args)
@@ -125,7 +125,7 @@ def test_a_burst_of_self_tests_holds_neither_diagnostics_nor_input_nor_other_cal
             expired.append(args)
         return real(*args)
 
-    monkeypatch.setattr(S, 'self_test', held)
+    monkeypatch.setattr(S, 'in_process', held)
     p = make_probe(excitation='ambient')
     clients = p.trigger_clients()
     # input first: the tones are made for its rate (a rate measured meanwhile is another run)

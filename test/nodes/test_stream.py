@@ -5,6 +5,7 @@ replacement, counters, status (the reset service: test_estimator_node.py)."""
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -134,17 +135,32 @@ def test_a_burst_of_self_tests_runs_the_tones_once(monkeypatch):
     from vib_estimator.nodes import stream as stream_module
 
     runs = []
-    real = stream_module.self_test
+    real = stream_module.in_process
     monkeypatch.setattr(
         stream_module,
-        'self_test',
-        lambda config, rate, create: runs.append((config, rate)) or real(config, rate, create),
+        'in_process',
+        lambda config, rate: runs.append((config, rate)) or real(config, rate),
     )
     s = stream_module.EstimatorStream(EstimatorConfig(), 0.0)
     answers = [s.self_test() for _ in range(50)]
     assert len(runs) == 1 and answers[0][0] and len(set(answers)) == 1
     s.configure(EstimatorConfig(window=5))
     assert s.self_test()[0] and len(runs) == 2
+
+
+def test_the_self_test_runs_in_a_process_of_its_own_or_here_said(monkeypatch):
+    """The tones run in a child Python process (their records and estimators never in the
+    node's memory): the same answer as in this process, the configuration's tuples carried
+    over; with no child process (here: no Python where the node's was), here, and the
+    answer says so."""
+    from vib_estimator.nodes import self_test as self_test_module
+
+    config = EstimatorConfig(min_periods=2.0, lines_hz=(50.0, 100.0))
+    assert self_test_module.in_process(config, 400.0) == self_test_module.self_test(config, 400.0)
+    monkeypatch.setattr(sys, 'executable', '/nonexistent/python')
+    assert self_test_module.in_process(config, 400.0) is None
+    ok, text = EstimatorStream(config, 0.0).self_test()
+    assert ok and text.endswith('(run in the node: no process of its own)')
 
 
 # ---- several channels (the node's components) ---------------------------------------------------

@@ -8,13 +8,18 @@ ambient or auto a white-noise-driven mode at each tone, over three identifier wi
 reports the median error of each tone's estimates. The tones sit across the configured
 ``band_hz`` (geometrically at 1/4, 1/2 and 3/4 of it), or, without a band, across
 :func:`default_band` of the sampling rate. The node answers its ``~/self_test`` service with
-it, off the data path: the live estimator is not touched. (ArduPilot's GyroFFT has the same
-kind of check.)
+it, off the data path: the live estimator is not touched, in a Python process of its own
+(:func:`in_process`; ``python -m vib_estimator.nodes.self_test CONFIG_JSON``), so that its
+records and estimators never weigh on the node's memory. (ArduPilot's GyroFFT has the same kind
+of check.)
 """
 
 from __future__ import annotations
 
+import json
 import math
+import subprocess
+import sys
 from dataclasses import dataclass
 from typing import Any, Callable, List, Optional, Tuple
 
@@ -40,6 +45,8 @@ SEED = 0
 #: a pure sine, undamped, is no mode it confirms)
 AMBIENT_ZETA = 0.01
 AMBIENT_WINDOWS = 3.0
+#: the longest a self-test's own process may take, s (the identifier's three tones: 2-4 s)
+PROCESS_TIMEOUT_S = 600.0
 
 
 @dataclass(frozen=True)
@@ -144,3 +151,42 @@ def self_test(
             f'{rate / 2:.6g} Hz)'
         )
     return ok, '\n'.join([head] + [r.describe() for r in results])
+
+
+def in_process(
+    config: EstimatorConfig, sample_rate_hz: Optional[float] = None
+) -> Optional[Tuple[bool, str]]:
+    """:func:`self_test` in a child Python process (this module run with ``-m``, the
+    configuration and the rate as JSON; its own session, so a terminal's Ctrl-C meant for the
+    node does not reach it): the tones' records, their estimators and what the C heap keeps of
+    them stay out of the caller's memory (the node kept 12 MB after its first self-test under
+    the identifier, docs/soak.md). None when the process could not run or answer (the caller
+    then runs :func:`self_test` itself)."""
+    fields = {name: getattr(config, name) for name in EstimatorConfig.names()}
+    request = json.dumps({'config': fields, 'rate': sample_rate_hz})
+    try:
+        done = subprocess.run(
+            [sys.executable, '-m', 'vib_estimator.nodes.self_test', request],
+            capture_output=True,
+            text=True,
+            timeout=PROCESS_TIMEOUT_S,
+            start_new_session=True,
+        )
+        answer = json.loads(done.stdout.strip().splitlines()[-1])
+        return bool(answer['ok']), str(answer['text'])
+    except (OSError, subprocess.SubprocessError, ValueError, KeyError, IndexError):
+        return None
+
+
+def main(argv: Optional[List[str]] = None) -> int:
+    """``python -m vib_estimator.nodes.self_test CONFIG_JSON``: :func:`in_process`'s child;
+    prints ``{"ok": ..., "text": ...}``."""
+    request = json.loads((sys.argv[1:] if argv is None else argv)[0])
+    fields = {k: tuple(v) if isinstance(v, list) else v for k, v in request['config'].items()}
+    ok, text = self_test(EstimatorConfig(**fields), request['rate'])
+    print(json.dumps({'ok': ok, 'text': text}))
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
