@@ -216,24 +216,37 @@ def several(freqs, amps, zetas, seconds=10.0, fs=1000.0, clip=None, seed=0):
 
 
 @pytest.mark.parametrize('factor', [1e-3, 1e3])
-@pytest.mark.parametrize('name', ['MODE_SHARE', 'MODE_GAP', 'HARMONIC_TOL', 'TRACKED_MODES'])
+@pytest.mark.parametrize(
+    'name', ['MODE_SHARE', 'MODE_GAP', 'HARMONIC_TOL', 'TRACKED_MODES', 'RING_DB', 'RING_FLOOR_DB']
+)
 def test_a_free_decay_of_several_modes_goes_to_the_mode_tracker(monkeypatch, name, factor):
-    """Two modes 30 % apart and 8/21 Hz at 1:0.3: the tracker; one mode, a heavily clipped one
-    (harmonics) and the simulated arm's three tip masses (a mode that moved, and its moves'
-    peaks): one estimator. Each constant at 0.001x and 1000x breaks one of them."""
+    """Two modes 30 % apart (also so lightly damped that the second falls by 2 dB only), 8/21 Hz
+    at 1:0.3 and 5/17.3 Hz at 1:0.05 (the second holds 0.1 % of the power, under MODE_SHARE, and
+    rings freely: 54 dB above its surroundings, falling by 18 dB): the tracker; one mode, a
+    heavily clipped one (harmonics), a heavily damped one at 300 Hz (its leakage's and the noise's
+    peaks fall with it, 4-9 dB above their surroundings), one beside a weak line fading by 20 %
+    (2 dB) and the simulated arm's three tip masses (a mode that moved, and its moves' peaks): one
+    estimator. Each constant at 0.001x and 1000x breaks one of them."""
     from vib_estimator.sim import arm_model
 
     pair = several((10.0, 13.0), (1.0, 0.5), (0.003, 0.003))
+    light = several((10.0, 13.0), (1.0, 0.5), (0.0003, 0.0003))
     wide = several((8.0, 21.0), (1.0, 0.3), (0.003, 0.002))
+    weak = several((5.0, 17.3), (1.0, 0.05), (0.004, 0.002))
     one = several((12.03,), (1.0,), (0.003,))
     clipped = several((12.03,), (1.0,), (0.003,), clip=0.2)
+    damped = several((12.03,), (1.0,), (0.05,), fs=300.0)
+    t, y = several((5.0,), (1.0,), (0.004,))
+    lined = (t, y + 0.03 * (1 - 0.2 * t / t[-1]) * np.sin(2 * np.pi * 23.1 * t))
     arm = arm_model.experiment_5_5(0)
 
     def right():
         try:
             return (
                 decide(*pair).modes == decide(*wide).modes == 3
+                and decide(*light).modes == decide(*weak).modes == 3
                 and decide(*one).modes == decide(*clipped).modes == 0
+                and decide(*damped).modes == decide(*lined).modes == 0
                 and decide(arm.t, arm.torque).modes == 0
                 and 'separate modes (10, 13 Hz)' in decide(*pair).reason
             )

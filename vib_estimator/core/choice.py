@@ -21,8 +21,10 @@ first :data:`DECIDE_S` seconds of the record (all channels):
    above :data:`DRIVEN_ABOVE`: ``ambient`` (output-only identification); between, one channel:
    ``auto`` (per stretch), several: the larger share's (the joint estimators take free or
    ambient).
-3. **Several modes** in a free decay: peaks that are modes of their own (:func:`separate_modes`)
-   send it to the mode tracker (``modes`` :data:`TRACKED_MODES`), each mode numbered.
+3. **Several modes** in a free decay: peaks that are modes of their own (:func:`separate_modes`:
+   holding :data:`MODE_SHARE` of the strongest's power, or weaker and ringing freely,
+   :func:`rings_freely`) send it to the mode tracker (``modes`` :data:`TRACKED_MODES`), each
+   mode numbered.
 4. **The window** of a driven record: :data:`WINDOW_PERIODS` periods of the fundamental
    (about 15 correlation times ``1 / (2 pi zeta f)`` of a mode at zeta = 2 %: the frequency of a
    lightly damped mode scatters by more than 2 % across windows of a few correlation times, and
@@ -92,6 +94,16 @@ TRACKED_MODES = 3
 #: ... a separate mode: a peak holding at least this share of the strongest's power (the
 #: simulated arm's moves leave peaks of 1-3 %, a second mode at 30 % amplitude 4-16 %)
 MODE_SHARE = 0.02
+#: ... or a weaker peak that rings freely (:func:`rings_freely`): standing at least this many dB
+#: above its surroundings (the 17.3 Hz mode of a 5 / 17.3 Hz decay at 1:20, 0.11 % of the power:
+#: 36-41 dB; a 97 Hz mode at 1 %: 46-47 dB; the noise's chance peaks in decays of one mode at
+#: 15-45 dB: at most 13 dB, a damped decay's leakage 2-8 dB, the simulated arm's moves' peaks
+#: 1-7 dB) ...
+RING_FLOOR_DB = 25.0
+#: ... and its band-passed response decaying by at least this many dB from its most energetic
+#: block (the 17.3 Hz mode: 16-19 dB over 10 s; the arm's moves' 2.3-2.4 Hz peaks, bursts at
+#: each move: 2-5 dB; a line: none)
+RING_DB = 10.0
 #: ... at least this far (relative) from every stronger mode (the arm's three tip masses'
 #: 1.33 / 1.56 Hz, 17 %, are one mode that moved)
 MODE_GAP = 0.25
@@ -302,24 +314,32 @@ def driven_share(t: np.ndarray, signal: np.ndarray, dominant_hz: float) -> float
     return float(np.sum(energy[driven])) / total if total > 0 else 0.0
 
 
-def peak_kurtosis(t: np.ndarray, signal: np.ndarray, peaks) -> tuple[np.ndarray, np.ndarray]:
-    """``(kurtosis, frequency)`` of ``signal`` band-passed (ideally, by FFT) within
-    :data:`LINE_BAND` of each of ``peaks`` (Hz), the record's ends (a twentieth each) left out --
-    1.5 for a sinusoid of steady amplitude, 3 for a mode driven by noise (:data:`LINE_KURTOSIS`)
-    -- and the band's centre: the record's strongest FFT bin (interpolated) within the Welch
-    peak's (whose resolution, 1 / :data:`SEGMENT_S`, is too coarse to tell a harmonic)."""
+def band_responses(t: np.ndarray, signal: np.ndarray, peaks):
+    """``(centre, response)`` for each of ``peaks`` (Hz): ``signal`` band-passed (ideally, by FFT)
+    within :data:`LINE_BAND` of the centre, the record's strongest FFT bin (interpolated) within
+    the Welch peak's (whose resolution, 1 / :data:`SEGMENT_S`, is too coarse to tell a
+    harmonic)."""
     n = len(signal)
     size = 1 << max(n - 1, 1).bit_length()  # a power of two: the FFT's fast length
     fs = (n - 1) / float(t[-1] - t[0])
     spec = np.fft.rfft(signal - np.mean(signal), size)
     freq = np.fft.rfftfreq(size, 1.0 / fs)
-    edge = n // 20
-    kurtosis, where = [], []
     magnitude = np.abs(spec)
     for f in peaks:
         f = strongest_bin(freq, magnitude * (np.abs(freq - f) <= 1.0 / SEGMENT_S))  # Welch's bin
         band = np.abs(freq - f) <= LINE_BAND * f  # (none at 0 Hz)
-        x = np.fft.irfft(np.where(band, spec, 0), size)[edge : n - edge]
+        yield f, np.fft.irfft(np.where(band, spec, 0), size)[:n]
+
+
+def peak_kurtosis(t: np.ndarray, signal: np.ndarray, peaks) -> tuple[np.ndarray, np.ndarray]:
+    """``(kurtosis, frequency)`` of ``signal`` band-passed around each of ``peaks`` (Hz,
+    :func:`band_responses`), the record's ends (a twentieth each) left out -- 1.5 for a sinusoid
+    of steady amplitude, 3 for a mode driven by noise (:data:`LINE_KURTOSIS`) -- and the band's
+    centre."""
+    edge = len(signal) // 20
+    kurtosis, where = [], []
+    for f, x in band_responses(t, signal, peaks):
+        x = x[edge : len(signal) - edge]
         power = float(np.mean(x * x))
         kurtosis.append(float(np.mean(x**4)) / power**2 if power > 0 else math.nan)
         where.append(f)
@@ -487,7 +507,8 @@ def decide(
             f'; window {window:.0f} s ({window * fundamental:.0f} periods of {fundamental:.3g} Hz)'
         )
     modes = 0
-    separate = separate_modes(peaks[~is_line], powers[~is_line])
+    rings = (lambda f: rings_freely(t, signal, f, spec)) if excitation == 'free' else None
+    separate = separate_modes(peaks[~is_line], powers[~is_line], rings)
     if excitation == 'free' and len(separate) > 1:
         modes = TRACKED_MODES
         seen += (
@@ -556,6 +577,30 @@ def decay_zeta(t: np.ndarray, y: np.ndarray, f: float) -> float:
     centres = (np.arange(peak + 1, k) + 0.5) * block_s
     slope = np.polyfit(centres, np.log(energy[peak + 1 : k] - floor), 1)[0]
     return float(-slope / 2 / (2 * math.pi * f))
+
+
+def rings_freely(t: np.ndarray, signal: np.ndarray, f: float, spec) -> bool:
+    """Whether the spectral peak at ``f`` Hz is a mode ringing freely: it stands
+    :data:`RING_FLOOR_DB` above its surroundings (the median of the spectrum ``spec``,
+    :func:`spectrum`, within :data:`MODE_GAP` of it) and the energy of ``signal`` band-passed
+    around it (:func:`band_responses`), in blocks of :data:`DECAY_BLOCK_PERIODS` periods
+    (:func:`decay_blocks`), falls from its most energetic block to the record's end by at least
+    :data:`RING_DB` along its least-squares line (in dB) -- not the noise's chance peaks nor a
+    decay's own leakage (a few dB over their surroundings), a move's broadband content (a
+    band-passed burst that comes and goes) nor a line (steady)."""
+    freq, psd, _ = spec
+    near = np.abs(freq / f - 1) <= MODE_GAP
+    at, floor = psd[np.argmin(np.abs(freq - f))], np.median(psd[near])
+    if not 10 * math.log10(max(at, 1e-300) / max(floor, 1e-300)) >= RING_FLOOR_DB:
+        return False
+    _, x = next(band_responses(t, signal, [f]))
+    energy = decay_blocks(t, x, f)[0].var(axis=1)
+    peak = int(np.argmax(energy)) if len(energy) else 0
+    if len(energy) - peak < 4 or not energy[peak] > 0:
+        return False
+    level = 10 * np.log10(np.maximum(energy[peak:], 1e-300 * energy[peak]))
+    slope = np.polyfit(np.arange(len(level)), level, 1)[0]
+    return -slope * (len(level) - 1) >= RING_DB
 
 
 def block_noise(blocks: np.ndarray) -> float:
@@ -663,16 +708,19 @@ def window_advice(window_s: float, d: Optional[Decision], option: str) -> str:
     )
 
 
-def separate_modes(peaks: np.ndarray, powers: np.ndarray) -> list[float]:
+def separate_modes(peaks: np.ndarray, powers: np.ndarray, rings=None) -> list[float]:
     """The spectral peaks (strongest first) that are modes of their own: at least
-    :data:`MODE_SHARE` of the strongest's power, :data:`MODE_GAP` (relative) from every stronger
-    one kept, and no harmonic (within :data:`HARMONIC_TOL`) of one (a clipped or non-sinusoidal
-    response)."""
+    :data:`MODE_SHARE` of the strongest's power -- or, weaker, ringing freely (``rings``: a
+    function of the frequency, :func:`rings_freely`; None: none does) --, :data:`MODE_GAP`
+    (relative) from every stronger one kept, and no harmonic (within :data:`HARMONIC_TOL`) of one
+    (a clipped or non-sinusoidal response)."""
     kept: list[float] = []
     for f, p in zip(peaks.tolist(), powers.tolist()):
-        if p < MODE_SHARE * powers[0] or any(abs(f / k - 1) < MODE_GAP for k in kept):
+        if any(abs(f / k - 1) < MODE_GAP for k in kept):
             continue
         if any(abs(f / (k * n) - 1) < HARMONIC_TOL for k in kept for n in range(2, 8)):
+            continue
+        if p < MODE_SHARE * powers[0] and (rings is None or not rings(f)):
             continue
         kept.append(f)
     return kept

@@ -38,7 +38,10 @@ How the modes are found and estimated (everything compiled, one call per sample)
   within ``DUPLICATE_TOL`` of a mode (``rejected_unresolved``); a candidate seen again within
   ``PENDING_TOL`` by a later analysis becomes a mode (``modes_found``), one not seen again within
   a period is ``rejected_noise``. With K modes a new one replaces the weakest only if twice as
-  strong. A mode no analysis sees for ``LOSE_PERIODS`` periods is lost (``modes_lost``).
+  strong. A mode no analysis sees for ``LOSE_PERIODS`` periods is lost (``modes_lost``), and so
+  is one that published its first estimate only and nothing in ``LOSE_PERIODS`` of its periods
+  since (a merged pole of the first short windows after an excitation, which hid the mode near
+  it, as unresolved, or at twice it, as a harmonic).
 * **Publishing**: each mode publishes from one scale, the longest window that (a) holds no more
   than ``C_CAP`` periods of the lowest mode (``C_CAP_CLOSE`` when two modes lie within
   ``CLOSE_RATIO``: resolving them takes longer windows, which react later to a change), (b) keeps
@@ -130,7 +133,7 @@ SUSPECT_RATIO = 3.0
 SUSPECT_CYCLES = 5.0  # ... is a harmonic unless seen over this many cycles
 CONSISTENCY = 0.01  # a published pole lies this close to the mode's previous pole,
 CONSISTENCY_FIRST = 0.03  # ... a close pair's first one (undamped refinement) this close
-LOSE_PERIODS = 3.0  # a mode unseen for this many of its periods is lost
+LOSE_PERIODS = 3.0  # a mode unseen (or published once and since not) this many periods is lost
 C_FAST = 1.0  # a mode's fast scale: the longest window of at most this many periods of the
 #: lowest mode (and C_TRACK of its own); it publishes from it once the RMS of its poles' relative
 #: deviations from the publishing window's (a running mean over DEV_N analyses) is DEV_MAX or less
@@ -629,7 +632,10 @@ def _analysis(b, ic, sl, pd, qs, lams, pa, s, t, out):
     ic[I_BUSY : I_BUSY + NS] = 0
     fmin, cap = _cap(sl)
     for k in range(KMAX):
-        if sl[k, SL_ACTIVE] != 0.0 and (t - sl[k, SL_SEEN]) * sl[k, SL_F] > LOSE_PERIODS:
+        if sl[k, SL_ACTIVE] != 0.0 and (
+            (t - sl[k, SL_SEEN]) * sl[k, SL_F] > LOSE_PERIODS
+            or (sl[k, SL_EST] == 1.0 and (t - sl[k, SL_LAST_T]) * sl[k, SL_F] > LOSE_PERIODS)
+        ):
             _remove(ic, sl, k)
         elif sl[k, SL_ACTIVE] != 0.0:
             for o in _owner(b, sl, k, t, fmin, _mode_cap(sl, k, cap)):
