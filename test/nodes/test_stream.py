@@ -148,6 +148,19 @@ def test_a_burst_of_self_tests_runs_the_tones_once(monkeypatch):
     assert s.self_test()[0] and len(runs) == 2
 
 
+def test_a_band_s_self_test_lasts_for_its_prefilter():
+    """With ``band_hz``, each tone lasts 10 periods of the band's lower edge too: the 2-20 Hz
+    band's 11.25 Hz tone (10 of its periods, 0.89 s) gave no estimate and the self-test failed,
+    the band-filtered estimator's first estimate coming after its prefilter settled."""
+    from vib_estimator.nodes.self_test import run_tone, self_test
+
+    config = EstimatorConfig(band_hz=(2.0, 20.0))
+    ok, text = self_test(config, 500.0)
+    assert ok, text
+    assert run_tone(config, 11.25, 500.0).estimates >= 20
+    assert run_tone(config.replace(band_hz=(0.5, 20.0)), 11.25, 500.0).estimates >= 100
+
+
 def test_the_self_test_runs_in_a_process_of_its_own_or_here_said(monkeypatch):
     """The tones run in a child Python process (their records and estimators never in the
     node's memory): the same answer as in this process, the configuration's tuples carried

@@ -35,7 +35,9 @@ DEFAULT_RATE_HZ = 500.0
 SNR_DB = 40.0
 #: a tone passes when the median of its estimates is within this relative error
 TOLERANCE = 0.01
-#: each tone lasts this many of its periods (more when min_periods asks for longer segments)
+#: each tone lasts this many of its periods (more when min_periods asks for longer segments),
+#: and with ``band_hz`` this many periods of its lower edge (the prefilter's settling: a 11.25 Hz
+#: tone of 10 periods through a 2-20 Hz band gave no estimate, and the self-test failed)
 PERIODS = 10.0
 #: at most this many samples per tone
 MAX_SAMPLES = 200_000
@@ -116,8 +118,10 @@ def run_tone(
         mode = [(frequency_hz, AMBIENT_ZETA, amplitude**2 / 2)]
         t, y, _ = ambient_record(seconds, sample_rate_hz, mode, SNR_DB, seed)
     else:
-        periods = max(PERIODS, 4 * (config.min_periods + 1))
-        n = min(MAX_SAMPLES, int(math.ceil(periods * sample_rate_hz / frequency_hz)))
+        seconds = max(PERIODS, 4 * (config.min_periods + 1)) / frequency_hz
+        if config.band_hz is not None:  # and the band's prefilter settles: periods of its edge
+            seconds = max(seconds, PERIODS / config.band_hz[0])
+        n = min(MAX_SAMPLES, int(math.ceil(seconds * sample_rate_hz)))
         rng = np.random.default_rng(seed)
         t = np.arange(n) / sample_rate_hz
         y = amplitude * np.sin(2 * np.pi * frequency_hz * t + rng.uniform(0, 2 * np.pi))
