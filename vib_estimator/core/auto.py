@@ -697,7 +697,7 @@ class AutoEstimator(Estimator):
             parts.append(self._process_run(t[: back[0]], y[: back[0]]))
             t, y = t[back[0] :], y[back[0] :]
         parts.append(self._process_run(t, y))
-        return parts[0] if len(parts) == 1 else EstimateArrays.concatenate(parts, False)
+        return parts[0] if len(parts) == 1 else EstimateArrays.concatenate(parts, by_time=False)
 
     def _process_run(self, t: np.ndarray, y: np.ndarray) -> EstimateArrays:
         """:meth:`process` of a batch whose stamps do not jump back beyond ``max_gap``."""
