@@ -625,16 +625,15 @@ class AutoEstimator(Estimator):
         self._free.reset()
         self._ambient.reset()
 
-    def _jumped_back(self, t: float) -> None:
-        """When a sample of stamp ``t`` jumps back beyond ``max_gap`` from the last kept (a
-        source restarted, a bag looping), the envelope, the free-decay test's samples and the
-        known modes start afresh, as the two estimators do by themselves
+    def _jumped_back(self) -> None:
+        """A sample's stamp jumped back beyond ``max_gap`` from the last kept (a source
+        restarted, a bag looping): the envelope, the free-decay test's samples and the known
+        modes start afresh, as the two estimators do by themselves
         (:func:`~.estimator.accept_sample`): else the envelope skipped every sample until the
         stamps passed the old ones (a restarted simulator: nothing published for minutes)."""
-        if self._envelope.last - t > self._config.max_gap:
-            self._envelope.restart()
-            self._modes.clear()
-            self._filled = 0
+        self._envelope.restart()
+        self._modes.clear()
+        self._filled = 0
 
     # ---- streaming ----------------------------------------------------------------------------
     def _remember(self, t: float, y: float) -> None:
@@ -661,9 +660,11 @@ class AutoEstimator(Estimator):
 
     def update(self, t: float, y: float) -> list[Estimate]:
         """Feed one sample; the estimates it completes that belong to the current stretch."""
-        self._jumped_back(float(t))
-        self._envelope.update(float(t), float(y))
-        self._remember(float(t), float(y))
+        tf, yf = float(t), float(y)
+        if self._envelope.last - tf > self._config.max_gap:
+            self._jumped_back()
+        self._envelope.update(tf, yf)
+        self._remember(tf, yf)
         free = self._free.update(t, y)
         self._ambient.idle = self._envelope.state == FREE
         ambient = self._ambient.update(t, y)
@@ -690,7 +691,7 @@ class AutoEstimator(Estimator):
             ahead = np.maximum.accumulate(np.concatenate(([last], finite)))[:-1]
             back = np.flatnonzero(ahead - t > self._config.max_gap)
             if len(back) and back[0] == 0:
-                self._jumped_back(float(t[0]))
+                self._jumped_back()
                 continue
             if not len(back):
                 break
