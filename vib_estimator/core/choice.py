@@ -44,7 +44,7 @@ Each decision carries its reasons in words (:attr:`Decision.reason`), which ``an
 A stream cannot be seen ahead: :class:`DrivenWatch` keeps the same envelope over
 ``estimator_node``'s input and tells, over the last :data:`WATCH_S` s, when a free-decay
 estimator is fed a response driven throughout (its ``/diagnostics`` then say so, and which
-``excitation`` helps).
+``excitation`` helps), or, for the node's own decision, driven now and in part of them.
 """
 
 from __future__ import annotations

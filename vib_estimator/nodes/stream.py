@@ -166,7 +166,7 @@ class EstimatorStream:
         #: seconds the last warm-up took (None before one ended), samples held when it ended
         self.warmup_seconds: Optional[float] = None
         self.warmup_held = 0
-        #: whether the input looks driven throughout, and what it needs (core.choice.StreamChoice)
+        #: whether the input looks driven, and what it needs (core.choice.StreamChoice)
         self._choice = StreamChoice(max(1, len(self.channels)))
         #: the excitation was last set by :meth:`decision` (not by the user)
         self.decided = False
@@ -433,7 +433,8 @@ class EstimatorStream:
     def decision(self) -> Optional[Decision]:
         """What the input needs now, if not what runs (``decide_excitation``; after
         :meth:`status`, which watches the input): from ``free``, once the input looks driven
-        throughout, analyze's decision over its last seconds (excitation and ambient window), or
+        (now, and for over :data:`~vib_estimator.core.choice.FREE_BELOW` of its last seconds'
+        energy), analyze's decision over those seconds (excitation and ambient window), or
         when its estimator stays silent on a ringing input or a decay's modes ring on, a decay
         of several modes (``modes``);
         from an ``ambient`` decided so, ``auto`` once it looks free again
