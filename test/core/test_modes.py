@@ -337,13 +337,16 @@ def test_a_weak_mode_near_a_multiple_of_a_strong_one_is_found_early():
     assert np.median(first) < 0.13, first
 
 
-@pytest.mark.parametrize('seed', [0, 3, 4])
-def test_a_merged_pole_published_once_is_lost_and_frees_the_mode_it_hid(seed):
-    """6 / 9 / 14 Hz at 1 : 0.5 : 0.2 (35 dB for the weakest): on these seeds the first short
-    windows after the excitation publish a merged pole (6.94 Hz: 14 Hz is its "harmonic"; 13.2 Hz:
-    14 Hz lies within DUPLICATE_TOL of it) once, and nothing after it. Unpublished for
-    LOSE_PERIODS of its periods it is lost, and 14 Hz is found within 5.5 periods of 6 Hz (while
-    it stayed: 7.5-9.5), the others as before (at most 2.2)."""
+@pytest.mark.parametrize('seed', [0, 1, 2, 3, 4])
+def test_a_merged_pole_gives_way_to_the_modes_it_hid(seed):
+    """6 / 9 / 14 Hz at 1 : 0.5 : 0.2 (35 dB for the weakest): the first short windows after the
+    excitation read merged poles (6.9 Hz: 14 Hz is its "harmonic"; 13.1-13.4 Hz: 14 Hz lies within
+    DUPLICATE_TOL of it). One published once, or not yet, is lost as soon as a window as long
+    sees poles on both sides of it and not it (``_unresolved``: seeds 0 and 3 fail without it);
+    one not yet published claims the poles within DUPLICATE_TOL (seed 1 fails without it: the
+    mode drifted to 15.1 Hz with the short windows' noisy poles and blocked 14.0 Hz as
+    unresolved). 14 Hz is found within 3.5 periods of 6 Hz (before these rules: 4.87-5.15 on
+    seeds 0-3), the others as before (at most 2.2)."""
     t = np.arange(0, 4, 1 / FS)
     tt = np.maximum(t - 1.0, 0.0)
     rng = np.random.default_rng(seed)
@@ -352,9 +355,7 @@ def test_a_merged_pole_published_once_is_lost_and_frees_the_mode_it_hid(seed):
         w = 2 * np.pi * f
         y += a * np.exp(-z * w * tt) * np.sin(w * np.sqrt(1 - z * z) * tt + rng.uniform(0, 6.28))
     y = y * (t >= 1.0) + 0.2 / math.sqrt(2) * 10**-1.75 * rng.standard_normal(len(t))
-    tr = ModeTracker(EstimatorConfig(modes=3))
-    e = tr.process(t, y)
-    for f, most in ((6.0, 2.2), (9.0, 2.2), (14.0, 5.5)):
+    e = ModeTracker(EstimatorConfig(modes=3)).process(t, y)
+    for f, most in ((6.0, 2.2), (9.0, 2.2), (14.0, 3.5)):
         ok = np.abs(e.frequency_hz / f - 1) < 0.02
-        assert (e.t[ok][0] - 1.0) * 6.0 <= most
-    assert tr.counters['modes_lost'] >= 1
+        assert (e.t[ok][0] - 1.0) * 6.0 <= most, f'{f} Hz'

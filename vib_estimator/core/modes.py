@@ -40,8 +40,11 @@ How the modes are found and estimated (everything compiled, one call per sample)
   a period is ``rejected_noise``. With K modes a new one replaces the weakest only if twice as
   strong. A mode no analysis sees for ``LOSE_PERIODS`` periods is lost (``modes_lost``), and so
   is one that published its first estimate only and nothing in ``LOSE_PERIODS`` of its periods
-  since (a merged pole of the first short windows after an excitation, which hid the mode near
-  it, as unresolved, or at twice it, as a harmonic).
+  since, or that, published once at most, a window as long as its estimate's does not see while
+  it sees poles within ``CLOSE_RATIO`` on both sides (:func:`_unresolved`): a merged pole of the
+  first short windows after an excitation, which would hide the mode near it, as unresolved, or
+  at twice it, as a harmonic. A mode not yet published matches poles within ``DUPLICATE_TOL``
+  (the poles it would reject as unresolved), published ones within ``MATCH_TOL``.
 * **Publishing**: each mode publishes from one scale, the longest window that (a) holds no more
   than ``C_CAP`` periods of the lowest mode (``C_CAP_CLOSE`` when two modes lie within
   ``CLOSE_RATIO``: resolving them takes longer windows, which react later to a change), (b) keeps
@@ -216,8 +219,9 @@ FINDER_COUNTERS = {
     SL_REF,
     SL_DEV,
     SL_NDEV,
+    SL_WIN,
     N_SL,
-) = range(18)  # N_*: the slots' number
+) = range(19)  # N_*: the slots' number
 #: per-mode counters: name -> column of sl (and, for the lost modes' sums, of ic after I_RET)
 MODE_COUNTERS = {
     'estimates': SL_EST,
@@ -451,6 +455,33 @@ def _publisher(b, sl, pa, k, t, fmin, cap):
 
 
 @jit
+def _unresolved(b, sl, pa, pp, n, k, s, t):
+    """Whether mode k, published once at most, is a merged pole that scale s's analysis at t
+    resolved: a pole of pp[:n] lies within ``CLOSE_RATIO`` below it and another within it above,
+    none is the mode's, and the window is no shorter than that of its estimate (``SL_WIN``, 0
+    before it), holds ``C_DETECT`` of its cycles and keeps it below ``NU_HI`` and in the band (the
+    first short windows after an excitation read 6 and 9 Hz as one 6.9 Hz pole; a longer one sees
+    6.0 and 9.0). Such a mode is lost at once, not ``LOSE_PERIODS`` later: meanwhile it would
+    hold a mode's place and hide its neighbours (as unresolved) or its double (as a harmonic)."""
+    f = sl[k, SL_F]
+    w = _scale_len(s)
+    if not (
+        sl[k, SL_EST] <= 1.0
+        and sl[k, SL_SEEN] < t
+        and w >= sl[k, SL_WIN]
+        and f * b[B_DT] * w >= C_DETECT
+        and f * b[B_DT] * (1 << (s // 2)) <= NU_HI
+        and pa[PA_BLO] <= f <= pa[PA_BHI]
+    ):
+        return False
+    below = above = False
+    for i in range(n):
+        below = below or (pp[i, 0] < f and f < CLOSE_RATIO * pp[i, 0])
+        above = above or (pp[i, 0] > f and pp[i, 0] < CLOSE_RATIO * f)
+    return below and above
+
+
+@jit
 def _remove(ic, sl, k):
     """Mode k is lost: its counters go to the lost modes' sums."""
     sl[k, SL_ACTIVE] = 0.0
@@ -484,6 +515,7 @@ def _publish(b, ic, sl, k, s, t, pp, i, r2, out):
     sl[k, SL_LAST_F] = f
     sl[k, SL_LAST_T] = t
     sl[k, SL_EST] += 1
+    sl[k, SL_WIN] = w
 
 
 @jit
@@ -588,10 +620,12 @@ def _analysis(b, ic, sl, pd, qs, lams, pa, s, t, out):
         if sl[k, SL_ACTIVE] == 0.0:
             continue
         best = -1
+        # an unpublished mode claims the poles it would reject as unresolved
+        tol = DUPLICATE_TOL if sl[k, SL_EST] == 0.0 else MATCH_TOL
         for i in range(n):
             if (
                 not used[i]
-                and abs(pp[i, 0] / sl[k, SL_F] - 1.0) < MATCH_TOL
+                and abs(pp[i, 0] / sl[k, SL_F] - 1.0) < tol
                 and (
                     best < 0
                     or abs(pp[i, 0] / sl[k, SL_F] - 1.0) < abs(pp[best, 0] / sl[k, SL_F] - 1.0)
@@ -635,6 +669,7 @@ def _analysis(b, ic, sl, pd, qs, lams, pa, s, t, out):
         if sl[k, SL_ACTIVE] != 0.0 and (
             (t - sl[k, SL_SEEN]) * sl[k, SL_F] > LOSE_PERIODS
             or (sl[k, SL_EST] == 1.0 and (t - sl[k, SL_LAST_T]) * sl[k, SL_F] > LOSE_PERIODS)
+            or _unresolved(b, sl, pa, pp, n, k, s, t)
         ):
             _remove(ic, sl, k)
         elif sl[k, SL_ACTIVE] != 0.0:
