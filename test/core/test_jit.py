@@ -53,3 +53,31 @@ def test_available_says_whether_a_call_would_compile_and_never_compiles():
     assert _twice(1.0) == 2.0
     assert available(_twice, (1.0,)) and not available(_twice, (np.zeros(2),))
     assert len(_twice.signatures) == 1
+
+
+# ---- NUMBA_DISABLE_JIT=1: numba's switch for debugging, the kernels as plain Python -------------
+def test_the_estimators_run_as_python_under_numba_disable_jit(tmp_path):
+    """A developer who sets numba's NUMBA_DISABLE_JIT=1 (to step through a kernel) gets the same
+    answer, not an AttributeError at import (njit then returns the plain function: no
+    ``py_func``, no ``compile``, ``borrowed`` unusable)."""
+    import os
+    import subprocess
+
+    t = np.arange(0.0, 4.0, 0.002)
+    y = np.exp(-0.05 * t) * np.sin(2 * np.pi * 3.0 * t) * (t >= 0.5)
+    y += 1e-3 * np.random.default_rng(0).standard_normal(len(t))
+    path = tmp_path / 'decay.csv'
+    np.savetxt(path, np.column_stack([t, y]), delimiter=',', header='t,y', comments='')
+    out = {}
+    for flag in ('0', '1'):
+        env = dict(os.environ, NUMBA_DISABLE_JIT=flag)
+        run = subprocess.run(
+            [sys.executable, '-m', 'vib_estimator.cli', 'analyze', str(path), '--format', 'jsonl'],
+            capture_output=True,
+            text=True,
+            env=env,
+            timeout=300,
+        )
+        assert run.returncode == 0, run.stderr[-2000:]
+        out[flag] = [line for line in run.stdout.splitlines() if line.startswith('{')]
+    assert out['0'] and out['1'] == out['0']

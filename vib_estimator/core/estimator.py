@@ -41,7 +41,7 @@ import numpy as np
 
 from . import kernel as K
 from .config import EstimatorConfig
-from .jit import available, entry, interpreted
+from .jit import available, entry, interpreted, python_of
 
 #: the input counters every estimator keeps (the first of the kernel's counter array, in order)
 INPUT_COUNTERS = (
@@ -438,7 +438,7 @@ class FrequencyEstimator(Estimator):
         """The parts derived from the buffer ``_f`` (not pickled): its views ``_p``, ``_row``,
         ``_s``, ``_seg`` (:func:`core.kernel.feed_buffer`'s layout) and the streaming path's
         compiled code, looked up at the first :meth:`update`."""
-        self._p, self._row, self._s, self._seg = K.feed_views.py_func(self._f, self._n_state)
+        self._p, self._row, self._s, self._seg = python_of(K.feed_views)(self._f, self._n_state)
         self._feed = None
 
     def kernels_available(self) -> bool:

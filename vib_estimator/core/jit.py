@@ -30,6 +30,7 @@ import sys
 from types import FunctionType, ModuleType, SimpleNamespace
 
 import numpy as np
+from numba import config as numba_config
 from numba import njit, typeof, types
 from numba.core import cgutils
 from numba.core.compiler_lock import global_compiler_lock
@@ -49,8 +50,8 @@ def jit(fn=None, **options):
     if fn is None:
         return lambda f: jit(f, **options)
     dispatcher = njit(cache=True, **options)(fn)
-    if options.get('inline', 'never') != 'never':
-        return dispatcher
+    if options.get('inline', 'never') != 'never' or not isinstance(dispatcher, Dispatcher):
+        return dispatcher  # (not a Dispatcher: numba's NUMBA_DISABLE_JIT=1, the plain function)
     template = dispatcher.get_call_template
 
     def get_call_template(args, kws):
@@ -68,7 +69,14 @@ def entry(dispatcher, args):
     ``typeof`` per argument, then the overload lookup); the returned function skips that and only
     unboxes them. For a per-sample call with many array arguments that is a third of its cost.
     """
+    if not isinstance(dispatcher, Dispatcher):
+        return dispatcher  # NUMBA_DISABLE_JIT=1
     return dispatcher.compile(tuple(typeof(a) for a in args))
+
+
+def python_of(fn):
+    """The plain Python function of a compiled one (itself under ``NUMBA_DISABLE_JIT=1``)."""
+    return getattr(fn, 'py_func', fn)
 
 
 def available(dispatcher, args) -> bool:
@@ -79,6 +87,8 @@ def available(dispatcher, args) -> bool:
     (:func:`vib_estimator.core.estimator.run_batch`): a short record's answer in a second, not
     after a compile of 20 s.
     """
+    if not isinstance(dispatcher, Dispatcher):
+        return True  # NUMBA_DISABLE_JIT=1: plain Python, nothing to compile
     sig = tuple(typeof(a) for a in args)
     with global_compiler_lock:
         if dispatcher.overloads.get(sig) is not None:
@@ -114,6 +124,10 @@ def borrowed(typingctx, array):
 def _identity(array):
     """:func:`borrowed` outside compiled code: the array itself."""
     return array
+
+
+if numba_config.DISABLE_JIT:  # numba's NUMBA_DISABLE_JIT=1: the kernels run as Python
+    borrowed = _identity  # noqa: F811
 
 
 #: ``math`` as compiled code has it: numba's ``math.hypot`` is the C library's (``np.hypot``),

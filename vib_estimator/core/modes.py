@@ -92,7 +92,7 @@ from .estimator import (
     Estimator,
     as_series,
 )
-from .jit import available, borrowed, jit
+from .jit import available, borrowed, jit, python_of
 from .kernel import BAND_DAMPING, advance, discretise
 from .subspace import (
     N_R,
@@ -853,7 +853,7 @@ class ModeTracker(Estimator):
             raise ValueError('ModeTracker needs modes >= 1 (FrequencyEstimator for modes = 0)')
         self._config = config
         self._fs = np.zeros(N_F)
-        self._b, self._sl, self._pd, self._lams, pa = _unpack.py_func(self._fs)
+        self._b, self._sl, self._pd, self._lams, pa = python_of(_unpack)(self._fs)
         self._ic = np.zeros(N_I, dtype=np.int64)
         self._qs = np.zeros((NS, NQ, PCOL))
         band = config.band_hz or (0.0, math.inf)
