@@ -75,7 +75,10 @@ def test_stale_ok_warn_and_the_rates():
     # the gate holds a segment back: WARN until the next estimate
     held = core(received=1501, used=1501, estimates=1, rejected_fit=1)
     s = h.status(4.0, h.totals(held), 3.0)
-    assert s.level == H.WARN and s.message == 'held back since the last estimate: rejected_fit 1'
+    assert s.level == H.WARN and s.message == (
+        'held back since the last estimate: rejected_fit 1 (the model fits the segment under '
+        'min_fit)'
+    )
     h.record(estimate(), 4.2, h.totals(held))
     assert h.status(5.0, h.totals({**held, 'received': 2000}), 4.0).level == H.OK
     # no input for more than STALE_AFTER
@@ -237,3 +240,20 @@ def test_the_identities_fail_when_a_sample_is_unaccounted():
     assert all(H.identities(c).values())
     assert not all(H.identities({**c, 'used': 7}).values())
     assert not all(H.identities({**c, 'missing_in_gaps': 2}).values())
+
+
+def test_each_held_back_counter_is_explained_with_a_parameter_of_the_node():
+    """The WARN of a held-back estimate says why in words and names the parameter that changes
+    it: each a parameter of ``estimator_node`` (config/estimator.yaml, the parameters' one
+    source), so the advice can be followed as written."""
+    import pathlib
+    import re
+
+    import yaml
+
+    config = pathlib.Path(__file__).resolve().parents[2] / 'config' / 'estimator.yaml'
+    params = set(yaml.safe_load(config.read_text())['/**']['ros__parameters'])
+    assert set(H.WHY_HELD) == set(H.HELD_BACK)
+    for name, why in H.WHY_HELD.items():
+        assert set(re.findall(r'\b[a-z_]+\b', why)) & params, (name, why)  # names one
+        assert set(re.findall(r'\b([a-z_]+):=', why)) <= params, (name, why)  # sets real ones

@@ -197,8 +197,8 @@ def explain_no_estimate(
         return (
             'every converged estimate was held back by the quality gate ('
             + ', '.join(f'{k}={v}' for k, v in held.items())
-            + '): check --min-fit, '
-            '--max-damping, --min-amplitude, or the model (--model)'
+            + '): check --min-fit, --max-damping, --min-amplitude, --consistency (0: off, '
+            'for a frequency that moves from one segment to the next), or the model (--model)'
         )
     text = 'the convergence test (Eqs. 16-17) never fired'
     if open_samples:

@@ -27,16 +27,25 @@ OK, WARN, ERROR, STALE = 0, 1, 2, 3
 DIAGNOSTICS_PERIOD = 1.0
 #: the status goes STALE when no input arrived for this long, s
 STALE_AFTER = 2.0
-#: core counters that grow when the quality gate holds a converged estimate back, or none forms
-HELD_BACK = (
-    'rejected_at_rest',
-    'rejected_fit',
-    'rejected_nyquist',
-    'rejected_damping',
-    'rejected_inconsistent',
-    'max_window_resets',
-    'not_free_decay',
-)
+#: core counters that grow when the quality gate holds a converged estimate back, or none forms,
+#: and why, in words, with the parameter that changes it (issue 37: counters alone are no
+#: explanation)
+WHY_HELD = {
+    'rejected_at_rest': 'no vibration above min_amplitude',
+    'rejected_fit': 'the model fits the segment under min_fit',
+    'rejected_nyquist': 'above half the sample rate: a faster sensor, or band_hz below it',
+    'rejected_damping': 'damped beyond max_damping: a transient',
+    'rejected_inconsistent': (
+        'each farther than consistency from the one before: a frequency that moves from one '
+        'segment to the next; consistency:=0.0 follows it'
+    ),
+    'max_window_resets': 'no convergence within max_window',
+    'not_free_decay': (
+        'the signal before each is no free decay, a driven response or an oscillation whose '
+        'phase wanders; decide_excitation:=false publishes them'
+    ),
+}
+HELD_BACK = tuple(WHY_HELD)
 #: counters of bad input: their growth since the previous status makes it WARN (and is logged
 #: once per episode): the core's (its short gaps, long ones and the samples they lost, outliers)
 #: and the stamps' cadence's (:mod:`.cadence`)
@@ -263,7 +272,7 @@ class Health:
         if any(held.values()):
             problems.append(
                 'held back since the last estimate: '
-                + ', '.join(f'{name} {n}' for name, n in held.items() if n)
+                + ', '.join(f'{name} {n} ({WHY_HELD[name]})' for name, n in held.items() if n)
             )
         if missing:
             problems.append(f'{missing} messages without the joint')
