@@ -410,12 +410,15 @@ def _mode_cap(sl, k, cap):
 @jit
 def _owner(b, sl, k, t, fmin, cap):
     """(the scale mode k publishes from (module docstring), the next longer one if only its start
-    keeps it from publishing: the owner soon), -1 for none; fmin, cap from :func:`_cap`."""
+    keeps it from publishing: the owner soon), -1 for none; fmin, cap from :func:`_cap`. The
+    shortest scale is under no cap: when the lowest mode lies above ``cap`` / ``M_A`` cycles per
+    sample (fs / 24 with ``C_CAP``: 97 Hz at 1 kHz, 25 Hz at 500 Hz) even its window holds more
+    periods of it, and the modes publish from there rather than not at all."""
     f = sl[k, SL_F]
     best = -1
     for s in range(NS):
         w = _scale_len(s) * b[B_DT]
-        if fmin * w > cap or f * b[B_DT] * (1 << (s // 2)) > NU_HI:
+        if (s > 0 and fmin * w > cap) or f * b[B_DT] * (1 << (s // 2)) > NU_HI:
             break
         if t - w < sl[k, SL_START]:
             return best, s
@@ -492,12 +495,9 @@ def _remove(ic, sl, k):
 
 @jit
 def _publish(b, ic, sl, k, s, t, pp, i, r2, out):
-    """One estimate of mode k (pole i of scale s's analysis at t) into the next row of out."""
+    """One estimate of mode k (pole i of scale s's analysis at t) into the next row of out (its
+    mode number: :func:`_number`, once the analysis has published all it publishes)."""
     f = pp[i, 0]
-    mode = 1
-    for j in range(KMAX):
-        if j != k and sl[j, SL_ACTIVE] != 0.0 and sl[j, SL_FIRST] < math.inf and sl[j, SL_F] < f:
-            mode += 1
     w = _scale_len(s)
     row = out[ic[I_NOUT]]
     ic[I_NOUT] += 1
@@ -510,12 +510,27 @@ def _publish(b, ic, sl, k, s, t, pp, i, r2, out):
     row[O_DAMP] = pp[i, 2]
     row[O_FSTD] = pp[i, 5]
     row[O_DSTD] = math.nan
-    row[O_MODE] = mode
+    row[O_MODE] = 0.0
     sl[k, SL_FIRST] = min(sl[k, SL_FIRST], t)
     sl[k, SL_LAST_F] = f
     sl[k, SL_LAST_T] = t
     sl[k, SL_EST] += 1
     sl[k, SL_WIN] = w
+
+
+@jit
+def _number(sl, out, first, last):
+    """The mode numbers of rows first..last-1 of out, published by one analysis: 1 + the active
+    modes that have published (this analysis included) at lower frequencies. Numbered after the
+    analysis, so that two modes' first estimates in one analysis (a higher one published before
+    the lower) do not both read 1."""
+    for r in range(first, last):
+        mode = 1
+        for j in range(KMAX):
+            published = sl[j, SL_ACTIVE] != 0.0 and sl[j, SL_FIRST] < math.inf
+            if published and sl[j, SL_F] < out[r, O_F]:
+                mode += 1
+        out[r, O_MODE] = mode
 
 
 @jit
@@ -736,7 +751,9 @@ def _feed(b, ic, sl, pd, qs, lams, pa, t, y, out):
         for half in range(2):
             hop = HOP if fast or ic[I_BUSY + 2 * d + half] else HOP_IDLE if d > 0 else HOP_TOP
             if n >= (M_A, M_B)[half] and (n + half * (HOP // 2)) % hop == 0:
+                first = ic[I_NOUT]
                 _analysis(b, ic, sl, pd, qs, lams, pa, 2 * d + half, t, out)
+                _number(sl, out, first, ic[I_NOUT])
 
 
 @jit(inline='always')
