@@ -585,8 +585,9 @@ class Counted:
 def test_a_free_stretch_that_passed_the_free_decay_test_is_trusted(monkeypatch, factor):
     """A free stretch whose estimates passed the free-decay test ``TRUSTED_PASSES`` times
     running (no onset, no block read driven between) is trusted: a 12 s pluck's ~40 estimates
-    take at most 4 tests (each ~1 ms: 4 us a sample at an estimate a period), while a driven
-    input's are all tested, none published before the decision."""
+    take at most 5 tests (each ~1 ms: 4 us a sample at an estimate a period; the first, from
+    the pluck's first period since the kernel restarts its segment there, too short to test),
+    while a driven input's are all tested, none published before the decision."""
     from vib_estimator.core import choice
     from vib_estimator.sim.ambient import ambient_record
 
@@ -596,7 +597,7 @@ def test_a_free_stretch_that_passed_the_free_decay_test_is_trusted(monkeypatch, 
         _, free, (tests, _) = counted.run(*plucked(((5.0, 1.0, 0.005),)))
         t, y, _ = ambient_record(50, 500, [(5.0, 0.01, 1.0)], 20, 0)
         _, driven, (shaken, _) = counted.run(t, y)
-        return 1 <= tests <= 4 and len(free) >= 5 and driven == [] and shaken >= 20
+        return 1 <= tests <= 5 and len(free) >= 5 and driven == [] and shaken >= 20
 
     assert right()
     monkeypatch.setattr(choice, 'TRUSTED_PASSES', round(choice.TRUSTED_PASSES * factor))

@@ -118,8 +118,9 @@ from .uncertainty import MODEL_BIASED, MODEL_DAMPED, MODEL_SINUSOID, TWO_PI
     C_MA_N,
     C_OUTLIER_RUN,
     C_SCALE_N,
+    C_ONSET,
     N_COUNTERS,
-) = range(23)
+) = range(24)
 
 # ---- state array layout (float64) -----------------------------------------------------------
 NH = 8  # samples in the interpolation stencil (degree-7 rule)
@@ -187,6 +188,13 @@ HRUN_WEIGHT = 1.0 / 16.0
 SCALE_WEIGHT = 1.0 / 1024.0
 SCALE_WARMUP = 64
 OUTLIER_RUN = 4
+#: a sample farther from the running centre than this many times the running peak of the
+#: deviation (``S_YR``: the last ~1000 samples) is an onset, a pluck after rest: the segment then
+#: running, begun in the rest before it, restarts at the sample before it (:func:`step`). Else
+#: that segment's integrals hold the rest and the pluck's first samples, and it converges only
+#: seconds later: a 10 Hz pluck after 1 s of noise gave its first estimate 12.9 periods after the
+#: pluck at 5 kHz and none at all at 300 Hz and below (bench_first_estimate.py --onset)
+ONSET_RATIO = 5.0
 #: a sample value beyond this magnitude is always an outlier (keeps every product of the moments,
 #: t^4 y, and every square of the fit finite)
 MAX_ABS_VALUE = 1e100
@@ -500,6 +508,8 @@ def _outlier(p, s, c, y):
         return False
     if c[C_SCALE_N] < SCALE_WARMUP:
         c[C_SCALE_N] += 1
+    elif dev > ONSET_RATIO * s[S_YR]:
+        c[C_ONSET] = 1  # taken by step
     s[S_YC] = yc + SCALE_WEIGHT * (y - yc)
     decayed = (1.0 - SCALE_WEIGHT) * s[S_YR]
     s[S_YR] = dev if dev > decayed else decayed
@@ -905,6 +915,10 @@ def step(p, s, c, seg, t, y, out, row, optional=None):
     if c[C_HIST_N] == 0:
         _first_sample(p, s, c, t, y)
         return 0
+    if c[C_ONSET] != 0:  # an onset (ONSET_RATIO): a segment from the sample before it
+        c[C_ONSET] = 0
+        if c[C_HIST_N] == NH:
+            reset_segment(s, c, seg, s[S_HT + NH - 1], s[S_HY + NH - 1])
     h = t - s[S_HT + NH - 1]  # the newest sample of the stencil is the previous one
     if abs(h - s[S_CACHE_H]) > 1e-9 * h:
         _update_discretisations(p, s, h)
