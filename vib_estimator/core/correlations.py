@@ -86,6 +86,14 @@ def lag_windows(ext: np.ndarray, lags: int) -> np.ndarray:
     return np.lib.stride_tricks.as_strided(ext, shape, (step, across, step), writeable=False)
 
 
+def summed(own: np.ndarray, view: np.ndarray) -> np.ndarray:
+    """``numpy.tensordot(own, view, axes=(0, 0))`` of rows ``own`` and a :func:`lag_windows`
+    ``view`` of as many rows: its own steps (one ``dot`` of ``own``'s transpose and the view's
+    rows as a matrix, the same floats) without its checks of the axes."""
+    m = own.shape[1]
+    return np.dot(own.T, view.reshape(len(own), -1)).reshape(m, m, view.shape[2])
+
+
 def lag_products(y, a, b, bound, off, sums, total, later=True, subtract=False) -> None:
     """Add to ``sums`` (lag k, channel i, channel j; k = 0 .. ``len(sums) - 1``) the products of
     the rows ``x = y - off`` that pair a row a <= t < b with another: ``later``, the products
@@ -102,14 +110,14 @@ def lag_products(y, a, b, bound, off, sums, total, later=True, subtract=False) -
             own = ext[lags:]
             view = lag_windows(ext, lags)
             # view[i, :, q] = ext[i + q] = y[a0 + i - (lags - q)]: lag k = lags - q
-            prod = np.tensordot(own, view, axes=(0, 0))[:, :, ::-1].transpose(2, 0, 1)
+            prod = summed(own, view)[:, :, ::-1].transpose(2, 0, 1)
         else:
             hi0 = min(bound, b0 + lags)
             ext[: hi0 - a0] = y[a0:hi0] - off
             own = ext[: b0 - a0]
             view = lag_windows(ext, lags)[: b0 - a0]
             # view[i, :, k] = y[a0 + i + k]
-            prod = np.tensordot(own, view, axes=(0, 0)).transpose(2, 1, 0)
+            prod = summed(own, view).transpose(2, 1, 0)
         if subtract:
             sums -= prod
             total -= own.sum(axis=0)

@@ -156,20 +156,20 @@ def ssi_poles(r: np.ndarray, fs: float, orders: Sequence[int] = ORDERS) -> list[
     hankel = r[idx].transpose(0, 2, 1, 3).reshape(rows * m, rows * m)
     u, s, vt = hankel_svd(hankel, max(orders), m)
     roots = np.sqrt(s)
+    obs = u[:m, : len(s)] * roots  # C, the first block row of O (each order's: its columns)
+    g = roots[:, None] * vt[:, :m]  # G (each order's: its rows)
     lams, phis, gs = [], [], []
     for order, a in zip(orders, state_matrices(u, s, m, orders)):
-        root = roots[:order]
-        obs = u[:m, :order] * root  # C, the first block row of O
         try:
             if a is None:
                 raise np.linalg.LinAlgError
             lam, vec = np.linalg.eig(a)
-            g_modal = np.linalg.solve(vec, root[:, None] * vt[:order, :m])
+            g_modal = np.linalg.solve(vec, g[:order])
         except np.linalg.LinAlgError:
             lam, vec, g_modal = np.empty(0, complex), np.empty((order, 0)), np.empty((0, m))
         keep = lam.imag > 1e-12
         lams.append(lam[keep])
-        phis.append(obs @ vec[:, keep])  # channels x poles
+        phis.append(obs[:, :order] @ vec[:, keep])  # channels x poles
         gs.append(g_modal[keep])
     return pole_rows(np.concatenate(lams), np.hstack(phis), np.vstack(gs), fs, lams)
 
