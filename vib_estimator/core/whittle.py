@@ -72,13 +72,16 @@ def sdof_density(
     ``dt``: the DTFT of its autocovariance ``c_k = variance e^(-zeta wn |k| dt) (cos wd k dt +
     zeta / sqrt(1 - zeta^2) sin wd |k| dt)``, summed in closed form (``c_k = Re(a z^|k|)``, ``z =
     e^((-zeta wn + i wd) dt)``: ``Re(a (1 - z^2) / (1 - 2 z cos w + z^2))``), in real
-    arithmetic."""
-    return _density(c, *_density_terms(frequency_hz, zeta, variance, dt))
+    arithmetic (:func:`density_at`, compiled)."""
+    c = np.asarray(c, dtype=np.float64)
+    out = np.empty(c.shape)
+    density_row(c.reshape(-1), _density_terms(frequency_hz, zeta, variance, dt), out.reshape(-1))
+    return out
 
 
 def _density_terms(frequency_hz: float, zeta: float, variance: float, dt: float) -> tuple:
-    """:func:`sdof_density`'s four scalars: with ``z`` and ``a (1 - z^2)`` as there, the real
-    and imaginary parts of ``1 + z^2`` and of ``2 z``, and of ``a (1 - z^2)``."""
+    """:func:`sdof_density`'s six scalars: with ``z`` and ``a (1 - z^2)`` as there, the real
+    parts of ``1 + z^2`` and of ``2 z``, their imaginary parts, and those of ``a (1 - z^2)``."""
     wn = 2 * math.pi * frequency_hz * dt
     root = math.sqrt(max(1.0 - zeta * zeta, 1e-12))
     decay = math.exp(-zeta * wn)
@@ -88,12 +91,23 @@ def _density_terms(frequency_hz: float, zeta: float, variance: float, dt: float)
     return zz.real, 2.0 * z.real, zz.imag, 2.0 * z.imag, num.real, num.imag
 
 
-def _density(c, zz_re, z2_re, zz_im, z2_im, num_re, num_im):
-    """:func:`sdof_density` from its scalars (:func:`_density_terms`; columns of them and ``c``
-    a row: several densities at once, each the same floats as alone)."""
+@jit(inline='always')
+def density_at(c, terms):
+    """:func:`sdof_density` at one ``c = cos w`` from its :func:`_density_terms` ``terms``:
+    ``Re(a (1 - z^2) / (1 + z^2 - 2 z c))`` in real arithmetic, the one place of its
+    arithmetic (compiled without ``fastmath``: IEEE operations in this order, the floats of
+    the same expression over numpy arrays)."""
+    zz_re, z2_re, zz_im, z2_im, num_re, num_im = terms
     dr = zz_re - z2_re * c
     di = zz_im - z2_im * c
     return (num_re * dr + num_im * di) / (dr * dr + di * di)
+
+
+@jit(error_model='numpy')  # (a division by zero gives numpy's inf or nan, not an error)
+def density_row(c, terms, out) -> None:
+    """:func:`density_at` of each entry of ``c`` into ``out``."""
+    for i in range(len(c)):
+        out[i] = density_at(c[i], terms)
 
 
 def peak_ratio(
@@ -131,11 +145,8 @@ def likelihood_terms(c, terms, a, b, gain, rest) -> None:
     density of :func:`_density_terms` ``terms``: ``gain = 1 + psi a`` and ``rest = b / (a
     gain)`` (their logarithm and sum left to numpy), in one pass: numpy's arithmetic of each
     bin in numpy's order, the same floats (the search calls it ~10 times a mode)."""
-    zz_re, z2_re, zz_im, z2_im, num_re, num_im = terms
     for i in range(len(c)):
-        dr = zz_re - z2_re * c[i]
-        di = zz_im - z2_im * c[i]
-        g = 1.0 + (num_re * dr + num_im * di) / (dr * dr + di * di) * a[i]
+        g = 1.0 + density_at(c[i], terms) * a[i]
         gain[i] = g
         rest[i] = b[i] / (a[i] * g)
 
@@ -262,12 +273,7 @@ def gradient_rows(c, terms, steps, variances, noise_var, grads, total) -> None:
     n, k = len(c), len(variances)
     dens = np.empty((5 * k, n))
     for r in range(5 * k):
-        zz_re, z2_re, zz_im, z2_im, num_re, num_im = terms[r]
-        row = dens[r]
-        for i in range(n):
-            dr = zz_re - z2_re * c[i]
-            di = zz_im - z2_im * c[i]
-            row[i] = (num_re * dr + num_im * di) / (dr * dr + di * di)
+        density_row(c, terms[r], dens[r])
     for i in range(n):
         s = 0.0 if k == 0 else dens[0, i]
         for j in range(1, k):
@@ -284,10 +290,11 @@ def gradient_rows(c, terms, steps, variances, noise_var, grads, total) -> None:
 
 
 def load_kernels() -> None:
-    """:func:`gradient_rows` and :func:`likelihood_terms` compiled (or loaded from numba's
-    cache) now: an identifier built ahead of its first analysis pays it there, as
-    :class:`.correlations.CorrelationCascade` its filter's."""
+    """:func:`sdof_density`'s kernel, :func:`gradient_rows` and :func:`likelihood_terms`
+    compiled (or loaded from numba's cache) now: an identifier built ahead of its first
+    analysis pays it there, as :class:`.correlations.CorrelationCascade` its filter's."""
     _log_density_gradient(np.zeros(1), [(1.0, 0.01, 1.0)], 1.0, 0.01)
+    sdof_density(np.zeros(1), 1.0, 0.01, 1.0, 0.01)
     one = np.ones(1)
     likelihood_terms(one, _density_terms(1.0, 0.01, 1.0, 0.01), one, one, one.copy(), one.copy())
 
