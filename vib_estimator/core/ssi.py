@@ -206,7 +206,8 @@ def pole_rows(lam, phi, g_modal, fs, orders) -> list[np.ndarray]:
     row[:, 3 : 3 + m] = share.T
     row[:, 3 + m : 3 + 2 * m] = phi.real.T
     row[:, 3 + 2 * m :] = phi.imag.T
-    return np.split(row, np.cumsum([len(k) for k in orders])[:-1])
+    ends = np.cumsum([len(k) for k in orders]).tolist()
+    return [row[a:b] for a, b in zip([0, *ends], ends)]
 
 
 # ---- 2. physical or spurious: stable clusters, shapes, strong modes -----------------------------
