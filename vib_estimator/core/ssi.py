@@ -53,7 +53,6 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.linalg import _umath_linalg  # (numpy.linalg.eig's and solve's LAPACK calls)
 
 from .correlations import BLOCK_ROWS, CorrelationCascade
 from .shapes import mac, normalise_shape
@@ -162,7 +161,10 @@ def ssi_poles(r: np.ndarray, fs: float, orders: Sequence[int] = ORDERS) -> list[
     lams, phis, gs = [], [], []
     for order, a in zip(orders, state_matrices(u, s, m, orders)):
         try:
-            lam, vec, g_modal = modal(a, g[:order])
+            if a is None:
+                raise np.linalg.LinAlgError
+            lam, vec = np.linalg.eig(a)
+            g_modal = np.linalg.solve(vec, g[:order])
         except np.linalg.LinAlgError:
             lam, vec, g_modal = np.empty(0, complex), np.empty((order, 0)), np.empty((0, m))
         keep = lam.imag > 1e-12
@@ -170,24 +172,6 @@ def ssi_poles(r: np.ndarray, fs: float, orders: Sequence[int] = ORDERS) -> list[
         phis.append(obs[:, :order] @ vec[:, keep])  # channels x poles
         gs.append(g_modal[keep])
     return pole_rows(np.concatenate(lams), np.hstack(phis), np.vstack(gs), fs, lams)
-
-
-def _failed(err, flag):
-    """A LAPACK call's NaN (no convergence, a singular matrix): numpy.linalg's own error."""
-    raise np.linalg.LinAlgError(err)
-
-
-def modal(a, g) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``lam, vec = numpy.linalg.eig(a)`` and ``numpy.linalg.solve(vec, g)`` (None ``a``: a
-    :class:`numpy.linalg.LinAlgError`, as for one not finite): numpy.linalg's own LAPACK calls
-    (its gufuncs, the same floats) in one error state (:func:`_failed`: a LAPACK failure raises
-    as in numpy), without numpy's checks and error state per call (a sixth of their time over
-    the orders' small matrices)."""
-    if a is None or not np.isfinite(a).all():
-        raise np.linalg.LinAlgError
-    with np.errstate(call=_failed, invalid='call', over='ignore', divide='ignore', under='ignore'):
-        lam, vec = _umath_linalg.eig(a, signature='d->DD')
-        return lam, vec, _umath_linalg.solve(vec, g, signature='DD->D')
 
 
 def pole_rows(lam, phi, g_modal, fs, orders) -> list[np.ndarray]:

@@ -75,7 +75,8 @@ def sdof_density(
     arithmetic (:func:`density_at`, compiled)."""
     c = np.asarray(c, dtype=np.float64)
     out = np.empty(c.shape)
-    density_row(c.reshape(-1), _density_terms(frequency_hz, zeta, variance, dt), out.reshape(-1))
+    terms = _density_terms(frequency_hz, zeta, variance, dt)
+    density_row(np.ascontiguousarray(c.reshape(-1)), terms, out.reshape(-1))  # (one layout)
     return out
 
 
