@@ -75,6 +75,7 @@ from .estimator import (
 from .identity import CONFIRM, CONFIRM_BESIDE, Mode, ModeRegister
 from .ssi import BLOCK_ROWS, WindowModes, block_rows, identify
 from .threads import single_blas_thread
+from .whittle import load_kernels
 
 #: seconds of input between two analyses (the estimates' update period) of a short window
 #: (:func:`hop_s`)
@@ -173,6 +174,7 @@ class AmbientEstimator(Estimator):
         self._t = np.empty(1 << 14)  # the window's stamps (its values: in the cascade)
         self._register = ModeRegister(self._window, CONFIRM, CONFIRM_BESIDE, new=_Track)
         self._cascade = CorrelationCascade(2 * block_rows(m), m)
+        load_kernels()  # (the Whittle kernels: now, not at the first analysis)
         #: samples fed one at a time since the last analysis (stamps, values): appended to the
         #: buffer at once when one is due (:meth:`_store`), not one numpy write each
         self._pending_t: list[float] = []

@@ -86,6 +86,14 @@ def lag_windows(ext: np.ndarray, lags: int) -> np.ndarray:
     return np.lib.stride_tricks.as_strided(ext, shape, (step, across, step), writeable=False)
 
 
+def summed(own: np.ndarray, view: np.ndarray) -> np.ndarray:
+    """``numpy.tensordot(own, view, axes=(0, 0))`` of rows ``own`` and a :func:`lag_windows`
+    ``view`` of as many rows: its own steps (one ``dot`` of ``own``'s transpose and the view's
+    rows as a matrix, the same floats) without its checks of the axes."""
+    m = own.shape[1]
+    return np.dot(own.T, view.reshape(len(own), -1)).reshape(m, m, view.shape[2])
+
+
 def lag_products(y, a, b, bound, off, sums, total, later=True, subtract=False) -> None:
     """Add to ``sums`` (lag k, channel i, channel j; k = 0 .. ``len(sums) - 1``) the products of
     the rows ``x = y - off`` that pair a row a <= t < b with another: ``later``, the products
@@ -102,14 +110,14 @@ def lag_products(y, a, b, bound, off, sums, total, later=True, subtract=False) -
             own = ext[lags:]
             view = lag_windows(ext, lags)
             # view[i, :, q] = ext[i + q] = y[a0 + i - (lags - q)]: lag k = lags - q
-            prod = np.tensordot(own, view, axes=(0, 0))[:, :, ::-1].transpose(2, 0, 1)
+            prod = summed(own, view)[:, :, ::-1].transpose(2, 0, 1)
         else:
             hi0 = min(bound, b0 + lags)
             ext[: hi0 - a0] = y[a0:hi0] - off
             own = ext[: b0 - a0]
             view = lag_windows(ext, lags)[: b0 - a0]
             # view[i, :, k] = y[a0 + i + k]
-            prod = np.tensordot(own, view, axes=(0, 0)).transpose(2, 1, 0)
+            prod = summed(own, view).transpose(2, 1, 0)
         if subtract:
             sums -= prod
             total -= own.sum(axis=0)
@@ -120,19 +128,37 @@ def lag_products(y, a, b, bound, off, sums, total, later=True, subtract=False) -
 
 def centred_correlations(sums, total, x, off) -> np.ndarray:
     """The unbiased correlation matrices of the mean-removed window ``x`` (rows) from its lag
-    products ``sums`` and sum ``total`` of ``x - off`` (:func:`lag_products`)."""
+    products ``sums`` and sum ``total`` of ``x - off`` (:func:`lag_products`): ``R_k = (sums_k -
+    (total - first_k) mean^T - mean (total - last_k)^T + (n - k) mean mean^T) / (n - k)``,
+    ``first_k`` and ``last_k`` the sums of ``x - off``'s first and last k rows
+    (:func:`centre`)."""
+    out = np.empty(sums.shape)
+    centre(sums, total, x, off, out)
+    return out
+
+
+@jit(error_model='numpy')  # (as numpy: a division by zero gives inf or nan)
+def centre(sums, total, x, off, out) -> None:
+    """:func:`centred_correlations` into ``out``: numpy's arithmetic of each entry in numpy's
+    order (``first`` and ``last`` running sums as ``cumsum``'s; the same floats as the array
+    expression), one pass, not its ~20 array calls."""
     lags, n, m = len(sums) - 1, len(x), x.shape[1]
-    first = np.concatenate((np.zeros((1, m)), np.cumsum(x[:lags] - off, 0)))
-    last = np.concatenate((np.zeros((1, m)), np.cumsum(x[: -lags - 1 : -1] - off, 0)))
+    first = np.zeros((lags + 1, m))
+    last = np.zeros((lags + 1, m))
+    for c in range(m):
+        for k in range(1, lags + 1):
+            a, b = x[k - 1, c] - off[c], x[n - k, c] - off[c]
+            first[k, c] = a if k == 1 else first[k - 1, c] + a
+            last[k, c] = b if k == 1 else last[k - 1, c] + b
     mean = total / n
-    count = np.arange(n, n - lags - 1, -1, dtype=np.float64)
-    r = (
-        sums
-        - (total - first)[:, :, None] * mean[None, None, :]
-        - mean[None, :, None] * (total - last)[:, None, :]
-        + count[:, None, None] * np.outer(mean, mean)[None]
-    )
-    return r / count[:, None, None]
+    for k in range(lags + 1):
+        count = float(n - k)
+        for i in range(m):
+            for j in range(m):
+                r = sums[k, i, j] - (total[i] - first[k, i]) * mean[j]
+                r = r - mean[i] * (total[j] - last[k, j])
+                r = r + count * (mean[i] * mean[j])
+                out[k, i, j] = r / count
 
 
 class LagProducts:
@@ -332,9 +358,13 @@ class CorrelationCascade:
         #: level (from 1) -> its window's lag products
         self._products: dict[int, EditedProducts] = {}
         self._moved()
-        # scipy.signal imported and the zero-phase filter compiled (or loaded from numba's cache)
-        # now, not at the first analysis
+        # scipy.signal imported and the zero-phase filter and the centring compiled (or loaded
+        # from numba's cache) now, not at the first analysis (a window at the input rate, and a
+        # halved one: every second sample)
         zero_phase(np.zeros(2 * decimation_filter().pad))
+        x, zero = np.zeros((4, channels)), np.zeros(channels)
+        for window in (x, x[::2]):
+            centred_correlations(np.zeros((2, channels, channels)), zero, window, zero)
 
     @classmethod
     def of(cls, y: np.ndarray, lags: int) -> 'CorrelationCascade':

@@ -155,35 +155,43 @@ def ssi_poles(r: np.ndarray, fs: float, orders: Sequence[int] = ORDERS) -> list[
     idx = 1 + np.add.outer(np.arange(rows), np.arange(rows))
     hankel = r[idx].transpose(0, 2, 1, 3).reshape(rows * m, rows * m)
     u, s, vt = hankel_svd(hankel, max(orders), m)
-    width = 3 + 3 * m
-    out = []
     roots = np.sqrt(s)
+    obs = u[:m, : len(s)] * roots  # C, the first block row of O (each order's: its columns)
+    g = roots[:, None] * vt[:, :m]  # G (each order's: its rows)
+    lams, phis, gs = [], [], []
     for order, a in zip(orders, state_matrices(u, s, m, orders)):
-        root = roots[:order]
-        obs = u[:m, :order] * root  # C, the first block row of O
         try:
             if a is None:
                 raise np.linalg.LinAlgError
             lam, vec = np.linalg.eig(a)
-            g_modal = np.linalg.solve(vec, root[:, None] * vt[:order, :m])
+            g_modal = np.linalg.solve(vec, g[:order])
         except np.linalg.LinAlgError:
-            out.append(np.empty((0, width)))
-            continue
+            lam, vec, g_modal = np.empty(0, complex), np.empty((order, 0)), np.empty((0, m))
         keep = lam.imag > 1e-12
-        lam_k = lam[keep]
-        phi = obs @ vec[:, keep]  # channels x poles
-        share = 2.0 * (phi * g_modal[keep].T / lam_k).real  # each channel's variance
-        pole = np.log(lam_k) * fs
-        size = np.abs(pole)
-        row = np.empty((len(lam_k), width))
-        row[:, 0] = size / (2 * math.pi)
-        row[:, 1] = -pole.real / size
-        row[:, 2] = share.sum(axis=0)
-        row[:, 3 : 3 + m] = share.T
-        row[:, 3 + m : 3 + 2 * m] = phi.real.T
-        row[:, 3 + 2 * m :] = phi.imag.T
-        out.append(row)
-    return out
+        lams.append(lam[keep])
+        phis.append(obs[:, :order] @ vec[:, keep])  # channels x poles
+        gs.append(g_modal[keep])
+    return pole_rows(np.concatenate(lams), np.hstack(phis), np.vstack(gs), fs, lams)
+
+
+def pole_rows(lam, phi, g_modal, fs, orders) -> list[np.ndarray]:
+    """:func:`ssi_poles`' rows of all orders' poles at once (eigenvalues ``lam``, shapes
+    ``phi``: channels x poles, ``g_modal``: poles x channels), split into one array per order
+    (``orders``: each order's eigenvalues; element-wise arithmetic: the same floats as order
+    by order)."""
+    m = phi.shape[0]
+    share = 2.0 * (phi * g_modal.T / lam).real  # each channel's variance
+    pole = np.log(lam) * fs
+    size = np.abs(pole)
+    row = np.empty((len(lam), 3 + 3 * m))
+    row[:, 0] = size / (2 * math.pi)
+    row[:, 1] = -pole.real / size
+    row[:, 2] = share.sum(axis=0)
+    row[:, 3 : 3 + m] = share.T
+    row[:, 3 + m : 3 + 2 * m] = phi.real.T
+    row[:, 3 + 2 * m :] = phi.imag.T
+    ends = np.cumsum([len(k) for k in orders]).tolist()
+    return [row[a:b] for a, b in zip([0, *ends], ends)]
 
 
 # ---- 2. physical or spurious: stable clusters, shapes, strong modes -----------------------------

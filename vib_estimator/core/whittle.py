@@ -34,6 +34,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from .jit import jit
+
 #: the Whittle refinement of a mode's frequency (:func:`whittle_frequencies`) reads the
 #: periodogram within this many half-power half-widths (``zeta f``) of it ...
 WHITTLE_SPAN = 15.0
@@ -70,16 +72,43 @@ def sdof_density(
     ``dt``: the DTFT of its autocovariance ``c_k = variance e^(-zeta wn |k| dt) (cos wd k dt +
     zeta / sqrt(1 - zeta^2) sin wd |k| dt)``, summed in closed form (``c_k = Re(a z^|k|)``, ``z =
     e^((-zeta wn + i wd) dt)``: ``Re(a (1 - z^2) / (1 - 2 z cos w + z^2))``), in real
-    arithmetic."""
+    arithmetic (:func:`density_at`, compiled)."""
+    c = np.asarray(c, dtype=np.float64)
+    out = np.empty(c.shape)
+    terms = _density_terms(frequency_hz, zeta, variance, dt)
+    density_row(np.ascontiguousarray(c.reshape(-1)), terms, out.reshape(-1))  # (one layout)
+    return out
+
+
+def _density_terms(frequency_hz: float, zeta: float, variance: float, dt: float) -> tuple:
+    """:func:`sdof_density`'s six scalars: with ``z`` and ``a (1 - z^2)`` as there, the real
+    parts of ``1 + z^2`` and of ``2 z``, their imaginary parts, and those of ``a (1 - z^2)``."""
     wn = 2 * math.pi * frequency_hz * dt
     root = math.sqrt(max(1.0 - zeta * zeta, 1e-12))
     decay = math.exp(-zeta * wn)
     z = complex(decay * math.cos(wn * root), decay * math.sin(wn * root))
     num = variance * complex(1.0, -zeta / root) * (1.0 - z * z)
     zz = 1.0 + z * z
-    dr = zz.real - 2.0 * z.real * c
-    di = zz.imag - 2.0 * z.imag * c
-    return (num.real * dr + num.imag * di) / (dr * dr + di * di)
+    return zz.real, 2.0 * z.real, zz.imag, 2.0 * z.imag, num.real, num.imag
+
+
+@jit(inline='always')
+def density_at(c, terms):
+    """:func:`sdof_density` at one ``c = cos w`` from its :func:`_density_terms` ``terms``:
+    ``Re(a (1 - z^2) / (1 + z^2 - 2 z c))`` in real arithmetic, the one place of its
+    arithmetic (compiled without ``fastmath``: IEEE operations in this order, the floats of
+    the same expression over numpy arrays)."""
+    zz_re, z2_re, zz_im, z2_im, num_re, num_im = terms
+    dr = zz_re - z2_re * c
+    di = zz_im - z2_im * c
+    return (num_re * dr + num_im * di) / (dr * dr + di * di)
+
+
+@jit(error_model='numpy')  # (a division by zero gives numpy's inf or nan, not an error)
+def density_row(c, terms, out) -> None:
+    """:func:`density_at` of each entry of ``c`` into ``out``."""
+    for i in range(len(c)):
+        out[i] = density_at(c[i], terms)
 
 
 def peak_ratio(
@@ -109,6 +138,18 @@ def _rank_one(c, spec, modes, shapes, noise, k, dt, n) -> tuple[np.ndarray, np.n
         u = np.linalg.solve(rest, np.broadcast_to(phi, (n_bins, m))[..., None])[..., 0]
     proj = np.sum(u * spec, axis=1)
     return u @ phi, (proj.real**2 + proj.imag**2) / n
+
+
+@jit(error_model='numpy')  # (a division by zero gives numpy's inf or nan, not an error)
+def likelihood_terms(c, terms, a, b, gain, rest) -> None:
+    """The terms of :func:`whittle_frequencies`' likelihood at the bins ``c`` of a mode's
+    density of :func:`_density_terms` ``terms``: ``gain = 1 + psi a`` and ``rest = b / (a
+    gain)`` (their logarithm and sum left to numpy), in one pass: numpy's arithmetic of each
+    bin in numpy's order, the same floats (the search calls it ~10 times a mode)."""
+    for i in range(len(c)):
+        g = 1.0 + density_at(c[i], terms) * a[i]
+        gain[i] = g
+        rest[i] = b[i] / (a[i] * g)
 
 
 def whittle_frequencies(
@@ -167,10 +208,12 @@ def whittle_frequencies(
             continue
         c = np.cos(w[near])
         a, b = _rank_one(c, spectrum[near], modes, shapes, noise, k, dt, n)
+        gain, rest = np.empty(len(c)), np.empty(len(c))
 
         def negative_log_likelihood(fk, zeta=zeta, variance=max(variance, 1e-300)):
-            gain = 1.0 + sdof_density(c, fk, zeta, variance, dt) * a
-            return float(np.sum(np.log(gain) + b / (a * gain)))
+            terms = _density_terms(fk, zeta, variance, dt)
+            likelihood_terms(c, terms, a, b, gain, rest)
+            return float(np.sum(np.log(gain) + rest))
 
         best = minimize_scalar(
             negative_log_likelihood,
@@ -199,22 +242,62 @@ def _active_bins(modes, noise_var: float, dt: float, n: int) -> np.ndarray:
 
 def _log_density_gradient(c: np.ndarray, modes, noise_var: float, dt: float):
     """The model's density ``S`` at ``c = cos w`` and the gradient of ``ln S`` with respect
-    to (f, zeta, variance of each mode, the noise variance), one row each."""
-    density = sdof_density
-    parts = [density(c, f, z, v, dt) for f, z, v in modes]
-    total = noise_var + (np.sum(parts, axis=0) if parts else 0.0)
-    grads = []
-    for (f, z, v), part in zip(modes, parts):
+    to (f, zeta, variance of each mode, the noise variance), one row each: f's and zeta's as
+    central differences (steps of 1e-6 of each), computed by :func:`gradient_rows`."""
+    terms, steps = [], []
+    for f, z, v in modes:
+        terms.append(_density_terms(f, z, v, dt))
         for i, x in enumerate((f, z)):
             h = 1e-6 * x
             hi = [f, z, v]
             lo = [f, z, v]
             hi[i] += h
             lo[i] -= h
-            grads.append((density(c, *hi, dt) - density(c, *lo, dt)) / (2 * h))
-        grads.append(part / v)
-    grads.append(np.ones(len(c)))
-    return total, np.array(grads) / total
+            terms += [_density_terms(*hi, dt), _density_terms(*lo, dt)]
+            steps.append(2 * h)
+    grads = np.empty((3 * len(modes) + 1, len(c)))
+    total = np.empty(len(c))
+    variances = np.array([float(v) for _, _, v in modes])
+    terms = np.array(terms).reshape(-1, 6)
+    gradient_rows(c, terms, np.array(steps), variances, float(noise_var), grads, total)
+    return total, grads
+
+
+@jit(error_model='numpy')  # (a division by zero gives numpy's inf or nan, not an error)
+def gradient_rows(c, terms, steps, variances, noise_var, grads, total) -> None:
+    """:func:`_log_density_gradient`'s rows into ``grads`` and ``S`` into ``total``, from the
+    :func:`_density_terms` of each mode and of its four steps (``terms``: five rows a mode: the
+    mode, f up, f down, zeta up, zeta down; ``steps``: each mode's two central differences'
+    widths): numpy's arithmetic of each bin in numpy's order (the same floats as
+    :func:`sdof_density` and the differences in array operations), without their passes over
+    the bins (two thirds of the bound's time)."""
+    n, k = len(c), len(variances)
+    dens = np.empty((5 * k, n))
+    for r in range(5 * k):
+        density_row(c, terms[r], dens[r])
+    for i in range(n):
+        s = 0.0 if k == 0 else dens[0, i]
+        for j in range(1, k):
+            s = s + dens[5 * j, i]
+        total[i] = noise_var + s
+    for j in range(k):
+        d = dens[5 * j : 5 * j + 5]
+        for i in range(n):
+            grads[3 * j, i] = (d[1, i] - d[2, i]) / steps[2 * j] / total[i]
+            grads[3 * j + 1, i] = (d[3, i] - d[4, i]) / steps[2 * j + 1] / total[i]
+            grads[3 * j + 2, i] = d[0, i] / variances[j] / total[i]
+    for i in range(n):
+        grads[3 * k, i] = 1.0 / total[i]
+
+
+def load_kernels() -> None:
+    """:func:`sdof_density`'s kernel, :func:`gradient_rows` and :func:`likelihood_terms`
+    compiled (or loaded from numba's cache) now: an identifier built ahead of its first
+    analysis pays it there, as :class:`.correlations.CorrelationCascade` its filter's."""
+    _log_density_gradient(np.zeros(1), [(1.0, 0.01, 1.0)], 1.0, 0.01)
+    sdof_density(np.zeros(1), 1.0, 0.01, 1.0, 0.01)
+    one = np.ones(1)
+    likelihood_terms(one, _density_terms(1.0, 0.01, 1.0, 0.01), one, one, one.copy(), one.copy())
 
 
 @functools.lru_cache(maxsize=16)
