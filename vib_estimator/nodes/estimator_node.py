@@ -118,6 +118,11 @@ from .stream import (
 #: (400 at depth 400); a depth above 5000 would keep the oldest 5000 and drop the newest, not a
 #: keep-last history (test/nodes/test_input_history.py; docs/nodes.md#the-input-qos).
 INPUT_DEPTH = 5000
+#: output history (reliable, keep-last) of the estimate topics: a node that resumes after a stall
+#: (SIGSTOP, CPU starvation) publishes its backlog's estimates at once; at depth 10 a reliable
+#: subscriber that had not taken them yet lost the oldest (the soak's shaper_node took 782 of
+#: 798 estimates). They are few a second: 100 costs nothing.
+OUTPUT_DEPTH = 100
 
 
 def input_qos() -> QoSProfile:
@@ -187,10 +192,10 @@ class Outputs:
         self._node = node
         self._msg = Float64()
         self._floats = [
-            (node.create_publisher(Float64, f'vibration/{topic}', 10), field)
+            (node.create_publisher(Float64, f'vibration/{topic}', OUTPUT_DEPTH), field)
             for topic, field in FLOAT_OUTPUTS
         ]
-        self._reset = node.create_publisher(Header, 'vibration/reset', 10)
+        self._reset = node.create_publisher(Header, 'vibration/reset', OUTPUT_DEPTH)
         self._modes = {}  # mode -> (frequency publisher, reset publisher)
         self._shapes = {}  # mode -> shape publisher (several channels)
         self._shape = Float64MultiArray()
@@ -218,7 +223,7 @@ class Outputs:
     def _shape_publisher(self, k: int):
         if k not in self._shapes:
             self._shapes[k] = self._node.create_publisher(
-                Float64MultiArray, f'vibration/mode{k}/shape', 10
+                Float64MultiArray, f'vibration/mode{k}/shape', OUTPUT_DEPTH
             )
         return self._shapes[k]
 
@@ -243,8 +248,8 @@ class Outputs:
     def _mode(self, k: int):
         if k not in self._modes:
             self._modes[k] = (
-                self._node.create_publisher(Float64, f'vibration/mode{k}/frequency', 10),
-                self._node.create_publisher(Header, f'vibration/mode{k}/reset', 10),
+                self._node.create_publisher(Float64, f'vibration/mode{k}/frequency', OUTPUT_DEPTH),
+                self._node.create_publisher(Header, f'vibration/mode{k}/reset', OUTPUT_DEPTH),
             )
         return self._modes[k]
 

@@ -132,8 +132,9 @@ class ShaperNode(Node):
         self._command_pub = self.create_publisher(Float64, 'position_command', 10)
         self._diagnostics_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
         self.create_subscription(Float64, 'reference', self._on_reference, 10)
-        self.create_subscription(Float64, 'vibration/frequency', self._on_frequency, 10)
-        self.create_subscription(Float64, 'vibration/damping_ratio', self._on_damping, 10)
+        # as deep as estimator_node's estimate publishers (OUTPUT_DEPTH): a backlog's burst
+        self.create_subscription(Float64, 'vibration/frequency', self._on_frequency, 100)
+        self.create_subscription(Float64, 'vibration/damping_ratio', self._on_damping, 100)
         self.add_on_set_parameters_callback(self._check_parameters)
         self.add_post_set_parameters_callback(self._apply_parameters)
         self._redesign()
