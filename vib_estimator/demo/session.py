@@ -131,9 +131,12 @@ class Listener:
         #: node names whose /diagnostics say they estimate (not warming up)
         self.ready: set = set()
         self._warming: set = set()
+        #: node name -> the key-values of its last /diagnostics status
+        self.values: dict = {}
 
     def _on_diagnostics(self, msg) -> None:
         for status in msg.status:
+            self.values[status.name] = {kv.key: kv.value for kv in status.values}
             if status.message == self._warmup_message:
                 if status.name not in self._warming:
                     self._warming.add(status.name)

@@ -40,6 +40,10 @@ SETTLE_S = 0.3
 #: taken while a move's transient still rings (the paper's configuration publishes those) does not
 #: steer the design
 MEDIAN_OF = 3
+#: before a shaper is switched on, the demo waits this long (wall s) at most for shaper_node to
+#: have taken every estimate the demo heard (its /diagnostics, 1 Hz): on a loaded machine they
+#: reached it behind its /clock ticks after the switch, and it designed for none (a CI run)
+TAKEN_WAIT_S = 5.0
 
 
 @dataclass
@@ -108,7 +112,22 @@ class ShapingDriver:
             raise RuntimeError(f'{node} refused {name} {value}: {result.reason}')
 
     def set_shaper(self, name: str) -> None:
+        if name != 'none':
+            self._estimates_taken()
         self._set(self._shaper, 'shaper_node', 'shaper', name)
+
+    def _estimates_taken(self) -> None:
+        """Wait (at most :data:`TAKEN_WAIT_S`; held, the simulator waits too) until shaper_node
+        says it took, or ignored, as many frequency estimates as the demo heard."""
+        listener = self._session.listener
+        heard = len(listener.record.est_f)
+
+        def taken() -> bool:
+            values = listener.values.get('/shaper_node', {})
+            counts = (values.get(k, '0') for k in ('frequency_estimates', 'estimates_ignored'))
+            return sum(int(float(c)) for c in counts) >= heard
+
+        self._session.spin_until(taken, TAKEN_WAIT_S)
 
     def pause_sim_at(self, t: float) -> None:
         """Hold sim_node once it has simulated ``t`` s (0: no hold)."""
