@@ -156,7 +156,7 @@ def interpreted(module) -> SimpleNamespace:
     space: dict = dict(vars(module))
     result = _interpreted[name] = SimpleNamespace()
     for key, value in vars(module).items():
-        fn = value.py_func if isinstance(value, Dispatcher) else value
+        fn = python_of(value)
         if isinstance(fn, FunctionType) and fn.__module__ == name:
             space[key] = FunctionType(
                 fn.__code__, space, fn.__name__, fn.__defaults__, fn.__closure__
