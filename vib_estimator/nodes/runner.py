@@ -198,21 +198,6 @@ def end_process(code: int) -> None:
     os._exit(code)
 
 
-def destroy_half_built(err: BaseException) -> None:
-    """Destroy the node whose ``__init__`` raised ``err`` after ``Node.__init__`` had made its
-    participant (its frame's ``self``: :func:`run` never held it), so that rclpy's context is not
-    shut down with it alive (a ``bag_replayer`` refusing a bag once died of SIGABRT after its
-    ``error:`` line, under load). The base class's ``destroy_node`` only: a subclass's may need
-    what its ``__init__`` never made."""
-    tb = err.__traceback__
-    while tb is not None:
-        node = tb.tb_frame.f_locals.get('self')
-        if isinstance(node, Node):
-            Node.destroy_node(node)
-            return
-        tb = tb.tb_next
-
-
 def run(
     factory: Callable[[], Node],
     args: Optional[Sequence[str]] = None,
@@ -258,8 +243,6 @@ def run(
     except StartupError as err:
         print(f'error: {err}', file=sys.stderr)
         code = 2
-        if node is None:
-            destroy_half_built(err)
     except (NameValidationException, RCLError) as err:  # e.g. -p input_topic:=1bad
         print(f'error: {argument_error(err)}', file=sys.stderr)
         code = 2
