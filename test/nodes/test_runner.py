@@ -10,6 +10,7 @@ import os
 import re
 import subprocess
 import sys
+import weakref
 
 from vib_estimator.nodes import runner
 
@@ -123,3 +124,53 @@ def test_an_invalid_handle_from_the_executor_is_skipped_unless_it_never_ends(mon
                 pass
             else:
                 raise AssertionError('an endless series of InvalidHandle was skipped')
+
+
+def test_a_node_that_refuses_to_start_ends_its_process_before_it_is_destroyed(monkeypatch):
+    """A node refusing to start after ``Node.__init__`` made its participant: its process ends
+    (exit 2, one ``error:`` line) while the exception still holds the half-built node -- its
+    participant's destruction could deadlock Fast DDS amid peers coming and going (runner.refuse).
+    A test calling ``run`` in its own process gets 2 back."""
+    from vib_estimator.errors import StartupError
+
+    made = []
+
+    class Refusing:
+        def __init__(self):
+            made.append(weakref.ref(self))
+            raise StartupError('parameter bag is required')
+
+    class Ended(Exception):
+        pass
+
+    def end_process(code):
+        raise Ended(code, made[-1]() is not None)
+
+    monkeypatch.setattr(runner, 'init_or_error', lambda args: None)
+    monkeypatch.setattr(runner, 'end_process', end_process)
+    monkeypatch.setattr(runner, 'runs_a_node', lambda: True)
+    try:
+        runner.run(Refusing, [])
+    except Ended as ended:
+        assert ended.args == (2, True)
+    else:
+        raise AssertionError('the process of a node refusing to start was not ended')
+    monkeypatch.setattr(runner, 'runs_a_node', lambda: False)
+    assert runner.run(Refusing, []) == 2
+    assert made[-1]() is None
+
+
+def test_a_node_module_run_with_python_m_runs_a_node(monkeypatch):
+    """``python -m vib_estimator.nodes.<module>`` is a node's process; pytest's, or ``python -c``,
+    is not."""
+    from types import SimpleNamespace
+
+    from vib_estimator.nodes import stopping
+
+    assert not stopping.runs_a_node()
+    code = 'from vib_estimator.nodes import stopping; print(stopping.runs_a_node())'
+    plain = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True)
+    assert plain.stdout.split() == ['False'], plain.stderr
+    node_main = SimpleNamespace(__spec__=SimpleNamespace(name='vib_estimator.nodes.bag_replayer'))
+    monkeypatch.setitem(sys.modules, '__main__', node_main)
+    assert stopping.runs_a_node()

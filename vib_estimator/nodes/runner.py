@@ -39,7 +39,7 @@ from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
 from ..errors import StartupError
-from .stopping import StopRequest, in_executable
+from .stopping import StopRequest, in_executable, runs_a_node
 
 #: rclpy's warning when a node that failed to be created is finalised
 ROSOUT_FINI = 'Failed to fini rosout publisher'
@@ -174,8 +174,9 @@ def spin_until_arrival(executor, arrived: list, predicate: Callable, timeout: fl
 
 
 def end_process(code: int) -> None:
-    """End an executable's process with ``code`` once its node is destroyed and rclpy shut down:
-    Python's and C's output flushed, then ``os._exit``, without the interpreter's finalization.
+    """End an executable's process with ``code`` once its node is destroyed and rclpy shut down
+    (or at once, a node refusing to start: :func:`refuse`): Python's and C's output flushed, then
+    ``os._exit``, without the interpreter's finalization.
 
     Measured on ``estimator_node`` (on ``sim_node`` at speed 10 for 50-70 s, its default deciding
     the identifier; SIGINT 3 s after the simulator stopped; both nodes at nice 10 beside two
@@ -196,6 +197,25 @@ def end_process(code: int) -> None:
     except (OSError, AttributeError):
         pass
     os._exit(code)
+
+
+def refuse(reason: str) -> int:
+    """Print a node's refusal to start (one ``error:`` line) and return its exit code, 2; in a
+    process that runs the node (:func:`~.stopping.runs_a_node`), end it there and then.
+
+    Called inside the ``except`` clause, while the exception's traceback still holds the node its
+    ``__init__`` left half-built (a ``StartupError`` raised after ``Node.__init__``, a topic
+    name rcl refuses): ending the process there destroys nothing. Destroying that node's DDS
+    participant while its peers come and go deadlocked Fast DDS 2.14 (``rcl_node_fini`` ->
+    ``destroy_participant`` -> ``DomainParticipant::set_listener`` spinning while a discovery
+    thread in ``onWriterDiscovery`` waits for the lock it holds; gdb, Dec 2026): twelve
+    ``bag_replayer`` refusing bags at once (``test_unplayable_bags_are_refused_with_one_line``)
+    left one spinning a core for good, in about one round of two. Its peers see the participant
+    leave when its lease ends."""
+    print(f'error: {reason}', file=sys.stderr)
+    if runs_a_node():
+        end_process(2)
+    return 2
 
 
 def run(
@@ -241,11 +261,9 @@ def run(
                 if skipped > MAX_INVALID_HANDLES:
                     raise
     except StartupError as err:
-        print(f'error: {err}', file=sys.stderr)
-        code = 2
+        code = refuse(str(err))
     except (NameValidationException, RCLError) as err:  # e.g. -p input_topic:=1bad
-        print(f'error: {argument_error(err)}', file=sys.stderr)
-        code = 2
+        code = refuse(argument_error(err))
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import os
 import signal
+import sys
 import threading
 
 #: the package's node executables (setup.py's console scripts into vib_estimator.nodes)
@@ -38,6 +39,14 @@ def in_executable() -> bool:
     """Whether this process is one of the package's node executables (its ``main`` ends the
     process; a test calling it in its own process is not)."""
     return _executable
+
+
+def runs_a_node() -> bool:
+    """Whether this process runs a node's ``main`` as its own: one of :data:`EXECUTABLES`, or
+    ``python -m vib_estimator.nodes.<module>`` (the tests' way of starting one) -- not a test
+    calling :func:`~.runner.run` in its own process."""
+    spec = getattr(sys.modules.get('__main__'), '__spec__', None)
+    return _executable or (spec is not None and spec.name.startswith(f'{__package__}.'))
 
 
 def early(argv0: str) -> bool:
