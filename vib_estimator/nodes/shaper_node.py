@@ -51,6 +51,10 @@ PENDING_WARN_AFTER = 10.0
 MIN_FREQUENCY_HZ = 0.01
 #: at most this much simulated or real time is computed in one tick; beyond, the node skips ahead
 MAX_CATCH_UP_S = 1.0
+#: history of the estimate subscriptions: as deep as estimator_node's estimate publishers
+#: (``OUTPUT_DEPTH``), so that a backlog's burst of estimates (the estimator resuming after a
+#: stall) is taken whole
+ESTIMATE_DEPTH = 100
 
 PARAMETERS = {
     # name: (default, descriptor)
@@ -132,9 +136,12 @@ class ShaperNode(Node):
         self._command_pub = self.create_publisher(Float64, 'position_command', 10)
         self._diagnostics_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
         self.create_subscription(Float64, 'reference', self._on_reference, 10)
-        # as deep as estimator_node's estimate publishers (OUTPUT_DEPTH): a backlog's burst
-        self.create_subscription(Float64, 'vibration/frequency', self._on_frequency, 100)
-        self.create_subscription(Float64, 'vibration/damping_ratio', self._on_damping, 100)
+        self.create_subscription(
+            Float64, 'vibration/frequency', self._on_frequency, ESTIMATE_DEPTH
+        )
+        self.create_subscription(
+            Float64, 'vibration/damping_ratio', self._on_damping, ESTIMATE_DEPTH
+        )
         self.add_on_set_parameters_callback(self._check_parameters)
         self.add_post_set_parameters_callback(self._apply_parameters)
         self._redesign()
