@@ -64,6 +64,13 @@ def records(folder: Path, real: Path | None):
     y = np.exp(-0.01 * 2 * np.pi * 5 * t) * np.sin(2 * np.pi * 5 * t)
     y += 0.01 * rng.standard_normal(len(t))
     out.append(('decay 5 Hz', 'free', write_csv(folder, 'decay5', t, y), [], [5.0], ['--paper']))
+    # an IMU's rate: a 10 Hz pluck after 2 s of rest at 100 samples/s (10 samples a period)
+    t = np.arange(0, 12, 0.01)
+    tau = np.maximum(t - 2.0, 0)
+    y = np.exp(-0.005 * 2 * np.pi * 10 * tau) * np.sin(2 * np.pi * 10 * tau + 1) * (t >= 2)
+    y += 0.01 / np.sqrt(2) * np.random.default_rng(10).standard_normal(len(t))  # (rng's draws
+    path = write_csv(folder, 'decay10at100', t, y)  # for the records below unchanged)
+    out.append(('decay 10 Hz at 100 Hz', 'free', path, [], [10.0], ['--modes', '3']))
     for name, modes in (
         ('decay 10 / 13 Hz, 1:0.5', ((10.0, 1.0, 0.003), (13.0, 0.5, 0.003))),
         ('decay 8 / 21 / 55 Hz', ((8.0, 1.0, 0.003), (21.0, 0.3, 0.002), (55.0, 0.05, 0.002))),

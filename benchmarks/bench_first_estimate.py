@@ -18,6 +18,7 @@ around the mode, and a window of about one period reads that spread as a 2 % shi
     cd benchmarks && ../.venv/bin/python bench_first_estimate.py --sweep   # SWEEP, 6 seeds each
     cd benchmarks && ../.venv/bin/python bench_first_estimate.py --noisy   # NOISY, beside free
     cd benchmarks && ../.venv/bin/python bench_first_estimate.py --onset   # a pluck after rest
+    cd benchmarks && ../.venv/bin/python bench_first_estimate.py --low-rate  # few samples a period
 """
 
 from __future__ import annotations
@@ -29,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from vib_estimator.analysis.choosing import decided_config
-from vib_estimator.core import EstimatorConfig, estimate
+from vib_estimator.core import EstimatorConfig, choice, create_estimator, estimate
 from vib_estimator.core.choice import decide
 from vib_estimator.io.csv_reader import read_csv_series
 from vib_estimator.sim import arm_model
@@ -237,7 +238,7 @@ def onset() -> int:
             cells = []
             for sel in (t >= 0.0, t >= 1.0):
                 config, y_used, _ = decided(t[sel], y[sel])
-                e = estimate(t[sel], y_used, config)
+                e = create_estimator(config).process(t[sel], y_used)
                 if not len(e):
                     cells.append('none')
                     continue
@@ -245,6 +246,58 @@ def onset() -> int:
                 cells.append(f'{(e.t[0] - 1.0) * 10.0:.2f}, {len(e)}, {within:.0f} %')
             print(f'| {rate} | {zeta:g} | ' + ' | '.join(cells) + ' |')
             sys.stdout.flush()
+    return 0
+
+
+#: ``--low-rate``: samples a period of a 10 Hz decay, and its damping ratios (3 seeds each)
+LOW_RATES = (6, 8, 10, 12, 15, 20, 30)
+LOW_RATE_ZETAS = (0.002, 0.005, 0.01, 0.02, 0.05)
+
+
+def low_rate(base: bool = False) -> int:
+    """A 10 Hz decay (37 dB, four time constants and 1 s) at few samples a period: the decided
+    configuration (``core.choice.few_samples``: the mode tracker under ``TRACKER_SAMPLES``), or
+    with ``base`` the decision without it (the default before 6 Dec 2026), both through the
+    estimator the configuration builds; per rate over its damping ratios and seeds: records with
+    no estimate, the lowest share within 2 %, the largest error, the median first estimate and
+    window (periods)."""
+    f = 10.0
+    if base:  # the decision as it was
+        choice.few_samples = lambda rate, dominant: (0, '')
+    print(
+        '| samples a period | records with none | lowest within 2 % | largest error | first '
+        '(periods, median) | window (periods, median) |'
+    )
+    print('|---|---|---|---|---|---|')
+    for rate in LOW_RATES:
+        none, share, worst, first, window = 0, [], [], [], []
+        for zeta in LOW_RATE_ZETAS:
+            for seed in range(3):
+                rng = np.random.default_rng(seed)
+                t = np.arange(0, 4 / (zeta * 2 * np.pi * f) + 1, 1 / (rate * f))
+                y = np.exp(-zeta * 2 * np.pi * f * t) * np.sin(
+                    2 * np.pi * f * t + rng.uniform(0, 6.28)
+                )
+                y = y + 0.01 / np.sqrt(2) * rng.standard_normal(len(t))
+                config, y_used, d = decided(t, y)
+                e = create_estimator(config).process(t, y_used)
+                if not len(e):
+                    none += 1
+                    continue
+                err = np.abs(e.frequency_hz / f - 1)
+                share.append(np.mean(err <= 0.02))
+                worst.append(err.max())
+                first.append(e.t[0] * f)
+                window.append(np.median(e.convergence_time) * f)
+        n = len(LOW_RATE_ZETAS) * 3
+        cells = (
+            f'{100 * min(share):.0f} % | {100 * max(worst):.1f} % | {np.median(first):.1f} | '
+            f'{np.median(window):.2f}'
+            if share
+            else '- | - | - | -'
+        )
+        print(f'| {rate} | {none} of {n} | {cells} |')
+        sys.stdout.flush()
     return 0
 
 
@@ -263,7 +316,15 @@ def main() -> int:
     parser.add_argument(
         '--onset', action='store_true', help='a pluck after rest beside the record cut at it'
     )
+    parser.add_argument(
+        '--low-rate',
+        action='store_true',
+        help='a decay at 6-30 samples a period, decided (--base: without few_samples)',
+    )
+    parser.add_argument('--base', action='store_true', help='--low-rate: the decision before')
     args = parser.parse_args()
+    if args.low_rate:
+        return low_rate(args.base)
     if args.onset:
         return onset()
     if args.sweep:

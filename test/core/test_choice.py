@@ -47,6 +47,19 @@ def test_free_decays_stay_free(record):
     assert d.window_s == 30.0  # the configured window, untouched
 
 
+def test_a_rest_read_driven_gives_the_pluck_after_it_none_of_its_energy():
+    """At 10 samples a period the envelope's blocks of a rest's noise (37 samples) wander enough
+    to read driven; the block that holds the pluck is the pluck's (an onset: free), not the
+    rest's: the decay stays free (its strongest quarter second, 15 % of its energy, went to the
+    rest, and the record to ``auto``)."""
+    t = np.arange(0, 12, 0.01)
+    tau = np.maximum(t - 2.0, 0)
+    y = np.exp(-0.005 * 2 * np.pi * 10 * tau) * np.sin(2 * np.pi * 10 * tau + 1) * (t >= 2)
+    y += 0.01 / np.sqrt(2) * np.random.default_rng(10).standard_normal(len(t))
+    d = decide(t, y)
+    assert d.excitation == 'free' and d.driven_share < 0.001, (d.excitation, d.driven_share)
+
+
 @pytest.mark.parametrize(
     'modes, fundamental',
     [

@@ -149,6 +149,19 @@ CLEAN_SNR_DB = 33.0
 FAST_ZETA = 0.015
 #: the envelope blocks of :func:`decay_zeta`, in periods
 DECAY_BLOCK_PERIODS = 2.0
+#: a free decay of one mode sampled at fewer than this many samples a period of its dominant
+#: mode goes to the mode tracker (``modes`` :data:`TRACKED_MODES`, :func:`few_samples`), whose
+#: subspace fits need no integrals of the samples: the free estimator's convergence test (Eqs.
+#: 16-17: estimates 3 samples apart within 0.1 %) rarely passes there, its algebraic estimate
+#: swinging by 1-5 % from one sample to the next (its ratio's denominator crosses zero twice a
+#: period). 10 Hz decays, zeta 0.2-5 %, 37 dB, 3 seeds each (``bench_first_estimate.py
+#: --low-rate``, 6 Dec): the free estimator gave no estimate on 13, 10, 9 and 4 of 15 records at
+#: 6, 8, 10 and 12 samples a period, 1 of 15 at 15; the tracker none, every record 100 % within
+#: 2 %. A pluck after 1 s of rest (``--onset``): the free estimator none on 4 of 6 at 12 and 2 of 6
+#: at 13 samples, the tracker 100 % within 2 % on all, its first estimate after 4.2-5.2 periods.
+#: Its windows are 48 samples or more (3.4 periods at 14 samples), the free estimator's a period:
+#: at 15 samples and more the free estimator keeps the decay
+TRACKER_SAMPLES = 14.0
 #: a free decay whose offset is known (:func:`known_offset`) is estimated with that offset removed
 #: by the damped-sinusoid model, whose frequency holds the decay (no :data:`FAST_ZETA` limit) and,
 #: with no offset to fit, is more precise over a short window: 6 seeds each (5 Dec), 0.9 periods,
@@ -301,17 +314,21 @@ def spectral_peaks(t: np.ndarray, y: np.ndarray, spec=None) -> tuple[np.ndarray,
 
 
 def driven_share(t: np.ndarray, signal: np.ndarray, dominant_hz: float) -> float:
-    """The share of the record's energy (``signal`` centred, squared) in the samples the envelope
-    (:class:`.auto.Envelope`, its block fitted to ``dominant_hz``) reads as driven: the noise a
-    free decay rings down into (a stationary tail the envelope reads as driven) weighs nothing
-    beside the decay."""
+    """The share of the record's energy (the envelope's block variances, :class:`.auto.Envelope`,
+    its block fitted to ``dominant_hz``) in the blocks it reads as driven, each block in the state
+    decided at its own end: the noise a free decay rings down into (a stationary tail the envelope
+    reads as driven) weighs nothing beside the decay, and neither does a rest before a pluck read
+    as driven (at 10-12 samples a period its 37-sample blocks of noise wander by 1.5 x), whose
+    block with the pluck is the pluck's (a sample's state, the one after the block before, gave
+    that block -- the decay's strongest quarter second, 15 % of its energy -- to the rest: 4 of
+    32 such records at 10 samples a period read ``auto``, none at 20)."""
     block = MIN_BLOCK_S
     if dominant_hz > 0:
         block = max(MIN_BLOCK_S, BLOCK_MARGIN * BLOCK_PERIODS / dominant_hz)
-    valid, driven = Envelope(block).feed(t, signal)
-    energy = np.where(valid, (signal - np.mean(signal[valid])) ** 2, 0.0)
-    total = float(np.sum(energy))
-    return float(np.sum(energy[driven])) / total if total > 0 else 0.0
+    envelope = Envelope(block)
+    envelope.feed(t, signal)
+    total = envelope.energy[FREE] + envelope.energy[DRIVEN]
+    return envelope.energy[DRIVEN] / total if total > 0 else 0.0
 
 
 def band_responses(t: np.ndarray, signal: np.ndarray, peaks):
@@ -516,6 +533,10 @@ def decide(
             + ', '.join(f'{f:.3g}' for f in sorted(separate))
             + f' Hz): the mode tracker, modes {modes}'
         )
+    rate = (len(t) - 1) / span
+    if excitation == 'free' and not modes and channels == 1:
+        modes, said = few_samples(rate, dominant)
+        seen += said
     free = (math.nan, 0.0, '', math.nan)  # a free decay's window, precision, model, offset
     # a stream (the node) keeps its window
     if excitation == 'free' and not (modes or stream) and channels == 1 and dominant > 0:
@@ -523,11 +544,24 @@ def decide(
         seen += f'; {why}'
     if lines and excitation != 'free':
         seen += '; the identifier drops its modes at the lines (lines_hz)'
-    seen_at = (tuple(peaks), seen, span, (len(t) - 1) / span)  # what was read, at what rate
+    seen_at = (tuple(peaks), seen, span, rate)  # what was read, at what rate
     drive = tuple(lines) if excitation != 'free' else ()
     return Decision(
         excitation, window, share, dominant, fundamental, *seen_at, modes, *free, drive, band
     )
+
+
+def few_samples(rate: float, dominant: float) -> tuple[int, str]:
+    """For a free decay of one mode, ``rate`` samples a second, its dominant mode at ``dominant``
+    Hz: the modes to track and the reason in words -- the mode tracker (``modes``
+    :data:`TRACKED_MODES`) under :data:`TRACKER_SAMPLES` samples a period, else ``(0, '')``."""
+    per = rate / dominant if dominant > 0 else math.inf
+    if per < TRACKER_SAMPLES:
+        return TRACKED_MODES, (
+            f'; {per:.3g} samples a period, too few for the free estimator: the mode tracker, '
+            f'modes {TRACKED_MODES}'
+        )
+    return 0, ''
 
 
 def impurity(t: np.ndarray, y: np.ndarray, f: float, spec=None) -> float:
