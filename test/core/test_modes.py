@@ -453,13 +453,13 @@ def test_a_mode_near_a_high_multiple_of_a_stronger_one_is_no_harmonic(seed):
 def test_a_gap_too_long_to_bridge_restarts_the_windows(seed):
     """``MAX_FILL`` (64 steps): 12 and 31 Hz ringing, 100 ms of samples missing at 3 s. A gap
     that long is not bridged by a straight line: the levels restart, and the modes publish again
-    from windows that start after it, the short ones first: > 60 estimates in the 0.5 s after
-    the gap, every one within 2 % (70-72; bridged, the modes wait for their longer windows to
-    clear the line: 42-45)."""
+    from windows that start after it, the short ones first: > 55 estimates in the 0.5 s after
+    the gap, every one within 2 % (64-72 over seeds 0-9; bridged, the modes wait for their
+    longer windows to clear the line: 42-45)."""
     t = np.arange(0, 4, 1 / FS)
     y = decay(t, 0.5, 12.0, 1.0, 0.001) + decay(t, 0.5, 31.0, 0.3, 0.001) + noise(t, 0.003, seed)
     keep = (t < 3.0) | (t >= 3.1)
     e = ModeTracker(CFG).process(t[keep], y[keep])
     err = np.min(np.abs(e.frequency_hz[:, None] / np.array([12.0, 31.0]) - 1), axis=1)
     assert np.all(err < 0.02)
-    assert np.sum((e.t > 3.1) & (e.t < 3.6)) > 60
+    assert np.sum((e.t > 3.1) & (e.t < 3.6)) > 55
