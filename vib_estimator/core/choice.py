@@ -107,6 +107,14 @@ RING_DB = 10.0
 #: ... at least this far (relative) from every stronger mode (the arm's three tip masses'
 #: 1.33 / 1.56 Hz, 17 %, are one mode that moved)
 MODE_GAP = 0.25
+#: ... or closer, when it rings with the stronger one (:func:`coexistence` at least this: their
+#: band-passed energies over time share this much): two modes 20-25 % apart plucked together
+#: read 0.87-0.94 (a 10 Hz mode and a 12 or 12.5 Hz one at 1:0.2-0.8, 30 dB), whose beating the
+#: one-mode estimator read as one frequency between them (at 1:0.8, 5-13 estimates, every one
+#: > 3 % off, 4 seeds of 6; at 1:0.2-0.3, 32-80 % within 2 %; the mode tracker 80-100 %); a mode
+#: that moved 0.01-0.04 (10 Hz, then 12 Hz plucked 10 s later), the arm's (bags/arm_5_5, whose
+#: 18 s hold few of the narrow bands' time resolution) 0.73
+COEXIST = 0.8
 #: ... and not within this of a harmonic (2-7 x) of one
 HARMONIC_TOL = 0.02
 #: a driven record's window, in periods of its fundamental (~15 correlation times at zeta 2 %)
@@ -524,8 +532,11 @@ def decide(
             f'; window {window:.0f} s ({window * fundamental:.0f} periods of {fundamental:.3g} Hz)'
         )
     modes = 0
-    rings = (lambda f: rings_freely(t, signal, f, spec)) if excitation == 'free' else None
-    separate = separate_modes(peaks[~is_line], powers[~is_line], rings)
+    rings = together = None
+    if excitation == 'free':
+        rings = lambda f: rings_freely(t, signal, f, spec)  # noqa: E731
+        together = lambda f, g: coexistence(t, signal, f, g)  # noqa: E731
+    separate = separate_modes(peaks[~is_line], powers[~is_line], rings, together)
     if excitation == 'free' and len(separate) > 1:
         modes = TRACKED_MODES
         seen += (
@@ -611,6 +622,18 @@ def decay_zeta(t: np.ndarray, y: np.ndarray, f: float) -> float:
     centres = (np.arange(peak + 1, k) + 0.5) * block_s
     slope = np.polyfit(centres, np.log(energy[peak + 1 : k] - floor), 1)[0]
     return float(-slope / 2 / (2 * math.pi * f))
+
+
+def coexistence(t: np.ndarray, signal: np.ndarray, f: float, g: float) -> float:
+    """How much the modes at ``f`` and ``g`` Hz ring at the same time: ``signal`` band-passed
+    around each (:func:`band_responses`), its energy in blocks of :data:`DECAY_BLOCK_PERIODS`
+    periods of the lower (:func:`decay_blocks`), each normalised to a unit sum; the sum over the
+    blocks of the smaller share (1: one envelope, 0: one after the other)."""
+    low = min(f, g)
+    a, b = (decay_blocks(t, x, low)[0].var(axis=1) for _, x in band_responses(t, signal, [f, g]))
+    if not (len(a) and a.sum() > 0 and b.sum() > 0):
+        return 0.0
+    return float(np.minimum(a / a.sum(), b / b.sum()).sum())
 
 
 def rings_freely(t: np.ndarray, signal: np.ndarray, f: float, spec) -> bool:
@@ -742,15 +765,19 @@ def window_advice(window_s: float, d: Optional[Decision], option: str) -> str:
     )
 
 
-def separate_modes(peaks: np.ndarray, powers: np.ndarray, rings=None) -> list[float]:
+def separate_modes(
+    peaks: np.ndarray, powers: np.ndarray, rings=None, together=None
+) -> list[float]:
     """The spectral peaks (strongest first) that are modes of their own: at least
     :data:`MODE_SHARE` of the strongest's power -- or, weaker, ringing freely (``rings``: a
     function of the frequency, :func:`rings_freely`; None: none does) --, :data:`MODE_GAP`
-    (relative) from every stronger one kept, and no harmonic (within :data:`HARMONIC_TOL`) of one
-    (a clipped or non-sinusoidal response)."""
+    (relative) from every stronger one kept -- or closer, ringing with it (``together``: a
+    function of both frequencies, :func:`coexistence`; None: never) --, and no harmonic (within
+    :data:`HARMONIC_TOL`) of one (a clipped or non-sinusoidal response)."""
     kept: list[float] = []
     for f, p in zip(peaks.tolist(), powers.tolist()):
-        if any(abs(f / k - 1) < MODE_GAP for k in kept):
+        near = [k for k in kept if abs(f / k - 1) < MODE_GAP]
+        if near and not (together is not None and all(together(k, f) >= COEXIST for k in near)):
             continue
         if any(abs(f / (k * n) - 1) < HARMONIC_TOL for k in kept for n in range(2, 8)):
             continue
