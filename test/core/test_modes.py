@@ -415,6 +415,10 @@ def test_a_mode_above_a_tenth_of_the_rate_is_tracked_from_level_0(seed):
     e = tr.process(t, y)
     assert np.sum(np.abs(e.frequency_hz / 150.0 - 1) < 0.02) > 200
     assert tr.counters['modes_found'] == 2 and tr.counters['modes_lost'] == 0
+    # its poles on the edge of levels 1-2 are counted (the counter was never incremented)
+    alone = ModeTracker(CFG)
+    alone.process(t, decay(t, 0.5, 10.0, 0.5) + noise(t, 0.003, seed))
+    assert tr.counters['rejected_band_edge'] > alone.counters['rejected_band_edge'] + 10
 
 
 @pytest.mark.parametrize('seed', [0, 1])

@@ -330,13 +330,15 @@ def _poles(b, ic, qs, lams, pa, s, pp, undamped):
         f = nu / h
         if (
             nu * m < C_TRACK
-            or nu > NU_HI
             or z > pa[PA_MAXDAMP]
             or z < MIN_DAMPING
             or sig < SIG_TRACK
             or f < pa[PA_BLO]
             or f > pa[PA_BHI]
         ):
+            continue
+        if nu > NU_HI:  # a pole that would count, on the level's anti-alias edge
+            ic[I_REJ_EDGE] += 1
             continue
         pp[n, 0] = f
         pp[n, 1] = rows[i, R_AMP]
