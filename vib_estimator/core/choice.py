@@ -531,22 +531,11 @@ def decide(
         seen += (
             f'; window {window:.0f} s ({window * fundamental:.0f} periods of {fundamental:.3g} Hz)'
         )
-    modes = 0
-    rings = together = None
+    modes, rate = 0, (len(t) - 1) / span
     if excitation == 'free':
-        rings = lambda f: rings_freely(t, signal, f, spec)  # noqa: E731
-        together = lambda f, g: coexistence(t, signal, f, g)  # noqa: E731
-    separate = separate_modes(peaks[~is_line], powers[~is_line], rings, together)
-    if excitation == 'free' and len(separate) > 1:
-        modes = TRACKED_MODES
-        seen += (
-            f'; {len(separate)} separate modes ('
-            + ', '.join(f'{f:.3g}' for f in sorted(separate))
-            + f' Hz): the mode tracker, modes {modes}'
-        )
-    rate = (len(t) - 1) / span
-    if excitation == 'free' and not modes and channels == 1:
-        modes, said = few_samples(rate, dominant)
+        modes, said = free_modes(t, signal, spec, peaks[~is_line], powers[~is_line])
+        if not modes and channels == 1:
+            modes, said = few_samples(rate, dominant)
         seen += said
     free = (math.nan, 0.0, '', math.nan)  # a free decay's window, precision, model, offset
     # a stream (the node) keeps its window
@@ -559,6 +548,25 @@ def decide(
     drive = tuple(lines) if excitation != 'free' else ()
     return Decision(
         excitation, window, share, dominant, fundamental, *seen_at, modes, *free, drive, band
+    )
+
+
+def free_modes(t, signal, spec, peaks: np.ndarray, powers: np.ndarray) -> tuple[int, str]:
+    """A free decay's modes to track and the reason in words: :data:`TRACKED_MODES` when its
+    spectral peaks (``spec``: :func:`spectrum`) hold several separate modes
+    (:func:`separate_modes`, with :func:`rings_freely` and :func:`coexistence`), else ``(0,
+    '')``."""
+    separate = separate_modes(
+        peaks,
+        powers,
+        lambda f: rings_freely(t, signal, f, spec),
+        lambda f, g: coexistence(t, signal, f, g),
+    )
+    if len(separate) < 2:
+        return 0, ''
+    listed = ', '.join(f'{f:.3g}' for f in sorted(separate))
+    return TRACKED_MODES, (
+        f'; {len(separate)} separate modes ({listed} Hz): the mode tracker, modes {TRACKED_MODES}'
     )
 
 
