@@ -111,3 +111,18 @@ def test_auto_keeps_the_identifiers_own_counters():
     assert ambient['rejected_damping'] > 0
     assert c['ambient_rejected_damping'] == ambient['rejected_damping']
     assert c['ambient_estimates'] == ambient['estimates']
+
+
+def test_the_batch_convenience_runs_the_configurations_estimator():
+    """``core.estimate`` runs the estimator ``create_estimator`` builds (it ran the one-mode free
+    estimator whatever ``modes`` said): a decay of 10 and 13 Hz with ``modes`` 3 gives both
+    modes, numbered, the same floats as the tracker's own batch."""
+    from vib_estimator.core import estimate
+
+    t = np.arange(0, 6, 1e-3)
+    y = np.exp(-0.02 * t) * np.sin(2 * np.pi * 10 * t) + 0.5 * np.sin(2 * np.pi * 13 * t + 1)
+    y = y + 1e-3 * np.random.default_rng(0).standard_normal(len(t))
+    config = EstimatorConfig(modes=3)
+    e = estimate(t, y, config)
+    assert set(e.mode.tolist()) == {1, 2}
+    assert np.array_equal(e.frequency_hz, create_estimator(config).process(t, y).frequency_hz)

@@ -17,9 +17,8 @@ from .estimator import (
     EstimateArrays,
     Estimator,
     FrequencyEstimator,
-    estimate,
 )
-from .factory import KINDS, create_estimator
+from .factory import KINDS, create_estimator, estimate
 
 __all__ = [
     'MODELS',

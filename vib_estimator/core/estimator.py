@@ -555,13 +555,3 @@ def run_batch(estimator, t, y, fed: int = 0) -> EstimateArrays:
     first = estimator.process(t[:k], y[:k])
     estimator.compiled()
     return EstimateArrays.concatenate([first, estimator.process(t[k:], y[k:])])
-
-
-def estimate(
-    t: Sequence[float], y: Sequence[float], config: EstimatorConfig = EstimatorConfig()
-) -> EstimateArrays:
-    """Batch convenience: run a fresh estimator over a whole record (uncompiled when its kernels
-    would have to be compiled for it, up to :data:`UNCOMPILED_SAMPLES`: :func:`run_batch`)."""
-    estimator = FrequencyEstimator(config, interpret=True)
-    batch_start(estimator)
-    return run_batch(estimator, t, y)

@@ -23,7 +23,14 @@ from typing import Callable, Optional, Sequence
 from .ambient import AmbientEstimator
 from .auto import AutoEstimator
 from .config import EstimatorConfig
-from .estimator import MIN_CHANNELS, Estimator, FrequencyEstimator, batch_start
+from .estimator import (
+    MIN_CHANNELS,
+    EstimateArrays,
+    Estimator,
+    FrequencyEstimator,
+    batch_start,
+    run_batch,
+)
 from .modes import ModeTracker
 from .multichannel_free import JointFreeEstimator
 
@@ -138,3 +145,18 @@ def batch_estimator(config: EstimatorConfig, channels: Sequence[str] = ()) -> Es
         return create_estimator(config, channels)
     batch_start(estimator)
     return estimator
+
+
+def estimate(
+    t: Sequence[float], y: Sequence[float], config: EstimatorConfig = EstimatorConfig()
+) -> EstimateArrays:
+    """Batch convenience: the estimates of ``config``'s estimator (:func:`create_estimator`, one
+    channel) over a whole record -- the one-mode free estimator uncompiled when its kernels would
+    have to be compiled for it, up to :data:`.estimator.UNCOMPILED_SAMPLES`
+    (:func:`.estimator.run_batch`). (Until 6 Dec 2026 it ran the one-mode free estimator whatever
+    ``modes`` and ``excitation`` said.)"""
+    if config.excitation != 'free' or config.modes:
+        return create_estimator(config).process(t, y)
+    estimator = FrequencyEstimator(config, interpret=True)
+    batch_start(estimator)
+    return run_batch(estimator, t, y)
