@@ -116,7 +116,7 @@ def test_auto_keeps_the_identifiers_own_counters():
 def test_the_batch_convenience_runs_the_configurations_estimator():
     """``core.estimate`` runs the estimator ``create_estimator`` builds (it ran the one-mode free
     estimator whatever ``modes`` said): a decay of 10 and 13 Hz with ``modes`` 3 gives both
-    modes, numbered, the same floats as the tracker's own batch."""
+    modes, numbered, the tracker's own batch's floats (its uncompiled start: within 1e-9)."""
     from vib_estimator.core import estimate
 
     t = np.arange(0, 6, 1e-3)
@@ -125,4 +125,5 @@ def test_the_batch_convenience_runs_the_configurations_estimator():
     config = EstimatorConfig(modes=3)
     e = estimate(t, y, config)
     assert set(e.mode.tolist()) == {1, 2}
-    assert np.array_equal(e.frequency_hz, create_estimator(config).process(t, y).frequency_hz)
+    ref = create_estimator(config).process(t, y)
+    assert np.allclose(e.frequency_hz, ref.frequency_hz, rtol=1e-9, atol=0)

@@ -151,12 +151,8 @@ def estimate(
     t: Sequence[float], y: Sequence[float], config: EstimatorConfig = EstimatorConfig()
 ) -> EstimateArrays:
     """Batch convenience: the estimates of ``config``'s estimator (:func:`create_estimator`, one
-    channel) over a whole record -- the one-mode free estimator uncompiled when its kernels would
-    have to be compiled for it, up to :data:`.estimator.UNCOMPILED_SAMPLES`
-    (:func:`.estimator.run_batch`). (Until 6 Dec 2026 it ran the one-mode free estimator whatever
-    ``modes`` and ``excitation`` said.)"""
-    if config.excitation != 'free' or config.modes:
-        return create_estimator(config).process(t, y)
-    estimator = FrequencyEstimator(config, interpret=True)
-    batch_start(estimator)
-    return run_batch(estimator, t, y)
+    channel) over a whole record, run as ``analyze`` runs it (:func:`batch_estimator`,
+    :func:`~.estimator.run_batch`: uncompiled at first when its kernels would have to be compiled
+    for it). (Until 6 Dec 2026 it ran the one-mode free estimator whatever ``modes`` and
+    ``excitation`` said.)"""
+    return run_batch(batch_estimator(config), t, y)
