@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from vib_estimator.analysis.choosing import decided_config
-from vib_estimator.core import EstimatorConfig, choice, create_estimator, estimate
+from vib_estimator.core import EstimatorConfig, choice, estimate
 from vib_estimator.core.choice import decide
 from vib_estimator.io.csv_reader import read_csv_series
 from vib_estimator.sim import arm_model
@@ -238,7 +238,7 @@ def onset() -> int:
             cells = []
             for sel in (t >= 0.0, t >= 1.0):
                 config, y_used, _ = decided(t[sel], y[sel])
-                e = create_estimator(config).process(t[sel], y_used)
+                e = estimate(t[sel], y_used, config)
                 if not len(e):
                     cells.append('none')
                     continue
@@ -280,7 +280,7 @@ def low_rate(base: bool = False) -> int:
                 )
                 y = y + 0.01 / np.sqrt(2) * rng.standard_normal(len(t))
                 config, y_used, d = decided(t, y)
-                e = create_estimator(config).process(t, y_used)
+                e = estimate(t, y_used, config)
                 if not len(e):
                     none += 1
                     continue

@@ -232,14 +232,14 @@ def few_samples_decay(per_period: float, zeta: float, seed: int):
 
 def default_estimates(t, y):
     """What ``analyze`` with no option estimates, through the estimator its configuration
-    builds (the mode tracker too)."""
-    from vib_estimator.core import create_estimator
+    builds (``core.estimate``: the mode tracker too)."""
+    from vib_estimator.core import estimate
 
     args = argparse.Namespace(
         excitation=None, paper=False, min_periods=None, ambient_window_s=None, model=None
     )
     config, d, _ = prepare(args, EstimatorConfig(), t, y, 1, 'analyze')
-    return create_estimator(config).process(t, y - d.offset if np.isfinite(d.offset) else y)
+    return estimate(t, y - d.offset if np.isfinite(d.offset) else y, config)
 
 
 @pytest.mark.parametrize(
