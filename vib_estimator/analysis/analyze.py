@@ -38,7 +38,15 @@ from ..io.csv_reader import csv_layout
 from ..io.fields import INPUT_TYPES, signal_unit
 from ..io.streaming import Signal, is_csv, open_signal
 from .channels import channel_names, component_names, need_joint, run_joint, topic_list
-from .choosing import explain_no_estimate, prepare, read_ahead
+from .choosing import (
+    decides,
+    explain_no_estimate,
+    model_given,
+    periods_given,
+    prepare,
+    read_ahead,
+    rescue,
+)
 from .outputs import check_output
 from .summary import summarise_modes, summary_lines
 
@@ -329,6 +337,24 @@ def damage_warning(signal: Signal, prog: str) -> None:
         )
 
 
+def estimate_record(args, signal: Signal, config, decision, blocks, offset: float, notes: list):
+    """``(config, run)``: ``signal`` (its ``blocks`` read ahead) estimated less ``offset`` by
+    ``config``; a free decay the free estimator gave no estimate of read again by the mode
+    tracker (:func:`.choosing.rescue`: decided, no ``--model`` or ``--min-periods``), its line
+    added to ``notes``."""
+    keep = bool(args.plot or args.report)
+    result = estimate_signal(signal, config, keep, blocks, offset)
+    free_kept = model_given(args) or periods_given(args)  # the free estimator, as chosen
+    chosen = decides(args) and not free_kept
+    again = rescue(config, decision, chosen, len(result.estimates), 'analyze')
+    if again is None:
+        return config, result
+    config, line = again
+    notes.append(line)
+    signal.skipped = signal.corrupt = 0  # counted again
+    return config, estimate_signal(signal, config, keep)
+
+
 def run(args: argparse.Namespace) -> int:
     try:
         config = make_config(args)
@@ -366,7 +392,7 @@ def run(args: argparse.Namespace) -> int:
         if ahead is not None:
             config, decision, notes = prepare(args, config, *ahead, 1, 'analyze')
         offset = decision.offset if decision is not None and math.isfinite(decision.offset) else 0
-        result = estimate_signal(signal, config, bool(args.plot or args.report), blocks, offset)
+        config, result = estimate_record(args, signal, config, decision, blocks, offset, notes)
     except (VibEstimatorError, ValueError) as err:
         return report(err, 'vib-estimator analyze')
     damage_warning(signal, 'vib-estimator analyze')

@@ -24,7 +24,7 @@ from typing import Iterable, Iterator, Optional, Tuple
 import numpy as np
 
 from ..core.ambient import MIN_WINDOW_SAMPLES
-from ..core.choice import DECIDE_S, DRIVEN_ABOVE, FREE_BELOW, Decision, decide
+from ..core.choice import DECIDE_S, DRIVEN_ABOVE, FREE_BELOW, TRACKED_MODES, Decision, decide
 from ..core.choice import window_advice as choice_window_advice
 from ..core.config import EstimatorConfig
 
@@ -88,6 +88,27 @@ def decided_config(
         band_hz=config.band_hz or d.band_hz or None,
     )
     return changed, line
+
+
+def rescue(
+    config: EstimatorConfig, d: Optional[Decision], decided: bool, estimated: int, prog: str
+) -> Optional[Tuple[EstimatorConfig, str]]:
+    """For a record decided (``decided``: no option chose the excitation) a free decay of one
+    mode whose free estimator gave no estimate (``estimated`` 0) -- its convergence test (Eqs.
+    16-17) never passing in the record's noise at its samples a period, or its fit gate holding
+    back every estimate of a heavily damped decay --: the mode tracker's configuration (``modes``
+    :data:`..core.choice.TRACKED_MODES`, the samples as read) and the line that says so; None
+    otherwise (an estimate, an option, a record with no spectral peak)."""
+    if estimated or not decided or d is None or config.excitation != 'free' or config.modes:
+        return None
+    if not d.dominant_hz > 0:
+        return None
+    line = (
+        f'{prog}: the free estimator gave no estimate of this free decay at {d.dominant_hz:.4g} '
+        f'Hz: the mode tracker (modes {TRACKED_MODES}) estimated it; --excitation free keeps the '
+        'free estimator'
+    )
+    return config.replace(modes=TRACKED_MODES), line
 
 
 def contradiction(config: EstimatorConfig, d: Decision, prog: str) -> str:

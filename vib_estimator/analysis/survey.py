@@ -67,7 +67,15 @@ from ..io.streaming import BagInfo, bag_info, is_csv, open_signal, supported_top
 from . import health
 from .analyze import Run, add_config_arguments, estimate_signal, make_config
 from .channels import channel_list, joint_run, mode_shapes, need_joint, read_channels
-from .choosing import decided_config, decides, read_ahead, window_given
+from .choosing import (
+    decided_config,
+    decides,
+    model_given,
+    periods_given,
+    read_ahead,
+    rescue,
+    window_given,
+)
 from .interval import combine
 from .outputs import check_output, progress
 
@@ -150,6 +158,9 @@ class Options:
     keep_window: bool = False
     #: ``--covariates``: each recording's mean of these (:mod:`..io.covariates`) in its rows
     covariates: Tuple[str, ...] = ()
+    #: a free decay of one mode that the free estimator gave no estimate of is read again by the
+    #: mode tracker (:func:`.choosing.rescue`; decided, and no ``--model`` or ``--min-periods``)
+    rescues: bool = False
 
     def kept(self) -> Tuple[bool, bool]:
         """(keep_window, keep_periods) of :func:`.choosing.decided_config`: the free-decay window
@@ -564,21 +575,19 @@ def _recording_rows(path: Path, options: Options) -> List[Dict]:
                 continue
             column = channels[0] if channels else options.column
             signal = open_signal(path, topic, component, column, options.strict, info=info)
-            config, blocks = options.config, None
+            config, blocks, d = options.config, None, None
             if options.decide:
                 ahead, blocks = read_ahead(signal.blocks())
                 if ahead is not None:
                     d = decide(*ahead, 1, config.ambient_window_s)
                     config = decided_config(config, d, 'survey', *options.kept())[0]
-            rows.extend(
-                _stat_rows(
-                    path,
-                    signal,
-                    estimate_signal(signal, config, blocks=blocks),
-                    config.modes,
-                    options.summary,
-                )
-            )
+            result = estimate_signal(signal, config, blocks=blocks)
+            again = rescue(config, d, options.rescues, len(result.estimates), 'survey')
+            if again is not None:  # read again, by the mode tracker
+                config = again[0]
+                signal.skipped = signal.corrupt = 0
+                result = estimate_signal(signal, config)
+            rows.extend(_stat_rows(path, signal, result, config.modes, options.summary))
         except Exception as err:  # noqa: BLE001 -- as above
             rows.append(_error_row(path, topic or '', component or ','.join(channels), err))
     return rows
@@ -995,6 +1004,7 @@ def _options(args: argparse.Namespace) -> Options:
         decides(args),
         window_given(args),
         covariates,
+        decides(args) and not (model_given(args) or periods_given(args)),
     )
 
 

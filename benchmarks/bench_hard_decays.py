@@ -1,0 +1,151 @@
+# Copyright 2026 vib_estimator developers
+# SPDX-License-Identifier: Apache-2.0
+"""Free decays the default once got wrong or left silent, through ``vib-estimator analyze FILE
+--format jsonl`` with no option (in process), beside the default as it was before 6 Dec 2026
+(``--base``: no :func:`core.choice.heavily_damped`, no :func:`core.choice.steady_line`, no
+:func:`analysis.choosing.rescue`), in the same run (issue 37: "whatever they bring").
+
+- ``--heavy``: one mode damped at 1-8 % (2, 5 and 20 Hz at 50-500 samples a period, a pluck after
+  1 s of rest, ringing 5 time constants, 30 and 45 dB, 2 seeds): records with no estimate, the
+  lowest share within 2 %, estimates beyond 5 %, the median first estimate after the pluck and
+  the median window (periods).
+- ``--silent``: one lightly damped mode (0.2-4 %) at 20 and 60 samples a period in 20 and 30 dB,
+  where the free estimator's convergence test rarely passes (1, 5, 20 and 60 Hz, 2 seeds).
+- ``--hum``: a 5 Hz (2 Hz) pluck with mains hum at 50 Hz (60 Hz), 0.3-10 % of its amplitude, 14
+  or 40 s: estimates, share within 2 % of the decay's frequency, estimates beyond 5 %.
+
+    cd benchmarks && ../.venv/bin/python bench_hard_decays.py --heavy [--base]
+    cd benchmarks && ../.venv/bin/python bench_hard_decays.py --silent [--base]
+    cd benchmarks && ../.venv/bin/python bench_hard_decays.py --hum [--base]
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import io
+import itertools
+import json
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from vib_estimator.analysis import analyze as analyze_module
+from vib_estimator.cli import main as cli
+from vib_estimator.core import choice
+
+#: --heavy: damping ratios; (frequency Hz, samples a second) of each
+HEAVY_ZETAS = (0.01, 0.02, 0.03, 0.05, 0.08)
+HEAVY_RECORDS = ((2.0, 500.0), (5.0, 1000.0), (20.0, 1000.0))
+#: --silent: frequencies, samples a period, damping ratios, SNRs (dB)
+SILENT = ((1.0, 5.0, 20.0, 60.0), (20, 60), (0.002, 0.005, 0.01, 0.02, 0.04), (20, 30))
+
+
+def pluck(f: float, fs: float, zeta: float, snr: float, seed: int, seconds: float = 0.0):
+    """A decay at ``f`` Hz after 1 s of rest, ringing 5 time constants (at most 60 s) or
+    ``seconds``, in white noise ``snr`` dB below its start."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(0, seconds or min(5 / (zeta * 2 * np.pi * f), 60) + 1.0, 1 / fs)
+    tau = np.clip(t - 1.0, 0, None)
+    w = 2 * np.pi * f * np.sqrt(1 - zeta * zeta)
+    y = np.exp(-zeta * 2 * np.pi * f * tau) * np.sin(w * tau + rng.uniform(0, 2 * np.pi))
+    y = y * (t >= 1.0) + 10 ** (-snr / 20) / np.sqrt(2) * rng.standard_normal(len(t))
+    return t, y
+
+
+def analyzed(t: np.ndarray, y: np.ndarray, folder: Path) -> list[dict]:
+    """``analyze``'s rows of ``(t, y)`` written as a CSV, no option."""
+    path = folder / 'record.csv'
+    header = 'time_s,y'
+    np.savetxt(path, np.column_stack([t, y]), delimiter=',', header=header, comments='')
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(io.StringIO()):
+        cli(['analyze', str(path), '--format', 'jsonl'])
+    return [json.loads(line) for line in out.getvalue().splitlines() if line.startswith('{')]
+
+
+def score(rows: list[dict], f: float) -> tuple:
+    """(estimates, share within 2 %, beyond 5 %, first after the pluck and median window in
+    periods) of ``rows`` against ``f`` Hz."""
+    if not rows:
+        return 0, np.nan, 0, np.nan, np.nan
+    est = np.array([r['frequency_hz'] for r in rows])
+    err = np.abs(est / f - 1)
+    conv = np.median([r['convergence_time_s'] for r in rows]) * f
+    return len(est), np.mean(err <= 0.02), int(np.sum(err > 0.05)), (rows[0]['t'] - 1) * f, conv
+
+
+def table(cases, folder: Path) -> None:
+    """One row per group of ``cases`` ((label, [(f, t, y)...])): records with none, the lowest
+    and mean share within 2 %, estimates beyond 5 %, median first and window (periods)."""
+    print(
+        '| case | records with none | within 2 %: lowest, mean | > 5 % | first (periods, '
+        'median) | window (periods, median) |'
+    )
+    print('|---|---|---|---|---|---|')
+    for label, records in cases:
+        s = np.array([score(analyzed(t, y, folder), f) for f, t, y in records], float)
+        got = s[s[:, 0] > 0]
+        cells = (
+            f'{100 * np.min(got[:, 1]):.0f} %, {100 * np.mean(got[:, 1]):.1f} % | '
+            f'{int(np.sum(got[:, 2]))} | {np.median(got[:, 3]):.2f} | {np.median(got[:, 4]):.2f}'
+            if len(got)
+            else '- | - | - | -'
+        )
+        print(f'| {label} | {int(np.sum(s[:, 0] == 0))} of {len(s)} | {cells} |')
+        sys.stdout.flush()
+
+
+def heavy():
+    for zeta in HEAVY_ZETAS:
+        records = [
+            (f, *pluck(f, fs, zeta, snr, seed))
+            for (f, fs), snr, seed in itertools.product(HEAVY_RECORDS, (30, 45), range(2))
+        ]
+        yield f'zeta {100 * zeta:g} %', records
+
+
+def silent():
+    freqs, periods, zetas, snrs = SILENT
+    for per, snr in itertools.product(periods, snrs):
+        records = [
+            (f, *pluck(f, per * f, zeta, snr, seed))
+            for f, zeta, seed in itertools.product(freqs, zetas, range(2))
+        ]
+        yield f'{per} samples a period, {snr} dB', records
+
+
+def hum():
+    for f, line, seconds, lines in (
+        (5.0, 50.0, 0.0, (0.02, 0.1)),
+        (5.0, 50.0, 40.0, (0.003, 0.01, 0.03)),
+        (2.0, 60.0, 40.0, (0.01, 0.03, 0.1)),
+    ):
+        for a in lines:
+            t, y = pluck(f, 1000.0, 0.01, 40, 0, seconds)
+            label = f'{f:g} Hz, {t[-1]:.0f} s, hum at {line:g} Hz {100 * a:g} %'
+            yield label, [(f, t, y + a * np.sin(2 * np.pi * line * t))]
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument('--heavy', action='store_true', help='decays damped at 1-8 %%')
+    parser.add_argument('--silent', action='store_true', help='20-60 samples a period, 20-30 dB')
+    parser.add_argument('--hum', action='store_true', help='a pluck beside mains hum')
+    parser.add_argument('--base', action='store_true', help='the default before 6 Dec 2026')
+    args = parser.parse_args()
+    if args.base:
+        choice.heavily_damped = lambda t, signal, dominant: (0, '')
+        choice.steady_line = lambda t, signal, f, dominant: False
+        analyze_module.rescue = lambda *args: None
+    with tempfile.TemporaryDirectory() as folder:
+        for wanted, cases in ((args.heavy, heavy), (args.silent, silent), (args.hum, hum)):
+            if wanted:
+                table(cases(), Path(folder))
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
