@@ -117,6 +117,33 @@ def test_the_window_is_bounded_by_the_record_and_the_maximum():
     assert decide(t, y).window_s == choice.MAX_WINDOW_S
 
 
+@pytest.mark.parametrize('factor', [1e-3, 1e3])
+def test_a_short_driven_record_gets_a_window_it_holds_twice(monkeypatch, factor):
+    """A 20 s driven record (a 5 Hz mode at zeta 1 %), shorter than two configured windows (30
+    s: no analysis at all, before): windows of half the record (``SHORT_WINDOWS``), whose
+    estimates are all within 2 %. At 0.001x and 1000x no estimate (a 30 s window; a 0.01 s
+    one)."""
+    from vib_estimator.core import EstimatorConfig, estimate
+
+    t, y, _ = ambient_record(20, 500, [(5.0, 0.01, 1.0)], 20, 1)
+
+    def right():
+        d = decide(t, y)
+        try:
+            config = EstimatorConfig(excitation='ambient', ambient_window_s=d.window_s)
+            e = estimate(t, y, config)
+        except ValueError:
+            return False
+        return (
+            d.excitation == 'ambient'
+            and len(e) >= 3
+            and np.all(abs(e.frequency_hz / 5 - 1) < 0.02)
+        )
+
+    assert decide(t, y).window_s == pytest.approx(10.0, abs=0.01)
+    holds_then_breaks(monkeypatch, 'SHORT_WINDOWS', factor, right)
+
+
 def test_several_channels_decide_on_their_principal_component():
     t, y, freqs, _ = frame_record(300, 40, seed=3)
     d = decide(t, y, channels=y.shape[1])

@@ -29,7 +29,9 @@ first :data:`DECIDE_S` seconds of the record (all channels):
    (about 15 correlation times ``1 / (2 pi zeta f)`` of a mode at zeta = 2 %: the frequency of a
    lightly damped mode scatters by more than 2 % across windows of a few correlation times, and
    the identifier drops it), at least the configured ``ambient_window_s`` and at most
-   :data:`MAX_WINDOW_S`, and no longer than the record allows :data:`MIN_ANALYSES` analyses of.
+   :data:`MAX_WINDOW_S`, and no longer than the record allows :data:`MIN_ANALYSES` analyses of;
+   a record shorter than :data:`SHORT_WINDOWS` configured windows gets windows of that share of
+   it.
 
 5. **A periodic drive** (a move cycle, a machine's harmonics): spectral peaks whose band-passed
    response is a sinusoid of steady amplitude (kurtosis under :data:`LINE_KURTOSIS`, Brincker et
@@ -203,6 +205,10 @@ OFFSET_MOVE = 0.1
 ASSUMED_ZETA = 0.02
 #: the window leaves the record room for at least this many analyses (one per second)
 MIN_ANALYSES = 60
+#: ... and a record shorter than this many configured windows is analysed in windows of that
+#: share of it (a 20 s driven record: 10 s windows, 6 analyses; with the configured 30 s it gave
+#: no analysis at all)
+SHORT_WINDOWS = 2.0
 #: a spectral peak whose response, band-passed within :data:`LINE_BAND` of it, has a kurtosis
 #: below this is a sinusoid of steady amplitude -- a line of a periodic drive -- not a mode
 #: driven by noise (:func:`peak_kurtosis`; Brincker, Andersen and Moeller 2000, "An indicator
@@ -495,9 +501,10 @@ def decide(
 ) -> Decision:
     """The :class:`Decision` for the record ``(t, y)`` (its first :data:`DECIDE_S` s are read;
     ``y`` samples or samples x ``channels``), ``window_s`` the shortest window (the configured
-    one). ``stream``: the record is the last seconds of a stream that goes on (the window is not
-    bounded by the room for :data:`MIN_ANALYSES` analyses, and a free decay's window is not
-    decided: the node cannot see a spectrum ahead, and a stream's default stays ``free``'s).
+    one; a record shorter than :data:`SHORT_WINDOWS` of them: that share of it). ``stream``: the
+    record is the last seconds of a stream that goes on (the window is not bounded by the room
+    for :data:`MIN_ANALYSES` analyses, and a free decay's window is not decided: the node cannot
+    see a spectrum ahead, and a stream's default stays ``free``'s).
     ``offset_ok``: the caller can remove a known offset from the samples (:attr:`Decision.offset`;
     :func:`fast_window`)."""
     t, y = readable(t, y)
@@ -534,7 +541,9 @@ def decide(
         band = ()
     window = window_s
     if excitation != 'free' and math.isfinite(fundamental):
-        room = math.inf if stream else max(window_s, span - MIN_ANALYSES)
+        room = (
+            math.inf if stream else max(min(window_s, span / SHORT_WINDOWS), span - MIN_ANALYSES)
+        )
         window = min(max(window_s, WINDOW_PERIODS / fundamental), MAX_WINDOW_S, room)
         seen += (
             f'; window {window:.0f} s ({window * fundamental:.0f} periods of {fundamental:.3g} Hz)'

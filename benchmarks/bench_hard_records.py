@@ -1,9 +1,10 @@
 # Copyright 2026 vib_estimator developers
 # SPDX-License-Identifier: Apache-2.0
-"""Free decays the default once got wrong or left silent, through ``vib-estimator analyze FILE
+"""Records the default once got wrong or left silent, through ``vib-estimator analyze FILE
 --format jsonl`` with no option (in process), beside the default as it was before 6 Dec 2026
 (``--base``: no :func:`core.choice.heavily_damped`, no :func:`core.choice.steady_line`, no
-:func:`analysis.choosing.rescue`), in the same run (issue 37: "whatever they bring").
+:func:`analysis.choosing.rescue`, no short-record windows, ``core.choice.SHORT_WINDOWS``), in
+the same run (issue 37: "whatever they bring").
 
 - ``--heavy``: one mode damped at 1-8 % (2, 5 and 20 Hz at 50-500 samples a period, a pluck after
   1 s of rest, ringing 5 time constants, 30 and 45 dB, 2 seeds): records with no estimate, the
@@ -13,10 +14,13 @@
   where the free estimator's convergence test rarely passes (1, 5, 20 and 60 Hz, 2 seeds).
 - ``--hum``: a 5 Hz (2 Hz) pluck with mains hum at 50 Hz (60 Hz), 0.3-10 % of its amplitude, 14
   or 40 s: estimates, share within 2 % of the decay's frequency, estimates beyond 5 %.
+- ``--short``: driven records of 15-90 s (white noise through 1.2, 2, 5 and 5 + 17 Hz modes at
+  zeta 0.5-2 %, 500 Hz, 26 dB): estimates, modes found (within 2 %), share within 2 %, beyond 5 %.
 
-    cd benchmarks && ../.venv/bin/python bench_hard_decays.py --heavy [--base]
-    cd benchmarks && ../.venv/bin/python bench_hard_decays.py --silent [--base]
-    cd benchmarks && ../.venv/bin/python bench_hard_decays.py --hum [--base]
+    cd benchmarks && ../.venv/bin/python bench_hard_records.py --heavy [--base]
+    cd benchmarks && ../.venv/bin/python bench_hard_records.py --silent [--base]
+    cd benchmarks && ../.venv/bin/python bench_hard_records.py --hum [--base]
+    cd benchmarks && ../.venv/bin/python bench_hard_records.py --short [--base]
 """
 
 from __future__ import annotations
@@ -35,6 +39,7 @@ import numpy as np
 from vib_estimator.analysis import analyze as analyze_module
 from vib_estimator.cli import main as cli
 from vib_estimator.core import choice
+from vib_estimator.sim.ambient import ambient_record
 
 #: --heavy: damping ratios; (frequency Hz, samples a second) of each
 HEAVY_ZETAS = (0.01, 0.02, 0.03, 0.05, 0.08)
@@ -129,21 +134,56 @@ def hum():
             yield label, [(f, t, y + a * np.sin(2 * np.pi * line * t))]
 
 
+#: --short: the records' seconds, and their modes ((f, zeta, amplitude) each)
+SHORT_SECONDS = (15, 20, 30, 45, 60, 90)
+SHORT_MODES = {
+    '5 Hz, zeta 1 %': [(5.0, 0.01, 1.0)],
+    '2 Hz, zeta 1 %': [(2.0, 0.01, 1.0)],
+    '5 + 17 Hz': [(5.0, 0.01, 1.0), (17.0, 0.005, 0.3)],
+    '1.2 Hz, zeta 2 %': [(1.2, 0.02, 1.0)],
+}
+
+
+def short(folder: Path) -> None:
+    print('| record | seconds | estimates | modes found | within 2 % | > 5 % |')
+    print('|---|---|---|---|---|---|')
+    for name, modes in SHORT_MODES.items():
+        truth = np.array([m[0] for m in modes])
+        for seconds in SHORT_SECONDS:
+            t, y, _ = ambient_record(seconds, 500, modes, 26, 8)
+            rows = analyzed(t, y, folder)
+            if not rows:
+                print(f'| {name} | {seconds} | 0 | 0/{len(truth)} | - | - |')
+                continue
+            est = np.array([r['frequency_hz'] for r in rows])
+            err = np.min(np.abs(est[:, None] / truth - 1), axis=1)
+            found = sum(np.any(np.abs(est / f - 1) <= 0.02) for f in truth)
+            print(
+                f'| {name} | {seconds} | {len(est)} | {found}/{len(truth)} | '
+                f'{100 * np.mean(err <= 0.02):.0f} % | {int(np.sum(err > 0.05))} |'
+            )
+            sys.stdout.flush()
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--heavy', action='store_true', help='decays damped at 1-8 %%')
     parser.add_argument('--silent', action='store_true', help='20-60 samples a period, 20-30 dB')
     parser.add_argument('--hum', action='store_true', help='a pluck beside mains hum')
+    parser.add_argument('--short', action='store_true', help='driven records of 15-90 s')
     parser.add_argument('--base', action='store_true', help='the default before 6 Dec 2026')
     args = parser.parse_args()
     if args.base:
         choice.heavily_damped = lambda t, signal, dominant: (0, '')
         choice.steady_line = lambda t, signal, f, dominant: False
         analyze_module.rescue = lambda *args: None
+        choice.SHORT_WINDOWS = 1e-9  # the configured window, whatever the record's length
     with tempfile.TemporaryDirectory() as folder:
         for wanted, cases in ((args.heavy, heavy), (args.silent, silent), (args.hum, hum)):
             if wanted:
                 table(cases(), Path(folder))
+        if args.short:
+            short(Path(folder))
     return 0
 
 
