@@ -86,6 +86,18 @@ def records(folder: Path, real: Path | None):
     rec = arm_model.experiment_5_3(0)
     path = write_csv(folder, 'arm53', rec.t, rec.torque)
     out.append(('arm 5.3 (sim)', 'free', path, [], [1.3306], ['--paper']))
+    # added 6 Dec 2026 (bench_hard_records.py): a heavily damped pluck, one beside mains hum
+    for name, zeta, seconds, hum, tuned in (
+        ('decay 5 Hz, zeta 5 %', 0.05, 4.2, 0.0, ['--modes', '3']),
+        ('decay 5 Hz beside 3 % hum', 0.01, 40.0, 0.03, ['--band-hz', '1.58', '15.8']),
+    ):
+        t = np.arange(0, seconds, 0.001)
+        tau = np.maximum(t - 1.0, 0)
+        y = np.exp(-zeta * 2 * np.pi * 5 * tau) * np.sin(2 * np.pi * 5 * tau + 1) * (t >= 1)
+        y += hum * np.sin(2 * np.pi * 50 * t)
+        y += 10**-1.5 / np.sqrt(2) * np.random.default_rng(11).standard_normal(len(t))
+        path = write_csv(folder, name.split(',')[0].replace(' ', '_'), t, y)
+        out.append((name, 'free', path, [], [5.0], tuned))
     cases = {
         '5 Hz, zeta 1 %': [(5.0, 0.01, 1.0)],
         '5 Hz, zeta 0.2 %': [(5.0, 0.002, 1.0)],
@@ -107,6 +119,10 @@ def records(folder: Path, real: Path | None):
                 ['--excitation', 'ambient'],
             )
         )
+    t, y, _ = ambient_record(20, 500, cases['5 + 17 Hz'], 20, 0)  # a short record (6 Dec)
+    path = write_csv(folder, 'driven_short', t, y)
+    tuned = ['--excitation', 'ambient', '--ambient-window-s', '10']
+    out.append(('driven 5 + 17 Hz, 20 s', 'driven', path, [], [5.0, 17.0], tuned))
     for drive, level in (('random', 0.3), ('ambient', 0.02)):
         rec = arm_model.simulate_driven(180, drive, level, seed=0)
         path = write_csv(folder, f'arm_{drive}', rec.t, rec.torque)
