@@ -5,18 +5,22 @@ the record (analysis.choosing over core.choice): a free decay gives exactly ``--
 free``'s output, a driven record the identifier's modes; ``--paper`` and ``--excitation`` are
 never overridden."""
 
-import argparse
 import json
 import re
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-from vib_estimator.analysis.choosing import prepare, window_advice
+from vib_estimator.analysis.choosing import window_advice
 from vib_estimator.cli import main
 from vib_estimator.core import EstimatorConfig
 from vib_estimator.sim.ambient import ambient_record
 from vib_estimator.sim.frame import frame_record
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from test_analyze import decided  # noqa: E402 -- analyze's estimates with no option
 
 
 def write(path, t, y, names=None):
@@ -132,7 +136,6 @@ def test_a_forced_excitation_the_record_contradicts_is_warned_about(capsys, free
 
 
 def test_no_mode_from_a_short_window_says_which_window_helps(capsys, tmp_path):
-    from vib_estimator.core import EstimatorConfig
     from vib_estimator.core.choice import decide
 
     # a 0.5 Hz mode: 20 s hold 1.3 correlation times at zeta 2 %, 6 s at 20 Hz too few samples
@@ -230,18 +233,6 @@ def few_samples_decay(per_period: float, zeta: float, seed: int):
     return t, y + 0.01 / np.sqrt(2) * rng.standard_normal(len(t))
 
 
-def default_estimates(t, y):
-    """What ``analyze`` with no option estimates, through the estimator its configuration
-    builds (``core.estimate``: the mode tracker too)."""
-    from vib_estimator.core import estimate
-
-    args = argparse.Namespace(
-        excitation=None, paper=False, min_periods=None, ambient_window_s=None, model=None
-    )
-    config, d, _ = prepare(args, EstimatorConfig(), t, y, 1, 'analyze')
-    return estimate(t, y - d.offset if np.isfinite(d.offset) else y, config)
-
-
 @pytest.mark.parametrize(
     'per_period, zeta, seed',
     [(7, 0.005, 0), (12, 0.01, 0), (12, 0.002, 0), (13, 0.01, 1)],  # none of them before
@@ -250,7 +241,7 @@ def test_a_decay_at_few_samples_a_period_is_estimated(per_period, zeta, seed):
     """Under 14 samples a period the paper's convergence test (estimates 3 samples apart within
     0.1 %) rarely passes: the mode tracker estimates the decay (core.choice.few_samples), every
     estimate within 2 %."""
-    e = default_estimates(*few_samples_decay(per_period, zeta, seed))
+    e = decided(*few_samples_decay(per_period, zeta, seed))
     err = np.abs(e.frequency_hz / 10.0 - 1)
     assert len(e) >= 20 and np.all(err <= 0.02), (len(e), err.max() if len(e) else None)
 
@@ -261,9 +252,9 @@ def test_a_decay_at_many_samples_a_period_keeps_the_convergence_test(monkeypatch
     from vib_estimator.core import choice
 
     t, y = few_samples_decay(100, 0.01, 1)
-    e = default_estimates(t, y)
+    e = decided(t, y)
     monkeypatch.setattr(choice, 'few_samples', lambda rate, dominant: (0, ''))
-    before = default_estimates(t, y)
+    before = decided(t, y)
     assert len(e) >= 20 and np.array_equal(e.frequency_hz, before.frequency_hz)
 
 
