@@ -3,8 +3,8 @@
 """Records the default once got wrong or left silent, through ``vib-estimator analyze FILE
 --format jsonl`` with no option (in process), beside the default as it was before 6 Dec 2026
 (``--base``: no :func:`core.choice.heavily_damped`, no :func:`core.choice.steady_line`, no
-:func:`analysis.choosing.rescue`, no short-record windows, ``core.choice.SHORT_WINDOWS``), in
-the same run (issue 37: "whatever they bring").
+:func:`analysis.choosing.rescue` nor the node's ``core.choice.SILENT_PERIODS``, no short-record
+windows, ``core.choice.SHORT_WINDOWS``), in the same run (issue 37: "whatever they bring").
 
 - ``--heavy``: one mode damped at 1-8 % (2, 5 and 20 Hz at 50-500 samples a period, a pluck after
   1 s of rest, ringing 5 time constants, 30 and 45 dB, 2 seeds): records with no estimate, the
@@ -21,6 +21,7 @@ the same run (issue 37: "whatever they bring").
     cd benchmarks && ../.venv/bin/python bench_hard_records.py --silent [--base]
     cd benchmarks && ../.venv/bin/python bench_hard_records.py --hum [--base]
     cd benchmarks && ../.venv/bin/python bench_hard_records.py --short [--base]
+    cd benchmarks && ../.venv/bin/python bench_hard_records.py --heavy --silent --node [--base]
 """
 
 from __future__ import annotations
@@ -30,11 +31,13 @@ import contextlib
 import io
 import itertools
 import json
+import math
 import sys
 import tempfile
 from pathlib import Path
 
 import numpy as np
+from bench_defaults import streamed
 
 from vib_estimator.analysis import analyze as analyze_module
 from vib_estimator.cli import main as cli
@@ -60,11 +63,14 @@ def pluck(f: float, fs: float, zeta: float, snr: float, seed: int, seconds: floa
     return t, y
 
 
-def analyzed(t: np.ndarray, y: np.ndarray, folder: Path) -> list[dict]:
-    """``analyze``'s rows of ``(t, y)`` written as a CSV, no option."""
+def analyzed(t: np.ndarray, y: np.ndarray, folder: Path, node: bool = False) -> list[dict]:
+    """``analyze``'s rows of ``(t, y)`` written as a CSV, no option (``node``: the node's
+    defaults on it streamed, ``bench_defaults.streamed``: rows without ``t``)."""
     path = folder / 'record.csv'
     header = 'time_s,y'
     np.savetxt(path, np.column_stack([t, y]), delimiter=',', header=header, comments='')
+    if node:
+        return streamed(path, [])[1]
     out = io.StringIO()
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(io.StringIO()):
         cli(['analyze', str(path), '--format', 'jsonl'])
@@ -79,10 +85,16 @@ def score(rows: list[dict], f: float) -> tuple:
     est = np.array([r['frequency_hz'] for r in rows])
     err = np.abs(est / f - 1)
     conv = np.median([r['convergence_time_s'] for r in rows]) * f
-    return len(est), np.mean(err <= 0.02), int(np.sum(err > 0.05)), (rows[0]['t'] - 1) * f, conv
+    first = (rows[0]['t'] - 1) * f if 't' in rows[0] else np.nan
+    return len(est), np.mean(err <= 0.02), int(np.sum(err > 0.05)), first, conv
 
 
-def table(cases, folder: Path) -> None:
+def first(periods: np.ndarray) -> str:
+    """The median first estimate, or '-' (the node's rows carry no time)."""
+    return '-' if np.all(np.isnan(periods)) else f'{np.nanmedian(periods):.2f}'
+
+
+def table(cases, folder: Path, node: bool = False) -> None:
     """One row per group of ``cases`` ((label, [(f, t, y)...])): records with none, the lowest
     and mean share within 2 %, estimates beyond 5 %, median first and window (periods)."""
     print(
@@ -91,11 +103,11 @@ def table(cases, folder: Path) -> None:
     )
     print('|---|---|---|---|---|---|')
     for label, records in cases:
-        s = np.array([score(analyzed(t, y, folder), f) for f, t, y in records], float)
+        s = np.array([score(analyzed(t, y, folder, node), f) for f, t, y in records], float)
         got = s[s[:, 0] > 0]
         cells = (
             f'{100 * np.min(got[:, 1]):.0f} %, {100 * np.mean(got[:, 1]):.1f} % | '
-            f'{int(np.sum(got[:, 2]))} | {np.median(got[:, 3]):.2f} | {np.median(got[:, 4]):.2f}'
+            f'{int(np.sum(got[:, 2]))} | {first(got[:, 3])} | {np.median(got[:, 4]):.2f}'
             if len(got)
             else '- | - | - | -'
         )
@@ -172,16 +184,20 @@ def main() -> int:
     parser.add_argument('--hum', action='store_true', help='a pluck beside mains hum')
     parser.add_argument('--short', action='store_true', help='driven records of 15-90 s')
     parser.add_argument('--base', action='store_true', help='the default before 6 Dec 2026')
+    parser.add_argument(
+        '--node', action='store_true', help="--heavy, --silent: the node's defaults, streamed"
+    )
     args = parser.parse_args()
     if args.base:
         choice.heavily_damped = lambda t, signal, dominant: (0, '')
         choice.steady_line = lambda t, signal, f, dominant: False
         analyze_module.rescue = lambda *args: None
+        choice.SILENT_PERIODS = math.inf  # the node: a silent decay of one mode stays free
         choice.SHORT_WINDOWS = 1e-9  # the configured window, whatever the record's length
     with tempfile.TemporaryDirectory() as folder:
         for wanted, cases in ((args.heavy, heavy), (args.silent, silent), (args.hum, hum)):
             if wanted:
-                table(cases(), Path(folder))
+                table(cases(), Path(folder), args.node)
         if args.short:
             short(Path(folder))
     return 0

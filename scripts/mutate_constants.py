@@ -79,6 +79,7 @@ TESTS = {
     'choice': [
         'test/core/test_choice.py',
         'test/analysis/test_choosing.py',
+        'test/nodes/test_stream.py',  # the node's decisions (StreamChoice)
     ],
     'config': ['test/core/test_estimator.py'],
     'correlations': ['test/core/test_ambient_incremental.py', 'test/core/test_ambient.py'],

@@ -442,6 +442,49 @@ def test_a_silent_decay_of_several_modes_goes_to_the_mode_tracker(monkeypatch, f
     assert not right()
 
 
+def noisy_pluck(f: float, rate: float, zeta: float, snr_db: float, seconds: float = 40.0):
+    """A pluck at 1 s of one mode (a random phase), ``snr_db`` above white noise."""
+    rng = np.random.default_rng(0)
+    t = np.arange(0, seconds, 1 / rate)
+    tau = np.maximum(t - 1.0, 0)
+    wave = np.sin(2 * np.pi * f * np.sqrt(1 - zeta**2) * tau + rng.uniform(0, 2 * np.pi))
+    y = np.exp(-zeta * 2 * np.pi * f * tau) * wave * (t >= 1)
+    return t, y + 10 ** (-snr_db / 20) / np.sqrt(2) * rng.standard_normal(len(t))
+
+
+@pytest.mark.parametrize('factor', [1e-3, 1e3])
+def test_a_decay_its_free_estimator_leaves_silent_goes_to_the_mode_tracker(monkeypatch, factor):
+    """A 5 Hz pluck at 20 samples a period in 20 dB: the free estimator's convergence test never
+    passes (no estimate in 40 s). Once it has been silent since the onset for ``SILENT_PERIODS``
+    periods (and ``SILENT_S`` s), the deciding stream takes the mode tracker (the node's form of
+    analyze's rescue): 13 estimates, within 2 %. A 0.5 Hz pluck (40 dB, 50 Hz), whose free
+    estimator's first estimate comes 3.5 periods after it, keeps the free estimator.
+    ``SILENT_PERIODS`` at 0.001x sends the slow pluck to the tracker 2.6 periods after the
+    onset, at 1000x leaves the noisy one silent."""
+    from vib_estimator.core import choice
+
+    def run(record):
+        stream = EstimatorStream(EstimatorConfig(), now=0.0, deciding=True)
+        got = []
+        decided = decisions(stream, *record[:2], step=record[2], estimates=got)
+        return decided, np.array([e.frequency_hz for _, _, e in got])
+
+    noisy = (*noisy_pluck(5.0, 100.0, 0.005, 20.0), 100)
+    slow = (*noisy_pluck(0.5, 50.0, 0.01, 40.0), 50)
+
+    def right():
+        decided, f = run(noisy)
+        silent = [x for _, x in decided if 'no free estimate for' in x.reason]
+        rescued = len(silent) == 1 and silent[0].modes == 3 and len(f) >= 10
+        decided, g = run(slow)
+        kept = not any(x.modes for _, x in decided) and len(g) >= 5
+        return rescued and np.all(np.abs(f / 5 - 1) <= 0.02) and kept
+
+    assert right()
+    monkeypatch.setattr(choice, 'SILENT_PERIODS', choice.SILENT_PERIODS * factor)
+    assert not right()
+
+
 def test_a_clean_decay_sets_the_streams_window_as_analyze_decides_it():
     """Once its free stretch has shown a decay (core.choice.decay_zeta), the deciding stream
     takes analyze's window for it (``min_periods`` 0.9 and its ``early_std_rel``): a clean

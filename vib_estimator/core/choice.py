@@ -911,6 +911,12 @@ MAX_KEPT = 2**18
 #: rings after an onset, is asked whether it is a decay of several modes (their beating fails
 #: the one-mode fits: a 10 and a 13 Hz mode gave no estimate at all); again this often
 SILENT_S = 3.0
+#: ... and a decay of one mode whose free estimator has published nothing since its onset for
+#: this many periods of it (and :data:`SILENT_S` s) goes to the mode tracker: its first estimate
+#: comes within 2-3 periods when its convergence test passes at all (bench_hard_records.py
+#: --silent: a median of 2.8-5.3 periods where it gave one), and a slow mode's first seconds are
+#: not silence (a 0.4 Hz decay's 3 s are 1.2 periods)
+SILENT_PERIODS = 20.0
 #: the most times a decay's window is read (a decision a second) while it shows several modes
 WINDOW_READS = 5
 #: ... each read that shows several modes reads again this last share of the decay since its
@@ -1165,7 +1171,27 @@ class StreamChoice:
         if not self.watch.ringing():
             return None
         chosen = decide(*self.kept(), self.channels, window_s, stream=True)
-        return chosen if chosen.excitation == 'free' and chosen.modes else None
+        if chosen.excitation != 'free' or chosen.modes:
+            return chosen if chosen.excitation == 'free' else None
+        return self._silent_decay(now, chosen)
+
+    def _silent_decay(self, now: float, chosen: Decision) -> Optional[Decision]:
+        """The mode tracker for a free decay of one mode (``chosen``, :func:`decide` over the
+        kept samples) whose free estimator has published nothing since the onset, for
+        :data:`SILENT_PERIODS` periods of its dominant mode (the node's form of ``analyze``'s
+        rescue: its convergence test never passing in the noise, or its fit gate holding every
+        estimate back; a decay it estimated and whose tail it leaves is not silent); else
+        None."""
+        f = chosen.dominant_hz
+        onset = self.watch.onset_t
+        quiet = now - onset
+        if self._estimated_at >= onset or not f > 0 or not quiet * f >= SILENT_PERIODS:
+            return None
+        reason = (
+            f'{chosen.reason}; no free estimate for {quiet:.3g} s ({quiet * f:.0f} periods of '
+            f'{f:.4g} Hz) while the decay rings: the mode tracker, modes {TRACKED_MODES}'
+        )
+        return Decision(**{**chosen.__dict__, 'modes': TRACKED_MODES, 'reason': reason})
 
     def _decay_window(self, now: float) -> Optional[Decision]:
         """:func:`decide`'s window for the decay since the last onset, read once per onset when
