@@ -296,3 +296,22 @@ def test_mains_hum_beside_a_decay_is_filtered_out_not_estimated(tmp_path, capsys
     f = np.array([r['frequency_hz'] for r in rows])
     err_rel = np.abs(f / 5.0 - 1)
     assert len(f) >= 30 and np.mean(err_rel <= 0.02) >= 0.9 and np.mean(err_rel > 0.05) <= 0.03
+
+
+def test_several_channels_of_a_heavily_damped_pluck_go_to_the_mode_tracker(tmp_path, capsys):
+    """Three channels of a 5 Hz pluck damped at 5 % (40 dB): each channel's mode tracker gives
+    the joint fit its events (core.choice.heavily_damped, now for several channels too): 15
+    estimates, all within 2 %, one mode; the algebraic estimator's events gave 2."""
+    rng = np.random.default_rng(0)
+    t = np.arange(0, 1 + 5 / (0.05 * 2 * np.pi * 5), 1e-3)
+    tau = np.maximum(t - 1.0, 0)
+    wave = np.sin(2 * np.pi * 5 * np.sqrt(1 - 0.05**2) * tau + rng.uniform(0, 6.28))
+    q = np.exp(-0.05 * 2 * np.pi * 5 * tau) * wave * (t >= 1.0)
+    y = np.outer(q, [1.0, 0.7, 0.3]) + 0.01 / np.sqrt(2) * rng.standard_normal((len(t), 3))
+    rows, err = analyze(
+        capsys, write(tmp_path / 'three.csv', t, y), '--columns', 'all', '--format', 'jsonl'
+    )
+    assert 'a decay damped at' in err and 'the mode tracker, modes 3' in err
+    f = np.array([r['frequency_hz'] for r in rows])
+    assert len(f) >= 10 and np.all(np.abs(f / 5 - 1) <= 0.02)
+    assert {r['mode'] for r in rows} == {1}

@@ -551,13 +551,15 @@ def decide(
     modes, rate = 0, (len(t) - 1) / span
     if excitation == 'free':
         modes, said, band = free_modes(t, signal, spec, peaks[~is_line], powers[~is_line])
-        if not modes and channels == 1:
+        if not modes:
             modes, fewer = few_samples(rate, dominant)
             said += fewer
+        if not modes and band and channels > 1:  # each channel's tail, band-passed: the tracker
+            modes, said = TRACKED_MODES, f'{said}; several channels: the mode tracker'
         seen += said
     free = (math.nan, 0.0, '', math.nan)  # a free decay's window, precision, model, offset
-    if excitation == 'free' and not modes and channels == 1 and dominant > 0:
-        modes, free, said = free_window(t, y, signal, dominant, spec, offset_ok, stream)
+    if excitation == 'free' and not modes and dominant > 0:  # (several channels: no window)
+        modes, free, said = free_window(t, y, signal, dominant, spec, offset_ok, stream, channels)
         seen += said
     if lines and excitation != 'free':
         seen += '; the identifier drops its modes at the lines (lines_hz)'
@@ -630,14 +632,15 @@ def few_samples(rate: float, dominant: float) -> tuple[int, str]:
     return 0, ''
 
 
-def free_window(t, y, signal, dominant: float, spec, offset_ok: bool, stream: bool):
+def free_window(t, y, signal, dominant: float, spec, offset_ok: bool, stream: bool, channels=1):
     """A free decay of one mode at ``dominant`` Hz (``signal``: the principal component of
     ``y``): the modes to track, the window, precision, model and offset of :func:`fast_window`
-    (a stream, the node, keeps its window) and the reason in words -- the mode tracker
-    (:func:`heavily_damped`) where no fast window is given to a heavily damped decay."""
+    (a stream, the node, and several channels keep their window) and the reason in words -- the
+    mode tracker (:func:`heavily_damped`; with several channels, each channel's, whose events
+    the joint fit refines) where no fast window is given to a heavily damped decay."""
     free = (math.nan, 0.0, '', math.nan)
     why = ''
-    if not stream:
+    if not stream and channels == 1:
         *free, why = fast_window(t, y, dominant, spec, offset_ok)
         why = f'; {why}'
     if math.isfinite(free[0]):
