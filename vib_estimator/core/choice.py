@@ -53,7 +53,7 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Optional
 
 import numpy as np
@@ -160,7 +160,7 @@ CLEAN_SNR_DB = 33.0
 #: (:func:`heavily_damped`), whose subspace fits hold the decay in their model: the free
 #: estimator's estimates of a decay that falls by a quarter a period are few, late and held back
 #: by its fit gate. 2, 5 and 20 Hz decays after 1 s of rest, 30 and 45 dB, 2-4 seeds each
-#: (``bench_first_estimate.py --heavy``, 6 Dec): at 2 % the free estimator's first estimate came
+#: (``bench_hard_records.py --heavy``, 6 Dec): at 2 % the free estimator's first estimate came
 #: after a median of 4.1 periods (86-100 % within 2 %), the tracker's after 1.4 (94-100 %); at 5 %
 #: the free estimator gave nothing on 4 of 12 records, at 8 % on 11 of 12, the tracker 96-100 %
 #: within 2 % on every one
@@ -555,7 +555,8 @@ def decide(
             modes, fewer = few_samples(rate, dominant)
             said += fewer
         if not modes and band and channels > 1:  # each channel's tail, band-passed: the tracker
-            modes, said = TRACKED_MODES, f'{said}; several channels: the mode tracker'
+            modes = TRACKED_MODES
+            said += f'; several channels: the mode tracker, modes {modes}'
         seen += said
     free = (math.nan, 0.0, '', math.nan)  # a free decay's window, precision, model, offset
     if excitation == 'free' and not modes and dominant > 0:  # (several channels: no window)
@@ -915,10 +916,10 @@ MAX_KEPT = 2**18
 #: the one-mode fits: a 10 and a 13 Hz mode gave no estimate at all); again this often
 SILENT_S = 3.0
 #: ... and a decay of one mode whose free estimator has published nothing since its onset for
-#: this many periods of it (and :data:`SILENT_S` s) goes to the mode tracker: its first estimate
-#: comes within 2-3 periods when its convergence test passes at all (bench_hard_records.py
-#: --silent: a median of 2.8-5.3 periods where it gave one), and a slow mode's first seconds are
-#: not silence (a 0.4 Hz decay's 3 s are 1.2 periods)
+#: this many periods of it (and :data:`SILENT_S` s) goes to the mode tracker: where its
+#: convergence test passes at all its first estimate comes a median of 4.4-12 periods after the
+#: pluck in 20-30 dB (``bench_hard_records.py --silent --base``), and a slow mode's first seconds
+#: are not silence (a 0.5 Hz decay's 3 s are 1.5 periods: test_stream.py)
 SILENT_PERIODS = 20.0
 #: the most times a decay's window is read (a decision a second) while it shows several modes
 WINDOW_READS = 5
@@ -1165,9 +1166,10 @@ class StreamChoice:
         )
 
     def _several_modes(self, now: float, window_s: float) -> Optional[Decision]:
-        """:func:`decide`'s free decay of several modes over the kept samples, asked (at most
-        every :data:`SILENT_S` s) when no free estimate came for that long while the stream
-        rings (:meth:`DrivenWatch.ringing`); else None."""
+        """:func:`decide`'s free decay over the kept samples when it takes the mode tracker
+        (several modes, heavy damping, few samples a period; or one mode silent since its onset:
+        :meth:`_silent_decay`), asked (at most every :data:`SILENT_S` s) when no free estimate
+        came for that long while the stream rings (:meth:`DrivenWatch.ringing`); else None."""
         if now - max(self._estimated_at, self._silent_retry) < SILENT_S:
             return None
         self._silent_retry = now
@@ -1194,7 +1196,7 @@ class StreamChoice:
             f'{chosen.reason}; no free estimate for {quiet:.3g} s ({quiet * f:.0f} periods of '
             f'{f:.4g} Hz) while the decay rings: the mode tracker, modes {TRACKED_MODES}'
         )
-        return Decision(**{**chosen.__dict__, 'modes': TRACKED_MODES, 'reason': reason})
+        return replace(chosen, modes=TRACKED_MODES, reason=reason)
 
     def _decay_window(self, now: float) -> Optional[Decision]:
         """:func:`decide`'s window for the decay since the last onset, read once per onset when
