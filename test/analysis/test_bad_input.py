@@ -162,3 +162,18 @@ def test_gaps_are_counted_in_analyze_and_survey_rows(tmp_path):
     header, row = out.getvalue().splitlines()[:2]
     values = dict(zip(header.split(','), row.split(',')))
     assert values['gaps'] == '3' and values['samples_lost'] == '300'
+
+
+def test_white_noise_says_the_mode_tracker_found_no_mode():
+    """A sensor at rest (white noise, 30 s at 1 kHz): its flat spectrum's peaks read as several
+    modes, the mode tracker finds none; the line says so in the tracker's words (it said "the
+    convergence test (Eqs. 16-17) never fired ... --model damped-sinusoid", the free estimator's,
+    which did not run)."""
+    t = np.arange(0, 30, 0.001)
+    y = np.random.default_rng(0).standard_normal(len(t))
+    text = 't,y\n' + ''.join(f'{a!r},{b!r}\n' for a, b in zip(t.tolist(), y.tolist()))
+    code, out, err = analyze(text.encode(), '--format', 'jsonl')
+    why = [line for line in err.splitlines() if line.startswith('analyze: no estimate: ')]
+    assert code == 0 and out == '' and 'modes 3' in err
+    assert len(why) == 1 and 'the mode tracker found no mode' in why[0]
+    assert 'Eqs. 16-17' not in why[0]

@@ -191,6 +191,24 @@ def prepare(
     return config, d, [warning] if warning else []
 
 
+def tracker_silence(counters) -> str:
+    """Why the mode tracker published nothing, from its counters (:mod:`..core.modes`)."""
+    held = {k: v for k, v in counters.items() if v and k.startswith('rejected_')}
+    seen = ', '.join(f'{k}={v}' for k, v in held.items())
+    if not counters.get('modes_found', 0):
+        return (
+            'the mode tracker found no mode: no pole stood above the noise and lasted ('
+            + (seen or 'none even a candidate')
+            + '): the record may hold no vibration above its noise (a sensor at rest); if it '
+            'does, --band-hz around the mode, or --excitation ambient for a driven structure'
+        )
+    return (
+        f'the mode tracker found {counters["modes_found"]} mode(s) and lost them before they '
+        f'published ({seen or "no rejection"}): a frequency that moves, or poles of the noise; '
+        'try --band-hz around the mode'
+    )
+
+
 def explain_no_estimate(
     counters, open_samples: Optional[int], config: EstimatorConfig, d: Optional[Decision] = None
 ) -> str:
@@ -213,6 +231,8 @@ def explain_no_estimate(
                 or 'try --band-hz around the modes of interest or a longer --ambient-window-s'
             )
         )
+    if config.modes:  # the mode tracker (its counters: core.modes)
+        return tracker_silence(counters)
     held = {k: v for k, v in counters.items() if v and k.startswith('rejected_')}
     if held:
         return (
