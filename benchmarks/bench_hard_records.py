@@ -223,7 +223,7 @@ def main() -> int:
     args = parser.parse_args()
     if args.base:
         choice.heavily_damped = lambda t, signal, dominant: (0, '')
-        choice.steady_line = lambda t, signal, f, dominant: False
+        choice.steady_line = lambda t, signal, f, dominant_fall: False
         analyze_module.rescue = lambda *args: None
         choice.SILENT_PERIODS = math.inf  # the node: a silent decay of one mode stays free
         choice.SHORT_WINDOWS = 1e-9  # the configured window, whatever the record's length

@@ -337,22 +337,40 @@ def damage_warning(signal: Signal, prog: str) -> None:
         )
 
 
-def estimate_record(args, signal: Signal, config, decision, blocks, offset: float, notes: list):
-    """``(config, run)``: ``signal`` (its ``blocks`` read ahead) estimated less ``offset`` by
-    ``config``; a free decay the free estimator gave no estimate of read again by the mode
-    tracker (:func:`.choosing.rescue`: decided, no ``--model`` or ``--min-periods``), its line
-    added to ``notes``."""
-    keep = bool(args.plot or args.report)
+def rescues(args) -> bool:
+    """Whether a free decay the free estimator gives nothing of may be read again by the mode
+    tracker (:func:`.choosing.rescue`): decided from the record, no ``--model`` or
+    ``--min-periods`` (which keep the free estimator as chosen)."""
+    return decides(args) and not (model_given(args) or periods_given(args))
+
+
+def estimate_rescued(
+    signal: Signal, config, decision, allowed: bool, prog: str, keep=False, blocks=None, offset=0.0
+):
+    """``(config, run, line)``: :func:`estimate_signal`, and a free decay it gave no estimate of
+    read again by the mode tracker when ``allowed`` (:func:`.choosing.rescue`; the record's
+    counts started afresh), with the line that says so ('' otherwise)."""
     result = estimate_signal(signal, config, keep, blocks, offset)
-    free_kept = model_given(args) or periods_given(args)  # the free estimator, as chosen
-    chosen = decides(args) and not free_kept
-    again = rescue(config, decision, chosen, len(result.estimates), 'analyze')
+    again = rescue(config, decision, allowed, len(result.estimates), prog)
     if again is None:
-        return config, result
+        return config, result, ''
     config, line = again
-    notes.append(line)
     signal.skipped = signal.corrupt = 0  # counted again
-    return config, estimate_signal(signal, config, keep)
+    return config, estimate_signal(signal, config, keep), line
+
+
+def say_column(columns: Optional[list]) -> list:
+    """Say which column the default took (``columns``: the CSV's, when no ``--column`` named one;
+    None otherwise) and return the others."""
+    others = columns[1:] if columns else []
+    if columns:
+        print(
+            f'analyze: column {columns[0]} (the first after the time, the default'
+            + (f'; the others: {", ".join(others)}: --column NAME' if others else '')
+            + ')',
+            file=sys.stderr,
+        )
+    return others
 
 
 def run(args: argparse.Namespace) -> int:
@@ -392,20 +410,16 @@ def run(args: argparse.Namespace) -> int:
         if ahead is not None:
             config, decision, notes = prepare(args, config, *ahead, 1, 'analyze')
         offset = decision.offset if decision is not None and math.isfinite(decision.offset) else 0
-        config, result = estimate_record(args, signal, config, decision, blocks, offset, notes)
+        keep = bool(args.plot or args.report)
+        config, result, rescued = estimate_rescued(
+            signal, config, decision, rescues(args), 'analyze', keep, blocks, offset
+        )
     except (VibEstimatorError, ValueError) as err:
         return report(err, 'vib-estimator analyze')
     damage_warning(signal, 'vib-estimator analyze')
-    for line in notes:
+    for line in filter(None, [*notes, rescued]):
         print(line, file=sys.stderr)
-    others = columns[1:] if columns else []
-    if columns:
-        print(
-            f'analyze: column {columns[0]} (the first after the time, the default'
-            + (f'; the others: {", ".join(others)}: --column NAME' if others else '')
-            + ')',
-            file=sys.stderr,
-        )
+    others = say_column(columns)
     estimates = result.estimates
     numbered = kind_of(config).numbered
     _print(estimates, signal.origin_ns, args.format, numbered)

@@ -65,17 +65,9 @@ from ..io.fields import DEFAULT_COMPONENT, check_component
 from ..io.heap import M_MMAP_THRESHOLD, M_TRIM_THRESHOLD, MMAP_THRESHOLD, glibc, mallopt
 from ..io.streaming import BagInfo, bag_info, is_csv, open_signal, supported_topics
 from . import health
-from .analyze import Run, add_config_arguments, estimate_signal, make_config
+from .analyze import Run, add_config_arguments, estimate_rescued, make_config, rescues
 from .channels import channel_list, joint_run, mode_shapes, need_joint, read_channels
-from .choosing import (
-    decided_config,
-    decides,
-    model_given,
-    periods_given,
-    read_ahead,
-    rescue,
-    window_given,
-)
+from .choosing import decided_config, decides, read_ahead, window_given
 from .interval import combine
 from .outputs import check_output, progress
 
@@ -581,12 +573,9 @@ def _recording_rows(path: Path, options: Options) -> List[Dict]:
                 if ahead is not None:
                     d = decide(*ahead, 1, config.ambient_window_s)
                     config = decided_config(config, d, 'survey', *options.kept())[0]
-            result = estimate_signal(signal, config, blocks=blocks)
-            again = rescue(config, d, options.rescues, len(result.estimates), 'survey')
-            if again is not None:  # read again, by the mode tracker
-                config = again[0]
-                signal.skipped = signal.corrupt = 0
-                result = estimate_signal(signal, config)
+            config, result, _ = estimate_rescued(
+                signal, config, d, options.rescues, 'survey', blocks=blocks
+            )
             rows.extend(_stat_rows(path, signal, result, config.modes, options.summary))
         except Exception as err:  # noqa: BLE001 -- as above
             rows.append(_error_row(path, topic or '', component or ','.join(channels), err))
@@ -1004,7 +993,7 @@ def _options(args: argparse.Namespace) -> Options:
         decides(args),
         window_given(args),
         covariates,
-        decides(args) and not (model_given(args) or periods_given(args)),
+        rescues(args),
     )
 
 

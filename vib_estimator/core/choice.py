@@ -555,8 +555,8 @@ def decide(
             modes, fewer = few_samples(rate, dominant)
             said += fewer
         if not modes and band and channels > 1:  # each channel's tail, band-passed: the tracker
-            modes = TRACKED_MODES
-            said += f'; several channels: the mode tracker, modes {modes}'
+            modes, tracked = to_tracker('several channels')
+            said += tracked
         seen += said
     free = (math.nan, 0.0, '', math.nan)  # a free decay's window, precision, model, offset
     if excitation == 'free' and not modes and dominant > 0:  # (several channels: no window)
@@ -577,10 +577,15 @@ def free_modes(t, signal, spec, peaks: np.ndarray, powers: np.ndarray) -> tuple[
     :func:`rings_freely`, :func:`coexistence` and :func:`steady_line`), else 0 --, the reason in
     words and the band that leaves out the steady lines above them (:func:`line_band`)."""
     lines: list[float] = []
+    dominant_fall = None  # read once, at the first candidate
 
     def steady(f: float) -> bool:
-        line = steady_line(t, signal, f, float(peaks[0]))
-        lines.extend([f] if line else [])
+        nonlocal dominant_fall
+        if dominant_fall is None:
+            dominant_fall = fall_db(t, signal, float(peaks[0]))
+        line = steady_line(t, signal, f, dominant_fall)
+        if line:
+            lines.append(f)
         return line
 
     separate = separate_modes(
@@ -603,8 +608,15 @@ def free_modes(t, signal, spec, peaks: np.ndarray, powers: np.ndarray) -> tuple[
     if len(separate) < 2:
         return 0, said, band
     listed = ', '.join(f'{f:.3g}' for f in sorted(separate))
-    said += f'; {len(separate)} separate modes ({listed} Hz): the mode tracker, modes '
-    return TRACKED_MODES, f'{said}{TRACKED_MODES}', band
+    modes, tracked = to_tracker(f'{len(separate)} separate modes ({listed} Hz)')
+    return modes, said + tracked, band
+
+
+def to_tracker(why: str) -> tuple[int, str]:
+    """The mode tracker's ``modes`` (:data:`TRACKED_MODES`) and the words that send a free decay
+    to it, ``why`` first (every route: several modes, few samples a period, heavy damping,
+    several channels beside a line, a one-mode decay left silent)."""
+    return TRACKED_MODES, f'; {why}: the mode tracker, modes {TRACKED_MODES}'
 
 
 def line_band(modes: list, lines: list) -> tuple:
@@ -626,10 +638,7 @@ def few_samples(rate: float, dominant: float) -> tuple[int, str]:
     :data:`TRACKED_MODES`) under :data:`TRACKER_SAMPLES` samples a period, else ``(0, '')``."""
     per = rate / dominant if dominant > 0 else math.inf
     if per < TRACKER_SAMPLES:
-        return TRACKED_MODES, (
-            f'; {per:.3g} samples a period, too few for the free estimator: the mode tracker, '
-            f'modes {TRACKED_MODES}'
-        )
+        return to_tracker(f'{per:.3g} samples a period, too few for the free estimator')
     return 0, ''
 
 
@@ -657,10 +666,8 @@ def heavily_damped(t: np.ndarray, signal: np.ndarray, dominant: float) -> tuple[
     :data:`FAST_ZETA`, else ``(0, '')``."""
     zeta = decay_zeta(t, signal, dominant) if dominant > 0 else math.nan
     if zeta > FAST_ZETA:
-        return TRACKED_MODES, (
-            f'; a decay damped at {100 * zeta:.1f} % (its envelope), beyond what the free '
-            f'estimator holds: the mode tracker, modes {TRACKED_MODES}'
-        )
+        why = f'a decay damped at {100 * zeta:.1f} % (its envelope), beyond the free estimator'
+        return to_tracker(why)
     return 0, ''
 
 
@@ -757,15 +764,15 @@ def fall_db(t: np.ndarray, signal: np.ndarray, f: float) -> float:
     return float(-slope * (len(level) - 1))
 
 
-def steady_line(t: np.ndarray, signal: np.ndarray, f: float, dominant: float) -> bool:
-    """Whether the spectral peak at ``f`` Hz of a free decay ``signal`` whose dominant mode is at
-    ``dominant`` Hz is a line -- a sinusoid of steady amplitude beside the decay (mains hum, a
-    machine running nearby), not a mode --: while the dominant mode decays by at least twice
-    :data:`RING_DB` (:func:`fall_db`; a decay's first seconds show its modes alike steady), the
+def steady_line(t: np.ndarray, signal: np.ndarray, f: float, dominant_fall: float) -> bool:
+    """Whether the spectral peak at ``f`` Hz of a free decay ``signal`` whose dominant mode falls
+    by ``dominant_fall`` dB (:func:`fall_db`) is a line -- a sinusoid of steady amplitude beside
+    the decay (mains hum, a machine running nearby), not a mode --: while the dominant mode decays
+    by at least twice :data:`RING_DB` (a decay's first seconds show its modes alike steady), the
     peak's band-passed response reads as a sinusoid (:func:`peak_kurtosis` below
     :data:`LINE_KURTOSIS`) that does not decay (:func:`fall_db` under :data:`RING_DB`, or too
     few blocks after its most energetic one: steady to the record's end)."""
-    if not fall_db(t, signal, dominant) >= 2 * RING_DB:
+    if not dominant_fall >= 2 * RING_DB:
         return False
     kurtosis = peak_kurtosis(t, signal, [f])[0]
     return bool(kurtosis[0] < LINE_KURTOSIS) and not fall_db(t, signal, f) >= RING_DB
@@ -1192,11 +1199,11 @@ class StreamChoice:
         quiet = now - onset
         if self._estimated_at >= onset or not f > 0 or not quiet * f >= SILENT_PERIODS:
             return None
-        reason = (
-            f'{chosen.reason}; no free estimate for {quiet:.3g} s ({quiet * f:.0f} periods of '
-            f'{f:.4g} Hz) while the decay rings: the mode tracker, modes {TRACKED_MODES}'
+        modes, said = to_tracker(
+            f'no free estimate for {quiet:.3g} s ({quiet * f:.0f} periods of {f:.4g} Hz) while '
+            'the decay rings'
         )
-        return replace(chosen, modes=TRACKED_MODES, reason=reason)
+        return replace(chosen, modes=modes, reason=chosen.reason + said)
 
     def _decay_window(self, now: float) -> Optional[Decision]:
         """:func:`decide`'s window for the decay since the last onset, read once per onset when
