@@ -208,6 +208,19 @@ def test_retunes_only_at_rest():
     np.testing.assert_allclose(y[[0, 24, 25, 49, 50]], [0.75, 0.75, 0.25, 0.25, 0.0], atol=1e-12)
 
 
+def test_a_move_requested_with_its_shaper_is_shaped_by_it():
+    """A shaper requested at rest and a move's first sample right after it, with no sample
+    between (the shaping demo holds its simulator: no tick between the parameter and the move):
+    the move is shaped by the new design (ZVD's first impulse, a quarter of the step), not sent
+    unshaped while the switch waits for the next rest (the demo's 30 g move: 2.8 % reduction)."""
+    sh = StreamingShaper(none(), 100.0)
+    sh.process(np.zeros(5))
+    sh.request(zvd(2.0))
+    y = sh.process(np.ones(60))
+    assert sh.shaper.name == 'zvd' and sh.pending is None and sh.retunes == 1
+    np.testing.assert_allclose(y[[0, 24, 25, 49, 50]], [0.25, 0.25, 0.75, 0.75, 1.0], atol=1e-12)
+
+
 def test_rest_tolerance():
     sh = StreamingShaper(zv(5.0), 100.0, rest_tolerance=1e-3)
     sh.process(np.full(20, 2.0) + 1e-4 * np.sin(np.arange(20)))

@@ -275,7 +275,9 @@ class StreamingShaper:
         return self._rest_count >= len(self._kernel)
 
     def request(self, shaper: Shaper) -> None:
-        """Use ``shaper`` from the next sample at which the reference is at rest."""
+        """Use ``shaper`` from the next sample before which the reference was at rest (that
+        sample may be a move's first: a move requested with its shaper, no sample between them,
+        is shaped by it)."""
         self.pending = shaper
 
     def update(self, x: float) -> float:
@@ -284,14 +286,14 @@ class StreamingShaper:
         if math.isnan(self._history[0]):  # first sample: it has rested there
             self._history[:] = x
             self._rest_value, self._rest_count = x, len(self._kernel)
+        if self.pending is not None and self.at_rest:  # at rest up to this sample
+            self._install(self.pending, self._rest_value)
+            self.pending = None
+            self.retunes += 1
         if abs(x - self._rest_value) <= self.rest_tolerance:
             self._rest_count += 1
         else:
             self._rest_value, self._rest_count = x, 1
-        if self.pending is not None and self.at_rest:
-            self._install(self.pending, self._rest_value)
-            self.pending = None
-            self.retunes += 1
         n = len(self._history)
         self._head = (self._head + 1) % n
         self._history[self._head] = x
