@@ -189,7 +189,8 @@ def streamed(path: Path, select: list[str]):
     rows, decided, next_status = [], [], float(t[0]) + 1.0
     for k, (stamp, value) in enumerate(zip(stamps, values)):
         for e in stream.feed(stamp, value):
-            row = {'frequency_hz': e.frequency_hz, 'convergence_time_s': e.convergence_time}
+            row = {'t': e.t, 'frequency_hz': e.frequency_hz}
+            row['convergence_time_s'] = e.convergence_time
             shape = getattr(e, 'shape', None)
             for i, a in enumerate(() if shape is None else shape.tolist()):
                 row[f'shape_ch{i + 1:02d}'] = float(np.real(a))

@@ -16,6 +16,11 @@ windows, ``core.choice.SHORT_WINDOWS``), in the same run (issue 37: "whatever th
   or 40 s: estimates, share within 2 % of the decay's frequency, estimates beyond 5 %.
 - ``--channels``: three channels of a free decay (one mode, zeta 1 or 5 %; two at 4 %; 10
   samples a period; beside hum): the same figures, against the nearest mode.
+- ``--steady``: a closed loop's limit cycle (``sim.signals.limit_cycle``, the real arm's kind:
+  harmonics, a wandering amplitude and phase, 1 mm steps; 120 s at 200 Hz and 1 kHz, 3 seeds),
+  streamed through the node's defaults: estimates, share within 2 % and 5 % of 1.8116 Hz, the
+  first estimate (s of stream) and the decisions; ``--base`` without ``core.choice.HELD_RUN``'s
+  rule (the node before 6 Dec 2026, 10:00 UTC).
 - ``--short``: driven records of 15-90 s (white noise through 1.2, 2, 5 and 5 + 17 Hz modes at
   zeta 0.5-2 %, 500 Hz, 26 dB): estimates, modes found (within 2 %), share within 2 %, beyond 5 %.
 
@@ -25,6 +30,7 @@ windows, ``core.choice.SHORT_WINDOWS``), in the same run (issue 37: "whatever th
     cd benchmarks && ../.venv/bin/python bench_hard_records.py --short [--base]
     cd benchmarks && ../.venv/bin/python bench_hard_records.py --channels [--base]
     cd benchmarks && ../.venv/bin/python bench_hard_records.py --heavy --silent --node [--base]
+    cd benchmarks && ../.venv/bin/python bench_hard_records.py --steady [--base]
 """
 
 from __future__ import annotations
@@ -46,6 +52,7 @@ from vib_estimator.analysis import analyze as analyze_module
 from vib_estimator.cli import main as cli
 from vib_estimator.core import choice
 from vib_estimator.sim.ambient import ambient_record
+from vib_estimator.sim.signals import limit_cycle
 
 #: --heavy: damping ratios; (frequency Hz, samples a second) of each
 HEAVY_ZETAS = (0.01, 0.02, 0.03, 0.05, 0.08)
@@ -68,8 +75,8 @@ def pluck(f: float, fs: float, zeta: float, snr: float, seed: int, seconds: floa
 
 def analyzed(t: np.ndarray, y: np.ndarray, folder: Path, node: bool = False) -> list[dict]:
     """``analyze``'s rows of ``(t, y)`` written as a CSV, no option but ``--columns all`` for
-    several channels (``node``: the node's defaults on one streamed, ``bench_defaults.streamed``:
-    rows without ``t``)."""
+    several channels (``node``: the node's defaults on one streamed, ``bench_defaults.streamed``,
+    ``t`` the stream's seconds)."""
     path = folder / 'record.csv'
     names = ['y'] if np.ndim(y) == 1 else [f'ch{i + 1}' for i in range(y.shape[1])]
     header = ','.join(['time_s', *names])
@@ -97,7 +104,7 @@ def score(rows: list[dict], f) -> tuple:
 
 
 def first(periods: np.ndarray) -> str:
-    """The median first estimate, or '-' (the node's rows carry no time)."""
+    """The median first estimate, or '-'."""
     return '-' if np.all(np.isnan(periods)) else f'{np.nanmedian(periods):.2f}'
 
 
@@ -178,6 +185,26 @@ def channels():
         yield label, records
 
 
+def steady(folder: Path) -> None:
+    """``--steady`` (module doc): one row per record."""
+    print('| record | estimates | within 2 % | within 5 % | first (s) | decisions |')
+    print('|---|---|---|---|---|---|')
+    for rate, seed in itertools.product((200.0, 1000.0), range(3)):
+        t, y = limit_cycle(120.0, rate, seed)
+        path = folder / 'record.csv'
+        np.savetxt(path, np.column_stack([t, y]), delimiter=',', header='time_s,y', comments='')
+        _, rows, decided, _ = streamed(path, [])
+        err = np.abs(np.array([r['frequency_hz'] for r in rows]) / 1.8116 - 1)
+        shares = (
+            f'{100 * np.mean(err <= 0.02):.0f} % | {100 * np.mean(err <= 0.05):.0f} %'
+            if len(err)
+            else '- | -'
+        )
+        start = f'{rows[0]["t"]:.0f}' if rows and 't' in rows[0] else '-'
+        print(f'| {rate:g} Hz, seed {seed} | {len(err)} | {shares} | {start} | {decided} |')
+        sys.stdout.flush()
+
+
 #: --short: the records' seconds, and their modes ((f, zeta, amplitude) each)
 SHORT_SECONDS = (15, 20, 30, 45, 60, 90)
 SHORT_MODES = {
@@ -215,6 +242,7 @@ def main() -> int:
     parser.add_argument('--silent', action='store_true', help='20-60 samples a period, 20-30 dB')
     parser.add_argument('--hum', action='store_true', help='a pluck beside mains hum')
     parser.add_argument('--short', action='store_true', help='driven records of 15-90 s')
+    parser.add_argument('--steady', action='store_true', help="a limit cycle, the node's defaults")
     parser.add_argument('--channels', action='store_true', help='three channels of free decays')
     parser.add_argument('--base', action='store_true', help='the default before 6 Dec 2026')
     parser.add_argument(
@@ -227,6 +255,7 @@ def main() -> int:
         analyze_module.rescue = lambda *args: None
         choice.SILENT_PERIODS = math.inf  # the node: a silent decay of one mode stays free
         choice.SHORT_WINDOWS = 1e-9  # the configured window, whatever the record's length
+        choice.HELD_RUN = 10**9  # the node: a steady oscillation's held estimates held on
     with tempfile.TemporaryDirectory() as folder:
         kinds = ((args.heavy, heavy), (args.silent, silent), (args.hum, hum))
         for wanted, cases in (*kinds, (args.channels, channels)):
@@ -234,6 +263,8 @@ def main() -> int:
                 table(cases(), Path(folder), args.node)
         if args.short:
             short(Path(folder))
+        if args.steady:
+            steady(Path(folder))
     return 0
 
 

@@ -485,6 +485,43 @@ def test_a_decay_its_free_estimator_leaves_silent_goes_to_the_mode_tracker(monke
     assert not right()
 
 
+@pytest.mark.parametrize('factor', [1e-3, 1e3])
+def test_a_steady_oscillation_that_is_no_decay_goes_to_the_mode_tracker(monkeypatch, factor):
+    """A limit cycle (``sim.signals.limit_cycle``, the real arm's kind) is no free decay: the
+    free-decay test holds back every free estimate of it, and the node stayed silent (0-3
+    estimates in 120 s). Once ``HELD_RUN`` estimates running were held back and the watch has
+    read the stream free and live over half its span (60 s), the deciding stream takes the mode
+    tracker: estimates at the cycle's frequency (within 5 %, median within 1.5 %: its phase
+    wanders). A slow, lightly damped decay (1 Hz, 0.1 %: live for all of 90 s) keeps the free
+    estimator. ``HELD_RUN`` at 0.001x sends the decay to the tracker, at 1000x leaves the limit
+    cycle silent."""
+    from vib_estimator.core import choice
+    from vib_estimator.sim.signals import limit_cycle
+
+    def run(t, y, rate):
+        stream = EstimatorStream(EstimatorConfig(), now=0.0, deciding=True)
+        got = []
+        decided = decisions(stream, t, y, step=rate, estimates=got)
+        return decided, np.array([e.frequency_hz for _, _, e in got])
+
+    def right():
+        decided, f = run(*limit_cycle(90.0, 200.0), 200)
+        steady = [(s, x) for s, x in decided if 'a steady oscillation' in x.reason]
+        tracked = len(steady) == 1 and steady[0][1].modes == 3 and 60 <= steady[0][0] <= 66
+        err = np.abs(f / 1.8116 - 1)
+        cycle = tracked and len(f) >= 30 and np.all(err <= 0.05) and np.median(err) <= 0.015
+        t = np.arange(0, 90, 0.01)
+        decay = np.exp(-0.001 * 2 * np.pi * t) * np.sin(2 * np.pi * t + 0.3)
+        rng = np.random.default_rng(1)
+        decided, g = run(t, decay + 1e-3 * rng.standard_normal(len(t)), 100)
+        free = not any(x.modes for _, x in decided) and len(g) >= 60
+        return cycle and free and np.all(np.abs(g - 1) <= 0.02)
+
+    assert right()
+    monkeypatch.setattr(choice, 'HELD_RUN', round(choice.HELD_RUN * factor))
+    assert not right()
+
+
 def test_a_clean_decay_sets_the_streams_window_as_analyze_decides_it():
     """Once its free stretch has shown a decay (core.choice.decay_zeta), the deciding stream
     takes analyze's window for it (``min_periods`` 0.9 and its ``early_std_rel``): a clean

@@ -1,7 +1,7 @@
 # Copyright 2026 vib_estimator developers
 # SPDX-License-Identifier: Apache-2.0
-"""Test signals of the paper (pure numpy): the Fig. 1 sine and the normalised damped
-sine of Eq. 15."""
+"""Test signals (pure numpy): the paper's Fig. 1 sine and normalised damped sine of Eq. 15,
+gappy and repeatedly plucked decays, and a closed loop's limit cycle."""
 
 from __future__ import annotations
 
@@ -63,3 +63,27 @@ def plucked_decays(seed, f=5.0, zeta=0.004, snr_db=30.0, plucks=3, every_s=20.0,
         y += np.where(u >= 0, ring, 0.0)
     noise = np.sqrt(0.5 / 10 ** (snr_db / 10))
     return t, y + noise * rng.standard_normal(len(t))
+
+
+def limit_cycle(
+    seconds: float,
+    rate_hz: float,
+    seed: int = 0,
+    wander: float = 0.05,
+    diffusion: float = 0.02,
+    step: float = 1e-3,
+) -> Tuple[np.ndarray, np.ndarray]:
+    """A closed loop's limit cycle of the real flexible-link arm's kind (``flex8``'s fit,
+    ``benchmarks/real_arm.py``: -4.8 mm offset, 10.1 mm at 1.8116 Hz, 2nd and 3rd harmonics 0.19
+    and 0.05 mm; m): its amplitude wandering by ``wander`` (at 0.37 Hz), its phase diffusing by
+    ``diffusion`` x 2 pi rad in a second's square root (0.13 rad in a second: its frequency
+    wanders by ~1 % over a second), in 0.2 mm of white noise, read in steps of ``step`` m (the
+    rig's 1 mm; 0: not quantised). ``(t, y)``."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(0, seconds, 1 / rate_hz)
+    drift = np.cumsum(diffusion * 2 * np.pi * rng.standard_normal(len(t))) / np.sqrt(rate_hz)
+    w = 2 * np.pi * 1.8116 * t + rng.uniform(0, 2 * np.pi) + drift
+    a = 10.1e-3 * (1 + wander * np.sin(2 * np.pi * 0.37 * t + 1))
+    y = -4.8e-3 + a * np.sin(w) + 0.19e-3 * np.sin(2 * w + 1) + 0.05e-3 * np.sin(3 * w + 2)
+    y = y + 0.2e-3 * rng.standard_normal(len(t))
+    return t, (np.round(y / step) * step if step else y)
