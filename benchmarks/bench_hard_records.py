@@ -16,6 +16,10 @@ windows, ``core.choice.SHORT_WINDOWS``), in the same run (issue 37: "whatever th
   or 40 s: estimates, share within 2 % of the decay's frequency, estimates beyond 5 %.
 - ``--channels``: three channels of a free decay (one mode, zeta 1 or 5 %; two at 4 %; 10
   samples a period; beside hum): the same figures, against the nearest mode.
+- ``--impacts``: a train of impacts on one mode, each before the last decay has rung down (a
+  hammer every 2, 3 or 5 s on a 7 Hz mode at zeta 0.3-2 %, from 1 s for 120 s, 1 kHz, 20 and 40
+  dB below a unit impact, 2 seeds: ``sim.signals.plucked_decays``), read driven by the
+  envelope; ``--base`` without :func:`core.choice.decay_train` (before 6 Dec 2026, 10:10 UTC).
 - ``--steady``: a closed loop's limit cycle (``sim.signals.limit_cycle``, the real arm's kind:
   harmonics, a wandering amplitude and phase, 1 mm steps; 120 s at 200 Hz and 1 kHz, 3 seeds),
   streamed through the node's defaults: estimates, share within 2 % and 5 % of 1.8116 Hz, the
@@ -30,6 +34,7 @@ windows, ``core.choice.SHORT_WINDOWS``), in the same run (issue 37: "whatever th
     cd benchmarks && ../.venv/bin/python bench_hard_records.py --short [--base]
     cd benchmarks && ../.venv/bin/python bench_hard_records.py --channels [--base]
     cd benchmarks && ../.venv/bin/python bench_hard_records.py --heavy --silent --node [--base]
+    cd benchmarks && ../.venv/bin/python bench_hard_records.py --impacts [--node] [--base]
     cd benchmarks && ../.venv/bin/python bench_hard_records.py --steady [--base]
 """
 
@@ -52,7 +57,7 @@ from vib_estimator.analysis import analyze as analyze_module
 from vib_estimator.cli import main as cli
 from vib_estimator.core import choice
 from vib_estimator.sim.ambient import ambient_record
-from vib_estimator.sim.signals import limit_cycle
+from vib_estimator.sim.signals import limit_cycle, plucked_decays
 
 #: --heavy: damping ratios; (frequency Hz, samples a second) of each
 HEAVY_ZETAS = (0.01, 0.02, 0.03, 0.05, 0.08)
@@ -161,6 +166,19 @@ def hum():
             yield label, [(f, t, y + a * np.sin(2 * np.pi * line * t))]
 
 
+def impacts():
+    """``--impacts`` (module doc): one row per spacing and damping."""
+    for every, zeta in ((3.0, 0.003), (3.0, 0.01), (5.0, 0.005), (2.0, 0.01), (2.0, 0.02)):
+        records = [
+            (
+                7.0,
+                *plucked_decays(seed, 7.0, zeta, snr, round(120 / every), every, 1000.0, True, 1),
+            )
+            for snr, seed in itertools.product((20, 40), range(2))
+        ]
+        yield f'every {every:g} s, zeta {100 * zeta:g} %', records
+
+
 def channels():
     """Three channels of free decays (shapes (1, 0.7, 0.3) and (0.5, -0.6, 0.9), a pluck after 1
     s of rest, 1 kHz unless said, 40 dB, 2 seeds): the kinds one channel got wrong."""
@@ -242,11 +260,12 @@ def main() -> int:
     parser.add_argument('--silent', action='store_true', help='20-60 samples a period, 20-30 dB')
     parser.add_argument('--hum', action='store_true', help='a pluck beside mains hum')
     parser.add_argument('--short', action='store_true', help='driven records of 15-90 s')
+    parser.add_argument('--impacts', action='store_true', help='a train of impacts on a mode')
     parser.add_argument('--steady', action='store_true', help="a limit cycle, the node's defaults")
     parser.add_argument('--channels', action='store_true', help='three channels of free decays')
     parser.add_argument('--base', action='store_true', help='the default before 6 Dec 2026')
     parser.add_argument(
-        '--node', action='store_true', help="--heavy, --silent: the node's defaults, streamed"
+        '--node', action='store_true', help="the node's defaults, streamed (not --short)"
     )
     args = parser.parse_args()
     if args.base:
@@ -256,8 +275,14 @@ def main() -> int:
         choice.SILENT_PERIODS = math.inf  # the node: a silent decay of one mode stays free
         choice.SHORT_WINDOWS = 1e-9  # the configured window, whatever the record's length
         choice.HELD_RUN = 10**9  # the node: a steady oscillation's held estimates held on
+        choice.TRAIN_SHARE = math.inf  # a train of impacts read driven: the identifier
     with tempfile.TemporaryDirectory() as folder:
-        kinds = ((args.heavy, heavy), (args.silent, silent), (args.hum, hum))
+        kinds = (
+            (args.heavy, heavy),
+            (args.silent, silent),
+            (args.hum, hum),
+            (args.impacts, impacts),
+        )
         for wanted, cases in (*kinds, (args.channels, channels)):
             if wanted:
                 table(cases(), Path(folder), args.node)

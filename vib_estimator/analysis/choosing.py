@@ -24,7 +24,15 @@ from typing import Iterable, Iterator, Optional, Tuple
 import numpy as np
 
 from ..core.ambient import MIN_WINDOW_SAMPLES
-from ..core.choice import DECIDE_S, DRIVEN_ABOVE, FREE_BELOW, TRACKED_MODES, Decision, decide
+from ..core.choice import (
+    DECIDE_S,
+    DRIVEN_ABOVE,
+    FREE_BELOW,
+    TRACKED_MODES,
+    TRAIN_SHARE,
+    Decision,
+    decide,
+)
 from ..core.choice import window_advice as choice_window_advice
 from ..core.config import EstimatorConfig
 
@@ -113,15 +121,18 @@ def rescue(
 
 def contradiction(config: EstimatorConfig, d: Decision, prog: str) -> str:
     """One ``warning:`` line when the chosen excitation contradicts the record (free decays'
-    estimates of a driven record scatter; the identifier needs a stationary response), else
-    ''."""
+    estimates of a driven record scatter -- not of a train of plucks, ``Decision.train`` --; the
+    identifier needs a stationary response), else ''."""
     share = f'{100 * d.driven_share:.0f} % of its energy read driven'
-    if config.excitation == 'free' and d.driven_share > DRIVEN_ABOVE:
+    driven = d.driven_share > DRIVEN_ABOVE and not d.train >= TRAIN_SHARE
+    if config.excitation == 'free' and driven:
         return (
             f'{prog}: warning: the record looks driven throughout ({share}): free-decay estimates '
             'of a driven structure scatter; without --excitation the default would use ambient'
         )
-    if config.excitation == 'ambient' and d.driven_share < FREE_BELOW:
+    if config.excitation == 'ambient' and (d.driven_share < FREE_BELOW or d.train >= TRAIN_SHARE):
+        if d.train >= TRAIN_SHARE:
+            share = f'{100 * d.train:.0f} % of its stretches clean free decays, plucks in a row'
         return (
             f'{prog}: warning: the record looks like free decays ({share}): the identifier '
             'needs a stationary response; without --excitation the default would use free'
@@ -223,6 +234,13 @@ def explain_no_estimate(
         if not analyses:
             return short_window(config, d)
         advice = window_advice(config, d)
+        if config.lines_hz:  # its modes dropped at a periodic drive's lines
+            advice = (
+                f'the identifier drops its modes at the {len(config.lines_hz)} lines of a '
+                'periodic drive (lines_hz); where every peak is such a line (a train of impacts '
+                'on one mode, its response at their harmonics) --excitation free reads each decay'
+                + (f'; {advice}' if advice else '')
+            )
         return (
             f'no mode stood out of the noise, stable over the model orders and in consecutive '
             f'windows, in {analyses} analyses: '

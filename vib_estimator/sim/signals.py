@@ -47,18 +47,29 @@ def gappy_sine(
     return t[keep], np.sin(2 * np.pi * f * t[keep]) + offset, int((~keep).sum())
 
 
-def plucked_decays(seed, f=5.0, zeta=0.004, snr_db=30.0, plucks=3, every_s=20.0, rate_hz=500.0):
+def plucked_decays(
+    seed,
+    f=5.0,
+    zeta=0.004,
+    snr_db=30.0,
+    plucks=3,
+    every_s=20.0,
+    rate_hz=500.0,
+    impacts=False,
+    start_s=0.0,
+):
     """A day of free decays (issue 20's survey fleet): ``plucks`` decays of an ``f`` Hz mode of
-    damping ratio ``zeta``, one every ``every_s`` s (each of random phase, amplitude 0.5-2, the
-    last ones' tails still ringing), plus white noise ``snr_db`` below a unit pluck's power,
-    ``plucks * every_s`` s at ``rate_hz``; returns (t, y)."""
+    damping ratio ``zeta``, one every ``every_s`` s from ``start_s`` (each of random phase,
+    amplitude 0.5-2, the last ones' tails still ringing; ``impacts``: each a unit impact, phase
+    0, as a hammer's), plus white noise ``snr_db`` below a unit pluck's power,
+    ``start_s + plucks * every_s`` s at ``rate_hz``; returns (t, y)."""
     rng = np.random.default_rng(seed)
-    t = np.arange(round(plucks * every_s * rate_hz)) / rate_hz
+    t = np.arange(round((start_s + plucks * every_s) * rate_hz)) / rate_hz
     w = 2 * np.pi * f
     y = np.zeros_like(t)
     for k in range(plucks):
-        u = t - k * every_s
-        a, phase = rng.uniform(0.5, 2.0), rng.uniform(0, 2 * np.pi)
+        u = t - start_s - k * every_s
+        a, phase = (1.0, 0.0) if impacts else (rng.uniform(0.5, 2.0), rng.uniform(0, 2 * np.pi))
         ring = a * np.exp(-zeta * w * u) * np.sin(w * np.sqrt(1 - zeta**2) * u + phase)
         y += np.where(u >= 0, ring, 0.0)
     noise = np.sqrt(0.5 / 10 ** (snr_db / 10))
