@@ -13,7 +13,7 @@ from vib_estimator.core import auto, choice
 from vib_estimator.core.choice import decide, principal_component, spectral_peaks
 from vib_estimator.sim.ambient import ambient_record
 from vib_estimator.sim.frame import frame_record
-from vib_estimator.sim.signals import plucked_decays
+from vib_estimator.sim.signals import beside_lines, plucked_decays
 
 
 def holds_then_breaks(monkeypatch, name: str, factor: float, right) -> None:
@@ -815,6 +815,27 @@ def test_a_train_of_impacts_read_driven_is_free(monkeypatch, name, factor):
     value = getattr(choice, name) * factor
     monkeypatch.setattr(choice, name, round(value) if name == 'TRAIN_TESTS' else value)
     assert not right()
+
+
+@pytest.mark.parametrize('factor', [0.001, 1000])
+def test_a_decay_beside_a_machine_s_lines_is_free(monkeypatch, factor):
+    """A 5 Hz pluck beside a motor's 30, 60 and 90 Hz (a periodic drive's lines, the mode apart
+    from them ringing down): free, in a band that leaves the lines out -- the identifier gave it
+    5 estimates in 30 s. A structure moved periodically (a 1.35 Hz mode whose start rang down
+    among a cycle's odd harmonics of 0.625 Hz, below and about it) stays with the identifier,
+    its lines dropped. ``LINES_ABOVE`` at 0.001x sends the moved structure to the free
+    estimator, at 1000x the pluck to the identifier."""
+    motor = beside_lines(5.0, 0.005, [(30, 0.05), (60, 0.03), (90, 0.02)], 30, 1000.0)
+    moved = beside_lines(1.35, 0.02, [(0.625 * k, 0.3 / k) for k in (1, 3, 5, 7, 9)], 60, 200.0)
+
+    def right():
+        d = decide(*motor)
+        free = d.excitation == 'free' and not d.modes and d.lines_hz == ()
+        free = free and d.band_hz[0] < 5 < d.band_hz[1] < 30 and 'rings down freely' in d.reason
+        d = decide(*moved)
+        return free and d.excitation == 'ambient' and len(d.lines_hz) >= 3
+
+    holds_then_breaks(monkeypatch, 'LINES_ABOVE', factor, right)
 
 
 def slow_drive(variance):

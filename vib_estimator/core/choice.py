@@ -238,6 +238,11 @@ LOW_GAP = 0.5
 #: :data:`HARMONIC_TOL`); a free decay ringing through its record (a sinusoid of steady
 #: amplitude too) or a limit cycle is one line, or one with its harmonics below it
 PERIODIC_LINES = 3
+#: a periodic drive's lines beside a free decay (a machine running nearby: a motor's 30, 60, 90
+#: Hz beside a beam's 5 Hz pluck) when the lowest lies this many times above the decay's modes
+#: or more (:func:`beside_decay`: a band leaves them out); the identifier gave such a pluck 5
+#: estimates in 30 s, the free estimator 130
+LINES_ABOVE = 2.0
 #: a record the envelope reads driven is a train of free decays -- plucks or impacts that come
 #: before the last has rung down (an impact test, a hammer every 3 s on a 7 Hz mode at zeta 1 %:
 #: each rise ~6 x, not the envelope's onset; read 77-99 % driven, and its response, at the
@@ -547,8 +552,15 @@ def decide(
     if share >= FREE_BELOW and dominant > 0:  # read driven: a train of plucks? (at its mode)
         train, said = decay_train(t, signal, float(modal[0]) if len(modal) else dominant)
         seen += said
+    beside: list = []  # a machine's lines beside a free decay
     if train >= TRAIN_SHARE:
         excitation, lines = 'free', []  # (the impacts' harmonics: no drive)
+    elif (
+        lines and len(modal) and share < FREE_BELOW and beside_decay(t, signal, modal, lines, spec)
+    ):
+        excitation, beside, lines = 'free', lines, []
+        dominant, fundamental = float(modal[0]), float(np.min(modal))
+        seen += f'; the {dominant:.4g} Hz mode rings down freely beside them: a free decay'
     elif lines and len(modal):  # the modes between a periodic drive's lines
         excitation = 'ambient'
         dominant, fundamental = float(modal[0]), float(np.min(modal))
@@ -574,7 +586,7 @@ def decide(
         )
     modes, rate = 0, (len(t) - 1) / span
     if excitation == 'free':
-        modes, said, band = free_modes(t, signal, spec, peaks[~is_line], powers[~is_line])
+        modes, said, band = free_modes(t, signal, spec, peaks[~is_line], powers[~is_line], beside)
         if not modes:
             modes, fewer = few_samples(rate, dominant)
             said += fewer
@@ -605,6 +617,18 @@ def decide(
     )
 
 
+def beside_decay(t: np.ndarray, signal: np.ndarray, modal, lines, spec) -> bool:
+    """Whether a periodic drive's ``lines`` (Hz) run beside a free decay -- a machine nearby --
+    rather than drive the structure: its strongest ``modal`` peak rings freely
+    (:func:`rings_freely`, ``spec``: :func:`spectrum`) and every line lies :data:`LINES_ABOVE`
+    times above every modal peak or more, so that a band leaves them out (:func:`line_band`).
+    A structure moved periodically has lines at and below its mode (the simulated arm moved
+    every 0.8 s: 0.625 Hz and its harmonics about its 1.35 Hz, whose start rang down)."""
+    if min(lines) < LINES_ABOVE * float(np.max(modal)):
+        return False
+    return rings_freely(t, signal, float(modal[0]), spec)
+
+
 def decay_train(t: np.ndarray, signal: np.ndarray, f: float) -> tuple[float, str]:
     """The share of the record ``(t, signal)``'s stretches of ``TEST_PERIODS`` periods of ``f``
     Hz (at most :data:`TRAIN_TESTS`, evenly spaced) that are clean free decays -- passing the
@@ -630,15 +654,19 @@ def decay_train(t: np.ndarray, signal: np.ndarray, f: float) -> tuple[float, str
         return share, ''
     return share, (
         f'; but {sum(told)} of {len(told)} stretches of {TEST_PERIODS} periods of {f:.4g} Hz are '
-        'clean free decays: plucks or impacts that come before the last has rung down, free'
+        'clean free decays (each one damped sinusoid, none driven): plucks or impacts that come '
+        'before the last has rung down, or an oscillation growing freely, free'
     )
 
 
-def free_modes(t, signal, spec, peaks: np.ndarray, powers: np.ndarray) -> tuple[int, str, tuple]:
+def free_modes(
+    t, signal, spec, peaks: np.ndarray, powers: np.ndarray, beside: list = ()
+) -> tuple[int, str, tuple]:
     """A free decay's modes to track -- :data:`TRACKED_MODES` when its spectral peaks (``spec``:
     :func:`spectrum`) hold several separate modes (:func:`separate_modes`, with
     :func:`rings_freely`, :func:`coexistence` and :func:`steady_line`), else 0 --, the reason in
-    words and the band that leaves out the steady lines above them (:func:`line_band`)."""
+    words and the band that leaves out the steady lines above them (:func:`line_band`), and a
+    periodic drive's lines ``beside`` the decay (Hz: a machine running nearby)."""
     lines: list[float] = []
     dominant_fall = None  # read once, at the first candidate
 
@@ -665,7 +693,7 @@ def free_modes(t, signal, spec, peaks: np.ndarray, powers: np.ndarray) -> tuple[
         if lines
         else ''
     )
-    band = line_band(separate, lines)
+    band = line_band(separate, lines + list(beside))
     if band:
         said += f' (band_hz {band[0]:.3g}-{band[1]:.3g} Hz)'
     if len(separate) < 2:

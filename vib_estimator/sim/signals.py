@@ -1,7 +1,8 @@
 # Copyright 2026 vib_estimator developers
 # SPDX-License-Identifier: Apache-2.0
 """Test signals (pure numpy): the paper's Fig. 1 sine and normalised damped sine of Eq. 15,
-gappy and repeatedly plucked decays, and a closed loop's limit cycle."""
+gappy and repeatedly plucked decays, a pluck beside a machine's lines, and a closed loop's limit
+cycle."""
 
 from __future__ import annotations
 
@@ -74,6 +75,19 @@ def plucked_decays(
         y += np.where(u >= 0, ring, 0.0)
     noise = np.sqrt(0.5 / 10 ** (snr_db / 10))
     return t, y + noise * rng.standard_normal(len(t))
+
+
+def beside_lines(mode, zeta, lines, seconds, rate_hz, start_s=1.0, seed=0):
+    """A pluck of a ``mode`` Hz mode of damping ratio ``zeta`` at ``start_s`` beside steady
+    ``lines`` ((Hz, amplitude), ...: a machine running nearby, the k-th at phase k), in white
+    noise of 0.005 (46 dB below the unit pluck), ``seconds`` at ``rate_hz``; returns (t, y)."""
+    t = np.arange(0, seconds, 1 / rate_hz)
+    tau = np.clip(t - start_s, 0, None)
+    y = np.where(t >= start_s, np.exp(-zeta * 2 * np.pi * mode * tau), 0.0)
+    y = y * np.sin(2 * np.pi * mode * tau)
+    for k, (f, a) in enumerate(lines):
+        y = y + a * np.sin(2 * np.pi * f * t + k)
+    return t, y + 0.005 * np.random.default_rng(seed).standard_normal(len(t))
 
 
 def limit_cycle(
