@@ -20,6 +20,11 @@ windows, ``core.choice.SHORT_WINDOWS``), in the same run (issue 37: "whatever th
   hammer every 2, 3 or 5 s on a 7 Hz mode at zeta 0.3-2 %, from 1 s for 120 s, 1 kHz, 20 and 40
   dB below a unit impact, 2 seeds: ``sim.signals.plucked_decays``), read driven by the
   envelope; ``--base`` without :func:`core.choice.decay_train` (before 6 Dec 2026, 10:10 UTC).
+- ``--machine``: a pluck beside a machine's lines (5 Hz beside 30, 60, 90 Hz; 2 Hz beside 25,
+  50, 75 Hz; the first line at 5-50 % of the pluck, the others at 1/2 and 1/3 of it; zeta 0.5 %,
+  1 kHz, 46 dB, 2 seeds: ``sim.signals.beside_lines``): a periodic drive's lines and a mode
+  apart from them; ``--base`` without :func:`core.choice.beside_decay` (before 6 Dec 2026,
+  10:20 UTC).
 - ``--steady``: a closed loop's limit cycle (``sim.signals.limit_cycle``, the real arm's kind:
   harmonics, a wandering amplitude and phase, 1 mm steps; 120 s at 200 Hz and 1 kHz, 3 seeds),
   streamed through the node's defaults: estimates, share within 2 % and 5 % of 1.8116 Hz, the
@@ -35,6 +40,7 @@ windows, ``core.choice.SHORT_WINDOWS``), in the same run (issue 37: "whatever th
     cd benchmarks && ../.venv/bin/python bench_hard_records.py --channels [--base]
     cd benchmarks && ../.venv/bin/python bench_hard_records.py --heavy --silent --node [--base]
     cd benchmarks && ../.venv/bin/python bench_hard_records.py --impacts [--node] [--base]
+    cd benchmarks && ../.venv/bin/python bench_hard_records.py --machine [--node] [--base]
     cd benchmarks && ../.venv/bin/python bench_hard_records.py --steady [--base]
 """
 
@@ -57,7 +63,7 @@ from vib_estimator.analysis import analyze as analyze_module
 from vib_estimator.cli import main as cli
 from vib_estimator.core import choice
 from vib_estimator.sim.ambient import ambient_record
-from vib_estimator.sim.signals import limit_cycle, plucked_decays
+from vib_estimator.sim.signals import beside_lines, limit_cycle, plucked_decays
 
 #: --heavy: damping ratios; (frequency Hz, samples a second) of each
 HEAVY_ZETAS = (0.01, 0.02, 0.03, 0.05, 0.08)
@@ -166,6 +172,18 @@ def hum():
             yield label, [(f, t, y + a * np.sin(2 * np.pi * line * t))]
 
 
+def machine():
+    """``--machine`` (module doc): one row per line amplitude."""
+    for f, base, seconds in ((5.0, 30.0, 30.0), (2.0, 25.0, 40.0)):
+        for a in (0.05, 0.2, 0.5):
+            lines = [(base * k, a / k) for k in (1, 2, 3)]
+            records = [
+                (f, *beside_lines(f, 0.005, lines, seconds, 1000.0, seed=seed))
+                for seed in range(2)
+            ]
+            yield f'{f:g} Hz beside {base:g}, {2 * base:g}, {3 * base:g} Hz at {a:g}', records
+
+
 def impacts():
     """``--impacts`` (module doc): one row per spacing and damping."""
     for every, zeta in ((3.0, 0.003), (3.0, 0.01), (5.0, 0.005), (2.0, 0.01), (2.0, 0.02)):
@@ -261,6 +279,7 @@ def main() -> int:
     parser.add_argument('--hum', action='store_true', help='a pluck beside mains hum')
     parser.add_argument('--short', action='store_true', help='driven records of 15-90 s')
     parser.add_argument('--impacts', action='store_true', help='a train of impacts on a mode')
+    parser.add_argument('--machine', action='store_true', help="a pluck beside a machine's lines")
     parser.add_argument('--steady', action='store_true', help="a limit cycle, the node's defaults")
     parser.add_argument('--channels', action='store_true', help='three channels of free decays')
     parser.add_argument('--base', action='store_true', help='the default before 6 Dec 2026')
@@ -276,12 +295,14 @@ def main() -> int:
         choice.SHORT_WINDOWS = 1e-9  # the configured window, whatever the record's length
         choice.HELD_RUN = 10**9  # the node: a steady oscillation's held estimates held on
         choice.TRAIN_SHARE = math.inf  # a train of impacts read driven: the identifier
+        choice.LINES_ABOVE = math.inf  # a decay beside a machine's lines: the identifier
     with tempfile.TemporaryDirectory() as folder:
         kinds = (
             (args.heavy, heavy),
             (args.silent, silent),
             (args.hum, hum),
             (args.impacts, impacts),
+            (args.machine, machine),
         )
         for wanted, cases in (*kinds, (args.channels, channels)):
             if wanted:

@@ -552,18 +552,18 @@ def decide(
     if share >= FREE_BELOW and dominant > 0:  # read driven: a train of plucks? (at its mode)
         train, said = decay_train(t, signal, float(modal[0]) if len(modal) else dominant)
         seen += said
-    beside: list = []  # a machine's lines beside a free decay
-    if train >= TRAIN_SHARE:
-        excitation, lines = 'free', []  # (the impacts' harmonics: no drive)
+    beside: list = []  # a machine's lines beside a free decay (banded out)
+    if len(modal) and (train >= TRAIN_SHARE or lines):  # the structure's modes, not the lines
+        dominant, fundamental = float(modal[0]), float(np.min(modal))
+    if train >= TRAIN_SHARE:  # (with no mode apart from them, the lines are the impacts')
+        excitation, beside, lines = 'free', (lines if len(modal) else []), []
     elif (
         lines and len(modal) and share < FREE_BELOW and beside_decay(t, signal, modal, lines, spec)
     ):
         excitation, beside, lines = 'free', lines, []
-        dominant, fundamental = float(modal[0]), float(np.min(modal))
         seen += f'; the {dominant:.4g} Hz mode rings down freely beside them: a free decay'
     elif lines and len(modal):  # the modes between a periodic drive's lines
         excitation = 'ambient'
-        dominant, fundamental = float(modal[0]), float(np.min(modal))
     elif share < FREE_BELOW:
         excitation = 'free'
     elif share > DRIVEN_ABOVE or channels > 1:
