@@ -786,8 +786,8 @@ BUILDING = [(1.23, 0.015, 1.0), (1.29, 0.015, 0.8), (1.45, 0.02, 0.6), (3.85, 0.
 def test_a_train_of_impacts_read_driven_is_free(monkeypatch, name, factor):
     """Impacts every 3 s on a 7 Hz mode (zeta 0.3-1 %) read driven by the envelope (each rise
     ~6 x, no onset) and, at the impacts' harmonics only, as a periodic drive's lines: the
-    identifier had no mode to give. Its stretches are clean free decays: free, no lines, words
-    that say so. A building driven by wind (whose stretches pass the test but not cleanly) and a
+    identifier had no mode to give. Its stretches are clean free decays: free, no lines (nor a
+    band leaving the impacts' harmonics out: they are the mode's response), words that say so. A building driven by wind (whose stretches pass the test but not cleanly) and a
     mode driven by noise stay ambient; at most ``TRAIN_TESTS`` stretches are tested."""
     trains = [impacts(), impacts(zeta=0.003), impacts(every=5.0, zeta=0.005)]
     driven = [
@@ -805,6 +805,7 @@ def test_a_train_of_impacts_read_driven_is_free(monkeypatch, name, factor):
         for record in trains:
             d = decide(*record)
             ok.append(d.excitation == 'free' and d.lines_hz == () and d.train >= 0.75)
+            ok.append(d.band_hz == () and d.dominant_hz == pytest.approx(7.0, rel=0.02))
             ok.append('clean free decays' in d.reason and d.driven_share > choice.DRIVEN_ABOVE)
         for record in driven:
             d = decide(*record)

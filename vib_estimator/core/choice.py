@@ -555,8 +555,9 @@ def decide(
     beside: list = []  # a machine's lines beside a free decay (banded out)
     if len(modal) and (train >= TRAIN_SHARE or lines):  # the structure's modes, not the lines
         dominant, fundamental = float(modal[0]), float(np.min(modal))
-    if train >= TRAIN_SHARE:  # (with no mode apart from them, the lines are the impacts')
-        excitation, beside, lines = 'free', (lines if len(modal) else []), []
+    if train >= TRAIN_SHARE:  # the lines near the mode are the impacts', those far above not
+        top = LINES_ABOVE * float(np.max(modal)) if len(modal) else math.inf
+        excitation, beside, lines = 'free', [f for f in lines if f >= top], []
     elif (
         lines and len(modal) and share < FREE_BELOW and beside_decay(t, signal, modal, lines, spec)
     ):
