@@ -548,23 +548,21 @@ def decide(
     is_line, lines = drive_lines(t, signal, peaks)
     modal = peaks[~is_line]
     seen += drive_said(is_line, lines, modal)
-    train = math.nan
-    if share >= FREE_BELOW and dominant > 0:  # read driven: a train of plucks? (at its mode)
-        train, said = decay_train(t, signal, float(modal[0]) if len(modal) else dominant)
+    train, at = math.nan, float(modal[0]) if len(modal) else dominant  # (the strongest mode)
+    if share >= FREE_BELOW and dominant > 0:  # read driven: a train of plucks?
+        train, said = decay_train(t, signal, at)
         seen += said
     beside: list = []  # a machine's lines beside a free decay (banded out)
-    if len(modal) and (train >= TRAIN_SHARE or lines):  # the structure's modes, not the lines
-        dominant, fundamental = float(modal[0]), float(np.min(modal))
-    if train >= TRAIN_SHARE:  # the lines near the mode are the impacts', those far above not
-        top = LINES_ABOVE * float(np.max(modal)) if len(modal) else math.inf
-        excitation, beside, lines = 'free', [f for f in lines if f >= top], []
-    elif (
-        lines and len(modal) and share < FREE_BELOW and beside_decay(t, signal, modal, lines, spec)
-    ):
-        excitation, beside, lines = 'free', lines, []
-        seen += f'; the {dominant:.4g} Hz mode rings down freely beside them: a free decay'
-    elif lines and len(modal):  # the modes between a periodic drive's lines
-        excitation = 'ambient'
+    if train >= TRAIN_SHARE:  # the mode: the strongest peak near it (the impacts' lines are its
+        near = peaks[(peaks > at / LINES_ABOVE) & (peaks < at * LINES_ABOVE)]  # response)
+        dominant = float(near[0]) if len(near) else at
+        excitation, beside, lines = 'free', [f for f in lines if f >= LINES_ABOVE * at], []
+    elif lines and len(modal):  # the structure's modes, not the lines
+        dominant, fundamental = at, float(np.min(modal))
+        excitation = 'ambient'  # the modes between a periodic drive's lines
+        if share < FREE_BELOW and beside_decay(t, signal, modal, lines, spec):
+            excitation, beside, lines = 'free', lines, []
+            seen += f'; the {dominant:.4g} Hz mode rings down freely beside them: a free decay'
     elif share < FREE_BELOW:
         excitation = 'free'
     elif share > DRIVEN_ABOVE or channels > 1:
@@ -578,44 +576,56 @@ def decide(
         band = ()
     window = window_s
     if excitation != 'free' and math.isfinite(fundamental):
-        room = (
-            math.inf if stream else max(min(window_s, span / SHORT_WINDOWS), span - MIN_ANALYSES)
-        )
-        window = min(max(window_s, WINDOW_PERIODS / fundamental), MAX_WINDOW_S, room)
-        seen += (
-            f'; window {window:.0f} s ({window * fundamental:.0f} periods of {fundamental:.3g} Hz)'
-        )
-    modes, rate = 0, (len(t) - 1) / span
-    if excitation == 'free':
-        modes, said, band = free_modes(t, signal, spec, peaks[~is_line], powers[~is_line], beside)
-        if not modes:
-            modes, fewer = few_samples(rate, dominant)
-            said += fewer
-        if not modes and band and channels > 1:  # each channel's tail, band-passed: the tracker
-            modes, tracked = to_tracker('several channels')
-            said += tracked
+        window, said = driven_window(window_s, fundamental, span, stream)
         seen += said
+    modes, rate = 0, (len(t) - 1) / span
     free = (math.nan, 0.0, '', math.nan)  # a free decay's window, precision, model, offset
-    if excitation == 'free' and not modes and dominant > 0:  # (several channels: no window)
-        modes, free, said = free_window(t, y, signal, dominant, spec, offset_ok, stream, channels)
+    if excitation == 'free':
+        modal_powers = powers[~is_line]
+        decay = (t, y, signal, spec, dominant, channels)  # the free decay
+        modes, free, band, said = free_choice(
+            *decay, modal, modal_powers, beside, offset_ok, stream
+        )
         seen += said
     if lines and excitation != 'free':
         seen += '; the identifier drops its modes at the lines (lines_hz)'
     seen_at = (tuple(peaks), seen, span, rate)  # what was read, at what rate
-    drive = tuple(lines) if excitation != 'free' else ()
-    return Decision(
-        excitation,
-        window,
-        share,
-        dominant,
-        fundamental,
-        *seen_at,
-        modes,
-        *free,
-        drive,
-        band,
-        train,
+    found = (modes, *free, tuple(lines) if excitation != 'free' else (), band, train)
+    return Decision(excitation, window, share, dominant, fundamental, *seen_at, *found)
+
+
+def driven_window(window_s: float, fundamental: float, span: float, stream: bool) -> tuple:
+    """A driven record's window (s) and the words: :data:`WINDOW_PERIODS` periods of its
+    ``fundamental`` (Hz), at least the configured ``window_s``, at most :data:`MAX_WINDOW_S`,
+    and (not a ``stream``) leaving a record of ``span`` s :data:`MIN_ANALYSES` analyses, or,
+    shorter than :data:`SHORT_WINDOWS` configured windows, that share of it."""
+    room = math.inf if stream else max(min(window_s, span / SHORT_WINDOWS), span - MIN_ANALYSES)
+    window = min(max(window_s, WINDOW_PERIODS / fundamental), MAX_WINDOW_S, room)
+    return window, (
+        f'; window {window:.0f} s ({window * fundamental:.0f} periods of {fundamental:.3g} Hz)'
     )
+
+
+def free_choice(
+    t, y, signal, spec, dominant, channels, modal, powers, beside, offset_ok, stream
+) -> tuple:
+    """A free decay's ``(modes, window, band, words)``: several separate modes among its
+    ``modal`` peaks (``powers``; :func:`free_modes`, the lines ``beside`` it banded out), few
+    samples a period (:func:`few_samples`), several channels beside a line: the mode tracker;
+    else one mode at ``dominant`` Hz and its window (:func:`free_window`: its precision, model
+    and offset; NaN window: the configured)."""
+    modes, said, band = free_modes(t, signal, spec, modal, powers, beside)
+    if not modes:
+        modes, fewer = few_samples((len(t) - 1) / float(t[-1] - t[0]), dominant)
+        said += fewer
+    if not modes and band and channels > 1:  # each channel's tail, band-passed: the tracker
+        modes, tracked = to_tracker('several channels')
+        said += tracked
+    free = (math.nan, 0.0, '', math.nan)
+    if not modes and dominant > 0:  # (several channels: no window)
+        modes, free, more = free_window(t, y, signal, dominant, spec, offset_ok, stream, channels)
+        said += more
+    return modes, free, band, said
 
 
 def beside_decay(t: np.ndarray, signal: np.ndarray, modal, lines, spec) -> bool:
