@@ -787,8 +787,9 @@ def test_a_train_of_impacts_read_driven_is_free(monkeypatch, name, factor):
     """Impacts every 3 s on a 7 Hz mode (zeta 0.3-1 %) read driven by the envelope (each rise
     ~6 x, no onset) and, at the impacts' harmonics only, as a periodic drive's lines: the
     identifier had no mode to give. Its stretches are clean free decays: free, no lines (nor a
-    band leaving the impacts' harmonics out: they are the mode's response), words that say so. A building driven by wind (whose stretches pass the test but not cleanly) and a
-    mode driven by noise stay ambient; at most ``TRAIN_TESTS`` stretches are tested."""
+    band leaving the impacts' harmonics out: they are the mode's response), words that say so.
+    A building driven by wind (whose stretches pass the test but not cleanly) and a mode driven
+    by noise stay ambient; at most ``TRAIN_TESTS`` stretches are tested."""
     trains = [impacts(), impacts(zeta=0.003), impacts(every=5.0, zeta=0.005)]
     driven = [
         ambient_record(300, 40.0, BUILDING, 10, 1)[:2],
