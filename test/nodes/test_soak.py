@@ -34,6 +34,7 @@ def test_a_minute_of_faults(tmp_path):
         text=True,
         timeout=600,
     )
+    assert out.exists(), f'exit {run.returncode}: ' + run.stdout[-4000:] + run.stderr[-4000:]
     fig = json.loads(out.read_text())
     assert run.returncode in (0, 1), run.stdout + run.stderr
     assert fig['problems'] == [], run.stdout
