@@ -1199,7 +1199,8 @@ class StreamChoice:
         self._share: Optional[float] = None
         self._estimated_at = -math.inf  # stream time of the last free estimate (follow)
         self._silent_retry = -math.inf
-        self._held: list = []  # the frequencies of the free estimates held back running
+        self._held = 0  # free estimates held back running ...
+        self._held_hz: list = []  # ... the last HELD_RUN of them (Hz)
         self._window_onset = 0  # the onset whose decay is read for its window
         self._window_reads = 0  # ... how many times (WINDOW_READS: done)
         #: ((onsets, driven blocks) of the stretch, free-decay tests passed running in it)
@@ -1240,7 +1241,7 @@ class StreamChoice:
         self._kept.clear()
         self._kept_n = 0
         self._estimated_at = self._silent_retry = self._retry_at = -math.inf
-        self._held = []
+        self._held, self._held_hz = 0, []
         self.watch = DrivenWatch()
         self._share = None
         self._window_onset = self._window_reads = 0
@@ -1325,7 +1326,7 @@ class StreamChoice:
         a free decay of one mode: a limit cycle, a machine running steadily, whose wandering
         amplitude and waveform (harmonics, a quantiser's steps) the decay model misfits, so that
         the node would stay silent; asked at most every :data:`SILENT_S` s; else None."""
-        if len(self._held) < HELD_RUN or now - self._silent_retry < SILENT_S:
+        if self._held < HELD_RUN or now - self._silent_retry < SILENT_S:
             return None
         if not (self.watch.live() and self.watch.freed()):
             return None
@@ -1333,9 +1334,9 @@ class StreamChoice:
         chosen = decide(*self.kept(), self.channels, window_s, stream=True)
         if chosen.excitation != 'free' or chosen.modes:
             return chosen if chosen.excitation == 'free' else None
-        held = self._held[-HELD_RUN:] or [chosen.dominant_hz]
+        held = self._held_hz or [chosen.dominant_hz]
         modes, said = to_tracker(
-            f'{len(self._held)} free estimates running ({min(held):.4g}-{max(held):.4g} Hz) '
+            f'{self._held} free estimates running ({min(held):.4g}-{max(held):.4g} Hz) '
             'failed the free-decay test while the stream rang steadily: a steady oscillation '
             '(a limit cycle, a machine running), not a decay'
         )
@@ -1414,7 +1415,9 @@ class StreamChoice:
         verdict = is_free_decay(*self.recent((TEST_PERIODS + 2) / f), f)
         passes = self._passed[1] if self._passed[0] == stretch else 0
         self._passed = (stretch, passes + 1 if verdict is True else 0)
-        self._held = self._held + [f] if verdict is False else []
+        held = verdict is False
+        self._held = self._held + 1 if held else 0
+        self._held_hz = (self._held_hz + [f])[-max(HELD_RUN, 1) :] if held else []
         return verdict
 
     def driven(self, above: float = DRIVEN_ABOVE) -> Optional[float]:
