@@ -90,14 +90,7 @@ def beside_lines(mode, zeta, lines, seconds, rate_hz, start_s=1.0, seed=0):
     return t, y + 0.005 * np.random.default_rng(seed).standard_normal(len(t))
 
 
-def limit_cycle(
-    seconds: float,
-    rate_hz: float,
-    seed: int = 0,
-    wander: float = 0.05,
-    diffusion: float = 0.02,
-    step: float = 1e-3,
-) -> Tuple[np.ndarray, np.ndarray]:
+def limit_cycle(seconds, rate_hz, seed=0, wander=0.05, diffusion=0.02, step=1e-3):
     """A closed loop's limit cycle of the real flexible-link arm's kind (``flex8``'s fit,
     ``benchmarks/real_arm.py``: -4.8 mm offset, 10.1 mm at 1.8116 Hz, 2nd and 3rd harmonics 0.19
     and 0.05 mm; m): its amplitude wandering by ``wander`` (at 0.37 Hz), its phase diffusing by
