@@ -82,6 +82,26 @@ def test_single_mode():
     assert np.median(np.diff(est.t)) == pytest.approx(4.0)  # a fifth of the window
 
 
+@pytest.mark.parametrize('factor', [0.001, 1000])
+def test_a_pole_near_nyquist_is_not_published(monkeypatch, factor):
+    """Poles above ``ssi.NU_MAX`` (0.45) of the sampling rate are dropped: a 47 Hz mode sampled
+    at 100 Hz, where a real recorder's anti-alias filter bends it, is not published, the 10 Hz
+    mode beside it is (26 estimates). At 1000x the 47 Hz mode is published too (and a 46 Hz
+    one: 56 estimates); at 0.001x nothing is."""
+    from vib_estimator.core import ssi
+
+    t, y, _ = ambient_record(120.0, 100.0, [(10.0, 0.01, 1.0), (47.0, 0.01, 1.0)], 26.0, 3)
+
+    def right():
+        est = AmbientEstimator(AMBIENT).process(t, y)
+        f = np.asarray(est.frequency_hz)
+        return len(f) >= 10 and np.all(np.abs(f / 10.0 - 1) <= 0.02)
+
+    assert right()
+    monkeypatch.setattr(ssi, 'NU_MAX', ssi.NU_MAX * factor)
+    assert not right()
+
+
 def test_the_update_period_is_a_fifth_of_the_window_from_1_to_5_s():
     """Once its modes are confirmed, a window is analysed every fifth of its length, at least
     every second (a short window: an estimate a second) and at most every 5 s (a long window on a
