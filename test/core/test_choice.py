@@ -819,6 +819,17 @@ def test_a_train_of_impacts_read_driven_is_free(monkeypatch, name, factor):
     assert not right()
 
 
+def test_a_record_with_a_gap_is_decided():
+    """A stretch of :func:`core.choice.decay_train` that falls in a gap of the record (the node's
+    kept samples across a source's restart: the soak's estimator_node died of it, an IndexError)
+    tells nothing: a driven record with 30 s missing is still decided, ambient."""
+    t, y, _ = ambient_record(120, 100.0, [(1.2, 0.015, 1.0)], 20, 1)
+    keep = (t < 40) | (t > 70)
+    d = decide(t[keep], y[keep])
+    assert d.excitation == 'ambient' and d.train == 0.0
+    assert auto.is_free_decay(np.empty(0), np.empty(0), 5.0) is None
+
+
 @pytest.mark.parametrize('factor', [0.001, 1000])
 def test_a_decay_beside_a_machine_s_lines_is_free(monkeypatch, factor):
     """A 5 Hz pluck beside a motor's 30, 60 and 90 Hz (a periodic drive's lines, the mode apart

@@ -276,8 +276,9 @@ def decay_misfit(
     amplitudes ``c`` of its one-period blocks, half a period apart, after the last :data:`JUMP`
     (looked for one period further back), fitted by ``c[k+1] = r c[k]`` (a decay; the frequency
     refined twice from ``r``'s phase): the prediction error's mean square over the noise's and its
-    RMS over the amplitude's. None when fewer than :data:`TEST_BLOCKS` blocks are left."""
-    if not f > 0:
+    RMS over the amplitude's. None when fewer than :data:`TEST_BLOCKS` blocks are left (or no
+    samples: a stretch of a record that fell in a gap)."""
+    if not f > 0 or len(t) < 2:
         return None
     lo = np.searchsorted(t, t[-1] - (periods + 1) / f, 'left')
     t, y = t[lo:], y[lo:]

@@ -646,7 +646,8 @@ def decay_train(t: np.ndarray, signal: np.ndarray, f: float) -> tuple[float, str
     free-decay test (:func:`.auto.is_free_decay`, which starts after an impact within them) with
     blocks :data:`TRAIN_SNR_DB` over their noise (:func:`.auto.decay_misfit`; a pass under it is
     not told: a decay rung down, or a mode among others) -- among those it tells (NaN: none),
-    and, when that share is :data:`TRAIN_SHARE` or more, the words."""
+    and, when that share is :data:`TRAIN_SHARE` or more, the words. A stretch in a gap of the
+    record (a stream's kept samples across a source's restart) tells nothing."""
     reach = (TEST_PERIODS + 2) / f
     count = min(TRAIN_TESTS, int((t[-1] - t[0]) / reach))
     verdicts = []
