@@ -22,7 +22,7 @@ windows, ``core.choice.SHORT_WINDOWS``), in the same run (issue 37: "whatever th
   envelope; ``--base`` without :func:`core.choice.decay_train` (before 6 Dec 2026, 10:10 UTC).
 - ``--machine``: a pluck beside a machine's lines (5 Hz beside 30, 60, 90 Hz; 2 Hz beside 25,
   50, 75 Hz; the first line at 5-50 % of the pluck, the others at 1/2 and 1/3 of it; zeta 0.5 %,
-  1 kHz, 46 dB, 2 seeds: ``sim.signals.beside_lines``): a periodic drive's lines and a mode
+  1 kHz, 43 dB, 2 seeds: ``sim.signals.beside_lines``): a periodic drive's lines and a mode
   apart from them; ``--base`` without :func:`core.choice.beside_decay` (before 6 Dec 2026,
   10:20 UTC).
 - ``--steady``: a closed loop's limit cycle (``sim.signals.limit_cycle``, the real arm's kind:

@@ -797,7 +797,7 @@ def test_a_train_of_impacts_read_driven_is_free(monkeypatch, name, factor):
     ]
     tests = []
     monkeypatch.setattr(
-        choice, 'is_free_decay', lambda *a: tests.append(1) or auto.is_free_decay(*a)
+        choice, 'decay_verdict', lambda *a: tests.append(1) or auto.decay_verdict(*a)
     )
 
     def right():

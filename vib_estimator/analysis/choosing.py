@@ -29,7 +29,6 @@ from ..core.choice import (
     DRIVEN_ABOVE,
     FREE_BELOW,
     TRACKED_MODES,
-    TRAIN_SHARE,
     Decision,
     decide,
 )
@@ -121,17 +120,17 @@ def rescue(
 
 def contradiction(config: EstimatorConfig, d: Decision, prog: str) -> str:
     """One ``warning:`` line when the chosen excitation contradicts the record (free decays'
-    estimates of a driven record scatter -- not of a train of plucks, ``Decision.train`` --; the
-    identifier needs a stationary response), else ''."""
+    estimates of a driven record scatter -- not of a train of plucks,
+    ``Decision.plucks_in_a_row`` --; the identifier needs a stationary response), else ''."""
     share = f'{100 * d.driven_share:.0f} % of its energy read driven'
-    driven = d.driven_share > DRIVEN_ABOVE and not d.train >= TRAIN_SHARE
+    driven = d.driven_share > DRIVEN_ABOVE and not d.plucks_in_a_row
     if config.excitation == 'free' and driven:
         return (
             f'{prog}: warning: the record looks driven throughout ({share}): free-decay estimates '
             'of a driven structure scatter; without --excitation the default would use ambient'
         )
-    if config.excitation == 'ambient' and (d.driven_share < FREE_BELOW or d.train >= TRAIN_SHARE):
-        if d.train >= TRAIN_SHARE:
+    if config.excitation == 'ambient' and (d.driven_share < FREE_BELOW or d.plucks_in_a_row):
+        if d.plucks_in_a_row:
             share = f'{100 * d.train:.0f} % of its stretches clean free decays, plucks in a row'
         return (
             f'{prog}: warning: the record looks like free decays ({share}): the identifier '

@@ -307,15 +307,23 @@ def decay_misfit(
 
 def is_free_decay(t: np.ndarray, y: np.ndarray, f: float) -> Optional[bool]:
     """Whether the signal before a free estimate of ``f`` Hz is a free decay
-    (:func:`decay_misfit`): not when its prediction error exceeds :data:`NOISE_RATIO` x the
-    noise's and :data:`INNOVATION` of the amplitude (a driven mode's amplitude and phase wander),
-    unless its last :data:`RECENT_PERIODS` are a decay within ``INNOVATION / CLEAN``; None when
-    too short to tell."""
+    (:func:`decay_verdict`); None when too short to tell."""
+    return decay_verdict(t, y, f)[0]
+
+
+def decay_verdict(
+    t: np.ndarray, y: np.ndarray, f: float
+) -> tuple[Optional[bool], Optional[tuple]]:
+    """:func:`is_free_decay`'s verdict and the misfit it read (:func:`decay_misfit` over the
+    last :data:`TEST_PERIODS` periods; None when too short): not a free decay when its
+    prediction error exceeds :data:`NOISE_RATIO` x the noise's and :data:`INNOVATION` of the
+    amplitude (a driven mode's amplitude and phase wander), unless its last
+    :data:`RECENT_PERIODS` are a decay within ``INNOVATION / CLEAN``."""
     m = decay_misfit(t, y, f)
     if m is None or m[0] <= NOISE_RATIO or m[1] <= INNOVATION:
-        return None if m is None else True
+        return (None if m is None else True), m
     recent = decay_misfit(t, y, f, RECENT_PERIODS)
-    return recent is not None and recent[1] <= INNOVATION / CLEAN
+    return recent is not None and recent[1] <= INNOVATION / CLEAN, m
 
 
 def _is_onset(

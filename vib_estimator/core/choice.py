@@ -67,7 +67,7 @@ from .auto import (
     MIN_BLOCK_S,
     TEST_PERIODS,
     Envelope,
-    decay_misfit,
+    decay_verdict,
     is_free_decay,
 )
 from .ssi import NU_MAX
@@ -295,6 +295,12 @@ class Decision:
     #: a stream's way from the identifier to ``auto``: only the excitation changes (the window,
     #: the lines and the band its driven decision set stay)
     keeps: bool = False
+
+    @property
+    def plucks_in_a_row(self) -> bool:
+        """Read driven, but a train of free decays (:attr:`train` at least
+        :data:`TRAIN_SHARE`): free."""
+        return self.train >= TRAIN_SHARE
 
     def changes(self) -> dict:
         """The configuration fields a stream switching to this decision sets (the node's
@@ -643,9 +649,9 @@ def beside_decay(t: np.ndarray, signal: np.ndarray, modal, lines, spec) -> bool:
 def decay_train(t: np.ndarray, signal: np.ndarray, f: float) -> tuple[float, str]:
     """The share of the record ``(t, signal)``'s stretches of ``TEST_PERIODS`` periods of ``f``
     Hz (at most :data:`TRAIN_TESTS`, evenly spaced) that are clean free decays -- passing the
-    free-decay test (:func:`.auto.is_free_decay`, which starts after an impact within them) with
-    blocks :data:`TRAIN_SNR_DB` over their noise (:func:`.auto.decay_misfit`; a pass under it is
-    not told: a decay rung down, or a mode among others) -- among those it tells (NaN: none),
+    free-decay test (:func:`.auto.decay_verdict`, which starts after an impact within them) with
+    blocks :data:`TRAIN_SNR_DB` over their noise (the misfit it read; a pass under it is not
+    told: a decay rung down, or a mode among others) -- among those it tells (NaN: none),
     and, when that share is :data:`TRAIN_SHARE` or more, the words. A stretch in a gap of the
     record (a stream's kept samples across a source's restart) tells nothing."""
     reach = (TEST_PERIODS + 2) / f
@@ -654,9 +660,9 @@ def decay_train(t: np.ndarray, signal: np.ndarray, f: float) -> tuple[float, str
     for end in np.linspace(t[0] + reach, t[-1], count):
         k = int(np.searchsorted(t, end, 'right'))
         part = slice(int(np.searchsorted(t, end - reach, 'left')), k)
-        verdict = is_free_decay(t[part], signal[part], f)
+        verdict, misfit = decay_verdict(t[part], signal[part], f)
         if verdict is True:  # clean, or a mode among others (a building's): not told
-            ratio, rms = decay_misfit(t[part], signal[part], f)  # err / noise, err / power
+            ratio, rms = misfit  # err / noise, err / power
             snr = 10 * math.log10(max(ratio, 1e-300) / max(rms * rms, 1e-300))
             verdict = True if snr >= TRAIN_SNR_DB else None
         verdicts.append(verdict)

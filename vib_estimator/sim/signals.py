@@ -78,16 +78,14 @@ def plucked_decays(
 
 
 def beside_lines(mode, zeta, lines, seconds, rate_hz, start_s=1.0, seed=0):
-    """A pluck of a ``mode`` Hz mode of damping ratio ``zeta`` at ``start_s`` beside steady
-    ``lines`` ((Hz, amplitude), ...: a machine running nearby, the k-th at phase k), in white
-    noise of 0.005 (46 dB below the unit pluck), ``seconds`` at ``rate_hz``; returns (t, y)."""
-    t = np.arange(0, seconds, 1 / rate_hz)
-    tau = np.clip(t - start_s, 0, None)
-    y = np.where(t >= start_s, np.exp(-zeta * 2 * np.pi * mode * tau), 0.0)
-    y = y * np.sin(2 * np.pi * mode * tau)
+    """A pluck of a ``mode`` Hz mode of damping ratio ``zeta`` at ``start_s`` (a unit impact,
+    :func:`plucked_decays`, in white noise of 0.005: 43 dB below its power) beside steady
+    ``lines`` ((Hz, amplitude), ...: a machine running nearby, the k-th at phase k), ``seconds``
+    at ``rate_hz``; returns (t, y)."""
+    t, y = plucked_decays(seed, mode, zeta, 43.0, 1, seconds - start_s, rate_hz, True, start_s)
     for k, (f, a) in enumerate(lines):
         y = y + a * np.sin(2 * np.pi * f * t + k)
-    return t, y + 0.005 * np.random.default_rng(seed).standard_normal(len(t))
+    return t, y
 
 
 def limit_cycle(seconds, rate_hz, seed=0, wander=0.05, diffusion=0.02, step=1e-3):
