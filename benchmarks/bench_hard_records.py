@@ -26,10 +26,12 @@ windows, ``core.choice.SHORT_WINDOWS``), in the same run (issue 37: "whatever th
   apart from them; ``--base`` without :func:`core.choice.beside_decay` (before 6 Dec 2026,
   10:20 UTC).
 - ``--steady``: a closed loop's limit cycle (``sim.signals.limit_cycle``, the real arm's kind:
-  harmonics, a wandering amplitude and phase, 1 mm steps; 120 s at 200 Hz and 1 kHz, 3 seeds),
-  streamed through the node's defaults: estimates, share within 2 % and 5 % of 1.8116 Hz, the
-  first estimate (s of stream) and the decisions; ``--base`` without ``core.choice.HELD_RUN``'s
-  rule (the node before 6 Dec 2026, 10:00 UTC).
+  harmonics, a wandering amplitude and phase, 1 mm steps; 120 s at 200 Hz and 1 kHz, 3 seeds;
+  at 4 mm, undithered, as flex1; after a step's ringing at 1.6 Hz, zeta 6 %): estimates, share
+  within 2 % and 5 % of 1.8116 Hz, estimates above 3 Hz, the first estimate (s) and (the node,
+  ``--node``) the decisions; ``--base`` without :func:`core.choice.steady_oscillation`
+  (``analyze`` before 6 Dec 2026, 13:00 UTC) and ``core.choice.HELD_RUN``'s rule (the node
+  before 6 Dec 2026, 10:00 UTC).
 - ``--short``: driven records of 15-90 s (white noise through 1.2, 2, 5 and 5 + 17 Hz modes at
   zeta 0.5-2 %, 500 Hz, 26 dB): estimates, modes found (within 2 %), share within 2 %, beyond 5 %.
 
@@ -41,7 +43,7 @@ windows, ``core.choice.SHORT_WINDOWS``), in the same run (issue 37: "whatever th
     cd benchmarks && ../.venv/bin/python bench_hard_records.py --heavy --silent --node [--base]
     cd benchmarks && ../.venv/bin/python bench_hard_records.py --impacts [--node] [--base]
     cd benchmarks && ../.venv/bin/python bench_hard_records.py --machine [--node] [--base]
-    cd benchmarks && ../.venv/bin/python bench_hard_records.py --steady [--base]
+    cd benchmarks && ../.venv/bin/python bench_hard_records.py --steady [--node] [--base]
 """
 
 from __future__ import annotations
@@ -221,23 +223,43 @@ def channels():
         yield label, records
 
 
-def steady(folder: Path) -> None:
-    """``--steady`` (module doc): one row per record."""
-    print('| record | estimates | within 2 % | within 5 % | first (s) | decisions |')
-    print('|---|---|---|---|---|---|')
+def cycles():
+    """``--steady``'s records: (label, t, y) each."""
     for rate, seed in itertools.product((200.0, 1000.0), range(3)):
-        t, y = limit_cycle(120.0, rate, seed)
+        yield f'{rate:g} Hz, seed {seed}', *limit_cycle(120.0, rate, seed)
+    for seed in range(3):  # flex1's kind: 4 mm in clean 1 mm steps
+        yield (
+            f'4 mm, undithered, seed {seed}',
+            *limit_cycle(120.0, 1000.0, seed, 0.05, 0.02, 1e-3, 0.4, 6e-5),
+        )
+    for seed in range(3):  # a step's ringing (1.6 Hz, zeta 6 %, 30 mm) into the cycle
+        t, y = limit_cycle(120.0, 1000.0, seed)
+        on = t >= 2.0
+        ring = np.exp(-0.06 * 2 * np.pi * 1.6 * (t[on] - 2)) * np.sin(
+            2 * np.pi * 1.6 * (t[on] - 2)
+        )
+        y[on] += np.round(30 * ring) * 1e-3
+        yield f'after a step, seed {seed}', t, y
+
+
+def steady(folder: Path, node: bool) -> None:
+    """``--steady`` (module doc): one row per record."""
+    print('| record | estimates | within 2 % | within 5 % | above 3 Hz | first (s) | decisions |')
+    print('|---|---|---|---|---|---|---|')
+    for label, t, y in cycles():
         path = folder / 'record.csv'
         np.savetxt(path, np.column_stack([t, y]), delimiter=',', header='time_s,y', comments='')
-        _, rows, decided, _ = streamed(path, [])
-        err = np.abs(np.array([r['frequency_hz'] for r in rows]) / 1.8116 - 1)
+        rows, decided = (streamed(path, [])[1:3]) if node else (analyzed(t, y, folder), '')
+        f = np.array([r['frequency_hz'] for r in rows])
+        err = np.abs(f / 1.8116 - 1)
         shares = (
             f'{100 * np.mean(err <= 0.02):.0f} % | {100 * np.mean(err <= 0.05):.0f} %'
             if len(err)
             else '- | -'
         )
         start = f'{rows[0]["t"]:.0f}' if rows and 't' in rows[0] else '-'
-        print(f'| {rate:g} Hz, seed {seed} | {len(err)} | {shares} | {start} | {decided} |')
+        high = int(np.sum(f > 3))
+        print(f'| {label} | {len(err)} | {shares} | {high} | {start} | {decided} |')
         sys.stdout.flush()
 
 
@@ -280,7 +302,7 @@ def main() -> int:
     parser.add_argument('--short', action='store_true', help='driven records of 15-90 s')
     parser.add_argument('--impacts', action='store_true', help='a train of impacts on a mode')
     parser.add_argument('--machine', action='store_true', help="a pluck beside a machine's lines")
-    parser.add_argument('--steady', action='store_true', help="a limit cycle, the node's defaults")
+    parser.add_argument('--steady', action='store_true', help='a limit cycle')
     parser.add_argument('--channels', action='store_true', help='three channels of free decays')
     parser.add_argument('--base', action='store_true', help='the default before 6 Dec 2026')
     parser.add_argument(
@@ -296,6 +318,7 @@ def main() -> int:
         choice.HELD_RUN = 10**9  # the node: a steady oscillation's held estimates held on
         choice.TRAIN_SHARE = math.inf  # a train of impacts read driven: the identifier
         choice.LINES_ABOVE = math.inf  # a decay beside a machine's lines: the identifier
+        choice.STEADY_SHARE = 0.0  # a steady oscillation read free: the free estimator
     with tempfile.TemporaryDirectory() as folder:
         kinds = (
             (args.heavy, heavy),
@@ -310,7 +333,7 @@ def main() -> int:
         if args.short:
             short(Path(folder))
         if args.steady:
-            steady(Path(folder))
+            steady(Path(folder), args.node)
     return 0
 
 

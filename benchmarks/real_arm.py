@@ -5,7 +5,8 @@
 Reads ``flex8.csv`` of ``../shared/real-data/flexible_link_arm`` (or the real-data folder given as
 argument; see its SOURCE.md) and prints two tables (``docs/real_arm.md`` quotes them).
 
-1. Per configuration, the issue's goals on the recording: estimates after 4.5 s (the limit cycle,
+1. Per configuration (the last: what ``vib-estimator analyze`` with no option decides from the
+   record), the issue's goals on the recording: estimates after 4.5 s (the limit cycle,
    1.812 Hz), the share within 2 % and the number beyond 5 %, the longest wait between two of them
    (the first one's time, then the longest gap), and the estimates during the ringing (3.2-4.5 s)
    with their worst error against the local frequency (period by period from the upward crossings
@@ -24,7 +25,9 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import least_squares
 
+from vib_estimator.analysis.choosing import decided_config
 from vib_estimator.core import EstimatorConfig, create_estimator
+from vib_estimator.core.choice import decide
 from vib_estimator.io.csv_reader import read_csv_series
 
 LIMIT_CYCLE_HZ = 1.812
@@ -32,9 +35,10 @@ RINGING_S = (3.2, 4.5)
 HARMONICS = 3
 
 
-def configs():
+def configs(decided=None):
+    """The configurations compared (``decided``: the default's, decided from the record, last)."""
     paper = EstimatorConfig.paper()
-    return {
+    out = {
         'paper (the old defaults)': paper,
         'paper, biased-sinusoid': paper.replace(model='biased-sinusoid'),
         'paper, damped-sinusoid': paper.replace(model='damped-sinusoid'),
@@ -45,6 +49,9 @@ def configs():
         'biased, 1.5 periods': EstimatorConfig(min_periods=1.5, consistency=0.0),
         'defaults (+ consistency 0.03)': EstimatorConfig(),
     }
+    if decided is not None:
+        out['no option (decided: analyze)'] = decided
+    return out
 
 
 def local_frequency(t, y):
@@ -78,7 +85,8 @@ def goals_table(t, y):
         f'{"configuration":32} {"n>4.5s":>6} {"in 2 %":>7} {">5 %":>5} {"first":>7} '
         f'{"max wait":>9} {"ringing n":>9} {"worst":>7}'
     )
-    for name, cfg in configs().items():
+    decided = decided_config(EstimatorConfig(), decide(t, y), 'real_arm')[0]
+    for name, cfg in configs(decided).items():
         e = create_estimator(cfg).process(t, y)
         late = e.t >= RINGING_S[1]
         err = np.abs(e.frequency_hz[late] / LIMIT_CYCLE_HZ - 1)

@@ -13,7 +13,7 @@ from vib_estimator.core import auto, choice
 from vib_estimator.core.choice import decide, principal_component, spectral_peaks
 from vib_estimator.sim.ambient import ambient_record
 from vib_estimator.sim.frame import frame_record
-from vib_estimator.sim.signals import beside_lines, plucked_decays
+from vib_estimator.sim.signals import beside_lines, limit_cycle, plucked_decays
 
 
 def holds_then_breaks(monkeypatch, name: str, factor: float, right) -> None:
@@ -886,3 +886,45 @@ def test_a_driven_record_s_weak_slow_content_is_left_out_of_its_band(monkeypatch
         )
 
     holds_then_breaks(monkeypatch, name, factor, right)
+
+
+def steady_oscillation(clean_stretch=None, seed=0):
+    """The real arm's limit cycle (:func:`sim.signals.limit_cycle`: 10 mm at 1.81 Hz, its
+    amplitude and phase wandering, read in 1 mm steps), 30 s at 1 kHz; ``clean_stretch``: the
+    stretch of :func:`core.choice.decay_stretches` (of 5) where it runs as a clean sinusoid."""
+    t, y = limit_cycle(30.0, 1000.0, seed=seed)
+    if clean_stretch is not None:
+        f, reach = 1.8116, (auto.TEST_PERIODS + 2) / 1.8116
+        end = np.linspace(t[0] + reach, t[-1], int((t[-1] - t[0]) / reach))[clean_stretch]
+        on = (t >= end - reach - 0.5) & (t <= end + 0.5)
+        noise = 2e-4 * np.random.default_rng(seed).standard_normal(int(on.sum()))
+        y[on] = -4.8e-3 + 10.1e-3 * np.sin(2 * np.pi * f * t[on]) + noise
+    return t, y
+
+
+@pytest.mark.parametrize('factor', [0.001, 1000])
+def test_a_steady_oscillation_is_no_decay_and_goes_to_the_mode_tracker(monkeypatch, factor):
+    """A limit cycle read free by its envelope (steady) fails the free-decay test on every
+    stretch: not a decay, the mode tracker (the real arm's flex1: 6 of 9 sub-period free
+    estimates within 2 % of its cycles, the tracker's 100 %), in a band about it, with words
+    that say so; so does one that runs cleanly over one stretch in five. A lightly damped decay
+    (every stretch clean) keeps the free estimator's fast window. ``STEADY_SHARE`` at 0.001x
+    sends the second to the free estimator, at 1000x the decay to the tracker."""
+    steady = [steady_oscillation(seed=1), steady_oscillation(clean_stretch=2)]
+    light = decay(5.0, 0.002, 20)
+
+    def right():
+        ok = []
+        for record in steady:
+            d = decide(*record)
+            ok.append(d.excitation == 'free' and d.modes == choice.TRACKED_MODES)
+            ok.append(d.band_hz == pytest.approx((0.9, 3.6), rel=0.02))
+            ok.append('a steady oscillation (a limit cycle' in d.reason)
+        d = decide(*light)
+        return all(ok) and d.modes == 0 and d.min_periods == choice.FAST_PERIODS
+
+    assert choice.decay_stretches(*steady[1], 1.8116) == (1, 5)
+    holds_then_breaks(monkeypatch, 'STEADY_SHARE', factor, right)
+    # a stream (the node: its own rule, over the free estimates it held back) is not judged so
+    monkeypatch.undo()
+    assert decide(*steady[0], stream=True).modes == 0

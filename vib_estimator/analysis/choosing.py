@@ -66,9 +66,10 @@ def decided_config(
     keep_periods: bool = False,
 ) -> Tuple[EstimatorConfig, str]:
     """``config`` with the excitation, (unless ``keep_window``: ``--ambient-window-s`` was
-    given) the ambient window, (unless ``config.modes`` is set) the modes to track and (unless
-    ``keep_periods``: ``--min-periods`` was given) the free-decay window and model of the
-    decision ``d``, and the line that says so."""
+    given) the ambient window, (unless ``config.modes`` is set) the modes to track, (unless
+    ``keep_periods``: ``--min-periods`` was given) the free-decay window and model and (a
+    steady oscillation's) the mode tracker's ``max_damping`` of the decision ``d``, and the line
+    that says so."""
     window = config.ambient_window_s
     if not keep_window and d.excitation != 'free':
         window = d.window_s
@@ -93,6 +94,7 @@ def decided_config(
         model=model,
         lines_hz=config.lines_hz or d.lines_hz or None,
         band_hz=config.band_hz or d.band_hz or None,
+        max_damping=d.max_damping if math.isfinite(d.max_damping) else config.max_damping,
     )
     return changed, line
 
@@ -192,6 +194,8 @@ def prepare(
     if d.model and (not decides(args) or periods_given(args) or model_given(args)):
         kept = '; --model, --band-hz or --min-periods given: the record as read, their model'
         d = dataclasses.replace(d, model='', offset=math.nan, reason=d.reason + kept)
+    if getattr(args, 'max_damping', None) is not None:  # (its own, not a steady oscillation's)
+        d = dataclasses.replace(d, max_damping=math.nan)
     if decides(args):
         config, line = decided_config(config, d, prog, window_given(args), periods_given(args))
         return config, d, [line]

@@ -257,6 +257,22 @@ TRAIN_SHARE = 0.75
 TRAIN_SNR_DB = 20.0
 #: ... of at most this many stretches, evenly spaced (~1 ms each)
 TRAIN_TESTS = 48
+#: a record read free of one mode is a steady oscillation, not a decay -- the mode tracker's --
+#: when under this share of the stretches the free-decay test tells are clean free decays
+#: (:func:`steady_oscillation`; the real arm's limit cycles (flex1, flex5, flex8) 0 of 1, the
+#: beams' and synthetic decays' 100 %): free windows under a period, on an oscillation whose
+#: amplitude and phase wander in 1 mm steps, were 2-4 % off (flex1: 6 of 9 within 2 % of the
+#: cycles' local rate; the tracker: 96 %)
+STEADY_SHARE = 0.25
+#: ... and its band (``band_hz``) this factor either side of it: a quantiser's staircase on its
+#: slow stretches (1 mm steps every 15 ms: a 65 Hz "mode" on flex1) and its harmonics left out
+STEADY_BAND = 2.0
+#: ... and the mode tracker there takes a pole damped beyond this for the transient before the
+#: oscillation, not the oscillation (``max_damping``): the real arm's step response rings at
+#: zeta 3.5-8 % into its limit cycle (flex8: 1.66, 1.67, 1.72 Hz at 4.7-5.1 s, 5-8 % below the
+#: cycle), its cycles read -0.8 to 2.3 % (a 2-period window on a wandering amplitude; flex5
+#: once 4.1 %, held back)
+STEADY_ZETA = 0.03
 
 
 @dataclass(frozen=True)
@@ -292,6 +308,9 @@ class Decision:
     #: the share of its stretches that are clean free decays (:func:`decay_train`; NaN: not
     #: asked): a record read driven that is a train of plucks is free
     train: float = math.nan
+    #: a steady oscillation (:func:`steady_oscillation`): the damping beyond which the mode
+    #: tracker's pole is the transient before it, not it (``max_damping``; NaN: the configured)
+    max_damping: float = math.nan
     #: a stream's way from the identifier to ``auto``: only the excitation changes (the window,
     #: the lines and the band its driven decision set stay)
     keeps: bool = False
@@ -310,6 +329,8 @@ class Decision:
             out: dict = {'excitation': 'free'}
             if self.modes:
                 out['modes'] = self.modes
+            if math.isfinite(self.max_damping):
+                out['max_damping'] = self.max_damping
             if math.isfinite(self.min_periods):
                 out.update(min_periods=self.min_periods, early_std_rel=self.early_std_rel)
             return out
@@ -585,18 +606,18 @@ def decide(
         window, said = driven_window(window_s, fundamental, span, stream)
         seen += said
     modes, rate = 0, (len(t) - 1) / span
-    free = (math.nan, 0.0, '', math.nan)  # a free decay's window, precision, model, offset
-    if excitation == 'free':
+    free, cap = (math.nan, 0.0, '', math.nan), math.nan  # a free decay's window, precision,
+    if excitation == 'free':  # model, offset; a steady oscillation's max_damping
         modal_powers = powers[~is_line]
         decay = (t, y, signal, spec, dominant, channels)  # the free decay
-        modes, free, band, said = free_choice(
-            *decay, modal, modal_powers, beside, offset_ok, stream
+        modes, free, band, said, cap = free_choice(
+            *decay, modal, modal_powers, beside, offset_ok, stream, train
         )
         seen += said
     if lines and excitation != 'free':
         seen += '; the identifier drops its modes at the lines (lines_hz)'
     seen_at = (tuple(peaks), seen, span, rate)  # what was read, at what rate
-    found = (modes, *free, tuple(lines) if excitation != 'free' else (), band, train)
+    found = (modes, *free, tuple(lines) if excitation != 'free' else (), band, train, cap)
     return Decision(excitation, window, share, dominant, fundamental, *seen_at, *found)
 
 
@@ -613,13 +634,15 @@ def driven_window(window_s: float, fundamental: float, span: float, stream: bool
 
 
 def free_choice(
-    t, y, signal, spec, dominant, channels, modal, powers, beside, offset_ok, stream
+    t, y, signal, spec, dominant, channels, modal, powers, beside, offset_ok, stream, train
 ) -> tuple:
-    """A free decay's ``(modes, window, band, words)``: several separate modes among its
-    ``modal`` peaks (``powers``; :func:`free_modes`, the lines ``beside`` it banded out), few
-    samples a period (:func:`few_samples`), several channels beside a line: the mode tracker;
-    else one mode at ``dominant`` Hz and its window (:func:`free_window`: its precision, model
-    and offset; NaN window: the configured)."""
+    """A free decay's ``(modes, window, band, words, max_damping)``: several separate modes
+    among its ``modal`` peaks (``powers``; :func:`free_modes`, the lines ``beside`` it banded
+    out), few samples a period (:func:`few_samples`), several channels beside a line, a steady
+    oscillation (:func:`steady_oscillation`; not a stream, nor a train of decays: ``train``,
+    the share :func:`decay_train` read; its band :func:`steady_band`, its ``max_damping``
+    :data:`STEADY_ZETA`, else NaN): the mode tracker; else one mode at ``dominant`` Hz and its
+    window (:func:`free_window`: its precision, model and offset; NaN window: the configured)."""
     modes, said, band = free_modes(t, signal, spec, modal, powers, beside)
     if not modes:
         modes, fewer = few_samples((len(t) - 1) / float(t[-1] - t[0]), dominant)
@@ -627,11 +650,19 @@ def free_choice(
     if not modes and band and channels > 1:  # each channel's tail, band-passed: the tracker
         modes, tracked = to_tracker('several channels')
         said += tracked
-    free = (math.nan, 0.0, '', math.nan)
+    asked = not (modes or stream or train >= TRAIN_SHARE) and dominant > 0
+    steady = steady_oscillation(t, signal, dominant) if asked else ''
+    if steady:  # (the node: StreamChoice's own rule, over the estimates it held back)
+        band = band or steady_band(dominant, (len(t) - 1) / float(t[-1] - t[0]))
+        if band:
+            steady += f' (band_hz {band[0]:.3g}-{band[1]:.3g} Hz)'
+        modes, tracked = to_tracker(steady)
+        said += tracked
+    free, cap = (math.nan, 0.0, '', math.nan), (STEADY_ZETA if steady else math.nan)
     if not modes and dominant > 0:  # (several channels: no window)
         modes, free, more = free_window(t, y, signal, dominant, spec, offset_ok, stream, channels)
         said += more
-    return modes, free, band, said
+    return modes, free, band, said, cap
 
 
 def beside_decay(t: np.ndarray, signal: np.ndarray, modal, lines, spec) -> bool:
@@ -646,17 +677,16 @@ def beside_decay(t: np.ndarray, signal: np.ndarray, modal, lines, spec) -> bool:
     return rings_freely(t, signal, float(modal[0]), spec)
 
 
-def decay_train(t: np.ndarray, signal: np.ndarray, f: float) -> tuple[float, str]:
-    """The share of the record ``(t, signal)``'s stretches of ``TEST_PERIODS`` periods of ``f``
-    Hz (at most :data:`TRAIN_TESTS`, evenly spaced) that are clean free decays -- passing the
-    free-decay test (:func:`.auto.decay_verdict`, which starts after an impact within them) with
-    blocks :data:`TRAIN_SNR_DB` over their noise (the misfit it read; a pass under it is not
-    told: a decay rung down, or a mode among others) -- among those it tells (NaN: none),
-    and, when that share is :data:`TRAIN_SHARE` or more, the words. A stretch in a gap of the
+def decay_stretches(t: np.ndarray, signal: np.ndarray, f: float) -> tuple[int, int]:
+    """Of the record ``(t, signal)``'s stretches of ``TEST_PERIODS`` periods of ``f`` Hz (at most
+    :data:`TRAIN_TESTS`, evenly spaced): how many are clean free decays -- passing the free-decay
+    test (:func:`.auto.decay_verdict`, which starts after an impact within them) with blocks
+    :data:`TRAIN_SNR_DB` over their noise (the misfit it read; a pass under it is not told: a
+    decay rung down, or a mode among others) -- and how many it tells. A stretch in a gap of the
     record (a stream's kept samples across a source's restart) tells nothing."""
     reach = (TEST_PERIODS + 2) / f
     count = min(TRAIN_TESTS, int((t[-1] - t[0]) / reach))
-    verdicts = []
+    clean = told = 0
     for end in np.linspace(t[0] + reach, t[-1], count):
         k = int(np.searchsorted(t, end, 'right'))
         part = slice(int(np.searchsorted(t, end - reach, 'left')), k)
@@ -665,16 +695,49 @@ def decay_train(t: np.ndarray, signal: np.ndarray, f: float) -> tuple[float, str
             ratio, rms = misfit  # err / noise, err / power
             snr = 10 * math.log10(max(ratio, 1e-300) / max(rms * rms, 1e-300))
             verdict = True if snr >= TRAIN_SNR_DB else None
-        verdicts.append(verdict)
-    told = [v for v in verdicts if v is not None]
-    share = sum(told) / len(told) if told else math.nan
+        clean += verdict is True
+        told += verdict is not None
+    return clean, told
+
+
+def decay_train(t: np.ndarray, signal: np.ndarray, f: float) -> tuple[float, str]:
+    """The share of the record ``(t, signal)``'s stretches that are clean free decays among those
+    :func:`decay_stretches` tells (NaN: none), and, when it is :data:`TRAIN_SHARE` or more, the
+    words."""
+    clean, told = decay_stretches(t, signal, f)
+    share = clean / told if told else math.nan
     if not share >= TRAIN_SHARE:
         return share, ''
     return share, (
-        f'; but {sum(told)} of {len(told)} stretches of {TEST_PERIODS} periods of {f:.4g} Hz are '
+        f'; but {clean} of {told} stretches of {TEST_PERIODS} periods of {f:.4g} Hz are '
         'clean free decays (each one damped sinusoid, none driven): plucks or impacts that come '
         'before the last has rung down, or an oscillation growing freely, free'
     )
+
+
+def steady_oscillation(t: np.ndarray, signal: np.ndarray, f: float) -> str:
+    """For a record read free (its envelope steady or falling) of one mode at ``f`` Hz: the
+    words when it is a steady oscillation, not a decay -- under :data:`STEADY_SHARE` of the
+    stretches :func:`decay_stretches` tells are clean free decays (a limit cycle, a machine
+    running steadily: the amplitude and phase wander, the waveform has a quantiser's steps and
+    harmonics, which sub-period free windows misread) --, else ''."""
+    clean, told = decay_stretches(t, signal, f)
+    if not told or clean / told >= STEADY_SHARE:
+        return ''
+    return (
+        f'{told - clean} of {told} stretches of {TEST_PERIODS} periods of {f:.4g} Hz fail the '
+        'free-decay test (their amplitude and phase wander): a steady oscillation (a limit '
+        'cycle, a machine running), not a decay'
+    )
+
+
+def steady_band(f: float, rate: float) -> tuple:
+    """A steady oscillation's band (``band_hz``) at ``f`` Hz, ``rate`` samples a second:
+    :data:`STEADY_BAND` either way of it, () where that reaches half the Nyquist frequency (the
+    low-pass then too close to it to be made; the tracker's own decimation filters take the
+    rest)."""
+    high = f * STEADY_BAND
+    return (f / STEADY_BAND, high) if high < rate / 4 else ()
 
 
 def free_modes(

@@ -88,18 +88,22 @@ def beside_lines(mode, zeta, lines, seconds, rate_hz, start_s=1.0, seed=0):
     return t, y
 
 
-def limit_cycle(seconds, rate_hz, seed=0, wander=0.05, diffusion=0.02, step=1e-3):
+def limit_cycle(
+    seconds, rate_hz, seed=0, wander=0.05, diffusion=0.02, step=1e-3, scale=1.0, noise=2e-4
+):
     """A closed loop's limit cycle of the real flexible-link arm's kind (``flex8``'s fit,
     ``benchmarks/real_arm.py``: -4.8 mm offset, 10.1 mm at 1.8116 Hz, 2nd and 3rd harmonics 0.19
-    and 0.05 mm; m): its amplitude wandering by ``wander`` (at 0.37 Hz), its phase diffusing by
-    ``diffusion`` x 2 pi rad in a second's square root (0.13 rad in a second: its frequency
-    wanders by ~1 % over a second), in 0.2 mm of white noise, read in steps of ``step`` m (the
-    rig's 1 mm; 0: not quantised). ``(t, y)``."""
+    and 0.05 mm; m; all but the offset x ``scale``: ``flex1``'s ~5 mm at 0.5): its amplitude
+    wandering by ``wander`` (at 0.37 Hz), its phase diffusing by ``diffusion`` x 2 pi rad in a
+    second's square root (0.13 rad in a second: its frequency wanders by ~1 % over a second), in
+    ``noise`` m of white noise (0.2 mm), read in steps of ``step`` m (the rig's 1 mm; 0: not
+    quantised; flex1 moves in clean 1 mm steps, undithered). ``(t, y)``."""
     rng = np.random.default_rng(seed)
     t = np.arange(0, seconds, 1 / rate_hz)
     drift = np.cumsum(diffusion * 2 * np.pi * rng.standard_normal(len(t))) / np.sqrt(rate_hz)
     w = 2 * np.pi * 1.8116 * t + rng.uniform(0, 2 * np.pi) + drift
     a = 10.1e-3 * (1 + wander * np.sin(2 * np.pi * 0.37 * t + 1))
-    y = -4.8e-3 + a * np.sin(w) + 0.19e-3 * np.sin(2 * w + 1) + 0.05e-3 * np.sin(3 * w + 2)
-    y = y + 0.2e-3 * rng.standard_normal(len(t))
+    y = a * np.sin(w) + 0.19e-3 * np.sin(2 * w + 1) + 0.05e-3 * np.sin(3 * w + 2)
+    y = -4.8e-3 + scale * y
+    y = y + noise * rng.standard_normal(len(t))
     return t, (np.round(y / step) * step if step else y)
