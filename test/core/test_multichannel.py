@@ -136,3 +136,30 @@ def test_close_modes_with_different_shapes_stay_two():
     assert set(e.mode[late].tolist()) == {1, 2}
     for mode, (f, _, _) in enumerate(modes, 1):
         assert abs(np.median(e.frequency_hz[late & (e.mode == mode)]) / f - 1) < 0.005
+
+
+@pytest.mark.parametrize('name, factor', [('JOINT_MIN_ROWS', 0.001), ('JOINT_HANKEL', 1000)])
+def test_many_channels_keep_enough_lags_in_a_small_hankel_matrix(monkeypatch, name, factor):
+    """Ten channels (a 10-storey frame, 300 s at 20 Hz): its six modes below 9 Hz found, each
+    in at least 10 analyses within 1 %, the Hankel matrix at most 100 rows (the SVD's cost grows
+    as its cube). ``JOINT_MIN_ROWS`` at 0.001x leaves 4 block rows (40 / 10 channels): lags of
+    0.2 s at most, a fifth of the 0.89 Hz fundamental's period, which is lost; ``JOINT_HANKEL`` at
+    1000x gives every channel count one channel's 40 rows: a 400-row matrix, 3x the CPU for
+    the same modes."""
+    from vib_estimator.core import ssi
+
+    t, y, freqs, _ = frame_record(300.0, FS, zeta=0.02, snr_db=20.0, seed=1, storeys=10)
+    decompose, sizes = ssi.hankel_svd, []
+    monkeypatch.setattr(ssi, 'hankel_svd', lambda h, *a: sizes.append(len(h)) or decompose(h, *a))
+
+    def right():
+        del sizes[:]
+        result = AmbientEstimator(CONFIG, [f'storey{i}' for i in range(10)]).process(t, y)
+        f = result.estimates.frequency_hz
+        found = [np.sum(np.abs(f / g - 1) <= 0.01) for g in freqs[freqs < 9.0]]
+        return min(found) >= 10 and max(sizes) <= 100
+
+    assert right()
+    value = getattr(ssi, name) * factor
+    monkeypatch.setattr(ssi, name, round(value))
+    assert not right()
