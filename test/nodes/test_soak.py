@@ -6,12 +6,13 @@ estimator_node, shaper_node on the first's estimates; four faults from a seeded 
 waited for and judged before the next (``--count``: no wall-clock budget a loaded machine could
 cut short) -- a restart with time going back, a 5-s SIGSTOP of estimator_node second (a stop first
 met the kernels' compile ending, a restart of its own), a parameter storm with invalid values, a
-5000-message burst: after the stop, input taken again and an estimate within two estimator windows
-of stream (over shared memory the node went deaf for good after such a stop about one time in
-two: docs/nodes.md#never-deaf); every fault recovered (an estimate within 3 windows of stream,
-measured in the simulator's time, not in steady seconds), every call answered, every burst message
-received or counted, the counters' identities, what the replay estimator and the shaper took of
-what was sent to them, no traceback, SIGINT exit 0 within 2 s for every node (issue 40)."""
+5000-message burst: after the stop, input taken again and an estimate within two estimator
+windows of stream and an analysis hop (over shared memory the node went deaf for good after such
+a stop about one time in two: docs/nodes.md#never-deaf); every fault recovered (an estimate
+within 3 windows of stream, measured in the simulator's time, not in steady seconds), every call
+answered, every burst message received or counted, the counters' identities, what the replay
+estimator and the shaper took of what was sent to them, no traceback, SIGINT exit 0 within 2 s
+for every node (issue 40)."""
 
 from __future__ import annotations
 
@@ -19,6 +20,8 @@ import json
 import subprocess
 import sys
 from pathlib import Path
+
+from vib_estimator.core.ambient import hop_s
 
 SOAK = Path(__file__).resolve().parents[2] / 'benchmarks' / 'soak.py'
 
@@ -52,7 +55,7 @@ def test_a_minute_of_faults(tmp_path):
     # never deaf: after the node's own stall, input again and estimates within the windows
     stop = next(f for f in fig['faults'] if f['kind'] == 'stop')
     assert stop['input_s'] == stop['input_s'] and stop['recovered'] is True, run.stdout
-    assert stop['windows'] <= 2.0, run.stdout
+    assert stop['windows'] <= 2.0 + hop_s(stop['window_s']) / stop['window_s'], run.stdout
     assert fig['counters']['input_resubscribed'] == 0, run.stdout  # no silence it had to answer
     for storm in (f for f in fig['faults'] if f['kind'] == 'storm'):
         assert storm['answered'] == storm['calls'] == 200 and storm['wrong_verdicts'] == 0
