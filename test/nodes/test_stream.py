@@ -522,6 +522,28 @@ def test_a_steady_oscillation_that_is_no_decay_goes_to_the_mode_tracker(monkeypa
     assert not right()
 
 
+def test_a_limit_cycle_after_a_step_s_ringing_goes_to_the_mode_tracker():
+    """A step's ringing (30 mm at 1.6 Hz, zeta 6 %) into a limit cycle: the watch, whose largest
+    block is the ringing's, reads the steady level after it driven (93 % at 60 s), while
+    :func:`core.choice.decide` over the kept samples reads a free decay of one mode, and the
+    free-decay test holds back every free estimate: the node stayed silent (0-2 estimates in
+    120 s). With ``HELD_RUN`` estimates held, that contradiction is a steady oscillation after a
+    transient: the mode tracker, estimates within 5 % of the cycle."""
+    from vib_estimator.sim.signals import limit_cycle
+
+    t, y = limit_cycle(80.0, 1000.0, 1)
+    on = t >= 2.0
+    ring = np.exp(-0.06 * 2 * np.pi * 1.6 * (t[on] - 2)) * np.sin(2 * np.pi * 1.6 * (t[on] - 2))
+    y[on] += np.round(30 * ring) * 1e-3
+    stream = EstimatorStream(EstimatorConfig(), now=0.0, deciding=True)
+    got = []
+    decided = decisions(stream, t, y, step=1000, estimates=got)
+    steady = [(s, x) for s, x in decided if 'a steady oscillation' in x.reason]
+    assert len(steady) == 1 and steady[0][1].modes == 3 and 60 <= steady[0][0] <= 66, decided
+    f = np.array([e.frequency_hz for _, _, e in got])
+    assert len(f) >= 30 and np.all(np.abs(f / 1.8116 - 1) <= 0.05)
+
+
 def test_a_clean_decay_sets_the_streams_window_as_analyze_decides_it():
     """Once its free stretch has shown a decay (core.choice.decay_zeta), the deciding stream
     takes analyze's window for it (``min_periods`` 0.9 and its ``early_std_rel``): a clean

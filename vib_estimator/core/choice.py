@@ -1404,13 +1404,20 @@ class StreamChoice:
         chosen = decide(*self.kept(), self.channels, window_s, stream=True)
         if chosen.excitation != 'free' or chosen.modes:
             return chosen if chosen.excitation == 'free' else None
+        return self._steady_tracker(chosen)
+
+    def _steady_tracker(self, chosen: Decision) -> Decision:
+        """:func:`decide`'s free decision of one mode ``chosen``, given the mode tracker for a
+        steady oscillation (a pole damped beyond :data:`STEADY_ZETA` the transient before it,
+        as ``analyze`` has it), with the held free estimates' words."""
         held = self._held_hz or [chosen.dominant_hz]
         modes, said = to_tracker(
             f'{self._held} free estimates running ({min(held):.4g}-{max(held):.4g} Hz) '
             'failed the free-decay test while the stream rang steadily: a steady oscillation '
             '(a limit cycle, a machine running), not a decay'
         )
-        return replace(chosen, modes=modes, reason=chosen.reason + said)
+        reason = chosen.reason + said
+        return replace(chosen, modes=modes, reason=reason, max_damping=STEADY_ZETA)
 
     def _decay_window(self, now: float) -> Optional[Decision]:
         """:func:`decide`'s window for the decay since the last onset, read once per onset when
@@ -1541,4 +1548,10 @@ class StreamChoice:
             return None
         self._retry_at = now + WATCH_S / 2
         chosen = decide(*self.kept(), self.channels, window_s, stream=True)
-        return None if chosen.excitation == 'free' else chosen
+        if chosen.excitation != 'free':
+            return chosen
+        # read driven by the watch (a steady level after a ringing's peak), free by decide (one
+        # mode or, the ringing in its envelope, a damped one), its free estimates held: a steady
+        # oscillation after a transient (a step into a limit cycle)
+        steady = self._held >= HELD_RUN and chosen.dominant_hz > 0
+        return self._steady_tracker(chosen) if steady else None
