@@ -65,7 +65,12 @@ from vib_estimator.analysis import analyze as analyze_module
 from vib_estimator.cli import main as cli
 from vib_estimator.core import choice
 from vib_estimator.sim.ambient import ambient_record
-from vib_estimator.sim.signals import beside_lines, limit_cycle, plucked_decays
+from vib_estimator.sim.signals import (
+    beside_lines,
+    limit_cycle,
+    plucked_decays,
+    step_into_limit_cycle,
+)
 
 #: --heavy: damping ratios; (frequency Hz, samples a second) of each
 HEAVY_ZETAS = (0.01, 0.02, 0.03, 0.05, 0.08)
@@ -233,13 +238,7 @@ def cycles():
             *limit_cycle(120.0, 1000.0, seed, 0.05, 0.02, 1e-3, 0.4, 6e-5),
         )
     for seed in range(3):  # a step's ringing (1.6 Hz, zeta 6 %, 30 mm) into the cycle
-        t, y = limit_cycle(120.0, 1000.0, seed)
-        on = t >= 2.0
-        ring = np.exp(-0.06 * 2 * np.pi * 1.6 * (t[on] - 2)) * np.sin(
-            2 * np.pi * 1.6 * (t[on] - 2)
-        )
-        y[on] += np.round(30 * ring) * 1e-3
-        yield f'after a step, seed {seed}', t, y
+        yield f'after a step, seed {seed}', *step_into_limit_cycle(120.0, 1000.0, seed)
 
 
 def steady(folder: Path, node: bool) -> None:

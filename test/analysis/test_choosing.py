@@ -18,7 +18,12 @@ from vib_estimator.cli import main
 from vib_estimator.core import EstimatorConfig
 from vib_estimator.sim.ambient import ambient_record
 from vib_estimator.sim.frame import frame_record
-from vib_estimator.sim.signals import beside_lines, limit_cycle, plucked_decays
+from vib_estimator.sim.signals import (
+    beside_lines,
+    limit_cycle,
+    plucked_decays,
+    step_into_limit_cycle,
+)
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from test_analyze import decided  # noqa: E402 -- analyze's estimates with no option
@@ -392,15 +397,25 @@ def test_a_limit_cycle_after_a_step_s_ringing_gives_the_cycle_not_the_ringing(
         monkeypatch.setattr(choice, 'STEADY_ZETA', choice.STEADY_ZETA * factor)
     found = []
     for seed in (1, 2):
-        t, y = limit_cycle(30.0, 1000.0, seed=seed)
-        on = t >= 2.0
-        ring = np.exp(-0.06 * 2 * np.pi * 1.6 * (t[on] - 2)) * np.sin(
-            2 * np.pi * 1.6 * (t[on] - 2)
-        )
-        y[on] += np.round(30 * ring) * 1e-3  # (in 1 mm steps)
+        t, y = step_into_limit_cycle(30.0, 1000.0, seed)
         code = main(['analyze', str(write(tmp_path / 'step.csv', t, y)), '--format', 'jsonl'])
         out, err = capsys.readouterr()
         f = np.array([json.loads(line)['frequency_hz'] for line in out.splitlines()])
         found.append(code == 0 and 'a steady oscillation (a limit cycle' in err and len(f) >= 60)
         found.append(bool(len(f)) and np.all(np.abs(f / 1.8116 - 1) <= 0.05))
     assert all(found) == (factor is None)
+
+
+def test_a_given_max_damping_overrides_a_steady_oscillation_s_in_analyze_and_survey(
+    capsys, tmp_path
+):
+    """The steady oscillation's ``max_damping`` (core.choice.STEADY_ZETA) is the decision's, not
+    the user's: with ``--max-damping`` given, ``analyze`` and ``survey`` use that one (0.1: the
+    step's ringing published again), and given as the decision's value they print the same."""
+    path = write(tmp_path / 'step.csv', *step_into_limit_cycle(30.0, 1000.0, 1))
+    for command in ('analyze', 'survey'):
+        out = []
+        for given in ([], ['--max-damping', '0.03'], ['--max-damping', '0.1']):
+            assert main([command, str(path), '--format', 'jsonl', *given]) == 0
+            out.append(capsys.readouterr().out)
+        assert out[0] == out[1] != out[2], command

@@ -529,12 +529,9 @@ def test_a_limit_cycle_after_a_step_s_ringing_goes_to_the_mode_tracker():
     free-decay test holds back every free estimate: the node stayed silent (0-2 estimates in
     120 s). With ``HELD_RUN`` estimates held, that contradiction is a steady oscillation after a
     transient: the mode tracker, estimates within 5 % of the cycle."""
-    from vib_estimator.sim.signals import limit_cycle
+    from vib_estimator.sim.signals import step_into_limit_cycle
 
-    t, y = limit_cycle(80.0, 1000.0, 1)
-    on = t >= 2.0
-    ring = np.exp(-0.06 * 2 * np.pi * 1.6 * (t[on] - 2)) * np.sin(2 * np.pi * 1.6 * (t[on] - 2))
-    y[on] += np.round(30 * ring) * 1e-3
+    t, y = step_into_limit_cycle(80.0, 1000.0, 1)
     stream = EstimatorStream(EstimatorConfig(), now=0.0, deciding=True)
     got = []
     decided = decisions(stream, t, y, step=1000, estimates=got)

@@ -52,6 +52,12 @@ def periods_given(args) -> bool:
     return getattr(args, 'min_periods', None) is not None
 
 
+def damping_given(args) -> bool:
+    """Whether the command line sets ``--max-damping`` (a steady oscillation's is then not
+    applied)."""
+    return getattr(args, 'max_damping', None) is not None
+
+
 def model_given(args) -> bool:
     """Whether the command line sets the model or a band (``--model``, ``--band-hz``): the
     decided model and offset are then not applied."""
@@ -64,12 +70,13 @@ def decided_config(
     prog: str,
     keep_window: bool = False,
     keep_periods: bool = False,
+    keep_damping: bool = False,
 ) -> Tuple[EstimatorConfig, str]:
     """``config`` with the excitation, (unless ``keep_window``: ``--ambient-window-s`` was
     given) the ambient window, (unless ``config.modes`` is set) the modes to track, (unless
-    ``keep_periods``: ``--min-periods`` was given) the free-decay window and model and (a
-    steady oscillation's) the mode tracker's ``max_damping`` of the decision ``d``, and the line
-    that says so."""
+    ``keep_periods``: ``--min-periods`` was given) the free-decay window and model and (unless
+    ``keep_damping``: ``--max-damping`` was given) a steady oscillation's ``max_damping`` of the
+    decision ``d``, and the line that says so."""
     window = config.ambient_window_s
     if not keep_window and d.excitation != 'free':
         window = d.window_s
@@ -94,7 +101,11 @@ def decided_config(
         model=model,
         lines_hz=config.lines_hz or d.lines_hz or None,
         band_hz=config.band_hz or d.band_hz or None,
-        max_damping=d.max_damping if math.isfinite(d.max_damping) else config.max_damping,
+        max_damping=(
+            d.max_damping
+            if math.isfinite(d.max_damping) and not keep_damping
+            else config.max_damping
+        ),
     )
     return changed, line
 
@@ -194,10 +205,9 @@ def prepare(
     if d.model and (not decides(args) or periods_given(args) or model_given(args)):
         kept = '; --model, --band-hz or --min-periods given: the record as read, their model'
         d = dataclasses.replace(d, model='', offset=math.nan, reason=d.reason + kept)
-    if getattr(args, 'max_damping', None) is not None:  # (its own, not a steady oscillation's)
-        d = dataclasses.replace(d, max_damping=math.nan)
     if decides(args):
-        config, line = decided_config(config, d, prog, window_given(args), periods_given(args))
+        kept = (window_given(args), periods_given(args), damping_given(args))
+        config, line = decided_config(config, d, prog, *kept)
         return config, d, [line]
     if getattr(args, 'paper', False):
         return config, d, []  # the paper's configuration, as printed

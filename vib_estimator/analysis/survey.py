@@ -67,7 +67,7 @@ from ..io.streaming import BagInfo, bag_info, is_csv, open_signal, supported_top
 from . import health
 from .analyze import Run, add_config_arguments, estimate_rescued, make_config, rescues
 from .channels import channel_list, joint_run, mode_shapes, need_joint, read_channels
-from .choosing import decided_config, decides, read_ahead, window_given
+from .choosing import damping_given, decided_config, decides, read_ahead, window_given
 from .interval import combine
 from .outputs import check_output, progress
 
@@ -148,18 +148,20 @@ class Options:
     #: ``keep_window``) is decided from it (:mod:`.choosing`)
     decide: bool = False
     keep_window: bool = False
+    #: ``--max-damping`` given: a steady oscillation's is not applied
+    keep_damping: bool = False
     #: ``--covariates``: each recording's mean of these (:mod:`..io.covariates`) in its rows
     covariates: Tuple[str, ...] = ()
     #: a free decay of one mode that the free estimator gave no estimate of is read again by the
     #: mode tracker (:func:`.choosing.rescue`; decided, and no ``--model`` or ``--min-periods``)
     rescues: bool = False
 
-    def kept(self) -> Tuple[bool, bool]:
-        """(keep_window, keep_periods) of :func:`.choosing.decided_config`: the free-decay window
-        is never decided per recording -- a survey compares recordings, and a window that changed
-        with a recording's noise would move its estimates' small model bias (0.1 % between 0.9 and
-        1.25 periods of a damped mode) like a drift."""
-        return self.keep_window, True
+    def kept(self) -> Tuple[bool, bool, bool]:
+        """(keep_window, keep_periods, keep_damping) of :func:`.choosing.decided_config`: the
+        free-decay window is never decided per recording -- a survey compares recordings, and a
+        window that changed with a recording's noise would move its estimates' small model bias
+        (0.1 % between 0.9 and 1.25 periods of a damped mode) like a drift."""
+        return self.keep_window, True, self.keep_damping
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -992,6 +994,7 @@ def _options(args: argparse.Namespace) -> Options:
         joint,
         decides(args),
         window_given(args),
+        damping_given(args),
         covariates,
         rescues(args),
     )
