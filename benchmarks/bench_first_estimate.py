@@ -19,11 +19,13 @@ around the mode, and a window of about one period reads that spread as a 2 % shi
     cd benchmarks && ../.venv/bin/python bench_first_estimate.py --noisy   # NOISY, beside free
     cd benchmarks && ../.venv/bin/python bench_first_estimate.py --onset   # a pluck after rest
     cd benchmarks && ../.venv/bin/python bench_first_estimate.py --low-rate  # few samples a period
+    cd benchmarks && ../.venv/bin/python bench_first_estimate.py --at-start  # from the 1st sample
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from pathlib import Path
 
@@ -249,6 +251,90 @@ def onset() -> int:
     return 0
 
 
+#: ``--at-start``: decays from a record's first sample that ring down in a small part of it --
+#: frequency (Hz), damping ratio, SNR (dB, at the start), samples a period, record (s)
+AT_START = (
+    (50.0, 0.01, 40, 20, 10),
+    (50.0, 0.01, 40, 20, 60),
+    (50.0, 0.01, 40, 20, 600),
+    (20.0, 0.01, 40, 50, 30),
+    (50.0, 0.014, 40, 20, 10),
+    (12.0, 0.05, 37, 25, 10),
+    (16.0, 0.003, 40, 60, 60),
+)
+
+
+def at_start(seeds: int = 3) -> int:
+    """The decided configuration on decays from a record's first sample (``AT_START``, phases
+    0, 1, 2 rad: from rest or with a jump) through the estimator it builds, beside the decision
+    read with the segments' taper alone (``core.choice.START_RATIO`` infinite: the default
+    before 6 Dec 2026) and ``--excitation free``, in the same run: per case the decisions, the
+    least share within 2 % (of the estimates within 20 % of the mode) and the median convergence
+    (periods; of the records' medians); estimates farther than 20 % (another 'mode') counted."""
+    from vib_estimator.core import EstimatorConfig
+
+    ratio = choice.START_RATIO
+    print(
+        '| decay | decided: route, within 2 %, conv, off | taper alone: route, within 2 %, '
+        'conv, off | free: within 2 %, conv |'
+    )
+    print('|---|---|---|---|')
+    for f, zeta, snr, per, seconds in AT_START:
+        cells = [[], [], []]
+        for seed in range(seeds):
+            rng = np.random.default_rng(seed)
+            t = np.arange(0, seconds, 1 / (per * f))
+            y = np.exp(-zeta * 2 * np.pi * f * t) * np.sin(2 * np.pi * f * t + seed)
+            y = y + 10 ** (-snr / 20) / np.sqrt(2) * rng.standard_normal(len(t))
+            for k, start in enumerate((ratio, math.inf, None)):
+                if start is None:
+                    config, y_used, d = EstimatorConfig(), y, None
+                else:
+                    choice.START_RATIO = start
+                    config, y_used, d = decided(t, y)
+                    choice.START_RATIO = ratio
+                cells[k].append((route(d), *scored(estimate(t, y_used, config), f)))
+        row = [f'{f:g} Hz, zeta {zeta:g}, {snr} dB, {per} a period, {seconds:g} s']
+        for k, rows in enumerate(cells):
+            routes = ', '.join(sorted({r[0] for r in rows}))
+            within = f'{min(r[1] for r in rows):.0f} %'
+            convs = [r[2] for r in rows if np.isfinite(r[2])]
+            conv = f'{np.median(convs):.2f}' if convs else 'none'
+            off = f'{sum(r[3] for r in rows)}'
+            row.append(f'{within}, {conv}' if k == 2 else f'{routes}, {within}, {conv}, {off}')
+        print('| ' + ' | '.join(row) + ' |')
+        sys.stdout.flush()
+    return 0
+
+
+def route(d) -> str:
+    """A decision in a word: the tracker, free over its window, or the identifier."""
+    if d is None:
+        return ''
+    if d.excitation != 'free':
+        return d.excitation
+    return (
+        'tracker'
+        if d.modes
+        else f'free {d.min_periods:g}'
+        if np.isfinite(d.min_periods)
+        else 'free'
+    )
+
+
+def scored(e, f: float) -> tuple[float, float, int]:
+    """Of the estimates ``e`` within 20 % of ``f``: the share within 2 % (%) and the median
+    convergence (periods); and how many lie farther."""
+    if not len(e):
+        return 0.0, math.nan, 0
+    rel = np.abs(e.frequency_hz / f - 1)
+    near = rel <= 0.2
+    if not np.any(near):
+        return 0.0, math.nan, int(np.sum(~near))
+    conv = float(np.median(e.convergence_time[near] * f))
+    return 100 * float(np.mean(rel[near] <= 0.02)), conv, int(np.sum(~near))
+
+
 #: ``--low-rate``: samples a period of a 10 Hz decay, and its damping ratios (3 seeds each)
 LOW_RATES = (6, 8, 10, 12, 15, 20, 30)
 LOW_RATE_ZETAS = (0.002, 0.005, 0.01, 0.02, 0.05)
@@ -321,12 +407,19 @@ def main() -> int:
         action='store_true',
         help='a decay at 6-30 samples a period, decided (--base: without few_samples)',
     )
+    parser.add_argument(
+        '--at-start',
+        action='store_true',
+        help="decays from a record's first sample, beside the taper alone and free",
+    )
     parser.add_argument('--base', action='store_true', help='--low-rate: the decision before')
     args = parser.parse_args()
     if args.low_rate:
         return low_rate(args.base)
     if args.onset:
         return onset()
+    if args.at_start:
+        return at_start()
     if args.sweep:
         return sweep()
     if args.noisy:
