@@ -225,6 +225,25 @@ def ringing(parts, seconds, fs, noise, start=0.0, phase=0.0, seed=0):
     return t, (t >= start) * y + noise * np.random.default_rng(seed).standard_normal(len(t))
 
 
+def test_several_channels_of_one_free_mode_are_estimated_over_the_short_window():
+    """A 12 Hz decay at zeta 1 % on three channels (45 dB), 1 s in: judged on the principal
+    component (no offset removed, each channel's own), 0.9 periods -- the joint fit's estimates
+    a median of 0.91 periods, all within 2 % (1.26 periods with the configured window)."""
+    from vib_estimator.analysis.choosing import decided_config
+    from vib_estimator.core import EstimatorConfig, create_estimator
+
+    t, y = ringing([(12.0, 0.01, 1.0)], 10, 1000, 0.0, start=1.0)
+    y = np.outer(y, [1.0, 0.6, -0.4])
+    y += 0.004 * np.random.default_rng(0).standard_normal(y.shape)
+    d = decide(t, y, 3)
+    assert d.modes == 0 and d.min_periods == choice.FAST_PERIODS and math.isnan(d.offset)
+    config = decided_config(EstimatorConfig(), d, 'test')[0]
+    e = create_estimator(config, ('a', 'b', 'c')).process(t, y).estimates
+    assert len(e) >= 30
+    assert np.median(e.convergence_time) * 12.0 <= 1.0
+    assert np.mean(np.abs(e.frequency_hz / 12.0 - 1) <= 0.02) >= 0.95
+
+
 @pytest.mark.parametrize('zeta', [0.003, 0.01, 0.03, 0.1])
 @pytest.mark.parametrize('phase', [0.0, np.pi / 2])
 def test_decay_tails_is_the_impurity_of_a_decay_seen_from_its_start(zeta, phase):

@@ -683,7 +683,7 @@ def free_choice(
         modes, tracked = to_tracker(steady)
         said += tracked
     free, cap = (math.nan, 0.0, '', math.nan), (STEADY_ZETA if steady else math.nan)
-    if not modes and dominant > 0:  # (several channels: no window)
+    if not modes and dominant > 0:
         modes, free, more = free_window(t, y, signal, dominant, spec, offset_ok, stream, channels)
         said += more
     return modes, free, band, said, cap
@@ -841,13 +841,16 @@ def few_samples(rate: float, dominant: float) -> tuple[int, str]:
 def free_window(t, y, signal, dominant: float, spec, offset_ok: bool, stream: bool, channels=1):
     """A free decay of one mode at ``dominant`` Hz (``signal``: the principal component of
     ``y``): the modes to track, the window, precision, model and offset of :func:`fast_window`
-    (a stream, the node, and several channels keep their window) and the reason in words -- the
-    mode tracker (:func:`heavily_damped`; with several channels, each channel's, whose events
-    the joint fit refines) where no fast window is given to a heavily damped decay."""
+    (a stream, the node, keeps its window; several channels are judged on ``signal``, no offset
+    removed: their joint fit's channels over 0.9 periods, 96-100 % within 2 %, a median of
+    0.90-0.95 periods where 1.25 gave 1.23-1.28) and the reason in words -- the mode tracker
+    (:func:`heavily_damped`; with several channels, each channel's, whose events the joint fit
+    refines) where no fast window is given to a heavily damped decay."""
     free = (math.nan, 0.0, '', math.nan)
     why = ''
-    if not stream and channels == 1:
-        *free, why = fast_window(t, y, dominant, spec, offset_ok)
+    if not stream:
+        one = channels == 1
+        *free, why = fast_window(t, y if one else signal, dominant, spec, offset_ok and one)
         why = f'; {why}'
     if math.isfinite(free[0]):
         return 0, tuple(free), why
