@@ -874,11 +874,15 @@ def test_a_train_of_impacts_read_driven_is_free(monkeypatch, name, factor):
     identifier had no mode to give. Its stretches are clean free decays: free, no lines (nor a
     band leaving the impacts' harmonics out: they are the mode's response), words that say so.
     A building driven by wind (whose stretches pass the test but not cleanly) and a mode driven
-    by noise stay ambient; at most ``TRAIN_TESTS`` stretches are tested."""
+    by noise stay ambient, also lightly damped modes in 10 dB of measurement noise (whose
+    stretches pass quietly, the noise hiding their wander: few are told; 9 of 10 told clean, of
+    23, read as a train before 6 Dec 2026); at most ``TRAIN_TESTS`` stretches are tested."""
     trains = [impacts(), impacts(zeta=0.003), impacts(every=5.0, zeta=0.005)]
     driven = [
         ambient_record(300, 40.0, BUILDING, 10, 1)[:2],
         ambient_record(240, 200.0, [(5.0, 0.002, 1.0)], 26, 3)[:2],
+        ambient_record(120, 100.0, [(2.0, 0.005, 1.0)], 10, 1)[:2],
+        ambient_record(60, 500.0, [(25.0, 0.003, 1.0), (60.0, 0.005, 0.05)], 10, 2)[:2],
     ]
     tests = []
     monkeypatch.setattr(
@@ -896,7 +900,7 @@ def test_a_train_of_impacts_read_driven_is_free(monkeypatch, name, factor):
         for record in driven:
             d = decide(*record)
             ok.append(d.excitation == 'ambient' and not d.train >= 0.5)
-        return all(ok) and len(tests) <= 5 * 48
+        return all(ok) and len(tests) <= 7 * 48
 
     assert right()
     value = getattr(choice, name) * factor
@@ -1008,7 +1012,7 @@ def test_a_steady_oscillation_is_no_decay_and_goes_to_the_mode_tracker(monkeypat
         d = decide(*light)
         return all(ok) and d.modes == 0 and d.min_periods == choice.FAST_PERIODS
 
-    assert choice.decay_stretches(*steady[1], 1.8116) == (1, 5)
+    assert choice.decay_stretches(*steady[1], 1.8116)[:2] == (1, 5)
     holds_then_breaks(monkeypatch, 'STEADY_SHARE', factor, right)
     # a stream (the node: its own rule, over the free estimates it held back) is not judged so
     monkeypatch.undo()
