@@ -347,16 +347,21 @@ def rescues(args) -> bool:
 def estimate_rescued(
     signal: Signal, config, decision, allowed: bool, prog: str, keep=False, blocks=None, offset=0.0
 ):
-    """``(config, run, line)``: :func:`estimate_signal`, and a free decay it gave no estimate of
-    read again by the mode tracker when ``allowed`` (:func:`.choosing.rescue`; the record's
-    counts started afresh), with the line that says so ('' otherwise)."""
+    """``(config, run, line)``: :func:`estimate_signal`, and a free decay it gave (almost) no
+    estimate of read again by the mode tracker when ``allowed`` (:func:`.choosing.rescue`; the
+    record's counts started afresh) and kept where the tracker gives more, with the line that
+    says so ('' otherwise)."""
     result = estimate_signal(signal, config, keep, blocks, offset)
     again = rescue(config, decision, allowed, len(result.estimates), prog)
     if again is None:
         return config, result, ''
-    config, line = again
+    skipped, corrupt = signal.skipped, signal.corrupt
     signal.skipped = signal.corrupt = 0  # counted again
-    return config, estimate_signal(signal, config, keep), line
+    tracked = estimate_signal(signal, again[0], keep)
+    if len(tracked.estimates) <= len(result.estimates):  # the free estimates, as they were
+        signal.skipped, signal.corrupt = skipped, corrupt
+        return config, result, ''
+    return again[0], tracked, again[1]
 
 
 def say_column(columns: Optional[list]) -> list:

@@ -220,6 +220,10 @@ OFFSET_MOVE = 0.1
 #: the damping ratio :func:`window_advice` assumes of the lowest mode (:data:`WINDOW_PERIODS`
 #: is ~15 correlation times at it)
 ASSUMED_ZETA = 0.02
+#: ... unless the record is noise: its strongest spectral peak stands under this many dB above
+#: the spectrum's median (white noise 6-12 dB, a random walk 14; a mode driven by noise in as
+#: much measurement noise 20-27 dB, the Heritage Court Tower 20.5, the shear frame 35)
+FLAT_DB = 15.0
 #: the window leaves the record room for at least this many analyses (one per second)
 MIN_ANALYSES = 60
 #: ... and a record shorter than this many configured windows is analysed in windows of that
@@ -330,6 +334,9 @@ class Decision:
     #: a stream's way from the identifier to ``auto``: only the excitation changes (the window,
     #: the lines and the band its driven decision set stay)
     keeps: bool = False
+    #: how far (dB) the strongest spectral peak stands above the spectrum's median (NaN: no
+    #: peak): under :data:`FLAT_DB`, noise
+    peak_db: float = math.nan
 
     @property
     def plucks_in_a_row(self) -> bool:
@@ -642,7 +649,18 @@ def decide(
         seen += '; the identifier drops its modes at the lines (lines_hz)'
     seen_at = (tuple(peaks), seen, span, rate)  # what was read, at what rate
     found = (modes, *free, tuple(lines) if excitation != 'free' else (), band, train, cap)
-    return Decision(excitation, window, share, dominant, fundamental, *seen_at, *found)
+    out = Decision(excitation, window, share, dominant, fundamental, *seen_at, *found)
+    return replace(out, peak_db=standing(spec, powers))
+
+
+def standing(spec, powers: np.ndarray) -> float:
+    """How far (dB) the strongest of the spectral peaks ``powers`` stands above the median of
+    the spectrum ``spec`` (:func:`spectrum`) above its lowest resolved frequency; NaN without."""
+    freq, psd, lowest, _ = spec
+    floor = float(np.median(psd[freq > lowest])) if np.any(freq > lowest) else 0.0
+    if not (len(powers) and floor > 0):
+        return math.nan
+    return 10 * math.log10(float(powers[0]) / floor)
 
 
 def driven_window(window_s: float, fundamental: float, span: float, stream: bool) -> tuple:
@@ -1090,7 +1108,13 @@ def window_advice(window_s: float, d: Optional[Decision], option: str) -> str:
     """Why a ``window_s`` window gave no mode, from the record's lowest spectral peak: how many
     correlation times ``1 / (2 pi zeta f)`` (at :data:`ASSUMED_ZETA`) of it the window holds,
     and ``option`` with the window that holds :data:`WINDOW_PERIODS` periods of it (at most
-    :data:`MAX_WINDOW_S`); '' without a peak, or when the window holds them."""
+    :data:`MAX_WINDOW_S`); '' without a peak, or when the window holds them. A spectrum whose
+    strongest peak stands under :data:`FLAT_DB` above its median is noise: the words say so."""
+    if d is not None and d.peak_db < FLAT_DB:
+        return (
+            f'the spectrum is flat (its strongest peak {d.peak_db:.0f} dB above its median; a '
+            f'mode stands {FLAT_DB:g} dB and more): noise, no mode to estimate'
+        )
     if d is None or not math.isfinite(d.fundamental_hz):
         return ''
     f = d.fundamental_hz
