@@ -393,10 +393,11 @@ def spectrum(t: np.ndarray, y: np.ndarray) -> tuple:
     nper = int(min(len(t), max(64, round(SEGMENT_S * fs))))
     freq, psd = welch(y, fs, nper)
     plain = None
-    rest = np.concatenate([np.broadcast_to(np.mean(y, axis=0), (nper // 2, y.shape[1])), y])
-    if np.sum(welch(rest[:nper], fs, nper)[1]) > START_RATIO * np.sum(psd):  # its start tapered
+    rest = np.broadcast_to(np.mean(y, axis=0), (nper // 2, y.shape[1]))
+    start = np.concatenate([rest, y[: nper - nper // 2]])  # the segment centred on the start
+    if np.sum(welch(start, fs, nper)[1]) > START_RATIO * np.sum(psd):  # its start tapered
         plain = np.sum(psd, axis=1)
-        freq, psd = welch(rest, fs, nper)
+        freq, psd = welch(np.concatenate([rest, y]), fs, nper)
     return freq, np.sum(psd, axis=1), 2 * fs / nper, plain
 
 
@@ -646,8 +647,8 @@ def decide(
         seen += '; the identifier drops its modes at the lines (lines_hz)'
     seen_at = (tuple(peaks), seen, span, rate)  # what was read, at what rate
     found = (modes, *free, tuple(lines) if excitation != 'free' else (), band, train, cap)
-    out = Decision(excitation, window, share, dominant, fundamental, *seen_at, *found)
-    return replace(out, peak_db=standing(spec, powers))
+    read = (excitation, window, share, dominant, fundamental, *seen_at, *found)
+    return Decision(*read, peak_db=standing(spec, powers))
 
 
 def standing(spec, powers: np.ndarray) -> float:
