@@ -37,6 +37,19 @@ windows, ``core.choice.SHORT_WINDOWS``), in the same run (issue 37: "whatever th
   free-decay test quietly: records read free, estimates, modes found in every record, the least
   share within 2 %, those beyond 5 %; ``--base`` with :func:`core.choice.decay_train` counting
   only the stretches it tells (before 6 Dec 2026, 16:40 UTC: read as trains of impacts).
+- ``--weak``: a free decay whose strongest mode is the lowest, its others weak above it (0.3-1 %
+  of the power: a beam's brief higher modes; 4.2/27.6, 6/39, 5/17.3 and 10/62 Hz, zeta 0.3-0.5 %,
+  after 1 s of rest, 1 kHz, 30 and 45 dB, 2 seeds), and the real beams with 5 s of rest before
+  their records (noise at their own tails' level; with ``../shared/real-data``): for the lowest
+  mode the estimates, the share within 2 % of its frequency, the first estimate within 2 %
+  after the pluck and the median window (periods), and the higher modes found (within 2 %);
+  ``--base`` without :func:`core.choice.dominant_window` (before 6 Dec 2026, 19:30 UTC: the
+  mode tracker's estimates alone).
+- ``--pulled``: a 9.4 Hz pluck as a hand gives it -- 1, 2 or 5 s of rest, a pull over 0.02, 0.1
+  or 0.2 s, the release (zeta 0.4 %, 1 kHz, 57 dB, 2 seeds) -- through the free estimator as
+  ``analyze`` runs a decay whose offset it knows (the damped model over 0.9 periods) beside the
+  biased sinusoid: the first estimate after the release (periods: median, worst), estimates and
+  the share within 2 %. (Its "before" is an earlier commit's kernel: run it from a worktree.)
 - ``--short``: driven records of 15-90 s (white noise through 1.2, 2, 5 and 5 + 17 Hz modes at
   zeta 0.5-2 %, 500 Hz, 26 dB): estimates, modes found (within 2 %), share within 2 %, beyond 5 %.
 
@@ -50,6 +63,8 @@ windows, ``core.choice.SHORT_WINDOWS``), in the same run (issue 37: "whatever th
     cd benchmarks && ../.venv/bin/python bench_hard_records.py --machine [--node] [--base]
     cd benchmarks && ../.venv/bin/python bench_hard_records.py --steady [--node] [--base]
     cd benchmarks && ../.venv/bin/python bench_hard_records.py --noisy [--base]
+    cd benchmarks && ../.venv/bin/python bench_hard_records.py --weak [--base]
+    cd benchmarks && ../.venv/bin/python bench_hard_records.py --pulled
 """
 
 from __future__ import annotations
@@ -75,6 +90,7 @@ from vib_estimator.sim.signals import (
     beside_lines,
     limit_cycle,
     plucked_decays,
+    pulled_pluck,
     step_into_limit_cycle,
 )
 
@@ -342,6 +358,92 @@ def noisy(folder: Path) -> None:
             sys.stdout.flush()
 
 
+#: ``--weak``: (lowest mode Hz, higher mode Hz, its amplitude ratio), zeta 0.3 % and 0.5 %
+WEAK_CASES = ((4.2, 27.6, 0.07), (6.0, 39.0, 0.075), (5.0, 17.3, 0.05), (10.0, 62.0, 0.1))
+#: ... the real beams' first and second modes (their FFT), when ``../shared/real-data`` is there
+WEAK_BEAMS = {30: (16.36, 101.0), 40: (9.392, 58.6), 50: (6.054, 39.1), 60: (4.268, 27.6)}
+
+
+def weak_records():
+    """``(label, [(f1, f2, t, y)...])`` of ``--weak``: the synthetic cases, 2 seeds and 2 SNRs
+    each, and the real beams after 5 s of rest (noise drawn at their tails' high-passed level)."""
+    for f1, f2, ratio in WEAK_CASES:
+        for snr in (30, 45):
+            records = []
+            for seed in range(2):
+                t, y = pluck(f1, 1000.0, 0.003, snr, seed, seconds=20.0)
+                higher = pluck(f2, 1000.0, 0.005, math.inf, seed + 10, seconds=20.0)[1]
+                records.append((f1, f2, t, y + ratio * higher))
+            yield f'{f1:g} / {f2:g} Hz, 1:{ratio:g}, {snr} dB', records
+    real = Path(__file__).resolve().parents[2] / 'shared' / 'real-data'
+    for length, (f1, f2) in WEAK_BEAMS.items():
+        path = real / 'aluminium_cantilever_adxl357' / f'{length}cm_uniform_1000Hz.csv'
+        if not path.exists():
+            continue
+        t, y = np.loadtxt(path, delimiter=',', comments='#').T
+        tail = y[-2000:] - np.convolve(y[-2000:], np.ones(5) / 5, 'same')
+        rest = np.median(y[:50]) + np.std(tail) * np.random.default_rng(1).standard_normal(5000)
+        y = np.concatenate([rest, y])
+        yield f'real beam {length} cm after 5 s of rest', [(f1, f2, np.arange(len(y)) * 1e-3, y)]
+
+
+def weak(folder: Path) -> None:
+    """``--weak``: per case, over its records, the lowest mode's estimates (within 25 %), least
+    share within 2 %, median first estimate within 2 % after the pluck and median window
+    (periods), and the records whose higher mode was found (an estimate within 2 %)."""
+    print(
+        '| case | lowest mode: estimates | within 2 %: least | first within 2 % (periods) | '
+        'window (periods) | higher mode found |'
+    )
+    print('|---|---|---|---|---|---|')
+    for label, records in weak_records():
+        n, least, firsts, windows, found = 0, 100.0, [], [], 0
+        for f1, f2, t, y in records:
+            rows = analyzed(t, y, folder)
+            est = np.array([r['frequency_hz'] for r in rows])
+            low = np.abs(est / f1 - 1) < 0.25
+            good = low & (np.abs(est / f1 - 1) <= 0.02)
+            start = 5.0 if label.startswith('real') else 1.0
+            n += int(np.sum(low))
+            least = min(least, 100 * float(np.mean(good[low])) if low.any() else 0.0)
+            if good.any():
+                firsts.append((rows[int(np.argmax(good))]['t'] - start) * f1)
+            conv = [r['convergence_time_s'] * f1 for r, keep in zip(rows, low) if keep]
+            windows += conv
+            found += bool(np.any(np.abs(est / f2 - 1) <= 0.02))
+        cells = f'{first(np.array(firsts or [np.nan]))} | {np.median(windows or [np.nan]):.2f}'
+        print(f'| {label} | {n} | {least:.0f} % | {cells} | {found} of {len(records)} |')
+        sys.stdout.flush()
+
+
+def pulled() -> None:
+    """``--pulled``: per rest and pull, for the damped and the biased model over 0.9 periods,
+    the first estimate after the release (periods, median and worst of 2 seeds), the estimates
+    and the share within 2 %."""
+    from vib_estimator.core import EstimatorConfig, estimate
+
+    print(
+        '| rest (s) | pull (s) | model | first (periods): median, worst | estimates | within 2 % |'
+    )
+    print('|---|---|---|---|---|---|')
+    for rest, pull in itertools.product((1.0, 2.0, 5.0), (0.02, 0.1, 0.2)):
+        for model in ('damped-sinusoid', 'biased-sinusoid'):
+            config = EstimatorConfig(model=model, min_periods=0.9, early_std_rel=0.01)
+            firsts, n, good = [], 0, 0
+            for seed in range(2):
+                t, y = pulled_pluck(rest, pull, seed)
+                e = estimate(t, y, config)
+                firsts.append((e.t[0] - rest - pull) * 9.4 if len(e) else math.inf)
+                n += len(e)
+                good += int(np.sum(np.abs(e.frequency_hz / 9.4 - 1) <= 0.02))
+            share = f'{100 * good / n:.0f} %' if n else '-'
+            print(
+                f'| {rest:g} | {pull:g} | {model} | {np.median(firsts):.2f}, {max(firsts):.2f} | '
+                f'{n} | {share} |'
+            )
+            sys.stdout.flush()
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--heavy', action='store_true', help='decays damped at 1-8 %%')
@@ -353,6 +455,8 @@ def main() -> int:
     parser.add_argument('--steady', action='store_true', help='a limit cycle')
     parser.add_argument('--channels', action='store_true', help='three channels of free decays')
     parser.add_argument('--noisy', action='store_true', help='driven modes in 5-10 dB of noise')
+    parser.add_argument('--weak', action='store_true', help='weak higher modes beside a decay')
+    parser.add_argument('--pulled', action='store_true', help='a pluck pulled over 0.02-0.2 s')
     parser.add_argument('--base', action='store_true', help='the default before 6 Dec 2026')
     parser.add_argument(
         '--node', action='store_true', help="the node's defaults, streamed (not --short)"
@@ -364,6 +468,15 @@ def main() -> int:
             choice.decay_stretches = lambda *a: (lambda c, n, _: (c, n, n))(*stretches(*a))
         with tempfile.TemporaryDirectory() as folder:
             noisy(Path(folder))
+        return 0
+    if args.pulled:
+        pulled()
+        return 0
+    if args.weak:  # (its --base: no free estimator for the strongest, not before 6 Dec)
+        if args.base:
+            choice.dominant_window = lambda *a: ()
+        with tempfile.TemporaryDirectory() as folder:
+            weak(Path(folder))
         return 0
     if args.base:
         choice.heavily_damped = lambda t, signal, dominant: (0, '')

@@ -13,9 +13,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from vib_estimator.analysis.choosing import explain_no_estimate, window_advice
+from vib_estimator.analysis.choosing import explain_no_estimate, window_advice, with_dominant
 from vib_estimator.cli import main
 from vib_estimator.core import EstimatorConfig
+from vib_estimator.core.estimator import EstimateArrays
 from vib_estimator.sim.ambient import ambient_record
 from vib_estimator.sim.frame import frame_record
 from vib_estimator.sim.signals import (
@@ -210,7 +211,10 @@ def test_a_free_decay_of_two_modes_reports_both(capsys, tmp_path):
 def test_a_free_decay_s_weak_mode_that_rings_freely_is_reported(capsys, tmp_path):
     """A 5 Hz decay with a 17.3 Hz mode at 1:20 (0.1 % of the spectral power, under MODE_SHARE,
     ringing freely: core.choice.rings_freely): the default reports both modes (issue 37 item 4's
-    goals: each first within 2 % within 2 periods of 5 Hz, >= 90 % within 2 %)."""
+    goals: each first within 2 % within 2 periods of 5 Hz, >= 90 % within 2 %), the 5 Hz one,
+    the strongest and lowest, read by the free estimator over 0.9 periods from its first
+    estimate on (core.choice.dominant_window; the mode tracker's windows: 1.65 periods or more)
+    under the tracker's mode number, the tracker's before it; --modes keeps the tracker's."""
     t = np.arange(0, 11, 0.001)
     tau = np.maximum(t - 1.0, 0)
     y = sum(
@@ -224,9 +228,47 @@ def test_a_free_decay_s_weak_mode_that_rings_freely_is_reported(capsys, tmp_path
     f = np.array([r['frequency_hz'] for r in rows])
     for true in (5.0, 17.3):
         near = np.abs(f / true - 1) <= 0.02
-        assert near.sum() > 50 and (tt[near][0] - 1.0) * 5.0 <= 2.0
+        assert near.sum() > 40 and (tt[near][0] - 1.0) * 5.0 <= 2.0
     err_rel = np.min(np.abs(f[:, None] / [5.0, 17.3] - 1), axis=1)
     assert np.mean(err_rel <= 0.02) >= 0.9
+    mode = np.array([r['mode'] for r in rows])
+    conv = np.array([r['convergence_time_s'] for r in rows]) * 5.0
+    low = np.abs(f / 5.0 - 1) < 0.25
+    assert len(set(mode[low])) == 1 and np.median(conv[low]) < 1.0
+    assert re.search(
+        rf'mode {mode[low][0]} \(5(\.\d+)? Hz\), the strongest.*: from t = [\d.]+ s the free', err
+    )
+    tracked, err = analyze(capsys, write(tmp_path / 'weak.csv', t, y), '--modes', '3')
+    slow = np.array([r['convergence_time_s'] for r in tracked]) * 5.0
+    f = np.array([r['frequency_hz'] for r in tracked])
+    assert 'the free estimator' not in err
+    assert np.median(slow[np.abs(f / 5.0 - 1) < 0.25]) > np.median(conv[low]) + 0.03
+
+
+def estimates(t, f, mode):
+    """EstimateArrays at times ``t`` of frequencies ``f`` and modes ``mode`` (the rest zeros)."""
+    rows = np.zeros((len(t), EstimateArrays.__dataclass_fields__.__len__()))
+    out = EstimateArrays(*rows.T.copy())
+    out.t, out.frequency_hz = np.asarray(t, float), np.asarray(f, float)
+    out.mode = np.asarray(mode, np.int64)
+    return out
+
+
+def test_with_dominant_puts_the_free_estimates_in_place_of_the_tracker_s_from_the_first_on():
+    """The tracker's mode 2 (5 Hz) before the free estimator's first estimate is kept, after it
+    replaced by the free estimates (numbered 2; one 9 Hz among them, beyond MODE_GAP of their
+    median, left out); its mode 1 (17 Hz) untouched; no tracker mode near: a new number; no free
+    estimate: the tracker's as they were."""
+    tracked = estimates([1.0, 1.1, 1.2, 1.3, 1.4], [17.0, 5.0, 5.02, 17.1, 4.99], [1, 2, 2, 1, 2])
+    free = estimates([1.15, 1.35, 1.5, 1.6], [5.01, 5.0, 9.0, 4.99], [0, 0, 0, 0])
+    merged, words = with_dominant(tracked, free)
+    assert merged.t.tolist() == [1.0, 1.1, 1.15, 1.3, 1.35, 1.6]
+    assert merged.mode.tolist() == [1, 2, 2, 1, 2, 2] and 9.0 not in merged.frequency_hz
+    assert words.startswith('mode 2 (5 Hz)') and "the free estimator's 3 estimates" in words
+    alone, _ = with_dominant(estimates([1.0], [17.0], [1]), free)
+    assert alone.mode.tolist() == [1, 2, 2, 2]
+    same, words = with_dominant(tracked, estimates([], [], []))
+    assert same is tracked and words == ''
 
 
 def test_a_periodic_drive_s_lines_are_never_published(capsys, tmp_path):
@@ -283,26 +325,48 @@ def test_a_decay_at_many_samples_a_period_keeps_the_convergence_test(monkeypatch
     assert len(e) >= 20 and np.array_equal(e.frequency_hz, before.frequency_hz)
 
 
-def test_a_decay_the_free_estimator_cannot_estimate_goes_to_the_mode_tracker(tmp_path, capsys):
-    """A 20 Hz pluck after 1 s of rest (zeta 1.5 %, 30 dB, 50 samples a period): the free
-    estimator as decided (0.9 periods, the damped model) passes its convergence test in 6
-    segments and its fit gate holds back every one: no estimate. The default reads the record
-    again with the mode tracker and says so: 62 estimates, 98 % within 2 %, none > 5 %.
-    ``--excitation free`` keeps the free estimator (7 estimates over 1.25 periods)."""
-    rng = np.random.default_rng(1)
-    t = np.arange(0, 1 + 5 / (0.015 * 2 * np.pi * 20), 1e-3)
+def heavy_pluck(f: float, zeta: float, snr: float, seed: int):
+    """A pluck of ``f`` Hz after 1 s of rest ringing 5 time constants at 1 kHz in ``snr`` dB."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(0, 1 + 5 / (zeta * 2 * np.pi * f), 1e-3)
     tau = np.maximum(t - 1.0, 0)
-    y = np.exp(-0.015 * 2 * np.pi * 20 * tau) * np.sin(2 * np.pi * 20 * tau + rng.uniform(0, 6.28))
-    y = y * (t >= 1.0) + 10**-1.5 / np.sqrt(2) * rng.standard_normal(len(t))
-    path = write(tmp_path / 'decay.csv', t, y)
-    rows, err = analyze(capsys, path, '--format', 'jsonl')
-    assert 'the free estimator gave no estimate of this free decay at 19.98 Hz' in err
+    y = np.exp(-zeta * 2 * np.pi * f * tau) * np.sin(2 * np.pi * f * tau + rng.uniform(0, 6.28))
+    return t, y * (t >= 1.0) + 10 ** (-snr / 20) / np.sqrt(2) * rng.standard_normal(len(t))
+
+
+@pytest.mark.parametrize('factor', [1.0, 1e-3, 1e3])
+def test_a_decay_the_free_estimator_reads_sparsely_goes_to_the_mode_tracker(
+    tmp_path, capsys, monkeypatch, factor
+):
+    """``survey`` (the damped model over 1.25 periods) of a lightly damped 5 Hz pluck at 20
+    samples a period in 20 dB: 6 free estimates over the 91 periods it rings above its noise,
+    under ``RESCUE_SHARE`` (11) of the 73 its window allows: read again by the mode tracker (30 or
+    more). ``analyze`` of a 20 Hz pluck at 1.5 % in 30 dB (the damped model over 0.9 periods,
+    its offset known): the free estimator's 17 estimates, all within 2 %, a median window of
+    0.92 periods, are 40 % of what its window allows and stay (until 6 Dec 2026 its segment
+    begun before the pluck stalled, core.kernel._stalled: none, and the tracker's 62 over 1.92
+    periods). ``RESCUE_SHARE`` at 0.001x leaves the 6, at 1000x sends the 20 Hz pluck to the
+    tracker."""
+    from vib_estimator.analysis import choosing
+
+    monkeypatch.setattr(choosing, 'RESCUE_SHARE', choosing.RESCUE_SHARE * factor)
+    rng = np.random.default_rng(0)
+    t = np.arange(0, 1 + 5 / (0.005 * 2 * np.pi * 5), 0.01)
+    tau = np.clip(t - 1.0, 0, None)
+    y = np.exp(-0.005 * 2 * np.pi * 5 * tau) * np.sin(2 * np.pi * 5 * tau + rng.uniform(0, 6.28))
+    y = y * (t >= 1.0) + 0.1 / np.sqrt(2) * rng.standard_normal(len(t))
+    folder = tmp_path / 'survey'
+    folder.mkdir()
+    write(folder / 'pluck.csv', t, y)
+    assert main(['survey', str(folder), '--format', 'jsonl', '--jobs', '1']) == 0
+    row = json.loads(capsys.readouterr().out.splitlines()[0])
+    rescued = row['mode'] == 1 and row['estimates'] >= 30
+    rows, err = analyze(capsys, write(tmp_path / 'd.csv', *rung(20.0, 0.015, 30, 50, 1)))
     f = np.array([r['frequency_hz'] for r in rows])
-    err_rel = np.abs(f / 20.0 - 1)
-    assert len(f) >= 30 and np.mean(err_rel <= 0.02) >= 0.95 and np.all(err_rel <= 0.05)
-    rows, err = analyze(capsys, path, '--format', 'jsonl', '--excitation', 'free')
-    assert 0 < len(rows) < 10 and 'mode tracker' not in err
-    assert all(r['mode'] == 0 for r in rows)  # the free estimator's (the tracker's: 1, 2 ...)
+    conv = np.array([r['convergence_time_s'] for r in rows]) * 20.0
+    kept = 'mode tracker' not in err and all(r['mode'] == 0 for r in rows)
+    kept = kept and len(f) >= 12 and np.all(np.abs(f / 20 - 1) <= 0.02) and np.median(conv) < 1
+    assert bool(rescued and kept) is (factor == 1.0)
 
 
 def rung(f, zeta, snr, per_period, seed):

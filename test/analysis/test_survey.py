@@ -476,9 +476,11 @@ def test_a_decay_the_free_estimator_leaves_silent_is_surveyed_by_the_mode_tracke
     tmp_path, capsys
 ):
     """A lightly damped 5 Hz pluck at 20 samples a period in 20 dB, after 1 s of rest: the free
-    estimator (survey's one window, 1.25 periods) gives no estimate; the recording is read again
-    by the mode tracker (analysis.choosing.rescue), its mode 1 within 1 % of 5 Hz on 30 estimates
-    or more. ``--excitation free`` keeps the free estimator's empty row."""
+    estimator (survey's one window, 1.25 periods) gives 6 estimates over the 91 periods the decay
+    rings above its noise (none until 6 Dec 2026, when its segment begun in the rest stalled:
+    core.kernel._stalled), under RESCUE_SHARE of the 73 its window allows; the recording is read
+    again by the mode tracker (analysis.choosing.rescue), its mode 1 within 1 % of 5 Hz on 30
+    estimates or more. ``--excitation free`` keeps the free estimator's few."""
     rng = np.random.default_rng(0)
     t = np.arange(0, 1 + 5 / (0.005 * 2 * np.pi * 5), 0.01)
     tau = np.clip(t - 1.0, 0, None)
@@ -492,4 +494,4 @@ def test_a_decay_the_free_estimator_leaves_silent_is_surveyed_by_the_mode_tracke
     args = ['survey', str(tmp_path), '--format', 'jsonl', '--jobs', '1', '--excitation', 'free']
     assert main(args) == 0
     (row,) = jsonl(capsys.readouterr().out)
-    assert row['mode'] == 0 and row['estimates'] == 0
+    assert row['mode'] == 0 and 0 < row['estimates'] < 10

@@ -380,6 +380,23 @@ def hum(line: float = 0.03, seconds: float = 40.0):
     return t, y + 1e-3 * np.random.default_rng(0).standard_normal(len(t))
 
 
+def test_the_strongest_of_several_modes_the_others_weak_above_it_gets_the_free_window():
+    """5/17.3 Hz at 1:0.05 (the 17.3 Hz mode 0.1 % of the power): tracked, and the 5 Hz mode,
+    the strongest and lowest, gets the free estimator's short window (core.choice.dominant_window,
+    as a one-mode decay's); 8/21 Hz at 1:0.3 (the 21 Hz mode 9 %, over MODE_SHARE) and 17.3 Hz
+    over a weak 5 Hz mode (the strongest not the lowest: the weak one a drift in its window)
+    none."""
+    weak = decide(*several((5.0, 17.3), (1.0, 0.05), (0.004, 0.002)))
+    assert weak.modes == choice.TRACKED_MODES and weak.dominant_window[0] == choice.FAST_PERIODS
+    assert weak.min_periods != weak.min_periods  # (the tracker's own windows: not set)
+    strong = decide(*several((8.0, 21.0), (1.0, 0.3), (0.003, 0.002)))
+    under = decide(*several((17.3, 5.0), (1.0, 0.05), (0.002, 0.004)))
+    assert strong.modes == under.modes == choice.TRACKED_MODES
+    assert strong.dominant_window == under.dominant_window == ()
+    one = decide(*several((5.0,), (1.0,), (0.004,)))
+    assert one.modes == 0 and one.dominant_window == ()
+
+
 def test_a_steady_line_beside_a_free_decay_is_no_mode():
     """Mains hum beside a pluck (50 Hz at 3 % of a 5 Hz decay's amplitude, 40 s: kurtosis 1.5,
     falling 0 dB while the decay falls 31 dB) is a line, not a second mode: one mode (not the

@@ -40,12 +40,14 @@ from ..io.streaming import Signal, is_csv, open_signal
 from .channels import channel_names, component_names, need_joint, run_joint, topic_list
 from .choosing import (
     decides,
+    dominant_reading,
     explain_no_estimate,
     model_given,
     periods_given,
     prepare,
     read_ahead,
     rescue,
+    with_dominant,
 )
 from .outputs import check_output
 from .summary import summarise_modes, summary_lines
@@ -339,9 +341,11 @@ def damage_warning(signal: Signal, prog: str) -> None:
 
 def rescues(args) -> bool:
     """Whether a free decay the free estimator gives nothing of may be read again by the mode
-    tracker (:func:`.choosing.rescue`): decided from the record, no ``--model`` or
-    ``--min-periods`` (which keep the free estimator as chosen)."""
-    return decides(args) and not (model_given(args) or periods_given(args))
+    tracker (:func:`.choosing.rescue`), and the strongest of a free decay's modes by the free
+    estimator (:func:`.choosing.dominant_reading`): decided from the record, no ``--model``,
+    ``--min-periods`` or ``--modes`` (which keep the estimator as chosen)."""
+    chosen = model_given(args) or periods_given(args) or getattr(args, 'modes', None) is not None
+    return decides(args) and not chosen
 
 
 def estimate_rescued(
@@ -352,6 +356,13 @@ def estimate_rescued(
     record's counts started afresh) and kept where the tracker gives more, with the line that
     says so ('' otherwise)."""
     result = estimate_signal(signal, config, keep, blocks, offset)
+    lowest = dominant_reading(config, decision, allowed)
+    if lowest is not None:  # the strongest of several modes: the free estimator's
+        skipped, corrupt = signal.skipped, signal.corrupt
+        free = estimate_signal(signal, lowest[0], offset=lowest[1]).estimates
+        signal.skipped, signal.corrupt = skipped, corrupt  # (counted once)
+        result.estimates, words = with_dominant(result.estimates, free)
+        return config, result, f'{prog}: {words}' if words else ''
     again = rescue(config, decision, allowed, len(result.estimates), prog)
     if again is None:
         return config, result, ''

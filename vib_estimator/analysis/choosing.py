@@ -28,12 +28,14 @@ from ..core.choice import (
     DECIDE_S,
     DRIVEN_ABOVE,
     FREE_BELOW,
+    MODE_GAP,
     TRACKED_MODES,
     Decision,
     decide,
 )
 from ..core.choice import window_advice as choice_window_advice
 from ..core.config import EstimatorConfig
+from ..core.estimator import EstimateArrays
 
 
 def decides(args) -> bool:
@@ -116,31 +118,94 @@ def decided_config(
 #: in, 4.7 % off, the tracker 19, all within 2 %; at 20 samples a period in 30 dB 1-2 estimates
 #: 20-29 periods in, the tracker 55); the simulated arm of Section 5.3 gives 10
 RESCUE_BELOW = 3
+#: ... and so is one whose free estimator gives fewer than this share of the estimates its
+#: window allows over the periods the decay rings above its noise
+#: (:attr:`..core.choice.Decision.ringing_periods`): a lightly damped 5 Hz pluck at 20 samples a
+#: period in 20 dB (91 periods ringing: 73 windows of 1.25) gave the damped model 6 estimates,
+#: the tracker 50; clean decays give 80-100 % of theirs. ``bench_hard_records.py --silent``
+#: (6 Dec): at 20 samples a period in 20 dB 10 -> 22 estimates a record, the least share within
+#: 2 % 67 -> 83 %, 60 samples in 30 dB 31 -> 40; 0.25 gave two estimates beyond 5 % at 60
+#: samples in 20 dB, 0.1 left the latter at 31
+RESCUE_SHARE = 0.15
 
 
 def rescue(
     config: EstimatorConfig, d: Optional[Decision], decided: bool, estimated: int, prog: str
 ) -> Optional[Tuple[EstimatorConfig, str]]:
     """For a record decided (``decided``: no option chose the excitation) a free decay of one
-    mode whose free estimator gave fewer than :data:`RESCUE_BELOW` estimates (``estimated``) --
+    mode whose free estimator gave fewer than :data:`RESCUE_BELOW` estimates (``estimated``), or
+    fewer than :data:`RESCUE_SHARE` of those its window allows over the decay's ringing --
     its convergence test (Eqs. 16-17) rarely passing in the record's noise at its samples a
     period, or its fit gate holding back the estimates of a heavily damped decay --: the mode
     tracker's configuration (``modes`` :data:`..core.choice.TRACKED_MODES`, the samples as read)
     and the line that says so (the caller keeps the free estimates where the tracker gives
     fewer); None otherwise (enough estimates, an option, a record with no spectral peak)."""
-    if estimated >= RESCUE_BELOW or not decided or d is None:
+    if not decided or d is None:
+        return None
+    allowed = RESCUE_SHARE * d.ringing_periods / config.min_periods  # (NaN: not read)
+    if estimated >= RESCUE_BELOW and not estimated < allowed:
         return None
     if config.excitation != 'free' or config.modes or not d.dominant_hz > 0:
         return None
     gave = (
         f'only {estimated} estimate{"s" if estimated > 1 else ""}' if estimated else 'no estimate'
     )
+    if estimated >= RESCUE_BELOW:
+        gave += f' (its window allows {allowed / RESCUE_SHARE:.0f} over the decay)'
     line = (
         f'{prog}: the free estimator gave {gave} of this free decay at {d.dominant_hz:.4g} '
         f'Hz: the mode tracker (modes {TRACKED_MODES}) estimated it; --excitation free keeps the '
         'free estimator'
     )
     return config.replace(modes=TRACKED_MODES), line
+
+
+def dominant_reading(
+    config: EstimatorConfig, d: Optional[Decision], allowed: bool
+) -> Optional[Tuple[EstimatorConfig, float]]:
+    """For a free decay of several modes decided from the record (``allowed``: no option chose
+    the excitation, the modes, the model or the window) whose strongest mode the free estimator
+    reads (:attr:`..core.choice.Decision.dominant_window`): the free estimator's configuration
+    for that mode and the offset to remove from the samples first (0: none); None otherwise.
+    The mode tracker reads the others (:func:`with_dominant`)."""
+    if not allowed or d is None or not d.dominant_window or config.excitation != 'free':
+        return None
+    periods, early, model, offset = d.dominant_window
+    free = config.replace(
+        modes=0, min_periods=periods, early_std_rel=early, model=model or config.model
+    )
+    return free, (offset if math.isfinite(offset) else 0.0)
+
+
+def with_dominant(tracked: EstimateArrays, free: EstimateArrays) -> Tuple[EstimateArrays, str]:
+    """The mode tracker's estimates ``tracked`` with those of the mode the free estimator read
+    (``free``: its estimates within :data:`..core.choice.MODE_GAP` of their median; separate
+    modes lie farther apart) in place of the tracker's mode nearest it within that gap (its
+    number; else a new one) from the free estimator's first estimate on (the tracker's before
+    it: after rest, the tracker's first can come earlier), and the words that say so ('' when
+    the free estimator gave none: the tracker's, as they were)."""
+    if not len(free):
+        return tracked, ''
+    f = float(np.median(free.frequency_hz))
+    free = free.where(np.abs(free.frequency_hz / f - 1) < MODE_GAP)
+    f = float(np.median(free.frequency_hz))
+    medians = {
+        int(m): float(np.median(tracked.frequency_hz[tracked.mode == m]))
+        for m in np.unique(tracked.mode)
+    }
+    near = [m for m, g in medians.items() if abs(g / f - 1) < MODE_GAP]
+    number = (
+        min(near, key=lambda m: abs(medians[m] / f - 1)) if near else max(medians, default=0) + 1
+    )
+    mine = (tracked.mode == number) & (tracked.t >= free.t[0])
+    free.mode[:] = number
+    words = (
+        f'mode {number} ({f:.4g} Hz), the strongest and lowest, the others weak: from t = '
+        f"{free.t[0]:.4g} s the free estimator's {len(free)} estimates (a pure peak: its short "
+        f"window) in place of the mode tracker's {int(np.sum(mine))} (the counters: the "
+        "tracker's; --modes keeps the tracker's)"
+    )
+    return EstimateArrays.concatenate([tracked.where(~mine), free]), words
 
 
 def contradiction(config: EstimatorConfig, d: Decision, prog: str) -> str:

@@ -724,14 +724,13 @@ class AutoEstimator(Estimator):
         n_keep = min(HISTORY, len(ht))
         self._history[:, :n_keep] = ht[len(ht) - n_keep :], hy[len(hy) - n_keep :]
         self._filled = n_keep
-        names = list(EstimateArrays.__dataclass_fields__)
         parts, driven = [], []
         for est, want in ((free, False), (ambient, True)):
             if not want:
                 keep = passed
             else:
                 keep = states[self._samples(t, est.t)] if len(t) else np.zeros(0, dtype=bool)
-            parts.append(EstimateArrays(**{n: getattr(est, n)[keep] for n in names}))
+            parts.append(est.where(keep))
             driven.append(np.full(int(np.sum(keep)), want))
         # by time, stable: at one stamp the free estimate first, an analysis's modes in order
         kind = np.concatenate(driven)[

@@ -337,6 +337,14 @@ class Decision:
     #: how far (dB) the strongest spectral peak stands above the spectrum's median (NaN: no
     #: peak): under :data:`FLAT_DB`, noise
     peak_db: float = math.nan
+    #: a free decay of several separate modes tracked (:attr:`modes`) whose strongest mode is
+    #: the lowest, rings purely and holds the others under :data:`MODE_SHARE` of its power: the
+    #: free estimator's ``(min_periods, early_std_rel, model, offset)`` for it
+    #: (:func:`fast_window`; ``analyze`` reads that mode so, the mode tracker the others); ()
+    dominant_window: tuple = ()
+    #: a free decay of one mode: the periods it rings above its noise in the record
+    #: (:func:`ringing_periods`; NaN: not read), for ``analyze``'s rescue
+    ringing_periods: float = math.nan
 
     @property
     def plucks_in_a_row(self) -> bool:
@@ -638,17 +646,20 @@ def decide(
         seen += said
     modes, rate = 0, (len(t) - 1) / span
     free, cap = (math.nan, 0.0, '', math.nan), math.nan  # a free decay's window, precision,
+    lowest: tuple = ()  # (its lowest mode's, several tracked)
     if excitation == 'free':  # model, offset; a steady oscillation's max_damping
         decay = (t, y, signal, spec, dominant, channels)  # the free decay
         chosen = (modal, powers[~is_line], beside, offset_ok, stream, train, crowded)
-        modes, free, band, said, cap = free_choice(*decay, *chosen)
+        modes, free, band, said, cap, lowest = free_choice(*decay, *chosen)
         seen += said
     if lines and excitation != 'free':
         seen += '; the identifier drops its modes at the lines (lines_hz)'
     seen_at = (tuple(peaks), seen, span, rate)  # what was read, at what rate
     found = (modes, *free, tuple(lines) if excitation != 'free' else (), band, train, cap)
     read = (excitation, window, share, dominant, fundamental, *seen_at, *found)
-    return Decision(*read, peak_db=standing(spec, powers))
+    one = excitation == 'free' and not (modes or stream) and dominant > 0  # (a free decay's)
+    more = dict(ringing_periods=ringing_periods(t, signal, dominant) if one else math.nan)
+    return Decision(*read, peak_db=standing(spec, powers), dominant_window=lowest, **more)
 
 
 def standing(spec, powers: np.ndarray) -> float:
@@ -709,10 +720,12 @@ def free_choice(
     train,
     crowded,
 ) -> tuple:
-    """A free decay's ``(modes, window, band, words, max_damping)``: several separate modes
-    among its ``modal`` peaks (``powers``; :func:`free_modes`, the lines ``beside`` it banded
-    out), few samples a period (:func:`few_samples`), several channels beside a line, a steady
-    oscillation (:func:`steady_oscillation`; not a stream, nor a train of decays: ``train``,
+    """A free decay's ``(modes, window, band, words, max_damping, lowest)``: several separate
+    modes among its ``modal`` peaks (``powers``; :func:`free_modes`, the lines ``beside`` it
+    banded out; ``lowest``: the free estimator's window for the strongest,
+    :func:`dominant_window`, one channel, no band, where it is the lowest and the others minor,
+    else ()), few samples a period (:func:`few_samples`), several channels beside a line, a
+    steady oscillation (:func:`steady_oscillation`; not a stream, nor a train of decays: ``train``,
     the share :func:`decay_train` read; its band :func:`steady_band`, its ``max_damping``
     :data:`STEADY_ZETA`, else NaN): the mode tracker; else one mode at ``dominant`` Hz and its
     window (:func:`free_window`: its precision, model and offset; NaN window: the configured).
@@ -720,8 +733,11 @@ def free_choice(
     no stretch free of an impact."""
     if crowded:
         modes, said = to_tracker('impacts closer than its stretches')
-        return modes, (math.nan, 0.0, '', math.nan), (), said, math.nan
-    modes, said, band = free_modes(t, signal, spec, modal, powers, beside)
+        return modes, (math.nan, 0.0, '', math.nan), (), said, math.nan, ()
+    modes, said, band, minor = free_modes(t, signal, spec, modal, powers, beside)
+    lowest = ()  # (its strongest mode the lowest, the others minor: the free estimator's too)
+    if modes and minor and not (stream or band) and channels == 1:
+        lowest = dominant_window(t, y, dominant, spec, offset_ok)
     if not modes:
         modes, fewer = few_samples((len(t) - 1) / float(t[-1] - t[0]), dominant)
         said += fewer
@@ -740,7 +756,19 @@ def free_choice(
     if not modes and dominant > 0:
         modes, free, more = free_window(t, y, signal, dominant, spec, offset_ok, stream, channels)
         said += more
-    return modes, free, band, said, cap
+    return modes, free, band, said, cap, lowest
+
+
+def dominant_window(t, y, dominant: float, spec, offset_ok: bool) -> tuple:
+    """For a free decay of several separate modes whose strongest, at ``dominant`` Hz, is the
+    lowest and holds the others under :data:`MODE_SHARE` of its power: the free estimator's
+    window for that mode (:func:`fast_window`: ``(min_periods, early_std_rel, model, offset)``;
+    () where its peak is impure; ``analyze`` says it where it applies it). The mode tracker's
+    windows are 1.4 periods or more (a brief higher mode of a real beam, plucked after 5 s of
+    rest, sent its 6 Hz mode there: a median of 1.65 periods, where the free estimator gives
+    0.90)."""
+    *window, _ = fast_window(t, y, dominant, spec, offset_ok)
+    return tuple(window) if math.isfinite(window[0]) else ()
 
 
 def beside_decay(t: np.ndarray, signal: np.ndarray, modal, lines, spec) -> bool:
@@ -825,12 +853,14 @@ def steady_band(f: float, rate: float) -> tuple:
 
 def free_modes(
     t, signal, spec, peaks: np.ndarray, powers: np.ndarray, beside: list = ()
-) -> tuple[int, str, tuple]:
+) -> tuple[int, str, tuple, bool]:
     """A free decay's modes to track -- :data:`TRACKED_MODES` when its spectral peaks (``spec``:
     :func:`spectrum`) hold several separate modes (:func:`separate_modes`, with
     :func:`rings_freely`, :func:`coexistence` and :func:`steady_line`), else 0 --, the reason in
-    words and the band that leaves out the steady lines above them (:func:`line_band`), and a
-    periodic drive's lines ``beside`` the decay (Hz: a machine running nearby)."""
+    words, the band that leaves out the steady lines above them (:func:`line_band`) and a
+    periodic drive's lines ``beside`` the decay (Hz: a machine running nearby), and whether the
+    strongest is the lowest and every other holds under :data:`MODE_SHARE` of its power (each
+    admitted by :func:`rings_freely`: a beam's brief higher modes)."""
     lines: list[float] = []
     dominant_fall = None  # read once, at the first candidate
 
@@ -861,10 +891,12 @@ def free_modes(
     if band:
         said += f' (band_hz {band[0]:.3g}-{band[1]:.3g} Hz)'
     if len(separate) < 2:
-        return 0, said, band
+        return 0, said, band, False
     listed = ', '.join(f'{f:.3g}' for f in sorted(separate))
     modes, tracked = to_tracker(f'{len(separate)} separate modes ({listed} Hz)')
-    return modes, said + tracked, band
+    power = dict(zip(peaks.tolist(), powers.tolist()))
+    minor = all(f > separate[0] and power[f] < MODE_SHARE * powers[0] for f in separate[1:])
+    return modes, said + tracked, band, minor
 
 
 def to_tracker(why: str) -> tuple[int, str]:
@@ -1058,6 +1090,17 @@ def block_noise(blocks: np.ndarray) -> float:
     second differences' variance / 6 (a sinusoid's second difference is ``(2 pi f / fs)^2`` of
     it, and the least block is where the decay has rung down)."""
     return float(np.min(np.diff(blocks, 2, axis=1).var(axis=1))) / 6
+
+
+def ringing_periods(t: np.ndarray, signal: np.ndarray, f: float) -> float:
+    """The periods of ``f`` Hz a free decay rings above its noise in the record ``(t, signal)``:
+    its signal-to-noise ratio (:func:`snr_db`) over the dB its envelope falls a period (54.6
+    zeta, :func:`decay_zeta`), at most the record's periods; NaN where either is not read."""
+    zeta, snr = decay_zeta(t, signal, f), snr_db(t, signal, f)
+    if not (zeta > 0 and snr > 0):
+        return math.nan
+    fall = 20 * math.log10(math.e) * 2 * math.pi * zeta  # dB a period
+    return min(snr / fall, float(t[-1] - t[0]) * f)
 
 
 def snr_db(t: np.ndarray, y: np.ndarray, f: float) -> float:

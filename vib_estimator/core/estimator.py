@@ -340,6 +340,10 @@ class EstimateArrays:
             mode.astype(np.int64),
         )
 
+    def where(self, keep: np.ndarray) -> 'EstimateArrays':
+        """The estimates ``keep`` (a mask or indices) selects, in their order."""
+        return EstimateArrays(**{n: getattr(self, n)[keep] for n in self.__dataclass_fields__})
+
     @classmethod
     def concatenate(
         cls, parts: Sequence['EstimateArrays'], by_time: bool = True

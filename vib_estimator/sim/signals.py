@@ -118,3 +118,17 @@ def step_into_limit_cycle(seconds, rate_hz, seed=0):
     ring = np.exp(-0.06 * 2 * np.pi * 1.6 * tau) * np.sin(2 * np.pi * 1.6 * tau)
     y[t >= 2.0] += np.round(30 * ring) * 1e-3
     return t, y
+
+
+def pulled_pluck(rest, pull, seed=0, f=9.4, rate_hz=1000.0, noise=1e-3):
+    """A pluck as a hand gives it: ``rest`` s of rest, the beam pulled to -1 over ``pull`` s (a
+    half cosine), then let go: ``f`` Hz at damping ratio 0.004 for 10 s, plus white ``noise``
+    (its std), at ``rate_hz``; returns (t, y)."""
+    t = np.arange(0, rest + pull + 10, 1 / rate_hz)
+    y = np.zeros_like(t)
+    ramp = (t >= rest) & (t < rest + pull)
+    y[ramp] = -0.5 * (1 - np.cos(np.pi * (t[ramp] - rest) / pull))
+    tau = t - rest - pull
+    on = tau >= 0
+    y[on] = -np.exp(-0.004 * 2 * np.pi * f * tau[on]) * np.cos(2 * np.pi * f * tau[on])
+    return t, y + noise * np.random.default_rng(seed).standard_normal(len(t))
