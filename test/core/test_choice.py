@@ -388,7 +388,7 @@ def test_the_strongest_of_several_modes_the_others_weak_above_it_gets_the_free_w
     none."""
     weak = decide(*several((5.0, 17.3), (1.0, 0.05), (0.004, 0.002)))
     assert weak.modes == choice.TRACKED_MODES and weak.dominant_window[0] == choice.FAST_PERIODS
-    assert weak.min_periods != weak.min_periods  # (the tracker's own windows: not set)
+    assert math.isnan(weak.min_periods)  # (the tracker's own windows: not set)
     strong = decide(*several((8.0, 21.0), (1.0, 0.3), (0.003, 0.002)))
     under = decide(*several((17.3, 5.0), (1.0, 0.05), (0.002, 0.004)))
     assert strong.modes == under.modes == choice.TRACKED_MODES

@@ -142,7 +142,8 @@ def rescue(
     fewer); None otherwise (enough estimates, an option, a record with no spectral peak)."""
     if not decided or d is None:
         return None
-    allowed = RESCUE_SHARE * d.ringing_periods / config.min_periods  # (NaN: not read)
+    window = config.min_periods  # (0: the convergence test's alone, no share asked)
+    allowed = RESCUE_SHARE * d.ringing_periods / window if window > 0 else math.nan
     if estimated >= RESCUE_BELOW and not estimated < allowed:
         return None
     if config.excitation != 'free' or config.modes or not d.dominant_hz > 0:
