@@ -164,16 +164,28 @@ def test_gaps_are_counted_in_analyze_and_survey_rows(tmp_path):
     assert values['gaps'] == '3' and values['samples_lost'] == '300'
 
 
-def test_white_noise_says_the_mode_tracker_found_no_mode():
-    """A sensor at rest (white noise, 30 s at 1 kHz): its flat spectrum's peaks read as several
-    modes, the mode tracker finds none; the line says so in the tracker's words (it said "the
-    convergence test (Eqs. 16-17) never fired ... --model damped-sinusoid", the free estimator's,
-    which did not run)."""
+def test_white_noise_says_it_is_noise():
+    """A sensor at rest (white noise, 30 s at 1 kHz): its spectrum's strongest peak stands under
+    ``FLAT_DB`` and no other above what its noise reaches by chance; the line says it is noise
+    (it said "the convergence test (Eqs. 16-17) never fired ... --model damped-sinusoid", then,
+    its chance peaks read as several modes, "the mode tracker found no mode")."""
     t = np.arange(0, 30, 0.001)
     y = np.random.default_rng(0).standard_normal(len(t))
     text = 't,y\n' + ''.join(f'{a!r},{b!r}\n' for a, b in zip(t.tolist(), y.tolist()))
     code, out, err = analyze(text.encode(), '--format', 'jsonl')
     why = [line for line in err.splitlines() if line.startswith('analyze: no estimate: ')]
-    assert code == 0 and out == '' and 'modes 3' in err
-    assert len(why) == 1 and 'the mode tracker found no mode' in why[0]
-    assert 'Eqs. 16-17' not in why[0]
+    assert code == 0 and out == ''
+    assert len(why) == 1 and 'the spectrum is flat' in why[0] and 'noise, no mode' in why[0]
+    assert 'Eqs. 16-17' not in why[0] and '--min-fit' not in why[0]
+
+
+def test_a_numpy_file_gets_one_error_line_that_says_how_to_write_it_as_a_csv(tmp_path):
+    """A lab's ``numpy.save`` of (time, signal) rows is no bag nor CSV: exit 2, one ``error:``
+    line that says how to write it as a CSV file (it said only that it is not a bag)."""
+    path = tmp_path / 'rec.npy'
+    np.save(path, np.zeros((2, 100)))
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = cli.main(['analyze', str(path)])
+    check_run(code, out.getvalue(), err.getvalue())
+    assert code == 2 and 'a NumPy array: write it as one' in err.getvalue()

@@ -140,6 +140,9 @@ def bad_bag(tmp_path, kind, mcap_bag):
     if kind == 'text_file':
         (tmp_path / 'notes.txt').write_text('hello')
         return tmp_path / 'notes.txt'
+    if kind == 'numpy_file':
+        np.save(tmp_path / 'rec.npy', np.zeros((2, 100)))
+        return tmp_path / 'rec.npy'
     if kind == 'empty':
         with BagWriter(tmp_path / 'empty') as bag:
             bag.add_topic('/coupling_torque', WRENCH_STAMPED)
@@ -156,6 +159,10 @@ def bad_bag(tmp_path, kind, mcap_bag):
         ('truncated_dir', r'corrupt or truncated bag\?; `vib-estimator reindex .*` rebuilds it'),
         ('not_a_bag_dir', 'has no metadata.yaml'),
         ('text_file', 'is not a bag'),
+        (
+            'numpy_file',
+            r'is not a bag: .* a NumPy array: write it as one, e\.g\. .*numpy\.savetxt',
+        ),
         ('empty', 'contains no messages'),
     ],
 )

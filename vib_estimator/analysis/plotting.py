@@ -15,6 +15,7 @@ from typing import Optional, Sequence, Tuple
 
 import numpy as np
 
+from ..core.choice import regular
 from ..io.fields import UNKNOWN_UNIT
 from .summary import summarise_modes
 
@@ -137,11 +138,12 @@ def segment_medians(est_t, est_f, truth) -> list:
 
 def welch_psd(t: np.ndarray, y: np.ndarray, lowest_hz: float = math.nan):
     """One-sided Welch PSD (scipy.signal.welch, Hann, 50 % overlap) of ``y`` sampled at the median
-    interval of ``t``: (frequencies in Hz, PSD in unit^2/Hz). The segments are long enough to
-    resolve ``lowest_hz`` / :data:`PSD_RESOLUTION` when given, else a quarter of the record."""
+    interval of ``t`` (irregular stamps: on a uniform grid, :func:`..core.choice.regular`):
+    (frequencies in Hz, PSD in unit^2/Hz). The segments are long enough to resolve ``lowest_hz``
+    / :data:`PSD_RESOLUTION` when given, else a quarter of the record."""
     from scipy.signal import welch
 
-    y = np.asarray(y, dtype=float)
+    t, y = regular(np.asarray(t, dtype=float), np.asarray(y, dtype=float))
     fs = 1.0 / float(np.median(np.diff(t)))
     want = PSD_RESOLUTION * fs / lowest_hz if lowest_hz > 0 else len(y) / 4
     nperseg = int(min(len(y), max(PSD_MIN_SEGMENT, want)))

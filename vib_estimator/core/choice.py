@@ -70,6 +70,7 @@ from .auto import (
     decay_verdict,
     is_free_decay,
 )
+from .modes import MAX_FILL
 from .ssi import NU_MAX
 
 #: the first seconds of a record the decision reads
@@ -79,6 +80,12 @@ MAX_STAMP_S = 1e12
 #: ... nor values farther from the median than this many median absolute deviations (a pluck of
 #: 1 in a long record of 1e-4 noise stands at ~1e4)
 ABSURD = 1e6
+#: stamps whose steps differ from their median by more than this share of it are irregular: the
+#: decision reads the record resampled onto a uniform grid (:func:`regular`; a real beam recorded
+#: at 4 kHz by a software clock, steps 0.19-0.25 ms and 19 gaps of 2-6 ms: read at its mean rate,
+#: its 16.33 Hz decay showed 17 "peaks" from 6.3 to 30.6 Hz and its strongest at 16.13 Hz; on the
+#: grid one peak, at 16.33 Hz)
+JITTER = 0.01
 #: Welch segment, s (0.05 Hz resolution: a 1.2 Hz building mode's peak stands apart)
 SEGMENT_S = 20.0
 #: a record whose Welch segment centred on its first sample (half a segment of rest, its mean,
@@ -96,6 +103,11 @@ START_RATIO = 10.0
 PEAK_DB = 10.0
 #: ... and its power at least this share of the strongest peak's
 PEAK_SHARE = 1e-3
+#: ... and above what the spectrum's noise reaches by chance in one of its bins with this
+#: probability (:func:`chance_level`)
+CHANCE = 0.01
+#: ... its floor the median of this many bins around (odd; 2.5 Hz either side at 0.05 Hz)
+FLOOR_BINS = 101
 #: a record whose envelope reads driven for less than this share of its time is a free decay
 FREE_BELOW = 0.1
 #: ... and one read driven for more than this share is driven throughout (the envelope's first
@@ -108,12 +120,9 @@ TRACKED_MODES = 3
 #: ... a separate mode: a peak holding at least this share of the strongest's power (the
 #: simulated arm's moves leave peaks of 1-3 %, a second mode at 30 % amplitude 4-16 %)
 MODE_SHARE = 0.02
-#: ... or a weaker peak that rings freely (:func:`rings_freely`): standing at least this many dB
-#: above its surroundings (the 17.3 Hz mode of a 5 / 17.3 Hz decay at 1:20, 0.11 % of the power:
-#: 36-41 dB; a 97 Hz mode at 1 %: 46-47 dB; the noise's chance peaks in decays of one mode at
-#: 15-45 dB: at most 13 dB, a damped decay's leakage 2-8 dB, the simulated arm's moves' peaks
-#: 1-7 dB) ...
-RING_FLOOR_DB = 25.0
+#: ... or a weaker peak that rings freely (:func:`rings_freely`): a spectral peak (above what
+#: the noise reaches by chance: :func:`chance_level`; until 6 Dec 2026 also 25 dB above its
+#: surroundings, which the noise's chance peaks no longer reach) ...
 #: ... and its band-passed response decaying by at least this many dB from its most energetic
 #: block (the 17.3 Hz mode: 16-19 dB over 10 s; the arm's moves' 2.3-2.4 Hz peaks, bursts at
 #: each move: 2-5 dB; a line: none)
@@ -391,38 +400,66 @@ def principal_component(y: np.ndarray) -> np.ndarray:
 def spectrum(t: np.ndarray, y: np.ndarray) -> tuple:
     """Welch's spectrum of ``(t, y)`` (segments of :data:`SEGMENT_S` s), summed over the channels
     of ``y``: ``(frequencies, powers, the lowest frequency it resolves, the powers without the
-    start's segment)`` -- a segment centred on the first sample (half a segment of rest before
-    it), added where it holds :data:`START_RATIO` times the segments' mean power (a decay ringing
-    down from that sample; else the last is None)."""
+    start's segment, the segments averaged)`` -- a segment centred on the first sample (half a
+    segment of rest before it), added where it holds :data:`START_RATIO` times the segments' mean
+    power (a decay ringing down from that sample; else the fourth is None)."""
     from .spectra import welch  # scipy.signal's, in numpy (.spectra: its import cost)
 
     fs = (len(t) - 1) / float(t[-1] - t[0])
     y = np.asarray(y, dtype=np.float64).reshape(len(t), -1)
     nper = int(min(len(t), max(64, round(SEGMENT_S * fs))))
     freq, psd = welch(y, fs, nper)
-    plain = None
+    plain, n = None, len(y)
     rest = np.broadcast_to(np.mean(y, axis=0), (nper // 2, y.shape[1]))
     start = np.concatenate([rest, y[: nper - nper // 2]])  # the segment centred on the start
     if np.sum(welch(start, fs, nper)[1]) > START_RATIO * np.sum(psd):  # its start tapered
-        plain = np.sum(psd, axis=1)
+        plain, n = np.sum(psd, axis=1), n + len(rest)
         freq, psd = welch(np.concatenate([rest, y]), fs, nper)
-    return freq, np.sum(psd, axis=1), 2 * fs / nper, plain
+    segments = (n - nper) // (nper - nper // 2) + 1
+    return freq, np.sum(psd, axis=1), 2 * fs / nper, plain, segments
 
 
 def spectral_peaks(t: np.ndarray, y: np.ndarray, spec=None) -> tuple[np.ndarray, np.ndarray]:
     """``(frequencies, powers)`` of the spectrum's peaks (module docstring, 1), strongest first,
-    summed over the channels of ``y`` (``spec``: its :func:`spectrum`, if computed already)."""
+    summed over the channels of ``y`` (``spec``: its :func:`spectrum`, if computed already);
+    each but the strongest above what the noise reaches by chance (:func:`chance_level`; the
+    strongest, a short decay's in a long record among them, is judged by :data:`FLAT_DB`)."""
     from .spectra import peaks_by_prominence  # scipy.signal's find_peaks (prominence only)
 
-    freq, psd, lowest, _ = spectrum(t, y) if spec is None else spec
+    freq, psd, lowest, _, segments = spectrum(t, y) if spec is None else spec
     level = 10 * np.log10(np.maximum(psd, 1e-300 + 1e-12 * float(np.max(psd))))
     idx = peaks_by_prominence(level, PEAK_DB)
     idx = idx[freq[idx] > lowest]  # above the segment's own lowest bins (a drift)
     if not len(idx):
         return np.empty(0), np.empty(0)
     order = idx[np.argsort(psd[idx])[::-1]]
+    level = chance_level(psd, order[1:], segments, int(np.sum(freq > lowest)))
+    order = np.r_[order[:1], order[1:][psd[order[1:]] >= level]]  # the strongest: FLAT_DB
     order = order[psd[order] >= PEAK_SHARE * psd[order[0]]]
     return freq[order], psd[order]
+
+
+def chance_level(psd: np.ndarray, at: np.ndarray, segments: int, bins: int) -> np.ndarray:
+    """At the bins ``at``, the power the noise alone reaches by chance in one of ``bins`` bins with
+    probability :data:`CHANCE` (a spectral peak must reach it): the local floor (the median of
+    the :data:`FLOOR_BINS` bins around) times the ratio of the (1 - CHANCE / bins) quantile of a
+    Welch average of ``segments`` segments (chi-square, 2 ``segments`` degrees of freedom:
+    Wilson-Hilferty; the normal quantile by Abramowitz & Stegun 26.2.23) to its median. One
+    20 s segment of 57 000 bins: 14 dB over the floor (a noisy decay's record of 20 s, read with
+    prominence alone, showed 2 445 peaks, "lines" of a "periodic drive" among them); 30
+    segments: 3.7 dB."""
+    from numpy.lib.stride_tricks import sliding_window_view
+
+    half = min(FLOOR_BINS // 2, (len(psd) - 1) // 2)
+    padded = np.pad(psd, half, mode='reflect') if half else psd
+    floor = np.median(sliding_window_view(padded, 2 * half + 1)[at], axis=1)
+    tail = math.sqrt(-2.0 * math.log(min(CHANCE / max(bins, 1), 0.5)))
+    z = tail - (2.515517 + 0.802853 * tail + 0.010328 * tail**2) / (
+        1 + 1.432788 * tail + 0.189269 * tail**2 + 0.001308 * tail**3
+    )
+    spread = 2.0 / (9.0 * 2 * max(segments, 1))
+    ratio = ((1 - spread + z * math.sqrt(spread)) / (1 - spread)) ** 3
+    return floor * ratio
 
 
 def driven_share(t: np.ndarray, signal: np.ndarray, dominant_hz: float) -> float:
@@ -563,7 +600,35 @@ def readable(t, y) -> tuple[np.ndarray, np.ndarray]:
     if len(t) > 1:
         n = int(np.searchsorted(t, t[0] + DECIDE_S, 'right'))
         t, y = t[:n], y[:n]
-    return t, y
+    return regular(t, y)
+
+
+def regular(t: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(t, y)`` as they are if their stamps step evenly (within :data:`JITTER` of their median
+    step, gaps of over ``MAX_FILL`` steps aside) or do not rise throughout (left to the
+    estimators' own time rules); else ``y`` (samples, or samples x channels) linearly
+    interpolated onto a uniform grid at the median step, stretch by stretch between those gaps
+    (the mode tracker bridges the same: :data:`.modes.MAX_FILL`): a spectrum read at the mean rate
+    of jittered stamps, or across short gaps, smears every peak."""
+    if len(t) < 3:
+        return t, y
+    steps = np.diff(t)
+    h = float(np.median(steps))
+    if not (h > 0.0 and np.all(steps > 0.0)):
+        return t, y
+    gaps = steps > MAX_FILL * h
+    if np.max(np.abs(steps[~gaps] - h)) <= JITTER * h:
+        return t, y
+    cut = np.flatnonzero(gaps)
+    grid = np.concatenate(
+        [
+            t[a] + h * np.arange(int((t[b] - t[a]) / h) + 1)
+            for a, b in zip(np.r_[0, cut + 1], np.r_[cut, len(t) - 1])
+        ]
+    )
+    if y.ndim == 1:
+        return grid, np.interp(grid, t, y)
+    return grid, np.stack([np.interp(grid, t, column) for column in y.T], axis=1)
 
 
 def drive_said(is_line: np.ndarray, lines: list, modal: np.ndarray) -> str:
@@ -626,7 +691,7 @@ def decide(
     elif lines and len(modal):  # the structure's modes, not the lines
         dominant, fundamental = at, float(np.min(modal))
         excitation = 'ambient'  # the modes between a periodic drive's lines
-        if beside_decay(t, signal, modal, lines, spec):  # (however loud the lines)
+        if beside_decay(t, signal, modal, lines):  # (however loud the lines)
             excitation, beside, lines = 'free', lines, []
             seen += f'; the {dominant:.4g} Hz mode rings down freely beside them: a free decay'
     elif share < FREE_BELOW:
@@ -665,7 +730,7 @@ def decide(
 def standing(spec, powers: np.ndarray) -> float:
     """How far (dB) the strongest of the spectral peaks ``powers`` stands above the median of
     the spectrum ``spec`` (:func:`spectrum`) above its lowest resolved frequency; NaN without."""
-    freq, psd, lowest, _ = spec
+    freq, psd, lowest = spec[:3]
     floor = float(np.median(psd[freq > lowest])) if np.any(freq > lowest) else 0.0
     if not (len(powers) and floor > 0):
         return math.nan
@@ -771,16 +836,16 @@ def dominant_window(t, y, dominant: float, spec, offset_ok: bool) -> tuple:
     return tuple(window) if math.isfinite(window[0]) else ()
 
 
-def beside_decay(t: np.ndarray, signal: np.ndarray, modal, lines, spec) -> bool:
+def beside_decay(t: np.ndarray, signal: np.ndarray, modal, lines) -> bool:
     """Whether a periodic drive's ``lines`` (Hz) run beside a free decay -- a machine nearby --
     rather than drive the structure: its strongest ``modal`` peak rings freely
-    (:func:`rings_freely`, ``spec``: :func:`spectrum`) and every line lies :data:`LINES_ABOVE`
+    (:func:`rings_freely`) and every line lies :data:`LINES_ABOVE`
     times above every modal peak or more, so that a band leaves them out (:func:`line_band`).
     A structure moved periodically has lines at and below its mode (the simulated arm moved
     every 0.8 s: 0.625 Hz and its harmonics about its 1.35 Hz, whose start rang down)."""
     if min(lines) < LINES_ABOVE * float(np.max(modal)):
         return False
-    return rings_freely(t, signal, float(modal[0]), spec)
+    return rings_freely(t, signal, float(modal[0]))
 
 
 def decay_stretches(t: np.ndarray, signal: np.ndarray, f: float) -> tuple[int, int, int]:
@@ -876,7 +941,7 @@ def free_modes(
     separate = separate_modes(
         peaks,
         powers,
-        lambda f: rings_freely(t, signal, f, spec),
+        lambda f: rings_freely(t, signal, f),
         lambda f, g: coexistence(t, signal, f, g),
         steady,
     )
@@ -969,7 +1034,7 @@ def impurity(t: np.ndarray, y: np.ndarray, f: float, spec=None, zeta: float = ma
     centred in that segment (:func:`decay_tails` ``T``: ``(share - T) / (1 - T)``, the power of a
     decay plus a spread beside it). That segment shows a short decay the taper hides, but also
     the start of one that rings through a short record (and its falling half shortens it)."""
-    freq, psd, _, plain = spectrum(t, y) if spec is None else spec
+    freq, psd, _, plain = (spectrum(t, y) if spec is None else spec)[:4]
     near = (freq > f / IMPURITY_SPAN) & (freq < f * IMPURITY_SPAN)
     off = near & (np.abs(freq / f - 1) > PEAK_WIDTH)
     views = [(np.sum(p[off]), np.sum(p[near])) for p in (psd, plain) if p is not None]
@@ -1039,20 +1104,13 @@ def coexistence(t: np.ndarray, signal: np.ndarray, f: float, g: float) -> float:
     return float(np.minimum(a / a.sum(), b / b.sum()).sum())
 
 
-def rings_freely(t: np.ndarray, signal: np.ndarray, f: float, spec) -> bool:
-    """Whether the spectral peak at ``f`` Hz is a mode ringing freely: it stands
-    :data:`RING_FLOOR_DB` above its surroundings (the median of the spectrum ``spec``,
-    :func:`spectrum`, within :data:`MODE_GAP` of it) and the energy of ``signal`` band-passed
-    around it (:func:`band_responses`), in blocks of :data:`DECAY_BLOCK_PERIODS` periods
-    (:func:`decay_blocks`), falls from its most energetic block to the record's end by at least
-    :data:`RING_DB` along its least-squares line (in dB) -- not the noise's chance peaks nor a
-    decay's own leakage (a few dB over their surroundings), a move's broadband content (a
-    band-passed burst that comes and goes) nor a line (steady)."""
-    freq, psd = spec[:2]
-    near = np.abs(freq / f - 1) <= MODE_GAP
-    at, floor = psd[np.argmin(np.abs(freq - f))], np.median(psd[near])
-    if not 10 * math.log10(max(at, 1e-300) / max(floor, 1e-300)) >= RING_FLOOR_DB:
-        return False
+def rings_freely(t: np.ndarray, signal: np.ndarray, f: float) -> bool:
+    """Whether the spectral peak at ``f`` Hz is a mode ringing freely: the energy of ``signal``
+    band-passed around it (:func:`band_responses`), in blocks of :data:`DECAY_BLOCK_PERIODS`
+    periods (:func:`decay_blocks`), falls from its most energetic block to the record's end by
+    at least :data:`RING_DB` along its least-squares line (in dB) -- not a move's broadband
+    content (a band-passed burst that comes and goes) nor a line (steady); the noise's chance
+    peaks are no spectral peaks (:func:`chance_level`)."""
     return fall_db(t, signal, f) >= RING_DB
 
 

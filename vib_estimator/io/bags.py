@@ -336,6 +336,19 @@ def only_topic(path: Path, candidates: List[str], what: str, listing: str, how: 
     return candidates[0].split(' ')[0]
 
 
+#: what to do with a file of a kind users bring that is neither a bag nor a CSV file
+NOT_A_BAG = {
+    '.npy': (
+        "; a NumPy array: write it as one, e.g. a = numpy.load(path); numpy.savetxt('rec.csv', "
+        "a.T if a.shape[0] < a.shape[1] else a, delimiter=',') (time first)"
+    ),
+    '.npz': '; NumPy arrays: write the time and the signals as the columns of a CSV file',
+    '.mat': '; a MATLAB file: writematrix([t y], "rec.csv") writes it as one',
+    '.xlsx': '; a spreadsheet: save it as CSV',
+    '.xls': '; a spreadsheet: save it as CSV',
+}
+
+
 def check_bag_path(path: Path) -> None:
     """:class:`BagError` unless ``path`` is a ``.mcap``/``.db3`` file or a directory with a
     ``metadata.yaml`` (a directory of storage files without one: run ``vib-estimator reindex``)."""
@@ -351,8 +364,10 @@ def check_bag_path(path: Path) -> None:
             f'{path} is not a rosbag2 bag: it has no metadata.yaml and no .mcap or .db3 file'
         )
     if path.is_file() and path.suffix not in _STORAGE_READERS:
+        hint = NOT_A_BAG.get(path.suffix.lower(), '')
         raise BagError(
-            f'{path} is not a bag: expected a .mcap or .db3 file or a rosbag2 directory'
+            f'{path} is not a bag: expected a .mcap or .db3 file or a rosbag2 directory, or a '
+            f'CSV file (.csv, .txt: the time first){hint}'
         )
 
 
