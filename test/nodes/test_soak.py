@@ -22,6 +22,7 @@ import sys
 from pathlib import Path
 
 from vib_estimator.core.ambient import hop_s
+from vib_estimator.nodes.cadence import WATCHDOG_MIN_S
 
 SOAK = Path(__file__).resolve().parents[2] / 'benchmarks' / 'soak.py'
 
@@ -56,7 +57,13 @@ def test_a_minute_of_faults(tmp_path):
     stop = next(f for f in fig['faults'] if f['kind'] == 'stop')
     assert stop['input_s'] == stop['input_s'] and stop['recovered'] is True, run.stdout
     assert stop['windows'] <= 2.0 + hop_s(stop['window_s']) / stop['window_s'], run.stdout
-    assert fig['counters']['input_resubscribed'] == 0, run.stdout  # no silence it had to answer
+    # no silence it had to answer: none, unless the simulator's restart left the node without
+    # input (a publisher matched: the new simulator's, before its first sample) past the
+    # watchdog's wait, as a loaded machine can (once in three suite runs on 2 cores)
+    restart = next(f for f in fig['faults'] if f['kind'] == 'restart')
+    silent = restart['end'] - restart['start'] + restart['input_s']
+    allowed = sum(WATCHDOG_MIN_S * (2**k - 1) <= silent for k in range(1, 6))
+    assert fig['counters']['input_resubscribed'] <= allowed, (silent, run.stdout)
     for storm in (f for f in fig['faults'] if f['kind'] == 'storm'):
         assert storm['answered'] == storm['calls'] == 200 and storm['wrong_verdicts'] == 0
     for burst in (f for f in fig['faults'] if f['kind'] == 'burst'):
