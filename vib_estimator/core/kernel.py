@@ -163,7 +163,12 @@ S_XSIGN = S_FPREV + 1  # the signal's side of its centre (+-1, 0: none yet; half
 S_XING = S_XSIGN + 1  # half cycles of the signal since the segment began (a stalled segment)
 S_CHAINED = S_XING + 1  # 1: the segment began at the estimate before (0: an onset, a restart,
 #: a timeout, a rejection)
-S_MA = S_CHAINED + 1  # moving-average ring (2M+1 values) starts here
+S_RUN = S_CHAINED + 1  # time of the signal's last half cycle (the current run on one side began)
+S_EXT = S_RUN + 1  # the run's farthest deviation from the centre (|d|) ...
+S_TEXT = S_EXT + 1  # ... its time
+S_PEXT = S_TEXT + 1  # the run before's farthest deviation
+S_RELEASE = S_PEXT + 1  # 1: a release seen (:func:`_half_cycle`), for step to restart at
+S_MA = S_RELEASE + 1  # moving-average ring (2M+1 values) starts here
 N_STATE_FIXED = S_MA
 
 # ---- estimate row layout --------------------------------------------------------------------
@@ -192,6 +197,17 @@ AUTO_WINDOW_PERIODS = 2.0
 #: a published estimate: a decay's noisy tail keeps its own (all of them: 20 dB decays lost a
 #: tenth of their estimates within 2 %)
 HALF_CYCLE_LEVEL = 0.25
+#: a pluck's release (:func:`_half_cycle`): a run of the signal on one side of its centre that
+#: rose beyond :data:`RELEASE_GROWTH` times the run before's farthest deviation (from rest: a
+#: noise run's farthest is at least HALF_CYCLE_LEVEL of the running peak, so noise alone cannot),
+#: took more than :data:`RELEASE_RATIO` times longer (and more than NH sample intervals) to reach
+#: its farthest than to come back across the centre (a free vibration: 1; a hand's pull: its
+#: length over a quarter period) and began no segment at an onset: a segment not begun at a
+#: published estimate restarts at that crossing, a quarter period after the release. The segment
+#: that held the pull (no model of it) gave the first estimate 2.6-4.6 periods after a 9.4 Hz
+#: pluck pulled over 0.1-0.2 s (``bench_hard_records.py --pulled``; now 2.07-2.09)
+RELEASE_RATIO = 1.5
+RELEASE_GROWTH = 8.0
 #: the quality gate's limit on how far the refinement may move the algebraic estimate: this many
 #: of its stds, and never less than this fraction of f (a clean or coarsely sampled signal:
 #: std ~ 0, the algebraic estimate's discretisation error up to ~1e-3)
@@ -498,17 +514,23 @@ def _first_sample(p, s, c, t, y):
 
 
 @jit(inline='always')
-def _half_cycle(s, d):
+def _half_cycle(s, t, d):
     """Count a half cycle of the signal (``S_XING``) where its deviation ``d`` from the running
     centre crosses to the other side by :data:`HALF_CYCLE_LEVEL` of its running peak deviation
-    (``S_YR``; the side ``S_XSIGN`` kept across segments)."""
+    (``S_YR``; the side ``S_XSIGN`` kept across segments); at the crossing, a release
+    (``S_RELEASE``, :data:`RELEASE_RATIO`) ends the run on the side left."""
     level = HALF_CYCLE_LEVEL * s[S_YR]
-    if d > level and s[S_XSIGN] <= 0.0:
-        s[S_XSIGN] = 1.0
+    if (d > level and s[S_XSIGN] <= 0.0) or (d < -level and s[S_XSIGN] >= 0.0):
+        rise, fall = s[S_TEXT] - s[S_RUN], t - s[S_TEXT]
+        grew = s[S_EXT] > RELEASE_GROWTH * s[S_PEXT] > 0.0  # (a run before it: the rest's)
+        if grew and rise > RELEASE_RATIO * fall and rise > NH * s[S_HRUN]:
+            s[S_RELEASE] = 1.0
+        s[S_XSIGN] = 1.0 if d > 0.0 else -1.0
         s[S_XING] += 1.0
-    elif d < -level and s[S_XSIGN] >= 0.0:
-        s[S_XSIGN] = -1.0
-        s[S_XING] += 1.0
+        s[S_RUN], s[S_PEXT], s[S_EXT], s[S_TEXT] = t, s[S_EXT], abs(d), t
+    elif abs(d) > s[S_EXT] and d * s[S_XSIGN] > 0.0:  # the run's farthest so far
+        s[S_EXT] = abs(d)
+        s[S_TEXT] = t
 
 
 @jit(inline='always')
@@ -524,7 +546,22 @@ def _stalled(p, s, c) -> bool:
 
 
 @jit(inline='always')
-def _outlier(p, s, c, y):
+def _restarts(p, s, c) -> bool:
+    """Whether the segment restarts at this sample (from the sample before it): at an onset
+    (``C_ONSET``, :data:`ONSET_RATIO`; its run is then no pull's), a stalled segment
+    (:func:`_stalled`) or a release (``S_RELEASE``, :func:`_half_cycle`) in a segment not begun at
+    a published estimate (a decay's own segments are kept)."""
+    onset = c[C_ONSET] != 0
+    if onset:
+        s[S_PEXT] = MAX_ABS_VALUE
+    released = s[S_RELEASE] != 0.0 and s[S_CHAINED] == 0.0
+    s[S_RELEASE] = 0.0
+    c[C_ONSET] = 0
+    return onset or _stalled(p, s, c) or released
+
+
+@jit(inline='always')
+def _outlier(p, s, c, t, y):
     """True if the value ``y`` is an outlier, to skip (counted ``skipped_outlier``).
 
     The signal's running centre ``S_YC`` (exponential average, weight :data:`SCALE_WEIGHT`) and
@@ -557,7 +594,7 @@ def _outlier(p, s, c, y):
     s[S_YC] = yc + SCALE_WEIGHT * (y - yc)
     decayed = (1.0 - SCALE_WEIGHT) * s[S_YR]
     s[S_YR] = dev if dev > decayed else decayed
-    _half_cycle(s, y - yc)
+    _half_cycle(s, t, y - yc)
     if c[C_OUTLIER_RUN] != 0:
         c[C_OUTLIER_RUN] = 0
     return False
@@ -605,7 +642,7 @@ def _accept_time(p, s, c, t, y):
         if h < 0.0 and -h <= max_gap:
             c[C_OUT_OF_ORDER] += 1
             return False
-    if _outlier(p, s, c, y):
+    if _outlier(p, s, c, t, y):
         return False
     if c[C_HIST_N] > 0:
         h = t - s[S_TLAST]
@@ -960,10 +997,8 @@ def step(p, s, c, seg, t, y, out, row, optional=None):
     if c[C_HIST_N] == 0:
         _first_sample(p, s, c, t, y)
         return 0
-    if c[C_ONSET] != 0 or _stalled(p, s, c):  # an onset (ONSET_RATIO) or a stalled segment:
-        c[C_ONSET] = 0  # a segment from the sample before it
-        if c[C_HIST_N] == NH:
-            reset_segment(s, c, seg, s[S_HT + NH - 1], s[S_HY + NH - 1])
+    if _restarts(p, s, c) and c[C_HIST_N] == NH:  # a segment from the sample before it
+        reset_segment(s, c, seg, s[S_HT + NH - 1], s[S_HY + NH - 1])
     h = t - s[S_HT + NH - 1]  # the newest sample of the stencil is the previous one
     if abs(h - s[S_CACHE_H]) > 1e-9 * h:
         _update_discretisations(p, s, h)
