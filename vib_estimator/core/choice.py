@@ -447,7 +447,7 @@ def chance_level(psd: np.ndarray, at: np.ndarray, segments: int, bins: int) -> n
     Wilson-Hilferty; the normal quantile by Abramowitz & Stegun 26.2.23) to its median. One
     20 s segment of 57 000 bins: 14 dB over the floor (a noisy decay's record of 20 s, read with
     prominence alone, showed 2 445 peaks, "lines" of a "periodic drive" among them); 30
-    segments: 3.7 dB."""
+    segments: 3.5 dB."""
     from numpy.lib.stride_tricks import sliding_window_view
 
     half = min(FLOOR_BINS // 2, (len(psd) - 1) // 2)
