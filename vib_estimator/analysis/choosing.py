@@ -27,12 +27,12 @@ from ..core.ambient import MIN_WINDOW_SAMPLES
 from ..core.choice import (
     DECIDE_S,
     DRIVEN_ABOVE,
-    FLAT_DB,
     FREE_BELOW,
     MODE_GAP,
     TRACKED_MODES,
     Decision,
     decide,
+    is_noise,
 )
 from ..core.choice import window_advice as choice_window_advice
 from ..core.config import EstimatorConfig
@@ -322,7 +322,7 @@ def explain_no_estimate(
     analyses, flat = counters.get('analyses', 0), counters.get('flat_windows', 0)
     if analyses and flat == analyses:
         return f'the signal is constant (every window analysed was flat: flat_windows={flat})'
-    if d is not None and d.peak_db < FLAT_DB:  # noise, whatever the excitation
+    if is_noise(d):  # whatever the excitation
         return window_advice(config, d)
     if config.excitation == 'ambient':
         if not analyses:

@@ -83,7 +83,7 @@ ABSURD = 1e6
 #: stamps whose steps differ from their median by more than this share of it are irregular: the
 #: decision reads the record resampled onto a uniform grid (:func:`regular`; a real beam recorded
 #: at 4 kHz by a software clock, steps 0.19-0.25 ms and 19 gaps of 2-6 ms: read at its mean rate,
-#: its 16.33 Hz decay showed 17 "peaks" from 6.3 to 30.6 Hz and its strongest at 16.13 Hz; on the
+#: its 16.33 Hz decay showed 19 "peaks" from 6.3 to 30.6 Hz and its strongest at 16.13 Hz; on the
 #: grid one peak, at 16.33 Hz)
 JITTER = 0.01
 #: Welch segment, s (0.05 Hz resolution: a 1.2 Hz building mode's peak stands apart)
@@ -1241,13 +1241,19 @@ def fast_window(
     return FAST_PERIODS, precision, 'damped-sinusoid' if damped else '', offset, why
 
 
+def is_noise(d: Optional[Decision]) -> bool:
+    """Whether the record ``d`` decided is noise: its strongest spectral peak stands under
+    :data:`FLAT_DB` above the spectrum's median (the others under what noise reaches by chance)."""
+    return d is not None and d.peak_db < FLAT_DB
+
+
 def window_advice(window_s: float, d: Optional[Decision], option: str) -> str:
     """Why a ``window_s`` window gave no mode, from the record's lowest spectral peak: how many
     correlation times ``1 / (2 pi zeta f)`` (at :data:`ASSUMED_ZETA`) of it the window holds,
     and ``option`` with the window that holds :data:`WINDOW_PERIODS` periods of it (at most
     :data:`MAX_WINDOW_S`); '' without a peak, or when the window holds them. A spectrum whose
     strongest peak stands under :data:`FLAT_DB` above its median is noise: the words say so."""
-    if d is not None and d.peak_db < FLAT_DB:
+    if is_noise(d):
         return (
             f'the spectrum is flat (its strongest peak {d.peak_db:.0f} dB above its median; a '
             f'mode stands {FLAT_DB:g} dB and more): noise, no mode to estimate'
