@@ -59,7 +59,8 @@ def test_a_minute_of_faults(tmp_path):
     assert stop['windows'] <= 2.0 + hop_s(stop['window_s']) / stop['window_s'], run.stdout
     # no silence it had to answer: none, unless the simulator's restart left the node without
     # input (a publisher matched: the new simulator's, before its first sample) past the
-    # watchdog's wait, as a loaded machine can (once in three suite runs on 2 cores)
+    # watchdog's wait, as a loaded machine can. (A re-subscription after a restart silent for
+    # 0.36 s only, seen once in a suite run on 2 cores, is not explained by it: issue 40.)
     restart = next(f for f in fig['faults'] if f['kind'] == 'restart')
     silent = restart['end'] - restart['start'] + restart['input_s']
     allowed = sum(WATCHDOG_MIN_S * (2**k - 1) <= silent for k in range(1, 6))
