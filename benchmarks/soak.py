@@ -522,6 +522,7 @@ class Soak:
         burster = self.watch.create_publisher(WrenchStamped, 'coupling_torque', reliable)
         self.spin(5.0, lambda: len(stamps) > 50 and burster.get_subscription_count() >= 2)
         self.sim.signal(signal.SIGSTOP)
+        stopped = time.monotonic()
         self.spin(1.0)
         self.watch.destroy_subscription(sub)
         if len(stamps) < 50:
@@ -546,6 +547,7 @@ class Soak:
         self.spin(1.5)
         msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(last + 5001 * period, 10**9)
         burster.publish(msg)
+        closed = time.monotonic()
 
         def accounted():
             c = self.watch.counters()
@@ -567,6 +569,9 @@ class Soak:
             self.problems.append(f'burst: {accounted()} of 5001 received or counted')
         self.watch.destroy_publisher(burster)
         self.sim.signal(signal.SIGCONT)
+        # the node's silences, a stopped publisher matched: before the burst and after it (each
+        # past the watchdog's wait re-creates the input subscription, as it should)
+        f['silences_s'] = [t0 - stopped, time.monotonic() - closed]
 
     def _others(self, settled: dict) -> dict:
         """The replayed bag and the shaper: what each node took of what was sent to it, the

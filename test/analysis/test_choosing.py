@@ -13,9 +13,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from vib_estimator.analysis.choosing import explain_no_estimate, window_advice, with_dominant
+from vib_estimator.analysis.choosing import (
+    explain_no_estimate,
+    peaks_without_mode,
+    window_advice,
+    with_dominant,
+)
 from vib_estimator.cli import main
 from vib_estimator.core import EstimatorConfig
+from vib_estimator.core.choice import Decision
 from vib_estimator.core.estimator import EstimateArrays
 from vib_estimator.sim.ambient import ambient_record
 from vib_estimator.sim.frame import frame_record
@@ -539,3 +545,22 @@ def test_a_given_max_damping_overrides_a_steady_oscillation_s_in_analyze_and_sur
             assert main([command, str(path), '--format', 'jsonl', *given]) == 0
             out.append(capsys.readouterr().out)
         assert out[0] == out[1] != out[2], command
+
+
+def test_a_spectral_peak_without_a_mode_is_named_with_what_helps():
+    """The identifier published 17 Hz but not the record's strongest peak, 5 Hz: one line names
+    it; a peak with a mode within 3 % and a bin, a drive's line, a peak outside the band, a free
+    decay's run or a run without any mode (explained apart) say nothing; a low peak a short
+    window cannot hold gets the window that does."""
+    config = EstimatorConfig(excitation='ambient', ambient_window_s=10.0)
+    d = Decision('ambient', 10.0, 0.98, 5.0, 5.0, (5.0, 17.0))
+    text = peaks_without_mode(config, d, [17.01])
+    assert text.startswith('no mode at the spectral peak(s) 5 Hz') and '3 analyses' in text
+    assert peaks_without_mode(config, d, [4.9, 17.01]) == ''  # 2 % off
+    assert peaks_without_mode(config, d, [4.7, 17.01]) != ''  # 6 % off
+    assert peaks_without_mode(config.replace(lines_hz=(5.0,)), d, [17.0]) == ''
+    assert peaks_without_mode(config.replace(band_hz=(10.0, 30.0)), d, [17.0]) == ''
+    assert peaks_without_mode(config.replace(excitation='free'), d, [17.0]) == ''
+    assert peaks_without_mode(config, d, []) == ''
+    low = Decision('ambient', 10.0, 0.98, 5.0, 0.5, (5.0, 0.5))
+    assert peaks_without_mode(config, low, [5.0]).endswith('--ambient-window-s 240')

@@ -12,6 +12,7 @@ import pytest
 
 from vib_estimator.analysis.summary import (
     STRETCH_REL,
+    renumber,
     shaped_mode,
     stretches,
     summarise_modes,
@@ -64,6 +65,43 @@ def test_the_summary_of_a_moved_mode_is_per_stretch_and_shapes_the_last():
     assert pooled.stretches == 1 and pooled.spread_rel > 0.1
 
 
+def test_modes_renumbered_by_a_lower_one_found_later_are_summarised_by_identity():
+    """An estimator numbers its published modes by frequency: a 17 Hz mode is 1 until a 5 Hz one
+    publishes, then 2 (the 20 s record of test_ambient). The summary follows each mode, not its
+    number: two modes, neither moved. A mode of one number that moves where no other mode is
+    stays one mode of two stretches; two modes 3 % apart at the same times stay two."""
+    rng = np.random.default_rng(0)
+    t = np.array([12, 13, 14, 15, 16, 16, 17, 17, 18, 18, 19, 19], dtype=float)
+    mode = np.array([1, 1, 1, 1, 1, 2, 1, 2, 1, 2, 1, 2])
+    f = np.where((mode == 2) | (t < 16), 17.0, 5.0) * (1 + 0.001 * rng.standard_normal(len(t)))
+    assert renumber(f, mode, t).tolist() == [2, 2, 2, 2, 1, 2, 1, 2, 1, 2, 1, 2]
+    modes = summarise_modes(f, np.full(len(f), np.nan), mode, t)
+    assert [(m.mode, m.count, m.stretches) for m in modes] == [(1, 4, 1), (2, 8, 1)]
+    assert [round(m.frequency_hz) for m in modes] == [5, 17]
+    assert 'moved' not in '\n'.join(summary_lines(modes))
+    # the mode tracker's first estimate, 13.26 Hz as mode 1 before the 10 Hz mode was found,
+    # continues the 13 Hz mode (its estimates come at their own times, not with the others')
+    t = np.concatenate([[0.0], np.arange(1.0, 10.0), np.arange(1.5, 10.0)])
+    mode = np.repeat([1, 1, 2], [1, 9, 9])
+    f = np.repeat([13.26, 10.0, 13.0], [1, 9, 9])
+    assert renumber(f, mode, t).tolist() == [2] + [1] * 9 + [2] * 9
+    modes = summarise_modes(f, np.full(len(f), np.nan), mode, t)
+    assert [(m.mode, m.count, m.stretches) for m in modes] == [(1, 9, 1), (2, 10, 1)]
+    # mode 1 moves from 1.33 to 1.15 Hz (a tip mass) beside a steady mode 2 at 3 Hz
+    t = np.repeat(np.arange(8.0), 2)
+    mode = np.tile([1, 2], 8)
+    f = np.where(mode == 2, 3.0, np.where(t < 4, 1.33, 1.15))
+    assert renumber(f, mode, t).tolist() == mode.tolist()
+    modes = summarise_modes(f, np.full(len(f), np.nan), mode, t)
+    assert [(m.mode, m.stretch, m.stretches) for m in modes] == [(1, 1, 2), (1, 2, 2), (2, 1, 1)]
+    # a close pair (3 % apart, within STRETCH_REL) seen together keeps its numbers, also when
+    # one of it is missing from an analysis (the other keeps its own)
+    f = np.where(mode == 1, 1.2276, 1.2645)
+    keep = np.ones(len(f), bool)
+    keep[[4, 9]] = False  # mode 1 missing at t = 2, mode 2 at t = 4
+    assert renumber(f[keep], mode[keep], t[keep]).tolist() == mode[keep].tolist()
+
+
 def test_a_mode_on_too_few_estimates_is_tentative_and_not_shaped():
     # two estimates (a stray pair) are too few to shape for; ten of one mode are a mode
     few, many = 2, 10
@@ -81,6 +119,24 @@ def test_a_mode_on_too_few_estimates_is_tentative_and_not_shaped():
     assert shaped_mode(summarise_modes(f[:few], np.full(few, 0.01))) is None
     assert lines[-1].startswith('no input shaper recommended')
     assert not any('ros2 run' in line for line in lines)
+
+
+def test_analyze_gives_both_modes_of_a_short_driven_record(tmp_path, capsys):
+    """``analyze`` with no option on 20 s of 5 Hz (variance 1) and 17 Hz (0.3), white-noise
+    driven: both modes, each summarised once (the 17 Hz mode, numbered 1 before the 5 Hz one
+    published, did not "move"), the shaper for the lowest, no peak without a mode (before: 17 Hz
+    alone, a shaper for it, and no word of the record's strongest peak)."""
+    from vib_estimator.sim.ambient import ambient_record
+
+    t, y, _ = ambient_record(20, 500, [(5.0, 0.01, 1.0), (17.0, 0.005, 0.3)], 20, 0)
+    path = tmp_path / 'short.csv'
+    np.savetxt(path, np.c_[t, y], delimiter=',', header='time_s,y', comments='', fmt='%.6f')
+    assert main(['analyze', str(path), '--format', 'csv']) == 0
+    err = capsys.readouterr().err
+    found = re.findall(r'mode (\d): f = ([0-9.]+)', err)
+    assert [(k, round(float(f))) for k, f in found] == [('1', 5), ('2', 17)], err
+    assert 'moved' not in err and 'no mode at' not in err
+    assert re.search(r'initial_frequency_hz:=(4\.9|5\.0)', err), err
 
 
 def test_analyze_summarises_a_bag_whose_frequency_moved_per_stretch(capsys):

@@ -331,6 +331,20 @@ def test_a_record_too_slow_to_decimate_is_identified_at_every_analysis():
         assert abs(np.median(est.frequency_hz[near]) / f - 1) < 0.01
 
 
+def test_a_strong_mode_found_after_a_weaker_one_publishes_in_a_short_record():
+    """A 20 s record of 5 Hz (variance 1) and 17 Hz (0.3) through 10 s windows: 9 analyses.
+    When the 17 Hz mode publishes first, the stronger 5 Hz mode beside it is a mode, not a
+    statistical pole (``identity.ModeRegister.need``): it publishes after 3 analyses, not 8 --
+    which this record does not have (seed 0: the 5 Hz mode was never published)."""
+    config = EstimatorConfig(excitation='ambient', ambient_window_s=10.0)
+    for seed in (0, 1):
+        t, y, _ = ambient_record(20, 500, [(5.0, 0.01, 1.0), (17.0, 0.005, 0.3)], 20, seed)
+        f = AmbientEstimator(config).process(t, y).frequency_hz
+        for mode in (5.0, 17.0):
+            assert np.sum(np.abs(f / mode - 1) < 0.02) >= 3, (seed, mode, f)
+        assert np.all((np.abs(f / 5.0 - 1) < 0.05) | (np.abs(f / 17.0 - 1) < 0.05)), f
+
+
 def test_publication_rule_scripted(monkeypatch, one_second_hop):
     """The identity rule alone (ambient.identify scripted per analysis): the first mode publishes
     after 3 analyses (``CONFIRM``); a published one missing from one analysis publishes again as

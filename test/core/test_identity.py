@@ -89,6 +89,40 @@ def test_a_new_mode_publishes_after_3_observations_running_and_8_beside_a_publis
     assert sorted(m.frequency for m in register.modes) == [5.0, 9.0]
 
 
+def test_a_new_mode_as_strong_as_the_published_ones_needs_only_3_observations():
+    """Beside a published mode, a new one at least as strong as the strongest published publishes
+    after ``CONFIRM`` (3) observations running, a weaker one after ``CONFIRM_BESIDE`` (8): a
+    coloured excitation's statistical poles beside a strong mode are weak; a mode stronger than
+    the first one published (the 5 Hz mode of a 5 + 17 Hz record found after the 17 Hz one) is a
+    mode. Without amplitudes (0: the estimators that publish at once) a new mode is beside."""
+    from vib_estimator.core import ambient, identity
+
+    def run(amplitudes, times=12):
+        register = ModeRegister(
+            10.0, identity.CONFIRM, identity.CONFIRM_BESIDE, new=ambient._Track
+        )
+        first = []
+        for t in range(times):
+            frequencies = [17.0] + ([5.0] if t >= 3 else [])
+            match = register.match(frequencies)
+            seen = {}
+            for i, f in enumerate(frequencies):
+                mode = register.observe(f, t, None, match.get(i))
+                mode.amplitude = amplitudes[i]
+                seen[mode] = i
+            ready, _, _ = register.settle(seen, t)
+            first += [(m.frequency, t) for m in ready if m.estimates == 0]
+            for m in ready:
+                m.estimates += 1
+        return dict(first)
+
+    # 17 Hz publishes at its third analysis (t = 2); 5 Hz, seen from t = 3
+    assert run([0.55, 1.0]) == {17.0: 2, 5.0: 5}  # stronger: its third
+    assert run([0.55, 0.55]) == {17.0: 2, 5.0: 5}  # as strong
+    assert run([0.55, 0.5]) == {17.0: 2, 5.0: 10}  # weaker: its eighth
+    assert run([0.0, 0.0]) == {17.0: 2, 5.0: 10}  # no amplitudes
+
+
 @pytest.mark.parametrize('replace', [False, True])
 def test_at_most_8_modes_are_known(replace):
     """``MAX_TRACKS`` (8): a register never holds more than 8 modes (a stream of ever new

@@ -57,14 +57,18 @@ def test_a_minute_of_faults(tmp_path):
     stop = next(f for f in fig['faults'] if f['kind'] == 'stop')
     assert stop['input_s'] == stop['input_s'] and stop['recovered'] is True, run.stdout
     assert stop['windows'] <= 2.0 + hop_s(stop['window_s']) / stop['window_s'], run.stdout
-    # no silence it had to answer: none, unless the simulator's restart left the node without
-    # input (a publisher matched: the new simulator's, before its first sample) past the
-    # watchdog's wait, as a loaded machine can. (A re-subscription after a restart silent for
-    # 0.36 s only, seen once in a suite run on 2 cores, is not explained by it: issue 40.)
+    # no silence it had to answer but those the schedule makes: the simulator's restart (a
+    # publisher matched -- the new simulator's, before its first sample -- past the watchdog's
+    # wait, as a loaded machine can) and the burst's stopped simulator before and after the
+    # burst (the soak waits on the node's counters there, 2-4 s on a loaded machine: the
+    # re-subscription once seen after a restart silent for 0.36 s only was most likely one
+    # of the latter: no other fault of the four leaves a matched publisher silent)
     restart = next(f for f in fig['faults'] if f['kind'] == 'restart')
-    silent = restart['end'] - restart['start'] + restart['input_s']
-    allowed = sum(WATCHDOG_MIN_S * (2**k - 1) <= silent for k in range(1, 6))
-    assert fig['counters']['input_resubscribed'] <= allowed, (silent, run.stdout)
+    silences = [restart['end'] - restart['start'] + restart['input_s']]
+    for burst in (f for f in fig['faults'] if f['kind'] == 'burst'):
+        silences += burst['silences_s']
+    allowed = sum(WATCHDOG_MIN_S * (2**k - 1) <= s for s in silences for k in range(1, 6))
+    assert fig['counters']['input_resubscribed'] <= allowed, (silences, run.stdout)
     for storm in (f for f in fig['faults'] if f['kind'] == 'storm'):
         assert storm['answered'] == storm['calls'] == 200 and storm['wrong_verdicts'] == 0
     for burst in (f for f in fig['faults'] if f['kind'] == 'burst'):

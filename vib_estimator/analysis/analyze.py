@@ -43,6 +43,7 @@ from .choosing import (
     dominant_reading,
     explain_no_estimate,
     model_given,
+    peaks_without_mode,
     periods_given,
     prepare,
     read_ahead,
@@ -462,6 +463,9 @@ def run(args: argparse.Namespace) -> int:
     modes = summarise_modes(estimates.frequency_hz, estimates.damping, mode, estimates.t)
     for line in summary_lines(modes, config.excitation != 'free'):
         print('analyze: ' + line, file=sys.stderr)
+    missing = peaks_without_mode(config, decision, [m.frequency_hz for m in modes])
+    if missing:
+        print('analyze: ' + missing, file=sys.stderr)
     pictures(args, config, signal, result, mode, geometry, why)
     return 0
 

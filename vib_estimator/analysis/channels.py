@@ -31,8 +31,8 @@ from ..errors import BagError, CsvError
 from ..io.csv_reader import column_names, read_csv_columns
 from ..io.fields import UNKNOWN_UNIT, seconds_since, signal_unit
 from ..io.streaming import is_csv, open_signal, read_topics
-from .choosing import explain_no_estimate, prepare
-from .summary import summarise_modes, summary_lines
+from .choosing import explain_no_estimate, peaks_without_mode, prepare
+from .summary import renumber, summarise_modes, summary_lines
 
 
 def channel_names(args) -> list[str]:
@@ -192,16 +192,18 @@ def print_rows(table: list[dict], fmt: str, json_row) -> None:
 
 def mode_shapes(result: JointEstimates) -> dict[int, tuple[float, np.ndarray, np.ndarray]]:
     """Per mode number: (median frequency, median signed shape amplitude per channel, median
-    shape std per channel)."""
+    shape std per channel); modes numbered by identity, as the summary numbers them
+    (:func:`.summary.renumber`)."""
     e = result.estimates
+    mode = renumber(e.frequency_hz, e.mode, e.t)
     signed = np.abs(result.shapes) * np.sign(result.shapes.real)
     return {
         int(k): (
-            float(np.median(e.frequency_hz[e.mode == k])),
-            np.median(signed[e.mode == k], axis=0),
-            np.median(result.shape_std[e.mode == k], axis=0),
+            float(np.median(e.frequency_hz[mode == k])),
+            np.median(signed[mode == k], axis=0),
+            np.median(result.shape_std[mode == k], axis=0),
         )
-        for k in sorted(set(e.mode.tolist()))
+        for k in sorted(set(mode.tolist()))
     }
 
 
@@ -228,8 +230,9 @@ def plot_shapes(
     strips = [fig.add_subplot(top[0])]
     strips += [fig.add_subplot(top[i], sharex=strips[0]) for i in range(1, rows)]
     e = result.estimates
+    mode = renumber(e.frequency_hz, e.mode, e.t)
     for ax, (k, (f, _, _)) in zip(strips, shapes.items()):
-        m = e.mode == k
+        m = mode == k
         ax.errorbar(e.t[m], e.frequency_hz[m], yerr=e.frequency_std_hz[m], fmt='.', ms=3,
                     lw=0.5, color=mode_colour(k))  # fmt: skip
         ax.set_ylabel(f'mode {k}\n{f:.3f} Hz', fontsize='small', rotation=0, ha='right',
@@ -302,6 +305,9 @@ def run_joint(args, config: EstimatorConfig, names, json_row, prog: str, warn=No
     modes = summarise_modes(e.frequency_hz, e.damping, e.mode, e.t)
     for line in summary_lines(modes, config.excitation != 'free'):
         print(f'{prog}: ' + line, file=sys.stderr)
+    missing = peaks_without_mode(config, decision, [m.frequency_hz for m in modes])
+    if missing:
+        print(f'{prog}: ' + missing, file=sys.stderr)
     for k, (f, amp, _) in mode_shapes(result).items():
         shape = ', '.join(f'{n} {a:+.2f}' for n, a in zip(names, amp))
         print(f'{prog}: mode {k} ({f:.3f} Hz) shape: {shape}', file=sys.stderr)

@@ -9,7 +9,9 @@
 - An ``--excitation`` that the record contradicts (free on a record driven throughout, ambient on
   a free decay) costs one ``warning:`` line (:func:`contradiction`).
 - No estimate from the identifier: why, with the numbers, and which option helps
-  (:func:`window_advice`: the window's correlation times of the record's lowest peak).
+  (:func:`window_advice`: the window's correlation times of the record's lowest peak); a
+  spectral peak of the record at which the identifier published no mode, while it published
+  others: named, with the same numbers (:func:`peaks_without_mode`).
 
 The lines are printed by the command once the record has been read without error (bad input is
 one ``error:`` line)."""
@@ -29,6 +31,7 @@ from ..core.choice import (
     DRIVEN_ABOVE,
     FREE_BELOW,
     MODE_GAP,
+    SEGMENT_S,
     TRACKED_MODES,
     Decision,
     decide,
@@ -37,6 +40,7 @@ from ..core.choice import (
 from ..core.choice import window_advice as choice_window_advice
 from ..core.config import EstimatorConfig
 from ..core.estimator import EstimateArrays
+from ..core.identity import CONFIRM, CONFIRM_BESIDE, MATCH_TOL
 
 
 def decides(args) -> bool:
@@ -235,6 +239,44 @@ def window_advice(config: EstimatorConfig, d: Optional[Decision]) -> str:
     """Why a window gave no mode, from the record's lowest spectral peak
     (:func:`..core.choice.window_advice`, the option ``analyze`` takes); '' without one."""
     return choice_window_advice(config.ambient_window_s, d, '--ambient-window-s ')
+
+
+def peaks_without_mode(config: EstimatorConfig, d: Optional[Decision], found_hz) -> str:
+    """The record's spectral peaks (the decision's, its drive's lines left out) at which the
+    identifier published no mode though it published others (``found_hz``: their
+    frequencies), in words, with the window's correlation times of the lowest of them and the
+    option that helps; '' when every peak has a mode (within :data:`..core.identity.MATCH_TOL`
+    and a bin of the decision's spectrum, 1 / :data:`..core.choice.SEGMENT_S` Hz), or without a
+    decision, a driven run, or a mode (:func:`explain_no_estimate` says why then). A periodic
+    drive's lines (the configuration's and the decision's) are no modes."""
+    found = np.asarray(found_hz, dtype=float)
+    if d is None or config.excitation != 'ambient' or not len(found):
+        return ''
+    lines = np.asarray((*(config.lines_hz or ()), *d.lines_hz), dtype=float)
+    band = config.band_hz or (0.0, math.inf)
+    missing = []
+    for p in d.peaks_hz:
+        near = MATCH_TOL * p + 1.0 / SEGMENT_S  # (a peak's frequency: the spectrum's bin)
+        if not band[0] <= p <= band[1] or np.any(np.abs(lines - p) <= near):
+            continue
+        if not np.any(np.abs(found - p) <= near):
+            missing.append(p)
+    if not missing:
+        return ''
+    peaks = ', '.join(f'{p:.3g}' for p in missing)
+    text = (
+        f'no mode at the spectral peak(s) {peaks} Hz of the record (strongest first): a peak is '
+        f'published once its poles stand stable over the model orders in {CONFIRM} analyses '
+        f'running ({CONFIRM_BESIDE} beside a stronger mode)'
+    )
+    advice = choice_window_advice(
+        config.ambient_window_s,
+        dataclasses.replace(d, fundamental_hz=min(missing)),
+        '--ambient-window-s ',
+    )
+    if advice:
+        return f'{text}; {advice}'
+    return text + ', which a sinusoid (a machine) or coloured noise does not'
 
 
 def short_window(config: EstimatorConfig, d: Optional[Decision]) -> str:

@@ -17,7 +17,7 @@ import numpy as np
 
 from ..core.choice import regular
 from ..io.fields import UNKNOWN_UNIT
-from .summary import summarise_modes
+from .summary import renumber, summarise_modes
 
 #: the spectrum's segments resolve the lowest mode's frequency / this
 PSD_RESOLUTION = 8.0
@@ -118,6 +118,8 @@ def plot_estimates(
     axes[2].set_xlabel('time (s)')
     if title:
         axes[0].set_title(title)
+    if mode is not None:  # by identity, as the summary numbers them
+        mode = renumber(est_f, mode, est_t)
     modes = summarise_modes(est_f, np.full(len(est_f), np.nan), mode)
     if truth:
         modes = segment_medians(est_t, est_f, truth)

@@ -31,7 +31,7 @@ from ..core.estimator import EstimateArrays
 from ..core.shapes import mac, phases_deg, signed_amplitudes
 from ..io.fields import UNKNOWN_UNIT
 from .plotting import PSD_RESOLUTION, mark_modes, mode_colour, pyplot, save_figure, welch_psd
-from .summary import ModeSummary, summarise_modes, summary_lines
+from .summary import ModeSummary, renumber, summarise_modes, summary_lines
 
 #: frames of a mode shape's animation (one period) and their rate, frames/s
 GIF_FRAMES = 12
@@ -72,8 +72,10 @@ class Record:
     def __post_init__(self):
         self.y = np.asarray(self.y, dtype=float).reshape(len(self.t), -1)
         e = self.estimates
-        self.modes = summarise_modes(e.frequency_hz, e.damping, e.mode)
-        self.stretches = summarise_modes(e.frequency_hz, e.damping, e.mode, e.t)
+        #: each estimate's mode by identity, as the summary numbers them (.summary.renumber)
+        self.mode = renumber(e.frequency_hz, e.mode, e.t)
+        self.modes = summarise_modes(e.frequency_hz, e.damping, self.mode)
+        self.stretches = summarise_modes(e.frequency_hz, e.damping, self.mode, e.t)
 
 
 def command_line(args) -> str:
@@ -90,14 +92,14 @@ def mode_shape(record: Record, mode: ModeSummary) -> np.ndarray:
     (normalised shapes); one channel: ``[1]``."""
     if record.shapes is None or len(record.channels) < 2:
         return np.ones(len(record.channels), dtype=complex)
-    s = record.shapes[record.estimates.mode == mode.mode]
+    s = record.shapes[record.mode == mode.mode]
     return np.median(s.real, axis=0) + 1j * np.median(s.imag, axis=0)
 
 
 def damping_std(record: Record, mode: ModeSummary) -> float:
     """The median of the mode's estimates' damping std (NaN if none)."""
     e = record.estimates
-    z = e.damping_std[(e.mode == mode.mode) & np.isfinite(e.damping_std)]
+    z = e.damping_std[(record.mode == mode.mode) & np.isfinite(e.damping_std)]
     return float(np.median(z)) if len(z) else math.nan
 
 
@@ -280,7 +282,7 @@ def tracks_figure(path: Path, record: Record) -> None:
     axes = axes[:, 0]
     several = len(record.modes) > 1
     for m in record.modes:
-        sel = e.mode == m.mode
+        sel = record.mode == m.mode
         f = 100 * (e.frequency_hz[sel] / m.frequency_hz - 1) if several else e.frequency_hz[sel]
         fstd = (
             100 * e.frequency_std_hz[sel] / m.frequency_hz if several else e.frequency_std_hz[sel]

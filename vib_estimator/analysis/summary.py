@@ -116,6 +116,57 @@ def stretches(f: np.ndarray) -> List[np.ndarray]:
     return [np.arange(a, b) for a, b in zip(bounds[:-1], bounds[1:])]
 
 
+def renumber(frequency_hz, mode, t) -> np.ndarray:
+    """The modes of estimates numbered by identity, 1 = the lowest: an estimator numbers its
+    published modes by frequency, so a mode found below known ones renumbers them (a 20 s record
+    of 5 + 17 Hz: the 17 Hz mode is 1 until the 5 Hz one publishes, then 2). Each number's
+    estimates are cut into stretches (:func:`stretches`); in time order, a stretch continues the
+    mode of an earlier one within :data:`STRETCH_REL` of it whose stretches all lie apart from
+    it in time (of its own number first, else the nearest); then a number's stretch that starts
+    where the mode of its previous stretch ends, and begins none seen before, is that mode moved.
+    Numbers <= 0 (the single-mode estimator) and non-finite frequencies are kept as they are."""
+    f = np.asarray(frequency_hz, dtype=float)
+    mode = np.asarray(mode).astype(int)
+    out = mode.copy()
+    live = (mode > 0) & np.isfinite(f)
+    if len(np.unique(mode[live])) < 2:
+        return out
+    times = np.asarray(t, dtype=float)
+    units = []  # (number, median, first t, last t, estimates), in time order
+    for k in np.unique(mode[live]):
+        sel = np.flatnonzero(live & (mode == k))
+        sel = sel[np.argsort(times[sel], kind='stable')]
+        for part in stretches(f[sel]):
+            idx = sel[part]
+            units.append((int(k), float(np.median(f[idx])), times[idx[0]], times[idx[-1]], idx))
+    units.sort(key=lambda u: u[2])
+    groups: list = []  # each mode: its units
+
+    def apart(group, u):
+        return all(v[3] < u[2] or u[3] < v[2] for v in group)
+
+    for u in units:
+        near = [g for g in groups if abs(u[1] / g[-1][1] - 1) <= STRETCH_REL and apart(g, u)]
+        if near:
+            min(near, key=lambda g: (g[-1][0] != u[0], abs(u[1] - g[-1][1]))).append(u)
+        else:
+            groups.append([u])
+    for k in np.unique(mode[live]):  # the moves: a number's stretch after its previous one's
+        mine = [u for u in units if u[0] == k]  # (in time order)
+        for u, v in zip(mine, mine[1:]):
+            before = next(g for g in groups if any(w is u for w in g))
+            after = next(g for g in groups if any(w is v for w in g))
+            if before is not after and max(w[3] for w in before) < min(w[2] for w in after):
+                before.extend(after)  # two modes never seen at once: one, moved
+                after.clear()
+    groups = [g for g in groups if g]
+    key = [float(np.median(f[np.concatenate([u[4] for u in g])])) for g in groups]
+    for number, i in enumerate(np.argsort(key, kind='stable'), 1):
+        for u in groups[i]:
+            out[u[4]] = number
+    return out
+
+
 def _summary(k: int, f: np.ndarray, zeta: np.ndarray, t: Optional[np.ndarray]) -> ModeSummary:
     median = float(np.median(f))
     std = MAD_TO_STD * float(np.median(np.abs(f - median)))
@@ -140,6 +191,8 @@ def summarise_modes(frequency_hz, damping, mode=None, t=None) -> List[ModeSummar
     damping = np.asarray(damping, dtype=float)
     mode = np.zeros(len(frequency_hz), dtype=int) if mode is None else np.asarray(mode)
     times = None if t is None else np.asarray(t, dtype=float)
+    if times is not None:
+        mode = renumber(frequency_hz, mode, times)
     groups = []  # per mode: (the median of its estimates, its summaries in time order)
     for k in np.unique(mode):
         sel = np.flatnonzero((mode == k) & np.isfinite(frequency_hz))

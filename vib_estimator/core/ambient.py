@@ -33,9 +33,9 @@ every mode tracked is published:
    shares): each mode continues the nearest tracked mode within :data:`.identity.MATCH_TOL`
    whose last shape it matches (with one channel every shape matches); the MAC between the two
    is published with a joint estimate. A new mode publishes once seen by
-   :data:`.identity.CONFIRM` consecutive analyses (:data:`.identity.CONFIRM_BESIDE` beside
-   published modes; ``modes_found``), a published one whenever seen; one unseen for a window is
-   lost (``modes_lost``). With ``modes`` >= 1 at most that many (the strongest) publish.
+   :data:`.identity.CONFIRM` consecutive analyses (:data:`.identity.CONFIRM_BESIDE` beside a
+   stronger published mode; ``modes_found``), a published one whenever seen; one unseen for a
+   window is lost (``modes_lost``). With ``modes`` >= 1 at most that many (the strongest) publish.
    Published modes are numbered by ascending frequency, 1 = the lowest, as the mode tracker's
    ``mode`` key.
 
