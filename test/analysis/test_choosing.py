@@ -549,9 +549,10 @@ def test_a_given_max_damping_overrides_a_steady_oscillation_s_in_analyze_and_sur
 
 def test_a_spectral_peak_without_a_mode_is_named_with_what_helps():
     """The identifier published 17 Hz but not the record's strongest peak, 5 Hz: one line names
-    it; a peak with a mode within 3 % and a bin, a drive's line, a peak outside the band, a free
-    decay's run or a run without any mode (explained apart) say nothing; a low peak a short
-    window cannot hold gets the window that does."""
+    it; a peak weaker than every peak with a mode (the noise's, maybe), a peak with a mode within
+    3 % and a bin, a drive's line, a peak outside the band, a free decay's run or a run without
+    any mode (explained apart) say nothing; a low peak a short window cannot hold gets the window
+    that does."""
     config = EstimatorConfig(excitation='ambient', ambient_window_s=10.0)
     d = Decision('ambient', 10.0, 0.98, 5.0, 5.0, (5.0, 17.0))
     text = peaks_without_mode(config, d, [17.01])
@@ -562,5 +563,7 @@ def test_a_spectral_peak_without_a_mode_is_named_with_what_helps():
     assert peaks_without_mode(config.replace(band_hz=(10.0, 30.0)), d, [17.0]) == ''
     assert peaks_without_mode(config.replace(excitation='free'), d, [17.0]) == ''
     assert peaks_without_mode(config, d, []) == ''
-    low = Decision('ambient', 10.0, 0.98, 5.0, 0.5, (5.0, 0.5))
+    weaker = Decision('ambient', 10.0, 0.98, 17.0, 5.0, (17.0, 5.0))
+    assert peaks_without_mode(config, weaker, [17.0]) == ''
+    low = Decision('ambient', 10.0, 0.98, 0.5, 0.5, (0.5, 5.0))
     assert peaks_without_mode(config, low, [5.0]).endswith('--ambient-window-s 240')

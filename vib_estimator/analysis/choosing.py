@@ -243,24 +243,27 @@ def window_advice(config: EstimatorConfig, d: Optional[Decision]) -> str:
 
 def peaks_without_mode(config: EstimatorConfig, d: Optional[Decision], found_hz) -> str:
     """The record's spectral peaks (the decision's, its drive's lines left out) at which the
-    identifier published no mode though it published others (``found_hz``: their
-    frequencies), in words, with the window's correlation times of the lowest of them and the
-    option that helps; '' when every peak has a mode (within :data:`..core.identity.MATCH_TOL`
-    and a bin of the decision's spectrum, 1 / :data:`..core.choice.SEGMENT_S` Hz), or without a
-    decision, a driven run, or a mode (:func:`explain_no_estimate` says why then). A periodic
-    drive's lines (the configuration's and the decision's) are no modes."""
+    identifier published no mode though it published modes at weaker ones (``found_hz``: their
+    frequencies; a peak weaker than every one with a mode may be the noise's), in words, with
+    the window's correlation times of the lowest of them and the option that helps; '' when
+    there is none (a mode is at a peak within :data:`..core.identity.MATCH_TOL` and a bin of the
+    decision's spectrum, 1 / :data:`..core.choice.SEGMENT_S` Hz), or without a decision, a
+    driven run, or a mode (:func:`explain_no_estimate` says why then). A periodic drive's lines
+    (the configuration's and the decision's) are no modes."""
     found = np.asarray(found_hz, dtype=float)
     if d is None or config.excitation != 'ambient' or not len(found):
         return ''
     lines = np.asarray((*(config.lines_hz or ()), *d.lines_hz), dtype=float)
     band = config.band_hz or (0.0, math.inf)
-    missing = []
+    missing, weaker = [], []  # (the peaks, strongest first)
     for p in d.peaks_hz:
         near = MATCH_TOL * p + 1.0 / SEGMENT_S  # (a peak's frequency: the spectrum's bin)
         if not band[0] <= p <= band[1] or np.any(np.abs(lines - p) <= near):
             continue
-        if not np.any(np.abs(found - p) <= near):
-            missing.append(p)
+        if np.any(np.abs(found - p) <= near):
+            missing, weaker = missing + weaker, []  # a mode at a weaker peak than these
+        else:
+            weaker.append(p)
     if not missing:
         return ''
     peaks = ', '.join(f'{p:.3g}' for p in missing)

@@ -1266,7 +1266,7 @@ def window_advice(window_s: float, d: Optional[Decision], option: str) -> str:
     if window_s >= want:
         return ''
     return (
-        f'the {window_s:g} s window holds {times:.1f} correlation times of the {f:.3g} Hz peak '
+        f'the {window_s:.4g} s window holds {times:.1f} correlation times of the {f:.3g} Hz peak '
         f'(at zeta {100 * ASSUMED_ZETA:g} %): {option}{math.ceil(want)}'
     )
 
