@@ -860,8 +860,21 @@ class Soak:
             for a, b in zip(stamps, stamps[1:])
             if not any(s <= b and a <= e for s, e in stops)
         ]
+        # when the node re-created its input subscription (the diagnostics' counter rose): s
+        # since the start, and the fault then running or last ended (a watchdog's re-creation
+        # is explained by a silence of the input, the fault's or not)
+        rows = self.watch.diag.get('/estimator_node', [])
+        counts = [(row[0], row[3].get('input_resubscribed', '0')) for row in rows]
+        counts = [(at, int(v) if v.isdigit() else 0) for at, v in counts]
+        resubscribed = []
+        for (_, a), (at, b) in zip(counts, counts[1:]):
+            if b > a:
+                last = [f for f in self.faults if f['start'] <= at]
+                since = f'{last[-1]["kind"]} +{at - last[-1]["start"]:.1f} s' if last else '-'
+                resubscribed.append((round(at - self.t0, 1), since))
         figures.update(
             counters=final,
+            resubscribed_at=resubscribed,
             identities=ident,
             estimates=len(self.watch.estimates['/']),
             replay_estimates=len(self.watch.estimates['/replay']),
@@ -979,6 +992,7 @@ def report(fig: dict) -> None:
         f'{c.get("missing_in_gaps")}; lost_in_transport {c.get("lost_in_transport")}), '
         f'stamp_jumps {c.get("stamp_jumps")}, time_jump_resets {c.get("time_jump_resets")}, '
         f'input_resubscribed {c.get("input_resubscribed")}'
+        + (f' (at s, after: {fig["resubscribed_at"]})' if fig['resubscribed_at'] else '')
     )
     print(
         'identities: '

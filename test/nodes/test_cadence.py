@@ -137,6 +137,23 @@ def test_a_step_back_is_followed_and_a_small_one_ignored():
     assert c['samples_missing'] == 0 and c['stamp_jumps'] == 0 and c['cadence_gaps'] == 0
 
 
+def test_messages_stamped_behind_the_last_are_taken_for_the_watchdog():
+    """A source restarted 0.3 s back in time (within ``back_ns``: its stamps stay behind the last
+    one followed, the core skips them as out of order): the cadence keeps its last stamp, but
+    every message is taken, so the watchdog sees no silence (before, it saw none taken for as
+    long as the stamps stayed behind, and re-created the subscription of a live source)."""
+    cadence = C.Cadence(back_ns=500_000_000)
+    for k in range(100):  # 1 kHz, in real time
+        cadence.observe(k * 1_000_000, 10.0 + k * 1e-3)
+    followed = cadence.last_at
+    for k in range(200):  # restarted 0.3 s back: 0.2 s of stamps still behind the last
+        cadence.observe(k * 1_000_000 - 200_000_000, 11.0 + k * 1e-3)
+    assert cadence.last_at == followed and cadence.taken_at == pytest.approx(11.199)
+    w = C.Watchdog()
+    assert fired(w, 11.2, 14.0, cadence.last_at) != []  # the stamps followed: "silent"
+    assert fired(C.Watchdog(), 11.2, 14.0, cadence.taken_at) == []
+
+
 def fired(w, start, stop, taken_at, matched=1, period=1e-4, step=1.0):
     """The times a watchdog checked every ``step`` s from ``start`` to ``stop`` said to
     re-create."""

@@ -122,9 +122,10 @@ def renumber(frequency_hz, mode, t) -> np.ndarray:
     of 5 + 17 Hz: the 17 Hz mode is 1 until the 5 Hz one publishes, then 2). Each number's
     estimates are cut into stretches (:func:`stretches`); in time order, a stretch continues the
     mode of an earlier one within :data:`STRETCH_REL` of it whose stretches all lie apart from
-    it in time (of its own number first, else the nearest); then a number's stretch that starts
-    where the mode of its previous stretch ends, and begins none seen before, is that mode moved.
-    Numbers <= 0 (the single-mode estimator) and non-finite frequencies are kept as they are."""
+    it in time (of its own number first, else the nearest), else it begins a mode; then two modes
+    holding consecutive stretches of one number, the first over before the second begins, are one
+    mode that moved (a tip mass changed). Numbers <= 0 (the single-mode estimator) and
+    non-finite frequencies are kept as they are."""
     f = np.asarray(frequency_hz, dtype=float)
     mode = np.asarray(mode).astype(int)
     out = mode.copy()

@@ -19,8 +19,8 @@ several) go through it:
    publishes once seen ``confirm`` times running (``confirm_beside`` while a stronger one is
    published, :meth:`ModeRegister.need`): 1 for estimates, which are published already;
    :data:`CONFIRM` and :data:`CONFIRM_BESIDE` for the identifier's windows, whose statistical
-   poles come and go. An
-   unpublished mode not seen is forgotten, a published one unseen for ``forget_s`` s too.
+   poles come and go. An unpublished mode not seen is forgotten, a published one unseen for
+   ``forget_s`` s too.
 4. **Number** (:meth:`ModeRegister.number`): published modes are numbered by ascending frequency,
    1 = the lowest (the compiled mode tracker's ``mode`` key numbers its modes so too).
 

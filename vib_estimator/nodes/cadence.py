@@ -84,12 +84,14 @@ class Cadence:
         self.rate = math.nan
         self._last: Optional[int] = None
         self._last_at = 0.0
+        self._taken_at = 0.0  # steady s of the last message taken, whatever its stamp
         self._window: Optional[tuple] = None  # (steady s, stamp ns) of its start; None: a gap
         self._gap: Optional[list] = None  # [missing, stamp ns, steady s, messages since]
 
     def observe(self, stamp: int, now: float) -> bool:
         """A message of stamp ``stamp`` (ns) taken at ``now`` (steady s); True when its step is a
         forward jump (the caller restarts the estimator)."""
+        self._taken_at = now
         last = self._last
         gap = self._gap
         if gap is not None:
@@ -127,8 +129,16 @@ class Cadence:
 
     @property
     def last_at(self) -> float:
-        """Steady time of the last message taken (0 before the first)."""
+        """Steady time of the last message taken whose stamp the cadence followed (0 before the
+        first)."""
         return self._last_at
+
+    @property
+    def taken_at(self) -> float:
+        """Steady time of the last message taken, whatever its stamp (0 before the first): a
+        source restarted a little back in time, whose stamps stay behind the last one followed
+        for a while, is not silent (the watchdog reads this)."""
+        return self._taken_at
 
     @property
     def period_s(self) -> float:

@@ -405,7 +405,7 @@ class EstimatorNode(Node):
         stamped = has_header(self._input_type)
         for i, watchdog in enumerate(self._watchdogs):
             sub, cadence = self._subscriptions_in[i], self._cadences[i]
-            taken_at = cadence.last_at if stamped else self._stream.health.input_at
+            taken_at = cadence.taken_at if stamped else self._stream.health.input_at
             matched = sub.get_publisher_count()
             if not watchdog.check(now, taken_at, matched, cadence.period_s):
                 continue
