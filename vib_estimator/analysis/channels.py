@@ -190,12 +190,14 @@ def print_rows(table: list[dict], fmt: str, json_row) -> None:
         )
 
 
-def mode_shapes(result: JointEstimates) -> dict[int, tuple[float, np.ndarray, np.ndarray]]:
+def mode_shapes(
+    result: JointEstimates, mode=None
+) -> dict[int, tuple[float, np.ndarray, np.ndarray]]:
     """Per mode number: (median frequency, median signed shape amplitude per channel, median
-    shape std per channel); modes numbered by identity, as the summary numbers them
-    (:func:`.summary.renumber`)."""
+    shape std per channel); ``mode``: each estimate's mode (None: the number it carries; the
+    summary's, by identity: :func:`.summary.renumber`)."""
     e = result.estimates
-    mode = renumber(e.frequency_hz, e.mode, e.t)
+    mode = e.mode if mode is None else mode
     signed = np.abs(result.shapes) * np.sign(result.shapes.real)
     return {
         int(k): (
@@ -221,7 +223,9 @@ def plot_shapes(
     from .plotting import mode_colour, pyplot
 
     plt = pyplot()
-    shapes = mode_shapes(result)
+    e = result.estimates
+    mode = renumber(e.frequency_hz, e.mode, e.t)  # as the summary numbers them
+    shapes = mode_shapes(result, mode)
     cols, rows = max(1, len(shapes)), max(1, len(shapes))
     fig = plt.figure(figsize=(max(8.0, 2.4 * cols), 3.8 + 0.75 * rows))
     outer = fig.add_gridspec(2, 1, height_ratios=(0.75 * rows, 3.2), hspace=0.28)
@@ -229,8 +233,6 @@ def plot_shapes(
     bottom = outer[1].subgridspec(1, cols, wspace=0.35)
     strips = [fig.add_subplot(top[0])]
     strips += [fig.add_subplot(top[i], sharex=strips[0]) for i in range(1, rows)]
-    e = result.estimates
-    mode = renumber(e.frequency_hz, e.mode, e.t)
     for ax, (k, (f, _, _)) in zip(strips, shapes.items()):
         m = mode == k
         ax.errorbar(e.t[m], e.frequency_hz[m], yerr=e.frequency_std_hz[m], fmt='.', ms=3,
@@ -302,13 +304,14 @@ def run_joint(args, config: EstimatorConfig, names, json_row, prog: str, warn=No
     why = '' if len(e) else explain_no_estimate(estimator.counters, None, config, decision)
     if why:
         print(f'{prog}: no estimate: {why}', file=sys.stderr)
-    modes = summarise_modes(e.frequency_hz, e.damping, e.mode, e.t)
+    mode = renumber(e.frequency_hz, e.mode, e.t)  # by identity (the summary's numbers)
+    modes = summarise_modes(e.frequency_hz, e.damping, mode, e.t)
     for line in summary_lines(modes, config.excitation != 'free'):
         print(f'{prog}: ' + line, file=sys.stderr)
     missing = peaks_without_mode(config, decision, [m.frequency_hz for m in modes])
     if missing:
         print(f'{prog}: ' + missing, file=sys.stderr)
-    for k, (f, amp, _) in mode_shapes(result).items():
+    for k, (f, amp, _) in mode_shapes(result, mode).items():
         shape = ', '.join(f'{n} {a:+.2f}' for n, a in zip(names, amp))
         print(f'{prog}: mode {k} ({f:.3f} Hz) shape: {shape}', file=sys.stderr)
     unit = signal_unit(names[0].rsplit(':', 1)[-1]) if signals else UNKNOWN_UNIT

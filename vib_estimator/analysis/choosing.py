@@ -36,6 +36,7 @@ from ..core.choice import (
     Decision,
     decide,
     is_noise,
+    peak_window_advice,
 )
 from ..core.choice import window_advice as choice_window_advice
 from ..core.config import EstimatorConfig
@@ -272,11 +273,7 @@ def peaks_without_mode(config: EstimatorConfig, d: Optional[Decision], found_hz)
         f'published once its poles stand stable over the model orders in {CONFIRM} analyses '
         f'running ({CONFIRM_BESIDE} beside a stronger mode)'
     )
-    advice = choice_window_advice(
-        config.ambient_window_s,
-        dataclasses.replace(d, fundamental_hz=min(missing)),
-        '--ambient-window-s ',
-    )
+    advice = peak_window_advice(config.ambient_window_s, min(missing), '--ambient-window-s ')
     if advice:
         return f'{text}; {advice}'
     return text + ', which a sinusoid (a machine) or coloured noise does not'

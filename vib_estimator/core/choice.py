@@ -1260,7 +1260,13 @@ def window_advice(window_s: float, d: Optional[Decision], option: str) -> str:
         )
     if d is None or not math.isfinite(d.fundamental_hz):
         return ''
-    f = d.fundamental_hz
+    return peak_window_advice(window_s, d.fundamental_hz, option)
+
+
+def peak_window_advice(window_s: float, f: float, option: str) -> str:
+    """How many correlation times of a peak at ``f`` Hz a ``window_s`` window holds, and
+    ``option`` with the window that holds :data:`WINDOW_PERIODS` periods of it (at most
+    :data:`MAX_WINDOW_S`); '' when the window holds them (:func:`window_advice`)."""
     times = window_s * 2 * math.pi * ASSUMED_ZETA * f
     want = min(WINDOW_PERIODS / f, MAX_WINDOW_S)
     if window_s >= want:

@@ -153,7 +153,12 @@ class ModeRegister:
                 if not m.published or t - m.last_t > self.forget_s:
                     self.modes.remove(m)
                     lost += m.published
-        ready = [m for m in self.modes if m in seen and (m.published or m.seen >= self.need(m))]
+        strongest = max((m.amplitude for m in self.modes if m.published), default=-1.0)
+        ready = [
+            m
+            for m in self.modes
+            if m in seen and (m.published or m.seen >= self.need(m, strongest))
+        ]
         if most:
             ready = sorted(ready, key=lambda m: -m.amplitude)[:most]
         found = sum(not m.published for m in ready)
@@ -161,13 +166,13 @@ class ModeRegister:
             m.published = True
         return ready, found, lost
 
-    def need(self, mode: Mode) -> int:
-        """The observations running a new ``mode`` needs to publish: ``confirm`` while none is
-        published, or when it is at least as strong as the strongest published (a mode, not a
+    def need(self, mode: Mode, strongest: float) -> int:
+        """The observations running a new ``mode`` needs to publish, ``strongest`` the largest
+        amplitude of the published modes (-1: none): ``confirm`` while none is published, or
+        when it is at least as strong as the strongest published (a mode, not a
         statistical pole beside one: the 5 Hz mode of a 20 s record of 5 + 17 Hz, found after
         the weaker 17 Hz, was never published in the record's 9 analyses), else
         ``confirm_beside`` (amplitudes not set, 0: beside)."""
-        strongest = max((m.amplitude for m in self.modes if m.published), default=-1.0)
         if strongest < 0 or 0 < strongest <= mode.amplitude:
             return self.confirm
         return self.confirm_beside

@@ -128,12 +128,6 @@ class Cadence:
         return False
 
     @property
-    def last_at(self) -> float:
-        """Steady time of the last message taken whose stamp the cadence followed (0 before the
-        first)."""
-        return self._last_at
-
-    @property
     def taken_at(self) -> float:
         """Steady time of the last message taken, whatever its stamp (0 before the first): a
         source restarted a little back in time, whose stamps stay behind the last one followed
