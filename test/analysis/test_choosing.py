@@ -557,6 +557,9 @@ def test_a_spectral_peak_without_a_mode_is_named_with_what_helps():
     d = Decision('ambient', 10.0, 0.98, 5.0, 5.0, (5.0, 17.0))
     text = peaks_without_mode(config, d, [17.01])
     assert text.startswith('no mode at the spectral peak(s) 5 Hz') and '3 analyses' in text
+    assert '(8 beside' in text  # a 10 s window
+    long = peaks_without_mode(config.replace(ambient_window_s=96.0), d, [17.01])
+    assert '(24 beside' in long  # a quarter of a 96 s window at one analysis a second
     assert peaks_without_mode(config, d, [4.9, 17.01]) == ''  # 2 % off
     assert peaks_without_mode(config, d, [4.7, 17.01]) != ''  # 6 % off
     assert peaks_without_mode(config.replace(lines_hz=(5.0,)), d, [17.0]) == ''

@@ -25,7 +25,7 @@ from typing import Iterable, Iterator, Optional, Tuple
 
 import numpy as np
 
-from ..core.ambient import MIN_WINDOW_SAMPLES
+from ..core.ambient import MIN_WINDOW_SAMPLES, beside_analyses
 from ..core.choice import (
     DECIDE_S,
     DRIVEN_ABOVE,
@@ -41,7 +41,7 @@ from ..core.choice import (
 from ..core.choice import window_advice as choice_window_advice
 from ..core.config import EstimatorConfig
 from ..core.estimator import EstimateArrays
-from ..core.identity import CONFIRM, CONFIRM_BESIDE, MATCH_TOL
+from ..core.identity import CONFIRM, MATCH_TOL
 
 
 def decides(args) -> bool:
@@ -271,7 +271,7 @@ def peaks_without_mode(config: EstimatorConfig, d: Optional[Decision], found_hz)
     text = (
         f'no mode at the spectral peak(s) {peaks} Hz of the record (strongest first): a peak is '
         f'published once its poles stand stable over the model orders in {CONFIRM} analyses '
-        f'running ({CONFIRM_BESIDE} beside a stronger mode)'
+        f'running ({beside_analyses(config.ambient_window_s)} beside a stronger mode)'
     )
     advice = peak_window_advice(config.ambient_window_s, min(missing), '--ambient-window-s ')
     if advice:
