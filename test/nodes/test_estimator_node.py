@@ -153,7 +153,9 @@ class Probe:
                 )
             return len(self.resets()) >= estimates and len(self.frequencies()) >= estimates
 
-        assert spin_until(self.executor, arrived, 5.0)
+        # (returns once they arrived; a full suite on 2 loaded cores took over 5 s, twice, for
+        # the outputs of a node that had just switched to the mode tracker)
+        assert spin_until(self.executor, arrived, 20.0)
 
     def feed(self, stamps_ns, values, component='torque.z', joints=JOINTS):
         """Publish samples (stamp 0 = a zero stamp) of the node's input type."""
