@@ -66,6 +66,29 @@ def test_csv_estimates_equal_the_core(tmp_path, capsys, samples):
     assert all(abs(r['frequency_hz'] / 1.33 - 1) < 0.01 for r in rows)
 
 
+def test_csv_in_milliseconds_and_semicolons_gives_the_same_estimates(tmp_path, capsys, samples):
+    """A logger's ``time_ms;y`` with decimal commas: the estimates of the same record in seconds
+    and decimal points, and one line that says the time's unit (before: read as seconds, a
+    1.33 Hz mode was a 0.00133 Hz one: no estimate, no word why)."""
+    t, y = samples
+    plain, logged = tmp_path / 'a.csv', tmp_path / 'b.csv'
+    plain.write_text('t,y\n' + '\n'.join(f'{a:.3f},{b:.6f}' for a, b in zip(t, y)))
+    logged.write_text(
+        'time_ms;y\n'
+        + '\n'.join(f'{a * 1000:.0f};{b:.6f}'.replace('.', ',') for a, b in zip(t, y))
+    )
+    outputs = []
+    for path in (plain, logged):
+        assert main(['analyze', str(path), '--format', 'jsonl']) == 0
+        outputs.append(capsys.readouterr())
+    first, second = (jsonl(o.out) for o in outputs)
+    assert len(first) > 5 and len(second) == len(first)  # (the stamps differ by rounding)
+    for key in ('t', 'frequency_hz'):
+        assert np.allclose([r[key] for r in second], [r[key] for r in first], rtol=1e-9)
+    said = [ln for ln in outputs[1].err.splitlines() if 'time column time_ms read in ms' in ln]
+    assert len(said) == 1 and 'time column' not in outputs[0].err
+
+
 def test_csv_with_comments_and_no_header_and_options(tmp_path, capsys, samples):
     t, y = samples
     path = tmp_path / 'sig.csv'

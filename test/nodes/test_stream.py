@@ -148,6 +148,34 @@ def test_a_burst_of_self_tests_runs_the_tones_once(monkeypatch):
     assert s.self_test()[0] and len(runs) == 2
 
 
+def test_a_self_test_running_is_not_replaced_when_the_configuration_or_rate_changes(monkeypatch):
+    """One run at a time: calls waiting for a run get its result even if the configuration (or
+    the input's rate, which moves with its losses) changed meanwhile; replaced at each change,
+    the run never finished and its calls were never answered. The next call tests what is
+    live."""
+    import threading
+
+    from vib_estimator.nodes import stream as stream_module
+
+    runs, release = [], threading.Event()
+
+    def slow(config, rate):
+        runs.append(config)
+        release.wait(30.0)
+        return True, f'window {config.window}'
+
+    monkeypatch.setattr(stream_module, 'in_process', slow)
+    s = stream_module.EstimatorStream(EstimatorConfig(), 0.0)
+    assert s.self_test(wait=False) is None
+    for window in (5, 6, 7):  # changes while it runs: still one run
+        s.configure(EstimatorConfig(window=window))
+        assert s.self_test(wait=False) is None
+    assert len(runs) == 1
+    release.set()
+    assert s.self_test() == (True, f'window {EstimatorConfig().window}')
+    assert s.self_test() == (True, 'window 7') and len(runs) == 2
+
+
 def test_a_band_s_self_test_lasts_for_its_prefilter():
     """With ``band_hz``, each tone lasts 10 periods of the band's lower edge too: the 2-20 Hz
     band's 11.25 Hz tone (10 of its periods, 0.89 s) gave no estimate and the self-test failed,

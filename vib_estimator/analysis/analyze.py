@@ -34,7 +34,7 @@ from ..core.estimator import run_batch
 from ..core.factory import batch_estimator, kind_of
 from ..errors import VibEstimatorError, report
 from ..io.align import ALIGN_TOLERANCE_S
-from ..io.csv_reader import csv_layout
+from ..io.csv_reader import NO_TIME, csv_layout, time_words
 from ..io.fields import INPUT_TYPES, signal_unit
 from ..io.streaming import Signal, is_csv, open_signal
 from .channels import channel_names, component_names, need_joint, run_joint, topic_list
@@ -217,6 +217,7 @@ def _check_times(t: np.ndarray, previous: float, count: int, name: str) -> None:
         raise ValueError(
             f'{name}: time is not strictly increasing at sample {count + i} '
             f'(t = {float(before)!r} then {float(t[i])!r})'
+            + (f'; {NO_TIME}' if is_csv(name) else '')
         )
 
 
@@ -324,10 +325,15 @@ def _print(estimates, origin, fmt, modes: int = 0) -> None:
 
 def default_column(args) -> Optional[list[str]]:
     """For a CSV input read without ``--column``: the file's signal columns, the one read (the
-    first after the time) first; else None."""
-    if args.column is not None or not is_csv(args.input):
+    first after the time) first; else None. Says the time column's unit when its name gives
+    one (:func:`..io.csv_reader.time_words`)."""
+    if not is_csv(args.input):
         return None
-    return list(csv_layout(args.input).names[1:])
+    layout = csv_layout(args.input)
+    words = time_words(layout)
+    if words:
+        print(f'analyze: {words}', file=sys.stderr)
+    return None if args.column is not None else list(layout.names[1:])
 
 
 def damage_warning(signal: Signal, prog: str) -> None:

@@ -28,7 +28,7 @@ from ..core.estimator import JointEstimates
 from ..core.factory import kind_of
 from ..core.shapes import SHAPE_ROWS, phases_deg, signed_amplitudes
 from ..errors import BagError, CsvError
-from ..io.csv_reader import column_names, read_csv_columns
+from ..io.csv_reader import NO_TIME, column_names, read_csv_columns
 from ..io.fields import UNKNOWN_UNIT, seconds_since, signal_unit
 from ..io.streaming import is_csv, open_signal, read_topics
 from .choosing import explain_no_estimate, peaks_without_mode, prepare
@@ -135,7 +135,10 @@ def joint_run(t: np.ndarray, y: np.ndarray, names, config: EstimatorConfig):
     need_joint(f'{len(names)} channels', config)
     bad = np.flatnonzero(~(np.diff(t) > 0))
     if bad.size:
-        raise ValueError(f'time is not strictly increasing at sample {int(bad[0]) + 1}')
+        raise ValueError(
+            f'time is not strictly increasing at sample {int(bad[0]) + 1} '
+            f'(in a CSV file: {NO_TIME})'
+        )
     estimator = create_estimator(config, names)
     return estimator, estimator.process(t, y)
 

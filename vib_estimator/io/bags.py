@@ -70,6 +70,7 @@ from rosbags.typesys import Stores, get_typestore
 
 from ..errors import BagError, DamageCount, McapFormatError, as_bag_error
 from . import cdr, mcap
+from .csv_reader import CSV_SUFFIXES
 from .fields import (
     JOINT_STATE,
     WRENCH_STAMPED,
@@ -367,7 +368,7 @@ def check_bag_path(path: Path) -> None:
         hint = NOT_A_BAG.get(path.suffix.lower(), '')
         raise BagError(
             f'{path} is not a bag: expected a .mcap or .db3 file or a rosbag2 directory, or a '
-            f'CSV file (.csv, .txt: the time first){hint}'
+            f'CSV file ({", ".join(CSV_SUFFIXES)}: the time first){hint}'
         )
 
 

@@ -3,7 +3,11 @@
 """Reading a signal from a CSV file (pure Python/numpy; no rclpy).
 
 Format: optional ``#`` comment lines, an optional header row, then rows whose first column is the
-time in seconds. The signal is a named column (header) or a column index; by default the second.
+time in seconds -- or in milliseconds, microseconds or nanoseconds where the time column's name
+says so (``time_ms``, ``t [us]``, ``stamp_ns``: :func:`time_unit`). The signal is a named column
+(header) or a column index; by default the second. The cells are separated by commas, or by
+semicolons or tabs where the first row has them (a decimal comma then read too: ``0,25;1,5``),
+or by spaces where it has none of these (``.asc``/``.dat`` exports): :func:`sniff`.
 Without a header row, the last comment line before the data names the columns when it lists one
 name per column (``# time_s,accel_g  (notes)``: names separated by commas, up to two spaces or a
 parenthesis; :func:`comment_names`).
@@ -42,6 +46,13 @@ from ..extras import optional
 CSV_BLOCK_BYTES = 1 << 19
 #: rows per block of the exact (row-by-row) path when no block size is given
 EXACT_BLOCK_ROWS = 1 << 18
+#: how a file without a time column is read (:func:`rate_layout`), said where one is missing
+NO_TIME = (
+    'the first column is the time; a file without one: a first row sample_rate_hz, the rate in '
+    'the second, then one sample a row'
+)
+#: the suffixes of the text tables read as CSV (commas, semicolons, tabs or spaces between cells)
+CSV_SUFFIXES = ('.csv', '.txt', '.tsv', '.dat', '.asc')
 
 
 @dataclass(frozen=True)
@@ -71,6 +82,15 @@ class CsvLayout:
     #: samples per second of a file without a time column (:func:`rate_layout`; 0: column 0 is
     #: the time): its columns are then the layout's columns 1 on
     rate: float = 0.0
+    #: the cells' separator (None: runs of whitespace) and decimal mark (:func:`sniff`)
+    delimiter: Optional[str] = ','
+    decimal: str = '.'
+    #: seconds per unit of the time column (:func:`time_unit`)
+    time_scale: float = 1.0
+
+    @property
+    def dialect(self) -> Tuple[Optional[str], str]:
+        return self.delimiter, self.decimal
 
     def cell(self, index: int) -> int:
         """The file's column of the layout's column ``index``."""
@@ -86,16 +106,92 @@ def _number(cell: str) -> float:
     return float('nan') if cell == '' else float(cell)
 
 
-def _rows(handle, first_line: int = 1) -> Iterator[Tuple[int, int, List[str]]]:
-    """(line number, byte offset, cells) of the non-comment, non-empty rows of a binary file."""
+def _rows(
+    handle, dialect: Tuple[Optional[str], str] = (',', '.'), first_line: int = 1
+) -> Iterator[Tuple[int, int, List[str]]]:
+    """(line number, byte offset, cells) of the non-comment, non-empty rows of a binary file,
+    split by ``dialect`` (:func:`sniff`: a decimal comma's cells given a decimal point)."""
+    delimiter, decimal = dialect
     offset, line = handle.tell(), first_line
     for raw in iter(handle.readline, b''):
         text = raw.decode()
-        row = next(csv.reader([text]), [])
+        if delimiter is None:
+            row = text.split()
+        else:
+            row = next(csv.reader([text], delimiter=delimiter), [])
         if row and not row[0].lstrip().startswith('#'):
-            yield line, offset, row
+            yield line, offset, [cell.replace(',', '.') for cell in row] if decimal == ',' else row
         offset += len(raw)
         line += 1
+
+
+#: the rows :func:`sniff` reads
+SNIFF_ROWS = 20
+#: a number written with a decimal comma (``-0,25``, ``1,5e-3``)
+_DECIMAL_COMMA = re.compile(r'[+-]?\d*,\d+(?:[eE][+-]?\d+)?')
+
+
+def sniff(path: Path) -> Tuple[Optional[str], str]:
+    """``(delimiter, decimal mark)`` of a CSV file from its first :data:`SNIFF_ROWS` rows that are
+    not comments: a semicolon, a tab or a comma, the first of them the first row has (or, a header
+    of one name, the second), else runs of whitespace (None); a decimal comma where a semicolon or
+    a tab separates the cells and one of these rows has a cell written so."""
+    rows = []
+    with path.open('rb') as handle:
+        for raw in handle:
+            text = raw.decode().strip()
+            if text and not text.startswith('#'):
+                rows.append(text)
+                if len(rows) == SNIFF_ROWS:
+                    break
+    for row in rows[:2]:
+        for delimiter in (';', '\t', ','):
+            if delimiter in row:
+                comma = delimiter != ',' and any(
+                    _DECIMAL_COMMA.fullmatch(cell.strip())
+                    for other in rows
+                    for cell in other.split(delimiter)
+                )
+                return delimiter, ',' if comma else '.'
+        if len(row.split()) > 1:
+            break
+    return (None if any(len(row.split()) > 1 for row in rows[:2]) else ','), '.'
+
+
+#: a time column's unit in its name (after a separator, or alone): seconds per unit
+TIME_UNITS = {
+    'ms': 1e-3,
+    'msec': 1e-3,
+    'millis': 1e-3,
+    'milliseconds': 1e-3,
+    'us': 1e-6,
+    'usec': 1e-6,
+    'micros': 1e-6,
+    'microseconds': 1e-6,
+    'ns': 1e-9,
+    'nsec': 1e-9,
+    'nanos': 1e-9,
+    'nanoseconds': 1e-9,
+}
+_TIME_UNIT = re.compile(r'(?:.*[\s_\-.\[(/])?([a-z]+)[\])]?', re.IGNORECASE)
+
+
+def time_words(layout: CsvLayout) -> str:
+    """What the time column is read in, when its name gives a unit (:func:`time_unit`); ''
+    for seconds."""
+    unit, scale = time_unit(layout.names[0]) if layout.names and not layout.rate else ('s', 1.0)
+    if scale == 1.0:
+        return ''
+    return f'time column {layout.names[0]} read in {unit} ({scale:g} s each: its name says so)'
+
+
+def time_unit(name: str) -> Tuple[str, float]:
+    """``(unit, seconds per unit)`` of a time column named ``name``: ``time_ms``, ``t [ms]``,
+    ``Time (us)``, ``stamp_ns``, ``ms`` are read in milliseconds, microseconds, nanoseconds;
+    any other name in seconds (``('s', 1.0)``)."""
+    match = _TIME_UNIT.fullmatch(name.strip())
+    unit = match.group(1).lower() if match else ''
+    return (unit, TIME_UNITS[unit]) if unit in TIME_UNITS else ('s', 1.0)
 
 
 def csv_layout(path, column: Optional[str] = None) -> CsvLayout:
@@ -105,8 +201,9 @@ def csv_layout(path, column: Optional[str] = None) -> CsvLayout:
     if not path.is_file():
         raise CsvError(f'no such file: {path}')
     try:
+        dialect = sniff(path)
         with path.open('rb') as handle:
-            rows = _rows(handle)
+            rows = _rows(handle, dialect)
             first = next(rows, None)
             if first is None:
                 raise CsvError(f'{path} has no data rows')
@@ -123,13 +220,23 @@ def csv_layout(path, column: Optional[str] = None) -> CsvLayout:
         raise CsvError(f'cannot read {path} as CSV: {err}') from None
     width = len(data[2])
     if header is not None:
-        timed = rate_layout(path, header, data, column)
+        timed = rate_layout(path, header, data, column, dialect)
         if timed is not None:
             return timed
+        header += [str(i) for i in range(len(header), width)]  # (a cell the header leaves out)
     names = header or comment_names(path, data[1], width) or [str(i) for i in range(width)]
     index = _column_index(path, column, names, width)
     return CsvLayout(
-        path, index, names[index], width, header is not None, data[1], names=tuple(names)
+        path,
+        index,
+        names[index],
+        width,
+        header is not None,
+        data[1],
+        names=tuple(names),
+        delimiter=dialect[0],
+        decimal=dialect[1],
+        time_scale=time_unit(names[0])[1],
     )
 
 
@@ -139,7 +246,9 @@ _RATE = re.compile(r'(sample_?rate|sampling_?rate|fs|rate)(_?hz)?', re.IGNORECAS
 RATE_NAMES = ('t', 'signal')
 
 
-def rate_layout(path: Path, header: List[str], settings, column: Optional[str]):
+def rate_layout(
+    path: Path, header: List[str], settings, column: Optional[str], dialect=(',', '.')
+):
     """The layout of a file without a time column (module doc), or None when ``header`` (the
     first row) and ``settings`` (the next: line, offset, cells) are not a header of settings
     naming the sample rate followed by one sample per row."""
@@ -151,7 +260,7 @@ def rate_layout(path: Path, header: List[str], settings, column: Optional[str]):
         with path.open('rb') as handle:
             handle.seek(settings[1])
             handle.readline()
-            sample = next(_rows(handle), None)
+            sample = next(_rows(handle, dialect), None)
         if sample is None or len(sample[2]) != 1:
             return None
         _number(sample[2][0])
@@ -169,6 +278,8 @@ def rate_layout(path: Path, header: List[str], settings, column: Optional[str]):
         sample[1],
         names=RATE_NAMES,
         rate=rate,
+        delimiter=dialect[0],
+        decimal=dialect[1],
     )
 
 
@@ -195,7 +306,7 @@ def comment_names(path: Path, data_offset: int, width: int) -> Optional[List[str
 def _column_index(path: Path, column: Optional[str], names: List[str], width: int) -> int:
     if column is None:
         if width < 2:
-            raise CsvError(f'{path} has one column; need time and a signal column')
+            raise CsvError(f'{path} has one column; need time and a signal column ({NO_TIME})')
         index = 1
     elif column in names:
         index = names.index(column)
@@ -218,13 +329,13 @@ def iter_csv_rows(layout: CsvLayout) -> Iterator[Tuple[float, float]]:
 def iter_csv_column_rows(layout: CsvLayout) -> Iterator[Tuple[float, List[float]]]:
     """(t, [value of each of ``layout.columns``]) of every data row, by the exact rules."""
     columns = [layout.cell(i) for i in layout.columns]
-    rate = layout.rate
+    rate, scale = layout.rate, layout.time_scale
     try:
         with layout.path.open('rb') as handle:
             handle.seek(layout.data_offset)
-            for count, (_, _, row) in enumerate(_rows(handle)):
+            for count, (_, _, row) in enumerate(_rows(handle, layout.dialect)):
                 try:
-                    t = count / rate if rate else _number(row[0])
+                    t = count / rate if rate else _number(row[0]) * scale
                     yield t, [_number(row[i]) for i in columns]
                 except (ValueError, IndexError):
                     line = count + (3 if rate else 2 if layout.has_header else 1)
@@ -251,8 +362,8 @@ def csv_column_blocks(
     it refuses, the rest by the exact rules (``block_rows`` rows per block); all of it by the exact
     rules where pyarrow is missing or does not load (:func:`..extras.optional`)."""
     pa, pacsv = optional('pyarrow'), optional('pyarrow.csv')
-    if pa is None or pacsv is None:
-        yield from _exact_blocks(layout, 0, block_rows)
+    if pa is None or pacsv is None or layout.delimiter is None or layout.decimal != '.':
+        yield from _exact_blocks(layout, 0, block_rows)  # (or spaces, a decimal comma)
         return
 
     rate = layout.rate
@@ -271,7 +382,9 @@ def csv_column_blocks(
                 read_options=pacsv.ReadOptions(
                     column_names=names, use_threads=False, block_size=CSV_BLOCK_BYTES
                 ),
-                parse_options=pacsv.ParseOptions(newlines_in_values=False),
+                parse_options=pacsv.ParseOptions(
+                    delimiter=layout.delimiter, newlines_in_values=False
+                ),
                 convert_options=pacsv.ConvertOptions(
                     column_types={n: pa.float64() for n in wanted},
                     include_columns=wanted,
@@ -287,6 +400,8 @@ def csv_column_blocks(
                     t = np.asarray(
                         batch.column(names[0]).to_numpy(zero_copy_only=False), np.float64
                     )
+                    if layout.time_scale != 1.0:
+                        t = t * layout.time_scale
                 y = np.empty((len(t), len(layout.columns)))
                 for k, i in enumerate(layout.columns):
                     y[:, k] = batch.column(names[layout.cell(i)]).to_numpy(zero_copy_only=False)

@@ -43,7 +43,7 @@ from ..errors import BagError, CdrLayoutError, DamageCount, McapFormatError, as_
 from . import cdr, mcap
 from .align import StampAligner
 from .bags import TYPESTORE, check_bag_path, only_topic
-from .csv_reader import csv_blocks, csv_layout
+from .csv_reader import CSV_SUFFIXES, csv_blocks, csv_layout
 from .fields import (
     DEFAULT_COMPONENT,
     DEFAULT_INPUT_TOPIC,
@@ -108,7 +108,7 @@ class Signal(DamageCount):
 
 
 def is_csv(path) -> bool:
-    return Path(path).suffix.lower() in ('.csv', '.txt')
+    return Path(path).suffix.lower() in CSV_SUFFIXES
 
 
 def open_signal(

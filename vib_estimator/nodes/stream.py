@@ -465,9 +465,13 @@ class EstimatorStream:
         (:func:`~.self_test.in_process`: their memory never the node's): ``wait`` False returns
         None while it runs (call again: its result once done), so that the node's executor
         thread, which carries the data path, the diagnostics and the other services, is never
-        held by it (under the identifier, three
-        tones over three windows of 89 s: 0.9 CPU s, which held /diagnostics silent for 3.8-5.2 s
-        on a loaded machine). While the kernels compile the tones run uncompiled only for the
+        held by it (under the identifier, three tones over three windows of 89 s: 0.9 CPU s,
+        which held /diagnostics silent for 3.8-5.2 s on a loaded machine). One run at a time: a
+        call while one runs gets that run's result, whatever changed since it began, and the
+        next call tests what is live then (the rate is the input's over the last status and
+        moves with its losses: a run replaced at each change never finished, and the calls
+        waiting for it were never answered).
+        While the kernels compile the tones run uncompiled only for the
         algebraic estimator without ``band_hz`` (0.1 CPU s): with ``band_hz`` (0.5 CPU s) or the
         mode tracker (0.9), sharing Python's lock with the compile, they held the data path up
         for seconds (21 s on a loaded machine): busy."""
@@ -477,15 +481,15 @@ class EstimatorStream:
         if math.isfinite(rate) and rate > 0:
             rate = float(f'{rate:.{SELF_TEST_DIGITS}g}')
         key = (self.config, rate if math.isfinite(rate) else None)
-        if self._self_test[0] == key:
-            return self._self_test[1]
         run = self._self_test_run
-        if run is None or run.key != key:  # uncompiled while the kernels compile: the same result
-            create = create_uncompiled if self.compiling else None
+        if run is None:
+            if self._self_test[0] == key:
+                return self._self_test[1]
+            create = create_uncompiled if self.compiling else None  # the same result
             run = self._self_test_run = _SelfTestRun(key, create)
         if not run.finished.wait(None if wait else 0.0):
             return None
-        self._self_test, self._self_test_run = (key, run.result), None
+        self._self_test, self._self_test_run = (run.key, run.result), None
         return run.result
 
 
