@@ -231,6 +231,39 @@ def test_a_time_column_named_in_ms_us_or_ns_is_read_in_seconds(tmp_path, name, s
     assert csv_reader.time_unit('rms') == ('s', 1.0) and csv_reader.time_unit('alarms')[1] == 1
 
 
+def test_pandas_to_csv_its_row_index_and_its_dates(tmp_path):
+    """``DataFrame.to_csv`` writes its row index first, unnamed (``,time,accel`` / ``0,0.0,..``:
+    the header was read as a data row, an error), and a time index as dates
+    (``2024-08-12 21:08:55.001``): the index is left out, the dates read as seconds since the
+    first, by both readers, and said."""
+    t = np.arange(3000) * 0.001
+    y = np.round(np.sin(2 * np.pi * 7 * t), 9)
+    indexed, dated = tmp_path / 'i.csv', tmp_path / 'd.csv'
+    indexed.write_text(
+        ',time,accel\n' + ''.join(f'{i},{a:.17g},{b:.17g}\n' for i, (a, b) in enumerate(zip(t, y)))
+    )
+    dated.write_text(
+        ',accel\n'
+        + ''.join(
+            f'2024-08-12 21:08:{55 + i // 1000:02d}.{i % 1000:03d},{b!r}\n'
+            for i, b in enumerate(y.tolist())
+        )
+    )
+    for path in (indexed, dated):
+        layout = csv_reader.csv_layout(path)
+        assert layout.names[1:] == ('accel',) and csv_reader.time_words(layout)
+        series = read_csv_series(path)
+        exact = np.array([(ti, yi) for ti, yi in csv_reader.iter_csv_rows(layout)])
+        assert np.allclose(series.t, t, rtol=0, atol=1e-9) and np.array_equal(series.y, y)
+        assert np.array_equal(exact, np.column_stack([series.t, series.y]))
+    assert csv_reader.csv_layout(indexed).first == 1
+    assert csv_reader.csv_layout(dated).origin.isoformat() == '2024-08-12T21:08:55'
+    zoned = tmp_path / 'z.csv'
+    zoned.write_text('t,y\n2024-08-12T21:08:55,1\n2024-08-12T21:08:56Z,2\n')
+    with pytest.raises(CsvError, match='data row 3 is not numbers'):
+        read_csv_series(zoned)
+
+
 def test_a_header_narrower_than_its_rows_names_the_rest_by_index(tmp_path):
     """``t`` over rows of two cells raised an IndexError (a traceback from ``analyze``)."""
     path = tmp_path / 'a.csv'

@@ -7,7 +7,10 @@ time in seconds -- or in milliseconds, microseconds or nanoseconds where the tim
 says so (``time_ms``, ``t [us]``, ``stamp_ns``: :func:`time_unit`). The signal is a named column
 (header) or a column index; by default the second. The cells are separated by commas, or by
 semicolons or tabs where the first row has them (a decimal comma then read too: ``0,25;1,5``),
-or by spaces where it has none of these (``.asc``/``.dat`` exports): :func:`sniff`.
+or by spaces where it has none of these (``.asc``/``.dat`` exports): :func:`sniff`. What pandas'
+``to_csv`` writes reads as meant: an unnamed row index before the time is left out, a time
+column of ISO 8601 dates is read as seconds since its first (:attr:`CsvLayout.first`,
+:attr:`CsvLayout.origin`; said by :func:`time_words`).
 Without a header row, the last comment line before the data names the columns when it lists one
 name per column (``# time_s,accel_g  (notes)``: names separated by commas, up to two spaces or a
 parenthesis; :func:`comment_names`).
@@ -31,6 +34,7 @@ import csv
 import math
 import re
 from dataclasses import dataclass, replace
+from datetime import datetime
 from pathlib import Path
 from typing import Iterator, List, Optional, Tuple
 
@@ -87,6 +91,10 @@ class CsvLayout:
     decimal: str = '.'
     #: seconds per unit of the time column (:func:`time_unit`)
     time_scale: float = 1.0
+    #: the file's columns before the time: 1 for a row index without a name (pandas' ``to_csv``)
+    first: int = 0
+    #: the first row's time, when the times are dates (ISO 8601): they are read as seconds since
+    origin: Optional[datetime] = None
 
     @property
     def dialect(self) -> Tuple[Optional[str], str]:
@@ -94,7 +102,21 @@ class CsvLayout:
 
     def cell(self, index: int) -> int:
         """The file's column of the layout's column ``index``."""
-        return index - 1 if self.rate else index
+        return index - 1 if self.rate else index + self.first
+
+    @property
+    def file_width(self) -> int:
+        return self.width + self.first - (1 if self.rate else 0)
+
+    def seconds(self, cell: str) -> float:
+        """The time of a row whose time cell is ``cell`` (ValueError if it is none)."""
+        if self.origin is None:
+            return _number(cell) * self.time_scale
+        date = _date(cell)
+        try:
+            return (date - self.origin).total_seconds()
+        except TypeError:  # no date, or a zone where the first had none (or none where it had)
+            raise ValueError(cell) from None
 
     @property
     def columns(self) -> Tuple[int, ...]:
@@ -104,6 +126,18 @@ class CsvLayout:
 def _number(cell: str) -> float:
     cell = cell.strip()
     return float('nan') if cell == '' else float(cell)
+
+
+def _date(cell: str) -> Optional[datetime]:
+    """The date and time of an ISO 8601 cell (``2024-08-12 21:08:55.125``, a ``T``, a zone),
+    None for any other text (a number among them)."""
+    text = cell.strip()
+    if len(text) < 8 or not ('-' in text[1:] or ':' in text):
+        return None
+    try:
+        return datetime.fromisoformat(text[:-1] + '+00:00' if text.endswith('Z') else text)
+    except ValueError:
+        return None
 
 
 def _rows(
@@ -177,12 +211,23 @@ _TIME_UNIT = re.compile(r'(?:.*[\s_\-.\[(/])?([a-z]+)[\])]?', re.IGNORECASE)
 
 
 def time_words(layout: CsvLayout) -> str:
-    """What the time column is read in, when its name gives a unit (:func:`time_unit`); ''
-    for seconds."""
-    unit, scale = time_unit(layout.names[0]) if layout.names and not layout.rate else ('s', 1.0)
-    if scale == 1.0:
+    """How the time was read, when not as seconds in the first column: a row index left out, a
+    unit the time column's name gives (:func:`time_unit`), dates; '' otherwise."""
+    if layout.rate:
         return ''
-    return f'time column {layout.names[0]} read in {unit} ({scale:g} s each: its name says so)'
+    name = layout.names[0] if layout.names else ''
+    words = ['the first column (no name, 0 in the first row) read as a row index'] * layout.first
+    if layout.origin is not None:
+        words.append(
+            f'time column {name or layout.first} read as dates, in seconds since the first '
+            f'({layout.origin.isoformat(" ")})'
+        )
+    elif layout.time_scale != 1.0:
+        unit = time_unit(name)[0]
+        words.append(
+            f'time column {name} read in {unit} ({layout.time_scale:g} s each: its name says so)'
+        )
+    return '; '.join(words)
 
 
 def time_unit(name: str) -> Tuple[str, float]:
@@ -207,11 +252,8 @@ def csv_layout(path, column: Optional[str] = None) -> CsvLayout:
             first = next(rows, None)
             if first is None:
                 raise CsvError(f'{path} has no data rows')
-            header = None
-            try:
-                _number(first[2][0])
-                data = first
-            except ValueError:
+            header, data = None, first
+            if _is_header(first[2]):
                 header = [name.strip() for name in first[2]]
                 data = next(rows, None)
                 if data is None:
@@ -225,19 +267,46 @@ def csv_layout(path, column: Optional[str] = None) -> CsvLayout:
             return timed
         header += [str(i) for i in range(len(header), width)]  # (a cell the header leaves out)
     names = header or comment_names(path, data[1], width) or [str(i) for i in range(width)]
-    index = _column_index(path, column, names, width)
+    skip = 1 if _row_index(names, data[2]) else 0
+    names = names[skip:]
+    index = _column_index(path, column, names, width - skip)
     return CsvLayout(
         path,
         index,
         names[index],
-        width,
+        width - skip,
         header is not None,
         data[1],
         names=tuple(names),
         delimiter=dialect[0],
         decimal=dialect[1],
         time_scale=time_unit(names[0])[1],
+        first=skip,
+        origin=_date(data[2][skip]),
     )
+
+
+def _is_header(cells: List[str]) -> bool:
+    """Whether a first row is a header: its first cell neither a number nor a date, or empty
+    (a row index without a name: pandas' ``to_csv``) beside a cell that is no number."""
+    head = cells[0].strip()
+    if head == '':
+        return any(_date(c) is None and not _is_number(c) for c in cells[1:])
+    return not _is_number(head) and _date(head) is None
+
+
+def _is_number(cell: str) -> bool:
+    try:
+        _number(cell)
+    except ValueError:
+        return False
+    return True
+
+
+def _row_index(names: List[str], cells: List[str]) -> bool:
+    """Whether the first column is a row index (pandas' ``to_csv`` with its default index: no
+    name, 0 in the first row) before a time column and at least one signal."""
+    return len(names) >= 3 and names[0] == '' and cells[0].strip() == '0'
 
 
 #: a header cell that names the sample rate (:func:`rate_layout`)
@@ -329,13 +398,13 @@ def iter_csv_rows(layout: CsvLayout) -> Iterator[Tuple[float, float]]:
 def iter_csv_column_rows(layout: CsvLayout) -> Iterator[Tuple[float, List[float]]]:
     """(t, [value of each of ``layout.columns``]) of every data row, by the exact rules."""
     columns = [layout.cell(i) for i in layout.columns]
-    rate, scale = layout.rate, layout.time_scale
+    rate = layout.rate
     try:
         with layout.path.open('rb') as handle:
             handle.seek(layout.data_offset)
             for count, (_, _, row) in enumerate(_rows(handle, layout.dialect)):
                 try:
-                    t = count / rate if rate else _number(row[0]) * scale
+                    t = count / rate if rate else layout.seconds(row[layout.first])
                     yield t, [_number(row[i]) for i in columns]
                 except (ValueError, IndexError):
                     line = count + (3 if rate else 2 if layout.has_header else 1)
@@ -362,13 +431,15 @@ def csv_column_blocks(
     it refuses, the rest by the exact rules (``block_rows`` rows per block); all of it by the exact
     rules where pyarrow is missing or does not load (:func:`..extras.optional`)."""
     pa, pacsv = optional('pyarrow'), optional('pyarrow.csv')
-    if pa is None or pacsv is None or layout.delimiter is None or layout.decimal != '.':
-        yield from _exact_blocks(layout, 0, block_rows)  # (or spaces, a decimal comma)
+    exact = layout.delimiter is None or layout.decimal != '.' or layout.origin is not None
+    if pa is None or pacsv is None or exact:  # (or spaces, a decimal comma, dates)
+        yield from _exact_blocks(layout, 0, block_rows)
         return
 
     rate = layout.rate
-    names = [f'c{i}' for i in range(layout.width - (1 if rate else 0))]
-    wanted = ([] if rate else [names[0]]) + [names[layout.cell(i)] for i in layout.columns]
+    names = [f'c{i}' for i in range(layout.file_width)]
+    time = names[layout.first]
+    wanted = ([] if rate else [time]) + [names[layout.cell(i)] for i in layout.columns]
     done = 0
     try:
         # read by arrow itself, not through a Python file: a Python read allocates a fresh 2 MB
@@ -397,9 +468,7 @@ def csv_column_blocks(
                 if rate:
                     t = (done + np.arange(batch.num_rows)) / rate
                 else:
-                    t = np.asarray(
-                        batch.column(names[0]).to_numpy(zero_copy_only=False), np.float64
-                    )
+                    t = np.asarray(batch.column(time).to_numpy(zero_copy_only=False), np.float64)
                     if layout.time_scale != 1.0:
                         t = t * layout.time_scale
                 y = np.empty((len(t), len(layout.columns)))
