@@ -56,6 +56,30 @@ def test_counters_add_up_across_replaced_estimators():
     assert list(totals)[-len(H.NODE_COUNTERS) :] == list(H.NODE_COUNTERS)
 
 
+def test_the_sampling_rate_is_kept_over_a_gap_a_burst_or_stamps_going_back():
+    """Samples used over the span of their stamps is the rate only where nothing was lost or
+    went back: a 2-s stop (1000 samples missing) read 250 Hz for a 500 Hz input (the self-test
+    then ran its tones at that rate, and a band's Nyquist check used it). Kept over the status
+    whose counters grew and the one after (a gap is counted up to a status late); measured again
+    after."""
+    h = H.Health(now=0.0)
+    h.status(1.0, h.totals(core(received=501, used=501)), 1.0)
+    assert h.sample_rate_hz == 500
+    h.count('samples_missing', 1000)
+    h.status(2.0, h.totals(core(received=1001, used=1001)), 3.0)  # 500 samples over 2 s
+    assert h.sample_rate_hz == 500
+    h.status(3.0, h.totals(core(received=1301, used=1301)), 4.0)  # the status after: kept
+    assert h.sample_rate_hz == 500
+    h.status(4.0, h.totals(core(received=1701, used=1701)), 5.0)
+    assert h.sample_rate_hz == 400  # measured again
+    h.status(5.0, h.totals(core(received=2101, used=2101, skipped_out_of_order=3)), 6.0)
+    assert h.sample_rate_hz == 400
+    fresh = H.Health(now=0.0)  # none known yet: measured even so
+    fresh.count('samples_missing', 10)
+    fresh.status(1.0, fresh.totals(core(received=301, used=301)), 1.0)
+    assert fresh.sample_rate_hz == 300
+
+
 def test_stale_ok_warn_and_the_rates():
     h = H.Health(now=0.0)
     s = h.status(1.0, h.totals(core()), None)

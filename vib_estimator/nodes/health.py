@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from typing import Dict, Mapping, Optional, Sequence
+from typing import Dict, Mapping, Optional, Sequence, Tuple
 
 from .cadence import CADENCE_COUNTERS
 
@@ -60,6 +60,18 @@ BAD_INPUT = (
     'lost_in_queue',
     'missing_in_gaps',
     'stamp_jumps',
+)
+#: the counters whose growth between two statuses makes the samples used over the span of their
+#: stamps no sampling rate (:meth:`Health._update_sample_rate`)
+RATE_UPSETS = (
+    'gaps',
+    'samples_lost',
+    'gap_resets',
+    'samples_missing',
+    'stamp_jumps',
+    'skipped_out_of_order',
+    'skipped_duplicate',
+    'time_jump_resets',
 )
 #: the node's own counters: zero header stamps replaced by the receipt time; JointState messages
 #: without the configured joint (skipped); samples received while ``band_hz`` reached above the
@@ -122,6 +134,7 @@ class _Tick:
     used: int = 0
     last_t: Optional[float] = None
     bad: Optional[Dict[str, int]] = None  # the BAD_INPUT counters
+    upsets: Optional[Tuple[int, ...]] = None  # the RATE_UPSETS counters
 
 
 @dataclass
@@ -195,6 +208,7 @@ class Health:
         self._band_warned: Optional[tuple] = None
         self._bad_warned = False
         self._hinted: Optional[str] = None
+        self._upset_before = False  # a RATE_UPSETS counter grew at the previous status
 
     # ---- counters ----------------------------------------------------------------------------
     def count(self, name: str, n: int = 1) -> int:
@@ -265,7 +279,7 @@ class Health:
         if messages > tick.messages:
             self._input_at = now
         input_rate = (messages - tick.messages) / (now - tick.at) if now > tick.at else math.nan
-        self._update_sample_rate(totals.get('used', 0), last_t)
+        self._update_sample_rate(totals, last_t)
         nyquist, log = self._check_band(band_hz, messages - tick.messages)
         missing = totals['skipped_joint_missing'] - tick.joint_missing
         held = {name: totals.get(name, 0) - self._held_at[name] for name in HELD_BACK}
@@ -302,6 +316,7 @@ class Health:
             totals.get('used', 0),
             last_t,
             {name: totals.get(name, 0) for name in BAD_INPUT},
+            tuple(totals.get(name, 0) for name in RATE_UPSETS),
         )
         values = {
             **self._estimate_values(now),
@@ -344,11 +359,18 @@ class Health:
         self._bad_warned = True
         return text, log
 
-    def _update_sample_rate(self, used: int, last_t: Optional[float]) -> None:
+    def _update_sample_rate(self, totals: Mapping[str, int], last_t: Optional[float]) -> None:
         """The input's sampling rate from its stamps: samples used over the time they span since
-        the previous call (since the first stamp, t = 0, at the first call with input)."""
-        tick = self._tick
-        if last_t is None:
+        the previous call (since the first stamp, t = 0, at the first call with input) -- kept
+        from before over a call in which, or after one in which, a :data:`RATE_UPSETS` counter
+        grew (a gap's lost samples, a burst, stamps going back: a stop of 2 s read 8.6 Hz for a
+        500 Hz input, a burst 2190 Hz, and the self-test and the band's Nyquist check used
+        them), unless none is known yet."""
+        tick, used = self._tick, totals.get('used', 0)
+        upsets = tuple(totals.get(name, 0) for name in RATE_UPSETS)
+        upset = tick.upsets is not None and upsets != tick.upsets
+        self._upset_before, upset = upset, upset or self._upset_before
+        if last_t is None or (upset and math.isfinite(self.sample_rate_hz)):
             return
         if tick.last_t is None:
             n, span = used - 1, last_t
