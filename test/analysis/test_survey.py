@@ -495,3 +495,19 @@ def test_a_decay_the_free_estimator_leaves_silent_is_surveyed_by_the_mode_tracke
     assert main(args) == 0
     (row,) = jsonl(capsys.readouterr().out)
     assert row['mode'] == 0 and 0 < row['estimates'] < 10
+
+
+def test_a_folder_of_whitespace_tables_is_searched(tmp_path, capsys):
+    """An instrument's ``.asc``/``.dat`` exports (columns aligned by spaces, the time first) are
+    recordings in a folder's search, as ``.csv`` files are; a ``.txt`` there is a note."""
+    t = np.arange(0, 6, 0.002)
+    y = np.exp(-0.02 * 2 * np.pi * 3 * t) * np.sin(2 * np.pi * 3 * t)
+    for name in ('a.asc', 'b.dat'):
+        (tmp_path / name).write_text(''.join(f'{a:14.6f}{b:14.6f}\n' for a, b in zip(t, y)))
+    (tmp_path / 'notes.txt').write_text('not a recording')
+    assert main(['survey', str(tmp_path), '--format', 'jsonl', '--jobs', '1']) == 0
+    out = capsys.readouterr()
+    rows = jsonl(out.out)
+    assert sorted(Path(r['recording']).name for r in rows) == ['a.asc', 'b.dat']
+    assert all(not r['error'] and abs(r['frequency_hz'] / 3 - 1) < 0.01 for r in rows)
+    assert any('notes.txt' in line and 'ignored' in line for line in out.err.splitlines())

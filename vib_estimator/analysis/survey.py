@@ -60,7 +60,7 @@ from ..core.estimator import INPUT_COUNTERS
 from ..core.shapes import mac
 from ..errors import VibEstimatorError, report
 from ..extras import optional
-from ..io.csv_reader import column_names
+from ..io.csv_reader import CSV_SUFFIXES, column_names
 from ..io.fields import DEFAULT_COMPONENT, check_component
 from ..io.heap import M_MMAP_THRESHOLD, M_TRIM_THRESHOLD, MMAP_THRESHOLD, glibc, mallopt
 from ..io.streaming import BagInfo, bag_info, is_csv, open_signal, supported_topics
@@ -264,7 +264,9 @@ def _is_bag_dir(path: Path) -> bool:
     return (path / 'metadata.yaml').is_file()
 
 
-_RECORDING_SUFFIXES = ('.mcap', '.db3', '.csv')
+#: the files a folder's search takes for recordings: the bags' storage files and the CSV tables
+#: (:data:`..io.csv_reader.CSV_SUFFIXES`) but ``.txt`` (a folder's notes; named, one is read)
+_RECORDING_SUFFIXES = ('.mcap', '.db3') + tuple(s for s in CSV_SUFFIXES if s != '.txt')
 
 
 def _in_directory(root: Path, ignored: List[Path]) -> Iterable[Path]:
@@ -946,8 +948,8 @@ def report_entries(rows: List[Dict], ignored: Sequence[Path], out) -> None:
         folders.setdefault(path.parent, []).append(path.name)
     for folder, names in sorted(folders.items()):
         out.write(
-            f'{prog}: {folder}: {len(names)} file(s) not a recording (not .mcap, .db3, '
-            f'.csv), ignored: {", ".join(names)}\n'
+            f'{prog}: {folder}: {len(names)} file(s) not a recording (not '
+            f'{", ".join(_RECORDING_SUFFIXES)}), ignored: {", ".join(names)}\n'
         )
 
 
@@ -1014,8 +1016,8 @@ def run(args: argparse.Namespace) -> int:
         where = ', '.join(args.inputs)
         return report(
             ValueError(
-                f'no recording found in {where} (rosbag2 bag folders, .mcap, .db3 or .csv '
-                'files, searched recursively, links followed)'
+                f'no recording found in {where} (rosbag2 bag folders, '
+                f'{", ".join(_RECORDING_SUFFIXES)} files, searched recursively, links followed)'
             ),
             'vib-estimator survey',
         )
