@@ -872,9 +872,21 @@ class Soak:
                 last = [f for f in self.faults if f['start'] <= at]
                 since = f'{last[-1]["kind"]} +{at - last[-1]["start"]:.1f} s' if last else '-'
                 resubscribed.append((round(at - self.t0, 1), since))
+        # the input's sampling rate each status gave (what the self-test and the band's Nyquist
+        # check read): {value to 3 digits: statuses}
+        rates: dict = {}
+        for row in rows:
+            try:
+                rate = float(row[3].get('sample_rate_hz', 'nan'))
+            except ValueError:
+                rate = math.nan
+            if rate == rate:
+                key = f'{rate:.3g}'
+                rates[key] = rates.get(key, 0) + 1
         figures.update(
             counters=final,
             resubscribed_at=resubscribed,
+            sample_rates=dict(sorted(rates.items(), key=lambda kv: -kv[1])),
             identities=ident,
             estimates=len(self.watch.estimates['/']),
             replay_estimates=len(self.watch.estimates['/replay']),
@@ -1007,6 +1019,10 @@ def report(fig: dict) -> None:
         f'RSS of estimator_node: {fig["rss_first_mb"]:.1f} MB at start, '
         f'{fig["rss_last_mb"]:.1f} MB at the end, growth after the first tenth '
         f'{fig["rss_growth_after_first_tenth_mb"]:.1f} MB'
+    )
+    print(
+        "sample_rate_hz in estimator_node's statuses (Hz: statuses): "
+        + ', '.join(f'{k}: {n}' for k, n in fig['sample_rates'].items())
     )
     silence, at = fig['diagnostics_longest_silence_s']
     print(f'diagnostics: longest silence outside the stops {silence:.2f} s (at {at:.0f} s)')

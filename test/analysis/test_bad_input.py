@@ -117,6 +117,17 @@ def test_no_estimate_says_why():
     assert 'open_segment_samples=4993' in err
 
 
+def test_a_constant_signal_says_it_is_at_rest():
+    """A flat column (a sensor unplugged, the wrong column) said "held back by the quality gate
+    (rejected_at_rest=18): check --min-fit, --max-damping ..." -- options that cannot help."""
+    t = np.arange(0, 30, 0.002)
+    text = 't,y\n' + ''.join(f'{a!r},0.25\n' for a in t.tolist())
+    code, out, err = analyze(text.encode(), '--format', 'jsonl')
+    why = [line for line in err.splitlines() if line.startswith('analyze: no estimate: ')]
+    assert code == 0 and out == '' and len(why) == 1
+    assert 'at rest' in why[0] and 'rejected_at_rest=' in why[0] and '--min-fit' not in why[0]
+
+
 def test_a_constant_signal_in_operation_says_so():
     """A constant column (an IMU axis at rest, an offset) through the output-only identifiers:
     one channel, several, and a constant beside moving channels. The halvings of a constant

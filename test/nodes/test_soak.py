@@ -72,6 +72,11 @@ def test_a_minute_of_faults(tmp_path):
     allowed = sum(WATCHDOG_MIN_S * (2**k - 1) <= s for s in silences for k in range(1, 6))
     resubscribed = fig['counters']['input_resubscribed']
     assert resubscribed <= allowed + 1, (silences, fig['resubscribed_at'], run.stdout)
+    # the input's rate in every status is the simulator's 500 Hz (a stop's lost samples over its
+    # span of stamps read 8.6 Hz, a burst's 2190 Hz: the self-test ran at them)
+    assert fig['sample_rates'] and all(
+        abs(float(rate) / 500.0 - 1) < 0.02 for rate in fig['sample_rates']
+    ), fig['sample_rates']
     for storm in (f for f in fig['faults'] if f['kind'] == 'storm'):
         assert storm['answered'] == storm['calls'] == 200 and storm['wrong_verdicts'] == 0
     for burst in (f for f in fig['faults'] if f['kind'] == 'burst'):

@@ -388,6 +388,13 @@ def explain_no_estimate(
     if config.modes:  # the mode tracker (its counters: core.modes)
         return tracker_silence(counters)
     held = {k: v for k, v in counters.items() if v and k.startswith('rejected_')}
+    if set(held) == {'rejected_at_rest'}:
+        rest = held['rejected_at_rest']
+        return (
+            f'the signal is at rest: every segment was flat (rejected_at_rest={rest}: no '
+            f'variance, or a half range at most --min-amplitude {config.min_amplitude:g}): a '
+            'constant signal, or the wrong column or topic'
+        )
     if held:
         return (
             'every converged estimate was held back by the quality gate ('
