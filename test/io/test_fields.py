@@ -21,6 +21,7 @@ def empty(input_type):
         F.VECTOR3_STAMPED: lambda: NS(vector=xyz()),
         F.JOINT_STATE: lambda: NS(name=[], effort=[], position=[], velocity=[]),
         F.FLOAT64: lambda: NS(data=0.0),
+        F.FLOAT32: lambda: NS(data=0.0),
     }[input_type]()
 
 
@@ -55,3 +56,4 @@ def test_types_and_components_are_checked():
     with pytest.raises(ValueError, match=r'effort\[NAME\]'):
         F.check_component('effort', F.JOINT_STATE)
     assert not F.has_header(F.FLOAT64) and F.has_header(F.JOINT_STATE)
+    assert not F.has_header(F.FLOAT32)

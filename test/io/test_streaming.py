@@ -20,7 +20,13 @@ from vib_estimator.io.bags import (
 )
 from vib_estimator.io.cdr import DOUBLE_INDEX
 from vib_estimator.io.csv_reader import CsvError, read_csv_series
-from vib_estimator.io.fields import INPUT_TYPES, JOINT_STATE, component_getter
+from vib_estimator.io.fields import (
+    FLOAT32,
+    INPUT_TYPES,
+    JOINT_STATE,
+    component_getter,
+    has_header,
+)
 from vib_estimator.io.streaming import open_signal
 
 EPOCH = 1_700_000_000_000_000_000
@@ -44,7 +50,7 @@ def make_message(msgtype, stamp, frame, value, k):
         frame_id=frame,
     )
     v3 = lambda a: T['geometry_msgs/msg/Vector3'](x=a, y=a + 1, z=a + 2)  # noqa: E731
-    if msgtype == 'std_msgs/msg/Float64':
+    if msgtype in ('std_msgs/msg/Float64', 'std_msgs/msg/Float32'):
         return T[msgtype](data=value)
     if msgtype == 'geometry_msgs/msg/WrenchStamped':
         return T[msgtype](
@@ -96,8 +102,11 @@ def test_every_type_equals_the_rosbags_deserialiser(tmp_path, msgtype, storage):
         keep = [k for k, m in enumerate(msgs) if get(m) is not None]
         signal = open_signal(tmp_path / 'bag', component=component)
         (t, y), _ = collect(signal)
-        assert y.tolist() == [float(get(msgs[k])) for k in keep]
-        base = stamps + 1000 if msgtype == 'std_msgs/msg/Float64' else stamps
+        exact = [
+            float(np.float32(get(msgs[k])) if msgtype == FLOAT32 else get(msgs[k])) for k in keep
+        ]
+        assert y.tolist() == exact
+        base = stamps if has_header(msgtype) else stamps + 1000
         assert signal.origin_ns == base[keep[0]]
         assert t.tolist() == ((base[keep] - base[keep[0]]) * 1e-9).tolist()
         assert signal.skipped == n - len(keep)

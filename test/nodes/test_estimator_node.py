@@ -523,11 +523,17 @@ def test_each_input_type_end_to_end(make_probe, input_type, component):
     assert p.node.counters['received'] == 2000
 
 
-def test_float64_input_is_timed_by_the_node_clock(make_probe):
-    """std_msgs/Float64 has no header: receipt time on the node clock (here /clock)."""
-    p = make_probe(input_type='std_msgs/Float64', use_sim_time=True)  # short name accepted
-    assert p.input_type == fields.FLOAT64 and p.node.get_parameter('component').value == 'data'
+@pytest.mark.parametrize(
+    'name, input_type',
+    [('std_msgs/Float64', fields.FLOAT64), ('std_msgs/msg/Float32', fields.FLOAT32)],
+)
+def test_float_input_is_timed_by_the_node_clock(make_probe, name, input_type):
+    """std_msgs/Float64 and Float32 (a micro-ROS sensor's) have no header: receipt time on the
+    node clock (here /clock)."""
+    p = make_probe(input_type=name, use_sim_time=True)  # short name accepted
+    assert p.input_type == input_type and p.node.get_parameter('component').value == 'data'
     values = np.sin(2 * np.pi * 1.33 * np.arange(800) / FS)
+    values = values.astype(np.float32).astype(np.float64)  # (what a Float32 carries)
     stamps = feed_on_sim_clock(p, values, 'data')
     expected = offline(stamps, values)
     assert len(expected) >= 2 and p.frequencies() == expected.frequency_hz.tolist()

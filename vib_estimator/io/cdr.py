@@ -11,7 +11,8 @@ known:
   as ``uint32 length`` (8, the length counting the terminating NUL) and the characters (12 ...);
 * then only ``float64`` fields, so the first double starts at ``align8(12 + length)`` and field k
   of the type's double sequence at ``align8(12 + length) + 8 k``;
-* ``std_msgs/Float64`` has no header: its ``data`` is the body's first 8 bytes.
+* ``std_msgs/Float64`` and ``Float32`` have no header: their ``data`` is the body's first 8 or 4
+  bytes (:data:`HEADERLESS`).
 
 The frame_id length differs between messages, so the offset is computed per message, as one
 vectorised expression over the array of payload offsets. A batch whose payloads are not
@@ -28,6 +29,7 @@ import numpy as np
 from ..errors import CdrLayoutError
 from .fields import (
     ACCEL_STAMPED,
+    FLOAT32,
     FLOAT64,
     IMU,
     VECTOR3_STAMPED,
@@ -50,9 +52,12 @@ DOUBLE_INDEX: Dict[str, Dict[str, int]] = {
     ACCEL_STAMPED: {**_indices('accel.linear.', 0), **_indices('accel.angular.', 3)},
     VECTOR3_STAMPED: _indices('vector.', 0),
     FLOAT64: {'data': 0},
+    FLOAT32: {'data': 0},
 }
 #: number of doubles after the header of each fixed-layout type
 N_DOUBLES = {WRENCH_STAMPED: 6, IMU: 37, ACCEL_STAMPED: 6, VECTOR3_STAMPED: 3, FLOAT64: 1}
+#: the types without a header: the dtype of their one ``data`` field, the body's first bytes
+HEADERLESS = {FLOAT64: '<f8', FLOAT32: '<f4'}
 
 
 def is_fixed_layout(msgtype: str) -> bool:
@@ -64,9 +69,10 @@ def fits_layout(data: bytes, msgtype: str) -> bool:
     """Whether one payload decodes as the fixed layout of ``msgtype``: little-endian CDR, the
     ``frame_id`` NUL-terminated inside it, long enough for the type's doubles (what a decoder can
     check of such a message: the doubles themselves may hold anything)."""
-    if len(data) < 4 + 8 or data[0] != 0 or data[1] != 1:
+    scalar = HEADERLESS.get(msgtype)
+    if len(data) < 4 + (np.dtype(scalar).itemsize if scalar else 8) or data[0] or data[1] != 1:
         return False
-    if msgtype == FLOAT64:
+    if scalar:
         return True
     if len(data) < 16:
         return False
@@ -94,7 +100,8 @@ def gather(buf: np.ndarray, offsets: np.ndarray, dtype: str) -> np.ndarray:
 def decode_fixed(
     buf: np.ndarray, offsets: np.ndarray, lengths: np.ndarray, msgtype: str, component: str
 ) -> Tuple[Optional[np.ndarray], np.ndarray]:
-    """Header stamps (int64 ns; None for ``Float64``) and ``component`` of many CDR payloads.
+    """Header stamps (int64 ns; None for :data:`HEADERLESS` types) and ``component`` of many CDR
+    payloads.
 
     ``buf`` is a uint8 array holding the payloads; payload i is ``buf[offsets[i]:offsets[i] +
     lengths[i]]``. Raises :class:`CdrLayoutError` if any payload is not little-endian CDR or is
@@ -103,22 +110,22 @@ def decode_fixed(
     check_component(component, msgtype)
     offsets = np.asarray(offsets, dtype=np.int64)
     lengths = np.asarray(lengths, dtype=np.int64)
+    scalar = HEADERLESS.get(msgtype)
     if len(offsets) == 0:
-        return (None if msgtype == FLOAT64 else np.empty(0, np.int64)), np.empty(0)
-    shortest = 12 if msgtype == FLOAT64 else 16
+        return (None if scalar else np.empty(0, np.int64)), np.empty(0)
+    shortest = 4 + np.dtype(scalar).itemsize if scalar else 16
     if lengths.min() < shortest or np.any(buf[offsets + 1] != 1) or np.any(buf[offsets] != 0):
         raise CdrLayoutError('not little-endian CDR')
     body = offsets + 4
-    if msgtype == FLOAT64:
-        first, stamps = body, None
-    else:
-        name_len = gather(buf, body + 8, '<u4').astype(np.int64)
-        if np.any(12 + name_len > lengths - 4):
-            raise CdrLayoutError('frame_id longer than the message')
-        first = body + ((12 + name_len + 7) & ~7)
-        stamps = gather(buf, body, '<i4').astype(np.int64) * 1_000_000_000 + gather(
-            buf, body + 4, '<u4'
-        ).astype(np.int64)
+    if scalar:
+        return None, gather(buf, body, scalar).astype(np.float64)
+    name_len = gather(buf, body + 8, '<u4').astype(np.int64)
+    if np.any(12 + name_len > lengths - 4):
+        raise CdrLayoutError('frame_id longer than the message')
+    first = body + ((12 + name_len + 7) & ~7)
+    stamps = gather(buf, body, '<i4').astype(np.int64) * 1_000_000_000 + gather(
+        buf, body + 4, '<u4'
+    ).astype(np.int64)
     if np.any(first + 8 * N_DOUBLES[msgtype] > offsets + lengths):
         raise CdrLayoutError('message shorter than its type')
     values = gather(buf, first + 8 * DOUBLE_INDEX[msgtype][component], '<f8')

@@ -15,7 +15,8 @@ Supported types (full names, as in ``input_type``) and their components:
 * ``sensor_msgs/msg/JointState``       -- ``effort[NAME]``, ``position[NAME]``, ``velocity[NAME]``
   (the joint is looked up by name in every message; a message without it gives ``None``)
 * ``std_msgs/msg/Float64``             -- ``data``
-  (no header: the receiver's clock is the time base)
+* ``std_msgs/msg/Float32``             -- ``data`` (a microcontroller's sensor, micro-ROS)
+  (no header, either: the receiver's clock is the time base)
 """
 
 from __future__ import annotations
@@ -32,6 +33,9 @@ ACCEL_STAMPED = 'geometry_msgs/msg/AccelStamped'
 VECTOR3_STAMPED = 'geometry_msgs/msg/Vector3Stamped'
 JOINT_STATE = 'sensor_msgs/msg/JointState'
 FLOAT64 = 'std_msgs/msg/Float64'
+FLOAT32 = 'std_msgs/msg/Float32'
+#: the types without a header (each sample stamped with its receipt time, or in a bag its log time)
+HEADERLESS = (FLOAT64, FLOAT32)
 
 #: the axes of a Vector3, in order
 XYZ = ('x', 'y', 'z')
@@ -43,6 +47,7 @@ _FIXED: Dict[str, Tuple[str, ...]] = {
     VECTOR3_STAMPED: tuple(f'vector.{a}' for a in XYZ),
     JOINT_STATE: (),
     FLOAT64: ('data',),
+    FLOAT32: ('data',),
 }
 #: every supported input type, default first
 INPUT_TYPES: Tuple[str, ...] = tuple(_FIXED)
@@ -54,6 +59,7 @@ DEFAULT_COMPONENT = {
     VECTOR3_STAMPED: 'vector.z',
     JOINT_STATE: 'effort[joint1]',
     FLOAT64: 'data',
+    FLOAT32: 'data',
 }
 #: the components of a WrenchStamped (the default input type)
 COMPONENTS = _FIXED[WRENCH_STAMPED]
@@ -76,7 +82,7 @@ def check_input_type(input_type: str) -> str:
 
 def has_header(input_type: str) -> bool:
     """Whether messages of this type carry a ``std_msgs/Header`` (time base: its stamp)."""
-    return check_input_type(input_type) != FLOAT64
+    return check_input_type(input_type) not in HEADERLESS
 
 
 def describe_components(input_type: str) -> str:

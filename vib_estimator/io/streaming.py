@@ -17,9 +17,9 @@ Three sources, one interface (:func:`open_signal` -> :class:`Signal`, whose ``bl
   ``JointState``, unindexed MCAP): ``rosbags`` iterates the raw messages of every storage file,
   merged in log-time order, and they are decoded in batches (vectorised where the layout allows).
 
-Bags: a topic of one of :data:`.fields.INPUT_TYPES`; time = header stamp (``Float64``: the log
-time), relative to the first one (:func:`.fields.seconds_since`), as the node does. A
-``JointState`` message without the joint is skipped and counted (``Signal.skipped``).
+Bags: a topic of one of :data:`.fields.INPUT_TYPES`; time = header stamp (``Float64``,
+``Float32``: the log time), relative to the first one (:func:`.fields.seconds_since`), as the node
+does. A ``JointState`` message without the joint is skipped and counted (``Signal.skipped``).
 
 Damaged records: a chunk whose checksum fails, an index entry that points at no message, a payload
 that does not decode as its type -- each message lost that way is skipped and counted
@@ -47,11 +47,11 @@ from .csv_reader import CSV_SUFFIXES, csv_blocks, csv_layout
 from .fields import (
     DEFAULT_COMPONENT,
     DEFAULT_INPUT_TOPIC,
-    FLOAT64,
     INPUT_TYPES,
     channels_getter,
     check_component,
     check_components,
+    has_header,
     normalise_type,
     seconds_since,
     stamp_ns,
@@ -375,7 +375,7 @@ def _decode_general(buf, offsets, lengths, log_times, signal: Signal, getter) ->
         try:
             msg = TYPESTORE.deserialize_cdr(raw[off : off + size], signal.msgtype)
             value = getter(msg)
-            stamp = log_time if signal.msgtype == FLOAT64 else stamp_ns(msg.header)
+            stamp = stamp_ns(msg.header) if has_header(signal.msgtype) else log_time
         except Exception as err:  # noqa: BLE001 -- rosbags raises what its parsing step does
             signal.count_damage(
                 1,

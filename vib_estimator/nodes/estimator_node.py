@@ -39,10 +39,10 @@ and the diagnostics bookkeeping, all without rclpy) and publishes what comes bac
 
 Time base: the header stamps (``t`` = stamp - first stamp, as the offline ``vib-estimator
 analyze``, so both give the same floats). A zero stamp, and every sample of a type without a header
-(``std_msgs/msg/Float64``), is stamped with the receipt time on the node clock (``use_sim_time``
-applies). Non-finite values, duplicate and out-of-order stamps, gaps and backward jumps are the
-core's business (skipped or restarted, and counted); a JointState without the configured joint is
-skipped and counted here.
+(``std_msgs/msg/Float64``, ``Float32``), is stamped with the receipt time on the node clock
+(``use_sim_time`` applies). Non-finite values, duplicate and out-of-order stamps, gaps and backward
+jumps are the core's business (skipped or restarted, and counted); a JointState without the
+configured joint is skipped and counted here.
 """
 
 from __future__ import annotations
