@@ -199,17 +199,22 @@ def dialect_texts():
         'tabs.tsv': 'time_s\ta\tb\n' + '\n'.join('\t'.join(r) for r in lines),
         'spaces.asc': '\n'.join(''.join(f'{c:>16}' for c in r) for r in lines),
         'spaces.dat': '# time_s, a, b\n' + '\n'.join(' '.join(r) for r in lines),
+        # Excel's "CSV UTF-8": a byte-order mark first, CRLF line ends (a German one: ; and ,)
+        'excel.csv': '\ufefftime_s;a;b\r\n'
+        + '\r\n'.join(';'.join(r).replace('.', ',') for r in lines),
+        'bom.csv': '\ufeff' + '\r\n'.join(','.join(r) for r in lines),
     }
 
 
 @pytest.mark.parametrize('name', list(dialect_texts()[1]))
 def test_csv_with_semicolons_tabs_spaces_or_a_decimal_comma_reads_the_same(tmp_path, name):
     """A European spreadsheet's ``0,25;1,5``, a tab-separated export, a whitespace-aligned
-    ``.asc``/``.dat`` table (the building's original files): the same samples as the comma
-    file, by the fast reader and by the exact rules, each column."""
+    ``.asc``/``.dat`` table (the building's original files), Excel's byte-order mark and CRLF
+    (the mark read as a header before: the first row lost): the same samples as the comma file,
+    by the fast reader and by the exact rules, each column."""
     rows, texts = dialect_texts()
     path = tmp_path / name
-    path.write_text(texts[name])
+    path.write_text(texts[name], encoding='utf-8')
     assert streaming.is_csv(path)
     layout = csv_reader.csv_layout(path)
     names = csv_reader.column_names(path, 'all')

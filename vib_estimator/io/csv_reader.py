@@ -149,6 +149,8 @@ def _rows(
     offset, line = handle.tell(), first_line
     for raw in iter(handle.readline, b''):
         text = raw.decode()
+        if offset == 0:  # a spreadsheet's byte-order mark (Excel's "CSV UTF-8") is no cell
+            text = text.lstrip(BOM)
         if delimiter is None:
             row = text.split()
         else:
@@ -159,6 +161,8 @@ def _rows(
         line += 1
 
 
+#: the byte-order mark a spreadsheet may write first (not part of the first cell)
+BOM = '\ufeff'
 #: the rows :func:`sniff` reads
 SNIFF_ROWS = 20
 #: a number written with a decimal comma (``-0,25``, ``1,5e-3``)
@@ -173,7 +177,7 @@ def sniff(path: Path) -> Tuple[Optional[str], str]:
     rows = []
     with path.open('rb') as handle:
         for raw in handle:
-            text = raw.decode().strip()
+            text = raw.decode().strip().lstrip(BOM)
             if text and not text.startswith('#'):
                 rows.append(text)
                 if len(rows) == SNIFF_ROWS:
@@ -361,7 +365,7 @@ def comment_names(path: Path, data_offset: int, width: int) -> Optional[List[str
     ``data_offset``), when it lists ``width`` distinct names separated by commas (text after two
     spaces or a parenthesis is a note); None otherwise."""
     with path.open('rb') as handle:
-        head = handle.read(data_offset).decode(errors='replace').splitlines()
+        head = handle.read(data_offset).decode(errors='replace').lstrip(BOM).splitlines()
     comments = [line.strip() for line in head if line.strip().startswith('#')]
     if not comments:
         return None
