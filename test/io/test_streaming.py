@@ -278,6 +278,26 @@ def test_pandas_to_csv_its_row_index_and_its_dates(tmp_path):
         read_csv_series(zoned)
 
 
+def test_a_row_of_units_under_the_names(tmp_path):
+    """An oscilloscope's export (PicoScope: ``Time,Channel A`` / ``(ms),(V)`` / a blank line):
+    the units row was data row 2, "not numbers". Now it is the columns' units, the time's read
+    from it (ms), and said; a units row whose time is in seconds changes nothing."""
+    t = np.arange(-500, 3000) * 0.001
+    y = np.round(np.sin(2 * np.pi * 7 * t), 8)
+    body = '\n'.join(f'{a * 1000:.6f},{b!r}' for a, b in zip(t.tolist(), y.tolist()))
+    scope, plain = tmp_path / 'scope.csv', tmp_path / 'plain.csv'
+    scope.write_text('Time,Channel A\n(ms),(V)\n\n' + body + '\n')
+    plain.write_text('time,a\ns,m/s^2\n' + body + '\n')
+    layout = csv_reader.csv_layout(scope)
+    assert layout.units == ('(ms)', '(V)') and layout.time_scale == 1e-3
+    assert 'the row of units says so' in csv_reader.time_words(layout)
+    series = read_csv_series(scope)
+    assert series.name == 'Channel A' and np.allclose(series.t, t, rtol=0, atol=1e-12)
+    assert np.array_equal(series.y, y)
+    assert csv_reader.csv_layout(plain).time_scale == 1.0  # (its times as written, in s)
+    assert len(read_csv_series(plain).t) == len(t)
+
+
 def test_a_header_narrower_than_its_rows_names_the_rest_by_index(tmp_path):
     """``t`` over rows of two cells raised an IndexError (a traceback from ``analyze``)."""
     path = tmp_path / 'a.csv'

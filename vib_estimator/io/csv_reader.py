@@ -4,7 +4,8 @@
 
 Format: optional ``#`` comment lines, an optional header row, then rows whose first column is the
 time in seconds -- or in milliseconds, microseconds or nanoseconds where the time column's name
-says so (``time_ms``, ``t [us]``, ``stamp_ns``: :func:`time_unit`). The signal is a named column
+says so (``time_ms``, ``t [us]``, ``stamp_ns``: :func:`time_unit`), or a row of units under the
+header (``(ms),(V)``) does. The signal is a named column
 (header) or a column index; by default the second. The cells are separated by commas, or by
 semicolons or tabs where the first row has them (a decimal comma then read too: ``0,25;1,5``),
 or by spaces where it has none of these (``.asc``/``.dat`` exports): :func:`sniff`. What pandas'
@@ -95,6 +96,8 @@ class CsvLayout:
     first: int = 0
     #: the first row's time, when the times are dates (ISO 8601): they are read as seconds since
     origin: Optional[datetime] = None
+    #: the row of units under the header, if the file has one (each column's, time first)
+    units: Tuple[str, ...] = ()
 
     @property
     def dialect(self) -> Tuple[Optional[str], str]:
@@ -227,10 +230,12 @@ def time_words(layout: CsvLayout) -> str:
             f'({layout.origin.isoformat(" ")})'
         )
     elif layout.time_scale != 1.0:
-        unit = time_unit(name)[0]
-        words.append(
-            f'time column {name} read in {unit} ({layout.time_scale:g} s each: its name says so)'
-        )
+        named = time_unit(name)[1] != 1.0
+        unit = time_unit(name if named else layout.units[0])[0]
+        says = 'its name says so' if named else 'the row of units says so'
+        words.append(f'time column {name} read in {unit} ({layout.time_scale:g} s each: {says})')
+    if layout.units:
+        words.append('the row under the names read as units: ' + ', '.join(layout.units))
     return '; '.join(words)
 
 
@@ -256,10 +261,12 @@ def csv_layout(path, column: Optional[str] = None) -> CsvLayout:
             first = next(rows, None)
             if first is None:
                 raise CsvError(f'{path} has no data rows')
-            header, data = None, first
+            header, data, units = None, first, ()
             if _is_header(first[2]):
                 header = [name.strip() for name in first[2]]
                 data = next(rows, None)
+                if data is not None and _is_units(data[2]):  # a row of units under the names
+                    units, data = tuple(cell.strip() for cell in data[2]), next(rows, None)
                 if data is None:
                     raise CsvError(f'{path} has a header but no data rows') from None
     except (OSError, UnicodeDecodeError, csv.Error) as err:
@@ -272,8 +279,11 @@ def csv_layout(path, column: Optional[str] = None) -> CsvLayout:
         header += [str(i) for i in range(len(header), width)]  # (a cell the header leaves out)
     names = header or comment_names(path, data[1], width) or [str(i) for i in range(width)]
     skip = 1 if _row_index(names, data[2]) else 0
-    names = names[skip:]
+    names, units = names[skip:], units[skip:]
     index = _column_index(path, column, names, width - skip)
+    unit = time_unit(names[0])
+    if unit[1] == 1.0 and units:
+        unit = time_unit(units[0])
     return CsvLayout(
         path,
         index,
@@ -284,10 +294,22 @@ def csv_layout(path, column: Optional[str] = None) -> CsvLayout:
         names=tuple(names),
         delimiter=dialect[0],
         decimal=dialect[1],
-        time_scale=time_unit(names[0])[1],
+        time_scale=unit[1],
         first=skip,
         origin=_date(data[2][skip]),
+        units=units,
     )
+
+
+#: a cell of a row of units under a header: ``(ms)``, ``[m/s^2]``, ``V``, ``deg``, ``%`` ...
+_UNIT = re.compile(r'[(\[]?\s*[A-Za-zµ°%][\w/^*.·°µ%\s-]{0,11}\s*[)\]]?')
+
+
+def _is_units(cells: List[str]) -> bool:
+    """Whether a row under the header is its columns' units (an oscilloscope's export: ``Time,
+    Channel A`` then ``(ms),(V)``): every cell empty or a short unit, one at least."""
+    texts = [cell.strip() for cell in cells]
+    return any(texts) and all(not t or _UNIT.fullmatch(t) for t in texts)
 
 
 def _is_header(cells: List[str]) -> bool:
