@@ -270,7 +270,7 @@ def test_pandas_to_csv_its_row_index_and_its_dates(tmp_path):
         exact = np.array([(ti, yi) for ti, yi in csv_reader.iter_csv_rows(layout)])
         assert np.allclose(series.t, t, rtol=0, atol=1e-9) and np.array_equal(series.y, y)
         assert np.array_equal(exact, np.column_stack([series.t, series.y]))
-    assert csv_reader.csv_layout(indexed).first == 1
+    assert csv_reader.csv_layout(indexed).order == (1, 2)
     assert csv_reader.csv_layout(dated).origin.isoformat() == '2024-08-12T21:08:55'
     zoned = tmp_path / 'z.csv'
     zoned.write_text('t,y\n2024-08-12T21:08:55,1\n2024-08-12T21:08:56Z,2\n')
@@ -296,6 +296,31 @@ def test_a_row_of_units_under_the_names(tmp_path):
     assert np.array_equal(series.y, y)
     assert csv_reader.csv_layout(plain).time_scale == 1.0  # (its times as written, in s)
     assert len(read_csv_series(plain).t) == len(t)
+
+
+def test_a_time_column_named_as_one_is_the_time_wherever_it_stands(tmp_path):
+    """A logger's ``ax,ay,az,millis`` (an Arduino's): ``ax`` was read as the time ("not strictly
+    increasing"). The one column named as a time is the time, in its name's unit; the others are
+    the signals, in their order, by both readers."""
+    t = np.arange(2000) * 0.001
+    a = np.round(np.sin(2 * np.pi * 7 * t), 6)
+    path = tmp_path / 'log.csv'
+    path.write_text(
+        'ax,ay,az,millis\n'
+        + '\n'.join(f'{v!r},{-v!r},9.81,{round(s * 1000)}' for v, s in zip(a.tolist(), t.tolist()))
+    )
+    layout = csv_reader.csv_layout(path)
+    assert layout.names == ('millis', 'ax', 'ay', 'az') and layout.order == (3, 0, 1, 2)
+    assert 'read as the time, by its name' in csv_reader.time_words(layout)
+    times, y, names = csv_reader.read_csv_columns(path, 'all')
+    assert names == ['ax', 'ay', 'az'] and np.allclose(times, t, rtol=0, atol=1e-12)
+    assert np.array_equal(y, np.column_stack([a, -a, np.full_like(a, 9.81)]))
+    exact = np.array([(ti, *yi) for ti, yi in csv_reader.iter_csv_column_rows(layout)])
+    assert np.array_equal(exact[:, 0], times) and np.array_equal(exact[:, 1], a)
+    for header in ('t,ax,millis', 'x,y,z'):  # a time first, or no name a time's: as they stand
+        other = tmp_path / 'other.csv'
+        other.write_text(header + '\n0,1,2\n1,2,3\n')
+        assert csv_reader.csv_layout(other).order == ()
 
 
 def test_a_header_narrower_than_its_rows_names_the_rest_by_index(tmp_path):

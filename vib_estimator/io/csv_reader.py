@@ -10,8 +10,9 @@ header (``(ms),(V)``) does. The signal is a named column
 semicolons or tabs where the first row has them (a decimal comma then read too: ``0,25;1,5``),
 or by spaces where it has none of these (``.asc``/``.dat`` exports): :func:`sniff`. What pandas'
 ``to_csv`` writes reads as meant: an unnamed row index before the time is left out, a time
-column of ISO 8601 dates is read as seconds since its first (:attr:`CsvLayout.first`,
-:attr:`CsvLayout.origin`; said by :func:`time_words`).
+column of ISO 8601 dates is read as seconds since its first, and a time column named as one is
+read as the time wherever it stands (:attr:`CsvLayout.order`, :attr:`CsvLayout.origin`; said by
+:func:`time_words`).
 Without a header row, the last comment line before the data names the columns when it lists one
 name per column (``# time_s,accel_g  (notes)``: names separated by commas, up to two spaces or a
 parenthesis; :func:`comment_names`).
@@ -92,8 +93,11 @@ class CsvLayout:
     decimal: str = '.'
     #: seconds per unit of the time column (:func:`time_unit`)
     time_scale: float = 1.0
-    #: the file's columns before the time: 1 for a row index without a name (pandas' ``to_csv``)
-    first: int = 0
+    #: the file's column of each of the layout's (the time first), where not the same column
+    #: (): a row index without a name left out (pandas' ``to_csv``), a time column not first
+    order: Tuple[int, ...] = ()
+    #: the file's columns (``width`` and those left out)
+    file_width: int = 0
     #: the first row's time, when the times are dates (ISO 8601): they are read as seconds since
     origin: Optional[datetime] = None
     #: the row of units under the header, if the file has one (each column's, time first)
@@ -105,11 +109,9 @@ class CsvLayout:
 
     def cell(self, index: int) -> int:
         """The file's column of the layout's column ``index``."""
-        return index - 1 if self.rate else index + self.first
-
-    @property
-    def file_width(self) -> int:
-        return self.width + self.first - (1 if self.rate else 0)
+        if self.order:
+            return self.order[index]
+        return index - 1 if self.rate else index
 
     def seconds(self, cell: str) -> float:
         """The time of a row whose time cell is ``cell`` (ValueError if it is none)."""
@@ -223,10 +225,15 @@ def time_words(layout: CsvLayout) -> str:
     if layout.rate:
         return ''
     name = layout.names[0] if layout.names else ''
-    words = ['the first column (no name, 0 in the first row) read as a row index'] * layout.first
+    time = layout.cell(0)
+    words = []
+    if layout.order and layout.file_width > layout.width:
+        words.append('the first column (no name, 0 in the first row) read as a row index')
+    if time and layout.names and time != layout.file_width - layout.width:
+        words.append(f'column {time} ({name}) read as the time, by its name')
     if layout.origin is not None:
         words.append(
-            f'time column {name or layout.first} read as dates, in seconds since the first '
+            f'time column {name or time} read as dates, in seconds since the first '
             f'({layout.origin.isoformat(" ")})'
         )
     elif layout.time_scale != 1.0:
@@ -278,9 +285,10 @@ def csv_layout(path, column: Optional[str] = None) -> CsvLayout:
             return timed
         header += [str(i) for i in range(len(header), width)]  # (a cell the header leaves out)
     names = header or comment_names(path, data[1], width) or [str(i) for i in range(width)]
-    skip = 1 if _row_index(names, data[2]) else 0
-    names, units = names[skip:], units[skip:]
-    index = _column_index(path, column, names, width - skip)
+    order = _time_first(names, data[2])
+    names = [names[i] for i in order]
+    units = tuple((units + ('',) * width)[i] for i in order) if units else ()
+    index = _column_index(path, column, names, len(order))
     unit = time_unit(names[0])
     if unit[1] == 1.0 and units:
         unit = time_unit(units[0])
@@ -288,15 +296,16 @@ def csv_layout(path, column: Optional[str] = None) -> CsvLayout:
         path,
         index,
         names[index],
-        width - skip,
+        len(order),
         header is not None,
         data[1],
         names=tuple(names),
         delimiter=dialect[0],
         decimal=dialect[1],
         time_scale=unit[1],
-        first=skip,
-        origin=_date(data[2][skip]),
+        order=() if order == list(range(width)) else tuple(order),
+        file_width=width,
+        origin=_date(data[2][order[0]]),
         units=units,
     )
 
@@ -329,10 +338,27 @@ def _is_number(cell: str) -> bool:
     return True
 
 
-def _row_index(names: List[str], cells: List[str]) -> bool:
-    """Whether the first column is a row index (pandas' ``to_csv`` with its default index: no
-    name, 0 in the first row) before a time column and at least one signal."""
-    return len(names) >= 3 and names[0] == '' and cells[0].strip() == '0'
+#: a time column's name: ``t``, ``time``, ``timestamp``, ``stamp``, ``elapsed``, ``seconds``,
+#: ``millis`` ..., alone or with a unit or note after a separator (``Time (s)``, ``time_ms``)
+_TIME_NAME = re.compile(
+    r'(t|time|timestamp|stamp|elapsed|seconds|secs?|millis|micros|zeit)([\s_\-\[(/.].*)?',
+    re.IGNORECASE,
+)
+
+
+def _time_first(names: List[str], cells: List[str]) -> List[int]:
+    """The file's columns in the layout's order, the time first: a row index (pandas' ``to_csv``
+    with its default index: no name, 0 in the first row, before a time and a signal) left out;
+    the one column whose name is a time's (:data:`_TIME_NAME`) first, where the first column's
+    is not (a logger's ``ax,ay,az,millis``)."""
+    order = list(range(len(names)))
+    if len(names) >= 3 and names[0] == '' and cells[0].strip() == '0':
+        order = order[1:]
+    timed = [i for i in order if _TIME_NAME.fullmatch(names[i].strip())]
+    if len(timed) == 1 and timed[0] != order[0] and not _TIME_NAME.fullmatch(names[order[0]]):
+        order.remove(timed[0])
+        order.insert(0, timed[0])
+    return order
 
 
 #: a header cell that names the sample rate (:func:`rate_layout`)
@@ -430,7 +456,7 @@ def iter_csv_column_rows(layout: CsvLayout) -> Iterator[Tuple[float, List[float]
             handle.seek(layout.data_offset)
             for count, (_, _, row) in enumerate(_rows(handle, layout.dialect)):
                 try:
-                    t = count / rate if rate else layout.seconds(row[layout.first])
+                    t = count / rate if rate else layout.seconds(row[layout.cell(0)])
                     yield t, [_number(row[i]) for i in columns]
                 except (ValueError, IndexError):
                     line = count + (3 if rate else 2 if layout.has_header else 1)
@@ -463,8 +489,8 @@ def csv_column_blocks(
         return
 
     rate = layout.rate
-    names = [f'c{i}' for i in range(layout.file_width)]
-    time = names[layout.first]
+    names = [f'c{i}' for i in range(layout.file_width or layout.width - (1 if rate else 0))]
+    time = names[layout.cell(0)] if not rate else ''
     wanted = ([] if rate else [time]) + [names[layout.cell(i)] for i in layout.columns]
     done = 0
     try:
