@@ -318,7 +318,7 @@ def _is_units(cells: List[str]) -> bool:
     """Whether a row under the header is its columns' units (an oscilloscope's export: ``Time,
     Channel A`` then ``(ms),(V)``): every cell empty or a short unit, one at least."""
     texts = [cell.strip() for cell in cells]
-    return any(texts) and all(not t or _UNIT.fullmatch(t) for t in texts)
+    return any(texts) and all(not t or (_UNIT.fullmatch(t) and not _is_number(t)) for t in texts)
 
 
 def _is_header(cells: List[str]) -> bool:
@@ -460,6 +460,7 @@ def iter_csv_column_rows(layout: CsvLayout) -> Iterator[Tuple[float, List[float]
                     yield t, [_number(row[i]) for i in columns]
                 except (ValueError, IndexError):
                     line = count + (3 if rate else 2 if layout.has_header else 1)
+                    line += 1 if layout.units else 0
                     raise CsvError(
                         f'{layout.path}: data row {line} is not numbers in columns 0 '
                         f'and {", ".join(map(str, columns))}: {",".join(row)!r}'
