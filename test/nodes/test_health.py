@@ -60,8 +60,8 @@ def test_the_sampling_rate_is_kept_over_a_gap_a_burst_or_stamps_going_back():
     """Samples used over the span of their stamps is the rate only where nothing was lost or
     went back: a 2-s stop (1000 samples missing) read 250 Hz for a 500 Hz input (the self-test
     then ran its tones at that rate, and a band's Nyquist check used it). Kept over the status
-    whose counters grew and the one after (a gap is counted up to a status late); measured again
-    after."""
+    whose counters grew and the one after (a gap is counted up to a status late), and across an
+    estimator replaced (a new configuration); measured again after."""
     h = H.Health(now=0.0)
     h.status(1.0, h.totals(core(received=501, used=501)), 1.0)
     assert h.sample_rate_hz == 500
@@ -73,6 +73,12 @@ def test_the_sampling_rate_is_kept_over_a_gap_a_burst_or_stamps_going_back():
     h.status(4.0, h.totals(core(received=1701, used=1701)), 5.0)
     assert h.sample_rate_hz == 400  # measured again
     h.status(5.0, h.totals(core(received=2101, used=2101, skipped_out_of_order=3)), 6.0)
+    assert h.sample_rate_hz == 400
+    h.status(6.0, h.totals(core(received=2101, used=2101, skipped_out_of_order=3)), 7.0)
+    h.status(7.0, h.totals(core(received=2501, used=2501, skipped_out_of_order=3)), 8.0)
+    assert h.sample_rate_hz == 400
+    h.absorb(core(received=10))  # an estimator replaced (a new configuration): kept across
+    h.status(8.0, h.totals(core(received=2601, used=2601, skipped_out_of_order=3)), 9.0)
     assert h.sample_rate_hz == 400
     fresh = H.Health(now=0.0)  # none known yet: measured even so
     fresh.count('samples_missing', 10)

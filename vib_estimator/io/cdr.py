@@ -12,7 +12,7 @@ known:
 * then only ``float64`` fields, so the first double starts at ``align8(12 + length)`` and field k
   of the type's double sequence at ``align8(12 + length) + 8 k``;
 * ``std_msgs/Float64`` and ``Float32`` have no header: their ``data`` is the body's first 8 or 4
-  bytes (:data:`HEADERLESS`).
+  bytes (:data:`SCALAR_DTYPES`).
 
 The frame_id length differs between messages, so the offset is computed per message, as one
 vectorised expression over the array of payload offsets. A batch whose payloads are not
@@ -57,7 +57,7 @@ DOUBLE_INDEX: Dict[str, Dict[str, int]] = {
 #: number of doubles after the header of each fixed-layout type
 N_DOUBLES = {WRENCH_STAMPED: 6, IMU: 37, ACCEL_STAMPED: 6, VECTOR3_STAMPED: 3, FLOAT64: 1}
 #: the types without a header: the dtype of their one ``data`` field, the body's first bytes
-HEADERLESS = {FLOAT64: '<f8', FLOAT32: '<f4'}
+SCALAR_DTYPES = {FLOAT64: '<f8', FLOAT32: '<f4'}
 
 
 def is_fixed_layout(msgtype: str) -> bool:
@@ -69,7 +69,7 @@ def fits_layout(data: bytes, msgtype: str) -> bool:
     """Whether one payload decodes as the fixed layout of ``msgtype``: little-endian CDR, the
     ``frame_id`` NUL-terminated inside it, long enough for the type's doubles (what a decoder can
     check of such a message: the doubles themselves may hold anything)."""
-    scalar = HEADERLESS.get(msgtype)
+    scalar = SCALAR_DTYPES.get(msgtype)
     if len(data) < 4 + (np.dtype(scalar).itemsize if scalar else 8) or data[0] or data[1] != 1:
         return False
     if scalar:
@@ -100,7 +100,7 @@ def gather(buf: np.ndarray, offsets: np.ndarray, dtype: str) -> np.ndarray:
 def decode_fixed(
     buf: np.ndarray, offsets: np.ndarray, lengths: np.ndarray, msgtype: str, component: str
 ) -> Tuple[Optional[np.ndarray], np.ndarray]:
-    """Header stamps (int64 ns; None for :data:`HEADERLESS` types) and ``component`` of many CDR
+    """Header stamps (int64 ns; None for :data:`SCALAR_DTYPES` types) and ``component`` of many CDR
     payloads.
 
     ``buf`` is a uint8 array holding the payloads; payload i is ``buf[offsets[i]:offsets[i] +
@@ -110,7 +110,7 @@ def decode_fixed(
     check_component(component, msgtype)
     offsets = np.asarray(offsets, dtype=np.int64)
     lengths = np.asarray(lengths, dtype=np.int64)
-    scalar = HEADERLESS.get(msgtype)
+    scalar = SCALAR_DTYPES.get(msgtype)
     if len(offsets) == 0:
         return (None if scalar else np.empty(0, np.int64)), np.empty(0)
     shortest = 4 + np.dtype(scalar).itemsize if scalar else 16

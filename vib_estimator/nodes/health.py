@@ -72,6 +72,8 @@ RATE_UPSETS = (
     'skipped_out_of_order',
     'skipped_duplicate',
     'time_jump_resets',
+    'skipped_non_finite',
+    'dropped_warmup',
 )
 #: the node's own counters: zero header stamps replaced by the receipt time; JointState messages
 #: without the configured joint (skipped); samples received while ``band_hz`` reached above the
@@ -209,6 +211,7 @@ class Health:
         self._bad_warned = False
         self._hinted: Optional[str] = None
         self._upset_before = False  # a RATE_UPSETS counter grew at the previous status
+        self._replaced = False  # an estimator was replaced since the previous status
 
     # ---- counters ----------------------------------------------------------------------------
     def count(self, name: str, n: int = 1) -> int:
@@ -218,6 +221,7 @@ class Health:
 
     def absorb(self, core_counters: Mapping[str, int]) -> None:
         """Keep the counters of an estimator about to be replaced (they go on adding up)."""
+        self._replaced = True  # (the samples used across it are no rate: _update_sample_rate)
         for name, value in core_counters.items():
             self._base[name] = self._base.get(name, 0) + value
 
@@ -363,12 +367,16 @@ class Health:
         """The input's sampling rate from its stamps: samples used over the time they span since
         the previous call (since the first stamp, t = 0, at the first call with input) -- kept
         from before over a call in which, or after one in which, a :data:`RATE_UPSETS` counter
-        grew (a gap's lost samples, a burst, stamps going back: a stop of 2 s read 8.6 Hz for a
-        500 Hz input, a burst 2190 Hz, and the self-test and the band's Nyquist check used
-        them), unless none is known yet."""
+        grew or an estimator was replaced (:meth:`absorb`: a new configuration; its samples
+        held while it builds) -- a gap's lost samples, a burst, stamps going back: a stop of 2 s
+        read 8.6 Hz for a 500 Hz input, a burst 2190 Hz, and the self-test and the band's
+        Nyquist check used them; with the counters alone, one status of the suite's soak
+        (restart, stop, storm of parameter sets, burst) still read 365 Hz --, unless none is
+        known yet."""
         tick, used = self._tick, totals.get('used', 0)
         upsets = tuple(totals.get(name, 0) for name in RATE_UPSETS)
-        upset = tick.upsets is not None and upsets != tick.upsets
+        upset = (tick.upsets is not None and upsets != tick.upsets) or self._replaced
+        self._replaced = False
         self._upset_before, upset = upset, upset or self._upset_before
         if last_t is None or (upset and math.isfinite(self.sample_rate_hz)):
             return
