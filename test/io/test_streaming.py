@@ -8,6 +8,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from vib_estimator.io import csv_reader, mcap, streaming
 from vib_estimator.io.bags import (
@@ -321,6 +323,66 @@ def test_a_time_column_named_as_one_is_the_time_wherever_it_stands(tmp_path):
         other = tmp_path / 'other.csv'
         other.write_text(header + '\n0,1,2\n1,2,3\n')
         assert csv_reader.csv_layout(other).order == ()
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    n=st.integers(3, 30),
+    signals=st.integers(1, 3),
+    dialect=st.sampled_from([',', ';', '\t', ' ']),
+    data=st.data(),
+)
+def test_any_dialect_header_units_and_time_position_reads_the_samples_written(
+    tmp_path_factory, n, signals, dialect, data
+):
+    """What spreadsheets, loggers, pandas and instruments write, combined at random -- delimiter,
+    decimal comma, header or none, a row of units, the time in ms, the time last, pandas' row
+    index, a byte-order mark, CRLF: every sample as written, the time in seconds, the signals in
+    their order (the decimal-comma traceback came from such a combination, not from random
+    bytes)."""
+    draw = data.draw
+    header = draw(st.booleans())
+    comma = dialect in (';', '\t') and draw(st.booleans())
+    units = header and draw(st.booleans())
+    ms = header and draw(st.booleans())
+    last = header and draw(st.booleans())
+    index = header and dialect in (',', ';') and draw(st.booleans())
+    bom, crlf = draw(st.booleans()), draw(st.booleans())
+    values = draw(
+        st.lists(
+            st.lists(st.floats(-1e3, 1e3, allow_nan=False), min_size=signals, max_size=signals),
+            min_size=n,
+            max_size=n,
+        )
+    )
+    t = np.cumsum(draw(st.lists(st.floats(1e-3, 1.0), min_size=n, max_size=n)))
+    t_text = [f'{v * (1000 if ms else 1):.6f}' for v in t]
+    y_text = [[f'{v:.6f}' for v in row] for row in values]
+    names = [f'sig{k}' for k in range(signals)]
+    time_name = 'time_ms' if ms else 'time'
+
+    def row(cells):
+        cells = [c.replace('.', ',') for c in cells] if comma else cells
+        return (' ' if dialect == ' ' else dialect).join(cells)
+
+    def ordered(time, rest):
+        return rest + [time] if last else [time] + rest
+
+    lines = []
+    if header:
+        lines.append(row(([''] if index else []) + ordered(time_name, names)))
+    if units:
+        lines.append(row(([''] if index else []) + ordered('ms' if ms else 's', ['V'] * signals)))
+    for k in range(n):
+        lines.append(row(([str(k)] if index else []) + ordered(t_text[k], y_text[k])))
+    text = ('\r\n' if crlf else '\n').join(lines) + '\n'
+    path = tmp_path_factory.mktemp('dialect') / 'rec.csv'
+    path.write_bytes((('\ufeff' if bom else '') + text).encode())
+    times, y, got = csv_reader.read_csv_columns(path, 'all')
+    assert got == (names if header else [str(k + 1) for k in range(signals)])
+    written = np.array([float(v) for v in t_text]) * (1e-3 if ms else 1.0)
+    assert np.allclose(times, written, rtol=1e-12, atol=0)
+    assert np.array_equal(y, np.array([[float(v) for v in r] for r in y_text]))
 
 
 def test_a_header_narrower_than_its_rows_names_the_rest_by_index(tmp_path):
