@@ -225,11 +225,11 @@ def time_words(layout: CsvLayout) -> str:
     if layout.rate:
         return ''
     name = layout.names[0] if layout.names else ''
-    time = layout.cell(0)
+    time, left_out = layout.cell(0), layout.file_width - layout.width if layout.order else 0
     words = []
-    if layout.order and layout.file_width > layout.width:
+    if left_out:
         words.append('the first column (no name, 0 in the first row) read as a row index')
-    if time and layout.names and time != layout.file_width - layout.width:
+    if time != left_out:
         words.append(f'column {time} ({name}) read as the time, by its name')
     if layout.origin is not None:
         words.append(

@@ -370,12 +370,13 @@ def _decode_general(buf, offsets, lengths, log_times, signal: Signal, getter) ->
     stamps: List[int] = []
     values: list = []
     several = len(signal.components)
+    stamped = has_header(signal.msgtype)  # (once: not per message)
     raw = buf.tobytes() if isinstance(buf, np.ndarray) else buf
     for off, size, log_time in zip(offsets.tolist(), lengths.tolist(), log_times.tolist()):
         try:
             msg = TYPESTORE.deserialize_cdr(raw[off : off + size], signal.msgtype)
             value = getter(msg)
-            stamp = stamp_ns(msg.header) if has_header(signal.msgtype) else log_time
+            stamp = stamp_ns(msg.header) if stamped else log_time
         except Exception as err:  # noqa: BLE001 -- rosbags raises what its parsing step does
             signal.count_damage(
                 1,

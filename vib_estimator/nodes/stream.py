@@ -468,9 +468,9 @@ class EstimatorStream:
         held by it (under the identifier, three tones over three windows of 89 s: 0.9 CPU s,
         which held /diagnostics silent for 3.8-5.2 s on a loaded machine). One run at a time: a
         call while one runs gets that run's result, whatever changed since it began, and the
-        next call tests what is live then (the rate is the input's over the last status and
-        moves with its losses: a run replaced at each change never finished, and the calls
-        waiting for it were never answered).
+        next call tests what is live then (a run replaced at each change of the key never
+        finished, and the calls waiting for it were never answered: the input's rate moved
+        with each fault; it is kept over one now: :data:`.health.RATE_UPSETS`).
         While the kernels compile the tones run uncompiled only for the
         algebraic estimator without ``band_hz`` (0.1 CPU s): with ``band_hz`` (0.5 CPU s) or the
         mode tracker (0.9), sharing Python's lock with the compile, they held the data path up
