@@ -345,6 +345,7 @@ def test_bad_input_is_counted_and_estimation_resumes(make_probe):
     assert kv['estimates'] == str(p.node.counters['estimates'])
     assert abs(float(kv['last_frequency_hz']) - 1.33) < 1.33e-3
     assert 0 < float(kv['last_convergence_time_s']) < 1.0
+    assert kv['frequency_subscribers'] == '1'  # the probe's, matched (the demo waits on it)
     # input_rate_hz: the messages taken between two statuses over the time between them (the
     # statuses' stamps, ~1 s apart); the input came in bursts, so some intervals saw none
     seen = [

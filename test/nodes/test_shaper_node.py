@@ -112,6 +112,23 @@ def design(node) -> dict:
     return {kv.key: kv.value for kv in node.status().values}
 
 
+def test_the_estimates_publisher_is_counted_once_matched(ros_context, executor):
+    """``estimate_publishers``: the publishers of vibration/frequency matched to the shaper
+    (the demo waits on it, and on estimator_node's ``frequency_subscribers``, before its first
+    move: estimates published before the match are never heard); none: the status says so."""
+    node = shaper_node(ros_context, use_sim_time=True, rate_hz=RATE)
+    assert design(node)['estimate_publishers'] == '0'
+    assert node.status().message == (
+        'passing through: no frequency estimate yet (no publisher of /vibration/frequency matched)'
+    )
+    rig = Rig(ros_context, executor, node)  # its probe publishes estimates (matched: it waits)
+    try:
+        assert design(node)['estimate_publishers'] == '1'
+        assert node.status().message == 'passing through: no frequency estimate yet'
+    finally:
+        rig.close()
+
+
 def test_step_reference_shaped_and_retuned_only_at_rest(ros_context, executor):
     node = shaper_node(ros_context, use_sim_time=True, shaper='zv', rate_hz=RATE)
     rig = Rig(ros_context, executor, node)

@@ -125,8 +125,13 @@ class Listener:
         )
         self.node.create_subscription(WrenchStamped, 'coupling_torque', self._on_torque, reliable)
         self.node.create_subscription(Float64, 'vibration/ground_truth', self._on_truth, latched)
-        self.node.create_subscription(Float64, 'vibration/frequency', self._on_frequency, reliable)
-        self.node.create_subscription(Header, 'vibration/reset', self._on_reset, reliable)
+        #: the estimates' subscriptions (the demo waits until they have matched a publisher)
+        self.estimate_subs = [
+            self.node.create_subscription(
+                Float64, 'vibration/frequency', self._on_frequency, reliable
+            ),
+            self.node.create_subscription(Header, 'vibration/reset', self._on_reset, reliable),
+        ]
         self.node.create_subscription(DiagnosticArray, '/diagnostics', self._on_diagnostics, 10)
         #: node names whose /diagnostics say they estimate (not warming up)
         self.ready: set = set()
@@ -182,6 +187,19 @@ class Listener:
                 f'{(f - f0) / f0 * 100:+6.2f} %   converged in {rec.est_conv[-1]:.3f} s',
                 flush=True,
             )
+
+    def status_count(self, node: str, key: str) -> int:
+        """A count in ``node``'s last /diagnostics status (0 before one)."""
+        return int(float(self.values.get(node, {}).get(key, '0')))
+
+    def hears_estimates(self) -> bool:
+        """Whether estimator_node's estimate publishers and this node's subscriptions have matched
+        each other (its /diagnostics' ``frequency_subscribers``; the graph is not enough: what is
+        published before the match is never heard)."""
+        return (
+            all(sub.get_publisher_count() >= 1 for sub in self.estimate_subs)
+            and self.status_count('/estimator_node', 'frequency_subscribers') >= 1
+        )
 
     def counts(self, topic: str) -> Tuple[int, int]:
         """(publishers, subscribers) of a topic as this node sees them."""
@@ -261,7 +279,7 @@ class Session:
             ['use_sim_time:=true', *params],
             lambda: (
                 '/estimator_node' in listener.ready
-                and listener.counts('vibration/frequency')[0]
+                and listener.hears_estimates()
                 and listener.counts('coupling_torque')[1]
             ),
             WARMUP_TIMEOUT,

@@ -40,9 +40,16 @@ SETTLE_S = 0.3
 #: taken while a move's transient still rings (the paper's configuration publishes those) does not
 #: steer the design
 MEDIAN_OF = 3
-#: before a shaper is switched on, the demo waits this long (wall s) at most for shaper_node to
-#: have taken every estimate the demo heard (its /diagnostics, 1 Hz): on a loaded machine they
-#: reached it behind its /clock ticks after the switch, and it designed for none (a CI run)
+#: estimator_node's counters that account for every sample sent to it (docs/nodes.md)
+ACCOUNTED = ('received', 'samples_missing')
+#: before a shaper is switched on (the simulator held), the demo waits this long (wall s) at
+#: most for estimator_node to have taken or counted missing every sample the demo heard, then
+#: for shaper_node to have taken every estimate the demo heard (their /diagnostics, 1 Hz): on a
+#: loaded machine the estimates reached it behind its /clock ticks after the switch, and it
+#: designed for none (a CI run); an estimator seconds behind the simulator (a slow machine, its
+#: kernels still compiling) had not estimated the mass yet, and the move was shaped for the
+#: mass before (a run on the Jazzy set, one core shared with two busy loops)
+CAUGHT_UP_WAIT_S = 60.0
 TAKEN_WAIT_S = 5.0
 
 
@@ -117,16 +124,25 @@ class ShapingDriver:
         self._set(self._shaper, 'shaper_node', 'shaper', name)
 
     def _estimates_taken(self) -> None:
-        """Wait (at most :data:`TAKEN_WAIT_S`; held, the simulator waits too) until shaper_node
-        says it took, or ignored, as many frequency estimates as the demo heard."""
+        """Wait (held, the simulator waits too) until estimator_node has taken, or counted
+        missing, every sample the demo heard (at most :data:`CAUGHT_UP_WAIT_S`), then until
+        shaper_node says it took, or ignored, as many frequency estimates as the demo heard (at
+        most :data:`TAKEN_WAIT_S`)."""
         listener = self._session.listener
-        heard = len(listener.record.est_f)
+        samples = len(listener.record.t)
+
+        def caught_up() -> bool:
+            counts = (listener.status_count('/estimator_node', k) for k in ACCOUNTED)
+            return sum(counts) >= samples
 
         def taken() -> bool:
-            values = listener.values.get('/shaper_node', {})
-            counts = (values.get(k, '0') for k in ('frequency_estimates', 'estimates_ignored'))
-            return sum(int(float(c)) for c in counts) >= heard
+            counts = (
+                listener.status_count('/shaper_node', k)
+                for k in ('frequency_estimates', 'estimates_ignored')
+            )
+            return sum(counts) >= len(listener.record.est_f)
 
+        self._session.spin_until(caught_up, CAUGHT_UP_WAIT_S)
         self._session.spin_until(taken, TAKEN_WAIT_S)
 
     def pause_sim_at(self, t: float) -> None:
@@ -279,17 +295,18 @@ def run_shaping(session: Session, args: argparse.Namespace, wall_start: float) -
     )
     session.start_estimator(PAPER_PARAMS)
     driver = ShapingDriver(session)
-    # ready when it takes the reference, commands the arm and its estimate subscription is in
-    # the graph beside the listener's: a shaper that never heard an estimate designs nothing
-    # (seen once in a suite run: every "zvd" move left unshaped)
+    # ready when it takes the reference, commands the arm and its estimate subscription and
+    # estimator_node's publisher have matched each other (each side's /diagnostics say so; in
+    # the graph is not enough): a shaper that never heard an estimate designs nothing (a suite
+    # run: every "zvd" move left unshaped; a CI run: the first mass's, its first estimates lost)
     session.start(
         'shaper_node',
         ['use_sim_time:=true', 'shaper:=none', f'median_of:={MEDIAN_OF}'],
         lambda: (
             driver.reference_pub.get_subscription_count()
             and listener.counts('position_command')[0]
-            and listener.counts('vibration/frequency')[0] >= 1
-            and listener.counts('vibration/frequency')[1] >= 2
+            and listener.status_count('/shaper_node', 'estimate_publishers') >= 1
+            and listener.status_count('/estimator_node', 'frequency_subscribers') >= 2
         ),
     )
     driver.move(0.0)  # the shaper holds the arm at 0

@@ -48,10 +48,11 @@ configured joint is skipped and counted here.
 from __future__ import annotations
 
 import importlib
+import itertools
 import sys
 import time
 from functools import partial
-from typing import Optional
+from typing import NamedTuple, Optional
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from rcl_interfaces.msg import SetParametersResult
@@ -135,6 +136,15 @@ def input_qos() -> QoSProfile:
     )
 
 
+class Standby(NamedTuple):
+    """A subscription the watchdog made beside a silent one: its token, the subscription, and
+    the messages the silent one had taken then."""
+
+    token: int
+    sub: object
+    taken: int
+
+
 #: how often the end of a warm-up is looked for, and after how long it is announced, s
 WARMUP_POLL = 0.05
 WARMUP_NOTICE = 1.0
@@ -199,6 +209,12 @@ class Outputs:
         self._modes = {}  # mode -> (frequency publisher, reset publisher)
         self._shapes = {}  # mode -> shape publisher (several channels)
         self._shape = Float64MultiArray()
+
+    @property
+    def frequency_subscribers(self) -> int:
+        """Subscriptions matched to ``vibration/frequency`` (their middleware has matched them,
+        not merely seen them in the graph: a new subscriber hears the estimates from then)."""
+        return self._floats[0][0].get_subscription_count()
 
     def set_channels(self, channels, modes: int) -> None:
         """The layout of the shapes of ``channels`` (several: publishers of modes 1..``modes``
@@ -334,7 +350,15 @@ class EstimatorNode(Node):
             callbacks = [partial(self._on_topic, i) for i in range(len(self._topics))]
         self._input_qos = qos
         self._input_callbacks = callbacks
-        self._subscriptions_in = [self._subscribe(i) for i in range(len(self._topics))]
+        #: per input topic: the token of the subscription whose messages are taken, the messages
+        #: taken, and the standby subscription the watchdog made beside a silent one
+        self._tokens = itertools.count()
+        self._taking = [next(self._tokens) for _ in self._topics]
+        self._taken = [0 for _ in self._topics]
+        self._standby: list = [None for _ in self._topics]
+        self._subscriptions_in = [
+            self._subscribe(i, self._taking[i]) for i in range(len(self._topics))
+        ]
         #: each input subscription's watchdog (never deaf: .cadence.Watchdog)
         self._watchdogs = [Watchdog() for _ in self._topics]
         self._input_names = ','.join(sub.topic_name for sub in self._subscriptions_in)
@@ -382,43 +406,74 @@ class EstimatorNode(Node):
         )
         self._self_test_timer.cancel()
 
-    def _subscribe(self, index: int, lost_events: bool = True):
-        """The subscription to input topic ``index`` (with ``lost_events``, the middleware's own
-        count of the samples it lost before the queue). A subscription the watchdog re-creates
-        has none: rclpy's EventsExecutor dispatches a QoS event of a subscription destroyed
-        meanwhile (InvalidHandle, or a segmentation fault; ros2/rclpy#1644) -- re-created every
-        20 ms under sim_node at speed 10 it died in 4 runs of 4 within 4-37 s, without the event
-        callback 0 in 2 runs of 2500 re-creations (benchmarks/resubscribe.py;
+    def _subscribe(self, index: int, token: int, lost_events: bool = True):
+        """The subscription ``token`` to input topic ``index`` (with ``lost_events``, the
+        middleware's own count of the samples it lost before the queue). A subscription the
+        watchdog makes has none: rclpy's EventsExecutor dispatches a QoS event of a subscription
+        destroyed meanwhile (InvalidHandle, or a segmentation fault; ros2/rclpy#1644) -- re-created
+        every 20 ms under sim_node at speed 10 it died in 4 runs of 4 within 4-37 s, without the
+        event callback 0 in 2 runs of 2500 re-creations (benchmarks/resubscribe.py;
         docs/nodes.md#never-deaf)."""
         events = SubscriptionEventCallbacks(message_lost=self._on_message_lost)
         return self.create_subscription(
             message_class(self._input_type),
             self._topics[index],
-            self._input_callbacks[index],
+            partial(self._on_input, index, token),
             self._input_qos,
             event_callbacks=events if lost_events else None,
         )
 
+    def _on_input(self, index: int, token: int, msg) -> None:
+        """A message of input topic ``index`` from subscription ``token``. The current one's is
+        taken. The standby's (:meth:`_watch_inputs`) makes the standby current -- the old one was
+        deaf -- unless the old one took a message since the standby was made: its publisher had
+        only paused, and the standby's copy is dropped. A message of a subscription destroyed
+        meanwhile is dropped."""
+        if token != self._taking[index]:
+            standby = self._standby[index]
+            if standby is None or token != standby.token or self._taken[index] > standby.taken:
+                return
+            self._standby[index] = None
+            self.destroy_subscription(self._subscriptions_in[index])
+            self._subscriptions_in[index], self._taking[index] = standby.sub, token
+        self._taken[index] += 1
+        self._input_callbacks[index](msg)
+
     def _watch_inputs(self, now: float) -> None:
-        """Re-create an input subscription whose publishers are matched but from which nothing
-        was taken for long (:class:`.cadence.Watchdog`), with one WARN per silence."""
+        """Never deaf: beside an input subscription whose publishers are matched but from which
+        nothing was taken for long (:class:`.cadence.Watchdog`), make a standby one, with one WARN
+        per silence; the first of the two to take a message is kept (:meth:`_on_input`). Made
+        before the old one is destroyed, so a publisher that had only paused (a simulator held, a
+        replay paused) loses nothing: a new subscription hears nothing until the publisher has
+        discovered it, seconds on a loaded machine (a CI run's demo lost a tip mass's whole
+        vibration so)."""
         stamped = has_header(self._input_type)
         for i, watchdog in enumerate(self._watchdogs):
             sub, cadence = self._subscriptions_in[i], self._cadences[i]
+            standby = self._standby[i]
+            if standby is not None and self._taken[i] > standby.taken:
+                self._drop_standby(i)  # the old one hears again: its publisher had paused
             taken_at = cadence.taken_at if stamped else self._stream.health.input_at
             matched = sub.get_publisher_count()
             if not watchdog.check(now, taken_at, matched, cadence.period_s):
                 continue
-            topic = sub.topic_name
-            self.destroy_subscription(sub)
-            self._subscriptions_in[i] = self._subscribe(i, lost_events=False)
+            self._drop_standby(i)  # one made in this silence has heard nothing either
+            token = next(self._tokens)
+            self._standby[i] = Standby(token, self._subscribe(i, token, False), self._taken[i])
             self._stream.health.count('input_resubscribed')
             if watchdog.episode == 1:
                 self.get_logger().warn(
-                    f'{topic}: {matched} publisher(s) matched but no message taken for '
-                    f'{now - taken_at:.1f} s: the subscription is re-created (counted in '
-                    'input_resubscribed; again, without a log, while the silence lasts)'
+                    f'{sub.topic_name}: {matched} publisher(s) matched but no message taken for '
+                    f'{now - taken_at:.1f} s: a new subscription is made beside it, the first '
+                    'of the two to take a message kept (counted in input_resubscribed; again, '
+                    'without a log, while the silence lasts)'
                 )
+
+    def _drop_standby(self, index: int) -> None:
+        """Destroy input topic ``index``'s standby subscription, if any."""
+        standby, self._standby[index] = self._standby[index], None
+        if standby is not None:
+            self.destroy_subscription(standby.sub)
 
     def _read_fields(self):
         """The fields of the current ``component`` / ``components`` (ValueError if bad)."""
@@ -766,6 +821,7 @@ class EstimatorNode(Node):
             status = self.baseline_monitor.status(status)
         if status.log:
             self.get_logger().warn(status.log)
+        status.values['frequency_subscribers'] = self._outputs.frequency_subscribers
         array = DiagnosticArray(
             status=[
                 DiagnosticStatus(

@@ -136,7 +136,7 @@ class ShaperNode(Node):
         self._command_pub = self.create_publisher(Float64, 'position_command', 10)
         self._diagnostics_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
         self.create_subscription(Float64, 'reference', self._on_reference, 10)
-        self.create_subscription(
+        self._frequency_sub = self.create_subscription(
             Float64, 'vibration/frequency', self._on_frequency, ESTIMATE_DEPTH
         )
         self.create_subscription(
@@ -313,6 +313,7 @@ class ShaperNode(Node):
         f, zeta, source = self.design_mode()
         pending = self._shaper.pending
         waited = time.monotonic() - self._pending_since if pending is not None else 0.0
+        publishers = self._frequency_sub.get_publisher_count()  # matched, not merely in the graph
         if self._ignored_run:
             level, message = (
                 DiagnosticStatus.WARN,
@@ -331,6 +332,8 @@ class ShaperNode(Node):
             )
         elif s.name == 'none' and f is None:
             level, message = DiagnosticStatus.OK, 'passing through: no frequency estimate yet'
+            if not publishers:
+                message += f' (no publisher of {self._frequency_sub.topic_name} matched)'
         else:
             level, message = DiagnosticStatus.OK, s.describe()
         values = {
@@ -346,6 +349,7 @@ class ShaperNode(Node):
             'damping_source': source,
             'reference_at_rest': str(self._shaper.at_rest).lower(),
             'retunes': str(self._shaper.retunes),
+            'estimate_publishers': str(publishers),
             **{name: str(n) for name, n in self.counters.items()},
         }
         return DiagnosticStatus(
