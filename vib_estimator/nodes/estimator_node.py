@@ -343,12 +343,23 @@ class EstimatorNode(Node):
         service_qos = QoSProfile(depth=SERVICE_DEPTH, reliability=ReliabilityPolicy.RELIABLE)
         self.create_service(Trigger, '~/reset', self._on_reset, qos_profile=service_qos)
         self._create_self_test(service_qos)
-        qos = input_qos()
+        self._create_inputs()
+        self.add_on_set_parameters_callback(self._check_parameters)
+        self.add_post_set_parameters_callback(self._apply_parameters)
+        self._create_timers()
+        self.get_logger().info(
+            f'estimating on {self._input_names} '
+            f'({self._input_type} [{", ".join(self._channels)}]) with '
+            f'{self._stream.config}'
+        )
+
+    def _create_inputs(self) -> None:
+        """The input subscriptions (one per topic), their watchdogs and bookkeeping."""
         if self._aligner is None:
             callbacks = [self._on_stamped if has_header(self._input_type) else self._on_unstamped]
         else:
             callbacks = [partial(self._on_topic, i) for i in range(len(self._topics))]
-        self._input_qos = qos
+        self._input_qos = input_qos()
         self._input_callbacks = callbacks
         #: per input topic: the token of the subscription whose messages are taken, the messages
         #: taken, and the standby subscription the watchdog made beside a silent one
@@ -362,14 +373,6 @@ class EstimatorNode(Node):
         #: each input subscription's watchdog (never deaf: .cadence.Watchdog)
         self._watchdogs = [Watchdog() for _ in self._topics]
         self._input_names = ','.join(sub.topic_name for sub in self._subscriptions_in)
-        self.add_on_set_parameters_callback(self._check_parameters)
-        self.add_post_set_parameters_callback(self._apply_parameters)
-        self._create_timers()
-        self.get_logger().info(
-            f'estimating on {self._input_names} '
-            f'({self._input_type} [{", ".join(self._channels)}]) with '
-            f'{self._stream.config}'
-        )
 
     def _create_timers(self) -> None:
         """/diagnostics and the warm-up poll, on the steady clock: diagnostics go on (and can
