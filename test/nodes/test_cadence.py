@@ -117,12 +117,15 @@ def test_a_gap_when_the_stream_stops_is_counted_at_the_next_flush():
     s = Stream(1.0)
     s.live(3000)
     s.source_gap(7)
+    assert not s.cadence.gap_pending
     s.live(1)
     assert s.counters['samples_missing'] == 0  # not told apart yet
+    assert s.cadence.gap_pending  # (the node keeps the sampling rate over such a status)
     s.cadence.flush(s.now + 0.1)
-    assert s.counters['samples_missing'] == 0
+    assert s.counters['samples_missing'] == 0 and s.cadence.gap_pending
     s.cadence.flush(s.now + 1.0)
     assert s.counters['samples_missing'] == s.counters['missing_in_gaps'] == 7
+    assert not s.cadence.gap_pending
 
 
 def test_a_step_back_is_followed_and_a_small_one_ignored():

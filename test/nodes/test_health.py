@@ -80,6 +80,20 @@ def test_the_sampling_rate_is_kept_over_a_gap_a_burst_or_stamps_going_back():
     h.absorb(core(received=10))  # an estimator replaced (a new configuration): kept across
     h.status(8.0, h.totals(core(received=2601, used=2601, skipped_out_of_order=3)), 9.0)
     assert h.sample_rate_hz == 400
+    used, t = 2601, 9.0
+
+    def status(n: int, span: float) -> float:
+        """A status after ``n`` more samples used over ``span`` s of stamps."""
+        nonlocal used, t
+        used, t = used + n, t + span
+        h.status(t, h.totals(core(received=used, used=used, skipped_out_of_order=3)), t)
+        return h.sample_rate_hz
+
+    assert [status(500, 1.0), status(500, 1.0)] == [400, 500]  # held after, measured again
+    h.hold_rate()  # a gap in the stamps not yet counted (the node's cadence): kept
+    assert [status(300, 2.0), status(500, 1.0), status(500, 1.0)] == [500, 500, 500]
+    h.count('lost_in_transport', 200)  # the middleware's count of samples lost: kept
+    assert [status(300, 2.0), status(500, 1.0), status(400, 1.0)] == [500, 500, 400]
     fresh = H.Health(now=0.0)  # none known yet: measured even so
     fresh.count('samples_missing', 10)
     fresh.status(1.0, fresh.totals(core(received=301, used=301)), 1.0)

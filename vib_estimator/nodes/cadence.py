@@ -128,6 +128,11 @@ class Cadence:
         return False
 
     @property
+    def gap_pending(self) -> bool:
+        """Whether a gap waits to be told apart (its samples not yet counted)."""
+        return self._gap is not None
+
+    @property
     def taken_at(self) -> float:
         """Steady time of the last message taken, whatever its stamp (0 before the first): a
         source restarted a little back in time, whose stamps stay behind the last one followed

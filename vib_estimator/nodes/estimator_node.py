@@ -801,6 +801,8 @@ class EstimatorNode(Node):
         self._diagnostics_due = now + DIAGNOSTICS_OVERDUE
         for cadence in self._cadences:
             cadence.flush(now)
+            if cadence.gap_pending:  # its samples used span it: no rate this status
+                self._stream.health.hold_rate()
         status = self._stream.status(now)
         if timer:
             self._watch_inputs(now)
