@@ -137,7 +137,8 @@ class ShapingDriver:
             estimator took nothing (samples lost at the end of its queue are counted only when
             a later one comes: none comes while held)."""
             values = listener.values.get('/estimator_node')
-            if values not in (None, before) and float(values.get('input_rate_hz', 'nan')) == 0:
+            held = values is not None and values is not before  # a status since the hold
+            if held and float(values.get('input_rate_hz', 'nan')) == 0:
                 return True
             counts = (listener.status_count('/estimator_node', k) for k in ACCOUNTED)
             return sum(counts) >= samples

@@ -212,7 +212,7 @@ class Health:
         self._bad_warned = False
         self._hinted: Optional[str] = None
         self._upset_before = False  # a RATE_UPSETS counter grew at the previous status
-        self._replaced = False  # an estimator replaced, or a gap pending, since the last status
+        self._hold = False  # keep the rate over the next status (hold_rate)
 
     # ---- counters ----------------------------------------------------------------------------
     def count(self, name: str, n: int = 1) -> int:
@@ -224,11 +224,11 @@ class Health:
         """Keep the sampling rate over the next status: samples were lost that no counter shows
         yet (a gap in the stamps not yet told apart, :class:`.cadence.Cadence`: counted a status
         late, and the status before it read 339 Hz for 500 in a suite soak on the Jazzy set)."""
-        self._replaced = True
+        self._hold = True
 
     def absorb(self, core_counters: Mapping[str, int]) -> None:
         """Keep the counters of an estimator about to be replaced (they go on adding up)."""
-        self._replaced = True  # (the samples used across it are no rate: _update_sample_rate)
+        self.hold_rate()  # (the samples used across it are no rate: _update_sample_rate)
         for name, value in core_counters.items():
             self._base[name] = self._base.get(name, 0) + value
 
@@ -382,8 +382,8 @@ class Health:
         known yet."""
         tick, used = self._tick, totals.get('used', 0)
         upsets = tuple(totals.get(name, 0) for name in RATE_UPSETS)
-        upset = (tick.upsets is not None and upsets != tick.upsets) or self._replaced
-        self._replaced = False
+        upset = (tick.upsets is not None and upsets != tick.upsets) or self._hold
+        self._hold = False
         self._upset_before, upset = upset, upset or self._upset_before
         if last_t is None or (upset and math.isfinite(self.sample_rate_hz)):
             return
