@@ -331,15 +331,16 @@ def test_the_constants_are_pinned_from_both_sides(monkeypatch, name, factor):
     holds_then_breaks(monkeypatch, name, factor, right)
 
 
-def watch(t, y, step=100):
-    """DrivenWatch over ``(t, y)``, asked every ``step`` samples: the answers."""
+def watch(t, y, step=100, freed=False):
+    """DrivenWatch over ``(t, y)``, asked every ``step`` samples: the answers (``freed``: those
+    of :meth:`~DrivenWatch.freed`)."""
     from vib_estimator.core.choice import DrivenWatch
 
     w = DrivenWatch()
     out = []
     for k in range(0, len(t), step):
         w.feed(t[k : k + step], y[k : k + step])
-        out.append(w.driven())
+        out.append(w.freed() if freed else w.driven())
     return out
 
 
@@ -348,16 +349,87 @@ def watch(t, y, step=100):
 def test_the_stream_watch_tells_a_driven_input_and_its_constants_are_pinned(
     monkeypatch, name, factor
 ):
-    """Driven throughout: said once half the watched span (60 s) is in, not before; a decay
-    ringing down into noise: never. Each constant at 0.001x and 1000x breaks one of them."""
+    """Driven throughout: said once EARLY_S (20 s) of the stream are in, not before; a decay
+    ringing down into noise: never; free again (:meth:`~DrivenWatch.freed`) once the driven
+    stretch has left the watched span (120 s), not before half of it is free. Each constant at
+    0.001x and 1000x breaks one of them. (Free from 410 s: the ring's tail, noise, reads driven
+    again once the ring has left the span.)"""
     t, y, _ = ambient_record(300, 100, [(1.2, 0.015, 1.0)], 20, 1)
     ring_t = np.arange(0, 300, 0.01)
     ring = np.exp(-0.01 * 2 * np.pi * 2 * ring_t) * np.sin(2 * np.pi * 2 * ring_t)
     ring += 0.01 * np.random.default_rng(0).standard_normal(len(ring_t))
+    both_t = np.concatenate([t, t[-1] + 0.01 + ring_t[:20000]])  # driven 300 s, then 200 s free
+    both = np.concatenate([y, 3 * ring[:20000]])
 
     def right():
         said = [s is not None for s in watch(t, y)]  # one answer a second
-        return not any(said[:59]) and sum(said[200:]) >= 90 and not any(watch(ring_t, ring))
+        freed = watch(both_t, both, freed=True)
+        return (
+            not any(said[:19])
+            and sum(said[200:]) >= 90
+            and not any(watch(ring_t, ring))
+            and not any(freed[:360])
+            and any(freed[400:])
+        )
+
+    holds_then_breaks(monkeypatch, name, factor, right)
+
+
+def first_driven_decision(t, y, asked: list):
+    """A deciding stream's first driven decision over ``(t, y)`` (:class:`StreamChoice` asked
+    each second as the node asks it): ``(stream time, decision)`` or None; ``asked`` gets the
+    stream time of each :func:`decide` call."""
+    from vib_estimator.core.choice import StreamChoice
+
+    stream = StreamChoice()
+    step = int(round(1 / (t[1] - t[0])))
+    for k in range(0, len(t), step):
+        for i in range(k, min(k + step, len(t))):
+            stream.update(t[i], y[i])
+        stream.driven(choice.FREE_BELOW)
+        d = stream.decision('free', False, 30.0, 0, windowed=True)
+        if d is not None:
+            return float(t[min(k + step, len(t)) - 1]), d
+    return None
+
+
+@pytest.mark.parametrize('factor', [1e-3, 1e3])
+@pytest.mark.parametrize('name', ['EARLY_S', 'LOOK_SHARE'])
+def test_a_driven_stream_is_decided_once_it_read_half_the_window_it_chose(
+    monkeypatch, name, factor
+):
+    """A 5 Hz mode driven by noise is decided at 20 s (EARLY_S: it used to wait for half the
+    watched span, 60 s), its 30-s window half read; the arm moved at random times, whose
+    spectrum after 20 or 40 s asks for a 89-300 s window (its moves' slow content), at 60 s
+    (half the span: 89 s, 120 periods of its 1.33 Hz); the decision asked every 20 s meanwhile
+    (each call reads the kept spectrum: not each second)."""
+    from vib_estimator.sim.arm_model import back_and_forth
+
+    t, y, _ = ambient_record(40, 200, [(5.0, 0.01, 1.0)], 20, 1)
+    arm = back_and_forth(80, 1.5, 0.5, 1.0, 0.5)
+    real = choice.decide
+
+    def right():
+        asked: list = []
+
+        def counted(*args, **kwargs):
+            asked.append(kwargs)
+            return real(*args, **kwargs)
+
+        monkeypatch.setattr(choice, 'decide', counted)
+        fast = first_driven_decision(t, y, asked)
+        del asked[:]
+        slow = first_driven_decision(arm.t, arm.torque, asked)
+        return (
+            fast is not None
+            and 19.5 <= fast[0] <= 21.5
+            and fast[1].excitation == 'ambient'
+            and fast[1].window_s == 30.0
+            and slow is not None
+            and 59.5 <= slow[0] <= 62.5
+            and 80 <= slow[1].window_s <= 100
+            and len(asked) <= 3
+        )
 
     holds_then_breaks(monkeypatch, name, factor, right)
 
@@ -496,8 +568,8 @@ def test_the_stream_choice_feeds_the_watch_in_batches_with_the_same_answers():
 
 def test_a_stream_whose_stamps_go_back_is_judged_afresh():
     """A source restarted (its stamps back to 1 s, within a batch of the node's): the watch and
-    the decision start again on the new stream, which reads driven after the watched span's half,
-    as the first did -- not once its time has passed the old stream's (its samples were all
+    the decision start again on the new stream, which reads driven after EARLY_S (20 s), as the
+    first did -- not once its time has passed the old stream's (its samples were all
     'earlier' than the old ones: the watch was blind for the old stream's length, issue 40)."""
     from vib_estimator.core.choice import StreamChoice
 
@@ -511,8 +583,9 @@ def test_a_stream_whose_stamps_go_back_is_judged_afresh():
             decided.append(stream.decision('free', False, 30.0))
     before, after = said[:300], said[300:]
     assert before[-1] is not None and after[0] is None  # the old stream's judgement forgotten
-    assert not any(after[:59]) and all(s is not None for s in after[80:])  # then the new one's
-    assert [d.excitation for d in decided[300:] if d is not None] == ['ambient']
+    assert not any(after[:19]) and all(s is not None for s in after[80:])  # then the new one's
+    got = [(k, d.excitation) for k, d in enumerate(decided[300:]) if d is not None]
+    assert {e for _, e in got} == {'ambient'} and 50 <= got[0][0] <= 70  # (half its window)
     assert stream.kept()[0][0] >= 1 and len(stream.kept()[0]) <= 12000
 
 

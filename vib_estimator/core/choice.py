@@ -1305,6 +1305,15 @@ def separate_modes(
 
 #: the seconds of a stream :class:`DrivenWatch` judges
 WATCH_S = 120.0
+#: ... of which it needs this many before it reads the stream driven (the node's first
+#: decision, then asked again this often while it keeps ``free``): a driven machine's modes
+#: then come after this and a window, not after half the span and a window (60 s: a 5 Hz mode
+#: driven by noise published nothing for a minute); the first blocks, a start's transient (the
+#: simulated arm's first move), would be decided on alone; back to free still needs half the span
+EARLY_S = 20.0
+#: ... and a driven decision so early is taken once the seconds it read are this share of the
+#: window it chose (:meth:`StreamChoice._looked_long_enough`): 60 of its 120 periods
+LOOK_SHARE = 0.5
 #: ... and the least mean variance they must hold, relative to the stream's largest block's
 #: (not the noise a decay rang down into): the simulated arm driven at its tip after its start's
 #: ramp holds ~0.5 % of the ramp's largest block (at 1e-2 it was read driven at 309 s of
@@ -1420,7 +1429,7 @@ class DrivenWatch:
         """The driven share of the last :data:`WATCH_S` s' energy when they look driven
         throughout (see the class doc; ``above``: the least share, :data:`FREE_BELOW` for
         driven in part: a mixed stream), else None."""
-        share, live = self._watched_share()
+        share, live = self._watched_share(EARLY_S)
         if share is None or self._envelope.state != DRIVEN:
             return None
         return share if share > above and live else None
@@ -1446,20 +1455,25 @@ class DrivenWatch:
     def freed(self) -> bool:
         """Whether the last :data:`WATCH_S` s look free: their driven share below
         :data:`FREE_BELOW` (what :func:`decide` calls a free decay)."""
-        share, _ = self._watched_share()
+        share, _ = self._watched_share(WATCH_S / 2)
         return share is not None and share < FREE_BELOW
 
-    def _watched_share(self) -> tuple[Optional[float], bool]:
-        """The driven share of the last :data:`WATCH_S` s (None before half of them are in) and
-        whether they are live (see the class doc)."""
-        env = self._envelope
+    @property
+    def span(self) -> float:
+        """The seconds of stream watched (at most :data:`WATCH_S` and a mark; 0 before any)."""
         marks = self._marks
-        if not math.isfinite(self._last_t) or not marks:
+        return self._last_t - marks[0][0] if marks and math.isfinite(self._last_t) else 0.0
+
+    def _watched_share(self, least_s: float) -> tuple[Optional[float], bool]:
+        """The driven share of the last :data:`WATCH_S` s (None before ``least_s`` of them are
+        in) and whether they are live (see the class doc)."""
+        env = self._envelope
+        span = self.span
+        if not span > 0:
             return None, False
-        span = self._last_t - marks[0][0]
-        free = env.energy[FREE] - marks[0][1]
-        driven = env.energy[DRIVEN] - marks[0][2]
-        if span < WATCH_S / 2 or not free + driven > 0:
+        free = env.energy[FREE] - self._marks[0][1]
+        driven = env.energy[DRIVEN] - self._marks[0][2]
+        if span < least_s or not free + driven > 0:
             return None, False
         return driven / (free + driven), (free + driven) / span >= LIVE_LEVEL * env.peak
 
@@ -1683,6 +1697,15 @@ class StreamChoice:
         chosen = decide(t[late], y[late], offset_ok=False)
         return chosen if chosen.excitation == 'free' and chosen.modes else None
 
+    def _looked_long_enough(self, chosen: Decision) -> bool:
+        """Whether a driven decision ``chosen`` read enough of the stream to be taken: at least
+        :data:`LOOK_SHARE` of the window it asks for (periods of the fundamental that sized it)
+        or half the watched span. Under it the fundamental came from one or two Welch segments:
+        an arm moved at random times, read after 40 s, asked for a 300-s window (a slow
+        content's peak), after 60 s 89 s; the decision is asked again :data:`EARLY_S` s later."""
+        need = min(LOOK_SHARE * chosen.window_s, WATCH_S / 2)
+        return self.watch.span >= need
+
     def recent(self, seconds: float) -> tuple[np.ndarray, np.ndarray]:
         """``(t, y)`` of the kept samples of the last ``seconds`` s (at least; y: the first
         channel), oldest first."""
@@ -1768,12 +1791,15 @@ class StreamChoice:
             return Decision('auto', window_s, 0.0, math.nan, math.nan, (), reason, keeps=True)
         if excitation != 'free' or self._share is None or now < self._retry_at:
             return None
-        self._retry_at = now + WATCH_S / 2
+        self._retry_at = now + EARLY_S
         chosen = decide(*self.kept(), self.channels, window_s, stream=True)
         if chosen.excitation != 'free':
-            return chosen
+            return chosen if self._looked_long_enough(chosen) else None
         # read driven by the watch (a steady level after a ringing's peak), free by decide (one
         # mode or, the ringing in its envelope, a damped one), its free estimates held: a steady
-        # oscillation after a transient (a step into a limit cycle)
+        # oscillation after a transient (a step into a limit cycle) -- once half the span is in
+        # (under it, an arm moved at random times read as one mode: the tracker, 79 % within 2 %)
         steady = self._held >= HELD_RUN and chosen.dominant_hz > 0
-        return self._steady_tracker(chosen) if steady else None
+        if not steady or self.watch.span < WATCH_S / 2:
+            return None
+        return self._steady_tracker(chosen)

@@ -42,8 +42,8 @@ WHY_HELD = {
     'max_window_resets': 'no convergence within max_window',
     'not_free_decay': (
         'the signal before each is no free decay, a driven response or an oscillation whose '
-        'phase wanders (read for a minute: a driven one goes to the identifier, a steady one '
-        'to the mode tracker); decide_excitation:=false publishes them'
+        'phase wanders (read for 20-60 s: a driven one goes to the identifier; a minute: a '
+        'steady one to the mode tracker); decide_excitation:=false publishes them'
     ),
 }
 HELD_BACK = tuple(WHY_HELD)

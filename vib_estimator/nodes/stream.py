@@ -283,7 +283,7 @@ class EstimatorStream:
         (:meth:`~vib_estimator.core.choice.StreamChoice.free_decay`, as ``auto`` tests its free
         stretches): while the node decides its excitation and runs the algebraic estimator on
         one channel (``excitation`` free, no ``modes``, no ``band_hz``), so that a driven input
-        gets no free-decay estimates of no mode before the decision (its first minute)."""
+        gets no free-decay estimates of no mode before the decision (its first 20-60 s)."""
         config = self._config
         return (
             self.deciding
@@ -401,9 +401,10 @@ class EstimatorStream:
         share = self._choice.driven(FREE_BELOW if self.deciding else DRIVEN_ABOVE)
         if share is None or self.config.excitation != 'free' or self.deciding:
             return None
+        span = min(self._choice.watch.span, WATCH_S)
         return (
-            f'the input looks driven ({100 * share:.0f} % of the energy of the last '
-            f'{WATCH_S:g} s): free-decay estimates of a driven structure scatter; '
+            f'the input looks driven ({100 * share:.0f} % of the energy of the last {span:.0f} '
+            's): free-decay estimates of a driven structure scatter; '
             'excitation:=ambient identifies its modes (auto: both, per stretch)'
         )
 
