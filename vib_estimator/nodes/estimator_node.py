@@ -30,8 +30,8 @@ and the diagnostics bookkeeping, all without rclpy) and publishes what comes bac
   executor thread goes on meanwhile).
 * ``/diagnostics`` at 1 Hz (steady clock): one status named after the node (:mod:`.health`).
 * ``decide_excitation`` (default true): while ``excitation`` is ``free`` (the default), once the
-  input looks driven (now, and in part of its last two minutes), the node sets its own
-  ``excitation`` (and ``ambient_window_s``) to what ``vib-estimator analyze`` decides on those
+  input looks driven (now, and in part of its last two minutes; from 20 s on), the node sets its
+  own ``excitation`` (and ``ambient_window_s``) to what ``vib-estimator analyze`` decides on those
   seconds (:meth:`~.stream.EstimatorStream.decision`: a building under wind, a machine driven
   without rest), with one log line; from an ``ambient`` it set so, to ``auto`` once the input
   looks free again. False keeps the configured excitation and says on ``/diagnostics`` when the
@@ -137,12 +137,13 @@ def input_qos() -> QoSProfile:
 
 
 class Standby(NamedTuple):
-    """A subscription the watchdog made beside a silent one: its token, the subscription, and
-    the messages the silent one had taken then."""
+    """A subscription the watchdog made beside a silent one: its token, the subscription, the
+    messages the silent one had taken then, and how long it had been silent (s)."""
 
     token: int
     sub: object
     taken: int
+    silent_s: float
 
 
 #: how often the end of a warm-up is looked for, and after how long it is announced, s
@@ -439,13 +440,19 @@ class EstimatorNode(Node):
             self._standby[index] = None
             self.destroy_subscription(self._subscriptions_in[index])
             self._subscriptions_in[index], self._taking[index] = standby.sub, token
+            self.get_logger().warn(
+                f'{standby.sub.topic_name}: the input subscription was deaf (nothing taken for '
+                f'{standby.silent_s:.1f} s with its publisher(s) matched, which the standby made '
+                'beside it now hears): replaced by the standby (counted in input_resubscribed)'
+            )
         self._taken[index] += 1
         self._input_callbacks[index](msg)
 
     def _watch_inputs(self, now: float) -> None:
         """Never deaf: beside an input subscription whose publishers are matched but from which
-        nothing was taken for long (:class:`.cadence.Watchdog`), make a standby one, with one WARN
-        per silence; the first of the two to take a message is kept (:meth:`_on_input`). Made
+        nothing was taken for long (:class:`.cadence.Watchdog`), make a standby one, with one INFO
+        per silence; the first of the two to take a message is kept (:meth:`_on_input`: a WARN
+        when it is the standby, the old one deaf; none for a publisher that paused). Made
         before the old one is destroyed, so a publisher that had only paused (a simulator held, a
         replay paused) loses nothing: a new subscription hears nothing until the publisher has
         discovered it, seconds on a loaded machine (a CI run's demo lost a tip mass's whole
@@ -462,14 +469,17 @@ class EstimatorNode(Node):
                 continue
             self._drop_standby(i)  # one made in this silence has heard nothing either
             token = next(self._tokens)
-            self._standby[i] = Standby(token, self._subscribe(i, token, False), self._taken[i])
+            silent = now - taken_at
+            self._standby[i] = Standby(
+                token, self._subscribe(i, token, False), self._taken[i], silent
+            )
             self._stream.health.count('input_resubscribed')
-            if watchdog.episode == 1:
-                self.get_logger().warn(
+            if watchdog.episode == 1:  # a publisher paused, or a deaf subscription: not known yet
+                self.get_logger().info(
                     f'{sub.topic_name}: {matched} publisher(s) matched but no message taken for '
-                    f'{now - taken_at:.1f} s: a new subscription is made beside it, the first '
-                    'of the two to take a message kept (counted in input_resubscribed; again, '
-                    'without a log, while the silence lasts)'
+                    f'{silent:.1f} s: a standby subscription is made beside it, the first of the '
+                    'two to take a message kept (counted in input_resubscribed; again, without a '
+                    'log, while the silence lasts; a WARN if the standby is the one that hears)'
                 )
 
     def _drop_standby(self, index: int) -> None:
