@@ -1426,9 +1426,9 @@ class DrivenWatch:
         self.followed_hz = f
 
     def driven(self, above: float = DRIVEN_ABOVE) -> Optional[float]:
-        """The driven share of the last :data:`WATCH_S` s' energy when they look driven
-        throughout (see the class doc; ``above``: the least share, :data:`FREE_BELOW` for
-        driven in part: a mixed stream), else None."""
+        """The driven share of the last :data:`WATCH_S` s' energy (from :data:`EARLY_S` s of
+        stream on) when they look driven throughout (see the class doc; ``above``: the least
+        share, :data:`FREE_BELOW` for driven in part: a mixed stream), else None."""
         share, live = self._watched_share(EARLY_S)
         if share is None or self._envelope.state != DRIVEN:
             return None
@@ -1453,8 +1453,8 @@ class DrivenWatch:
         return env.state == FREE and last is not None and last >= LIVE_LEVEL * env.peak
 
     def freed(self) -> bool:
-        """Whether the last :data:`WATCH_S` s look free: their driven share below
-        :data:`FREE_BELOW` (what :func:`decide` calls a free decay)."""
+        """Whether the last :data:`WATCH_S` s look free (from half of them on): their driven
+        share below :data:`FREE_BELOW` (what :func:`decide` calls a free decay)."""
         share, _ = self._watched_share(WATCH_S / 2)
         return share is not None and share < FREE_BELOW
 
@@ -1490,8 +1490,10 @@ class StreamChoice:
     any pace (:meth:`driven`, then :meth:`decision`; the node: once a second). What it keeps
     (:meth:`kept`) is the last :data:`WATCH_S` s, at most :data:`MAX_KEPT` samples (a fast
     stream's decision reads fewer seconds); a stamp going back by more than 1 % of
-    :data:`WATCH_S` starts it afresh (another time base). A decision that keeps ``free`` is not
-    asked again before :data:`WATCH_S` / 2 s of stream (its spectrum costs ~10 ms).
+    :data:`WATCH_S` starts it afresh (another time base). A driven decision is taken once the
+    seconds it read are :data:`LOOK_SHARE` of the window it chooses (or half the span); one not
+    taken, or that keeps ``free``, is not asked again before :data:`EARLY_S` s of stream (its
+    spectrum costs ~10 ms).
     """
 
     def __init__(self, channels: int = 1):
