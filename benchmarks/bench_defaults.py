@@ -260,11 +260,7 @@ def main() -> int:
     real = real if real.is_dir() else None
     if args.node_only:
         return node_only(real)
-    print(
-        '| record | configuration | estimates | modes found | within 2 % | > 5 % '
-        '| median conv (periods) | lowest MAC | CPU s | decided |'
-    )
-    print('|---|---|---|---|---|---|---|---|---|---|')
+    header('configuration', 'CPU s', 'decided')
     with tempfile.TemporaryDirectory() as tmp:
         for name, kind, path, select, truth, tuned, shapes in records(Path(tmp), real):
             for label, extra in (
@@ -296,14 +292,19 @@ def main() -> int:
     return 0
 
 
+def header(before: str, after: str, last: str) -> None:
+    """The table's two header lines: the record, ``before`` (if any), :func:`score`'s columns,
+    then ``after`` and ``last``."""
+    scored = 'estimates | modes found | within 2 % | > 5 % | median conv (periods) | lowest MAC'
+    columns = ' | '.join(c for c in ('record', before, scored, after, last) if c)
+    print(f'| {columns} |')
+    print('|' + '---|' * (columns.count('|') + 1))
+
+
 def node_only(real: Path | None) -> int:
     """The rows "node defaults, streamed" alone, with the stream time of the first estimate
     (a driven record's: the decision's time and then a window)."""
-    print(
-        '| record | estimates | modes found | within 2 % | > 5 % | median conv (periods) '
-        '| lowest MAC | first estimate (s) | CPU s | decided |'
-    )
-    print('|---|---|---|---|---|---|---|---|---|---|')
+    header('', 'first estimate (s) | CPU s', 'decided')
     with tempfile.TemporaryDirectory() as tmp:
         for name, kind, path, select, truth, _, shapes in records(Path(tmp), real):
             _, rows, decided, cpu = streamed(path, select)
