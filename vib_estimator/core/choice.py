@@ -1467,13 +1467,12 @@ class DrivenWatch:
     def _watched_share(self, least_s: float) -> tuple[Optional[float], bool]:
         """The driven share of the last :data:`WATCH_S` s (None before ``least_s`` of them are
         in) and whether they are live (see the class doc)."""
-        env = self._envelope
-        span = self.span
-        if not span > 0:
+        env, span = self._envelope, self.span
+        if not (span > 0 and span >= least_s):
             return None, False
         free = env.energy[FREE] - self._marks[0][1]
         driven = env.energy[DRIVEN] - self._marks[0][2]
-        if span < least_s or not free + driven > 0:
+        if not free + driven > 0:
             return None, False
         return driven / (free + driven), (free + driven) / span >= LIVE_LEVEL * env.peak
 
@@ -1760,7 +1759,8 @@ class StreamChoice:
         windowed: bool = False,
     ) -> Optional[Decision]:
         """The decision to switch to, or None: from ``free`` (when the watch read the stream driven
-        at the last :meth:`driven`), :func:`decide` over the kept samples, if not ``free``; from
+        at the last :meth:`driven`), :func:`decide` over the kept samples, if not ``free`` and
+        once they are :data:`LOOK_SHARE` of its window (:meth:`_looked_long_enough`); from
         ``free`` with ``modes`` 0 whose estimator has been silent for :data:`SILENT_S` s while the
         stream rings after an onset, a free decay of several modes (the mode tracker); from
         ``free`` on the default window (``windowed`` False), once per onset when it has shown
