@@ -217,10 +217,11 @@ def test_a_free_decay_of_two_modes_reports_both(capsys, tmp_path):
 def test_a_free_decay_s_weak_mode_that_rings_freely_is_reported(capsys, tmp_path):
     """A 5 Hz decay with a 17.3 Hz mode at 1:20 (0.1 % of the spectral power, under MODE_SHARE,
     ringing freely: core.choice.rings_freely): the default reports both modes (issue 37 item 4's
-    goals: each first within 2 % within 2 periods of 5 Hz, >= 90 % within 2 %), the 5 Hz one,
-    the strongest and lowest, read by the free estimator over 0.9 periods from its first
-    estimate on (core.choice.dominant_window; the mode tracker's windows: 1.65 periods or more)
-    under the tracker's mode number, the tracker's before it; --modes keeps the tracker's."""
+    goals: each first within 2 % within 2 periods of 5 Hz, >= 90 % within 2 %). The 5 Hz one,
+    the strongest and lowest, is read by the free estimator too (core.choice.dominant_window),
+    whose one-mode window the 17.3 Hz mode biases (its median 0.68 % from the tracker's, over
+    DOMINANT_AGREE): the tracker's estimates stay, over its fast scale (a median under a
+    period), and analyze says why; --modes reads the tracker alone."""
     t = np.arange(0, 11, 0.001)
     tau = np.maximum(t - 1.0, 0)
     y = sum(
@@ -241,14 +242,15 @@ def test_a_free_decay_s_weak_mode_that_rings_freely_is_reported(capsys, tmp_path
     conv = np.array([r['convergence_time_s'] for r in rows]) * 5.0
     low = np.abs(f / 5.0 - 1) < 0.25
     assert len(set(mode[low])) == 1 and np.median(conv[low]) < 1.0
+    assert np.median(np.abs(f[low] / 5.0 - 1)) < 0.001
     assert re.search(
-        rf'mode {mode[low][0]} \(5(\.\d+)? Hz\), the strongest.*: from t = [\d.]+ s the free', err
+        rf"mode {mode[low][0]} \(5(\.\d+)? Hz\), the strongest and lowest: the mode tracker's "
+        r"estimates \(the free estimator's short window strays 0\.\d+ %",
+        err,
     )
     tracked, err = analyze(capsys, write(tmp_path / 'weak.csv', t, y), '--modes', '3')
-    slow = np.array([r['convergence_time_s'] for r in tracked]) * 5.0
-    f = np.array([r['frequency_hz'] for r in tracked])
     assert 'the free estimator' not in err
-    assert np.median(slow[np.abs(f / 5.0 - 1) < 0.25]) > np.median(conv[low]) + 0.03
+    assert [r['frequency_hz'] for r in tracked] == f.tolist()
 
 
 def estimates(t, f, mode):
@@ -267,6 +269,7 @@ def test_with_dominant_puts_the_free_estimates_in_place_of_the_tracker_s_from_th
     estimate: the tracker's as they were."""
     tracked = estimates([1.0, 1.1, 1.2, 1.3, 1.4], [17.0, 5.0, 5.02, 17.1, 4.99], [1, 2, 2, 1, 2])
     free = estimates([1.15, 1.35, 1.5, 1.6], [5.01, 5.0, 9.0, 4.99], [0, 0, 0, 0])
+    tracked.convergence_time[:], free.convergence_time[:] = 0.3, 0.18  # (1.5, 0.9 periods)
     merged, words = with_dominant(tracked, free)
     assert merged.t.tolist() == [1.0, 1.1, 1.15, 1.3, 1.35, 1.6]
     assert merged.mode.tolist() == [1, 2, 2, 1, 2, 2] and 9.0 not in merged.frequency_hz
@@ -275,6 +278,36 @@ def test_with_dominant_puts_the_free_estimates_in_place_of_the_tracker_s_from_th
     assert alone.mode.tolist() == [1, 2, 2, 2]
     same, words = with_dominant(tracked, estimates([], [], []))
     assert same is tracked and words == ''
+
+
+@pytest.mark.parametrize('factor', [1e-3, 1, 1e3])
+def test_with_dominant_keeps_the_tracker_s_mode_where_the_free_reading_strays_or_is_no_faster(
+    monkeypatch, factor
+):
+    """The free estimates replace the tracker's 5 Hz mode (windows of 1.5 periods) where they lie
+    within DOMINANT_AGREE of its median and their windows are shorter (0.9 periods): 0.1 % off,
+    replaced; 1 % off (the other modes in its one-mode window), kept, and the words say the
+    deviation; windows of 0.9 periods or shorter (the tracker's fast scale), kept. The constant
+    at 0.001x keeps the first, at 1000x replaces the second."""
+    from vib_estimator.analysis import choosing
+
+    monkeypatch.setattr(choosing, 'DOMINANT_AGREE', choosing.DOMINANT_AGREE * factor)
+    tracked = estimates([1.0, 1.2, 1.4, 1.6], [5.0, 5.0, 4.999, 5.001], [1, 1, 1, 1])
+    tracked.convergence_time[:] = 0.3
+
+    def free(f, window):
+        out = estimates([1.1, 1.3, 1.5], [f, f * 1.001, f * 0.999], [0, 0, 0])
+        out.convergence_time[:] = window
+        return out
+
+    near, words = with_dominant(tracked, free(5.005, 0.18))
+    astray, why = with_dominant(tracked, free(5.05, 0.18))
+    slow, late = with_dominant(tracked, free(5.005, 0.3))
+    replaced = near.frequency_hz.tolist() != tracked.frequency_hz.tolist()
+    kept = astray is tracked and 'strays 1 % from them' in why
+    assert slow is tracked and "windows no longer than the free estimator's: 1.50 periods" in late
+    assert (replaced, kept) == {1e-3: (False, True), 1: (True, True), 1e3: (True, False)}[factor]
+    assert replaced == ('in place of' in words)
 
 
 def test_a_periodic_drive_s_lines_are_never_published(capsys, tmp_path):

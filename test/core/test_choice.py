@@ -495,7 +495,7 @@ def test_a_steady_line_beside_a_free_decay_is_no_mode():
 
 @pytest.mark.parametrize('factor', [1e-3, 1e3])
 @pytest.mark.parametrize(
-    'name', ['MODE_SHARE', 'MODE_GAP', 'HARMONIC_TOL', 'TRACKED_MODES', 'RING_DB']
+    'name', ['MODE_SHARE', 'MODE_GAP', 'HARMONIC_FINE', 'TRACKED_MODES', 'RING_DB']
 )
 def test_a_free_decay_of_several_modes_goes_to_the_mode_tracker(monkeypatch, name, factor):
     """Two modes 30 % apart (also so lightly damped that the second falls by 2 dB only), 8/21 Hz

@@ -28,6 +28,7 @@ import numpy as np
 from ..core.ambient import MIN_WINDOW_SAMPLES, beside_analyses
 from ..core.choice import (
     DECIDE_S,
+    DOMINANT_AGREE,
     DRIVEN_ABOVE,
     FREE_BELOW,
     MODE_GAP,
@@ -190,7 +191,11 @@ def with_dominant(tracked: EstimateArrays, free: EstimateArrays) -> Tuple[Estima
     modes lie farther apart) in place of the tracker's mode nearest it within that gap (its
     number; else a new one) from the free estimator's first estimate on (the tracker's before
     it: after rest, the tracker's first can come earlier), and the words that say so ('' when
-    the free estimator gave none: the tracker's, as they were)."""
+    the free estimator gave none: the tracker's, as they were). Where the tracker's windows of
+    that mode are no longer than the free estimator's (median: its fast scale engaged), or the
+    free estimates stray from the tracker's median of that mode by more than
+    :data:`..core.choice.DOMINANT_AGREE` (median relative deviation: the other modes bias its
+    one-mode window), the tracker's, as they were, and the words that say why."""
     if not len(free):
         return tracked, ''
     f = float(np.median(free.frequency_hz))
@@ -204,6 +209,12 @@ def with_dominant(tracked: EstimateArrays, free: EstimateArrays) -> Tuple[Estima
     number = (
         min(near, key=lambda m: abs(medians[m] / f - 1)) if near else max(medians, default=0) + 1
     )
+    kept = tracker_kept(tracked.where(tracked.mode == number), free) if near else ''
+    if kept:
+        return tracked, (
+            f'mode {number} ({medians[number]:.4g} Hz), the strongest and lowest: the mode '
+            f"tracker's estimates ({kept})"
+        )
     mine = (tracked.mode == number) & (tracked.t >= free.t[0])
     free.mode[:] = number
     words = (
@@ -213,6 +224,24 @@ def with_dominant(tracked: EstimateArrays, free: EstimateArrays) -> Tuple[Estima
         "tracker's; --modes keeps the tracker's)"
     )
     return EstimateArrays.concatenate([tracked.where(~mine), free]), words
+
+
+def tracker_kept(mode: EstimateArrays, free: EstimateArrays) -> str:
+    """Why the tracker's estimates of a ``mode`` stay in place of the free estimator's of it
+    (``free``), in words: its windows no longer (median), or the free estimates straying from
+    its median by more than :data:`..core.choice.DOMINANT_AGREE`; '' when the free estimates
+    replace them (:func:`with_dominant`)."""
+    g = float(np.median(mode.frequency_hz))
+    window = float(np.median(mode.convergence_time))
+    if window <= float(np.median(free.convergence_time)):
+        return f"its windows no longer than the free estimator's: {window * g:.2f} periods"
+    stray = float(np.median(np.abs(free.frequency_hz / g - 1)))
+    if stray > DOMINANT_AGREE:
+        return (
+            f"the free estimator's short window strays {100 * stray:.2g} % from them, the "
+            'other modes in it'
+        )
+    return ''
 
 
 def contradiction(config: EstimatorConfig, d: Decision, prog: str) -> str:
