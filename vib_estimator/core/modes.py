@@ -128,10 +128,11 @@ MIN_DAMPING = -0.02  # poles growing faster than this are not modes
 MATCH_TOL = 0.06  # a pole within this of a mode is the mode's
 DUPLICATE_TOL = 0.12  # a candidate this close to a mode is not a mode of its own
 PENDING_TOL = 0.02  # a candidate seen again within this is confirmed
-# relative distance to n f of a stronger pole or mode (n = 2..9): a clipped mode's harmonic
-# poles lie within ~0.1 % of it (bench_modes' 12 Hz clipped at 60 %: 0 % spurious at 0.5 %); at
-# 1.5 % modes near an integer ratio were dropped as harmonics (4.00 / 15.86 Hz at 1:0.3, 0.9 %
-# off 4 x: 7 estimates; 21.07 / 63.92 Hz at 1:0.37, 1.1 % off 3 x: none)
+# relative distance to n f of a stronger pole or mode (n = 2..9): at 0.5 % a clipped mode's
+# harmonics are still no modes (bench_modes' 12 Hz clipped at 60 %: 0 % spurious estimates;
+# test_harmonics_of_a_clipped_mode_are_no_modes); at 1.5 % modes near an integer ratio were
+# dropped as harmonics (4.00 / 15.86 Hz at 1:0.3, 0.9 % off 4 x: 7 estimates; 21.07 / 63.92 Hz
+# at 1:0.37, 1.1 % off 3 x: none)
 HARMONIC_TOL = 0.005
 MAX_HARMONIC = 9
 HARMONIC_RATIO = 2.0  # a harmonic's parent is at least this much stronger (amplitude)
