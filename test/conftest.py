@@ -94,3 +94,13 @@ def break_extra(monkeypatch):
     forget()
     with contextlib.redirect_stderr(io.StringIO()):  # said at the start of the run already
         _load_extras()
+
+
+@pytest.fixture(autouse=True)
+def fresh_uncompiled_budget(monkeypatch):
+    """Each test starts as a new process would: with its whole budget of uncompiled batch
+    samples (``core.estimator.UNCOMPILED``, which a process spends across records), so that what
+    earlier tests ran does not decide whether a later one runs compiled."""
+    from vib_estimator.core import estimator
+
+    monkeypatch.setattr(estimator.UNCOMPILED, 'spent', 0)

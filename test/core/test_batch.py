@@ -61,6 +61,38 @@ def test_a_batch_run_is_compiled_from_the_start_when_that_costs_nothing(monkeypa
     assert not batch_estimator(config.replace(excitation='ambient')).interpreted  # none to run
 
 
+@pytest.mark.parametrize(
+    'config', [EstimatorConfig(), EstimatorConfig(modes=3)], ids=['default', 'modes: 3']
+)
+def test_short_records_in_one_process_compile_once_they_add_up(config, monkeypatch):
+    """The budget of uncompiled samples is the process's (``UNCOMPILED``): a survey's worker
+    running short record after short record (each under ``UNCOMPILED_SAMPLES``) compiles in the
+    record that brings it over, and the next starts compiled -- each stayed uncompiled, its
+    kernels never compiled nor cached, until 7 Dec 2026."""
+    switched_at = []
+    t, y = _decay(2000)
+    compiled = type(create_uncompiled(config)).compiled
+
+    def spy(self):
+        switched_at.append(self.counters['received'])
+        compiled(self)
+
+    monkeypatch.setattr(type(create_uncompiled(config)), 'compiled', spy)
+    monkeypatch.setattr(type(create_uncompiled(config)), 'kernels_available', lambda self: False)
+    monkeypatch.setattr(E, 'UNCOMPILED_SAMPLES', 4500)
+    runs = []
+    for _ in range(4):
+        estimator = batch_estimator(config)
+        runs.append((estimator.interpreted, E.run_batch(estimator, t, y)))
+    assert [r[0] for r in runs] == [True, True, True, False]
+    assert switched_at == [500, 0]  # 2000 + 2000 + 500 uncompiled; the fourth from the start
+    want = create_estimator(config).process(t, y)
+    for _, got in runs:
+        np.testing.assert_allclose(
+            got.frequency_hz, want.frequency_hz, rtol=1e-9 if config.modes else 0
+        )
+
+
 def test_read_only_input_runs_the_kernel_compiled_for_writeable_arrays():
     """A CSV's time column comes read-only (pyarrow); numba would compile every kernel again for
     that type, a cost ``vib-estimator warmup`` does not cover."""

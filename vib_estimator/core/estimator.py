@@ -532,30 +532,54 @@ class FrequencyEstimator(Estimator):
 #: samples uncompiled before it compiles them (:func:`run_batch`): about 5 CPU s of the
 #: algebraic estimator (~100 us a sample), 5-10 of the mode tracker, less than their compile
 #: (20-25 CPU s on a 2-core machine, docs/startup.md), so a newcomer's first ``analyze`` of a
-#: record of a few minutes answers in seconds, and a longer record pays the compile once
+#: record of a few minutes answers in seconds, and a longer record pays the compile once. The
+#: budget is the process's (:data:`UNCOMPILED`): a survey's worker that runs record after short
+#: record compiles once they add up to it (a survey of 48 records of 11 s on a cold cache: 66 s
+#: each time until 7 Dec 2026, the cache never filled; now 45 s, then 2.5 s: docs/startup.md)
 UNCOMPILED_SAMPLES = 50_000
+
+
+class UncompiledBudget:
+    """The samples this process has run uncompiled in batch (:func:`run_batch`), of the
+    :data:`UNCOMPILED_SAMPLES` it may run before it compiles the kernels it runs."""
+
+    def __init__(self) -> None:
+        self.spent = 0
+
+    def left(self, fed: int = 0) -> int:
+        """Samples still to run uncompiled (``fed``: those of the current record already run,
+        spent in this process or not)."""
+        return max(UNCOMPILED_SAMPLES - max(fed, self.spent), 0)
+
+
+#: this process's budget of uncompiled batch samples
+UNCOMPILED = UncompiledBudget()
 
 
 def batch_start(estimator) -> None:
     """Make ``estimator`` (one built uncompiled: ``interpret``) compiled at once if its compiled
-    kernels cost nothing to run (in memory or numba's cache: ``kernels_available``); else it
-    starts uncompiled, and :func:`run_batch` compiles them after :data:`UNCOMPILED_SAMPLES`."""
-    if estimator.kernels_available():
+    kernels cost nothing to run (in memory or numba's cache: ``kernels_available``) or this
+    process has spent its uncompiled samples (:data:`UNCOMPILED`); else it starts uncompiled,
+    and :func:`run_batch` compiles them once the process has run :data:`UNCOMPILED_SAMPLES`."""
+    if estimator.kernels_available() or not UNCOMPILED.left():
         estimator.compiled()
 
 
 def run_batch(estimator, t, y, fed: int = 0) -> EstimateArrays:
     """``estimator.process(t, y)`` for the samples after the ``fed`` already processed, switched
-    to its compiled kernels at sample :data:`UNCOMPILED_SAMPLES` if it still runs uncompiled
+    to its compiled kernels once this process has run :data:`UNCOMPILED_SAMPLES` uncompiled
+    (:data:`UNCOMPILED`; ``fed`` of them this record's) if it still runs uncompiled
     (:func:`batch_start`). The switch is between two samples, on the same state; the algebraic
     estimator's floats are the same either way, the mode tracker's within ~1e-9 relative
     (:class:`~.modes.ModeTracker`)."""
     if not estimator.interpreted:
         return estimator.process(t, y)
-    k = max(UNCOMPILED_SAMPLES - fed, 0)
+    k = UNCOMPILED.left(fed)
     if k >= len(t):
+        UNCOMPILED.spent += len(t)
         return estimator.process(t, y)
     t, y = np.asarray(t), np.asarray(y)
     first = estimator.process(t[:k], y[:k])
+    UNCOMPILED.spent += k
     estimator.compiled()
     return EstimateArrays.concatenate([first, estimator.process(t[k:], y[k:])])
