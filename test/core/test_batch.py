@@ -25,8 +25,9 @@ def _decay(n, rate=500.0):
     'config', [EstimatorConfig(), EstimatorConfig(modes=3)], ids=['default', 'modes: 3']
 )
 def test_a_batch_run_switches_to_its_compiled_kernels_at_uncompiled_samples(config, monkeypatch):
-    """Fed as a record's samples UNCOMPILED_SAMPLES - 300 on (``fed``), the uncompiled estimator
-    runs 300 more uncompiled, then compiled; a whole short record (fed 0) stays uncompiled. The
+    """In a process that has run UNCOMPILED_SAMPLES - 300 samples uncompiled (``UNCOMPILED``),
+    the uncompiled estimator runs 300 more uncompiled, then compiled; a whole short record in a
+    fresh process stays uncompiled. The
     estimates are those of the compiled estimator (the mode tracker's within 1e-9: subspace's
     reassociated sums)."""
     switched_at = []
@@ -39,13 +40,15 @@ def test_a_batch_run_switches_to_its_compiled_kernels_at_uncompiled_samples(conf
         compiled(self)
 
     monkeypatch.setattr(type(estimator), 'compiled', spy)
-    got = E.run_batch(estimator, t, y, fed=E.UNCOMPILED_SAMPLES - 300)
+    monkeypatch.setattr(E.UNCOMPILED, 'spent', E.UNCOMPILED_SAMPLES - 300)
+    got = E.run_batch(estimator, t, y)
     assert switched_at == [300] and not estimator.interpreted
     want = create_estimator(config).process(t, y)
     assert len(got) == len(want) > 3 and list(got.t) == list(want.t)
     np.testing.assert_allclose(
         got.frequency_hz, want.frequency_hz, rtol=1e-9 if config.modes else 0
     )
+    monkeypatch.setattr(E.UNCOMPILED, 'spent', 0)  # a fresh process
     short = create_uncompiled(config)
     E.run_batch(short, t, y)
     assert short.interpreted and switched_at == [300]  # 1200 samples, all uncompiled
@@ -115,7 +118,7 @@ def test_a_long_record_pays_the_compile_before_its_end(monkeypatch):
     estimator = batch_estimator(config)
     got = E.EstimateArrays.concatenate(
         [
-            E.run_batch(estimator, t[i : i + 20_000], y[i : i + 20_000], i)
+            E.run_batch(estimator, t[i : i + 20_000], y[i : i + 20_000])
             for i in range(0, len(t), 20_000)
         ]
     )

@@ -271,7 +271,7 @@ def estimate_signal(
             )
             nyquist_checked = True
         first_t = float(t[0]) if first_t is None else first_t
-        parts.append(run_batch(estimator, t, y - offset if offset else y, count))
+        parts.append(run_batch(estimator, t, y - offset if offset else y))
         count, previous = count + len(t), float(t[-1])
         if keep_samples:
             kept.append((t, y))

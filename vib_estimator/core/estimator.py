@@ -546,10 +546,9 @@ class UncompiledBudget:
     def __init__(self) -> None:
         self.spent = 0
 
-    def left(self, fed: int = 0) -> int:
-        """Samples still to run uncompiled (``fed``: those of the current record already run,
-        spent in this process or not)."""
-        return max(UNCOMPILED_SAMPLES - max(fed, self.spent), 0)
+    def left(self) -> int:
+        """Samples still to run uncompiled."""
+        return max(UNCOMPILED_SAMPLES - self.spent, 0)
 
 
 #: this process's budget of uncompiled batch samples
@@ -565,16 +564,15 @@ def batch_start(estimator) -> None:
         estimator.compiled()
 
 
-def run_batch(estimator, t, y, fed: int = 0) -> EstimateArrays:
-    """``estimator.process(t, y)`` for the samples after the ``fed`` already processed, switched
-    to its compiled kernels once this process has run :data:`UNCOMPILED_SAMPLES` uncompiled
-    (:data:`UNCOMPILED`; ``fed`` of them this record's) if it still runs uncompiled
-    (:func:`batch_start`). The switch is between two samples, on the same state; the algebraic
-    estimator's floats are the same either way, the mode tracker's within ~1e-9 relative
-    (:class:`~.modes.ModeTracker`)."""
+def run_batch(estimator, t, y) -> EstimateArrays:
+    """``estimator.process(t, y)`` (continuing its record), switched to its compiled kernels once
+    this process has run :data:`UNCOMPILED_SAMPLES` uncompiled (:data:`UNCOMPILED`: this
+    record's earlier blocks among them) if it still runs uncompiled (:func:`batch_start`). The
+    switch is between two samples, on the same state; the algebraic estimator's floats are the
+    same either way, the mode tracker's within ~1e-9 relative (:class:`~.modes.ModeTracker`)."""
     if not estimator.interpreted:
         return estimator.process(t, y)
-    k = UNCOMPILED.left(fed)
+    k = UNCOMPILED.left()
     if k >= len(t):
         UNCOMPILED.spent += len(t)
         return estimator.process(t, y)
