@@ -16,6 +16,7 @@ around the mode, and a window of about one period reads that spread as a 2 % shi
 
     cd benchmarks && ../.venv/bin/python bench_first_estimate.py [--real-data DIR] [--periods P..]
     cd benchmarks && ../.venv/bin/python bench_first_estimate.py --sweep   # SWEEP, 6 seeds each
+    cd benchmarks && ../.venv/bin/python bench_first_estimate.py --rest    # REST, on an offset
     cd benchmarks && ../.venv/bin/python bench_first_estimate.py --noisy   # NOISY, beside free
     cd benchmarks && ../.venv/bin/python bench_first_estimate.py --onset   # a pluck after rest
     cd benchmarks && ../.venv/bin/python bench_first_estimate.py --low-rate  # few samples a period
@@ -96,6 +97,15 @@ SWEEP = (
 )
 
 
+#: ``--rest``: SWEEP's decays damped at 2 % and more, and more of them in 40-50 dB
+REST = tuple(c for c in SWEEP if c[1] >= 0.02) + (
+    (1.86, 0.027, 42),
+    (5.0, 0.03, 45),
+    (14.8, 0.02, 50),
+    (3.9, 0.016, 50),
+)
+
+
 def decided(t: np.ndarray, y: np.ndarray):
     """``analyze``'s decided configuration of ``(t, y)``, the samples it estimates (less the
     decided offset) and the decision."""
@@ -115,13 +125,15 @@ NOISY = (
 )
 
 
-def sweep(cases=SWEEP, seeds: int = 6, offset: float = 0.0, free: bool = False) -> int:
+def sweep(
+    cases=SWEEP, seeds: int = 6, offset: float = 0.0, free: bool = False, rest_s: float = 0.0
+) -> int:
     """The decided configuration (as ``analyze`` applies it) on each decay of ``cases`` ((f, zeta,
     SNR) at 50 samples a period, or (f, zeta, SNR, samples a period)) plus ``offset``, ringing six
-    time constants, over ``seeds`` noise seeds: the least and mean share within 2 %, the median
-    and largest of the records' median convergence (periods); with ``free`` the RMS error (%)
-    and the same figures of ``--excitation free``'s configuration (biased sinusoid, 1.25
-    periods) beside them."""
+    time constants after ``rest_s`` seconds at rest, over ``seeds`` noise seeds: the least and mean
+    share within 2 %, the median and largest of the records' median convergence (periods); with
+    ``free`` the RMS error (%) and the same figures of ``--excitation free``'s configuration
+    (biased sinusoid, 1.25 periods) beside them."""
     extra = ' RMS error % | free: within 2 %, RMS error % | free: conv |' if free else ''
     print(
         '| decay | early_std_rel decided | within 2 %: least, mean | conv: median, largest |'
@@ -134,8 +146,14 @@ def sweep(cases=SWEEP, seeds: int = 6, offset: float = 0.0, free: bool = False) 
         for seed in range(seeds):
             rng = np.random.default_rng(300 + seed)
             fs = max(100.0, per_period * f)
-            t = np.arange(0, min(30.0, 6.0 / (zeta * 2 * np.pi * f)), 1 / fs)
-            y = np.exp(-zeta * 2 * np.pi * f * t) * np.sin(2 * np.pi * f * t + seed) + offset
+            t = np.arange(0, rest_s + min(30.0, 6.0 / (zeta * 2 * np.pi * f)), 1 / fs)
+            tt = np.maximum(t - rest_s, 0.0)
+            y = (
+                (t >= rest_s)
+                * np.exp(-zeta * 2 * np.pi * f * tt)
+                * np.sin(2 * np.pi * f * tt + seed)
+            )
+            y += offset
             y += 10 ** (-snr / 20) / np.sqrt(2) * rng.standard_normal(len(t))
             config, y_used, _ = decided(t, y)
             early = f'{config.early_std_rel:g}' + (
@@ -395,6 +413,11 @@ def main() -> int:
         '--sweep', action='store_true', help='the decided window on SWEEP, 6 seeds each'
     )
     parser.add_argument(
+        '--rest',
+        action='store_true',
+        help='REST: damped decays after 2 s at rest, on an offset of 0.3',
+    )
+    parser.add_argument(
         '--noisy',
         action='store_true',
         help='the decided configuration beside free on NOISY, 6 seeds each; the CRB',
@@ -422,6 +445,8 @@ def main() -> int:
         return at_start()
     if args.sweep:
         return sweep()
+    if args.rest:
+        return sweep(REST, offset=0.3, rest_s=2.0)
     if args.noisy:
         noisy_bound()
         return sweep(NOISY, offset=0.05, free=True)

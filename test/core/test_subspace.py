@@ -30,7 +30,8 @@ def window(m, parts, noise=0.0, seed=0):
 
 
 def run(x, npc=10, steps=4):
-    """analyse() on the same window a few times (the subspace is warm-started)."""
+    """analyse() on the same window a few times (the subspace is warm-started): the pairs by
+    frequency, residual variance, R^2, level."""
     lag = len(x) // 3
     q = np.zeros((lag + 1, npc))
     init_subspace(q)
@@ -38,9 +39,9 @@ def run(x, npc=10, steps=4):
     rows = np.zeros((npc, 4))
     roots = np.full((2, npc), np.nan)
     for _ in range(steps):
-        k, var, r2 = analyse(x, q, lam, roots, 6.0, rows)
+        k, var, r2, level = analyse(x, q, lam, roots, 6.0, rows)
     order = np.argsort(rows[:k, R_NU])
-    return rows[:k][order], var, r2
+    return rows[:k][order], var, r2, level
 
 
 def test_building_blocks():
@@ -64,9 +65,11 @@ def test_building_blocks():
 
 def test_a_clean_window_gives_its_sinusoids_exactly():
     parts = [(0.03, 0.01, 1.0, 0.3), (0.041, 0.0, 0.5, 1.0), (0.15, 0.02, 0.05, 2.0)]
-    x = window(68, parts) + 0.2  # an offset: a real pole
-    rows, var, r2 = run(x)
+    x = window(68, parts) + 0.2  # an offset: a real pole, the window's level
+    rows, var, r2, level = run(x)
     assert len(rows) == 3 and r2 > 1 - 1e-12
+    assert level == pytest.approx(0.2, rel=1e-6)
+    assert run(window(68, parts))[3] == 0.0  # no real pole: no level
     for row, (nu, zeta, amp, _) in zip(rows, parts):
         assert row[R_NU] == pytest.approx(nu, rel=1e-7)
         assert row[R_ZETA] == pytest.approx(zeta, abs=1e-7)
@@ -78,7 +81,7 @@ def test_close_sinusoids_in_noise(seed):
     """Two sinusoids 30 % apart, 1.9 cycles of the lower in the window, SNR 30 dB (weaker)."""
     parts = [(1.9 / 48, 0.0, 1.0, 0.4 + seed), (1.3 * 1.9 / 48, 0.0, 0.5, 2.0 - seed)]
     x = window(48, parts, noise=0.5 / np.sqrt(2) * 10 ** (-30 / 20), seed=seed)
-    rows, var, r2 = run(x)
+    rows, *_ = run(x)
     assert len(rows) == 2
     for row, (nu, *_) in zip(rows, parts):
         assert abs(row[R_NU] / nu - 1) < 0.02
