@@ -522,8 +522,8 @@ def test_a_small_quantised_limit_cycle_gives_its_frequency_and_no_staircase(
     a steady oscillation, the mode tracker in a band about it -- no "mode" at its slow
     stretches' staircase (1 mm every ~23 ms: 42-43 Hz in 3 of 6 seeds without the band; flex1:
     65 Hz) --, every estimate within 5 % of its mean frequency (which wanders by ~1 % in a
-    second). ``STEADY_BAND`` at 1000x leaves the staircase in; at 0.001x the band is no band
-    (an ``error:``)."""
+    second). ``STEADY_BAND`` at 1000x leaves the staircase in (seeds 1-6: 0-2.4 % of the
+    estimates beyond 5 %, none with the band); at 0.001x the band is no band (an ``error:``)."""
     from vib_estimator.core import choice
 
     if factor:
@@ -536,7 +536,7 @@ def test_a_small_quantised_limit_cycle_gives_its_frequency_and_no_staircase(
         out, err = capsys.readouterr()
         f = np.array([json.loads(line)['frequency_hz'] for line in out.splitlines()])
         found.append(code == 0 and 'a steady oscillation (a limit cycle' in err and len(f) >= 60)
-        found.append(bool(len(f)) and np.mean(np.abs(f / 1.8116 - 1) > 0.05) <= 0.02)
+        found.append(bool(len(f)) and np.all(np.abs(f / 1.8116 - 1) <= 0.05))
     assert all(found) == (factor is None)
 
 
