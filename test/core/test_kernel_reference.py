@@ -7,7 +7,9 @@ A change that only restructures the kernels (compile time, speed) must leave eve
 this test compares each case's estimate columns and counters with ``data/kernel_reference.npz``
 exactly (NaN equal to NaN). The reference was written by the kernel of 7374e6d with
 ``python test/core/test_kernel_reference.py --write``; a change meant to alter the results (a new
-gate rule, a default) rewrites it with that command and says so in its commit.
+gate rule, a default) rewrites the cases it moves with ``--write CASE ...`` (each run with the
+configuration the reference stores for it; the cases not named are copied) and says so in its
+commit.
 
 Each case stores its whole configuration, so a later change of a default does not move the case;
 a parameter added since is set to the value that leaves the kernel as it was (:data:`ADDED_SINCE`,
@@ -231,16 +233,32 @@ def _assert_same(name, col, got, want, rtol=None) -> None:
         np.testing.assert_array_equal(got, want, err_msg=col)
 
 
-def write() -> None:
-    """Write the reference of every case (run on the kernel the reference is meant to pin)."""
+def write(only=()) -> None:
+    """Write the reference of the cases named in ``only`` (all when empty), each run with the
+    configuration the reference already stores for it (a new case: today's defaults with its
+    changes); the other cases are copied as they are. Run on the kernel the reference is meant to
+    pin."""
+    stored = {}
+    if DATA.exists():
+        with np.load(DATA) as data:
+            stored = {k: data[k] for k in data.files}
+    unknown = set(only) - {case[0] for case in CASES}
+    if unknown:
+        sys.exit(f'error: no such case: {", ".join(sorted(unknown))}')
     store = {}
     for name, kind, seed, changes in CASES:
-        config = _config(changes)
+        if only and name not in only and f'{name}/config' in stored:
+            store.update({k: v for k, v in stored.items() if k.startswith(name + '/')})
+            continue
+        known = f'{name}/config' in stored
+        config = _stored_config(stored, name) if known else _config(changes)
         cols, counters = _run(name, kind, seed, config)
         for col, v in cols.items():
             store[f'{name}/{col}'] = v
         store[f'{name}/counters'] = counters
-        store[f'{name}/config'] = np.array(json.dumps(dataclasses.asdict(config)))
+        store[f'{name}/config'] = (
+            stored[f'{name}/config'] if known else np.array(json.dumps(dataclasses.asdict(config)))
+        )
         print(f'{name:22s} {len(cols["t"]):4d} estimates')
     DATA.parent.mkdir(exist_ok=True)
     np.savez_compressed(DATA, **store)
@@ -488,6 +506,10 @@ def test_today_s_defaults_and_the_ambient_estimators_give_the_reference(name, ki
 
 
 if __name__ == '__main__':
-    if sys.argv[1:] not in (['--write'], ['--write-today']):
-        sys.exit(f'usage: python {sys.argv[0]} --write | --write-today')
-    write() if sys.argv[1] == '--write' else write_today()
+    if (
+        not sys.argv[1:]
+        or sys.argv[1] not in ('--write', '--write-today')
+        or (sys.argv[1] == '--write-today' and sys.argv[2:])
+    ):
+        sys.exit(f'usage: python {sys.argv[0]} --write [CASE ...] | --write-today')
+    write(sys.argv[2:]) if sys.argv[1] == '--write' else write_today()

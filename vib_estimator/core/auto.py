@@ -624,9 +624,8 @@ class AutoEstimator(Estimator):
 
     def restart(self) -> None:
         """Forget the signal and the known modes; counters are kept (the envelope's too)."""
-        self._free.restart()
-        self._ambient.restart()
-        self._envelope.restart()
+        for part in (self._free, self._ambient, self._envelope):
+            part.restart()
         self._modes.clear()
         self._filled = 0
 

@@ -1629,10 +1629,15 @@ class StreamChoice:
         self._silent_retry = now
         if not self.watch.ringing():
             return None
+        return self._kept_decision(window_s, lambda chosen: self._silent_decay(now, chosen))
+
+    def _kept_decision(self, window_s: float, one_mode) -> Optional[Decision]:
+        """:func:`decide` over the kept samples: None unless it reads a free decay; its decision
+        when that takes the mode tracker, else ``one_mode(decision)``."""
         chosen = decide(*self.kept(), self.channels, window_s, stream=True)
-        if chosen.excitation != 'free' or chosen.modes:
-            return chosen if chosen.excitation == 'free' else None
-        return self._silent_decay(now, chosen)
+        if chosen.excitation != 'free':
+            return None
+        return chosen if chosen.modes else one_mode(chosen)
 
     def _silent_decay(self, now: float, chosen: Decision) -> Optional[Decision]:
         """The mode tracker for a free decay of one mode (``chosen``, :func:`decide` over the
@@ -1665,10 +1670,7 @@ class StreamChoice:
         if not (self.watch.live() and self.watch.freed()):
             return None
         self._silent_retry = now
-        chosen = decide(*self.kept(), self.channels, window_s, stream=True)
-        if chosen.excitation != 'free' or chosen.modes:
-            return chosen if chosen.excitation == 'free' else None
-        return self._steady_tracker(chosen)
+        return self._kept_decision(window_s, self._steady_tracker)
 
     def _steady_tracker(self, chosen: Decision) -> Decision:
         """:func:`decide`'s free decision of one mode ``chosen``, given the mode tracker for a
