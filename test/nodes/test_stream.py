@@ -417,7 +417,11 @@ def test_the_deciding_stream_publishes_no_free_estimate_of_a_driven_input_before
     assert max(off) > 0.04 and undecided.counters['not_free_decay'] == 0
     assert all(abs(e.frequency_hz / 5 - 1) <= 0.02 for e in published)
     assert len(published) <= 2 and deciding.counters['not_free_decay'] >= len(held) - 2
-    assert 'not_free_decay' in deciding.status(now=56.0).message
+    early = EstimatorStream(EstimatorConfig(), now=0.0, deciding=True)
+    assert not decisions(early, t[:7500], y[:7500], step=500)  # 15 s: not decided yet
+    assert 'not_free_decay' in early.status(now=16.0).message
+    # decided, the identifier runs: what held the free estimator back is no longer its reason
+    assert 'not_free_decay' not in deciding.status(now=56.0).message
     ring_t = np.arange(0, 12, 0.002)
     ring = np.exp(-0.01 * 2 * np.pi * 5 * ring_t) * np.sin(2 * np.pi * 5 * ring_t)
     ring += 0.002 * np.random.default_rng(0).standard_normal(len(ring_t))
@@ -425,6 +429,28 @@ def test_the_deciding_stream_publishes_no_free_estimate_of_a_driven_input_before
     offline = FrequencyEstimator().process(np.round(ring_t * 1e9).astype(np.int64) * 1e-9, ring)
     assert len(free) >= 5
     assert [e.frequency_hz for e in free] == offline.frequency_hz.tolist()[: len(free)]
+
+
+def test_after_its_decision_the_status_says_how_much_of_the_window_it_holds():
+    """A driven input decided at ~20 s for a 30-s window: until that window is full, the status
+    is OK and says how much of it is held (the primed seconds and those since), not the free
+    estimator's holds before the decision; then the identifier's estimates."""
+    from vib_estimator.sim.ambient import ambient_record
+
+    t, y, _ = ambient_record(36, 500, [(5.0, 0.01, 1.0)], 20, 0)
+    stream = EstimatorStream(EstimatorConfig(), now=0.0, deciding=True)
+    got = []
+    (at, decision), *_ = decisions(stream, t, y, step=500, estimates=got)
+    assert 19 <= at <= 22 and decision.excitation == 'ambient' and decision.window_s == 30
+    first = min(k for k, _, _ in got)
+    assert 30 <= first <= 32  # (a window of input since the start)
+    again = EstimatorStream(EstimatorConfig(), now=0.0, deciding=True)
+    decisions(again, t[:13500], y[:13500], step=500)  # until 27 s
+    status = again.status(now=28.0)
+    assert status.level == H.OK, status.message
+    held = float(status.message.split(': ')[1].split(' s of its 30 s window held')[0])
+    assert 26.5 <= held <= 27.5  # (27 s of input: the stream time of its last sample)
+    assert 'window held' not in stream.status(now=37.0).message
 
 
 def plucked(modes, seconds=12.0, rate=500.0):

@@ -258,6 +258,11 @@ class Health:
             self._last = last
         self._held_at = {name: totals.get(name, 0) for name in HELD_BACK}
 
+    def restart_holds(self, totals: Mapping[str, int]) -> None:
+        """The held-back counters count from ``totals`` (:meth:`totals`): a new configuration
+        runs, and what held the one it replaced back no longer says why it is silent."""
+        self._held_at = {name: totals.get(name, 0) for name in HELD_BACK}
+
     @property
     def last_estimate(self):
         """The last estimate of ``vibration/frequency`` (None before the first)."""
@@ -276,13 +281,16 @@ class Health:
         band_hz: Optional[Sequence[float]] = None,
         modes: int = 0,
         hint: Optional[str] = None,
+        waiting: Optional[str] = None,
     ) -> Status:
         """The status at ``now``; updates the rates and the ``band_above_nyquist`` counter.
 
         STALE without input for :attr:`stale_after` s; WARN when a :data:`HELD_BACK` counter grew
-        since the last estimate, when JointState messages lacked the joint since the last call,
-        when ``band_hz`` reaches the Nyquist frequency of the input, or with a ``hint`` (what the
-        input shows that the configuration does not fit; logged when it starts); OK otherwise.
+        since the last estimate (or configuration, :meth:`restart_holds`), when JointState
+        messages lacked the joint since the last call, when ``band_hz`` reaches the Nyquist
+        frequency of the input, or with a ``hint`` (what the input shows that the configuration
+        does not fit; logged when it starts); OK otherwise, its message ``waiting`` when given
+        (what the estimator waits for).
         """
         tick = self._tick
         counted = dict(self.node_counters)  # what this call adds goes into the values too
@@ -316,6 +324,8 @@ class Health:
             level, message = STALE, 'no input'
         elif problems:
             level, message = WARN, '; '.join(problems)
+        elif waiting:
+            level, message = OK, waiting
         elif self._last is None:
             level, message = OK, 'waiting for a first estimate'
         else:

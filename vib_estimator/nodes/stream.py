@@ -176,6 +176,8 @@ class EstimatorStream:
         self._advice: Tuple[float, str] = (-math.inf, '')
         #: the samples a new estimator is primed with (:meth:`configure`)
         self._primer: Tuple[np.ndarray, np.ndarray] = NO_PRIMER
+        #: (stream time, seconds of input primed) of the last :meth:`configure` (:meth:`_waiting`)
+        self._configured: Tuple[Optional[float], float] = (None, 0.0)
         #: :meth:`decision` is asked (the node's ``decide_excitation``): no hint, a switch
         self.deciding = deciding
         #: a configuration was built since the last :func:`release_memory` (the node's 1-s
@@ -223,6 +225,8 @@ class EstimatorStream:
             and (config.excitation != 'free' or config.modes > 0)
         )
         self._primer = self._choice.kept() if primes else NO_PRIMER
+        primed = self._primer[0]
+        self._configured = (self.last_t, float(primed[-1] - primed[0]) if len(primed) else 0.0)
         self.channels = channels
         self.trim_due = True
         if self.estimator is not None:
@@ -239,6 +243,7 @@ class EstimatorStream:
                 self._build = _Build(config, channels)
         else:
             self._install(create_estimator(config, channels))
+        self.health.restart_holds(self.counters)
 
     def _decidable(self, config: EstimatorConfig, channels: Tuple[str, ...]) -> tuple:
         """The identifier a deciding stream on one channel may switch to (``auto``), to be
@@ -380,6 +385,7 @@ class EstimatorStream:
             config.band_hz,
             config.modes,
             self._driven_hint() or self._silent_hint(),
+            self._waiting(),
         )
         if self.compiling:  # estimating uncompiled meanwhile
             status.values['warmup_s'] = self.warmup_elapsed(now)
@@ -406,6 +412,22 @@ class EstimatorStream:
             f'the input looks driven ({100 * share:.0f} % of the energy of the last {span:.0f} '
             's): free-decay estimates of a driven structure scatter; '
             'excitation:=ambient identifies its modes (auto: both, per stretch)'
+        )
+
+    def _waiting(self) -> Optional[str]:
+        """Under the identifier (``excitation`` ambient or auto), before its first estimate since
+        it was configured and while its window is not full yet: how much of it it holds (the
+        input primed at a decision, and since); else None."""
+        config = self.config
+        at, primed = self._configured
+        if config.excitation == 'free' or self.last_t is None or self._estimated_at != at:
+            return None
+        held = primed + self.last_t - (at or 0.0)
+        if held >= config.ambient_window_s:
+            return None
+        return (
+            f'identifying the modes (excitation {config.excitation}): {held:.0f} s of its '
+            f'{config.ambient_window_s:g} s window held, the first estimate when it is full'
         )
 
     def _silent_hint(self) -> Optional[str]:
