@@ -101,6 +101,7 @@ TESTS = {
         'test/core/test_bad_input.py',
         'test/core/test_kernel_reference.py',
         'test/core/test_precision.py',
+        'test/core/test_kernel_early.py',  # the long window's start: onsets, releases, stalls
     ],
     'modes': [
         'test/core/test_modes.py',
