@@ -78,7 +78,10 @@ def test_a_pluck_after_rest_is_estimated_from_the_pluck(rate, seed):
     a period, estimated as ``analyze`` decides such a decay (the damped model over 0.9 periods
     where precise): the segment running in the rest restarts at the pluck
     (core.kernel.ONSET_RATIO), so the first estimate comes within 3 periods of it and there are
-    about as many as on the record cut at the pluck, all within 2 %. Before (and with
+    about as many as on the record cut at the pluck, all within 2 %; its segment starts once the
+    interpolation stencil holds none of the rest before the jump, so its first estimate comes
+    when the cut record's does (within 0.2 periods; with the stencil across the jump, 0.6 later
+    at 30 samples a period, until 7 Dec 2026). Before (and with
     ONSET_RATIO at 1000x): at 30 samples a period none on seed 2 and 37 against 52 on seed 1,
     the first after 16.5 periods; at 500 the first after 2.5-4.7 periods (the segment begun in
     the rest converged long after the pluck); at 0.001x every sample restarts the segment: no
@@ -92,39 +95,53 @@ def test_a_pluck_after_rest_is_estimated_from_the_pluck(rate, seed):
     e = estimate(t, y, config)
     cut = estimate(t[t >= 1.0], y[t >= 1.0], config)
     assert len(e) >= 0.9 * len(cut) > 0
-    assert (e.t[0] - 1.0) * f <= 3.0
+    assert (e.t[0] - 1.0) * f <= min(3.0, (cut.t[0] - 1.0) * f + 0.2)
     assert np.all(np.abs(e.frequency_hz / f - 1) <= 0.02)
 
 
-@pytest.mark.parametrize('seed', [0, 1, 2])
-def test_a_second_pluck_after_the_first_rang_down_is_an_onset_too(seed, rate=500):
-    """Two 10 Hz plucks (zeta 2 %, 37 dB), at 1 s and, half as strong, at 8 s (the first rang
-    down into the noise by 6 s): the second is an onset as the first is (core.kernel.ONSET_RATIO),
-    since the signal's running scale (its peak deviation, decaying by ``SCALE_WEIGHT`` a sample)
-    has followed the first down, so its first estimate comes within 3 periods of it, about as
-    many as on the record cut there, all within 2 %. With ``SCALE_WEIGHT`` at 0.001x the scale
-    keeps the first pluck's peak for good, and the second pluck's segments run on from the rest
-    (at 1000x the scale follows the noise sample by sample: onsets everywhere). At 30 samples a
-    period (300 Hz) the scale's 1024 samples are 3.4 s, and the second pluck is missed on seed 1:
-    docs/known_limits.md."""
-    f, second = 10.0, 8.0
-    t = np.arange(0, 13, 1 / (rate * f))
+@pytest.mark.parametrize('seed', [0, 1, 2, 3])
+@pytest.mark.parametrize(
+    'rate, zeta, second, margin',
+    [(30, 0.02, 8.0, 0.2), (2000, 0.1, 2.0, 0.3)],
+    ids=['300Hz', '20kHz'],
+)
+def test_a_second_pluck_after_the_first_rang_down_is_an_onset_too(
+    rate, zeta, second, margin, seed
+):
+    """Two 10 Hz plucks in 37 dB, the second (zeta 2 %) half as strong, once the first rang down
+    into the noise: 7 s after a 2 %-damped one at 300 Hz (30 samples a period), 1 s after a
+    10 %-damped one at 20 kHz. The second is an onset as the first is (core.kernel.ONSET_RATIO):
+    the onset test's running peak deviation has followed the first down (decaying by
+    ``SCALE_WEIGHT`` a sample, or over ``PEAK_TAU_S`` where that is faster), and its segment
+    starts once the interpolation stencil holds none of the rest before the jump, so its first
+    estimate comes within ``margin`` periods of the first on the record cut at it (the same on
+    every seed at 300 Hz), at least 0.6 as many within 2 % (the tail's count varies with the
+    noise), none beyond 5 %. With ``PEAK_TAU_S`` at 1000x (the 1024 samples
+    alone, 3.4 s at 300 Hz: as before 7 Dec 2026) the peak is still 0.13 of the first pluck's at
+    300 Hz, and on seed 1 the second is no onset: its segment, begun at the first decay's last
+    estimate in the noise, gives nothing for its 5 s (the others 2.3-5.2 periods to a first
+    estimate); with ``SCALE_WEIGHT`` at 0.001x the peak decays over 1 s at 20 kHz, and the first
+    estimate comes 0.6 periods later than on the cut record; either at 0.001x (and
+    ``SCALE_WEIGHT`` at 1000x) the peak follows the noise sample by sample: onsets
+    everywhere."""
+    f = 10.0
+    t = np.arange(0, second + 5, 1 / (rate * f))
     y = 0.01 / np.sqrt(2) * np.random.default_rng(seed).standard_normal(len(t))
-    for start, amplitude in ((1.0, 1.0), (second, 0.5)):
+    for start, amplitude, z in ((1.0, 1.0, zeta), (second, 0.5, 0.02)):
         tau = np.maximum(t - start, 0.0)
         y += (
             amplitude
-            * np.exp(-0.02 * 2 * np.pi * f * tau)
+            * np.exp(-z * 2 * np.pi * f * tau)
             * np.sin(2 * np.pi * f * tau + 1.0)
             * (t >= start)
         )
     config = EstimatorConfig(model='damped-sinusoid', min_periods=FAST_PERIODS, early_std_rel=0.01)
-    after = estimate(t, y, config)
-    after = after.t[after.t > second], after.frequency_hz[after.t > second]
+    e = estimate(t, y, config)
+    after = e.t > second
     cut = estimate(t[t >= second], y[t >= second], config)
-    assert len(after[0]) >= 0.9 * len(cut) > 0
-    assert (after[0][0] - second) * f <= 3.0
-    assert np.all(np.abs(after[1] / f - 1) <= 0.02)
+    error = np.abs(e.frequency_hz[after] / f - 1)
+    assert np.sum(error <= 0.02) >= 0.6 * len(cut) > 0 and np.all(error <= 0.05)
+    assert (e.t[after][0] - second) * f <= (cut.t[0] - second) * f + margin
 
 
 @pytest.mark.parametrize('rest, pull, seed', [(1.0, 0.1, 0), (2.0, 0.02, 1), (2.0, 0.1, 1)])

@@ -95,6 +95,34 @@ def test_a_close_pair_is_estimated_within_two_periods():
     assert np.all(np.median(firsts, axis=0) < 2.0)
 
 
+@pytest.mark.parametrize('seed', [1013, 1023])
+def test_a_close_pair_s_first_estimates_agree_with_the_poles_before_them(seed):
+    """Two modes 15-42 % apart plucked together (16.9 / 19.4 Hz at 1 : 0.74 in 32 dB, 10.1 /
+    14.3 Hz at 1 : 0.93 in 36 dB; zeta 0.7-0.8 %; ``modes`` 3): a close pair's first estimates
+    come from the undamped refinement of short windows and must lie within
+    ``CONSISTENCY_FIRST`` (3 %) of the pole before them, so every mode's first estimate is
+    within 2 % of its true frequency (1.5 and 1.2 % at worst). At 1000x a merged pole of a
+    window straddling both is published as a first estimate: 3.7 and 2.3 % off (a scratch
+    sweep of 80 such pairs: the worst first estimate worse on 7, better on 1 by 0.01 %)."""
+    rng = np.random.default_rng(seed)
+    f1, ratio = rng.uniform(5, 20), rng.uniform(1.12, 1.45)
+    a2, snr, zeta = rng.uniform(0.2, 1.0), rng.uniform(25, 40), rng.uniform(0.001, 0.01)
+    phases = rng.uniform(0, 6.28, 2)
+    t = np.arange(0, 4, 1 / FS)
+    y = sum(
+        (t >= 1.0)
+        * a
+        * np.exp(-zeta * 2 * np.pi * f * (t - 1.0))
+        * np.sin(2 * np.pi * f * math.sqrt(1 - zeta**2) * (t - 1.0) + ph)
+        for f, a, ph in ((f1, 1.0, phases[0]), (f1 * ratio, a2, phases[1]))
+    )
+    y = y + a2 / math.sqrt(2) * 10 ** (-snr / 20) * rng.standard_normal(len(t))
+    e = ModeTracker(EstimatorConfig(modes=3)).process(t, y)
+    rel = np.min(np.abs(e.frequency_hz[:, None] / np.array([f1, f1 * ratio]) - 1), axis=1)
+    firsts = [rel[np.flatnonzero(e.mode == m)[0]] for m in np.unique(e.mode)]
+    assert len(firsts) >= 2 and max(firsts) <= 0.02, firsts
+
+
 def test_a_mode_appears_and_one_disappears():
     t = np.arange(0, 16, 1 / FS)
     first = decay(t, 0.5, 9.0, 1.0, 0.0) * (t < 7.0)  # stops at 7 s (into the noise)

@@ -129,7 +129,8 @@ S_TLAST = 1  # time of the last accepted sample
 S_HRUN = 2  # running sample interval (kept across restarts: it describes the stream)
 S_YC = 3  # running centre of the raw signal (outlier test), kept across restarts
 S_YR = 4  # running (decaying) peak of |y - centre|, kept across restarts
-S_HT = 5  # NH last sample times (oldest first)
+S_YO = 5  # ... the same decaying within PEAK_TAU_S at least: the onset test's, kept too
+S_HT = 6  # NH last sample times (oldest first)
 S_HY = S_HT + NH  # NH last (prefiltered) sample values
 S_MOM = S_HY + NH  # moments M0..M4
 S_NF = S_MOM + 5  # low-pass state of n: x5, x6 (Eq. 11)
@@ -220,9 +221,23 @@ HRUN_WEIGHT = 1.0 / 16.0
 SCALE_WEIGHT = 1.0 / 1024.0
 SCALE_WARMUP = 64
 OUTLIER_RUN = 4
+#: the onset test's peak deviation (``S_YO``) decays by the same weight a sample, or over this
+#: time constant (s) where that is faster (below 1024 samples a second): a pluck after the last one
+#: rang down into the noise is an onset (:data:`ONSET_RATIO`) once that peak has followed the
+#: decay down. With the 1024 samples alone (3.4 s at 300 Hz), two 10 Hz plucks 7 s apart, the
+#: second half as strong: the peak still 0.13 of the first one's, the second no onset on 1 of 12
+#: seeds, nothing estimated for its 5 s, the others' first estimates 2.3-5.2 periods after it
+#: (now 2.1-2.2, as on the record cut at it; ``bench_first_estimate.py --second``). Only the
+#: onset's: the outlier test's and the half cycles' peak (``S_YR``) keeps its 1024 samples
+PEAK_TAU_S = 1.0
 #: a sample farther from the running centre than this many times the running peak of the
-#: deviation (``S_YR``: the last ~1000 samples) is an onset, a pluck after rest: the segment then
-#: running, begun in the rest before it, restarts at the sample before it (:func:`step`). Else
+#: deviation (``S_YO``: the last ~1000 samples, or second) is an onset, a pluck after rest: the
+#: segment then running, begun in the rest before it, restarts (:func:`step`): the interpolation
+#: stencil refills from that sample and the new segment begins once it is full, as a record's
+#: first does (until 7 Dec 2026 it began at the sample before, its stencil across the jump: the
+#: first intervals integrated wrongly, the first estimate 2.7 periods after a 10 Hz pluck at
+#: 300 Hz where the record cut at the pluck gives 2.1; bench_first_estimate.py --onset: now as
+#: cut at 10-500 samples a period). Else
 #: that segment's integrals hold the rest and the pluck's first samples, and it converges only
 #: seconds later: a 10 Hz pluck after 1 s of noise gave its first estimate 12.9 periods after the
 #: pluck at 5 kHz and none at all at 300 Hz and below (bench_first_estimate.py --onset)
@@ -547,7 +562,8 @@ def _stalled(p, s, c) -> bool:
 
 @jit(inline='always')
 def _restarts(p, s, c) -> bool:
-    """Whether the segment restarts at this sample (from the sample before it): at an onset
+    """Whether the segment restarts at this sample (from the sample before it; at an onset once
+    the stencil refilled, :func:`step`): at an onset
     (``C_ONSET``, :data:`ONSET_RATIO`; its run is then no pull's), a stalled segment
     (:func:`_stalled`) or a release (``S_RELEASE``, :func:`_half_cycle`) in a segment not begun at
     a published estimate (a decay's own segments are kept)."""
@@ -566,7 +582,8 @@ def _outlier(p, s, c, t, y):
 
     The signal's running centre ``S_YC`` (exponential average, weight :data:`SCALE_WEIGHT`) and
     scale ``S_YR`` (the peak of |y - centre|, decaying by the same weight per sample) describe the
-    stream, so they survive restarts. A value more than ``outlier_ratio`` scales from the centre,
+    stream, so they survive restarts, as does the onset test's peak ``S_YO`` (decaying within
+    :data:`PEAK_TAU_S` at least). A value more than ``outlier_ratio`` scales from the centre,
     or beyond :data:`MAX_ABS_VALUE`, is an outlier once :data:`SCALE_WARMUP` samples set the
     scale; :data:`OUTLIER_RUN` outliers in a row are a real change of level: that one is taken,
     the scale restarts from it and the estimator restarts.
@@ -582,18 +599,20 @@ def _outlier(p, s, c, t, y):
             c[C_OUTLIER] += 1
             return True
         s[S_YC] = y
-        s[S_YR] = dev
+        s[S_YR] = s[S_YO] = dev
         c[C_SCALE_N] = 1
         c[C_OUTLIER_RUN] = 0
         _restart(s, c)
         return False
     if c[C_SCALE_N] < SCALE_WARMUP:
         c[C_SCALE_N] += 1
-    elif dev > ONSET_RATIO * s[S_YR]:
+    elif dev > ONSET_RATIO * s[S_YO]:
         c[C_ONSET] = 1  # taken by step
     s[S_YC] = yc + SCALE_WEIGHT * (y - yc)
     decayed = (1.0 - SCALE_WEIGHT) * s[S_YR]
     s[S_YR] = dev if dev > decayed else decayed
+    decayed = (1.0 - max(SCALE_WEIGHT, s[S_HRUN] / PEAK_TAU_S)) * s[S_YO]
+    s[S_YO] = dev if dev > decayed else decayed
     _half_cycle(s, t, y - yc)
     if c[C_OUTLIER_RUN] != 0:
         c[C_OUTLIER_RUN] = 0
@@ -871,6 +890,7 @@ def forget_stream(s, c):
     s[S_HRUN] = 0.0
     s[S_YC] = 0.0
     s[S_YR] = 0.0
+    s[S_YO] = 0.0
     c[C_SCALE_N] = 0
     c[C_OUTLIER_RUN] = 0
 
@@ -997,8 +1017,12 @@ def step(p, s, c, seg, t, y, out, row, optional=None):
     if c[C_HIST_N] == 0:
         _first_sample(p, s, c, t, y)
         return 0
-    if _restarts(p, s, c) and c[C_HIST_N] == NH:  # a segment from the sample before it
-        reset_segment(s, c, seg, s[S_HT + NH - 1], s[S_HY + NH - 1])
+    onset = c[C_ONSET] != 0
+    if _restarts(p, s, c) and c[C_HIST_N] == NH:
+        if onset:  # the stencil refills from this sample (none straddles the jump)
+            c[C_HIST_N] = 0
+        else:  # a segment from the sample before it
+            reset_segment(s, c, seg, s[S_HT + NH - 1], s[S_HY + NH - 1])
     h = t - s[S_HT + NH - 1]  # the newest sample of the stencil is the previous one
     if abs(h - s[S_CACHE_H]) > 1e-9 * h:
         _update_discretisations(p, s, h)
