@@ -32,6 +32,7 @@ from ..core.choice import (
     DRIVEN_ABOVE,
     FREE_BELOW,
     MODE_GAP,
+    RESCUE_BELOW,
     SEGMENT_S,
     TRACKED_MODES,
     Decision,
@@ -119,12 +120,6 @@ def decided_config(
     return changed, line
 
 
-#: a free decay decided from the record whose free estimator gives fewer estimates than this is
-#: read again by the mode tracker (:func:`rescue`): one or two estimates, late in the decay's
-#: tail, are not a reading of it (a 5 Hz decay at zeta 4 % in 20 dB: one estimate 4.7 periods
-#: in, 4.7 % off, the tracker 19, all within 2 %; at 20 samples a period in 30 dB 1-2 estimates
-#: 20-29 periods in, the tracker 55); the simulated arm of Section 5.3 gives 10
-RESCUE_BELOW = 3
 #: ... and so is one whose free estimator gives fewer than this share of the estimates its
 #: window allows over the periods the decay rings above its noise
 #: (:attr:`..core.choice.Decision.ringing_periods`): a lightly damped 5 Hz pluck at 20 samples a
