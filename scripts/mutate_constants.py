@@ -134,6 +134,11 @@ STRUCTURAL = {
     r'MODEL_[A-Z]+': 'enumeration',
     r'RATE_HZ|TONE_HZ|SAMPLES': 'warm-up signal: compiles the kernels, its output is discarded',
     r'MAX_STAMP_S|MAX_ABS_VALUE': 'input-validity limits (bad-input contract, not a heuristic)',
+    r'PRODUCT_BLOCK': (
+        'a work block size (rows of lag products computed at once): the correlations are the same '
+        'at any value but for rounding (test_sliding_lag_products_equal_the_batch_correlations), '
+        'only memory and speed depend on it'
+    ),
 }
 
 
