@@ -37,7 +37,7 @@ from vib_estimator.analysis.choosing import decided_config
 from vib_estimator.core import EstimatorConfig, choice, estimate
 from vib_estimator.core.choice import decide
 from vib_estimator.io.csv_reader import read_csv_series
-from vib_estimator.sim import arm_model
+from vib_estimator.sim import arm_model, signals
 
 ROOT = Path(__file__).resolve().parents[1]
 #: the real beams' first modes (their own FFT: real_data.py)
@@ -291,16 +291,7 @@ def second_pluck() -> int:
     for rate, zeta, second in SECOND:
         first, cut_first, n, n_cut, none = [], [], 0, 0, 0
         for seed in range(seeds):
-            t = np.arange(0, second + 5, 1 / (rate * f))
-            y = 0.01 / np.sqrt(2) * np.random.default_rng(seed).standard_normal(len(t))
-            for start, amplitude, z in ((1.0, 1.0, zeta), (second, 0.5, 0.02)):
-                tau = np.maximum(t - start, 0.0)
-                y += (
-                    amplitude
-                    * np.exp(-z * 2 * np.pi * f * tau)
-                    * np.sin(2 * np.pi * f * tau + 1.0)
-                    * (t >= start)
-                )
+            t, y = signals.two_plucks(rate, zeta, second, seed, f)
             e = estimate(t, y, config)
             after = e.t[e.t > second]
             cut = estimate(t[t >= second], y[t >= second], config).t

@@ -8,7 +8,7 @@ import pytest
 
 from vib_estimator.core import EstimatorConfig, estimate
 from vib_estimator.core.choice import FAST_PERIODS, FAST_STD
-from vib_estimator.sim.signals import pulled_pluck
+from vib_estimator.sim.signals import pulled_pluck, two_plucks
 
 
 def decay(snr_db: float, seed: int = 0):
@@ -125,16 +125,7 @@ def test_a_second_pluck_after_the_first_rang_down_is_an_onset_too(
     ``SCALE_WEIGHT`` at 1000x) the peak follows the noise sample by sample: onsets
     everywhere."""
     f = 10.0
-    t = np.arange(0, second + 5, 1 / (rate * f))
-    y = 0.01 / np.sqrt(2) * np.random.default_rng(seed).standard_normal(len(t))
-    for start, amplitude, z in ((1.0, 1.0, zeta), (second, 0.5, 0.02)):
-        tau = np.maximum(t - start, 0.0)
-        y += (
-            amplitude
-            * np.exp(-z * 2 * np.pi * f * tau)
-            * np.sin(2 * np.pi * f * tau + 1.0)
-            * (t >= start)
-        )
+    t, y = two_plucks(rate, zeta, second, seed, f)
     config = EstimatorConfig(model='damped-sinusoid', min_periods=FAST_PERIODS, early_std_rel=0.01)
     e = estimate(t, y, config)
     after = e.t > second

@@ -120,6 +120,19 @@ def step_into_limit_cycle(seconds, rate_hz, seed=0):
     return t, y
 
 
+def two_plucks(per_period, zeta, second, seed=0, f=10.0):
+    """Two plucks of ``f`` Hz in 37 dB of white noise: at 1 s (damping ratio ``zeta``) and, half
+    as strong (zeta 0.02), at ``second`` s, once the first rang down; ``per_period`` samples a
+    period, 5 s after the second; returns (t, y)."""
+    t = np.arange(0, second + 5, 1 / (per_period * f))
+    y = 0.01 / np.sqrt(2) * np.random.default_rng(seed).standard_normal(len(t))
+    for start, amplitude, z in ((1.0, 1.0, zeta), (second, 0.5, 0.02)):
+        tau = np.maximum(t - start, 0.0)
+        wave = np.exp(-z * 2 * np.pi * f * tau) * np.sin(2 * np.pi * f * tau + 1.0)
+        y += amplitude * wave * (t >= start)
+    return t, y
+
+
 def pulled_pluck(rest, pull, seed=0, f=9.4, rate_hz=1000.0, noise=1e-3):
     """A pluck as a hand gives it: ``rest`` s of rest, the beam pulled to -1 over ``pull`` s (a
     half cosine), then let go: ``f`` Hz at damping ratio 0.004 for 10 s, plus white ``noise``
