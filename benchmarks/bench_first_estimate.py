@@ -281,8 +281,9 @@ def second_pluck() -> int:
     pluck's first estimate (periods, median and largest) and records without one, the estimates
     after it, beside the record cut at it (``core.kernel.ONSET_RATIO``, ``PEAK_TAU_S``)."""
     f, seeds = 10.0, 12
-    config = EstimatorConfig(model='damped-sinusoid', min_periods=choice.FAST_PERIODS)
-    config = config.replace(early_std_rel=0.01)
+    config = EstimatorConfig(
+        model='damped-sinusoid', min_periods=choice.FAST_PERIODS, early_std_rel=0.01
+    )
     print(
         '| samples a period | first pluck zeta | after it (s) | first (periods: median, largest) '
         '| none | estimates | cut at it: first (median), estimates |'

@@ -551,7 +551,7 @@ def test_a_pluck_its_free_estimator_reads_once_or_twice_goes_to_the_mode_tracker
     more estimates, all within 2 % (6 before)."""
     rng = np.random.default_rng(seed)
     t = np.arange(0, 60, 0.01)
-    y = 0.1 / np.sqrt(2) * np.zeros_like(t)
+    y = np.zeros_like(t)
     for start in (1.0, 30.0):
         tau = np.maximum(t - start, 0)
         wave = np.sin(2 * np.pi * 5 * tau + rng.uniform(0, 6.28))

@@ -1663,7 +1663,7 @@ class StreamChoice:
         onset = self.watch.onset_t
         counted, n = self._since_onset
         n = n if counted == onset else 0
-        quiet = now - (max(onset, self._estimated_at) if n else onset)
+        quiet = now - max(onset, self._estimated_at)
         if n >= RESCUE_BELOW or not f > 0 or not quiet * f >= SILENT_PERIODS:
             return None
         gave = f'only {n} free estimate{"s" if n > 1 else ""} since the onset, ' if n else ''

@@ -577,6 +577,14 @@ def _restarts(p, s, c) -> bool:
 
 
 @jit(inline='always')
+def _peak(peak, dev, weight):
+    """A running peak of the deviation: ``dev`` if it rises above ``peak`` decayed by ``weight``
+    (a share a sample), else the decayed peak."""
+    decayed = (1.0 - weight) * peak
+    return dev if dev > decayed else decayed
+
+
+@jit(inline='always')
 def _outlier(p, s, c, t, y):
     """True if the value ``y`` is an outlier, to skip (counted ``skipped_outlier``).
 
@@ -609,10 +617,8 @@ def _outlier(p, s, c, t, y):
     elif dev > ONSET_RATIO * s[S_YO]:
         c[C_ONSET] = 1  # taken by step
     s[S_YC] = yc + SCALE_WEIGHT * (y - yc)
-    decayed = (1.0 - SCALE_WEIGHT) * s[S_YR]
-    s[S_YR] = dev if dev > decayed else decayed
-    decayed = (1.0 - max(SCALE_WEIGHT, s[S_HRUN] / PEAK_TAU_S)) * s[S_YO]
-    s[S_YO] = dev if dev > decayed else decayed
+    s[S_YR] = _peak(s[S_YR], dev, SCALE_WEIGHT)
+    s[S_YO] = _peak(s[S_YO], dev, max(SCALE_WEIGHT, s[S_HRUN] / PEAK_TAU_S))
     _half_cycle(s, t, y - yc)
     if c[C_OUTLIER_RUN] != 0:
         c[C_OUTLIER_RUN] = 0

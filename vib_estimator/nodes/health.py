@@ -256,11 +256,12 @@ class Health:
             self._modes[estimate.mode] = last
         if estimate.mode <= 1:
             self._last = last
-        self._held_at = {name: totals.get(name, 0) for name in HELD_BACK}
+        self.count_holds_from(totals)
 
-    def restart_holds(self, totals: Mapping[str, int]) -> None:
-        """The held-back counters count from ``totals`` (:meth:`totals`): a new configuration
-        runs, and what held the one it replaced back no longer says why it is silent."""
+    def count_holds_from(self, totals: Mapping[str, int]) -> None:
+        """The held-back counters count from ``totals`` (:meth:`totals`): at an estimate, and
+        when a new configuration runs (what held the one it replaced back no longer says why it
+        is silent)."""
         self._held_at = {name: totals.get(name, 0) for name in HELD_BACK}
 
     @property
@@ -286,7 +287,7 @@ class Health:
         """The status at ``now``; updates the rates and the ``band_above_nyquist`` counter.
 
         STALE without input for :attr:`stale_after` s; WARN when a :data:`HELD_BACK` counter grew
-        since the last estimate (or configuration, :meth:`restart_holds`), when JointState
+        since the last estimate (or configuration, :meth:`count_holds_from`), when JointState
         messages lacked the joint since the last call, when ``band_hz`` reaches the Nyquist
         frequency of the input, or with a ``hint`` (what the input shows that the configuration
         does not fit; logged when it starts); OK otherwise, its message ``waiting`` when given

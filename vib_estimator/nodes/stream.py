@@ -243,7 +243,7 @@ class EstimatorStream:
                 self._build = _Build(config, channels)
         else:
             self._install(create_estimator(config, channels))
-        self.health.restart_holds(self.counters)
+        self.health.count_holds_from(self.counters)
 
     def _decidable(self, config: EstimatorConfig, channels: Tuple[str, ...]) -> tuple:
         """The identifier a deciding stream on one channel may switch to (``auto``), to be
