@@ -6,6 +6,7 @@ sides."""
 
 import itertools
 import math
+import re
 
 import numpy as np
 import pytest
@@ -294,6 +295,32 @@ def test_a_pluck_at_the_record_s_first_sample_is_read_where_the_taper_hides_it(
         tails = choice.decay_tails
         monkeypatch.setattr(choice, 'decay_tails', lambda zeta: 0.0 * tails(zeta))
         assert not right()
+
+
+@pytest.mark.parametrize('factor', [1e-3, 1e3])
+def test_a_decay_s_brief_higher_mode_is_said_where_one_mode_is_estimated(monkeypatch, factor):
+    """A beam-like 6 Hz decay whose 39 Hz second mode (zeta 0.5 %) rings down within its first
+    second, and an 8 Hz decay beside a 90 Hz mode at 1:0.8 (zeta 0.4 %): each read as one mode
+    (its brief mode under ``PEAK_SHARE`` of the record's strongest), the brief one named in the
+    decision's words, with ``--modes``; a decay of one mode (with a weak steady hum at 50 Hz,
+    no mode) names none. ``ONSET_PERIODS`` at 0.001 x reads a few samples, at 1000 x more than
+    the record: none named."""
+    beam = ringing([(6.0, 0.003, 1.0), (39.0, 0.005, 0.3)], 20, 1000, 1e-3, start=0.1)
+    pair = ringing([(8.0, 0.001, 1.0), (90.0, 0.004, 0.8)], 11, 1000, 1e-3, start=1.0)
+    t, y = ringing([(6.0, 0.003, 1.0)], 20, 1000, 1e-3, start=0.1)
+    hum = (t, y + 0.01 * np.sin(2 * np.pi * 50.0 * t))
+
+    def right():
+        said = [decide(*r) for r in (beam, pair, hum)]
+        named = [re.findall(r'brief higher modes [^(]*\(([0-9.]+) Hz\)', d.reason) for d in said]
+        return (
+            all(d.excitation == 'free' and d.modes == 0 for d in said)
+            and [len(n) for n in named] == [1, 1, 0]
+            and abs(float(named[0][0]) / 39 - 1) < 0.01
+            and abs(float(named[1][0]) / 90 - 1) < 0.01
+        )
+
+    holds_then_breaks(monkeypatch, 'ONSET_PERIODS', factor, right)
 
 
 @pytest.mark.parametrize('factor', [1e-3, 1e3])
