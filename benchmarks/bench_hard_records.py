@@ -59,6 +59,12 @@ windows, ``core.choice.SHORT_WINDOWS``), in the same run (issue 37: "whatever th
   within 2 %, beyond 5 %, median window (periods); ``--base`` without
   :func:`core.choice.regular` and :func:`core.choice.chance_level` (before 6 Dec 2026, 22:00
   UTC: the spectrum read at the mean rate, its peaks by prominence alone).
+- ``--lines``: modes driven by noise (8 and 40 Hz at zeta 1 and 0.5 %, 1:0.5, 20 dB, 500 Hz,
+  60 and 180 s, 2 seeds) beside one steady line -- a machine's rotation, mains: 3, 9.5, 12, 25
+  or 50 Hz at 0.3, 1 and 3 x the response's RMS --, and light modes with no line (1.3 or 2 Hz at
+  zeta 0.1 % beside 2.7 x it at 0.2 %, 20 and 60 s, 3 seeds): estimates, the share within 2 %
+  of the nearest mode, beyond 5 %; ``--base`` without :func:`core.choice.steady_lines` (before
+  8 Dec 2026: a line alone read as a mode).
 - ``--short``: driven records of 15-90 s (white noise through 1.2, 2, 5 and 5 + 17 Hz modes at
   zeta 0.5-2 %, 500 Hz, 26 dB): estimates, modes found (within 2 %), share within 2 %, beyond 5 %.
 
@@ -75,6 +81,7 @@ windows, ``core.choice.SHORT_WINDOWS``), in the same run (issue 37: "whatever th
     cd benchmarks && ../.venv/bin/python bench_hard_records.py --weak [--base]
     cd benchmarks && ../.venv/bin/python bench_hard_records.py --pulled
     cd benchmarks && ../.venv/bin/python bench_hard_records.py --clock [--base]
+    cd benchmarks && ../.venv/bin/python bench_hard_records.py --lines [--node] [--base]
 """
 
 from __future__ import annotations
@@ -221,6 +228,25 @@ def machine():
                 for seed in range(2)
             ]
             yield f'{f:g} Hz beside {base:g}, {2 * base:g}, {3 * base:g} Hz at {a:g}', records
+
+
+def lines():
+    """``--lines`` (module doc): one row per line's frequency, and the light modes alone."""
+    modes = [(8.0, 0.01, 1.0), (40.0, 0.005, 0.5)]
+    for line in (None, 3.0, 9.5, 12.0, 25.0, 50.0):
+        records = []
+        for level, seconds, seed in itertools.product((0.3, 1.0, 3.0), (60, 180), range(2)):
+            t, y, _ = ambient_record(seconds, 500.0, modes, 20, seed)
+            if line is not None:
+                y = y + level * np.std(y) * np.sin(2 * np.pi * line * t + 0.3)
+            records.append(([8.0, 40.0], t, y))
+        yield (f'a line at {line:g} Hz' if line else 'no line (levels: none)'), records
+    records = []
+    for f, seconds, seed in itertools.product((1.3, 2.0), (20, 60), range(3)):
+        light = [(f, 0.001, 1.0), (2.7 * f, 0.002, 0.4)]
+        t, y, _ = ambient_record(seconds, 500.0, light, 20, seed)
+        records.append(([f, 2.7 * f], t, y))
+    yield 'no line, modes at zeta 0.1 / 0.2 % (1.3, 2 Hz; 20, 60 s)', records
 
 
 def impacts():
@@ -541,6 +567,7 @@ def main() -> int:
     parser.add_argument('--weak', action='store_true', help='weak higher modes beside a decay')
     parser.add_argument('--pulled', action='store_true', help='a pluck pulled over 0.02-0.2 s')
     parser.add_argument('--clock', action='store_true', help='irregular stamps, noisy decays')
+    parser.add_argument('--lines', action='store_true', help='driven modes beside a line alone')
     parser.add_argument('--base', action='store_true', help='the default before 6 Dec 2026')
     parser.add_argument(
         '--node', action='store_true', help="the node's defaults, streamed (not --short)"
@@ -562,6 +589,12 @@ def main() -> int:
             choice.chance_level = lambda psd, at, *a: np.zeros(len(at))
         with tempfile.TemporaryDirectory() as folder:
             clock(Path(folder))
+        return 0
+    if args.lines:  # (its --base: a line alone no line, before 8 Dec 2026)
+        if args.base:
+            choice.steady_lines = lambda t, signal, peaks: (np.zeros(len(peaks), bool), [])
+        with tempfile.TemporaryDirectory() as folder:
+            table(lines(), Path(folder), args.node)
         return 0
     if args.weak:  # (its --base: no free estimator for the strongest, not before 6 Dec)
         if args.base:

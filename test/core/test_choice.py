@@ -298,6 +298,36 @@ def test_a_pluck_at_the_record_s_first_sample_is_read_where_the_taper_hides_it(
 
 
 @pytest.mark.parametrize('factor', [1e-3, 1e3])
+def test_a_steady_line_alone_beside_driven_modes_is_no_mode(monkeypatch, factor):
+    """8 and 40 Hz modes driven by noise (20 dB, 500 Hz) beside one steady line, no periodic drive:
+    12 Hz at twice the response's RMS over 180 s, and 50 Hz at three times it over 60 s, which
+    drowned the modes' envelope (read 0 % driven: a free decay of modes 8, 40 and the 50 Hz
+    line, the mode tracker) -- each a line (``lines_hz``, the identifier drops it), the record
+    driven, its window sized from 8 Hz. A 1.3 Hz mode at zeta 0.1 % driven for 60 s rings as
+    steadily (half a correlation time): no line. ``LINE_PERIODS`` at 0.001 x reads that mode as a
+    line, at 1000 x neither line is one."""
+
+    def record(f, level, seconds, modes=((8.0, 0.01, 1.0), (40.0, 0.005, 0.5)), seed=1):
+        t, y, _ = ambient_record(seconds, 500, list(modes), 20, seed)
+        return t, y + level * np.std(y) * np.sin(2 * np.pi * f * t + 0.3)
+
+    lines = [record(12.0, 2.0, 180), record(50.0, 3.0, 60)]
+    light = record(0.0, 0.0, 60, ((1.3, 0.001, 1.0), (3.5, 0.002, 0.4)))
+
+    def right():
+        said = [decide(*r) for r in lines]
+        return (
+            all(d.excitation == 'ambient' for d in said)
+            and [len(d.lines_hz) for d in said] == [1, 1]
+            and all(abs(d.lines_hz[0] / f - 1) < 0.01 for d, f in zip(said, (12.0, 50.0)))
+            and all(abs(d.fundamental_hz / 8 - 1) < 0.02 for d in said)
+            and 'steady, a line' not in decide(*light).reason
+        )
+
+    holds_then_breaks(monkeypatch, 'LINE_PERIODS', factor, right)
+
+
+@pytest.mark.parametrize('factor', [1e-3, 1e3])
 def test_a_decay_s_brief_higher_mode_is_said_where_one_mode_is_estimated(monkeypatch, factor):
     """A beam-like 6 Hz decay whose 39 Hz second mode (zeta 0.5 %) rings down within its first
     second, and an 8 Hz decay beside a 90 Hz mode at 1:0.8 (zeta 0.4 %): each read as one mode

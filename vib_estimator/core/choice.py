@@ -267,6 +267,11 @@ SHORT_WINDOWS = 2.0
 #: Tower's 2.5-7, the shear frame's 2.6-3.3; a line in noise reads 1.76 at 10 dB in its band,
 #: so weak lines are missed, never modes taken
 LINE_KURTOSIS = 1.8
+#: ... and a line alone (no periodic drive: :func:`steady_lines`) only in a record of at least
+#: this many of its periods: 10 correlation times of a mode at zeta 0.2 %, which over fewer rings
+#: as steadily (noise-driven modes of 0.5-30 Hz, zeta 0.1-2 %, 2 seeds of 20-600 s: 35 of 576
+#: records read a mode as a line without this, all under it)
+LINE_PERIODS = 800.0
 #: ... the band's half width (relative, around the record's strongest FFT bin within the Welch
 #: peak's): narrow, so that a mode's flank beside a line weighs little (at 0.1 a line 20 % below
 #: a mode read 2.2, at 0.03 1.7), and still several bins (a mode at zeta 5 %: its half-power band)
@@ -677,6 +682,62 @@ def regular(t: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return grid, np.stack([np.interp(grid, t, column) for column in y.T], axis=1)
 
 
+def steady_lines(t: np.ndarray, signal: np.ndarray, peaks: np.ndarray) -> tuple[np.ndarray, list]:
+    """For a driven record with no periodic drive (:func:`drive_lines`): its spectral ``peaks``
+    that are sinusoids of steady amplitude (:func:`peak_kurtosis` below :data:`LINE_KURTOSIS`),
+    each a line however alone -- a machine's rotation, mains --, where another peak is no line
+    (a record of one steady sinusoid, a limit cycle, keeps it): ``(whether each peak is one,
+    their frequencies, Hz)``. Alone, such a line beside modes driven by noise was identified as
+    a mode at zeta 0.0-0.2 % (a 12 Hz line at twice the response's RMS beside 8 and 40 Hz modes:
+    7 of 49 estimates; 9.5 Hz beside 8 Hz: 22 of 75, "zeta 0.13 %")."""
+    is_line = np.zeros(len(peaks), bool)
+    if len(peaks) < 2:
+        return is_line, []
+    kurtosis, where = peak_kurtosis(t, signal, peaks)
+    steady = (kurtosis < LINE_KURTOSIS) & (float(t[-1] - t[0]) * where >= LINE_PERIODS)
+    if np.all(steady):
+        return is_line, []
+    return steady, where[steady].tolist()
+
+
+def less_lines(t: np.ndarray, signal: np.ndarray, modal: np.ndarray, lines: list) -> tuple:
+    """A record with lines alone (:func:`steady_lines`) read as its modes': ``(the strongest
+    mode, the lowest, Hz, the signal less the lines' band-passed responses)`` -- a line three
+    times the response's RMS held the envelope steady: 8 and 40 Hz modes driven by noise read
+    0 % driven beside it, a free decay of "separate modes" 8, 40 and the 50 Hz line."""
+    less = signal - sum(x for _, x in band_responses(t, signal, lines))
+    return float(modal[0]), float(np.min(modal)), less
+
+
+def by_share(share: float, channels: int) -> str:
+    """The excitation of a record whose envelope reads ``share`` of its energy driven (no
+    periodic drive, no train of impacts): free under :data:`FREE_BELOW`, ambient over
+    :data:`DRIVEN_ABOVE` (or several channels, half of it driven), else auto."""
+    if share < FREE_BELOW:
+        return 'free'
+    if share > DRIVEN_ABOVE or channels > 1:
+        return 'ambient' if share >= 0.5 else 'free'
+    return 'auto'
+
+
+def lines_read(t: np.ndarray, signal: np.ndarray, peaks: np.ndarray) -> tuple:
+    """The spectral ``peaks`` that are lines, not modes: ``(whether each is one, the lines' or
+    the periodic drive's harmonics, Hz, whether a periodic drive, words)`` -- a periodic drive's
+    (:func:`drive_lines`), else lines alone (:func:`steady_lines`)."""
+    is_line, lines = drive_lines(t, signal, peaks)
+    if lines:
+        return is_line, lines, True, drive_said(is_line, lines, peaks[~is_line])
+    is_line, lines = steady_lines(t, signal, peaks)
+    if not lines:
+        return is_line, lines, False, ''
+    listed = ', '.join(f'{f:.4g}' for f in sorted(lines))
+    said = (
+        f'; the peak{"s" if len(lines) > 1 else ""} at {listed} Hz: steady, a line (a machine '
+        'running, mains), not a mode'
+    )
+    return is_line, lines, False, said
+
+
 def drive_said(is_line: np.ndarray, lines: list, modal: np.ndarray) -> str:
     """What :func:`drive_lines` found, in words ('' for no periodic drive)."""
     if not lines:
@@ -716,6 +777,11 @@ def decide(
     dominant = float(peaks[0]) if len(peaks) else math.nan
     fundamental = float(np.min(peaks)) if len(peaks) else math.nan
     signal = principal_component(y)
+    is_line, lines, periodic, lined = lines_read(t, signal, peaks)
+    modal = peaks[~is_line]
+    alone = bool(lines) and not periodic  # (a periodic drive's record is driven however read)
+    if alone:
+        dominant, fundamental, signal = less_lines(t, signal, modal, lines)
     share = driven_share(t, signal, dominant if len(peaks) else 0.0)
     span = float(t[-1] - t[0])
     seen = (
@@ -723,9 +789,7 @@ def decide(
         'peaks at '
         + (', '.join(f'{f:.3g}' for f in sorted(peaks[:8])) + ' Hz' if len(peaks) else 'none')
     )
-    is_line, lines = drive_lines(t, signal, peaks)
-    modal = peaks[~is_line]
-    seen += drive_said(is_line, lines, modal)
+    seen += lined
     at = float(modal[0]) if len(modal) else dominant  # (the strongest mode)
     train, said, crowded = impacts_read(t, signal, share, at, bool(lines) and not len(modal))
     seen += said
@@ -734,18 +798,16 @@ def decide(
         near = peaks[(peaks > at / LINES_ABOVE) & (peaks < at * LINES_ABOVE)]  # are its response)
         dominant = float(near[0]) if len(near) else at
         excitation, beside, lines = 'free', [f for f in lines if f >= LINES_ABOVE * at], []
-    elif lines and len(modal):  # the structure's modes, not the lines
+    elif periodic and len(modal):  # the structure's modes, not the lines
         dominant, fundamental = at, float(np.min(modal))
         excitation = 'ambient'  # the modes between a periodic drive's lines
         if beside_decay(t, signal, modal, lines):  # (however loud the lines)
             excitation, beside, lines = 'free', lines, []
             seen += f'; the {dominant:.4g} Hz mode rings down freely beside them: a free decay'
-    elif share < FREE_BELOW:
-        excitation = 'free'
-    elif share > DRIVEN_ABOVE or channels > 1:
-        excitation = 'ambient' if share >= 0.5 else 'free'
     else:
-        excitation = 'auto'
+        excitation = by_share(share, channels)
+    if alone and excitation == 'free':  # lines beside a free decay: banded out where above it
+        beside, lines = lines, []
     band, lowest, said = slow_content(modal, powers[~is_line], (len(t) - 1) / span)
     if excitation == 'ambient' and band:
         seen, fundamental = seen + said, (lowest if math.isfinite(lowest) else fundamental)
