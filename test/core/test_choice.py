@@ -304,8 +304,10 @@ def test_a_steady_line_alone_beside_driven_modes_is_no_mode(monkeypatch, factor)
     drowned the modes' envelope (read 0 % driven: a free decay of modes 8, 40 and the 50 Hz
     line, the mode tracker) -- each a line (``lines_hz``, the identifier drops it), the record
     driven, its window sized from 8 Hz. A 1.3 Hz mode at zeta 0.1 % driven for 60 s rings as
-    steadily (half a correlation time): no line. ``LINE_PERIODS`` at 0.001 x reads that mode as a
-    line, at 1000 x neither line is one."""
+    steadily (half a correlation time): no line. A 3 Hz line at 3 x over 180 s (540 of its
+    periods) is said, with the option that reads it as one (``given``: ``--lines-hz``), not
+    taken. ``LINE_PERIODS`` at 0.001 x reads
+    that mode as a line, at 1000 x neither line is one."""
 
     def record(f, level, seconds, modes=((8.0, 0.01, 1.0), (40.0, 0.005, 0.5)), seed=1):
         t, y, _ = ambient_record(seconds, 500, list(modes), 20, seed)
@@ -313,15 +315,21 @@ def test_a_steady_line_alone_beside_driven_modes_is_no_mode(monkeypatch, factor)
 
     lines = [record(12.0, 2.0, 180), record(50.0, 3.0, 60)]
     light = record(0.0, 0.0, 60, ((1.3, 0.001, 1.0), (3.5, 0.002, 0.4)))
+    short = record(3.0, 3.0, 180)  # 540 periods of the line: told in words, not taken
 
     def right():
         said = [decide(*r) for r in lines]
+        untold = decide(*short)
         return (
             all(d.excitation == 'ambient' for d in said)
             and [len(d.lines_hz) for d in said] == [1, 1]
             and all(abs(d.lines_hz[0] / f - 1) < 0.01 for d, f in zip(said, (12.0, 50.0)))
             and all(abs(d.fundamental_hz / 8 - 1) < 0.02 for d in said)
             and 'steady, a line' not in decide(*light).reason
+            and not untold.lines_hz
+            and 'at 3 Hz rings as steadily as a line' in untold.reason
+            and '--lines-hz 3 ' in untold.reason
+            and decide(*short, given=(3.0,)).excitation == 'ambient'
         )
 
     holds_then_breaks(monkeypatch, 'LINE_PERIODS', factor, right)

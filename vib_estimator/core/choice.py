@@ -682,22 +682,24 @@ def regular(t: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return grid, np.stack([np.interp(grid, t, column) for column in y.T], axis=1)
 
 
-def steady_lines(t: np.ndarray, signal: np.ndarray, peaks: np.ndarray) -> tuple[np.ndarray, list]:
+def steady_lines(t: np.ndarray, signal: np.ndarray, peaks: np.ndarray) -> tuple:
     """For a driven record with no periodic drive (:func:`drive_lines`): its spectral ``peaks``
     that are sinusoids of steady amplitude (:func:`peak_kurtosis` below :data:`LINE_KURTOSIS`),
     each a line however alone -- a machine's rotation, mains --, where another peak is no line
     (a record of one steady sinusoid, a limit cycle, keeps it): ``(whether each peak is one,
-    their frequencies, Hz)``. Alone, such a line beside modes driven by noise was identified as
+    their frequencies, those that ring as steadily in a record shorter than`` :data:`LINE_PERIODS`
+    ``of their periods, Hz)``. Alone, such a line beside modes driven by noise was identified as
     a mode at zeta 0.0-0.2 % (a 12 Hz line at twice the response's RMS beside 8 and 40 Hz modes:
     7 of 49 estimates; 9.5 Hz beside 8 Hz: 22 of 75, "zeta 0.13 %")."""
     is_line = np.zeros(len(peaks), bool)
     if len(peaks) < 2:
-        return is_line, []
+        return is_line, [], []
     kurtosis, where = peak_kurtosis(t, signal, peaks)
-    steady = (kurtosis < LINE_KURTOSIS) & (float(t[-1] - t[0]) * where >= LINE_PERIODS)
-    if np.all(steady):
-        return is_line, []
-    return steady, where[steady].tolist()
+    ringing = kurtosis < LINE_KURTOSIS
+    if np.all(ringing):
+        return is_line, [], []
+    told = float(t[-1] - t[0]) * where >= LINE_PERIODS
+    return ringing & told, where[ringing & told].tolist(), where[ringing & ~told].tolist()
 
 
 def less_lines(t: np.ndarray, signal: np.ndarray, modal: np.ndarray, lines: list) -> tuple:
@@ -720,21 +722,36 @@ def by_share(share: float, channels: int) -> str:
     return 'auto'
 
 
-def lines_read(t: np.ndarray, signal: np.ndarray, peaks: np.ndarray) -> tuple:
+def lines_read(t: np.ndarray, signal: np.ndarray, peaks: np.ndarray, given=()) -> tuple:
     """The spectral ``peaks`` that are lines, not modes: ``(whether each is one, the lines' or
     the periodic drive's harmonics, Hz, whether a periodic drive, words)`` -- a periodic drive's
-    (:func:`drive_lines`), else lines alone (:func:`steady_lines`)."""
+    (:func:`drive_lines`), else lines alone (:func:`steady_lines`) and the lines ``given``
+    (Hz: ``--lines-hz``; a peak within :data:`.ambient.LINE_TOL` or a Welch bin of one)."""
     is_line, lines = drive_lines(t, signal, peaks)
     if lines:
         return is_line, lines, True, drive_said(is_line, lines, peaks[~is_line])
-    is_line, lines = steady_lines(t, signal, peaks)
-    if not lines:
-        return is_line, lines, False, ''
-    listed = ', '.join(f'{f:.4g}' for f in sorted(lines))
-    said = (
-        f'; the peak{"s" if len(lines) > 1 else ""} at {listed} Hz: steady, a line (a machine '
-        'running, mains), not a mode'
+    is_line, lines, untold = steady_lines(t, signal, peaks)
+
+    def known(f: float) -> bool:
+        return any(abs(f - g) <= max(LINE_TOL * g, 1 / SEGMENT_S) for g in given)
+
+    said = ''.join(
+        f'; the peak at {f:.4g} Hz rings as steadily as a line (a machine running: --lines-hz '
+        f"{f:.4g} reads it as one) or a mode too lightly damped for the record's "
+        f'{float(t[-1] - t[0]) * f:.0f} periods of it to tell ({LINE_PERIODS:.0f} do)'
+        for f in sorted(untold)
+        if not known(f)
     )
+    if lines:
+        listed = ', '.join(f'{f:.4g}' for f in sorted(lines))
+        said += (
+            f'; the peak{"s" if len(lines) > 1 else ""} at {listed} Hz: steady, a line (a '
+            'machine running, mains), not a mode'
+        )
+    if len(given):
+        is_line = is_line | np.array([known(f) for f in peaks.tolist()], dtype=bool)
+        lines = sorted({*lines, *map(float, given)})
+        said += '; the lines given (lines_hz) read as lines'
     return is_line, lines, False, said
 
 
@@ -760,6 +777,7 @@ def decide(
     window_s: float = 30.0,
     stream: bool = False,
     offset_ok: bool = True,
+    given: tuple = (),
 ) -> Decision:
     """The :class:`Decision` for the record ``(t, y)`` (its first :data:`DECIDE_S` s are read;
     ``y`` samples or samples x ``channels``), ``window_s`` the shortest window (the configured
@@ -768,7 +786,7 @@ def decide(
     for :data:`MIN_ANALYSES` analyses, and a free decay's window is not decided: the node cannot
     see a spectrum ahead, and a stream's default stays ``free``'s).
     ``offset_ok``: the caller can remove a known offset from the samples (:attr:`Decision.offset`;
-    :func:`fast_window`)."""
+    :func:`fast_window`). ``given``: lines the caller knows (``lines_hz``, Hz), read as lines."""
     t, y = readable(t, y)
     if len(t) < 64 or not t[-1] > t[0]:
         return Decision('free', window_s, 0.0, math.nan, math.nan, (), 'too short to tell: free')
@@ -777,9 +795,9 @@ def decide(
     dominant = float(peaks[0]) if len(peaks) else math.nan
     fundamental = float(np.min(peaks)) if len(peaks) else math.nan
     signal = principal_component(y)
-    is_line, lines, periodic, lined = lines_read(t, signal, peaks)
+    is_line, lines, periodic, lined = lines_read(t, signal, peaks, given)
     modal = peaks[~is_line]
-    alone = bool(lines) and not periodic  # (a periodic drive's record is driven however read)
+    alone = bool(lines) and not periodic and len(modal) > 0  # (a periodic drive's: driven)
     if alone:
         dominant, fundamental, signal = less_lines(t, signal, modal, lines)
     share = driven_share(t, signal, dominant if len(peaks) else 0.0)
