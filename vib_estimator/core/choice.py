@@ -687,10 +687,11 @@ def steady_lines(t: np.ndarray, signal: np.ndarray, peaks: np.ndarray) -> tuple:
     that are sinusoids of steady amplitude (:func:`peak_kurtosis` below :data:`LINE_KURTOSIS`),
     each a line however alone -- a machine's rotation, mains --, where another peak is no line
     (a record of one steady sinusoid, a limit cycle, keeps it): ``(whether each peak is one,
-    their frequencies, those that ring as steadily in a record shorter than`` :data:`LINE_PERIODS`
-    ``of their periods, Hz)``. Alone, such a line beside modes driven by noise was identified as
-    a mode at zeta 0.0-0.2 % (a 12 Hz line at twice the response's RMS beside 8 and 40 Hz modes:
-    7 of 49 estimates; 9.5 Hz beside 8 Hz: 22 of 75, "zeta 0.13 %")."""
+    their frequencies, Hz, and the strongest peak's where it rings as steadily in a record shorter
+    than`` :data:`LINE_PERIODS` ``of its periods: its envelope the record's, told in words; a
+    weaker mode of a short decay rings as steadily)``. Alone, such a line beside modes driven by
+    noise was identified as a mode at zeta 0.0-0.2 % (a 12 Hz line at twice the response's RMS
+    beside 8 and 40 Hz modes: 7 of 49 estimates; 9.5 Hz beside 8 Hz: 22 of 75, "zeta 0.13 %")."""
     is_line = np.zeros(len(peaks), bool)
     if len(peaks) < 2:
         return is_line, [], []
@@ -699,7 +700,8 @@ def steady_lines(t: np.ndarray, signal: np.ndarray, peaks: np.ndarray) -> tuple:
     if np.all(ringing):
         return is_line, [], []
     told = float(t[-1] - t[0]) * where >= LINE_PERIODS
-    return ringing & told, where[ringing & told].tolist(), where[ringing & ~told].tolist()
+    untold = where[:1][ringing[:1] & ~told[:1]].tolist()
+    return ringing & told, where[ringing & told].tolist(), untold
 
 
 def less_lines(t: np.ndarray, signal: np.ndarray, modal: np.ndarray, lines: list) -> tuple:
@@ -797,8 +799,7 @@ def decide(
     signal = principal_component(y)
     is_line, lines, periodic, lined = lines_read(t, signal, peaks, given)
     modal = peaks[~is_line]
-    alone = bool(lines) and not periodic and len(modal) > 0  # (a periodic drive's: driven)
-    if alone:
+    if alone := bool(lines) and not periodic and len(modal) > 0:  # (a periodic drive: driven)
         dominant, fundamental, signal = less_lines(t, signal, modal, lines)
     share = driven_share(t, signal, dominant if len(peaks) else 0.0)
     span = float(t[-1] - t[0])
