@@ -346,7 +346,7 @@ def prepare(
     the record: :func:`decides`), the decision, and the lines to print once the record has been
     estimated (what was decided, or a contradiction). The decision's ``offset``, when finite, is
     to be removed from the samples the configuration estimates (not otherwise)."""
-    d = decide(t, y, channels, config.ambient_window_s, given=tuple(config.lines_hz or ()))
+    d = decide(t, y, channels, config.ambient_window_s, given=config.lines_hz or ())
     if d.model and (not decides(args) or periods_given(args) or model_given(args)):
         kept = '; --model, --band-hz or --min-periods given: the record as read, their model'
         d = dataclasses.replace(d, model='', offset=math.nan, reason=d.reason + kept)

@@ -575,7 +575,7 @@ def _recording_rows(path: Path, options: Options) -> List[Dict]:
             if options.decide:
                 ahead, blocks = read_ahead(signal.blocks())
                 if ahead is not None:
-                    d = decide(*ahead, 1, config.ambient_window_s)
+                    d = decide(*ahead, 1, config.ambient_window_s, given=config.lines_hz or ())
                     config = decided_config(config, d, 'survey', *options.kept())[0]
             config, result, _ = estimate_rescued(
                 signal, config, d, options.rescues, 'survey', blocks=blocks
@@ -593,7 +593,7 @@ def _joint_recording_rows(path, topic, names, options: Options, info) -> List[Di
         raise ValueError(f'{path} holds no samples')
     config = options.config
     if options.decide:
-        d = decide(t, y, len(names), config.ambient_window_s)
+        d = decide(t, y, len(names), config.ambient_window_s, given=config.lines_hz or ())
         config = decided_config(config, d, 'survey', *options.kept())[0]
     estimator, joint = joint_run(t, y, names, config)
     result = Run(estimator, joint.estimates, float(t[0]), float(t[-1]), None)
