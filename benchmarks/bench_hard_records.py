@@ -592,7 +592,7 @@ def main() -> int:
         return 0
     if args.lines:  # (its --base: a line alone no line, before 8 Dec 2026)
         if args.base:
-            choice.steady_lines = lambda t, signal, peaks: (np.zeros(len(peaks), bool), [], [])
+            choice.steady_lines = lambda span, k, where: (np.zeros(len(where), bool), [], [])
         with tempfile.TemporaryDirectory() as folder:
             table(lines(), Path(folder), args.node)
         return 0

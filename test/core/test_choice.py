@@ -938,7 +938,7 @@ def periodic_drive(f0=0.8, harmonics=(1, 3, 5, 7, 9), mode=(5.0, 0.01, 1.0), sec
 
 def lines_of(t, y):
     peaks, _ = spectral_peaks(t, y)
-    is_line, lines = choice.drive_lines(t, principal_component(y), peaks)
+    is_line, lines = choice.drive_lines(*choice.peak_kurtosis(t, principal_component(y), peaks))
     return peaks[is_line], lines
 
 

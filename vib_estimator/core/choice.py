@@ -54,6 +54,7 @@ from __future__ import annotations
 import math
 from collections import deque
 from dataclasses import dataclass, field, replace
+from functools import cache
 from typing import Optional
 
 import numpy as np
@@ -594,17 +595,17 @@ def harmonic_series(lines: np.ndarray) -> tuple[np.ndarray, float]:
     return best, f0
 
 
-def drive_lines(t: np.ndarray, signal: np.ndarray, peaks: np.ndarray) -> tuple[np.ndarray, list]:
-    """The spectral ``peaks`` that are lines of a periodic drive -- sinusoids of steady amplitude
-    (:func:`peak_kurtosis` below :data:`LINE_KURTOSIS`) on the harmonics of one fundamental, at
-    least :data:`PERIODIC_LINES` of them, else none --: ``(whether each peak is one, the drive's
+def drive_lines(kurtosis: np.ndarray, where: np.ndarray) -> tuple[np.ndarray, list]:
+    """The spectral peaks (read by :func:`peak_kurtosis`: ``kurtosis`` and ``where``, each
+    one's band centre) that are lines of a periodic drive -- sinusoids of steady amplitude
+    (below :data:`LINE_KURTOSIS`) on the harmonics of one fundamental, at least
+    :data:`PERIODIC_LINES` of them, else none --: ``(whether each peak is one, the drive's
     harmonics up to its highest line, Hz: the odd ones where the lines are all odd, a cycle
     there and back)``. A harmonic beside a mode reads as neither (a mixture), so every harmonic
     is listed."""
-    is_line = np.zeros(len(peaks), bool)
-    if len(peaks) < PERIODIC_LINES:
+    is_line = np.zeros(len(where), bool)
+    if len(where) < PERIODIC_LINES:
         return is_line, []
-    kurtosis, where = peak_kurtosis(t, signal, peaks)
     candidates = np.flatnonzero(kurtosis < LINE_KURTOSIS)
     on, f0 = harmonic_series(where[candidates])
     if len(on) < PERIODIC_LINES:
@@ -682,9 +683,10 @@ def regular(t: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return grid, np.stack([np.interp(grid, t, column) for column in y.T], axis=1)
 
 
-def steady_lines(t: np.ndarray, signal: np.ndarray, peaks: np.ndarray) -> tuple:
-    """For a driven record with no periodic drive (:func:`drive_lines`): its spectral ``peaks``
-    that are sinusoids of steady amplitude (:func:`peak_kurtosis` below :data:`LINE_KURTOSIS`),
+def steady_lines(span: float, kurtosis: np.ndarray, where: np.ndarray) -> tuple:
+    """For a record of ``span`` s with no periodic drive (:func:`drive_lines`): its spectral
+    peaks (read by :func:`peak_kurtosis`: ``kurtosis``, ``where``) that are sinusoids of steady
+    amplitude (below :data:`LINE_KURTOSIS`),
     each a line however alone -- a machine's rotation, mains --, where another peak is no line
     (a record of one steady sinusoid, a limit cycle, keeps it): ``(whether each peak is one,
     their frequencies, Hz, and the strongest peak's where it rings as steadily in a record shorter
@@ -692,14 +694,11 @@ def steady_lines(t: np.ndarray, signal: np.ndarray, peaks: np.ndarray) -> tuple:
     weaker mode of a short decay rings as steadily)``. Alone, such a line beside modes driven by
     noise was identified as a mode at zeta 0.0-0.2 % (a 12 Hz line at twice the response's RMS
     beside 8 and 40 Hz modes: 7 of 49 estimates; 9.5 Hz beside 8 Hz: 22 of 75, "zeta 0.13 %")."""
-    is_line = np.zeros(len(peaks), bool)
-    if len(peaks) < 2:
-        return is_line, [], []
-    kurtosis, where = peak_kurtosis(t, signal, peaks)
+    is_line = np.zeros(len(where), bool)
     ringing = kurtosis < LINE_KURTOSIS
-    if np.all(ringing):
+    if len(where) < 2 or np.all(ringing):
         return is_line, [], []
-    told = float(t[-1] - t[0]) * where >= LINE_PERIODS
+    told = span * where >= LINE_PERIODS
     untold = where[:1][ringing[:1] & ~told[:1]].tolist()
     return ringing & told, where[ringing & told].tolist(), untold
 
@@ -729,10 +728,12 @@ def lines_read(t: np.ndarray, signal: np.ndarray, peaks: np.ndarray, given=()) -
     the periodic drive's harmonics, Hz, whether a periodic drive, words)`` -- a periodic drive's
     (:func:`drive_lines`), else lines alone (:func:`steady_lines`) and the lines ``given``
     (Hz: ``--lines-hz``; a peak within :data:`.ambient.LINE_TOL` or a Welch bin of one)."""
-    is_line, lines = drive_lines(t, signal, peaks)
+    unread = (np.full(len(peaks), math.nan), np.asarray(peaks, dtype=float))  # (one peak: no line)
+    reading = peak_kurtosis(t, signal, peaks) if len(peaks) > 1 else unread
+    is_line, lines = drive_lines(*reading)
     if lines:
         return is_line, lines, True, drive_said(is_line, lines, peaks[~is_line])
-    is_line, lines, untold = steady_lines(t, signal, peaks)
+    is_line, lines, untold = steady_lines(float(t[-1] - t[0]), *reading)
 
     def known(f: float) -> bool:
         return any(abs(f - g) <= max(LINE_TOL * g, 1 / SEGMENT_S) for g in given)
@@ -1065,14 +1066,10 @@ def free_modes(
             lines.append(f)
         return line
 
-    separate = separate_modes(
-        peaks,
-        powers,
-        peak_frequencies(spec, peaks),
-        lambda f: rings_freely(t, signal, f),
-        lambda f, g: coexistence(t, signal, f, g),
-        steady,
-    )
+    fine = peak_frequencies(spec, peaks)
+    rings = cache(lambda f: rings_freely(t, signal, f))  # (read again for brief modes)
+    together = cache(lambda f, g: coexistence(t, signal, f, g))
+    separate = separate_modes(peaks, powers, fine, rings, together, steady)
     listed = ', '.join(f'{f:.4g}' for f in sorted(lines))
     said = (
         f'; the peak{"s" if len(lines) > 1 else ""} at {listed} Hz: steady, a line (mains, a '
@@ -1084,7 +1081,7 @@ def free_modes(
     if band:
         said += f' (band_hz {band[0]:.3g}-{band[1]:.3g} Hz)'
     if len(separate) < 2:
-        return 0, said + brief_said(t, signal, spec, peaks, powers), band, False
+        return 0, said + brief_said(t, signal, (peaks, powers, fine), rings, together), band, False
     listed = ', '.join(f'{f:.3g}' for f in sorted(separate))
     modes, tracked = to_tracker(f'{len(separate)} separate modes ({listed} Hz)')
     power = dict(zip(peaks.tolist(), powers.tolist()))
@@ -1092,17 +1089,19 @@ def free_modes(
     return modes, said + tracked, band, minor
 
 
-def brief_said(t, signal, spec, peaks: np.ndarray, powers: np.ndarray) -> str:
+def brief_said(t, signal, read: tuple, rings, together) -> str:
     """Words for a free decay read as one mode whose first periods hold brief higher modes
-    (:func:`onset_peaks`, each :data:`MODE_GAP` from every peak of the record's spectrum
-    ``spec`` and a separate mode by :func:`separate_modes`: ringing freely, no harmonic), which
-    ``--modes`` tracks; '' where none. Words only: the one-mode estimator keeps reading the
+    (:func:`onset_peaks`, each :data:`MODE_GAP` from every peak of the record's spectrum --
+    ``read``: their frequencies, powers and interpolated frequencies -- and a separate mode by
+    :func:`separate_modes`, with its ``rings`` and ``together``: ringing freely, no harmonic),
+    which ``--modes`` tracks; '' where none. Words only: the one-mode estimator keeps reading the
     strongest (a real beam's brief second mode, 39.3 Hz beside the 50 cm beam's 6.05 Hz, sent
     it to the mode tracker: the first mode's estimates a minority, each higher mode's windows
     several of its own periods; random decays of 2-3 modes, ``bench_modes.py --random``,
     45 -> 51 of 80 meeting every goal of issue 10)."""
+    peaks, powers, fine = read
     dominant = float(peaks[0]) if len(peaks) else math.nan
-    brief, fine = onset_peaks(t, signal, dominant)
+    brief, brief_fine = onset_peaks(t, signal, dominant)
     new = np.array(
         [f > dominant and not np.any(np.abs(peaks / f - 1) < MODE_GAP) for f in brief], dtype=bool
     )
@@ -1111,9 +1110,9 @@ def brief_said(t, signal, spec, peaks: np.ndarray, powers: np.ndarray) -> str:
     found = separate_modes(
         np.r_[peaks, brief[new]],
         np.r_[powers, np.zeros(int(np.sum(new)))],  # (weak over the record: they must ring)
-        np.r_[peak_frequencies(spec, peaks), fine[new]],
-        lambda f: rings_freely(t, signal, f),
-        lambda f, g: coexistence(t, signal, f, g),
+        np.r_[fine, brief_fine[new]],
+        rings,
+        together,
     )
     listed = ', '.join(f'{f:.4g}' for f in sorted(found) if f in brief[new])
     if not listed:
